@@ -1,0 +1,44 @@
+#pragma once
+/// @file core/progress.h
+/// @brief Progress reporting from stages to the front end.
+///
+/// A stage receives a ProgressSink* (may be null) and wraps its work in a
+/// Progress. Progress::advance is thread-safe and cheap: it only calls the sink
+/// when a new percent is reached, under a mutex, so TBB bodies may call it.
+
+#include <atomic>
+#include <cstddef>
+#include <mutex>
+#include <string>
+
+namespace lo {
+
+/// Implemented by the front end (a terminal bar, plain lines, or nothing).
+class ProgressSink {
+ public:
+  virtual ~ProgressSink() = default;
+  virtual void begin(const std::string& task, size_t total) = 0;
+  /// Called with a monotonically increasing `done` (<= total).
+  virtual void update(size_t done, size_t total) = 0;
+  virtual void end() = 0;
+};
+
+class Progress {
+ public:
+  Progress(ProgressSink* sink, const std::string& task, size_t total);
+  ~Progress();
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
+  void advance(size_t n = 1);
+
+ private:
+  ProgressSink* sink_;
+  size_t total_;
+  std::atomic<size_t> done_{0};
+  std::atomic<size_t> nextReport_{0};
+  std::mutex mutex_;
+  size_t reported_ = 0;
+};
+
+}  // namespace lo

@@ -1,0 +1,92 @@
+#pragma once
+/// @file grid/surface_grid.h
+/// @brief The sparse voxel grid of the scene's surfaces (paper §4.1: the octree
+/// "built on the whole scene, using a geometric subdivision criterion").
+///
+/// The scene's bounding cube, padded, is divided into 2^depth voxels per axis;
+/// a voxel is active exactly when its closed box intersects a triangle. OpenVDB
+/// holds the sparse index internally; the public data are plain arrays so that
+/// later stages do not compile OpenVDB headers.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/math.h"
+#include "core/progress.h"
+#include "photon/photon_map.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+/// Index space <-> world space of a cubic grid. Voxel (i,j,k) covers the world
+/// box [origin + (i,j,k) * voxelSize, origin + (i+1,j+1,k+1) * voxelSize].
+struct GridFrame {
+  Vec3 origin{0, 0, 0};   ///< world position of the lower corner of voxel (0,0,0)
+  float voxelSize = 1.0f; ///< world units (edge length of the cube / 2^depth)
+  int depth = 0;          ///< 2^depth voxels per axis
+
+  int resolution() const { return 1 << depth; }
+  Vec3 voxelCenter(const Coord& c) const;
+  Bounds3 voxelBounds(const Coord& c) const;
+  /// Voxel containing world point p (may lie outside [0, resolution)).
+  Coord coordOf(const Vec3& p) const;
+};
+
+/// The padded bounding cube of `sceneBounds` (edge = largest extent * (1 + 2 * padding),
+/// centred on the scene) divided into 2^depth voxels per axis.
+/// @throws InputError if depth is outside [1, 12] or the bounds are empty/degenerate.
+GridFrame makeGridFrame(const Bounds3& sceneBounds, int depth, float padding = 0.01f);
+
+struct GridParams {
+  int depth = 6;          ///< 2^depth voxels per axis (paper's delta)
+  float padding = 0.01f;  ///< fraction of the largest extent added on each side
+};
+
+/// Active voxels in canonical order: sorted by 8^3 block (OpenVDB leaf), then
+/// by position inside the block, so that neighbouring voxels are close in memory.
+class SurfaceGrid {
+ public:
+  GridFrame frame;
+  std::vector<Coord> coords;     ///< active voxels
+  std::vector<Vec3> normals;     ///< area-weighted mean geometric normal; unit, or zero when faces cancel
+  std::vector<Vec3> centroids;   ///< area-weighted centroid of the geometry inside the voxel, world space
+  std::vector<float> areas;      ///< area of the geometry clipped to the voxel, world units^2
+
+  /// Photon bins (CSR), filled by splatPhotons: the photons whose position lies
+  /// in voxel v are binPhotons[binStart[v] .. binStart[v+1]), in photon order.
+  std::vector<uint32_t> binStart;
+  std::vector<uint32_t> binPhotons;
+
+  size_t size() const { return coords.size(); }
+  /// Index of the active voxel at c, or -1. Thread-safe.
+  int64_t find(const Coord& c) const;
+
+  SurfaceGrid();
+  ~SurfaceGrid();
+  SurfaceGrid(SurfaceGrid&&) noexcept;
+  SurfaceGrid& operator=(SurfaceGrid&&) noexcept;
+
+  /// Rebuilds the internal index from `coords` (after coords changed).
+  void rebuildIndex();
+
+ private:
+  struct Index;
+  std::unique_ptr<Index> index_;
+};
+
+/// Voxelizes the scene: exact triangle/box overlap (separating axis test),
+/// per-voxel clipped area, normal and centroid. TBB-parallel, deterministic.
+SurfaceGrid buildSurfaceGrid(const Scene& scene, const GridParams& params,
+                             ProgressSink* progress = nullptr);
+
+/// Exact overlap test of a triangle and a closed axis-aligned box
+/// (Akenine-Möller's separating axis theorem). Exposed for tests.
+bool triangleOverlapsBox(const Vec3& a, const Vec3& b, const Vec3& c, const Bounds3& box);
+
+/// Fills grid.binStart / grid.binPhotons. Photons outside any active voxel are
+/// put in the nearest active voxel of their 3x3x3 neighbourhood, or dropped
+/// (counted in the return value).
+size_t splatPhotons(SurfaceGrid& grid, const std::vector<Photon>& photons);
+
+}  // namespace lo

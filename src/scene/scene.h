@@ -1,0 +1,111 @@
+#pragma once
+/// @file scene/scene.h
+/// @brief The scene every later stage reads: triangles in world space,
+/// materials, punctual lights and cameras. Loaded from glTF 2.0 (.gltf/.glb)
+/// through tinygltf or from OBJ/MTL through tinyobjloader; neither library is
+/// visible outside src/scene.
+///
+/// Units and spaces: positions in scene units (glTF: metres), world space
+/// (every node transform already applied). Colours are linear RGB.
+/// Light units follow glTF KHR_lights_punctual, read radiometrically with the
+/// photometric constant dropped (1 cd == 1 W/sr, 1 lx == 1 W/m^2), and emissive
+/// surfaces emit radiance emissiveFactor * emissive_strength (W/(m^2 sr)), so
+/// that a 1 cd point light and a 1 W/(m^2 sr) emitter are in the same units.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+
+namespace lo {
+
+/// A decoded texture: linear RGB floats, row-major, row 0 at the top
+/// (glTF's UV (0,0) is the top-left corner).
+struct Texture {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<Vec3> texels;  ///< width * height, already converted from sRGB to linear
+  Vec3 lookup(float u, float v) const;  ///< nearest texel, repeat wrap
+};
+
+/// glTF metallic-roughness material (the subset the bake and renderer use).
+struct Material {
+  std::string name;
+  Vec3 baseColor{0.8f, 0.8f, 0.8f};  ///< linear RGB albedo factor
+  int baseColorTexture = -1;          ///< index into Scene::textures, -1 = none
+  int baseColorTexCoord = 0;          ///< which UV set (0 or 1) the texture uses
+  float metallic = 0.0f;              ///< [0,1]
+  float roughness = 1.0f;             ///< [0,1], perceptual (alpha = roughness^2)
+  Vec3 emission{0, 0, 0};             ///< radiance W/(m^2 sr): emissiveFactor * strength
+  float transmission = 0.0f;          ///< KHR_materials_transmission, [0,1]
+  float ior = 1.5f;                   ///< KHR_materials_ior
+  bool doubleSided = false;
+
+  bool isEmissive() const { return maxComponent(emission) > 0; }
+  std::string ToString() const;
+};
+
+/// KHR_lights_punctual light, in world space.
+struct Light {
+  enum class Type { Point, Spot, Directional };
+  Type type = Type::Point;
+  std::string name;
+  Vec3 position{0, 0, 0};     ///< world space (point, spot)
+  Vec3 direction{0, 0, -1};   ///< unit, world space, the way the light travels (spot, directional)
+  Vec3 color{1, 1, 1};        ///< linear RGB
+  float intensity = 1.0f;     ///< point/spot: W/sr (cd); directional: W/m^2 (lx)
+  float range = 0.0f;         ///< 0 = infinite
+  float innerConeAngle = 0.0f;           ///< radians (spot)
+  float outerConeAngle = kPi / 4.0f;     ///< radians (spot)
+
+  /// Total emitted power in W (RGB). Directional lights need the scene's
+  /// bounds: their power is the flux through the scene's bounding disc.
+  Vec3 power(const Bounds3& sceneBounds) const;
+  std::string ToString() const;
+};
+
+/// A perspective camera in world space.
+struct Camera {
+  std::string name;
+  Vec3 position{0, 0, 0};
+  Vec3 forward{0, 0, -1};  ///< unit, view direction
+  Vec3 up{0, 1, 0};        ///< unit, orthogonal to forward
+  float yfov = 0.8f;       ///< vertical field of view, radians
+  float aspectRatio = 0;   ///< width/height; 0 = take it from the image
+  float znear = 0.01f;
+  float zfar = 0;          ///< 0 = infinite
+};
+
+/// Triangle soup in world space, one material index per triangle.
+struct Scene {
+  std::string sourcePath;
+  std::vector<Vec3> positions;        ///< world space
+  std::vector<Vec3> normals;          ///< per vertex, unit, world space; empty = use face normals
+  std::vector<float> texcoords0;      ///< 2 floats per vertex, or empty
+  std::vector<float> texcoords1;      ///< 2 floats per vertex, or empty
+  std::vector<uint32_t> indices;      ///< 3 per triangle, into positions
+  std::vector<int32_t> triangleMaterial;  ///< one per triangle, into materials
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Light> lights;
+  std::vector<Camera> cameras;
+
+  size_t triangleCount() const { return indices.size() / 3; }
+  Bounds3 bounds() const;
+  /// Geometric normal (unit, from the winding) and area of triangle t.
+  Vec3 faceNormal(size_t t) const;
+  float triangleArea(size_t t) const;
+  /// Base colour of triangle t at barycentrics (b1, b2), texture applied.
+  Vec3 albedo(size_t t, float b1, float b2) const;
+  std::string ToString() const;  ///< one-line summary
+};
+
+/// Loads a .gltf, .glb or .obj file. External resources (buffers, images,
+/// .mtl files) resolve only inside the scene file's own folder.
+/// @throws InputError naming the file and the problem (missing buffer, index
+/// out of range, non-finite vertex, unsupported primitive mode, unreadable
+/// image, unknown extension).
+Scene loadScene(const std::string& path);
+
+}  // namespace lo

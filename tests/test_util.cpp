@@ -1,0 +1,44 @@
+#include "test_util.h"
+
+#include <filesystem>
+
+namespace lo::test {
+
+std::string sharedScenesDir() { return std::string(LO_SHARED_DIR) + "/scenes"; }
+std::string dataDir() { return LO_DATA_DIR; }
+
+std::string outputDir(const std::string& testName) {
+  std::filesystem::path p = std::filesystem::path(LO_TEST_OUTPUT_DIR) / testName;
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p.string();
+}
+
+void addQuad(Scene& scene, const Vec3& corner, const Vec3& edgeU, const Vec3& edgeV,
+             const Vec3& normal, int material) {
+  uint32_t base = uint32_t(scene.positions.size());
+  scene.positions.push_back(corner);
+  scene.positions.push_back(corner + edgeU);
+  scene.positions.push_back(corner + edgeU + edgeV);
+  scene.positions.push_back(corner + edgeV);
+  bool flip = dot(cross(edgeU, edgeV), normal) < 0;
+  uint32_t tris[2][3] = {{0, 1, 2}, {0, 2, 3}};
+  for (auto& t : tris) {
+    if (flip) std::swap(t[1], t[2]);
+    for (uint32_t i : t) scene.indices.push_back(base + i);
+    scene.triangleMaterial.push_back(material);
+  }
+}
+
+void addClosedBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material) {
+  Vec3 d = hi - lo;
+  Vec3 ex{d.x, 0, 0}, ey{0, d.y, 0}, ez{0, 0, d.z};
+  addQuad(scene, lo, ex, ez, {0, 1, 0}, material);                      // floor, facing up
+  addQuad(scene, lo + ey, ex, ez, {0, -1, 0}, material);                // ceiling, facing down
+  addQuad(scene, lo, ey, ez, {1, 0, 0}, material);                      // x = lo, facing +x
+  addQuad(scene, lo + ex, ey, ez, {-1, 0, 0}, material);                // x = hi, facing -x
+  addQuad(scene, lo, ex, ey, {0, 0, 1}, material);                      // z = lo, facing +z
+  addQuad(scene, lo + ez, ex, ey, {0, 0, -1}, material);                // z = hi, facing -z
+}
+
+}  // namespace lo::test

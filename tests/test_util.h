@@ -1,0 +1,26 @@
+#pragma once
+/// @file tests/test_util.h
+/// @brief Small scenes built in code, and paths to test data.
+
+#include <string>
+
+#include "scene/scene.h"
+
+namespace lo::test {
+
+/// Folder with the shared test scenes (../shared/scenes beside the repository).
+std::string sharedScenesDir();
+/// The repository's data/ folder.
+std::string dataDir();
+/// A fresh, empty folder for files a test writes (under the build tree).
+std::string outputDir(const std::string& testName);
+
+/// Adds an axis-aligned quad (two triangles) with the given material; the
+/// winding makes its geometric normal equal `normal`.
+void addQuad(Scene& scene, const Vec3& corner, const Vec3& edgeU, const Vec3& edgeV,
+             const Vec3& normal, int material);
+
+/// Closed cube [lo, hi]^3 of six inward-facing quads with material `material`.
+void addClosedBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
+
+}  // namespace lo::test
