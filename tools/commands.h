@@ -1,0 +1,17 @@
+#pragma once
+/// @file tools/commands.h
+/// @brief Subcommands of the lightoctree front end. Each registers its flags
+/// on the CLI11 app and returns the function that runs it.
+
+#include <functional>
+
+namespace CLI {
+class App;
+}
+
+namespace lo::tool {
+
+/// `lightoctree bake SCENE -o OUT.vdb ...`
+std::function<int()> addBakeCommand(CLI::App& app);
+
+}  // namespace lo::tool

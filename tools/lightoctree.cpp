@@ -1,0 +1,42 @@
+// lightoctree: the command-line front end. Parses, calls the stages, reports.
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "commands.h"
+
+namespace {
+
+int run(int argc, char** argv) {
+  CLI::App app{
+      "Light Octree " LO_VERSION
+      ": bakes photon-mapped global illumination into sparse OpenVDB grids of virtual "
+      "directional lights.",
+      "lightoctree"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", LO_VERSION);
+  std::vector<std::function<int()>> commands;
+  commands.push_back(lo::tool::addBakeCommand(app));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  for (auto& command : commands) {
+    int rc = command();
+    if (rc >= 0) return rc;
+  }
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lightoctree: error: %s\n", e.what());
+    return 1;
+  }
+}

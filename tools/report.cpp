@@ -1,0 +1,92 @@
+#include "report.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cinttypes>
+
+namespace lo::tool {
+
+ConsoleProgress::ConsoleProgress(bool quiet) : quiet_(quiet), tty_(isatty(fileno(stderr)) != 0) {}
+
+void ConsoleProgress::begin(const std::string& task, size_t total) {
+  task_ = task;
+  lastQuarter_ = -1;
+  clock_.reset();
+  if (quiet_) return;
+  if (tty_) {
+    update(0, total);
+  } else {
+    std::fprintf(stderr, "%s: started (%s items)\n", task_.c_str(), formatCount(total).c_str());
+  }
+}
+
+void ConsoleProgress::update(size_t done, size_t total) {
+  if (quiet_) return;
+  double f = total ? double(done) / double(total) : 1.0;
+  if (tty_) {
+    constexpr int kWidth = 30;
+    int filled = int(f * kWidth + 0.5);
+    std::string bar(size_t(filled), '#');
+    bar.resize(kWidth, '.');
+    std::fprintf(stderr, "\r%-22s [%s] %5.1f%%  %6.1fs", task_.c_str(), bar.c_str(), 100.0 * f,
+                 clock_.seconds());
+    std::fflush(stderr);
+  } else {
+    int quarter = int(f * 4.0);
+    if (quarter > lastQuarter_ && quarter > 0 && quarter < 4) {
+      std::fprintf(stderr, "%s: %d%%\n", task_.c_str(), quarter * 25);
+    }
+    lastQuarter_ = std::max(lastQuarter_, quarter);
+  }
+}
+
+void ConsoleProgress::end() {
+  if (quiet_) return;
+  if (tty_) {
+    std::fprintf(stderr, "\n");
+  } else {
+    std::fprintf(stderr, "%s: done in %.2fs\n", task_.c_str(), clock_.seconds());
+  }
+}
+
+StageTimer::StageTimer(std::vector<StageReport>& rows, std::string name)
+    : rows_(rows), name_(std::move(name)) {}
+
+void StageTimer::finish(std::string detail) {
+  rows_.push_back({name_, clock_.seconds(), currentRssBytes(), peakRssBytes(), std::move(detail)});
+}
+
+std::string formatBytes(size_t bytes) {
+  char buf[32];
+  double b = double(bytes);
+  if (b >= 1024.0 * 1024.0 * 1024.0) {
+    std::snprintf(buf, sizeof buf, "%.2f GiB", b / (1024.0 * 1024.0 * 1024.0));
+  } else if (b >= 1024.0 * 1024.0) {
+    std::snprintf(buf, sizeof buf, "%.1f MiB", b / (1024.0 * 1024.0));
+  } else {
+    std::snprintf(buf, sizeof buf, "%.1f KiB", b / 1024.0);
+  }
+  return buf;
+}
+
+std::string formatCount(size_t n) {
+  std::string s = std::to_string(n);
+  for (int i = int(s.size()) - 3; i > 0; i -= 3) s.insert(size_t(i), ",");
+  return s;
+}
+
+void printSummary(std::FILE* out, const std::vector<StageReport>& rows) {
+  double total = 0;
+  std::fprintf(out, "\n%-18s %10s %12s %12s  %s\n", "stage", "time", "RSS after", "peak RSS",
+               "result");
+  for (const StageReport& r : rows) {
+    total += r.seconds;
+    std::fprintf(out, "%-18s %9.3fs %12s %12s  %s\n", r.name.c_str(), r.seconds,
+                 formatBytes(r.rssBytes).c_str(), formatBytes(r.peakBytes).c_str(),
+                 r.detail.c_str());
+  }
+  std::fprintf(out, "%-18s %9.3fs\n", "total", total);
+}
+
+}  // namespace lo::tool
