@@ -1,0 +1,111 @@
+#include <gtest/gtest.h>
+
+#include <set>
+#include <vector>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "core/progress.h"
+#include "core/rng.h"
+
+namespace lo {
+namespace {
+
+TEST(Rng, SameSeedAndIndexGiveSameStream) {
+  Rng a(7, 123), b(7, 123);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(a.next(), b.next());
+}
+
+TEST(Rng, NeighbouringIndicesAreDecorrelated) {
+  // First outputs of 10,000 consecutive indices: all distinct and uniform in mean.
+  std::set<uint32_t> firsts;
+  double sum = 0;
+  const int n = 10000;
+  for (int i = 0; i < n; ++i) {
+    Rng r(1, uint64_t(i));
+    firsts.insert(r.next());
+    sum += Rng(1, uint64_t(i)).uniform();
+  }
+  EXPECT_EQ(firsts.size(), size_t(n));
+  // Mean of n uniforms: standard error 1/sqrt(12 n) ~ 0.0029; allow 5 sigma.
+  EXPECT_NEAR(sum / n, 0.5, 5.0 / std::sqrt(12.0 * n));
+}
+
+TEST(Rng, UniformStaysInUnitInterval) {
+  Rng r(3, 4);
+  for (int i = 0; i < 100000; ++i) {
+    float u = r.uniform();
+    ASSERT_GE(u, 0.0f);
+    ASSERT_LT(u, 1.0f);
+  }
+}
+
+TEST(Math, OrthonormalBasisIsOrthonormalEverywhereIncludingPoles) {
+  std::vector<Vec3> normals = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {0, 1, 0},
+                               normalize(Vec3{1, 2, 3}), normalize(Vec3{-1e-7f, 0, -1})};
+  for (const Vec3& n : normals) {
+    Vec3 t, b;
+    orthonormalBasis(n, t, b);
+    EXPECT_NEAR(length(t), 1.0f, 1e-5f) << n.ToString();
+    EXPECT_NEAR(length(b), 1.0f, 1e-5f) << n.ToString();
+    EXPECT_NEAR(dot(t, n), 0.0f, 1e-5f) << n.ToString();
+    EXPECT_NEAR(dot(b, n), 0.0f, 1e-5f) << n.ToString();
+    EXPECT_NEAR(dot(t, b), 0.0f, 1e-5f) << n.ToString();
+  }
+}
+
+TEST(Math, NormalizeOfZeroIsZeroNotNaN) {
+  Vec3 z = normalize(Vec3{0, 0, 0});
+  EXPECT_EQ(z, Vec3(0, 0, 0));
+}
+
+TEST(Math, BoundsExtendAndEmpty) {
+  Bounds3 b;
+  EXPECT_TRUE(b.empty());
+  b.extend(Vec3{1, 2, 3});
+  b.extend(Vec3{-1, 5, 0});
+  EXPECT_FALSE(b.empty());
+  EXPECT_EQ(b.lower, Vec3(-1, 2, 0));
+  EXPECT_EQ(b.upper, Vec3(1, 5, 3));
+}
+
+TEST(Check, FailedCheckPrintsBothSides) {
+  try {
+    LO_CHECK_EQ(2 + 2, 5);
+    FAIL() << "LO_CHECK_EQ did not throw";
+  } catch (const InternalError& e) {
+    std::string msg = e.what();
+    EXPECT_NE(msg.find("4 vs 5"), std::string::npos) << msg;
+  }
+}
+
+class RecordingSink : public ProgressSink {
+ public:
+  void begin(const std::string&, size_t total) override { total_ = total; began = true; }
+  void update(size_t done, size_t) override {
+    EXPECT_GE(done, last);
+    EXPECT_LE(done, total_);
+    last = done;
+    ++updates;
+  }
+  void end() override { ended = true; }
+  bool began = false, ended = false;
+  size_t last = 0, total_ = 0;
+  int updates = 0;
+};
+
+TEST(Progress, ReportsMonotonicallyAndFinishesAtTotal) {
+  RecordingSink sink;
+  {
+    Progress p(&sink, "task", 10000);
+    for (int i = 0; i < 10000; ++i) p.advance();
+  }
+  EXPECT_TRUE(sink.began);
+  EXPECT_TRUE(sink.ended);
+  EXPECT_EQ(sink.last, 10000u);
+  // Throttled to about one report per percent.
+  EXPECT_LE(sink.updates, 102);
+}
+
+}  // namespace
+}  // namespace lo
