@@ -1,0 +1,102 @@
+/* octree_layout.h: the GPU light octree texture layout, one header valid in
+ * both C++ (included by src/octree and tests) and GLSL (prepended to shaders).
+ * A unit test asserts that the C++ build and the shaders agree on every value.
+ *
+ * Octree pool (paper §4.2.1, after Lefebvre, Hornus and Neyret, GPU Gems 2
+ * ch. 37): a 3D texture, internal format RGBA8UI, made of 2x2x2 node tiles.
+ * Tile t sits at texel (2*tx, 2*ty, 2*tz); its 8 texels are the 8 children of
+ * one node, child (cx,cy,cz) in {0,1}^3 at texel (2*tx+cx, 2*ty+cy, 2*tz+cz).
+ * The root node is tile (0,0,0). Each texel:
+ *   A == LO_FLAG_EMPTY    : empty branch (no geometry below)
+ *   A == LO_FLAG_INNER    : RGB = tile coordinates (tx, ty, tz) of the child tile
+ *   A in [1, LO_MAX_VDLS] : leaf holding A VDLs; RGB = 24-bit index
+ *                           (R | G<<8 | B<<16) of its first VDL texel
+ * A leaf stores only the VDLs its voxel has (the count lives in the flag).
+ *
+ * VDL texture (paper §4.2.2, Fig. 8): a 2D texture, RGBA32F (or RGBA16F when
+ * half precision is asked for), LO_VDL_TEXTURE_WIDTH texels wide. One texel
+ * per VDL: RGB = irradiance (W/m^2), A = direction packed into an integer
+ * thetaQ * 256 + phiQ (8+8 bits) held exactly in a float.
+ * VDL index i lives at texel (i % LO_VDL_TEXTURE_WIDTH, i / LO_VDL_TEXTURE_WIDTH).
+ *
+ * Direction frame: theta from +Z (0..pi), phi from +X towards +Y (0..2pi),
+ * world space: d = (sin(theta) cos(phi), sin(theta) sin(phi), cos(theta)).
+ */
+#ifndef LO_OCTREE_LAYOUT_H
+#define LO_OCTREE_LAYOUT_H
+
+#ifdef __cplusplus
+#include <cmath>
+#include <cstdint>
+namespace lo {
+namespace layout {
+using uint = uint32_t;
+using std::acos;
+using std::atan2;
+using std::cos;
+using std::floor;
+using std::sin;
+#define LO_LAYOUT_FN inline
+#else
+#define LO_LAYOUT_FN
+#endif
+
+const uint LO_FLAG_EMPTY = 0u;
+const uint LO_FLAG_INNER = 255u;
+const uint LO_MAX_VDLS = 8u;
+const uint LO_VDL_TEXTURE_WIDTH = 4096u;
+const uint LO_ADDRESS_BITS = 24u;
+const uint LO_MAX_ADDRESS = 16777215u; /* 2^24 - 1 */
+const uint LO_MAX_TILES_PER_AXIS = 256u; /* tile coordinates are 8-bit */
+const uint LO_THETA_STEPS = 255u; /* thetaQ in [0, 255] maps to [0, pi] */
+const uint LO_PHI_STEPS = 256u;   /* phiQ in [0, 255] maps to [0, 2pi), wraps */
+const float LO_PI = 3.14159265358979323846;
+
+LO_LAYOUT_FN bool loIsLeaf(uint flag) { return flag >= 1u && flag <= LO_MAX_VDLS; }
+
+/* 24-bit address <-> three 8-bit channels. */
+LO_LAYOUT_FN uint loPackAddressR(uint address) { return address & 255u; }
+LO_LAYOUT_FN uint loPackAddressG(uint address) { return (address >> 8u) & 255u; }
+LO_LAYOUT_FN uint loPackAddressB(uint address) { return (address >> 16u) & 255u; }
+LO_LAYOUT_FN uint loUnpackAddress(uint r, uint g, uint b) { return r | (g << 8u) | (b << 16u); }
+
+/* Texel of VDL index i in the VDL texture. */
+LO_LAYOUT_FN uint loVdlTexelX(uint index) { return index % LO_VDL_TEXTURE_WIDTH; }
+LO_LAYOUT_FN uint loVdlTexelY(uint index) { return index / LO_VDL_TEXTURE_WIDTH; }
+
+/* Direction packing: unit (x, y, z) -> thetaQ * 256 + phiQ, exact in a float. */
+LO_LAYOUT_FN float loPackDirection(float x, float y, float z) {
+  float c = z < -1.0 ? -1.0 : (z > 1.0 ? 1.0 : z);
+  float theta = acos(c);
+  float phi = atan2(y, x);
+  if (phi < 0.0) phi += 2.0 * LO_PI;
+  uint thetaQ = uint(floor(theta / LO_PI * float(LO_THETA_STEPS) + 0.5));
+  uint phiQ = uint(floor(phi / (2.0 * LO_PI) * float(LO_PHI_STEPS) + 0.5)) % LO_PHI_STEPS;
+  return float(thetaQ * 256u + phiQ);
+}
+
+LO_LAYOUT_FN float loPackedTheta(float packed) {
+  uint p = uint(packed);
+  return float(p / 256u) * (LO_PI / float(LO_THETA_STEPS));
+}
+
+LO_LAYOUT_FN float loPackedPhi(float packed) {
+  uint p = uint(packed);
+  return float(p % 256u) * (2.0 * LO_PI / float(LO_PHI_STEPS));
+}
+
+LO_LAYOUT_FN float loUnpackDirectionX(float packed) {
+  return sin(loPackedTheta(packed)) * cos(loPackedPhi(packed));
+}
+LO_LAYOUT_FN float loUnpackDirectionY(float packed) {
+  return sin(loPackedTheta(packed)) * sin(loPackedPhi(packed));
+}
+LO_LAYOUT_FN float loUnpackDirectionZ(float packed) { return cos(loPackedTheta(packed)); }
+
+#ifdef __cplusplus
+#undef LO_LAYOUT_FN
+}  // namespace layout
+}  // namespace lo
+#endif
+
+#endif /* LO_OCTREE_LAYOUT_H */

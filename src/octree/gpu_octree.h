@@ -1,0 +1,72 @@
+#pragma once
+/// @file octree/gpu_octree.h
+/// @brief The GPU light octree (paper §4.2.1): the VDL grid converted into a
+/// texture stack, an RGBA8UI indirection pool of 2x2x2 node tiles plus a 2D
+/// float VDL texture. The texel layout is defined once, for C++ and GLSL, in
+/// shaders/octree_layout.h. No GL here: plain arrays the renderer uploads.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cluster/vdl_grid.h"
+#include "core/math.h"
+
+namespace lo {
+
+struct GpuOctreeParams {
+  bool halfFloat = false;        ///< VDL texels as RGBA16F instead of RGBA32F
+  int max3DTextureSize = 2048;   ///< GL_MAX_3D_TEXTURE_SIZE of the target context
+  int max2DTextureSize = 16384;  ///< GL_MAX_TEXTURE_SIZE of the target context
+};
+
+struct GpuOctree {
+  int depth = 0;                ///< leaves at this depth (= the VDL grid's depth)
+  Vec3 origin{0, 0, 0};         ///< world position of the octree cube's lower corner
+  float cubeSize = 1.0f;        ///< world edge length of the octree cube (voxelSize * 2^depth)
+
+  /// Indirection pool: tilesX * tilesY * tilesZ tiles of 2x2x2 texels, stored
+  /// as a (2*tilesX) x (2*tilesY) x (2*tilesZ) RGBA8 3D texture, x fastest.
+  int tilesX = 0, tilesY = 0, tilesZ = 0;
+  std::vector<uint8_t> pool;
+
+  /// VDL texture: vdlWidth x vdlHeight RGBA texels, row-major. Exactly one of
+  /// vdlTexels (RGBA32F) / vdlTexelsHalf (RGBA16F bits) is filled.
+  int vdlWidth = 0, vdlHeight = 0;
+  bool halfFloat = false;
+  std::vector<float> vdlTexels;
+  std::vector<uint16_t> vdlTexelsHalf;
+
+  size_t leafCount = 0;   ///< non-empty voxels
+  size_t nodeCount = 0;   ///< tiles in the pool (inner nodes incl. root)
+  size_t vdlCount = 0;    ///< VDL texels used
+
+  int poolWidth() const { return 2 * tilesX; }
+  int poolHeight() const { return 2 * tilesY; }
+  int poolDepth() const { return 2 * tilesZ; }
+  size_t poolBytes() const { return pool.size(); }
+  size_t vdlBytes() const {
+    return halfFloat ? vdlTexelsHalf.size() * 2 : vdlTexels.size() * 4;
+  }
+  std::string ToString() const;  ///< sizes and memory per leaf
+};
+
+/// Builds the texture stack; only non-empty branches are stored, and each leaf
+/// stores only the VDLs its voxel has (count in the texel's alpha).
+/// @throws InputError naming the limit (3D/2D texture size, 24-bit address
+/// space) and by how much the scene exceeds it.
+GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params = {});
+
+/// Result of the C++ reference of the shader's lookup.
+struct OctreeSample {
+  bool found = false;   ///< false in empty space or outside the cube
+  Coord voxel;          ///< the leaf's voxel coordinate at the octree depth
+  int vdlCount = 0;
+  Vdl vdls[kMaxVdls];   ///< decoded (directions through the 8+8-bit packing)
+};
+
+/// The same descent the fragment shader does (depth texel fetches, then the VDL
+/// fetches), in C++: the reference the shader is tested against.
+OctreeSample lookupOctree(const GpuOctree& octree, const Vec3& worldPosition);
+
+}  // namespace lo
