@@ -13,10 +13,16 @@
  *                           (R | G<<8 | B<<16) of its first VDL texel
  * A leaf stores only the VDLs its voxel has (the count lives in the flag).
  *
- * VDL texture (paper §4.2.2, Fig. 8): a 2D texture, RGBA32F (or RGBA16F when
- * half precision is asked for), LO_VDL_TEXTURE_WIDTH texels wide. One texel
- * per VDL: RGB = irradiance (W/m^2), A = direction packed into an integer
- * thetaQ * 256 + phiQ (8+8 bits) held exactly in a float.
+ * VDL texture (paper §4.2.2, Fig. 8): a 2D texture, LO_VDL_TEXTURE_WIDTH
+ * texels wide. One texel per VDL: RGB = irradiance (W/m^2), A = direction
+ * packed into an integer thetaQ * 256 + phiQ (8+8 bits).
+ *   full precision: RGBA32F; A holds the packed integer exactly as a float.
+ *   half precision: RGBA16UI (not RGBA16F): RGB = IEEE half bits, decoded with
+ *     unpackHalf2x16(bits).x; A = the packed integer itself, used as
+ *     float(A). A half float holds integers exactly only up to 2048 and
+ *     overflows at 65504, and no 16-bit float encoding has 65536 finite,
+ *     non-denormal values, so the 16-bit packed direction cannot ride in a
+ *     half alpha; as an integer channel it costs the same 8 bytes per VDL.
  * VDL index i lives at texel (i % LO_VDL_TEXTURE_WIDTH, i / LO_VDL_TEXTURE_WIDTH).
  *
  * Direction frame: theta from +Z (0..pi), phi from +X towards +Y (0..2pi),
@@ -35,6 +41,7 @@ using std::acos;
 using std::atan2;
 using std::cos;
 using std::floor;
+using std::min;
 using std::sin;
 #define LO_LAYOUT_FN inline
 #else
@@ -70,7 +77,8 @@ LO_LAYOUT_FN float loPackDirection(float x, float y, float z) {
   float theta = acos(c);
   float phi = atan2(y, x);
   if (phi < 0.0) phi += 2.0 * LO_PI;
-  uint thetaQ = uint(floor(theta / LO_PI * float(LO_THETA_STEPS) + 0.5));
+  /* min(): a GPU acos may return a little more than pi; thetaQ must stay 8-bit. */
+  uint thetaQ = min(uint(floor(theta / LO_PI * float(LO_THETA_STEPS) + 0.5)), LO_THETA_STEPS);
   uint phiQ = uint(floor(phi / (2.0 * LO_PI) * float(LO_PHI_STEPS) + 0.5)) % LO_PHI_STEPS;
   return float(thetaQ * 256u + phiQ);
 }

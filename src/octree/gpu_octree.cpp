@@ -1,1 +1,427 @@
-// placeholder: implemented in the stage's work
+/// @file octree/gpu_octree.cpp
+/// @brief The VDL grid as a GPU texture stack (paper §4.2.1, §4.2.2): a pool
+/// of 2x2x2 RGBA8 node tiles and a 2D VDL texture; and the C++ reference of the
+/// shader's descent. Every texel is written and read through the functions of
+/// shaders/octree_layout.h, the header the GLSL includes, so that the C++
+/// reference and the shader share one definition of the layout.
+
+#include "octree/gpu_octree.h"
+
+#include <octree_layout.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <iomanip>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace lo {
+
+namespace gpu_octree_internal {
+
+using namespace layout;
+
+/// Interleaves the bits of a voxel coordinate, x lowest, so that the child
+/// index inside a node (x | y << 1 | z << 2) is the code's lowest 3 bits and
+/// the code of the ancestor at `k` levels up is code >> 3k.
+uint64_t mortonCode(const Coord& c, int depth) {
+  uint64_t code = 0;
+  for (int b = depth - 1; b >= 0; --b) {
+    code = (code << 3) | (uint64_t((c.z >> b) & 1) << 2) | (uint64_t((c.y >> b) & 1) << 1) |
+           uint64_t((c.x >> b) & 1);
+  }
+  return code;
+}
+
+/// Smallest n with n^k >= value (k = 2 or 3), for near-cubic tile arrangements.
+int64_t ceilRoot(int64_t value, int k) {
+  int64_t n = std::max<int64_t>(1, int64_t(std::floor(std::pow(double(value), 1.0 / k))));
+  auto power = [k](int64_t x) { return k == 2 ? x * x : x * x * x; };
+  while (n > 1 && power(n - 1) >= value) --n;
+  while (power(n) < value) ++n;
+  return n;
+}
+
+void validate(const VdlGrid& grid, const GpuOctreeParams& params) {
+  const GridFrame& f = grid.frame;
+  if (f.depth < 1 || f.depth > 12) {
+    throw InputError("GPU octree: grid depth " + std::to_string(f.depth) +
+                     " is outside [1, 12] (the octree needs at least one level below the root)");
+  }
+  if (!(f.voxelSize > 0.0f) || !std::isfinite(f.voxelSize) || !isFinite(f.origin)) {
+    throw InputError("GPU octree: grid frame has voxel size " + std::to_string(f.voxelSize) +
+                     " and origin " + f.origin.ToString() + "; need a finite positive size");
+  }
+  if (grid.maxVdls < 1 || grid.maxVdls > int(LO_MAX_VDLS)) {
+    throw InputError("GPU octree: maxVdls " + std::to_string(grid.maxVdls) + " is outside [1, " +
+                     std::to_string(LO_MAX_VDLS) + "]");
+  }
+  if (grid.vdlCount.size() != grid.coords.size() ||
+      grid.vdls.size() != grid.coords.size() * size_t(grid.maxVdls)) {
+    throw InputError("GPU octree: VDL grid arrays disagree: " + std::to_string(grid.coords.size()) +
+                     " voxels, " + std::to_string(grid.vdlCount.size()) + " VDL counts, " +
+                     std::to_string(grid.vdls.size()) + " VDL slots (expected voxels * " +
+                     std::to_string(grid.maxVdls) + ")");
+  }
+  if (params.max3DTextureSize < 2) {
+    throw InputError("GPU octree: max 3D texture size " + std::to_string(params.max3DTextureSize) +
+                     " cannot hold one 2x2x2 tile");
+  }
+  if (params.max2DTextureSize < 1) {
+    throw InputError("GPU octree: max 2D texture size " + std::to_string(params.max2DTextureSize) +
+                     " must be positive");
+  }
+  const int res = f.resolution();
+  for (size_t v = 0; v < grid.size(); ++v) {
+    const Coord& c = grid.coords[v];
+    if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= res || c.y >= res || c.z >= res) {
+      throw InputError("GPU octree: voxel " + std::to_string(v) + " at " + c.ToString() +
+                       " lies outside [0, " + std::to_string(res) + ")^3");
+    }
+    if (grid.vdlCount[v] > grid.maxVdls) {
+      throw InputError("GPU octree: voxel " + std::to_string(v) + " has " +
+                       std::to_string(grid.vdlCount[v]) + " VDLs, more than maxVdls " +
+                       std::to_string(grid.maxVdls));
+    }
+    const Vdl* vdls = grid.vdlsOf(v);
+    for (int i = 0; i < grid.vdlCount[v]; ++i) {
+      if (!isFinite(vdls[i].irradiance) || !isFinite(vdls[i].direction)) {
+        throw InputError("GPU octree: voxel " + std::to_string(v) + " VDL " + std::to_string(i) +
+                         " is not finite (irradiance " + vdls[i].irradiance.ToString() +
+                         ", direction " + vdls[i].direction.ToString() + ")");
+      }
+    }
+  }
+}
+
+std::string kib(size_t bytes) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(1) << double(bytes) / 1024.0 << " KiB";
+  return os.str();
+}
+
+}  // namespace gpu_octree_internal
+
+uint16_t floatToHalf(float value) {
+  uint32_t x;
+  std::memcpy(&x, &value, 4);
+  const uint32_t sign = (x >> 16) & 0x8000u;
+  const uint32_t a = x & 0x7fffffffu;
+  if (a > 0x7f800000u) return uint16_t(sign | 0x7e00u);  // NaN (quiet)
+  // 65520 = 0x477ff000 is where round-to-nearest-even reaches infinity;
+  // clamp from there (and for infinity itself) to the largest finite half.
+  if (a >= 0x477ff000u) return uint16_t(sign | 0x7bffu);
+  if (a >= 0x38800000u) {  // >= 2^-14: a normal half
+    // Rebias the exponent (127 -> 15) and drop 13 mantissa bits; a carry out
+    // of the mantissa correctly bumps the exponent.
+    uint32_t h = (a >> 13) - (112u << 10);
+    const uint32_t rest = a & 0x1fffu;
+    if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;
+    return uint16_t(sign | h);
+  }
+  // Denormal half: units of 2^-24. value = m * 2^(e - 150), so in those units
+  // m * 2^(e - 126): shift the 24-bit significand right by 126 - e.
+  const uint32_t e = a >> 23;
+  const uint32_t shift = 126u - e;         // >= 14 here
+  if (shift > 24u) return uint16_t(sign);  // below half the smallest denormal
+  const uint32_t m = (a & 0x7fffffu) | 0x800000u;
+  uint32_t q = m >> shift;
+  const uint32_t rest = m & ((1u << shift) - 1u);
+  const uint32_t halfway = 1u << (shift - 1u);
+  if (rest > halfway || (rest == halfway && (q & 1u))) ++q;  // may become 0x400: smallest normal
+  return uint16_t(sign | q);
+}
+
+float halfToFloat(uint16_t bits) {
+  const uint32_t sign = uint32_t(bits & 0x8000u) << 16;
+  const uint32_t exponent = (bits >> 10) & 0x1fu;
+  const uint32_t mantissa = bits & 0x3ffu;
+  uint32_t x;
+  if (exponent == 0x1fu) {
+    x = sign | 0x7f800000u | (mantissa << 13);
+  } else if (exponent != 0) {
+    x = sign | ((exponent + 112u) << 23) | (mantissa << 13);
+  } else {
+    // Zero or denormal: mantissa * 2^-24, exact in a float.
+    float f = std::ldexp(float(mantissa), -24);
+    return sign ? -f : f;
+  }
+  float f;
+  std::memcpy(&f, &x, 4);
+  return f;
+}
+
+GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
+  using namespace gpu_octree_internal;
+  validate(grid, params);
+  const int depth = grid.frame.depth;
+
+  // Lit voxels in Morton order. A voxel without VDLs is left out entirely: the
+  // flag cannot say "leaf with 0 VDLs" (0 = empty), and an empty branch reads
+  // as no indirect light, which is what a voxel without VDLs contributes.
+  struct Leaf {
+    uint64_t code;
+    uint32_t voxel;
+  };
+  std::vector<Leaf> leaves;
+  leaves.reserve(grid.size());
+  for (size_t v = 0; v < grid.size(); ++v) {
+    if (grid.vdlCount[v] > 0) leaves.push_back({mortonCode(grid.coords[v], depth), uint32_t(v)});
+  }
+  std::sort(leaves.begin(), leaves.end(),
+            [](const Leaf& a, const Leaf& b) { return a.code < b.code; });
+  for (size_t i = 1; i < leaves.size(); ++i) {
+    if (leaves[i].code == leaves[i - 1].code) {
+      throw InputError("GPU octree: voxel " + grid.coords[leaves[i].voxel].ToString() +
+                       " appears twice (indices " + std::to_string(leaves[i - 1].voxel) + " and " +
+                       std::to_string(leaves[i].voxel) + ")");
+    }
+  }
+
+  // Nodes per level, sorted: level l holds the distinct ancestors code >> 3(depth - l).
+  // Tiles are allocated breadth first: one tile per node at levels 0..depth-1,
+  // in level order, Morton order inside a level (= BFS with children visited
+  // in child-index order), so the layout does not depend on the input order.
+  std::vector<std::vector<uint64_t>> levels(size_t(depth) + 1);
+  levels[0].push_back(0);
+  for (int l = 1; l <= depth; ++l) {
+    std::vector<uint64_t>& nodes = levels[size_t(l)];
+    const int shift = 3 * (depth - l);
+    for (const Leaf& leaf : leaves) {
+      uint64_t code = leaf.code >> shift;
+      if (nodes.empty() || nodes.back() != code) nodes.push_back(code);
+    }
+  }
+  std::vector<size_t> levelOffset(size_t(depth) + 1, 0);
+  size_t tileCount = 0;
+  for (int l = 0; l < depth; ++l) {
+    levelOffset[size_t(l)] = tileCount;
+    tileCount += levels[size_t(l)].size();
+  }
+
+  // Near-cubic tile arrangement within the 8-bit tile coordinates and the
+  // context's 3D texture size (2 texels per tile per axis).
+  const int64_t maxPerAxis =
+      std::min<int64_t>(LO_MAX_TILES_PER_AXIS, int64_t(params.max3DTextureSize / 2));
+  const int64_t maxTiles = maxPerAxis * maxPerAxis * maxPerAxis;
+  if (int64_t(tileCount) > maxTiles) {
+    std::ostringstream os;
+    os << "GPU octree: " << tileCount << " node tiles needed but the pool holds at most "
+       << maxTiles << " (" << maxPerAxis << "^3 tiles: ";
+    if (maxPerAxis < int64_t(LO_MAX_TILES_PER_AXIS)) {
+      os << "3D texture size limit " << params.max3DTextureSize << " texels / 2 per tile";
+    } else {
+      os << "8-bit tile coordinates, 256 per axis";
+    }
+    os << "); over by " << int64_t(tileCount) - maxTiles << " tiles. Lower the grid depth " << depth
+       << " or light fewer voxels";
+    throw InputError(os.str());
+  }
+  GpuOctree out;
+  out.depth = depth;
+  out.origin = grid.frame.origin;
+  out.cubeSize = grid.frame.voxelSize * float(grid.frame.resolution());
+  {
+    const int64_t n = int64_t(tileCount);
+    const int64_t tx = std::min(maxPerAxis, ceilRoot(n, 3));
+    const int64_t rest = (n + tx - 1) / tx;
+    const int64_t ty = std::min(maxPerAxis, ceilRoot(rest, 2));
+    const int64_t tz = (n + tx * ty - 1) / (tx * ty);
+    LO_CHECK_LE(tz, maxPerAxis);
+    out.tilesX = int(tx);
+    out.tilesY = int(ty);
+    out.tilesZ = int(tz);
+  }
+
+  // VDL texture size and the 24-bit address space.
+  size_t vdlTotal = 0;
+  for (const Leaf& leaf : leaves) vdlTotal += grid.vdlCount[leaf.voxel];
+  const size_t addressSpace = size_t(LO_MAX_ADDRESS) + 1;
+  if (vdlTotal > addressSpace) {
+    throw InputError("GPU octree: " + std::to_string(vdlTotal) +
+                     " VDLs exceed the 24-bit VDL address space (" + std::to_string(addressSpace) +
+                     ") by " + std::to_string(vdlTotal - addressSpace));
+  }
+  const size_t width = std::max<size_t>(1, std::min<size_t>(LO_VDL_TEXTURE_WIDTH, vdlTotal));
+  const size_t height = std::max<size_t>(1, (vdlTotal + width - 1) / width);
+  if (width > size_t(params.max2DTextureSize) || height > size_t(params.max2DTextureSize)) {
+    const bool wide = width > size_t(params.max2DTextureSize);
+    const size_t size = wide ? width : height;
+    throw InputError("GPU octree: the VDL texture needs " + std::to_string(width) + " x " +
+                     std::to_string(height) + " texels for " + std::to_string(vdlTotal) +
+                     " VDLs; its " + (wide ? "width" : "height") + " exceeds the 2D texture size " +
+                     "limit " + std::to_string(params.max2DTextureSize) + " by " +
+                     std::to_string(size - size_t(params.max2DTextureSize)));
+  }
+  out.vdlWidth = int(width);
+  out.vdlHeight = int(height);
+  out.halfFloat = params.halfFloat;
+  if (out.halfFloat) {
+    out.vdlTexelsHalf.assign(width * height * 4, 0);
+  } else {
+    out.vdlTexels.assign(width * height * 4, 0.0f);
+  }
+
+  const size_t poolW = size_t(out.poolWidth()), poolH = size_t(out.poolHeight());
+  out.pool.assign(poolW * poolH * size_t(out.poolDepth()) * 4, 0);
+  auto tileCoord = [&](size_t tile, uint32_t& tx, uint32_t& ty, uint32_t& tz) {
+    tx = uint32_t(tile % size_t(out.tilesX));
+    ty = uint32_t((tile / size_t(out.tilesX)) % size_t(out.tilesY));
+    tz = uint32_t(tile / (size_t(out.tilesX) * size_t(out.tilesY)));
+  };
+  auto texel = [&](size_t tile, uint32_t child) -> uint8_t* {
+    uint32_t tx, ty, tz;
+    tileCoord(tile, tx, ty, tz);
+    const size_t x = 2 * tx + (child & 1u), y = 2 * ty + ((child >> 1) & 1u),
+                 z = 2 * tz + ((child >> 2) & 1u);
+    return &out.pool[((z * poolH + y) * poolW + x) * 4];
+  };
+  auto writeVdl = [&](size_t index, const Vdl& vdl) {
+    const size_t offset =
+        (size_t(loVdlTexelY(uint(index))) * width + size_t(loVdlTexelX(uint(index)))) * 4;
+    const Vec3 d = normalize(vdl.direction);
+    const float packed = loPackDirection(d.x, d.y, d.z);
+    if (out.halfFloat) {
+      for (int c = 0; c < 3; ++c)
+        out.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(vdl.irradiance[c]);
+      out.vdlTexelsHalf[offset + 3] = uint16_t(packed);
+    } else {
+      for (int c = 0; c < 3; ++c) out.vdlTexels[offset + size_t(c)] = vdl.irradiance[c];
+      out.vdlTexels[offset + 3] = packed;
+    }
+  };
+
+  // Each node at level l >= 1 is one texel in its parent's tile. Parents are
+  // found by walking the sorted parent level alongside the sorted children.
+  size_t nextVdl = 0;
+  for (int l = 1; l <= depth; ++l) {
+    const std::vector<uint64_t>& parents = levels[size_t(l) - 1];
+    const std::vector<uint64_t>& nodes = levels[size_t(l)];
+    size_t p = 0;
+    for (size_t j = 0; j < nodes.size(); ++j) {
+      const uint64_t code = nodes[j];
+      while (parents[p] != code >> 3) ++p;
+      uint8_t* t = texel(levelOffset[size_t(l) - 1] + p, uint32_t(code & 7u));
+      if (l < depth) {
+        uint32_t tx, ty, tz;
+        tileCoord(levelOffset[size_t(l)] + j, tx, ty, tz);
+        t[0] = uint8_t(tx);
+        t[1] = uint8_t(ty);
+        t[2] = uint8_t(tz);
+        t[3] = uint8_t(LO_FLAG_INNER);
+      } else {
+        const Leaf& leaf = leaves[j];  // level `depth` is the leaf list itself
+        LO_CHECK_EQ(leaf.code, code);
+        const int count = grid.vdlCount[leaf.voxel];
+        const uint address = uint(nextVdl);
+        t[0] = uint8_t(loPackAddressR(address));
+        t[1] = uint8_t(loPackAddressG(address));
+        t[2] = uint8_t(loPackAddressB(address));
+        t[3] = uint8_t(count);
+        const Vdl* vdls = grid.vdlsOf(leaf.voxel);
+        for (int i = 0; i < count; ++i) writeVdl(nextVdl++, vdls[i]);
+      }
+    }
+  }
+  LO_CHECK_EQ(nextVdl, vdlTotal);
+  out.leafCount = leaves.size();
+  out.nodeCount = tileCount;
+  out.vdlCount = vdlTotal;
+  return out;
+}
+
+OctreeSample lookupOctree(const GpuOctree& octree, const Vec3& worldPosition) {
+  using namespace layout;
+  OctreeSample sample;
+  if (octree.depth < 1 || octree.pool.empty()) return sample;
+  // Normalized octree position; the comparisons are written so that NaN fails.
+  const Vec3 u = (worldPosition - octree.origin) / octree.cubeSize;
+  if (!(u.x >= 0.0f && u.x < 1.0f && u.y >= 0.0f && u.y < 1.0f && u.z >= 0.0f && u.z < 1.0f)) {
+    return sample;
+  }
+  const int res = 1 << octree.depth;
+  auto voxelOf = [res](float t) { return std::min(int(std::floor(t * float(res))), res - 1); };
+  const Coord voxel{voxelOf(u.x), voxelOf(u.y), voxelOf(u.z)};
+
+  const size_t poolW = size_t(octree.poolWidth()), poolH = size_t(octree.poolHeight());
+  uint tx = 0, ty = 0, tz = 0;  // root tile
+  for (int l = 0; l < octree.depth; ++l) {
+    const int bit = octree.depth - 1 - l;
+    const size_t x = 2 * tx + uint((voxel.x >> bit) & 1), y = 2 * ty + uint((voxel.y >> bit) & 1),
+                 z = 2 * tz + uint((voxel.z >> bit) & 1);
+    const uint8_t* t = &octree.pool[((z * poolH + y) * poolW + x) * 4];
+    const uint flag = t[3];
+    if (l + 1 < octree.depth) {
+      if (flag != LO_FLAG_INNER) return sample;  // empty branch
+      tx = t[0];
+      ty = t[1];
+      tz = t[2];
+      continue;
+    }
+    if (!loIsLeaf(flag)) return sample;
+    const uint address = loUnpackAddress(t[0], t[1], t[2]);
+    sample.found = true;
+    sample.voxel = voxel;
+    sample.vdlCount = int(flag);
+    for (uint i = 0; i < flag; ++i) {
+      const uint index = address + i;
+      const size_t offset =
+          (size_t(loVdlTexelY(index)) * size_t(octree.vdlWidth) + size_t(loVdlTexelX(index))) * 4;
+      Vdl& vdl = sample.vdls[i];
+      float packed;
+      if (octree.halfFloat) {
+        const uint16_t* h = &octree.vdlTexelsHalf[offset];
+        vdl.irradiance = {halfToFloat(h[0]), halfToFloat(h[1]), halfToFloat(h[2])};
+        packed = float(h[3]);  // RGBA16UI alpha: the packed integer itself
+      } else {
+        const float* f = &octree.vdlTexels[offset];
+        vdl.irradiance = {f[0], f[1], f[2]};
+        packed = f[3];
+      }
+      vdl.direction = {loUnpackDirectionX(packed), loUnpackDirectionY(packed),
+                       loUnpackDirectionZ(packed)};
+    }
+  }
+  return sample;
+}
+
+std::string GpuOctree::ToString() const {
+  using gpu_octree_internal::kib;
+  std::ostringstream os;
+  const double leaves = leafCount > 0 ? double(leafCount) : 1.0;
+  os << "GpuOctree[depth " << depth << ", origin " << origin.ToString() << ", cube " << cubeSize
+     << ", leaves " << leafCount << ", tiles " << nodeCount << " in " << tilesX << "x" << tilesY
+     << "x" << tilesZ << " (pool " << poolWidth() << "x" << poolHeight() << "x" << poolDepth()
+     << " RGBA8, " << kib(poolBytes()) << "), VDLs " << vdlCount << " in " << vdlWidth << "x"
+     << vdlHeight << (halfFloat ? " RGBA16UI(half)" : " RGBA32F") << " (" << kib(vdlBytes())
+     << "), bytes/leaf: pool " << std::fixed << std::setprecision(2) << double(poolBytes()) / leaves
+     << " + VDLs " << double(vdlBytes()) / leaves << "]";
+  return os.str();
+}
+
+std::string octreeMemoryReport(const GpuOctree& octree) {
+  // Paper §4.2.1: 512 KiB (octree) + 4 MiB (VDLs) for 100k leaves, depth 6, k = 4.
+  constexpr double kPaperLeaves = 100000.0, kPaperVdlsPerLeaf = 4.0;
+  constexpr double kPaperPoolBytes = 512.0 * 1024.0, kPaperVdlBytes = 4.0 * 1024.0 * 1024.0;
+  const double leaves = octree.leafCount > 0 ? double(octree.leafCount) : 1.0;
+  const double vdls = octree.vdlCount > 0 ? double(octree.vdlCount) : 1.0;
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(2);
+  os << "                 pool B/leaf  VDL B/leaf  B/VDL  VDLs/leaf\n";
+  os << "paper (§4.2.1)   " << std::setw(11) << kPaperPoolBytes / kPaperLeaves << std::setw(12)
+     << kPaperVdlBytes / kPaperLeaves << std::setw(7)
+     << kPaperVdlBytes / (kPaperLeaves * kPaperVdlsPerLeaf) << std::setw(11) << kPaperVdlsPerLeaf
+     << "\n";
+  os << "this octree      " << std::setw(11) << double(octree.poolBytes()) / leaves << std::setw(12)
+     << double(octree.vdlBytes()) / leaves << std::setw(7) << double(octree.vdlBytes()) / vdls
+     << std::setw(11) << double(octree.vdlCount) / leaves << "\n";
+  os << "(" << octree.leafCount << " leaves, " << octree.nodeCount << " tiles of 32 B used, "
+     << octree.tilesX * octree.tilesY * octree.tilesZ << " allocated; "
+     << double(octree.leafCount) / double(std::max<size_t>(1, octree.nodeCount))
+     << " leaves per tile; " << (octree.halfFloat ? 8 : 16) << " B per VDL texel)\n";
+  return os.str();
+}
+
+}  // namespace lo

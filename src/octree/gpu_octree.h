@@ -31,7 +31,8 @@ struct GpuOctree {
   std::vector<uint8_t> pool;
 
   /// VDL texture: vdlWidth x vdlHeight RGBA texels, row-major. Exactly one of
-  /// vdlTexels (RGBA32F) / vdlTexelsHalf (RGBA16F bits) is filled.
+  /// vdlTexels (RGBA32F) / vdlTexelsHalf (RGBA16UI: RGB = IEEE half bits,
+  /// A = packed direction as an integer; see shaders/octree_layout.h) is filled.
   int vdlWidth = 0, vdlHeight = 0;
   bool halfFloat = false;
   std::vector<float> vdlTexels;
@@ -56,6 +57,18 @@ struct GpuOctree {
 /// @throws InputError naming the limit (3D/2D texture size, 24-bit address
 /// space) and by how much the scene exceeds it.
 GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params = {});
+
+/// Memory of this octree per leaf next to the paper's figure (§4.2.1: 512 KiB
+/// octree + 4 MiB VDLs for 100k leaves of a depth-6 octree with k = 4 VDLs),
+/// as a few lines of text. Sizes only, no timing.
+std::string octreeMemoryReport(const GpuOctree& octree);
+
+/// IEEE 754 binary16 conversion, round to nearest even, denormals kept.
+/// Finite values beyond the largest half (65504) clamp to +-65504 instead of
+/// becoming infinity (an infinite irradiance would poison the shader's sum);
+/// NaN stays NaN.
+uint16_t floatToHalf(float value);
+float halfToFloat(uint16_t bits);
 
 /// Result of the C++ reference of the shader's lookup.
 struct OctreeSample {
