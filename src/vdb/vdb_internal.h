@@ -1,0 +1,38 @@
+#pragma once
+/// @file vdb/vdb_internal.h
+/// @brief Private to src/vdb and its tests: hooks that write deliberately
+/// broken files and inspect point files, so that tests need no OpenVDB headers.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vdb/vdb_io.h"
+
+namespace lo::vdb_internal {
+
+/// Ways to damage a VDL file for reader tests.
+struct Damage {
+  std::string omitGrid;          ///< leave this grid out of the file ("" = none)
+  std::string shiftGrid;         ///< give this grid a transform shifted by one voxel ("" = none)
+  bool rotateTransform = false;  ///< every grid gets the same transform with a rotation
+};
+
+/// writeVdlGrid with damage applied (same metadata, same temp + rename).
+void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
+                         const Damage& damage);
+
+/// What a photon point file holds, read back through OpenVDB.
+struct PointFileInfo {
+  std::vector<std::string> gridNames;
+  uint64_t pointCount = 0;
+  std::vector<std::string> attributes;  ///< in descriptor order ("P" first)
+  Vec3 totalCd{0, 0, 0};                ///< sum of "Cd" over all points (double accumulation)
+  int64_t totalBounce = 0;              ///< sum of "bounce"
+  Bounds3 positionBounds;               ///< world-space bounds of "P"
+};
+
+/// @throws InputError if the file cannot be read or holds no "photons" grid.
+PointFileInfo inspectPointFile(const std::string& path);
+
+}  // namespace lo::vdb_internal

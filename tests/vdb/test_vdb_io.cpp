@@ -1,0 +1,355 @@
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "../test_util.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "vdb/vdb_internal.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The order readVdlGrid documents: 8^3 block first, then offset in the block.
+bool canonicalLess(const Coord& a, const Coord& b) {
+  Coord ba{a.x >> 3, a.y >> 3, a.z >> 3}, bb{b.x >> 3, b.y >> 3, b.z >> 3};
+  if (ba != bb) return ba < bb;
+  return Coord{a.x & 7, a.y & 7, a.z & 7} < Coord{b.x & 7, b.y & 7, b.z & 7};
+}
+
+VdlGrid makeGrid(size_t voxels, int maxVdls, uint64_t seed) {
+  Rng rng(seed, 0);
+  VdlGrid g;
+  g.frame.origin = {-1.25f, 0.3f, 7.1f};
+  g.frame.voxelSize = 0.0371f;  // not a power of two: the transform must still round-trip
+  g.frame.depth = 6;
+  g.maxVdls = maxVdls;
+  std::set<Coord> unique;
+  while (unique.size() < voxels) {
+    // Negative coordinates too: block order must use floor division.
+    unique.insert(
+        Coord{int(rng.uniformInt(40)) - 20, int(rng.uniformInt(40)) - 8, int(rng.uniformInt(40))});
+  }
+  g.coords.assign(unique.begin(), unique.end());
+  std::sort(g.coords.begin(), g.coords.end(), canonicalLess);
+  auto vec = [&] { return Vec3(rng.uniform(), rng.uniform() - 0.5f, rng.uniform() * 3.0f); };
+  for (size_t v = 0; v < voxels; ++v) {
+    g.normals.push_back(normalize(vec()));
+    g.areas.push_back(rng.uniform() * 0.01f);
+    g.irradiance.push_back(vec());
+    g.photonCount.push_back(float(rng.uniformInt(301)));
+    g.radius.push_back(rng.uniform() * 0.1f);
+    g.angularError.push_back(rng.uniform() * 0.5f);
+    uint8_t count = uint8_t(rng.uniformInt(uint32_t(maxVdls) + 1));
+    g.vdlCount.push_back(count);
+    for (int i = 0; i < maxVdls; ++i) {
+      g.vdls.push_back(i < count ? Vdl{vec(), normalize(vec())} : Vdl{});
+    }
+  }
+  return g;
+}
+
+BakeMetadata makeMeta() {
+  BakeMetadata m;
+  m.sourceScene = "scenes/cornell.gltf";
+  m.depth = 6;
+  m.photons = 600000;
+  m.emittedPaths = 1234567890123ll;
+  m.knn = 300;
+  m.radius = 0.125f;
+  m.vdls = "auto";
+  m.seed = -7;
+  m.sceneBounds.extend({-1, 0, -1});
+  m.sceneBounds.extend({1, 2, 1.5f});
+  return m;
+}
+
+std::string readBytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+void writeBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+template <typename T>
+void expectSameBits(const std::vector<T>& a, const std::vector<T>& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_TRUE(a[i] == b[i]) << what << " at " << i;
+}
+
+std::string expectInputError(const std::string& path) {
+  try {
+    readVdlGrid(path);
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected InputError for " << path;
+  return "";
+}
+
+TEST(VdbIo, RoundTripIsBitExact) {
+  std::string dir = test::outputDir("VdbIo.RoundTrip");
+  for (int maxVdls : {1, 3, kMaxVdls}) {
+    VdlGrid g = makeGrid(300, maxVdls, uint64_t(maxVdls));
+    BakeMetadata meta = makeMeta();
+    std::string path = dir + "/grid" + std::to_string(maxVdls) + ".vdb";
+    writeVdlGrid(path, g, meta);
+    EXPECT_FALSE(fs::exists(path + ".tmp"));
+    LoadedVdl back = readVdlGrid(path);
+    const VdlGrid& r = back.grid;
+    EXPECT_EQ(r.frame.origin, g.frame.origin);
+    EXPECT_EQ(r.frame.voxelSize, g.frame.voxelSize);
+    EXPECT_EQ(r.frame.depth, g.frame.depth);
+    EXPECT_EQ(r.maxVdls, g.maxVdls);
+    expectSameBits(r.coords, g.coords, "coords");
+    expectSameBits(r.normals, g.normals, "normals");
+    expectSameBits(r.areas, g.areas, "areas");
+    expectSameBits(r.irradiance, g.irradiance, "irradiance");
+    expectSameBits(r.photonCount, g.photonCount, "photonCount");
+    expectSameBits(r.radius, g.radius, "radius");
+    expectSameBits(r.angularError, g.angularError, "angularError");
+    expectSameBits(r.vdlCount, g.vdlCount, "vdlCount");
+    ASSERT_EQ(r.vdls.size(), g.vdls.size());
+    for (size_t i = 0; i < g.vdls.size(); ++i) {
+      ASSERT_EQ(r.vdls[i].irradiance, g.vdls[i].irradiance) << i;
+      ASSERT_EQ(r.vdls[i].direction, g.vdls[i].direction) << i;
+    }
+    const BakeMetadata& m = back.meta;
+    EXPECT_EQ(m.generator, meta.generator);
+    EXPECT_EQ(m.version, meta.version);
+    EXPECT_EQ(m.sourceScene, meta.sourceScene);
+    EXPECT_EQ(m.depth, meta.depth);
+    EXPECT_EQ(m.photons, meta.photons);
+    EXPECT_EQ(m.emittedPaths, meta.emittedPaths);
+    EXPECT_EQ(m.knn, meta.knn);
+    EXPECT_EQ(m.radius, meta.radius);
+    EXPECT_EQ(m.vdls, meta.vdls);
+    EXPECT_EQ(m.seed, meta.seed);
+    EXPECT_EQ(m.sceneBounds.lower, meta.sceneBounds.lower);
+    EXPECT_EQ(m.sceneBounds.upper, meta.sceneBounds.upper);
+    EXPECT_EQ(m.units, meta.units);
+  }
+}
+
+TEST(VdbIo, EmptyGridRoundTrips) {
+  std::string path = test::outputDir("VdbIo.Empty") + "/empty.vdb";
+  VdlGrid g = makeGrid(0, 4, 1);
+  writeVdlGrid(path, g, makeMeta());
+  LoadedVdl back = readVdlGrid(path);
+  EXPECT_EQ(back.grid.size(), 0u);
+  EXPECT_EQ(back.grid.maxVdls, 4);
+  EXPECT_EQ(back.grid.frame.voxelSize, g.frame.voxelSize);
+}
+
+TEST(VdbIo, SameInputGivesSameBytes) {
+  std::string dir = test::outputDir("VdbIo.SameBytes");
+  VdlGrid g = makeGrid(200, 4, 3);
+  writeVdlGrid(dir + "/a.vdb", g, makeMeta());
+  writeVdlGrid(dir + "/b.vdb", g, makeMeta());
+  std::string a = readBytes(dir + "/a.vdb");
+  EXPECT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == readBytes(dir + "/b.vdb"));
+  // A different grid gets a different (content-derived) file UUID.
+  g.irradiance[0].x += 1.0f;
+  writeVdlGrid(dir + "/c.vdb", g, makeMeta());
+  EXPECT_NE(a.substr(21, 36), readBytes(dir + "/c.vdb").substr(21, 36));
+}
+
+std::string runCommand(const std::string& command) {
+  std::string out;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return out;
+  char buffer[4096];
+  size_t got;
+  while ((got = fread(buffer, 1, sizeof(buffer), pipe)) > 0) out.append(buffer, got);
+  pclose(pipe);
+  return out;
+}
+
+TEST(VdbIo, VdbPrintListsTheContractGrids) {
+  const char* vdbPrint = "/usr/bin/vdb_print";
+  if (!fs::exists(vdbPrint)) GTEST_SKIP() << vdbPrint << " not installed";
+  std::string dir = test::outputDir("VdbIo.VdbPrint");
+  VdlGrid g = makeGrid(100, 2, 5);
+  writeVdlGrid(dir + "/g.vdb", g, makeMeta());
+  std::string out = runCommand(std::string(vdbPrint) + " -m " + dir + "/g.vdb 2>&1");
+  for (const char* name :
+       {"irradiance", "normal", "photon_count", "angular_error", "vdl_count", "radius", "area",
+        "vdl0_irradiance", "vdl0_direction", "vdl1_irradiance", "vdl1_direction"}) {
+    // One summary line per grid, starting with its name.
+    EXPECT_NE(out.find("\n" + std::string(name) + " "), std::string::npos) << name << "\n" << out;
+  }
+  EXPECT_EQ(out.find("vdl2_"), std::string::npos) << out;
+  EXPECT_NE(out.find("source_scene: scenes/cornell.gltf"), std::string::npos) << out;
+  EXPECT_NE(out.find("file_compression: blosc"), std::string::npos) << out;
+
+  std::vector<Photon> photons(50);
+  for (size_t i = 0; i < photons.size(); ++i) photons[i].position = Vec3(float(i) * 0.01f);
+  writePhotonPoints(dir + "/p.vdb", photons, 0.1f);
+  out = runCommand(std::string(vdbPrint) + " " + dir + "/p.vdb 2>&1");
+  EXPECT_EQ(out.rfind("photons ", 0), 0u) << out;
+}
+
+TEST(VdbIo, MissingGridIsAnInputError) {
+  std::string dir = test::outputDir("VdbIo.MissingGrid");
+  VdlGrid g = makeGrid(50, 2, 7);
+  for (const char* omit : {"irradiance", "vdl_count", "area", "vdl1_direction"}) {
+    std::string path = dir + "/" + omit + ".vdb";
+    vdb_internal::Damage damage;
+    damage.omitGrid = omit;
+    vdb_internal::writeVdlGridDamaged(path, g, makeMeta(), damage);
+    std::string msg = expectInputError(path);
+    EXPECT_NE(msg.find("missing grid '" + std::string(omit) + "'"), std::string::npos) << msg;
+  }
+}
+
+TEST(VdbIo, MismatchedTransformsAreAnInputError) {
+  std::string dir = test::outputDir("VdbIo.Transforms");
+  VdlGrid g = makeGrid(50, 2, 8);
+  vdb_internal::Damage shifted;
+  shifted.shiftGrid = "vdl0_irradiance";
+  vdb_internal::writeVdlGridDamaged(dir + "/shifted.vdb", g, makeMeta(), shifted);
+  std::string msg = expectInputError(dir + "/shifted.vdb");
+  EXPECT_NE(msg.find("mismatched transforms"), std::string::npos) << msg;
+
+  vdb_internal::Damage rotated;
+  rotated.rotateTransform = true;
+  vdb_internal::writeVdlGridDamaged(dir + "/rotated.vdb", g, makeMeta(), rotated);
+  msg = expectInputError(dir + "/rotated.vdb");
+  EXPECT_NE(msg.find("transform"), std::string::npos) << msg;
+}
+
+TEST(VdbIo, DamagedFilesAreInputErrorsNotCrashes) {
+  std::string dir = test::outputDir("VdbIo.Damaged");
+  VdlGrid g = makeGrid(200, 2, 9);
+  writeVdlGrid(dir + "/good.vdb", g, makeMeta());
+  const std::string bytes = readBytes(dir + "/good.vdb");
+  ASSERT_GT(bytes.size(), 200u);
+  // Truncated at the header, in the metadata, in the grid descriptors, in the
+  // middle of the data and just before the end.
+  for (size_t keep : {size_t(0), size_t(10), size_t(40), size_t(200), bytes.size() / 3,
+                      bytes.size() / 2, bytes.size() - 8}) {
+    std::string path = dir + "/truncated" + std::to_string(keep) + ".vdb";
+    writeBytes(path, bytes.substr(0, keep));
+    expectInputError(path);
+  }
+  std::string wrongMagic = bytes;
+  wrongMagic[0] ^= 0x5a;
+  writeBytes(dir + "/magic.vdb", wrongMagic);
+  expectInputError(dir + "/magic.vdb");
+  writeBytes(dir + "/text.vdb", "this is not a vdb file\n");
+  expectInputError(dir + "/text.vdb");
+}
+
+TEST(VdbIo, NonexistentFileIsAnInputError) {
+  std::string msg = expectInputError(test::outputDir("VdbIo.Nonexistent") + "/nope.vdb");
+  EXPECT_NE(msg.find("does not exist"), std::string::npos) << msg;
+}
+
+TEST(VdbIo, WritingIntoAMissingFolderFailsCleanly) {
+  std::string dir = test::outputDir("VdbIo.MissingFolder") + "/no/such/folder";
+  std::string path = dir + "/g.vdb";
+  try {
+    writeVdlGrid(path, makeGrid(10, 1, 1), makeMeta());
+    ADD_FAILURE() << "expected IoError";
+  } catch (const IoError& e) {
+    std::string msg = e.what();
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find("does not exist"), std::string::npos) << msg;
+  }
+  EXPECT_THROW(writePhotonPoints(path, {}, 1.0f), IoError);
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+}
+
+TEST(VdbIo, OverwritesAnExistingFileAndLeavesNoTemporary) {
+  std::string dir = test::outputDir("VdbIo.Overwrite");
+  std::string path = dir + "/g.vdb";
+  writeBytes(path, "old contents");
+  writeVdlGrid(path, makeGrid(20, 1, 2), makeMeta());
+  EXPECT_EQ(readVdlGrid(path).grid.size(), 20u);
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  // A directory where the file should go: the write fails, nothing is left.
+  fs::create_directories(dir + "/taken.vdb/inner");
+  EXPECT_THROW(writeVdlGrid(dir + "/taken.vdb", makeGrid(5, 1, 2), makeMeta()), IoError);
+  EXPECT_FALSE(fs::exists(dir + "/taken.vdb.tmp"));
+}
+
+std::vector<Photon> makePhotons(size_t n) {
+  Rng rng(4, 0);
+  std::vector<Photon> photons(n);
+  for (auto& p : photons) {
+    p.position = {rng.uniform() * 2 - 1, rng.uniform(), rng.uniform() * 3};
+    p.direction = normalize(Vec3(rng.uniform(), 1, rng.uniform()));
+    p.normal = {0, 1, 0};
+    p.power = {rng.uniform() * 1e-3f, 2e-4f, 1e-4f};
+    p.bounce = rng.uniformInt(4);
+  }
+  return photons;
+}
+
+TEST(VdbIo, PhotonPointsReadBack) {
+  std::string dir = test::outputDir("VdbIo.Points");
+  std::vector<Photon> photons = makePhotons(5000);
+  std::string path = dir + "/photons.vdb";
+  writePhotonPoints(path, photons, 0.05f);
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  vdb_internal::PointFileInfo info = vdb_internal::inspectPointFile(path);
+  EXPECT_EQ(info.gridNames, std::vector<std::string>{"photons"});
+  EXPECT_EQ(info.pointCount, photons.size());
+  EXPECT_EQ(info.attributes, (std::vector<std::string>{"P", "Cd", "direction", "N", "bounce"}));
+  double cd[3] = {0, 0, 0};
+  int64_t bounce = 0;
+  Bounds3 bounds;
+  for (const Photon& p : photons) {
+    for (int k = 0; k < 3; ++k) cd[k] += p.power[k];
+    bounce += p.bounce;
+    bounds.extend(p.position);
+  }
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(info.totalCd[k], cd[k], 1e-6 * cd[k]);
+  EXPECT_EQ(info.totalBounce, bounce);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(info.positionBounds.lower[k], bounds.lower[k], 1e-5f);
+    EXPECT_NEAR(info.positionBounds.upper[k], bounds.upper[k], 1e-5f);
+  }
+  // Not a VDL file: the VDL reader says so instead of misreading it.
+  expectInputError(path);
+}
+
+TEST(VdbIo, PhotonPointsAreDeterministicAndMayBeEmpty) {
+  std::string dir = test::outputDir("VdbIo.PointsDeterministic");
+  std::vector<Photon> photons = makePhotons(20000);
+  writePhotonPoints(dir + "/a.vdb", photons, 0.05f);
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    writePhotonPoints(dir + "/b.vdb", photons, 0.05f);
+  }
+  EXPECT_TRUE(readBytes(dir + "/a.vdb") == readBytes(dir + "/b.vdb"));
+
+  writePhotonPoints(dir + "/empty.vdb", {}, 0.05f);
+  vdb_internal::PointFileInfo info = vdb_internal::inspectPointFile(dir + "/empty.vdb");
+  EXPECT_EQ(info.pointCount, 0u);
+  EXPECT_EQ(info.gridNames, std::vector<std::string>{"photons"});
+  EXPECT_THROW(writePhotonPoints(dir + "/bad.vdb", photons, 0.0f), InputError);
+}
+
+}  // namespace
+}  // namespace lo
