@@ -1,1 +1,645 @@
-// placeholder: implemented in the stage's work
+/// @file photon/photon_map.cpp
+/// @brief Photon tracing with Embree 3 (paper §4.1). See docs/photon.md for
+/// the method, units and the determinism scheme.
+///
+/// Units: photon power is flux in W (RGB). A path starts with the power of its
+/// emitter divided by the probability of picking that emitter; after tracing,
+/// every stored power is divided once by the number of emitted paths, so the
+/// sum of the bounce-0 photons estimates the total emitted power.
+
+#include "photon/photon_map.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/rng.h"
+
+namespace lo {
+
+namespace photon_internal {
+
+/// Photons are stored only where the material has a diffuse lobe or a metal
+/// lobe at least this rough (perceptual roughness); sharper lobes are treated
+/// as specular and only redirect the path.
+constexpr float kGlossyRoughness = 0.2f;
+/// GGX alpha below which a metal is sampled as a perfect mirror.
+constexpr float kMirrorAlpha = 1e-3f;
+/// Ray origins move off the surface by this fraction of the scene's size
+/// (diagonal plus largest absolute coordinate, so far-from-origin scenes keep
+/// enough float precision).
+constexpr float kRayEpsilonScale = 1e-5f;
+/// Paths per work item: the unit TBB schedules and the unit whose photons stay
+/// in path order inside one buffer.
+constexpr size_t kChunkPaths = 256;
+constexpr size_t kMinBatchPaths = 4096;
+constexpr size_t kMaxBatchPaths = size_t(1) << 19;
+
+/// Per-triangle data read at every hit.
+struct TriangleInfo {
+  Vec3 normal;  ///< unit geometric normal from the winding (Scene::faceNormal)
+  uint32_t material = 0;
+};
+
+/// Lobe weights of a glTF metallic-roughness material with transmission
+/// (KHR_materials_transmission: transmission replaces the diffuse part of the
+/// dielectric base; the metal part is unaffected). They sum to 1 and are the
+/// probabilities of choosing each lobe, so a lobe's throughput is its tint.
+struct MaterialInfo {
+  float transmissionWeight = 0;
+  float metalWeight = 0;
+  float alpha = 1;  ///< GGX alpha = roughness^2
+  float ior = 1.5f;
+  bool storesPhotons = true;
+};
+
+struct Emitter {
+  enum class Kind { Point, Spot, Directional, Triangle };
+  Kind kind = Kind::Point;
+  uint32_t index = 0;  ///< into Scene::lights or triangle index
+  Vec3 power;          ///< W, RGB, what this emitter actually emits
+  /// W, RGB, the power of the distribution sampled before any rejection (a
+  /// spot's full outer cone); also the selection weight (its average).
+  Vec3 samplePower;
+  Vec3 pathPower;  ///< samplePower / pick probability: the power a path starts with
+};
+
+struct Context {
+  const Scene* scene = nullptr;
+  RTCScene rtcScene = nullptr;
+  std::vector<TriangleInfo> triangles;
+  std::vector<MaterialInfo> materials;
+  std::vector<Emitter> emitters;
+  std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
+  Bounds3 bounds;
+  float epsilon = 0;
+  int maxBounces = 0;
+  bool includeDirect = false;
+  uint64_t seed = 0;
+};
+
+/// Photons and statistics of consecutive paths, in path order.
+struct ChunkResult {
+  std::vector<Photon> photons;
+  std::vector<uint32_t> pathPhotons;  ///< stored photons per path
+  std::vector<uint32_t> pathRays;     ///< rays per path
+};
+
+/// Owns the Embree device and scene.
+class EmbreeScene {
+ public:
+  explicit EmbreeScene(const Scene& scene) {
+    device_ = rtcNewDevice(nullptr);
+    if (!device_) throw InternalError("rtcNewDevice failed (error " + errorCode(nullptr) + ")");
+    scene_ = rtcNewScene(device_);
+    // Robust traversal: the dragon has coincident opposite-winding triangles
+    // and the closed test boxes must not leak photons through shared edges.
+    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Copied into Embree-owned buffers: Embree reads vertices as 16 bytes,
+    // past the end of a tightly packed Vec3 array.
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), scene.positions.size()));
+    auto* indices = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(uint32_t), scene.triangleCount()));
+    if (!vertices || !indices) {
+      rtcReleaseGeometry(geom);
+      throw InternalError("Embree buffer allocation failed (error " + errorCode(device_) + ")");
+    }
+    for (size_t i = 0; i < scene.positions.size(); ++i) {
+      vertices[3 * i] = scene.positions[i].x;
+      vertices[3 * i + 1] = scene.positions[i].y;
+      vertices[3 * i + 2] = scene.positions[i].z;
+    }
+    std::copy(scene.indices.begin(), scene.indices.begin() + 3 * scene.triangleCount(), indices);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene_, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene_);
+    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE)
+      throw InternalError("Embree scene build failed (error " + errorCode(device_) + ")");
+  }
+  ~EmbreeScene() {
+    if (scene_) rtcReleaseScene(scene_);
+    if (device_) rtcReleaseDevice(device_);
+  }
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+  RTCScene scene() const { return scene_; }
+
+ private:
+  static std::string errorCode(RTCDevice device) {
+    return std::to_string(int(rtcGetDeviceError(device)));
+  }
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+};
+
+inline Vec3 fromLocal(const Vec3& v, const Vec3& t, const Vec3& b, const Vec3& n) {
+  return t * v.x + b * v.y + n * v.z;
+}
+
+inline Vec3 uniformSphere(float u1, float u2) {
+  float z = 1.0f - 2.0f * u1;
+  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * kPi * u2;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+/// Direction in the cone around +z with cos(theta) >= cosMax, uniform in solid angle.
+inline Vec3 uniformCone(float u1, float u2, float cosMax) {
+  float z = 1.0f - u1 * (1.0f - cosMax);
+  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  float phi = 2.0f * kPi * u2;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+/// Cosine-weighted direction around +z (Malley: uniform disc, projected up).
+inline Vec3 cosineHemisphere(float u1, float u2) {
+  float r = std::sqrt(u1);
+  float phi = 2.0f * kPi * u2;
+  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u1))};
+}
+
+/// glTF KHR_lights_punctual spot falloff: ((cos - cosOuter) / (cosInner - cosOuter))^2, clamped.
+inline float spotFalloff(float cosTheta, float cosInner, float cosOuter) {
+  float scale = 1.0f / std::max(1e-3f, cosInner - cosOuter);
+  float a = std::clamp((cosTheta - cosOuter) * scale, 0.0f, 1.0f);
+  return a * a;
+}
+
+/// Power of a spot light with the glTF falloff integrated over the cone:
+/// 2 pi I [(1 - cosInner) + (cosInner - cosOuter) / 3]. Light::power ignores
+/// the falloff; the photons follow the falloff, so this is what they carry.
+inline Vec3 spotPower(const Light& light) {
+  float cosOuter = std::cos(light.outerConeAngle);
+  float cosInner = std::max(cosOuter, std::cos(light.innerConeAngle));
+  float solid = 2.0f * kPi * ((1.0f - cosInner) + (cosInner - cosOuter) / 3.0f);
+  return light.color * light.intensity * solid;
+}
+
+/// glTF range window: clamp(1 - (d / range)^4, 0, 1); 1 for range <= 0.
+inline float rangeWindow(float distance, float range) {
+  if (range <= 0) return 1.0f;
+  float q = distance / range;
+  q *= q;
+  return std::clamp(1.0f - q * q, 0.0f, 1.0f);
+}
+
+/// Unpolarised Fresnel reflectance of a smooth dielectric interface, n1 -> n2.
+/// cosT receives the cosine of the refracted direction (0 at total reflection).
+inline float fresnelDielectric(float cosI, float n1, float n2, float& cosT) {
+  float eta = n1 / n2;
+  float sin2T = eta * eta * std::max(0.0f, 1.0f - cosI * cosI);
+  if (sin2T >= 1.0f) {
+    cosT = 0;
+    return 1.0f;
+  }
+  cosT = std::sqrt(1.0f - sin2T);
+  float rs = (n1 * cosI - n2 * cosT) / (n1 * cosI + n2 * cosT);
+  float rp = (n2 * cosI - n1 * cosT) / (n2 * cosI + n1 * cosT);
+  return 0.5f * (rs * rs + rp * rp);
+}
+
+/// Smith Lambda for GGX, w in the local frame (z = normal).
+inline float smithLambda(const Vec3& w, float alpha) {
+  float z2 = w.z * w.z;
+  if (z2 <= 0) return 0;
+  float tan2 = std::max(0.0f, 1.0f - z2) / z2;
+  return 0.5f * (-1.0f + std::sqrt(1.0f + alpha * alpha * tan2));
+}
+
+/// GGX visible-normal sample (Heitz 2018) for local outgoing direction wo (wo.z > 0).
+inline Vec3 sampleGgxVisibleNormal(const Vec3& wo, float alpha, float u1, float u2) {
+  Vec3 vh = normalize(Vec3{alpha * wo.x, alpha * wo.y, wo.z});
+  float lensq = vh.x * vh.x + vh.y * vh.y;
+  Vec3 t1 = lensq > 0 ? Vec3{-vh.y, vh.x, 0} / std::sqrt(lensq) : Vec3{1, 0, 0};
+  Vec3 t2 = cross(vh, t1);
+  float r = std::sqrt(u1);
+  float phi = 2.0f * kPi * u2;
+  float p1 = r * std::cos(phi);
+  float p2 = r * std::sin(phi);
+  float s = 0.5f * (1.0f + vh.z);
+  p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
+  Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
+  return normalize(Vec3{alpha * nh.x, alpha * nh.y, std::max(0.0f, nh.z)});
+}
+
+inline Vec3 reflect(const Vec3& wo, const Vec3& n) { return n * (2.0f * dot(wo, n)) - wo; }
+
+inline Vec3 abs3(const Vec3& v) { return {std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}; }
+
+/// Starting ray and power of one path. Returns false if the emitter sample
+/// is rejected (spot falloff), which ends the path with no photon.
+struct EmittedRay {
+  Vec3 origin, direction, power;
+  bool punctual = false;
+  float range = 0;
+};
+
+inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
+  const Scene& scene = *ctx.scene;
+  double pick = double(rng.uniform()) * ctx.emitterCdf.back();
+  size_t k = size_t(std::upper_bound(ctx.emitterCdf.begin(), ctx.emitterCdf.end(), pick) -
+                    ctx.emitterCdf.begin());
+  k = std::min(k, ctx.emitters.size() - 1);
+  const Emitter& e = ctx.emitters[k];
+  out.power = e.pathPower;
+  out.punctual = false;
+  out.range = 0;
+  switch (e.kind) {
+    case Emitter::Kind::Point: {
+      const Light& light = scene.lights[e.index];
+      out.origin = light.position;
+      float u1 = rng.uniform(), u2 = rng.uniform();
+      out.direction = uniformSphere(u1, u2);
+      out.punctual = true;
+      out.range = light.range;
+      return true;
+    }
+    case Emitter::Kind::Spot: {
+      const Light& light = scene.lights[e.index];
+      float cosOuter = std::cos(light.outerConeAngle);
+      float cosInner = std::max(cosOuter, std::cos(light.innerConeAngle));
+      float u1 = rng.uniform(), u2 = rng.uniform();
+      Vec3 local = uniformCone(u1, u2, cosOuter);
+      // Rejection against the falloff keeps every photon's power equal: the
+      // path carries the full-cone power (Light::power), the accepted
+      // fraction brings the expectation down to spotPower.
+      if (rng.uniform() >= spotFalloff(local.z, cosInner, cosOuter)) return false;
+      Vec3 n = normalize(light.direction), t, b;
+      orthonormalBasis(n, t, b);
+      out.origin = light.position;
+      out.direction = normalize(fromLocal(local, t, b, n));
+      out.punctual = true;
+      out.range = light.range;
+      return true;
+    }
+    case Emitter::Kind::Directional: {
+      const Light& light = scene.lights[e.index];
+      // A disc of the bounding sphere's radius (the same disc Light::power
+      // uses), perpendicular to the light, placed outside the bounds.
+      float radius = 0.5f * length(ctx.bounds.extent());
+      Vec3 n = normalize(light.direction), t, b;
+      orthonormalBasis(n, t, b);
+      float r = radius * std::sqrt(rng.uniform());
+      float phi = 2.0f * kPi * rng.uniform();
+      out.origin = ctx.bounds.center() - n * (radius + 4.0f * ctx.epsilon) +
+                   t * (r * std::cos(phi)) + b * (r * std::sin(phi));
+      out.direction = n;
+      return true;
+    }
+    case Emitter::Kind::Triangle: {
+      size_t tri = e.index;
+      const Vec3& p0 = scene.positions[scene.indices[3 * tri]];
+      const Vec3& p1 = scene.positions[scene.indices[3 * tri + 1]];
+      const Vec3& p2 = scene.positions[scene.indices[3 * tri + 2]];
+      float s = std::sqrt(rng.uniform());
+      float b1 = 1.0f - s, b2 = rng.uniform() * s;
+      Vec3 p = p0 + (p1 - p0) * b1 + (p2 - p0) * b2;
+      Vec3 n = ctx.triangles[tri].normal;
+      // One-sided emitters emit on the side of the winding normal;
+      // double-sided ones pick a side (their power counts both).
+      if (ctx.scene->materials[ctx.triangles[tri].material].doubleSided && rng.uniform() < 0.5f)
+        n = -n;
+      Vec3 t, b;
+      orthonormalBasis(n, t, b);
+      float u1 = rng.uniform(), u2 = rng.uniform();
+      out.direction = normalize(fromLocal(cosineHemisphere(u1, u2), t, b, n));
+      out.origin = p + n * ctx.epsilon;
+      return true;
+    }
+  }
+  return false;
+}
+
+inline void setRay(RTCRayHit& rh, const Vec3& org, const Vec3& dir) {
+  rh.ray.org_x = org.x;
+  rh.ray.org_y = org.y;
+  rh.ray.org_z = org.z;
+  rh.ray.tnear = 0.0f;
+  rh.ray.dir_x = dir.x;
+  rh.ray.dir_y = dir.y;
+  rh.ray.dir_z = dir.z;
+  rh.ray.time = 0.0f;
+  rh.ray.tfar = std::numeric_limits<float>::infinity();
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+/// Russian roulette on the tint of one scattering event: survive with
+/// probability min(1, max(tint)) and divide by it, so the expected power
+/// after the event is exactly power * tint. Returns false if the path ends.
+inline bool roulette(Rng& rng, const Vec3& tint, Vec3& power) {
+  float q = std::min(1.0f, maxComponent(tint));
+  if (!(q > 0)) return false;
+  if (q < 1.0f && rng.uniform() >= q) return false;
+  power *= tint / q;
+  return true;
+}
+
+/// Traces path `pathIndex` and appends its stored photons (unscaled power) to `out`.
+inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon>& out,
+                      uint32_t& photonCount, uint32_t& rayCount) {
+  Rng rng(ctx.seed, pathIndex);
+  photonCount = 0;
+  rayCount = 0;
+  EmittedRay start;
+  if (!emit(ctx, rng, start)) return;
+  Vec3 org = start.origin, dir = start.direction, power = start.power;
+
+  RTCIntersectContext ictx;
+  rtcInitIntersectContext(&ictx);
+  RTCRayHit rh;
+  for (uint32_t bounce = 0;; ++bounce) {
+    setRay(rh, org, dir);
+    rtcIntersect1(ctx.rtcScene, &ictx, &rh);
+    ++rayCount;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return;
+
+    float t = rh.ray.tfar;
+    // glTF range cut-off of punctual lights, applied as roulette at the first hit.
+    if (bounce == 0 && start.punctual && start.range > 0 &&
+        rng.uniform() >= rangeWindow(t, start.range))
+      return;
+    // From the ray parameter rather than the barycentrics: exactly coincident
+    // triangles give the same t whichever of them Embree reports.
+    Vec3 p = org + dir * t;
+    const TriangleInfo& tri = ctx.triangles[rh.hit.primID];
+    const MaterialInfo& mat = ctx.materials[tri.material];
+    bool frontFace = dot(dir, tri.normal) < 0;
+    Vec3 n = frontFace ? tri.normal : -tri.normal;  // faces the incoming side
+    Vec3 wo = -dir;
+
+    if (mat.storesPhotons && (bounce > 0 || ctx.includeDirect)) {
+      Photon ph;
+      ph.position = p;
+      ph.direction = wo;
+      ph.power = power;
+      ph.normal = n;
+      ph.bounce = bounce;
+      out.push_back(ph);
+      ++photonCount;
+    }
+    if (int(bounce) >= ctx.maxBounces) return;
+
+    Vec3 albedo = ctx.scene->albedo(rh.hit.primID, rh.hit.u, rh.hit.v);
+    Vec3 tint;
+    Vec3 newDir;
+    float lobe = rng.uniform();
+    if (lobe < mat.transmissionWeight) {
+      // Smooth dielectric: reflect with the Fresnel probability, else refract.
+      // Flux needs no eta^2 factor (that applies to radiance).
+      float n1 = frontFace ? 1.0f : mat.ior, n2 = frontFace ? mat.ior : 1.0f;
+      float cosI = std::min(1.0f, dot(wo, n)), cosT = 0;
+      float f = fresnelDielectric(cosI, n1, n2, cosT);
+      if (rng.uniform() < f) {
+        newDir = reflect(wo, n);
+        tint = Vec3{1, 1, 1};
+      } else {
+        float eta = n1 / n2;
+        newDir = -wo * eta + n * (eta * cosI - cosT);
+        tint = albedo;  // KHR_materials_transmission tints transmitted light by baseColor
+      }
+    } else if (lobe < mat.transmissionWeight + mat.metalWeight) {
+      // Metal: GGX reflection, Schlick Fresnel with F0 = baseColor.
+      if (mat.alpha < kMirrorAlpha) {
+        newDir = reflect(wo, n);
+        float c = 1.0f - std::max(0.0f, dot(wo, n));
+        tint = albedo + (Vec3{1, 1, 1} - albedo) * (c * c * c * c * c);
+      } else {
+        Vec3 tt, bb;
+        orthonormalBasis(n, tt, bb);
+        Vec3 woLocal{dot(wo, tt), dot(wo, bb), std::max(1e-6f, dot(wo, n))};
+        float u1 = rng.uniform(), u2 = rng.uniform();
+        Vec3 m = sampleGgxVisibleNormal(woLocal, mat.alpha, u1, u2);
+        Vec3 wiLocal = reflect(woLocal, m);
+        if (wiLocal.z <= 0) return;  // below the surface: the lobe's energy loss
+        float c = 1.0f - std::max(0.0f, dot(woLocal, m));
+        Vec3 fresnel = albedo + (Vec3{1, 1, 1} - albedo) * (c * c * c * c * c);
+        // f cos / pdf of VNDF sampling = F * G2 / G1(wo) (height-correlated Smith).
+        float lo = smithLambda(woLocal, mat.alpha), li = smithLambda(wiLocal, mat.alpha);
+        tint = fresnel * ((1.0f + lo) / (1.0f + lo + li));
+        newDir = fromLocal(wiLocal, tt, bb, n);
+      }
+    } else {
+      Vec3 tt, bb;
+      orthonormalBasis(n, tt, bb);
+      float u1 = rng.uniform(), u2 = rng.uniform();
+      newDir = fromLocal(cosineHemisphere(u1, u2), tt, bb, n);
+      tint = albedo;
+    }
+    if (!roulette(rng, tint, power)) return;
+    dir = normalize(newDir);
+    if (lengthSquared(dir) == 0) return;
+    // Offset to the side the new ray leaves on (refraction crosses over).
+    org = p + (dot(dir, tri.normal) > 0 ? tri.normal : -tri.normal) * ctx.epsilon;
+  }
+}
+
+/// Fills the emitter table; throws if the scene emits nothing.
+inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
+  totalPower = Vec3{0, 0, 0};
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& light = scene.lights[i];
+    Emitter e;
+    e.index = uint32_t(i);
+    switch (light.type) {
+      case Light::Type::Point:
+        e.kind = Emitter::Kind::Point;
+        e.power = light.power(ctx.bounds);
+        break;
+      case Light::Type::Spot:
+        e.kind = Emitter::Kind::Spot;
+        e.power = spotPower(light);
+        e.samplePower = light.power(ctx.bounds);
+        break;
+      case Light::Type::Directional:
+        e.kind = Emitter::Kind::Directional;
+        e.power = light.power(ctx.bounds);
+        break;
+    }
+    if (light.type != Light::Type::Spot) e.samplePower = e.power;
+    if (!isFinite(e.samplePower))
+      throw InputError("light " + std::to_string(i) + " '" + light.name +
+                       "' has non-finite power " + e.samplePower.ToString());
+    if (average(e.power) > 0) ctx.emitters.push_back(e);
+  }
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const Material& m = scene.materials[ctx.triangles[t].material];
+    if (!m.isEmissive()) continue;
+    // Lambertian emitter of radiance L: flux pi L A per emitting side.
+    float sides = m.doubleSided ? 2.0f : 1.0f;
+    Emitter e;
+    e.kind = Emitter::Kind::Triangle;
+    e.index = uint32_t(t);
+    e.power = m.emission * (sides * kPi * scene.triangleArea(t));
+    e.samplePower = e.power;
+    if (!isFinite(e.power))
+      throw InputError("material '" + m.name + "' of triangle " + std::to_string(t) +
+                       " emits non-finite power " + e.power.ToString());
+    if (average(e.power) > 0) ctx.emitters.push_back(e);
+  }
+  double total = 0;
+  ctx.emitterCdf.reserve(ctx.emitters.size());
+  for (const Emitter& e : ctx.emitters) {
+    total += double(average(e.samplePower));
+    ctx.emitterCdf.push_back(total);
+    totalPower += e.power;
+  }
+  if (ctx.emitters.empty() || !(total > 0)) {
+    std::ostringstream os;
+    os << "scene has no light with positive power (" << scene.lights.size()
+       << " punctual lights, no emissive triangle with positive emission) in '" << scene.sourcePath
+       << "'";
+    throw InputError(os.str());
+  }
+  for (Emitter& e : ctx.emitters) {
+    double pickProb = double(average(e.samplePower)) / total;
+    e.pathPower = e.samplePower * float(1.0 / pickProb);
+  }
+}
+
+/// TBB body: traces the chunks [r.begin(), r.end()) of a batch.
+struct TraceChunks {
+  const Context* ctx;
+  std::vector<ChunkResult>* chunks;
+  uint64_t firstPath;
+  size_t batchPaths;
+
+  void operator()(const tbb::blocked_range<size_t>& r) const {
+    for (size_t c = r.begin(); c != r.end(); ++c) {
+      ChunkResult& out = (*chunks)[c];
+      out.photons.clear();
+      out.pathPhotons.clear();
+      out.pathRays.clear();
+      size_t begin = c * kChunkPaths, end = std::min(batchPaths, begin + kChunkPaths);
+      for (size_t i = begin; i < end; ++i) {
+        uint32_t photons = 0, rays = 0;
+        tracePath(*ctx, firstPath + i, out.photons, photons, rays);
+        out.pathPhotons.push_back(photons);
+        out.pathRays.push_back(rays);
+      }
+    }
+  }
+};
+
+}  // namespace photon_internal
+
+PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressSink* progress) {
+  using namespace photon_internal;
+  if (params.maxBounces < 0)
+    throw InputError("PhotonParams.maxBounces must be >= 0, got " +
+                     std::to_string(params.maxBounces));
+  LO_CHECK_EQ(scene.indices.size() % 3, size_t(0));
+  LO_CHECK_EQ(scene.triangleMaterial.size(), scene.triangleCount());
+
+  Context ctx;
+  ctx.scene = &scene;
+  ctx.bounds = scene.bounds();
+  ctx.maxBounces = params.maxBounces;
+  ctx.includeDirect = params.includeDirect;
+  ctx.seed = params.seed;
+
+  ctx.triangles.resize(scene.triangleCount());
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    int32_t m = scene.triangleMaterial[t];
+    if (m < 0 || size_t(m) >= scene.materials.size())
+      throw InputError("triangle " + std::to_string(t) + " has material index " +
+                       std::to_string(m) + " outside [0, " +
+                       std::to_string(scene.materials.size()) + ")");
+    ctx.triangles[t].normal = scene.faceNormal(t);
+    ctx.triangles[t].material = uint32_t(m);
+  }
+  ctx.materials.resize(scene.materials.size());
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    MaterialInfo& info = ctx.materials[i];
+    float metallic = std::clamp(m.metallic, 0.0f, 1.0f);
+    float transmission = std::clamp(m.transmission, 0.0f, 1.0f);
+    float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+    info.metalWeight = metallic;
+    info.transmissionWeight = (1.0f - metallic) * transmission;
+    float diffuseWeight = (1.0f - metallic) * (1.0f - transmission);
+    info.alpha = roughness * roughness;
+    info.ior = m.ior > 0 ? m.ior : 1.5f;
+    info.storesPhotons = diffuseWeight > 0 || (metallic > 0 && roughness > kGlossyRoughness);
+  }
+
+  PhotonMap map;
+  buildEmitters(scene, ctx, map.emittedPower);
+  if (params.storedPhotons == 0 || scene.triangleCount() == 0) return map;
+
+  Vec3 ext = ctx.bounds.extent();
+  float scale = length(ext) + maxComponent(max(abs3(ctx.bounds.lower), abs3(ctx.bounds.upper)));
+  ctx.epsilon = kRayEpsilonScale * std::max(scale, 1e-6f);
+
+  EmbreeScene embree(scene);
+  ctx.rtcScene = embree.scene();
+
+  const size_t target = params.storedPhotons;
+  const size_t maxEmitted = params.maxEmitted ? params.maxEmitted : 64 * target;
+  Progress bar(progress, "Tracing photons", target);
+  map.photons.reserve(target);
+
+  std::vector<ChunkResult> chunks;
+  size_t emitted = 0;  // paths whose photons are in map.photons
+  size_t rays = 0;
+  bool done = false;
+  size_t batch = std::min(maxEmitted, std::clamp(target, kMinBatchPaths, size_t(65536)));
+  while (!done && emitted < maxEmitted) {
+    size_t nChunks = (batch + kChunkPaths - 1) / kChunkPaths;
+    if (chunks.size() < nChunks) chunks.resize(nChunks);
+    TraceChunks body{&ctx, &chunks, uint64_t(emitted), batch};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nChunks, 1), body, tbb::simple_partitioner());
+
+    // Concatenate in path order; stop inside the path that reaches the target.
+    size_t before = map.photons.size();
+    for (size_t c = 0; c < nChunks && !done; ++c) {
+      const ChunkResult& chunk = chunks[c];
+      size_t offset = 0;
+      for (size_t i = 0; i < chunk.pathPhotons.size(); ++i) {
+        size_t take = std::min<size_t>(chunk.pathPhotons[i], target - map.photons.size());
+        map.photons.insert(map.photons.end(), chunk.photons.begin() + offset,
+                           chunk.photons.begin() + offset + take);
+        offset += chunk.pathPhotons[i];
+        rays += chunk.pathRays[i];
+        ++emitted;
+        if (map.photons.size() == target) {
+          done = true;
+          break;
+        }
+      }
+    }
+    bar.advance(map.photons.size() - before);
+
+    // Next batch: the paths the photons-per-path ratio so far says are still
+    // needed, plus a margin. Only the amount of wasted work depends on it.
+    size_t have = map.photons.size();
+    size_t need = have > 0 ? size_t(double(target - have) * double(emitted) / double(have) * 1.1)
+                           : 4 * emitted;
+    batch = std::min(maxEmitted - emitted, std::clamp(need, kMinBatchPaths, kMaxBatchPaths));
+  }
+
+  map.emittedPaths = emitted;
+  map.raysTraced = rays;
+  float invPaths = emitted > 0 ? float(1.0 / double(emitted)) : 0.0f;
+  for (Photon& ph : map.photons) ph.power *= invPaths;
+  return map;
+}
+
+}  // namespace lo

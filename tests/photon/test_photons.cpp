@@ -1,0 +1,448 @@
+// Photon tracing: analytic energy balances, determinism, light sampling.
+//
+// Tolerances are derived from the number of emitted paths: the per-path
+// contribution of a bounce (or of the whole path) is a known discrete random
+// variable, so its mean over N paths has a computable standard error; the
+// checks allow 4 standard errors plus float slack and the at-most-one-path
+// bias of truncating the last path.
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "../test_util.h"
+#include "core/error.h"
+#include "photon/photon_map.h"
+
+namespace lo {
+namespace {
+
+using test::addClosedBox;
+using test::addQuad;
+
+struct Dvec3 {
+  double v[3] = {0, 0, 0};
+  void add(const Vec3& p) {
+    v[0] += p.x;
+    v[1] += p.y;
+    v[2] += p.z;
+  }
+};
+
+int addMaterial(Scene& scene, const Vec3& baseColor) {
+  Material m;
+  m.baseColor = baseColor;
+  m.name = "m" + std::to_string(scene.materials.size());
+  scene.materials.push_back(m);
+  return int(scene.materials.size()) - 1;
+}
+
+Light pointLight(const Vec3& position, const Vec3& color, float intensity) {
+  Light l;
+  l.type = Light::Type::Point;
+  l.position = position;
+  l.color = color;
+  l.intensity = intensity;
+  return l;
+}
+
+/// Closed cube [-1, 1]^3 of albedo `albedo`, point light in the centre.
+Scene litBox(const Vec3& albedo, const Vec3& lightColor, float intensity) {
+  Scene scene;
+  int m = addMaterial(scene, albedo);
+  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, m);
+  scene.lights.push_back(pointLight({0, 0, 0}, lightColor, intensity));
+  return scene;
+}
+
+/// Six outward-facing quads: a closed solid [lo, hi]^3.
+void addSolidBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material) {
+  Vec3 d = hi - lo;
+  Vec3 ex{d.x, 0, 0}, ey{0, d.y, 0}, ez{0, 0, d.z};
+  addQuad(scene, lo, ex, ez, {0, -1, 0}, material);
+  addQuad(scene, lo + ey, ex, ez, {0, 1, 0}, material);
+  addQuad(scene, lo, ey, ez, {-1, 0, 0}, material);
+  addQuad(scene, lo + ex, ey, ez, {1, 0, 0}, material);
+  addQuad(scene, lo, ex, ey, {0, 0, -1}, material);
+  addQuad(scene, lo + ez, ex, ey, {0, 0, 1}, material);
+}
+
+std::vector<Dvec3> powerPerBounce(const PhotonMap& map, int maxBounces) {
+  std::vector<Dvec3> sums(size_t(maxBounces) + 1);
+  for (const Photon& p : map.photons) {
+    EXPECT_LE(p.bounce, uint32_t(maxBounces));
+    if (p.bounce <= uint32_t(maxBounces)) sums[p.bounce].add(p.power);
+  }
+  return sums;
+}
+
+/// Per path, the stored power in one channel is phi * r^n at each of L hits,
+/// n = 0..L-1, with r = a / q, survival q = min(1, max albedo), P(L > l) = q^l,
+/// L <= K + 1. Returns the mean and the standard error over `paths` paths.
+void pathTotalStats(double phi, double a, double q, int maxBounces, size_t paths, double& mean,
+                    double& stdErr) {
+  double r = a / q, e1 = 0, e2 = 0;
+  for (int l = 1; l <= maxBounces + 1; ++l) {
+    double pL = std::pow(q, l - 1) * (l <= maxBounces ? 1.0 - q : 1.0);
+    double total = 0;
+    for (int n = 0; n < l; ++n) total += phi * std::pow(r, n);
+    e1 += pL * total;
+    e2 += pL * total * total;
+  }
+  mean = e1;
+  stdErr = std::sqrt(std::max(0.0, e2 - e1 * e1) / double(paths));
+}
+
+void checkClosedBoxEnergy(const Vec3& albedo) {
+  const float intensity = 2.0f;
+  const Vec3 color{1.0f, 0.7f, 0.4f};
+  Scene scene = litBox(albedo, color, intensity);
+  PhotonParams params;
+  params.storedPhotons = 200000;
+  params.includeDirect = true;
+  params.maxBounces = 16;
+  params.seed = 7;
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  const size_t n = map.emittedPaths;
+  const int k = params.maxBounces;
+  std::vector<Dvec3> sums = powerPerBounce(map, k);
+  const double q = std::min(1.0f, maxComponent(albedo));
+  Dvec3 total;
+  for (const Photon& p : map.photons) total.add(p.power);
+  for (int c = 0; c < 3; ++c) {
+    const double phi = 4.0 * M_PI * intensity * color[c];
+    EXPECT_NEAR(map.emittedPower[c], phi, 1e-4 * phi);
+    // Truncating the last path drops at most (K + 1) photons of <= phi / N each.
+    const double slack = (k + 1) * phi / double(n) + 1e-4 * phi;
+    const double a = albedo[c], r = a / q;
+    for (int b = 0; b <= k; ++b) {
+      double expected = phi * std::pow(a, b);
+      double pb = std::pow(q, b);
+      double stdErr = phi * std::pow(r, b) * std::sqrt(pb * (1.0 - pb) / double(n));
+      EXPECT_NEAR(sums[size_t(b)].v[c], expected, 4.0 * stdErr + slack)
+          << "channel " << c << " bounce " << b << " albedo " << albedo.ToString();
+    }
+    double mean = 0, stdErr = 0;
+    pathTotalStats(phi, a, q, k, n, mean, stdErr);
+    // The closed form phi (1 - a^(K+1)) / (1 - a) is what the test means by
+    // "phi / (1 - a)" with the path length cap applied.
+    ASSERT_NEAR(mean, phi * (1.0 - std::pow(a, k + 1)) / (1.0 - a), 1e-9 * phi);
+    EXPECT_NEAR(total.v[c], mean, 4.0 * stdErr + slack)
+        << "channel " << c << " albedo " << albedo.ToString();
+  }
+}
+
+TEST(Photons, ClosedBoxEnergyGrey) { checkClosedBoxEnergy({0.5f, 0.5f, 0.5f}); }
+
+TEST(Photons, ClosedBoxEnergyColoured) { checkClosedBoxEnergy({0.8f, 0.5f, 0.2f}); }
+
+TEST(Photons, EmissiveQuadEmitsPiLA) {
+  Scene scene;
+  int wall = addMaterial(scene, {0.5f, 0.5f, 0.5f});
+  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
+  int lamp = addMaterial(scene, {0.5f, 0.5f, 0.5f});
+  const Vec3 radiance{1.0f, 2.0f, 3.0f};
+  scene.materials[size_t(lamp)].emission = radiance;
+  // 0.5 x 0.4 quad below the ceiling, emitting downwards only.
+  addQuad(scene, {-0.25f, 0.9f, -0.2f}, {0.5f, 0, 0}, {0, 0, 0.4f}, {0, -1, 0}, lamp);
+  const double area = 0.5 * 0.4;
+
+  PhotonParams params;
+  params.storedPhotons = 50000;
+  params.includeDirect = true;
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  std::vector<Dvec3> sums = powerPerBounce(map, params.maxBounces);
+  for (int c = 0; c < 3; ++c) {
+    double phi = M_PI * radiance[c] * area;
+    EXPECT_NEAR(map.emittedPower[c], phi, 1e-4 * phi);
+    // Every path hits the box with the same power: only truncation and float error.
+    double slack = (params.maxBounces + 1) * phi / double(map.emittedPaths) + 1e-4 * phi;
+    EXPECT_NEAR(sums[0].v[c], phi, slack) << "channel " << c;
+  }
+  for (const Photon& p : map.photons) {
+    if (p.bounce != 0) continue;
+    ASSERT_LT(p.position.y, 0.9f) << "a one-sided emitter lit its back side";
+  }
+}
+
+TEST(Photons, MixedLightsAreUnbiasedPerChannel) {
+  // Two emitters with different spectra: selection by average power must still
+  // give each channel's total emitted power.
+  Scene scene;
+  int wall = addMaterial(scene, {0.3f, 0.3f, 0.3f});
+  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
+  int lamp = addMaterial(scene, {0.3f, 0.3f, 0.3f});
+  scene.materials[size_t(lamp)].emission = {0.2f, 0.5f, 4.0f};
+  addQuad(scene, {-0.3f, 0.95f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, {0, -1, 0}, lamp);
+  scene.lights.push_back(pointLight({0.2f, -0.3f, 0.1f}, {1.0f, 0.3f, 0.05f}, 0.4f));
+
+  PhotonParams params;
+  params.storedPhotons = 100000;
+  params.includeDirect = true;
+  params.seed = 3;
+  PhotonMap map = tracePhotons(scene, params);
+  std::vector<Dvec3> sums = powerPerBounce(map, params.maxBounces);
+  const size_t n = map.emittedPaths;
+  Vec3 phiQuad = scene.materials[size_t(lamp)].emission * float(M_PI * 0.36);
+  Vec3 phiPoint = scene.lights[0].color * float(4.0 * M_PI * 0.4);
+  double wq = average(phiQuad), wp = average(phiPoint);
+  double pq = wq / (wq + wp), pp = wp / (wq + wp);
+  for (int c = 0; c < 3; ++c) {
+    double expected = phiQuad[c] + phiPoint[c];
+    double xq = phiQuad[c] / pq, xp = phiPoint[c] / pp;
+    double var = pq * xq * xq + pp * xp * xp - expected * expected;
+    double stdErr = std::sqrt(std::max(0.0, var) / double(n));
+    double slack = std::max(xq, xp) / double(n) + 1e-4 * expected;
+    EXPECT_NEAR(sums[0].v[c], expected, 4.0 * stdErr + slack) << "channel " << c;
+  }
+}
+
+/// A scene with every lobe: diffuse, rough metal, mirror, glass.
+Scene mixedScene() {
+  Scene scene;
+  int wall = addMaterial(scene, {0.7f, 0.6f, 0.5f});
+  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
+  int metal = addMaterial(scene, {0.9f, 0.7f, 0.3f});
+  scene.materials[size_t(metal)].metallic = 1.0f;
+  scene.materials[size_t(metal)].roughness = 0.4f;
+  addSolidBox(scene, {-0.8f, -1.0f, -0.8f}, {-0.3f, -0.4f, -0.3f}, metal);
+  int mirror = addMaterial(scene, {0.95f, 0.95f, 0.95f});
+  scene.materials[size_t(mirror)].metallic = 1.0f;
+  scene.materials[size_t(mirror)].roughness = 0.0f;
+  addQuad(scene, {0.99f, -0.5f, -0.5f}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, mirror);
+  int glass = addMaterial(scene, {1, 1, 1});
+  scene.materials[size_t(glass)].transmission = 1.0f;
+  addSolidBox(scene, {0.2f, -1.0f, 0.2f}, {0.7f, -0.2f, 0.7f}, glass);
+  // A single-sided panel lit directly on its front and indirectly on its back.
+  int panel = addMaterial(scene, {0.6f, 0.6f, 0.6f});
+  addQuad(scene, {-0.2f, 0.0f, -0.5f}, {0, 0.6f, 0}, {0, 0, 1}, {1, 0, 0}, panel);
+  scene.lights.push_back(pointLight({0, 0.8f, 0}, {1, 1, 1}, 1.0f));
+  return scene;
+}
+
+PhotonMap traceWithThreads(const Scene& scene, const PhotonParams& params, int threads) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+  return tracePhotons(scene, params);
+}
+
+TEST(Photons, DeterministicAcrossThreadCounts) {
+  Scene scene = mixedScene();
+  PhotonParams params;
+  params.storedPhotons = 150000;  // several batches
+  params.seed = 11;
+  PhotonMap ref = traceWithThreads(scene, params, 1);
+  ASSERT_EQ(ref.photons.size(), params.storedPhotons);
+  for (int threads : {2, 4}) {
+    PhotonMap map = traceWithThreads(scene, params, threads);
+    EXPECT_EQ(map.emittedPaths, ref.emittedPaths) << threads << " threads";
+    EXPECT_EQ(map.raysTraced, ref.raysTraced) << threads << " threads";
+    ASSERT_EQ(map.photons.size(), ref.photons.size()) << threads << " threads";
+    EXPECT_EQ(
+        std::memcmp(map.photons.data(), ref.photons.data(), ref.photons.size() * sizeof(Photon)), 0)
+        << threads << " threads";
+  }
+  params.seed = 12;
+  PhotonMap other = traceWithThreads(scene, params, 2);
+  ASSERT_EQ(other.photons.size(), ref.photons.size());
+  EXPECT_NE(
+      std::memcmp(other.photons.data(), ref.photons.data(), ref.photons.size() * sizeof(Photon)),
+      0);
+}
+
+TEST(Photons, StoresExactCount) {
+  Scene scene = mixedScene();
+  for (size_t count : {size_t(1), size_t(777), size_t(12345)}) {
+    PhotonParams params;
+    params.storedPhotons = count;
+    PhotonMap map = tracePhotons(scene, params);
+    EXPECT_EQ(map.photons.size(), count);
+    EXPECT_GT(map.emittedPaths, 0u);
+    EXPECT_GE(map.raysTraced, map.emittedPaths);
+  }
+}
+
+TEST(Photons, MaxEmittedCapsPathsWhenLightMissesGeometry) {
+  // A small floor far from a point light: most paths leave the scene.
+  Scene scene;
+  int floor = addMaterial(scene, {0.5f, 0.5f, 0.5f});
+  addQuad(scene, {-0.1f, 0, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, {0, 1, 0}, floor);
+  scene.lights.push_back(pointLight({0, 10, 0}, {1, 1, 1}, 1));
+  PhotonParams params;
+  params.storedPhotons = 1000;
+  params.includeDirect = true;
+  params.maxEmitted = 5000;
+  PhotonMap map = tracePhotons(scene, params);
+  EXPECT_EQ(map.emittedPaths, params.maxEmitted);
+  EXPECT_LT(map.photons.size(), params.storedPhotons);
+  EXPECT_EQ(map.raysTraced, map.emittedPaths);  // one ray per path, nothing to bounce to
+}
+
+TEST(Photons, ExcludesDirectByDefault) {
+  Scene scene = mixedScene();
+  PhotonParams params;
+  params.storedPhotons = 20000;
+  ASSERT_FALSE(params.includeDirect);
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  size_t direct = 0;
+  for (const Photon& p : map.photons) direct += p.bounce == 0;
+  EXPECT_EQ(direct, 0u);
+
+  params.includeDirect = true;
+  map = tracePhotons(scene, params);
+  direct = 0;
+  for (const Photon& p : map.photons) direct += p.bounce == 0;
+  EXPECT_GT(direct, 0u);  // the check above can fail
+}
+
+TEST(Photons, NormalFacesDirectionAndDirectionIsUnit) {
+  Scene scene = mixedScene();
+  PhotonParams params;
+  params.storedPhotons = 30000;
+  params.includeDirect = true;
+  PhotonMap map = tracePhotons(scene, params);
+  size_t backOfPanel = 0;
+  for (const Photon& p : map.photons) {
+    ASSERT_NEAR(length(p.direction), 1.0f, 1e-4f);
+    ASSERT_NEAR(length(p.normal), 1.0f, 1e-4f);
+    ASSERT_GT(dot(p.normal, p.direction), 0.0f)
+        << "normal " << p.normal.ToString() << " direction " << p.direction.ToString();
+    ASSERT_TRUE(isFinite(p.power) && isFinite(p.position));
+    ASSERT_GE(std::min({p.power.x, p.power.y, p.power.z}), 0.0f);
+    backOfPanel += std::fabs(p.position.x + 0.2f) < 1e-4f && p.normal.x < 0;
+  }
+  EXPECT_GT(backOfPanel, 0u);  // the normal check above met a back face
+}
+
+TEST(Photons, GlassStoresNothingAndConservesEnergy) {
+  // Grey closed box with a glass slab below the light: glass only redirects,
+  // so the stored total is the same as without it, phi (1 - a^(K+1)) / (1 - a).
+  const float a = 0.5f;
+  Scene scene = litBox({a, a, a}, {1, 1, 1}, 1.0f);
+  int glass = addMaterial(scene, {1, 1, 1});
+  scene.materials[size_t(glass)].transmission = 1.0f;
+  scene.materials[size_t(glass)].ior = 1.5f;
+  const Vec3 slabLo{-0.8f, -0.4f, -0.8f}, slabHi{0.8f, -0.2f, 0.8f};
+  addSolidBox(scene, slabLo, slabHi, glass);
+
+  PhotonParams params;
+  params.storedPhotons = 200000;
+  params.includeDirect = true;
+  params.maxBounces = 64;
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  double total = 0, floorThroughGlass = 0;
+  for (const Photon& p : map.photons) {
+    bool onSlab = p.position.x > slabLo.x - 1e-3f && p.position.x < slabHi.x + 1e-3f &&
+                  p.position.y > slabLo.y - 1e-3f && p.position.y < slabHi.y + 1e-3f &&
+                  p.position.z > slabLo.z - 1e-3f && p.position.z < slabHi.z + 1e-3f;
+    ASSERT_FALSE(onSlab) << "photon stored on glass at " << p.position.ToString();
+    total += p.power.x;
+    // Refracted in and out: reached the floor under the slab through it.
+    if (p.bounce == 2 && p.position.y < -0.99f && std::fabs(p.position.x) < 0.5f &&
+        std::fabs(p.position.z) < 0.5f)
+      floorThroughGlass += p.power.x;
+  }
+  const double phi = 4.0 * M_PI;
+  double mean = 0, stdErr = 0;
+  pathTotalStats(phi, a, a, params.maxBounces, map.emittedPaths, mean, stdErr);
+  double slack = (params.maxBounces + 1) * phi / double(map.emittedPaths) + 1e-4 * phi;
+  EXPECT_NEAR(total, mean, 4.0 * stdErr + slack);
+  // The floor patch under the slab subtends a solid angle fraction
+  // 1/4 * (1 - 1/sqrt(1 + 2 * ...)) > 2%; most of it passes (T ~ 0.92^2).
+  EXPECT_GT(floorThroughGlass, 0.02 * phi);
+}
+
+TEST(Photons, NoLightThrows) {
+  Scene scene;
+  int m = addMaterial(scene, {0.5f, 0.5f, 0.5f});
+  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, m);
+  PhotonParams params;
+  params.storedPhotons = 100;
+  EXPECT_THROW(tracePhotons(scene, params), InputError);
+  scene.lights.push_back(pointLight({0, 0, 0}, {1, 1, 1}, 0.0f));  // zero power
+  EXPECT_THROW(tracePhotons(scene, params), InputError);
+  scene.lights[0].intensity = 1.0f;
+  EXPECT_NO_THROW(tracePhotons(scene, params));
+}
+
+TEST(Photons, SpotPhotonsStayInsideConeWithFalloffPower) {
+  Scene scene;
+  int m = addMaterial(scene, {0.5f, 0.5f, 0.5f});
+  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, m);
+  Light spot;
+  spot.type = Light::Type::Spot;
+  spot.position = {0.1f, 0.9f, -0.2f};
+  spot.direction = normalize(Vec3{0.3f, -1.0f, 0.2f});
+  spot.intensity = 3.0f;
+  spot.innerConeAngle = 0.15f;
+  spot.outerConeAngle = 0.4f;
+  scene.lights.push_back(spot);
+
+  PhotonParams params;
+  params.storedPhotons = 60000;
+  params.includeDirect = true;
+  PhotonMap map = tracePhotons(scene, params);
+  double direct = 0;
+  size_t count = 0;
+  for (const Photon& p : map.photons) {
+    if (p.bounce != 0) continue;
+    ++count;
+    direct += p.power.x;
+    float cosAngle = dot(normalize(p.position - spot.position), spot.direction);
+    ASSERT_GE(cosAngle, std::cos(spot.outerConeAngle) - 1e-4f) << p.position.ToString();
+  }
+  ASSERT_GT(count, 1000u);
+  // glTF falloff ((cos - cosO) / (cosI - cosO))^2 integrated over the cone.
+  double cosO = std::cos(spot.outerConeAngle), cosI = std::cos(spot.innerConeAngle);
+  double expected = 2.0 * M_PI * spot.intensity * ((1.0 - cosI) + (cosI - cosO) / 3.0);
+  double full = 2.0 * M_PI * spot.intensity * (1.0 - cosO);  // per accepted path
+  double accept = expected / full;
+  double stdErr = full * std::sqrt(accept * (1.0 - accept) / double(map.emittedPaths));
+  EXPECT_NEAR(direct, expected, 4.0 * stdErr + full * 17.0 / double(map.emittedPaths));
+  EXPECT_NEAR(map.emittedPower.x, expected, 1e-4 * expected);
+}
+
+TEST(Photons, DirectionalLightFluxThroughFloor) {
+  // A black floor facing a directional light: irradiance E over area A.
+  Scene scene;
+  int floor = addMaterial(scene, {0, 0, 0});
+  addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, floor);
+  Light sun;
+  sun.type = Light::Type::Directional;
+  sun.direction = {0, -1, 0};
+  sun.intensity = 2.5f;  // W/m^2
+  scene.lights.push_back(sun);
+
+  PhotonParams params;
+  params.storedPhotons = 40000;
+  params.includeDirect = true;
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  double sum = 0;
+  for (const Photon& p : map.photons) {
+    ASSERT_EQ(p.bounce, 0u);
+    ASSERT_NEAR(p.direction.y, 1.0f, 1e-6f);
+    sum += p.power.x;
+  }
+  double radius = 0.5 * std::sqrt(8.0);  // bounding sphere of the 2 x 2 floor
+  double full = sun.intensity * M_PI * radius * radius;
+  double hit = 4.0 / (M_PI * radius * radius);
+  double stdErr = full * std::sqrt(hit * (1.0 - hit) / double(map.emittedPaths));
+  EXPECT_NEAR(sum, sun.intensity * 4.0, 4.0 * stdErr + full / double(map.emittedPaths));
+}
+
+TEST(Photons, RejectsNegativeMaxBounces) {
+  Scene scene = litBox({0.5f, 0.5f, 0.5f}, {1, 1, 1}, 1.0f);
+  PhotonParams params;
+  params.maxBounces = -1;
+  EXPECT_THROW(tracePhotons(scene, params), InputError);
+}
+
+}  // namespace
+}  // namespace lo
