@@ -1,1 +1,942 @@
-// placeholder: implemented in the stage's work
+/// @file scene/load_gltf.cpp
+/// @brief glTF 2.0 (.gltf/.glb) loader on top of tinygltf.
+///
+/// tinygltf parses; this file distrusts everything it returns. Before tinygltf
+/// sees the file, external uris are confined to the scene's folder and buffer
+/// views are checked against their buffers (tinygltf 2.7 indexes a buffer with
+/// an unchecked bufferView when it decodes embedded images). After parsing,
+/// every accessor is checked to fit its bufferView and buffer, and every index
+/// to be below the vertex count, before a byte is read.
+
+#define TINYGLTF_IMPLEMENTATION
+#define STB_IMAGE_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#include <tiny_gltf.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "scene/scene_internal.h"
+
+namespace lo::scene_internal {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------
+// 4x4 transforms, column-major like glTF (m[col * 4 + row]), in double so that
+// deep hierarchies do not accumulate float error.
+struct Mat4 {
+  std::array<double, 16> m{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+  double& at(int row, int col) { return m[size_t(col * 4 + row)]; }
+  double at(int row, int col) const { return m[size_t(col * 4 + row)]; }
+
+  Mat4 operator*(const Mat4& b) const {
+    Mat4 r;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) {
+        double s = 0;
+        for (int k = 0; k < 4; ++k) s += at(i, k) * b.at(k, j);
+        r.at(i, j) = s;
+      }
+    return r;
+  }
+  Vec3 point(const Vec3& p) const {
+    double x = at(0, 0) * p.x + at(0, 1) * p.y + at(0, 2) * p.z + at(0, 3);
+    double y = at(1, 0) * p.x + at(1, 1) * p.y + at(1, 2) * p.z + at(1, 3);
+    double z = at(2, 0) * p.x + at(2, 1) * p.y + at(2, 2) * p.z + at(2, 3);
+    return {float(x), float(y), float(z)};
+  }
+  Vec3 vector(const Vec3& v) const {
+    double x = at(0, 0) * v.x + at(0, 1) * v.y + at(0, 2) * v.z;
+    double y = at(1, 0) * v.x + at(1, 1) * v.y + at(1, 2) * v.z;
+    double z = at(2, 0) * v.x + at(2, 1) * v.y + at(2, 2) * v.z;
+    return {float(x), float(y), float(z)};
+  }
+  double det3() const {
+    return at(0, 0) * (at(1, 1) * at(2, 2) - at(1, 2) * at(2, 1)) -
+           at(0, 1) * (at(1, 0) * at(2, 2) - at(1, 2) * at(2, 0)) +
+           at(0, 2) * (at(1, 0) * at(2, 1) - at(1, 1) * at(2, 0));
+  }
+  /// Inverse transpose of the upper 3x3 (normals), up to the positive factor
+  /// |det|: the cofactor matrix times sign(det). Normals are renormalized after.
+  Mat4 normalMatrix() const {
+    Mat4 r;
+    double s = det3() < 0 ? -1.0 : 1.0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+        r.at(i, j) = s * (at(i1, j1) * at(i2, j2) - at(i1, j2) * at(i2, j1));
+      }
+    return r;
+  }
+};
+
+Mat4 nodeLocalTransform(const tinygltf::Node& node) {
+  Mat4 r;
+  if (node.matrix.size() == 16) {
+    for (size_t i = 0; i < 16; ++i) r.m[i] = node.matrix[i];
+    return r;
+  }
+  Mat4 t, rot, s;
+  if (node.translation.size() == 3) {
+    t.at(0, 3) = node.translation[0];
+    t.at(1, 3) = node.translation[1];
+    t.at(2, 3) = node.translation[2];
+  }
+  if (node.rotation.size() == 4) {
+    double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2], w = node.rotation[3];
+    double n = std::sqrt(x * x + y * y + z * z + w * w);
+    if (n > 0) x /= n, y /= n, z /= n, w /= n;
+    rot.at(0, 0) = 1 - 2 * (y * y + z * z);
+    rot.at(0, 1) = 2 * (x * y - z * w);
+    rot.at(0, 2) = 2 * (x * z + y * w);
+    rot.at(1, 0) = 2 * (x * y + z * w);
+    rot.at(1, 1) = 1 - 2 * (x * x + z * z);
+    rot.at(1, 2) = 2 * (y * z - x * w);
+    rot.at(2, 0) = 2 * (x * z - y * w);
+    rot.at(2, 1) = 2 * (y * z + x * w);
+    rot.at(2, 2) = 1 - 2 * (x * x + y * y);
+  }
+  if (node.scale.size() == 3) {
+    s.at(0, 0) = node.scale[0];
+    s.at(1, 1) = node.scale[1];
+    s.at(2, 2) = node.scale[2];
+  }
+  return t * rot * s;
+}
+
+// ---------------------------------------------------------------------------
+// tinygltf callbacks.
+
+/// Keeps the encoded bytes; images are decoded later, and only those a
+/// material uses, so that the error names the problem precisely.
+bool storeEncodedImage(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                       const unsigned char* bytes, int size, void*) {
+  image->image.assign(bytes, bytes + size);
+  image->width = image->height = image->component = image->bits = -1;
+  image->as_is = true;
+  return true;
+}
+
+struct FsContext {
+  fs::path canonicalBase;
+};
+
+bool insideBase(const std::string& file, const FsContext& ctx) {
+  std::error_code ec;
+  fs::path canon = fs::weakly_canonical(file, ec);
+  if (ec) return false;
+  auto b = ctx.canonicalBase.begin(), f = canon.begin();
+  for (; b != ctx.canonicalBase.end() && f != canon.end(); ++b, ++f) {
+    if (b->empty()) continue;
+    if (*b != *f) return false;
+  }
+  return b == ctx.canonicalBase.end();
+}
+
+// Defence in depth: the uris were checked before parsing; these refuse any
+// other file too (tinygltf also looks for external files in the current
+// directory, which must not happen).
+bool fsFileExists(const std::string& file, void* user) {
+  std::error_code ec;
+  return insideBase(file, *static_cast<FsContext*>(user)) && fs::is_regular_file(file, ec);
+}
+std::string fsExpandFilePath(const std::string& file, void*) { return file; }
+bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& file,
+                     void* user) {
+  if (!fsFileExists(file, user)) {
+    if (err) *err += "refused or missing file '" + file + "'";
+    return false;
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    if (err) *err += "cannot open '" + file + "'";
+    return false;
+  }
+  out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return !in.bad();
+}
+bool fsWriteWholeFile(std::string* err, const std::string&, const std::vector<unsigned char>&,
+                      void*) {
+  if (err) *err += "the scene loader never writes files";
+  return false;
+}
+
+// ---------------------------------------------------------------------------
+// Checks on the raw JSON, before tinygltf dereferences anything.
+
+bool isDataUri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
+
+uint64_t jsonUInt(const nlohmann::json& o, const char* key, uint64_t fallback) {
+  auto it = o.find(key);
+  if (it == o.end() || !it->is_number_unsigned()) return fallback;
+  return it->get<uint64_t>();
+}
+
+void prevalidateJson(const std::string& path, const std::string& baseDir, const nlohmann::json& j) {
+  if (!j.is_object()) fail(path, "invalid glTF: the top level is not a JSON object");
+  std::vector<uint64_t> bufferLengths;
+  auto buffers = j.find("buffers");
+  if (buffers != j.end() && buffers->is_array()) {
+    for (size_t i = 0; i < buffers->size(); ++i) {
+      const nlohmann::json& b = (*buffers)[i];
+      if (!b.is_object()) fail(path, "buffer " + std::to_string(i) + " is not an object");
+      bufferLengths.push_back(jsonUInt(b, "byteLength", 0));
+      auto uri = b.find("uri");
+      if (uri == b.end() || !uri->is_string()) continue;
+      std::string u = uri->get<std::string>();
+      if (isDataUri(u)) continue;
+      std::string what = "buffer " + std::to_string(i);
+      std::string file = resolveInsideFolder(path, baseDir, percentDecode(u), what);
+      std::error_code ec;
+      if (!fs::is_regular_file(file, ec)) {
+        fail(path, "missing buffer file '" + u + "' (" + what + ", not found)");
+      }
+    }
+  }
+  std::vector<char> viewOk;
+  auto views = j.find("bufferViews");
+  if (views != j.end() && views->is_array()) {
+    for (size_t i = 0; i < views->size(); ++i) {
+      const nlohmann::json& v = (*views)[i];
+      if (!v.is_object()) fail(path, "bufferView " + std::to_string(i) + " is not an object");
+      uint64_t buffer = jsonUInt(v, "buffer", std::numeric_limits<uint64_t>::max());
+      if (buffer >= bufferLengths.size()) {
+        fail(path, "bufferView " + std::to_string(i) + " refers to a buffer index out of range");
+      }
+      uint64_t offset = jsonUInt(v, "byteOffset", 0), length = jsonUInt(v, "byteLength", 0);
+      if (offset > bufferLengths[buffer] || length > bufferLengths[buffer] - offset) {
+        fail(path, "bufferView " + std::to_string(i) + " (offset " + std::to_string(offset) +
+                       ", length " + std::to_string(length) + ") is out of range of buffer " +
+                       std::to_string(buffer) + " (" + std::to_string(bufferLengths[buffer]) +
+                       " bytes)");
+      }
+    }
+  }
+  size_t viewCount = views != j.end() && views->is_array() ? views->size() : 0;
+  auto images = j.find("images");
+  if (images != j.end() && images->is_array()) {
+    for (size_t i = 0; i < images->size(); ++i) {
+      const nlohmann::json& im = (*images)[i];
+      if (!im.is_object()) fail(path, "image " + std::to_string(i) + " is not an object");
+      std::string what = "image " + std::to_string(i);
+      auto bv = im.find("bufferView");
+      if (bv != im.end() && !(bv->is_number_unsigned() && bv->get<uint64_t>() < viewCount)) {
+        fail(path, what + " refers to a bufferView index out of range");
+      }
+      auto uri = im.find("uri");
+      if (uri == im.end() || !uri->is_string()) continue;
+      std::string u = uri->get<std::string>();
+      if (isDataUri(u)) continue;
+      std::string file = resolveInsideFolder(path, baseDir, percentDecode(u), what);
+      std::error_code ec;
+      if (!fs::is_regular_file(file, ec)) {
+        fail(path, "unreadable image: missing image file '" + u + "' (" + what + ", not found)");
+      }
+    }
+  }
+}
+
+uint32_t readU32(const unsigned char* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+
+/// Checks the GLB container (https://registry.khronos.org/glTF/specs/2.0/
+/// glTF-2.0.html#binary-gltf-layout) and returns the JSON chunk.
+std::string glbJson(const std::string& path, const std::vector<unsigned char>& bytes) {
+  if (bytes.size() < 20) {
+    fail(path, "truncated .glb: " + std::to_string(bytes.size()) + " bytes, header needs 20");
+  }
+  if (std::memcmp(bytes.data(), "glTF", 4) != 0) fail(path, "not a .glb file (bad magic)");
+  uint32_t version = readU32(&bytes[4]), length = readU32(&bytes[8]);
+  if (version != 2) fail(path, "unsupported .glb version " + std::to_string(version));
+  if (length > bytes.size()) {
+    fail(path, "truncated .glb: header says " + std::to_string(length) + " bytes, file has " +
+                   std::to_string(bytes.size()));
+  }
+  uint64_t jsonLength = readU32(&bytes[12]);
+  if (readU32(&bytes[16]) != 0x4E4F534Au) fail(path, "invalid .glb: first chunk is not JSON");
+  if (20 + jsonLength > length) {
+    fail(path, "truncated .glb: JSON chunk of " + std::to_string(jsonLength) +
+                   " bytes does not fit in the file");
+  }
+  uint64_t binStart = 20 + jsonLength;
+  if (binStart + 8 <= length) {
+    uint64_t binLength = readU32(&bytes[binStart]);
+    if (binStart + 8 + binLength > length) {
+      fail(path, "truncated .glb: BIN chunk of " + std::to_string(binLength) +
+                     " bytes does not fit in the file");
+    }
+  }
+  return std::string(reinterpret_cast<const char*>(&bytes[20]), size_t(jsonLength));
+}
+
+std::string firstLine(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  size_t nl = s.find('\n');
+  return nl == std::string::npos ? s : s.substr(0, nl) + " (...)";
+}
+
+// ---------------------------------------------------------------------------
+// Accessors.
+
+class GltfReader {
+ public:
+  GltfReader(const std::string& path, const tinygltf::Model& model) : path_(path), model_(model) {}
+
+  /// Reads accessor `index` as doubles, count * components values, with the
+  /// normalization of integer types applied. `type` is the required
+  /// TINYGLTF_TYPE_*; `what` names the use in error messages.
+  std::vector<double> read(int index, int type, const std::string& what) const {
+    if (index < 0 || size_t(index) >= model_.accessors.size()) {
+      fail(path_, what + ": accessor index " + std::to_string(index) + " out of range (" +
+                      std::to_string(model_.accessors.size()) + " accessors)");
+    }
+    const tinygltf::Accessor& acc = model_.accessors[size_t(index)];
+    std::string name = what + " (accessor " + std::to_string(index) + ")";
+    if (acc.type != type) fail(path_, name + " has the wrong type " + std::to_string(acc.type));
+    int comps = tinygltf::GetNumComponentsInType(uint32_t(type));
+    int csize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
+    if (comps <= 0 || csize <= 0) {
+      fail(path_, name + " has an invalid component type " + std::to_string(acc.componentType));
+    }
+    if (acc.count > (size_t(1) << 28)) {
+      fail(path_, name + " count " + std::to_string(acc.count) + " is out of range");
+    }
+    std::vector<double> out(acc.count * size_t(comps), 0.0);
+    size_t elemSize = size_t(comps) * size_t(csize);
+    if (acc.bufferView >= 0) {
+      const unsigned char* data = viewData(acc.bufferView, name);
+      const tinygltf::BufferView& bv = model_.bufferViews[size_t(acc.bufferView)];
+      size_t stride = bv.byteStride ? bv.byteStride : elemSize;
+      if (stride < elemSize) {
+        fail(path_, name + ": byteStride " + std::to_string(stride) +
+                        " is smaller than the element size " + std::to_string(elemSize));
+      }
+      if (acc.count > 0) {
+        uint64_t end = uint64_t(acc.byteOffset) + uint64_t(stride) * (acc.count - 1) + elemSize;
+        if (end > bv.byteLength) {
+          fail(path_, name + " is out of range of its bufferView " +
+                          std::to_string(acc.bufferView) + " (needs " + std::to_string(end) +
+                          " bytes, view has " + std::to_string(bv.byteLength) + ")");
+        }
+      }
+      for (size_t e = 0; e < acc.count; ++e)
+        for (int c = 0; c < comps; ++c)
+          out[e * size_t(comps) + size_t(c)] =
+              component(data + acc.byteOffset + e * stride + size_t(c) * size_t(csize),
+                        acc.componentType, acc.normalized);
+    } else if (!acc.sparse.isSparse) {
+      fail(path_, name + " has neither a bufferView nor sparse values");
+    }
+    if (acc.sparse.isSparse) readSparse(acc, comps, csize, name, out);
+    return out;
+  }
+
+  /// Reads an index accessor (SCALAR of unsigned byte/short/int).
+  std::vector<uint32_t> readIndices(int index, const std::string& what) const {
+    if (index >= 0 && size_t(index) < model_.accessors.size()) {
+      int ct = model_.accessors[size_t(index)].componentType;
+      if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+          ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+          ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+        fail(path_, what + " (accessor " + std::to_string(index) +
+                        ") must hold unsigned integers, has component type " + std::to_string(ct));
+      }
+    }
+    std::vector<double> v = read(index, TINYGLTF_TYPE_SCALAR, what);
+    std::vector<uint32_t> out(v.size());
+    for (size_t i = 0; i < v.size(); ++i) out[i] = uint32_t(v[i]);
+    return out;
+  }
+
+  size_t count(int index) const {
+    return index >= 0 && size_t(index) < model_.accessors.size()
+               ? model_.accessors[size_t(index)].count
+               : 0;
+  }
+
+ private:
+  const unsigned char* viewData(int view, const std::string& name) const {
+    if (view < 0 || size_t(view) >= model_.bufferViews.size()) {
+      fail(path_, name + ": bufferView index " + std::to_string(view) + " out of range");
+    }
+    const tinygltf::BufferView& bv = model_.bufferViews[size_t(view)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size()) {
+      fail(path_, name + ": buffer index " + std::to_string(bv.buffer) + " out of range");
+    }
+    const tinygltf::Buffer& buf = model_.buffers[size_t(bv.buffer)];
+    if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset) {
+      fail(path_, name + ": bufferView " + std::to_string(view) + " is out of range of buffer " +
+                      std::to_string(bv.buffer) + " (missing buffer data?)");
+    }
+    return buf.data.data() + bv.byteOffset;
+  }
+
+  void readSparse(const tinygltf::Accessor& acc, int comps, int csize, const std::string& name,
+                  std::vector<double>& out) const {
+    if (acc.sparse.count < 0 || size_t(acc.sparse.count) > acc.count) {
+      fail(path_, name + ": sparse count out of range");
+    }
+    size_t n = size_t(acc.sparse.count);
+    int ict = acc.sparse.indices.componentType;
+    int isize = tinygltf::GetComponentSizeInBytes(uint32_t(ict));
+    if (isize <= 0 || ict == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+      fail(path_, name + ": invalid sparse index component type");
+    }
+    auto fits = [&](int view, int offset, size_t bytes) {
+      if (offset < 0) fail(path_, name + ": negative sparse byteOffset");
+      const unsigned char* d = viewData(view, name + " sparse");
+      if (uint64_t(offset) + bytes > model_.bufferViews[size_t(view)].byteLength) {
+        fail(path_, name + ": sparse data out of range of bufferView " + std::to_string(view));
+      }
+      return d + offset;
+    };
+    const unsigned char* idx =
+        fits(acc.sparse.indices.bufferView, acc.sparse.indices.byteOffset, n * size_t(isize));
+    size_t elemSize = size_t(comps) * size_t(csize);
+    const unsigned char* val =
+        fits(acc.sparse.values.bufferView, acc.sparse.values.byteOffset, n * elemSize);
+    for (size_t s = 0; s < n; ++s) {
+      double target = component(idx + s * size_t(isize), ict, false);
+      if (target < 0 || target >= double(acc.count)) {
+        fail(path_, name + ": sparse index " + std::to_string(uint64_t(target)) +
+                        " out of range (count " + std::to_string(acc.count) + ")");
+      }
+      for (int c = 0; c < comps; ++c)
+        out[size_t(target) * size_t(comps) + size_t(c)] = component(
+            val + s * elemSize + size_t(c) * size_t(csize), acc.componentType, acc.normalized);
+    }
+  }
+
+  template <typename T>
+  static T load(const unsigned char* p) {
+    T v;
+    std::memcpy(&v, p, sizeof(T));
+    return v;
+  }
+
+  /// glTF 2.0 spec, "Animations / normalized integers": c / (2^(n-1) - 1)
+  /// clamped at -1 for signed, c / (2^n - 1) for unsigned.
+  static double component(const unsigned char* p, int type, bool normalized) {
+    switch (type) {
+      case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        double v = load<int8_t>(p);
+        return normalized ? std::max(v / 127.0, -1.0) : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+        double v = load<uint8_t>(p);
+        return normalized ? v / 255.0 : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        double v = load<int16_t>(p);
+        return normalized ? std::max(v / 32767.0, -1.0) : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        double v = load<uint16_t>(p);
+        return normalized ? v / 65535.0 : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_INT:
+        return double(load<int32_t>(p));
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        return double(load<uint32_t>(p));
+      case TINYGLTF_COMPONENT_TYPE_FLOAT:
+        return double(load<float>(p));
+      case TINYGLTF_COMPONENT_TYPE_DOUBLE:
+        return load<double>(p);
+      default:
+        return 0.0;
+    }
+  }
+
+  const std::string& path_;
+  const tinygltf::Model& model_;
+};
+
+// ---------------------------------------------------------------------------
+// Scene assembly.
+
+double numberExt(const tinygltf::ExtensionMap& ext, const char* name, const char* key,
+                 double fallback) {
+  auto it = ext.find(name);
+  if (it == ext.end() || !it->second.IsObject() || !it->second.Has(key)) return fallback;
+  const tinygltf::Value& v = it->second.Get(key);
+  return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
+}
+
+Vec3 vec3From(const std::vector<double>& v, const Vec3& fallback) {
+  if (v.size() < 3) return fallback;
+  return {float(v[0]), float(v[1]), float(v[2])};
+}
+
+class SceneBuilder {
+ public:
+  SceneBuilder(const std::string& path, const tinygltf::Model& model)
+      : path_(path), model_(model), reader_(path, model) {}
+
+  Scene build() {
+    convertMaterials();
+    traverse();
+    finishVertexAttributes();
+    return std::move(scene_);
+  }
+
+ private:
+  struct Pending {
+    std::vector<Vec3> positions, normals;
+    std::vector<float> uv0, uv1;
+    bool hasNormals = false, hasUv0 = false, hasUv1 = false;
+  };
+
+  void convertMaterials() {
+    for (size_t i = 0; i < model_.materials.size(); ++i) {
+      const tinygltf::Material& g = model_.materials[i];
+      Material m;
+      m.name = g.name.empty() ? "material" + std::to_string(i) : g.name;
+      const auto& pbr = g.pbrMetallicRoughness;
+      m.baseColor = vec3From(pbr.baseColorFactor, Vec3{1, 1, 1});
+      m.metallic = float(pbr.metallicFactor);
+      m.roughness = float(pbr.roughnessFactor);
+      float strength = float(
+          numberExt(g.extensions, "KHR_materials_emissive_strength", "emissiveStrength", 1.0));
+      m.emission = vec3From(g.emissiveFactor, Vec3{0, 0, 0}) * strength;
+      m.transmission =
+          float(numberExt(g.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0));
+      m.ior = float(numberExt(g.extensions, "KHR_materials_ior", "ior", 1.5));
+      m.doubleSided = g.doubleSided;
+      if (!isFinite(m.baseColor) || !isFinite(m.emission) || !std::isfinite(m.metallic) ||
+          !std::isfinite(m.roughness) || !std::isfinite(m.transmission) || !std::isfinite(m.ior)) {
+        fail(path_, "material " + std::to_string(i) + " has a non-finite factor");
+      }
+      int tex = pbr.baseColorTexture.index;
+      if (tex >= 0) {
+        if (size_t(tex) >= model_.textures.size()) {
+          fail(path_, "material " + std::to_string(i) + ": texture index " + std::to_string(tex) +
+                          " out of range");
+        }
+        int texCoord = pbr.baseColorTexture.texCoord;
+        if (texCoord == 0 || texCoord == 1) {
+          m.baseColorTexture = textureFromImage(model_.textures[size_t(tex)].source, tex);
+          m.baseColorTexCoord = texCoord;
+        }  // other UV sets are not loaded: the factor alone is used
+      }
+      scene_.materials.push_back(std::move(m));
+    }
+  }
+
+  int textureFromImage(int source, int tex) {
+    std::string what =
+        "(texture " + std::to_string(tex) + ", image " + std::to_string(source) + ")";
+    if (source < 0 || size_t(source) >= model_.images.size()) {
+      fail(path_, "unreadable image: image index out of range " + what);
+    }
+    if (!model_.images[size_t(source)].uri.empty()) {
+      what = "'" + model_.images[size_t(source)].uri + "' " + what;
+    }
+    auto it = imageToTexture_.find(source);
+    if (it != imageToTexture_.end()) return it->second;
+    const tinygltf::Image& im = model_.images[size_t(source)];
+    if (im.image.empty()) fail(path_, "unreadable image: no data " + what);
+    Texture t = decodeImage(path_, im.image.data(), im.image.size(), what);
+    t.name =
+        im.name.empty() ? (im.uri.empty() ? "image" + std::to_string(source) : im.uri) : im.name;
+    int index = int(scene_.textures.size());
+    scene_.textures.push_back(std::move(t));
+    imageToTexture_[source] = index;
+    return index;
+  }
+
+  int defaultMaterial() {
+    if (defaultMaterial_ < 0) {
+      defaultMaterial_ = int(scene_.materials.size());
+      Material m;
+      m.name = "default";
+      scene_.materials.push_back(m);
+    }
+    return defaultMaterial_;
+  }
+
+  std::vector<int> sceneRoots() const {
+    const auto& scenes = model_.scenes;
+    int s = model_.defaultScene;
+    if (s >= int(scenes.size())) fail(path_, "default scene index out of range");
+    if (s < 0 && !scenes.empty()) s = 0;
+    if (s >= 0) return scenes[size_t(s)].nodes;
+    // No scenes: every node that is nobody's child is a root.
+    std::vector<char> isChild(model_.nodes.size(), 0);
+    for (const auto& n : model_.nodes)
+      for (int c : n.children)
+        if (c >= 0 && size_t(c) < isChild.size()) isChild[size_t(c)] = 1;
+    std::vector<int> roots;
+    for (size_t i = 0; i < model_.nodes.size(); ++i)
+      if (!isChild[i]) roots.push_back(int(i));
+    return roots;
+  }
+
+  void traverse() {
+    struct Item {
+      int node;
+      Mat4 parent;
+      size_t depth;
+    };
+    std::vector<Item> stack;
+    std::vector<int> roots = sceneRoots();
+    for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.push_back({*r, Mat4{}, 0});
+    size_t visits = 0;
+    while (!stack.empty()) {
+      Item item = stack.back();
+      stack.pop_back();
+      if (item.node < 0 || size_t(item.node) >= model_.nodes.size()) {
+        fail(path_, "node index " + std::to_string(item.node) + " out of range");
+      }
+      // A valid glTF node tree visits each node once; a cycle or a shared
+      // child would never end or multiply the geometry.
+      if (item.depth > model_.nodes.size() || ++visits > model_.nodes.size()) {
+        fail(path_, "the node hierarchy is not a tree (cycle or shared node " +
+                        std::to_string(item.node) + ")");
+      }
+      const tinygltf::Node& node = model_.nodes[size_t(item.node)];
+      Mat4 world = item.parent * nodeLocalTransform(node);
+      for (double v : world.m)
+        if (!std::isfinite(v))
+          fail(path_, "node " + std::to_string(item.node) + " has a non-finite transform");
+      if (node.mesh >= 0) addMesh(node.mesh, world);
+      if (node.camera >= 0) addCamera(node, item.node, world);
+      auto ext = node.extensions.find("KHR_lights_punctual");
+      if (ext != node.extensions.end() && ext->second.IsObject() && ext->second.Has("light")) {
+        const tinygltf::Value& l = ext->second.Get("light");
+        if (!l.IsInt())
+          fail(path_, "node " + std::to_string(item.node) + ": light is not an index");
+        addLight(node, item.node, l.Get<int>(), world);
+      }
+      for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
+        stack.push_back({*c, world, item.depth + 1});
+    }
+  }
+
+  void addCamera(const tinygltf::Node& node, int nodeIndex, const Mat4& world) {
+    if (size_t(node.camera) >= model_.cameras.size()) {
+      fail(path_, "node " + std::to_string(nodeIndex) + ": camera index out of range");
+    }
+    const tinygltf::Camera& g = model_.cameras[size_t(node.camera)];
+    if (g.type != "perspective") return;  // orthographic cameras are skipped (docs/scene.md)
+    Camera c;
+    c.name = !node.name.empty() ? node.name
+                                : (!g.name.empty() ? g.name : "camera" + std::to_string(nodeIndex));
+    c.position = world.point({0, 0, 0});
+    c.forward = normalize(world.vector({0, 0, -1}));
+    Vec3 up = world.vector({0, 1, 0});
+    c.up = normalize(up - c.forward * dot(up, c.forward));
+    c.yfov = float(g.perspective.yfov);
+    c.aspectRatio = float(g.perspective.aspectRatio);
+    c.znear = float(g.perspective.znear);
+    c.zfar = float(g.perspective.zfar);
+    if (!(c.yfov > 0 && c.yfov < kPi) || lengthSquared(c.forward) == 0) {
+      fail(path_,
+           "camera on node " + std::to_string(nodeIndex) + " has an invalid yfov or transform");
+    }
+    scene_.cameras.push_back(c);
+  }
+
+  void addLight(const tinygltf::Node& node, int nodeIndex, int lightIndex, const Mat4& world) {
+    if (lightIndex < 0 || size_t(lightIndex) >= model_.lights.size()) {
+      fail(path_, "node " + std::to_string(nodeIndex) + ": light index " +
+                      std::to_string(lightIndex) + " out of range");
+    }
+    const tinygltf::Light& g = model_.lights[size_t(lightIndex)];
+    Light l;
+    if (g.type == "point")
+      l.type = Light::Type::Point;
+    else if (g.type == "spot")
+      l.type = Light::Type::Spot;
+    else if (g.type == "directional")
+      l.type = Light::Type::Directional;
+    else
+      fail(path_, "light " + std::to_string(lightIndex) + " has unknown type '" + g.type + "'");
+    l.name = !node.name.empty() ? node.name
+                                : (!g.name.empty() ? g.name : "light" + std::to_string(lightIndex));
+    l.position = world.point({0, 0, 0});
+    l.direction = normalize(world.vector({0, 0, -1}));
+    l.color = vec3From(g.color, Vec3{1, 1, 1});
+    l.intensity = float(g.intensity);
+    l.range = float(g.range);
+    l.innerConeAngle = float(g.spot.innerConeAngle);
+    l.outerConeAngle = float(g.spot.outerConeAngle);
+    if (!isFinite(l.color) || !std::isfinite(l.intensity) || !std::isfinite(l.range) ||
+        !isFinite(l.position) || lengthSquared(l.direction) == 0) {
+      fail(path_, "light " + std::to_string(lightIndex) + " has a non-finite value or transform");
+    }
+    scene_.lights.push_back(l);
+  }
+
+  void addMesh(int meshIndex, const Mat4& world) {
+    if (size_t(meshIndex) >= model_.meshes.size()) {
+      fail(path_, "mesh index " + std::to_string(meshIndex) + " out of range");
+    }
+    const tinygltf::Mesh& mesh = model_.meshes[size_t(meshIndex)];
+    Mat4 normalMatrix = world.normalMatrix();
+    bool flip = world.det3() < 0;
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+      const tinygltf::Primitive& prim = mesh.primitives[p];
+      std::string what = "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(p);
+      int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+      if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+          mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+        static const char* names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+        std::string name = mode >= 0 && mode < 4 ? names[mode] : std::to_string(mode);
+        fail(path_, what + ": unsupported primitive mode " + name + " (only triangles are loaded)");
+      }
+      auto attr = [&](const char* key) {
+        auto it = prim.attributes.find(key);
+        return it == prim.attributes.end() ? -1 : it->second;
+      };
+      int posAcc = attr("POSITION");
+      if (posAcc < 0) fail(path_, what + " has no POSITION attribute");
+      std::vector<double> pos = reader_.read(posAcc, TINYGLTF_TYPE_VEC3, what + " POSITION");
+      size_t nverts = pos.size() / 3;
+      auto readSameCount = [&](int acc, int type, const char* key) {
+        std::vector<double> v = reader_.read(acc, type, what + " " + key);
+        if (reader_.count(acc) != nverts) {
+          fail(path_, what + ": " + key + " has " + std::to_string(reader_.count(acc)) +
+                          " elements, POSITION has " + std::to_string(nverts));
+        }
+        return v;
+      };
+      std::vector<double> nrm, uv0, uv1;
+      if (attr("NORMAL") >= 0) nrm = readSameCount(attr("NORMAL"), TINYGLTF_TYPE_VEC3, "NORMAL");
+      if (attr("TEXCOORD_0") >= 0)
+        uv0 = readSameCount(attr("TEXCOORD_0"), TINYGLTF_TYPE_VEC2, "TEXCOORD_0");
+      if (attr("TEXCOORD_1") >= 0)
+        uv1 = readSameCount(attr("TEXCOORD_1"), TINYGLTF_TYPE_VEC2, "TEXCOORD_1");
+
+      std::vector<uint32_t> idx;
+      if (prim.indices >= 0) {
+        idx = reader_.readIndices(prim.indices, what + " indices");
+        for (uint32_t i : idx)
+          if (i >= nverts) {
+            fail(path_, what + ": vertex index " + std::to_string(i) + " out of range (" +
+                            std::to_string(nverts) + " vertices)");
+          }
+      } else {
+        idx.resize(nverts);
+        for (size_t i = 0; i < nverts; ++i) idx[i] = uint32_t(i);
+      }
+      std::vector<std::array<uint32_t, 3>> tris = triangulate(idx, mode);
+
+      int material = prim.material;
+      if (material < 0)
+        material = defaultMaterial();
+      else if (size_t(material) >= model_.materials.size())
+        fail(path_, what + ": material index " + std::to_string(material) + " out of range");
+
+      uint32_t base = uint32_t(scene_.positions.size());
+      if (uint64_t(base) + nverts > std::numeric_limits<uint32_t>::max()) {
+        fail(path_, "too many vertices for 32-bit indices");
+      }
+      for (size_t v = 0; v < nverts; ++v) {
+        Vec3 pw = world.point({float(pos[3 * v]), float(pos[3 * v + 1]), float(pos[3 * v + 2])});
+        if (!isFinite(pw)) {
+          fail(path_, what + ": non-finite vertex position (vertex " + std::to_string(v) + ")");
+        }
+        scene_.positions.push_back(pw);
+      }
+      // Normals / UV sets present on some primitives only: fill the others.
+      appendNormals(nrm, normalMatrix, nverts, base, tris, flip);
+      appendUv(scene_.texcoords0, hasUv0_, uv0, nverts, base);
+      appendUv(scene_.texcoords1, hasUv1_, uv1, nverts, base);
+
+      for (auto& t : tris) {
+        if (flip) std::swap(t[1], t[2]);
+        for (uint32_t i : t) scene_.indices.push_back(base + i);
+        scene_.triangleMaterial.push_back(material);
+      }
+    }
+  }
+
+  /// Triangle list from TRIANGLES / TRIANGLE_STRIP / TRIANGLE_FAN (glTF 2.0
+  /// spec 3.7.2.1); triangles with a repeated index (strip restarts) dropped.
+  static std::vector<std::array<uint32_t, 3>> triangulate(const std::vector<uint32_t>& idx,
+                                                          int mode) {
+    std::vector<std::array<uint32_t, 3>> tris;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      for (size_t i = 0; i + 2 < idx.size(); i += 3)
+        tris.push_back({idx[i], idx[i + 1], idx[i + 2]});
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      for (size_t i = 0; i + 2 < idx.size(); ++i) {
+        if (i % 2 == 0)
+          tris.push_back({idx[i], idx[i + 1], idx[i + 2]});
+        else
+          tris.push_back({idx[i + 1], idx[i], idx[i + 2]});
+      }
+    } else {
+      for (size_t i = 1; i + 1 < idx.size(); ++i) tris.push_back({idx[i], idx[i + 1], idx[0]});
+    }
+    std::vector<std::array<uint32_t, 3>> kept;
+    kept.reserve(tris.size());
+    for (const auto& t : tris)
+      if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) kept.push_back(t);
+    return kept;
+  }
+
+  void appendNormals(const std::vector<double>& nrm, const Mat4& normalMatrix, size_t nverts,
+                     uint32_t base, const std::vector<std::array<uint32_t, 3>>& tris, bool flip) {
+    if (nrm.empty() && !hasNormals_) {
+      return;  // still no normals anywhere: Scene::normals stays empty
+    }
+    if (!hasNormals_) {
+      // The first primitive with normals: earlier primitives get their
+      // (area-weighted) vertex normals from their faces.
+      hasNormals_ = true;
+      scene_.normals.assign(base, Vec3{});
+      for (size_t t = 0; t < scene_.triangleCount(); ++t) {
+        Vec3 n = cross(
+            scene_.positions[scene_.indices[3 * t + 1]] - scene_.positions[scene_.indices[3 * t]],
+            scene_.positions[scene_.indices[3 * t + 2]] - scene_.positions[scene_.indices[3 * t]]);
+        for (int k = 0; k < 3; ++k) scene_.normals[scene_.indices[3 * t + size_t(k)]] += n;
+      }
+      for (Vec3& n : scene_.normals) n = normalize(n);
+    }
+    if (!nrm.empty()) {
+      for (size_t v = 0; v < nverts; ++v) {
+        Vec3 n = normalize(
+            normalMatrix.vector({float(nrm[3 * v]), float(nrm[3 * v + 1]), float(nrm[3 * v + 2])}));
+        if (!isFinite(n)) fail(path_, "non-finite vertex normal");
+        scene_.normals.push_back(n);
+      }
+    } else {
+      std::vector<Vec3> acc(nverts, Vec3{});
+      for (const auto& t : tris) {
+        const Vec3& a = scene_.positions[base + t[0]];
+        Vec3 n = cross(scene_.positions[base + t[1]] - a, scene_.positions[base + t[2]] - a);
+        if (flip) n = -n;
+        for (uint32_t i : t) acc[i] += n;
+      }
+      for (const Vec3& n : acc) scene_.normals.push_back(normalize(n));
+    }
+  }
+
+  void appendUv(std::vector<float>& dst, bool& has, const std::vector<double>& uv, size_t nverts,
+                uint32_t base) {
+    if (uv.empty() && !has) return;
+    if (!has) {
+      has = true;
+      dst.assign(2 * size_t(base), 0.0f);
+    }
+    if (uv.empty()) {
+      dst.resize(dst.size() + 2 * nverts, 0.0f);
+    } else {
+      for (double x : uv) {
+        if (!std::isfinite(x)) fail(path_, "non-finite texture coordinate");
+        dst.push_back(float(x));
+      }
+    }
+  }
+
+  void finishVertexAttributes() {
+    LO_CHECK(!hasNormals_ || scene_.normals.size() == scene_.positions.size());
+  }
+
+  const std::string& path_;
+  const tinygltf::Model& model_;
+  GltfReader reader_;
+  Scene scene_;
+  std::map<int, int> imageToTexture_;
+  int defaultMaterial_ = -1;
+  bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false;
+};
+
+}  // namespace
+
+Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
+                    const std::string& what) {
+  if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
+    fail(scenePath, "unreadable image " + what + ": empty or too large");
+  }
+  int w = 0, h = 0, comp = 0;
+  int n = int(size);
+  Texture t;
+  auto finish = [&](auto* data, float scale) {
+    t.width = w;
+    t.height = h;
+    t.texels.resize(size_t(w) * size_t(h));
+    for (size_t i = 0; i < t.texels.size(); ++i) {
+      const auto* px = data + i * size_t(comp);
+      float r = float(px[0]) * scale;
+      float g = comp >= 3 ? float(px[1]) * scale : r;
+      float b = comp >= 3 ? float(px[2]) * scale : r;
+      t.texels[i] = {srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)};
+    }
+    stbi_image_free(data);
+  };
+  if (stbi_is_16_bit_from_memory(bytes, n)) {
+    stbi_us* data = stbi_load_16_from_memory(bytes, n, &w, &h, &comp, 0);
+    if (data && w > 0 && h > 0 && comp >= 1 && comp <= 4) {
+      finish(data, 1.0f / 65535.0f);
+      return t;
+    }
+    if (data) stbi_image_free(data);
+  }
+  stbi_uc* data = stbi_load_from_memory(bytes, n, &w, &h, &comp, 0);
+  if (!data || w <= 0 || h <= 0 || comp < 1 || comp > 4) {
+    if (data) stbi_image_free(data);
+    const char* reason = stbi_failure_reason();
+    fail(scenePath, "unreadable image " + what + ": " + (reason ? reason : "cannot decode"));
+  }
+  finish(data, 1.0f / 255.0f);
+  return t;
+}
+
+Scene loadGltf(const std::string& path) {
+  fs::path p(path);
+  std::string baseDir = p.parent_path().string();
+  if (baseDir.empty()) baseDir = ".";
+  bool binary = p.extension() == ".glb" || p.extension() == ".GLB";
+  std::vector<unsigned char> bytes = readFileBytes(path, path, "file");
+  if (bytes.size() > size_t(std::numeric_limits<uint32_t>::max())) {
+    fail(path, "file larger than 4 GiB");
+  }
+  std::string jsonText = binary ? glbJson(path, bytes) : std::string(bytes.begin(), bytes.end());
+  nlohmann::json j = nlohmann::json::parse(jsonText, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) fail(path, "invalid glTF: the JSON does not parse");
+  prevalidateJson(path, baseDir, j);
+  j = nlohmann::json();
+
+  FsContext ctx;
+  std::error_code ec;
+  ctx.canonicalBase = fs::weakly_canonical(baseDir, ec);
+  if (ec) fail(path, "cannot resolve the scene folder '" + baseDir + "'");
+  tinygltf::FsCallbacks callbacks{&fsFileExists, &fsExpandFilePath, &fsReadWholeFile,
+                                  &fsWriteWholeFile, &ctx};
+  tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks(callbacks);
+  loader.SetImageLoader(&storeEncodedImage, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;  // warnings are not errors: ignored
+  bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
+                                                 unsigned(bytes.size()), baseDir)
+                   : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(),
+                                                unsigned(jsonText.size()), baseDir);
+  if (!ok) {
+    std::string e = firstLine(err);
+    if (e.find("File not found") != std::string::npos ||
+        e.find("refused or missing") != std::string::npos) {
+      fail(path, "missing buffer: " + e);
+    }
+    fail(path, "invalid glTF: " + (e.empty() ? std::string("tinygltf failed") : e));
+  }
+  bytes.clear();
+  jsonText.clear();
+  return SceneBuilder(path, model).build();
+}
+
+}  // namespace lo::scene_internal

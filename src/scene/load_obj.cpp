@@ -1,1 +1,272 @@
-// placeholder: implemented in the stage's work
+/// @file scene/load_obj.cpp
+/// @brief Wavefront OBJ/MTL loader on top of tinyobjloader.
+///
+/// tinyobjloader parses only; triangulation is done here because tinyobj's
+/// own triangulation reads vertex positions through unchecked face indices.
+/// Every index is checked before use. .mtl files and map_Kd textures resolve
+/// only inside the .obj file's folder.
+
+#include <tiny_obj_loader.h>
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "scene/scene_internal.h"
+
+namespace lo::scene_internal {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Opens .mtl files only inside the scene folder; remembers the first refusal
+/// so that the loader can raise it (tinyobj treats a missing .mtl as a warning).
+class FolderMaterialReader : public tinyobj::MaterialReader {
+ public:
+  FolderMaterialReader(const std::string& scenePath, const std::string& baseDir)
+      : scenePath_(scenePath), baseDir_(baseDir) {}
+
+  bool operator()(const std::string& matId, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* matMap, std::string* warn,
+                  std::string* err) override {
+    if (!error_.empty()) return false;
+    try {
+      std::string file = resolveInsideFolder(scenePath_, baseDir_, matId, "mtllib");
+      std::error_code ec;
+      if (!fs::is_regular_file(file, ec)) {
+        error_ = scenePath_ + ": missing material library file '" + matId + "' (not found)";
+        return false;
+      }
+      std::ifstream in(file);
+      if (!in) {
+        error_ = scenePath_ + ": cannot open material library '" + matId + "'";
+        return false;
+      }
+      tinyobj::LoadMtl(matMap, materials, &in, warn, err);
+      return true;
+    } catch (const InputError& e) {
+      error_ = e.what();
+      return false;
+    }
+  }
+
+  const std::string& error() const { return error_; }
+
+ private:
+  std::string scenePath_, baseDir_, error_;
+};
+
+struct VertexKey {
+  int v, n, t;
+  bool operator<(const VertexKey& o) const {
+    return v != o.v ? v < o.v : (n != o.n ? n < o.n : t < o.t);
+  }
+};
+
+Vec3 rgb(const tinyobj::real_t c[3]) { return {float(c[0]), float(c[1]), float(c[2])}; }
+
+}  // namespace
+
+Scene loadObj(const std::string& path) {
+  std::string baseDir = fs::path(path).parent_path().string();
+  if (baseDir.empty()) baseDir = ".";
+  std::ifstream in(path);
+  if (!in) fail(path, "missing file (cannot open)");
+
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> objMaterials;
+  std::string warn, err;
+  FolderMaterialReader reader(path, baseDir);
+  bool ok = tinyobj::LoadObj(&attrib, &shapes, &objMaterials, &warn, &err, &in, &reader,
+                             /*triangulate=*/false, /*default_vcols_fallback=*/false);
+  if (!reader.error().empty()) throw InputError(reader.error());
+  if (!ok) {
+    while (!err.empty() && err.back() == '\n') err.pop_back();
+    fail(path, "invalid OBJ: " + (err.empty() ? std::string("parse failed") : err));
+  }
+
+  Scene scene;
+  const std::vector<tinyobj::real_t>& v = attrib.vertices;
+  const std::vector<tinyobj::real_t>& vn = attrib.normals;
+  const std::vector<tinyobj::real_t>& vt = attrib.texcoords;
+  size_t nv = v.size() / 3, nn = vn.size() / 3, nt = vt.size() / 2;
+
+  // Materials, in .mtl order; a shared default for faces without usemtl.
+  std::map<std::string, int> textureByFile;
+  for (size_t i = 0; i < objMaterials.size(); ++i) {
+    const tinyobj::material_t& o = objMaterials[i];
+    Material m;
+    m.name = o.name;
+    m.baseColor = rgb(o.diffuse);
+    m.emission = rgb(o.emission);
+    m.metallic = float(o.metallic);
+    // Phong exponent -> roughness (docs/scene.md). A material without a
+    // specular colour (Ks 0 0 0) has no glossy lobe at all: keep it diffuse.
+    bool hasSpecular = maxComponent(rgb(o.specular)) > 0;
+    m.roughness =
+        hasSpecular ? std::sqrt(2.0f / (std::max(float(o.shininess), 0.0f) + 2.0f)) : 1.0f;
+    if (o.dissolve < 1) m.transmission = 1.0f - std::max(float(o.dissolve), 0.0f);
+    if (o.ior > 0) m.ior = float(o.ior);
+    if (!isFinite(m.baseColor) || !isFinite(m.emission) || !std::isfinite(m.roughness) ||
+        !std::isfinite(m.ior) || !std::isfinite(m.transmission)) {
+      fail(path, "material '" + o.name + "' has a non-finite value");
+    }
+    if (!o.diffuse_texname.empty()) {
+      auto it = textureByFile.find(o.diffuse_texname);
+      if (it != textureByFile.end()) {
+        m.baseColorTexture = it->second;
+      } else {
+        std::string what = "map_Kd '" + o.diffuse_texname + "'";
+        std::string file = resolveInsideFolder(path, baseDir, o.diffuse_texname, what);
+        std::error_code ec;
+        if (!fs::is_regular_file(file, ec)) {
+          fail(path, "unreadable image: missing texture file " + what + " (not found)");
+        }
+        std::vector<unsigned char> bytes = readFileBytes(path, file, "texture");
+        Texture t = decodeImage(path, bytes.data(), bytes.size(), "(" + what + ")");
+        t.name = o.diffuse_texname;
+        m.baseColorTexture = int(scene.textures.size());
+        textureByFile[o.diffuse_texname] = m.baseColorTexture;
+        scene.textures.push_back(std::move(t));
+      }
+    }
+    scene.materials.push_back(std::move(m));
+  }
+  int defaultMaterial = -1;
+
+  // Faces, grouped by material (usemtl), in file order within a material.
+  struct FaceRef {
+    size_t shape, firstIndex, count;
+  };
+  std::map<int, std::vector<FaceRef>> facesByMaterial;
+  for (size_t s = 0; s < shapes.size(); ++s) {
+    const tinyobj::mesh_t& mesh = shapes[s].mesh;
+    size_t offset = 0;
+    for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
+      size_t count = mesh.num_face_vertices[f];
+      if (offset + count > mesh.indices.size()) fail(path, "face index list is truncated");
+      int mat = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
+      if (mat >= int(scene.materials.size())) {
+        fail(path, "face material id " + std::to_string(mat) + " out of range");
+      }
+      if (count >= 3) facesByMaterial[mat].push_back({s, offset, count});
+      offset += count;
+    }
+  }
+
+  std::map<VertexKey, uint32_t> vertexOf;
+  std::vector<char> hasNormal;
+  std::vector<float> uv;
+  bool anyNormals = false, anyUv = false;
+  auto vertex = [&](const tinyobj::index_t& ix) -> uint32_t {
+    if (ix.vertex_index < 0 || size_t(ix.vertex_index) >= nv) {
+      fail(path, "vertex index " + std::to_string(ix.vertex_index + 1) + " out of range (" +
+                     std::to_string(nv) + " vertices)");
+    }
+    if (ix.normal_index < -1 || (ix.normal_index >= 0 && size_t(ix.normal_index) >= nn)) {
+      fail(path, "normal index " + std::to_string(ix.normal_index + 1) + " out of range (" +
+                     std::to_string(nn) + " normals)");
+    }
+    if (ix.texcoord_index < -1 || (ix.texcoord_index >= 0 && size_t(ix.texcoord_index) >= nt)) {
+      fail(path, "texcoord index " + std::to_string(ix.texcoord_index + 1) + " out of range (" +
+                     std::to_string(nt) + " texcoords)");
+    }
+    VertexKey key{ix.vertex_index, ix.normal_index, ix.texcoord_index};
+    auto it = vertexOf.find(key);
+    if (it != vertexOf.end()) return it->second;
+    uint32_t id = uint32_t(scene.positions.size());
+    size_t p = size_t(ix.vertex_index);
+    Vec3 pos{float(v[3 * p]), float(v[3 * p + 1]), float(v[3 * p + 2])};
+    if (!isFinite(pos)) {
+      fail(path, "non-finite vertex position (v " + std::to_string(p + 1) + ")");
+    }
+    scene.positions.push_back(pos);
+    Vec3 n{};
+    if (ix.normal_index >= 0) {
+      size_t q = size_t(ix.normal_index);
+      n = normalize(Vec3{float(vn[3 * q]), float(vn[3 * q + 1]), float(vn[3 * q + 2])});
+      if (!isFinite(n)) fail(path, "non-finite normal (vn " + std::to_string(q + 1) + ")");
+      anyNormals = true;
+    }
+    scene.normals.push_back(n);
+    hasNormal.push_back(ix.normal_index >= 0);
+    float u = 0, w = 0;
+    if (ix.texcoord_index >= 0) {
+      // OBJ puts v = 0 at the bottom of the image; Scene uses glTF's top-left origin.
+      size_t q = size_t(ix.texcoord_index);
+      u = float(vt[2 * q]);
+      w = 1.0f - float(vt[2 * q + 1]);
+      anyUv = true;
+    }
+    uv.push_back(u);
+    uv.push_back(w);
+    vertexOf[key] = id;
+    return id;
+  };
+
+  for (auto& [mat, faces] : facesByMaterial) {
+    int material = mat;
+    if (material < 0) {
+      if (defaultMaterial < 0) {
+        defaultMaterial = int(scene.materials.size());
+        Material m;
+        m.name = "default";
+        scene.materials.push_back(m);
+      }
+      material = defaultMaterial;
+    }
+    for (const FaceRef& f : faces) {
+      const std::vector<tinyobj::index_t>& idx = shapes[f.shape].mesh.indices;
+      std::vector<uint32_t> poly(f.count);
+      for (size_t k = 0; k < f.count; ++k) poly[k] = vertex(idx[f.firstIndex + k]);
+      std::vector<std::array<uint32_t, 3>> tris;
+      if (f.count == 4) {
+        // Split a quad along its shorter diagonal (better for the slightly
+        // non-planar quads of scanned rooms such as the Cornell box).
+        const auto& P = scene.positions;
+        float d02 = lengthSquared(P[poly[2]] - P[poly[0]]);
+        float d13 = lengthSquared(P[poly[3]] - P[poly[1]]);
+        if (d02 <= d13)
+          tris = {{poly[0], poly[1], poly[2]}, {poly[0], poly[2], poly[3]}};
+        else
+          tris = {{poly[0], poly[1], poly[3]}, {poly[1], poly[2], poly[3]}};
+      } else {
+        // Polygons are fan-triangulated: assumed convex (docs/scene.md).
+        for (size_t k = 1; k + 1 < f.count; ++k) tris.push_back({poly[0], poly[k], poly[k + 1]});
+      }
+      for (const auto& t : tris) {
+        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+        for (uint32_t i : t) scene.indices.push_back(i);
+        scene.triangleMaterial.push_back(material);
+      }
+    }
+  }
+
+  if (!anyNormals) {
+    scene.normals.clear();
+  } else {
+    // Vertices without a `vn` get the area-weighted normal of their faces.
+    std::vector<Vec3> acc(scene.positions.size(), Vec3{});
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+      uint32_t a = scene.indices[3 * t], b = scene.indices[3 * t + 1], c = scene.indices[3 * t + 2];
+      Vec3 n =
+          cross(scene.positions[b] - scene.positions[a], scene.positions[c] - scene.positions[a]);
+      acc[a] += n;
+      acc[b] += n;
+      acc[c] += n;
+    }
+    for (size_t i = 0; i < scene.normals.size(); ++i)
+      if (!hasNormal[i]) scene.normals[i] = normalize(acc[i]);
+  }
+  if (anyUv) scene.texcoords0 = std::move(uv);
+  return scene;
+}
+
+}  // namespace lo::scene_internal

@@ -1,7 +1,14 @@
+#include "scene/scene.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "core/error.h"
-#include "scene/scene.h"
+#include "scene/scene_internal.h"
 
 namespace lo {
 
@@ -87,5 +94,135 @@ std::string Scene::ToString() const {
      << " cameras, bounds " << bounds().ToString();
   return os.str();
 }
+
+Scene loadScene(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  bool gltf = ext == ".gltf" || ext == ".glb";
+  if (!gltf && ext != ".obj") {
+    scene_internal::fail(path, "unknown extension '" + ext + "' (expected .gltf, .glb or .obj)");
+  }
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) scene_internal::fail(path, "missing file (not found)");
+  Scene scene;
+  try {
+    scene = gltf ? scene_internal::loadGltf(path) : scene_internal::loadObj(path);
+  } catch (const std::bad_alloc&) {
+    scene_internal::fail(path, "out of memory while loading (corrupt sizes?)");
+  }
+  scene.sourcePath = path;
+  scene_internal::validateScene(scene);
+  return scene;
+}
+
+namespace scene_internal {
+
+void fail(const std::string& path, const std::string& problem) {
+  throw InputError(path + ": " + problem);
+}
+
+std::string percentDecode(const std::string& uri) {
+  auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  std::string out;
+  out.reserve(uri.size());
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
+      out.push_back(char(hex(uri[i + 1]) * 16 + hex(uri[i + 2])));
+      i += 2;
+    } else {
+      out.push_back(uri[i]);
+    }
+  }
+  return out;
+}
+
+std::string resolveInsideFolder(const std::string& scenePath, const std::string& baseDir,
+                                const std::string& uri, const std::string& what) {
+  namespace fs = std::filesystem;
+  if (uri.empty()) fail(scenePath, what + " has an empty uri");
+  if (uri.find('\0') != std::string::npos) fail(scenePath, what + " uri contains a NUL byte");
+  bool absolute = uri[0] == '/' || uri[0] == '\\' || (uri.size() > 1 && uri[1] == ':');
+  bool dotdot = false;
+  size_t start = 0;
+  while (start <= uri.size()) {
+    size_t end = uri.find_first_of("/\\", start);
+    if (end == std::string::npos) end = uri.size();
+    if (uri.compare(start, end - start, "..") == 0 && end - start == 2) dotdot = true;
+    start = end + 1;
+  }
+  if (absolute || dotdot) {
+    fail(scenePath, what + " uri '" + uri +
+                        "' is outside the scene folder (absolute paths and '..' are rejected)");
+  }
+  fs::path base = baseDir.empty() ? fs::path(".") : fs::path(baseDir);
+  fs::path full = base / fs::path(uri);
+  // A symlink inside the folder may still point outside it: compare the
+  // resolved paths too.
+  std::error_code ec1, ec2;
+  fs::path canonBase = fs::weakly_canonical(base, ec1);
+  fs::path canonFull = fs::weakly_canonical(full, ec2);
+  if (!ec1 && !ec2) {
+    auto b = canonBase.begin(), f = canonFull.begin();
+    for (; b != canonBase.end() && f != canonFull.end(); ++b, ++f) {
+      if (b->empty()) continue;
+      if (*b != *f) break;
+    }
+    if (b != canonBase.end()) {
+      fail(scenePath, what + " uri '" + uri + "' resolves outside the scene folder");
+    }
+  }
+  return full.string();
+}
+
+std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std::string& file,
+                                         const std::string& what) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    fail(scenePath, "missing " + what + " '" + file + "' (not found)");
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail(scenePath, "cannot open " + what + " '" + file + "'");
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                   std::istreambuf_iterator<char>());
+  if (in.bad()) fail(scenePath, "cannot read " + what + " '" + file + "'");
+  return bytes;
+}
+
+float srgbToLinear(float c) {
+  if (c <= 0.04045f) return c / 12.92f;
+  return std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+void validateScene(const Scene& scene) {
+  const std::string& path = scene.sourcePath;
+  if (scene.triangleCount() == 0) fail(path, "no triangles in the scene");
+  if (scene.indices.size() % 3 != 0) fail(path, "index count is not a multiple of 3");
+  for (size_t i = 0; i < scene.positions.size(); ++i) {
+    if (!isFinite(scene.positions[i])) {
+      fail(path, "non-finite vertex position (vertex " + std::to_string(i) + " is " +
+                     scene.positions[i].ToString() + ")");
+    }
+  }
+  for (size_t i = 0; i < scene.indices.size(); ++i) {
+    if (scene.indices[i] >= scene.positions.size()) {
+      fail(path, "vertex index " + std::to_string(scene.indices[i]) + " out of range (" +
+                     std::to_string(scene.positions.size()) + " vertices)");
+    }
+  }
+  LO_CHECK_EQ(scene.triangleMaterial.size(), scene.triangleCount());
+  for (int32_t m : scene.triangleMaterial) LO_CHECK(m >= 0 && size_t(m) < scene.materials.size());
+  LO_CHECK(scene.normals.empty() || scene.normals.size() == scene.positions.size());
+  LO_CHECK(scene.texcoords0.empty() || scene.texcoords0.size() == 2 * scene.positions.size());
+  LO_CHECK(scene.texcoords1.empty() || scene.texcoords1.size() == 2 * scene.positions.size());
+}
+
+}  // namespace scene_internal
 
 }  // namespace lo

@@ -1,0 +1,49 @@
+#pragma once
+/// @file scene/scene_internal.h
+/// @brief Helpers shared by the glTF and OBJ loaders. Not part of the public
+/// API: nothing outside src/scene includes this header.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "scene/scene.h"
+
+namespace lo::scene_internal {
+
+/// Throws InputError "<path>: <problem>".
+[[noreturn]] void fail(const std::string& path, const std::string& problem);
+
+/// Resolves `uri` (already percent-decoded) against the folder `baseDir`.
+/// Rejects absolute paths and any path that leaves the folder ("..", or a
+/// symlink that resolves outside it) with InputError naming `scenePath`,
+/// `what` (e.g. "buffer 0") and the uri. Does not check that the file exists.
+std::string resolveInsideFolder(const std::string& scenePath, const std::string& baseDir,
+                                const std::string& uri, const std::string& what);
+
+/// Decodes %XX escapes of a URI reference (glTF uris are URI-encoded).
+std::string percentDecode(const std::string& uri);
+
+/// Reads a whole file; throws InputError "<scenePath>: missing <what> '<file>'"
+/// when it cannot be opened.
+std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std::string& file,
+                                         const std::string& what);
+
+/// Decodes a PNG/JPEG/... image (stb_image; 1-4 channels, 8 or 16 bit) into a
+/// linear-RGB Texture (sRGB transfer function removed; alpha ignored; grey
+/// replicated). Throws InputError "<scenePath>: unreadable image <what>".
+Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
+                    const std::string& what);
+
+/// sRGB electro-optical transfer function (IEC 61966-2-1), [0,1] -> [0,1].
+float srgbToLinear(float c);
+
+Scene loadGltf(const std::string& path);
+Scene loadObj(const std::string& path);
+
+/// Final checks shared by both loaders: at least one triangle, finite vertices,
+/// every index in range, one material per triangle in range.
+void validateScene(const Scene& scene);
+
+}  // namespace lo::scene_internal
