@@ -15,7 +15,7 @@
 namespace lo {
 
 struct GpuOctreeParams {
-  bool halfFloat = false;        ///< VDL texels as RGBA16F instead of RGBA32F
+  bool halfFloat = false;        ///< VDL texels as RGBA16UI (half RGB bits) instead of RGBA32F
   int max3DTextureSize = 2048;   ///< GL_MAX_3D_TEXTURE_SIZE of the target context
   int max2DTextureSize = 16384;  ///< GL_MAX_TEXTURE_SIZE of the target context
 };
