@@ -48,7 +48,31 @@ class Gatherer {
   GatherParams params_;
   float radius_;
   int reachVoxels_;
-  std::vector<std::pair<float, uint32_t>> candidates_;
+  /// Photons within r as (float bits of d^2) << 32 | photon index, so that one
+  /// integer comparison orders by distance with ties broken by index; split by
+  /// the side they arrived from relative to the unoriented voxel normal.
+  std::vector<uint64_t> candidates_;
+  std::vector<uint64_t> backCandidates_;
+
+  /// The photons of the active voxels near the 8^3 block of the last gathered
+  /// voxel, copied contiguously once per block (grid.find + bins) and scanned
+  /// by every voxel of the block: the scan then reads cache-resident memory
+  /// instead of photons scattered over the whole map.
+  struct LocalPhoton {
+    Vec3 position;
+    Vec3 normal;
+    Vec3 power;
+    uint32_t index;
+  };
+  struct Neighbour {
+    Coord coord;
+    uint32_t begin, end;  ///< range in blockPhotons_
+  };
+  void updateBlock(const Coord& voxelCoord);
+  Coord blockCoord_{};
+  bool blockValid_ = false;
+  std::vector<Neighbour> blockNeighbours_;
+  std::vector<LocalPhoton> blockPhotons_;
 };
 
 /// Reference: the same selection by scanning every photon. For tests.

@@ -57,6 +57,10 @@ class SurfaceGrid {
   /// in voxel v are binPhotons[binStart[v] .. binStart[v+1]), in photon order.
   std::vector<uint32_t> binStart;
   std::vector<uint32_t> binPhotons;
+  /// Largest distance (world units) from a binned photon to the box of the voxel
+  /// whose bin holds it: 0 unless a photon was moved to a neighbouring voxel.
+  /// A gather that prunes bins by their voxel box grows the box by this much.
+  float binMargin = 0.0f;
 
   size_t size() const { return coords.size(); }
   /// Index of the active voxel at c, or -1. Thread-safe.

@@ -1,0 +1,434 @@
+#include <gtest/gtest.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <vector>
+
+#include "../test_util.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "gather/gather.h"
+
+namespace lo {
+namespace {
+
+// A Cornell-like room: the closed unit box (inward faces) with two blocks
+// standing on the floor (outward faces, no bottom face), placed off the voxel
+// grid's planes.
+Scene cornellLikeBox() {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addClosedBox(scene, {0, 0, 0}, {1, 1, 1}, 0);
+  auto addBlock = [&](Vec3 lo, Vec3 hi) {
+    Vec3 d = hi - lo;
+    Vec3 ex{d.x, 0, 0}, ey{0, d.y, 0}, ez{0, 0, d.z};
+    test::addQuad(scene, lo + ey, ex, ez, {0, 1, 0}, 0);
+    test::addQuad(scene, lo, ey, ez, {-1, 0, 0}, 0);
+    test::addQuad(scene, lo + ex, ey, ez, {1, 0, 0}, 0);
+    test::addQuad(scene, lo, ex, ey, {0, 0, -1}, 0);
+    test::addQuad(scene, lo + ez, ex, ey, {0, 0, 1}, 0);
+  };
+  addBlock({0.13f, 0.0f, 0.097f}, {0.43f, 0.3f, 0.41f});
+  addBlock({0.551f, 0.0f, 0.523f}, {0.847f, 0.61f, 0.83f});
+  return scene;
+}
+
+// `count` photons spread uniformly (by area) over the scene's triangles, each
+// arriving on the side its triangle faces; power 1/count per channel.
+std::vector<Photon> uniformPhotons(const Scene& scene, size_t count, uint64_t seed) {
+  std::vector<double> cdf;
+  double total = 0;
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    total += scene.triangleArea(t);
+    cdf.push_back(total);
+  }
+  std::vector<Photon> photons(count);
+  for (size_t i = 0; i < count; ++i) {
+    Rng rng(seed, i);
+    double u = double(rng.uniform()) * total;
+    size_t t = size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin());
+    t = std::min(t, scene.triangleCount() - 1);
+    float b1 = rng.uniform(), b2 = rng.uniform();
+    if (b1 + b2 > 1) {
+      b1 = 1 - b1;
+      b2 = 1 - b2;
+    }
+    const Vec3& a = scene.positions[scene.indices[3 * t]];
+    const Vec3& b = scene.positions[scene.indices[3 * t + 1]];
+    const Vec3& c = scene.positions[scene.indices[3 * t + 2]];
+    Photon& p = photons[i];
+    p.position = a + (b - a) * b1 + (c - a) * b2;
+    p.normal = scene.faceNormal(t);
+    p.direction = p.normal;
+    p.power = Vec3(1.0f / float(count));
+    p.bounce = 1;
+  }
+  return photons;
+}
+
+SurfaceGrid gridFor(const Scene& scene, int depth, const std::vector<Photon>& photons) {
+  GridParams gp;
+  gp.depth = depth;
+  SurfaceGrid grid = buildSurfaceGrid(scene, gp);
+  EXPECT_EQ(splatPhotons(grid, photons), 0u);
+  return grid;
+}
+
+std::vector<uint32_t> sorted(std::vector<uint32_t> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+void expectSameAsBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+                            const GatherParams& params, size_t stride) {
+  Gatherer gatherer(grid, photons, params);
+  GatherResult g;
+  size_t checked = 0, full = 0;
+  for (size_t v = 0; v < grid.size(); v += stride) {
+    gatherer.gather(v, g);
+    GatherResult b = gatherBruteForce(grid, photons, v, params);
+    ASSERT_EQ(sorted(g.photons), sorted(b.photons)) << "voxel " << v << " " << grid.coords[v].ToString();
+    EXPECT_EQ(g.radius, b.radius) << "voxel " << v;
+    EXPECT_EQ(g.normal, b.normal) << "voxel " << v;
+    // The same photons summed in a different order: equal up to rounding.
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(g.irradiance[c], b.irradiance[c], 1e-6f * b.irradiance[c]) << "voxel " << v;
+    }
+    ++checked;
+    full += g.photons.size() == size_t(params.k);
+  }
+  EXPECT_GT(checked, 20u);
+  EXPECT_GT(full, 0u) << "no voxel reached k: the test would not exercise the selection";
+}
+
+TEST(Gather, ResolveRadius) {
+  GridFrame f;
+  f.voxelSize = 0.5f;
+  GatherParams p;
+  EXPECT_FLOAT_EQ(resolveRadius(p, f), kDefaultRadiusVoxels * 0.5f);
+  p.radius = 0.25f;
+  EXPECT_FLOAT_EQ(resolveRadius(p, f), 0.25f);
+  p.radius = -1.0f;
+  EXPECT_THROW(resolveRadius(p, f), InputError);
+  p.radius = NAN;
+  EXPECT_THROW(resolveRadius(p, f), InputError);
+  p.radius = INFINITY;
+  EXPECT_THROW(resolveRadius(p, f), InputError);
+}
+
+TEST(Gather, BadParametersThrow) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  std::vector<Photon> photons = uniformPhotons(scene, 100, 1);
+  SurfaceGrid grid = gridFor(scene, 3, photons);
+  GatherParams p;
+  p.k = 0;
+  EXPECT_THROW(Gatherer(grid, photons, p), InputError);
+  p.k = 10;
+  p.normalSquash = 0;
+  EXPECT_THROW(Gatherer(grid, photons, p), InputError);
+  p.normalSquash = 2;
+  p.radius = -0.1f;
+  EXPECT_THROW(Gatherer(grid, photons, p), InputError);
+}
+
+// Three crossing planes, photons arriving on both sides of each: the grid
+// gather must select exactly what a scan of every photon selects.
+TEST(Gather, MatchesBruteForceOnPlanes) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0.3f, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  test::addQuad(scene, {0.61f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, 0);
+  test::addQuad(scene, {0, 0, 0.2f}, {1, 0.8f, 0}, {0, 0, 0.7f}, normalize(Vec3(-0.8f, 1, 0)), 0);
+  std::vector<Photon> photons = uniformPhotons(scene, 20000, 7);
+  for (size_t i = 0; i < photons.size(); i += 3) photons[i].normal = -photons[i].normal;
+  SurfaceGrid grid = gridFor(scene, 4, photons);
+  for (float squash : {1.0f, 4.0f, 0.5f}) {
+    SCOPED_TRACE(squash);
+    GatherParams p;
+    p.k = 40;
+    p.normalSquash = squash;
+    expectSameAsBruteForce(grid, photons, p, 1);
+  }
+}
+
+// The Cornell-like box plus a two-sided panel (coincident quads of opposite
+// winding, so its voxels have a zero normal and take the fallback path).
+TEST(Gather, MatchesBruteForceInCornellLikeBox) {
+  Scene scene = cornellLikeBox();
+  test::addQuad(scene, {0.2f, 0.7f, 0.2f}, {0.3f, 0, 0}, {0, 0, 0.3f}, {0, 1, 0}, 0);
+  test::addQuad(scene, {0.2f, 0.7f, 0.2f}, {0.3f, 0, 0}, {0, 0, 0.3f}, {0, -1, 0}, 0);
+  std::vector<Photon> photons = uniformPhotons(scene, 60000, 3);
+  SurfaceGrid grid = gridFor(scene, 5, photons);
+  size_t zeroNormals = 0;
+  for (const Vec3& n : grid.normals) zeroNormals += n == Vec3{};
+  EXPECT_GT(zeroNormals, 0u);
+  for (float squash : {4.0f, 0.7f}) {
+    SCOPED_TRACE(squash);
+    GatherParams p;
+    p.k = 60;
+    p.normalSquash = squash;
+    expectSameAsBruteForce(grid, photons, p, 3);
+  }
+  GatherParams p;
+  p.k = 25;
+  p.radius = 0.09f;
+  expectSameAsBruteForce(grid, photons, p, 7);
+}
+
+// A floor and a wall leaning over it (its normal has an upward component, so
+// back rejection alone does not exclude it). Wall photons lie at least `h0`
+// above the floor: a sphere gathers many of them; the squashed ellipsoid,
+// whose half-height is r / squash < h0, gathers none.
+TEST(Gather, SquashExcludesPhotonsOnAnInclinedWall) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  const Vec3 wallUp = normalize(Vec3(-0.3f, 1.0f, 0.0f));
+  const Vec3 wallNormal = normalize(Vec3(-1.0f, -0.3f, 0.0f)) * -1.0f;  // faces +x, up a bit
+  test::addQuad(scene, {0.5f, 0, 0}, wallUp, {0, 0, 1}, wallNormal, 0);
+  const float h0 = 0.02f;
+  std::vector<Photon> photons;
+  for (size_t i = 0; i < 40000; ++i) {
+    Rng rng(11, i);
+    Photon p;
+    p.power = Vec3(1e-4f);
+    if (i % 2 == 0) {
+      p.position = {rng.uniform(), 0.0f, rng.uniform()};
+      p.normal = {0, 1, 0};
+    } else {
+      const float s = h0 / wallUp.y + rng.uniform() * 0.5f;
+      p.position = Vec3(0.5f, 0, 0) + wallUp * s + Vec3(0, 0, rng.uniform());
+      p.normal = wallNormal;
+    }
+    p.direction = p.normal;
+    photons.push_back(p);
+  }
+  ASSERT_GT(dot(wallNormal, Vec3(0, 1, 0)), 0.2f);
+  SurfaceGrid grid = gridFor(scene, 5, photons);
+  // A floor voxel just left of the wall's foot... on the side the wall faces.
+  const Coord c = grid.frame.coordOf({0.5f + 1.5f * grid.frame.voxelSize, 0.0f, 0.5f});
+  int64_t v = grid.find(c);
+  ASSERT_GE(v, 0);
+  ASSERT_EQ(grid.normals[size_t(v)], Vec3(0, 1, 0));
+  auto wallPhotons = [&](float squash) {
+    GatherParams p;
+    p.k = 300;
+    p.normalSquash = squash;
+    Gatherer g(grid, photons, p);
+    GatherResult r;
+    g.gather(size_t(v), r);
+    size_t n = 0;
+    for (uint32_t i : r.photons) n += photons[i].normal == wallNormal;
+    return std::make_pair(n, resolveRadius(p, grid.frame));
+  };
+  auto [sphere, radius] = wallPhotons(1.0f);
+  EXPECT_GT(sphere, 30u);
+  const float squash = 1.5f * radius / h0;
+  EXPECT_EQ(wallPhotons(squash).first, 0u) << "squash " << squash;
+}
+
+// A wall thicker than a voxel and one thinner than a voxel, lit on the front
+// (-x) side and, more weakly, on the back: the back photons are closer than r
+// but arrive from behind, so no voxel on the front gathers them.
+TEST(Gather, PhotonsBehindAThinWallAreRejected) {
+  for (float thicknessVoxels : {1.6f, 0.2f}) {
+    SCOPED_TRACE(thicknessVoxels);
+    Scene scene;
+    scene.materials.push_back(Material{});
+    const float vs = 1.02f / 16.0f;  // depth 4, unit scene, 1% padding
+    const float x0 = 0.5f + 0.3f * vs, x1 = x0 + thicknessVoxels * vs;
+    test::addQuad(scene, {x0, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, 0);
+    test::addQuad(scene, {x1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);
+    test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);  // sets the frame
+    std::vector<Photon> photons;
+    for (size_t i = 0; i < 30000; ++i) {
+      Rng rng(5, i);
+      Photon p;
+      const bool back = i % 3 == 0;
+      p.position = {back ? x1 : x0, 0.2f + 0.6f * rng.uniform(), 0.2f + 0.6f * rng.uniform()};
+      p.normal = back ? Vec3(1, 0, 0) : Vec3(-1, 0, 0);
+      p.direction = p.normal;
+      p.power = Vec3(1e-4f);
+      photons.push_back(p);
+    }
+    SurfaceGrid grid = gridFor(scene, 4, photons);
+    ASSERT_NEAR(grid.frame.voxelSize, vs, 1e-6f);
+    GatherParams params;
+    params.k = 100;
+    Gatherer g(grid, photons, params);
+    GatherResult r;
+    size_t tested = 0;
+    for (size_t v = 0; v < grid.size(); ++v) {
+      const Vec3 c = grid.centroids[v];
+      if (c.y < 0.35f || c.y > 0.65f || c.z < 0.35f || c.z > 0.65f || c.x > x0 + 0.5f * vs) continue;
+      if (grid.normals[v].y != 0) continue;  // not a wall voxel
+      g.gather(v, r);
+      ++tested;
+      EXPECT_EQ(r.normal, Vec3(-1, 0, 0)) << grid.coords[v].ToString();
+      EXPECT_EQ(r.photons.size(), size_t(params.k));
+      for (uint32_t i : r.photons) ASSERT_EQ(photons[i].normal, Vec3(-1, 0, 0));
+    }
+    EXPECT_GT(tested, 4u);
+  }
+}
+
+// N photons of power P spread uniformly on area A: E = N P / A. The KNN
+// estimate of one voxel has a relative standard deviation of about 1/sqrt(k).
+TEST(Gather, UniformPlaneIrradiance) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  const size_t n = 100000;
+  std::vector<Photon> photons = uniformPhotons(scene, n, 21);
+  for (Photon& p : photons) p.power = Vec3(2e-5f, 1e-5f, 3e-5f);
+  const Vec3 expected = Vec3(2e-5f, 1e-5f, 3e-5f) * float(n);  // A = 1 m^2
+  SurfaceGrid grid = gridFor(scene, 5, photons);
+  GatherParams params;
+  params.k = 300;
+  Gatherer g(grid, photons, params);
+  const float r = resolveRadius(params, grid.frame);
+  const float tol = 4.0f / std::sqrt(float(params.k));
+  GatherResult res;
+  double sum = 0;
+  size_t count = 0;
+  for (size_t v = 0; v < grid.size(); ++v) {
+    const Vec3 c = grid.centroids[v];
+    if (std::min({c.x, c.z, 1 - c.x, 1 - c.z}) < r) continue;  // the disc must lie on the plane
+    g.gather(v, res);
+    ASSERT_EQ(res.photons.size(), size_t(params.k));
+    ASSERT_LT(res.radius, r);
+    for (int ch = 0; ch < 3; ++ch) {
+      EXPECT_NEAR(res.irradiance[ch] / expected[ch], 1.0f, tol) << grid.coords[v].ToString();
+    }
+    sum += res.irradiance.x / expected.x;
+    ++count;
+  }
+  ASSERT_GT(count, 100u);
+  // Neighbouring estimates share photons, so the mean is only as good as a few
+  // independent discs; the KNN estimator's bias k/(k-1) is negligible here.
+  EXPECT_NEAR(sum / double(count), 1.0, 0.03);
+}
+
+// Fewer than k photons within r: all of them are kept and r_k = r.
+TEST(Gather, FewerThanKUsesTheSearchRadius) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  std::vector<Photon> photons = uniformPhotons(scene, 400, 9);
+  SurfaceGrid grid = gridFor(scene, 4, photons);
+  GatherParams params;
+  params.k = 300;
+  const float r = resolveRadius(params, grid.frame);
+  Gatherer g(grid, photons, params);
+  GatherResult res;
+  for (size_t v = 0; v < grid.size(); v += 5) {
+    g.gather(v, res);
+    const Vec3 q = grid.centroids[v];
+    size_t within = 0;
+    double power = 0;
+    for (const Photon& p : photons) {
+      if (lengthSquared(p.position - q) <= r * r) {  // on the plane: a disc
+        ++within;
+        power += p.power.x;
+      }
+    }
+    ASSERT_LT(within, size_t(params.k));
+    EXPECT_EQ(res.photons.size(), within);
+    EXPECT_EQ(res.radius, r);
+    EXPECT_NEAR(res.irradiance.x, power / (kPi * r * r), 1e-4 * power / (r * r) + 1e-9);
+  }
+}
+
+// Deterministic: the same result whatever the thread count.
+TEST(Gather, SameResultForAnyThreadCount) {
+  Scene scene = cornellLikeBox();
+  std::vector<Photon> photons = uniformPhotons(scene, 30000, 4);
+  SurfaceGrid grid = gridFor(scene, 4, photons);
+  GatherParams params;
+  params.k = 50;
+  auto run = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    std::vector<Vec3> e(grid.size());
+    tbb::enumerable_thread_specific<Gatherer> gs([&] { return Gatherer(grid, photons, params); });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.size(), 7),
+                      [&](const tbb::blocked_range<size_t>& rg) {
+                        GatherResult res;
+                        for (size_t v = rg.begin(); v != rg.end(); ++v) {
+                          gs.local().gather(v, res);
+                          e[v] = res.irradiance;
+                        }
+                      });
+    return e;
+  };
+  std::vector<Vec3> one = run(1), two = run(2);
+  for (size_t v = 0; v < grid.size(); ++v) ASSERT_EQ(one[v], two[v]) << v;
+}
+
+// Timing, not a test: run with --gtest_also_run_disabled_tests. The paper's
+// setting: 600k photons, depth 6, k = 300, in a Cornell-like box.
+TEST(Gather, DISABLED_Benchmark) {
+  Scene scene = cornellLikeBox();
+  std::vector<Photon> photons = uniformPhotons(scene, 600000, 1);
+  using Clock = std::chrono::steady_clock;
+  auto t0 = Clock::now();
+  GridParams gp;
+  gp.depth = 6;
+  SurfaceGrid grid = buildSurfaceGrid(scene, gp);
+  auto t1 = Clock::now();
+  splatPhotons(grid, photons);
+  auto t2 = Clock::now();
+  GatherParams params;
+  Gatherer g(grid, photons, params);
+  GatherResult res;
+  size_t gathered = 0;
+  // Thread CPU time as well as wall time: the build machine is shared.
+  const std::clock_t c0 = std::clock();
+  for (size_t v = 0; v < grid.size(); ++v) {
+    g.gather(v, res);
+    gathered += res.photons.size();
+  }
+  const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
+  auto t3 = Clock::now();
+  tbb::enumerable_thread_specific<Gatherer> gs([&] { return Gatherer(grid, photons, params); });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& rg) {
+                      GatherResult r;
+                      for (size_t v = rg.begin(); v != rg.end(); ++v) gs.local().gather(v, r);
+                    });
+  auto t4 = Clock::now();
+  // Cost of one grid.find: a gather that looked up every voxel of its
+  // (2 reach + 1)^3 neighbourhood itself would pay it ~700 times per voxel.
+  const std::clock_t f0 = std::clock();
+  int64_t found = 0;
+  const int res = grid.frame.resolution();
+  for (int rep = 0; rep < 4; ++rep) {
+    for (int x = 0; x < res; ++x) {
+      for (int y = 0; y < res; ++y) {
+        for (int z = 0; z < res; ++z) found += grid.find({x, y, z}) >= 0;
+      }
+    }
+  }
+  const double findNs = 1e9 * double(std::clock() - f0) / CLOCKS_PER_SEC / (4.0 * res * res * res);
+  std::printf("grid.find: %.1f ns per call (%lld hits)\n", findNs, (long long)found);
+  auto s = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double>(b - a).count();
+  };
+  std::printf("| voxels | photons | k | voxelize s | splat s | gather 1 thread s | CPU us/voxel | "
+              "gather all threads s | mean gathered |\n");
+  std::printf("| %zu | %zu | %d | %.3f | %.3f | %.3f | %.1f | %.3f | %.1f |\n", grid.size(),
+              photons.size(), params.k, s(t0, t1), s(t1, t2), s(t2, t3),
+              1e6 * cpu / double(grid.size()), s(t3, t4),
+              double(gathered) / double(grid.size()));
+}
+
+}  // namespace
+}  // namespace lo
