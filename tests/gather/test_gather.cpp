@@ -409,15 +409,15 @@ TEST(Gather, DISABLED_Benchmark) {
   // (2 reach + 1)^3 neighbourhood itself would pay it ~700 times per voxel.
   const std::clock_t f0 = std::clock();
   int64_t found = 0;
-  const int res = grid.frame.resolution();
+  const int n = grid.frame.resolution();
   for (int rep = 0; rep < 4; ++rep) {
-    for (int x = 0; x < res; ++x) {
-      for (int y = 0; y < res; ++y) {
-        for (int z = 0; z < res; ++z) found += grid.find({x, y, z}) >= 0;
+    for (int x = 0; x < n; ++x) {
+      for (int y = 0; y < n; ++y) {
+        for (int z = 0; z < n; ++z) found += grid.find({x, y, z}) >= 0;
       }
     }
   }
-  const double findNs = 1e9 * double(std::clock() - f0) / CLOCKS_PER_SEC / (4.0 * res * res * res);
+  const double findNs = 1e9 * double(std::clock() - f0) / CLOCKS_PER_SEC / (4.0 * n * n * n);
   std::printf("grid.find: %.1f ns per call (%lld hits)\n", findNs, (long long)found);
   auto s = [](Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double>(b - a).count();
