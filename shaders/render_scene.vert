@@ -1,0 +1,25 @@
+#version 330 core
+// Scene pass: a world-space triangle soup with per-vertex material values
+// (triangles never share vertices, so per-triangle materials stay exact).
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aNormal;
+layout(location = 2) in vec3 aBaseColor;  // linear, base colour texture applied per vertex
+layout(location = 3) in vec2 aMetallicRoughness;
+layout(location = 4) in vec3 aEmission;  // W/(m^2 sr)
+
+uniform mat4 uViewProj;
+
+out vec3 vPosition;
+out vec3 vNormal;
+out vec3 vBaseColor;
+out vec2 vMetallicRoughness;
+out vec3 vEmission;
+
+void main() {
+  vPosition = aPosition;
+  vNormal = aNormal;
+  vBaseColor = aBaseColor;
+  vMetallicRoughness = aMetallicRoughness;
+  vEmission = aEmission;
+  gl_Position = uViewProj * vec4(aPosition, 1.0);
+}

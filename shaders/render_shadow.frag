@@ -1,0 +1,12 @@
+#version 330 core
+// Point and spot lights store the linear distance to the light over uFar (the
+// lookup compares distances, so the bias is in world units whatever the
+// projection); directional lights (uFar == 0) keep the orthographic depth,
+// which is already linear.
+in vec3 vWorld;
+uniform vec3 uLightPosition;
+uniform float uFar;
+void main() {
+  gl_FragDepth = uFar > 0.0 ? clamp(length(vWorld - uLightPosition) / uFar, 0.0, 1.0)
+                            : gl_FragCoord.z;
+}

@@ -1,0 +1,104 @@
+// GlContext: what every back end shares (entry-point loading, limits query).
+
+#include "render/context.h"
+
+#include <glad/gl.h>
+
+#include <cstdio>
+#include <sstream>
+
+#include "core/error.h"
+#include "render/context_internal.h"
+
+namespace lo {
+namespace {
+
+/// glad 2 keeps one global table of entry points. OSMesa and libEGL/libGL hand
+/// out different function pointers, so the table must follow whichever back end
+/// is current (tests create both in one process).
+const GlContext* gLoadedFor = nullptr;
+
+void GLAD_API_PTR debugCallback(GLenum, GLenum type, GLuint, GLenum severity, GLsizei,
+                                const GLchar* message, const void*) {
+  if (severity == GL_DEBUG_SEVERITY_NOTIFICATION) return;
+  std::fprintf(stderr, "GL debug (type 0x%x): %s\n", type, message);
+}
+
+std::string glString(GLenum name) {
+  const GLubyte* s = glGetString(name);
+  return s ? reinterpret_cast<const char*>(s) : "";
+}
+
+}  // namespace
+
+GlBackend parseGlBackend(const std::string& name) {
+  if (name == "osmesa") return GlBackend::OSMesa;
+  if (name == "egl") return GlBackend::Egl;
+  if (name == "glfw") return GlBackend::Glfw;
+  throw InputError("unknown GL back end '" + name + "' (expected osmesa, egl or glfw)");
+}
+
+std::string toString(GlBackend backend) {
+  switch (backend) {
+    case GlBackend::OSMesa:
+      return "osmesa";
+    case GlBackend::Egl:
+      return "egl";
+    case GlBackend::Glfw:
+      return "glfw";
+  }
+  return "?";
+}
+
+std::string GlInfo::ToString() const {
+  std::ostringstream os;
+  os << "OpenGL " << major << "." << minor << " (" << version << ", " << renderer << ", " << vendor
+     << "), max 3D texture " << max3DTextureSize << ", max 2D texture " << max2DTextureSize;
+  return os.str();
+}
+
+void GlContext::makeCurrent() {
+  makeCurrentImpl();
+  if (gLoadedFor != this) {
+    if (!gladLoadGL(reinterpret_cast<GLADloadfunc>(procLoader()))) {
+      throw GlError(toString(backend_) + ": gladLoadGL failed");
+    }
+    gLoadedFor = this;
+  }
+}
+
+void GlContext::initialize(bool debugOutput) {
+  gLoadedFor = nullptr;  // a new context may reuse an old one's address
+  int version = gladLoadGL(reinterpret_cast<GLADloadfunc>(procLoader()));
+  if (!version) throw GlError(toString(backend_) + ": gladLoadGL failed (no GL entry points)");
+  gLoadedFor = this;
+  info_.major = GLAD_VERSION_MAJOR(version);
+  info_.minor = GLAD_VERSION_MINOR(version);
+  if (info_.major * 10 + info_.minor < 33) {
+    throw GlError(toString(backend_) + ": OpenGL 3.3 core or later needed, got " +
+                  std::to_string(info_.major) + "." + std::to_string(info_.minor));
+  }
+  info_.vendor = glString(GL_VENDOR);
+  info_.renderer = glString(GL_RENDERER);
+  info_.version = glString(GL_VERSION);
+  glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &info_.max3DTextureSize);
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &info_.max2DTextureSize);
+  if (debugOutput && GLAD_GL_KHR_debug) {
+    glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+    glDebugMessageCallback(debugCallback, nullptr);
+  }
+}
+
+std::unique_ptr<GlContext> createGlContext(const GlContextParams& params) {
+  switch (params.backend) {
+    case GlBackend::OSMesa:
+      return render_internal::createOsMesaContext(params);
+    case GlBackend::Egl:
+      return render_internal::createEglContext(params);
+    case GlBackend::Glfw:
+      return render_internal::createGlfwContext(params);
+  }
+  throw InputError("unknown GL back end");
+}
+
+}  // namespace lo

@@ -1,0 +1,126 @@
+#include "render/gl_util.h"
+
+#include <cstdio>
+
+#include "render/context.h"
+
+namespace lo::render_internal {
+namespace {
+
+GLenum stageOf(const std::string& file) {
+  auto ends = [&](const char* ext) {
+    std::string e(ext);
+    return file.size() >= e.size() && file.compare(file.size() - e.size(), e.size(), e) == 0;
+  };
+  if (ends(".vert")) return GL_VERTEX_SHADER;
+  if (ends(".frag")) return GL_FRAGMENT_SHADER;
+  if (ends(".geom")) return GL_GEOMETRY_SHADER;
+  if (ends(".comp")) return GL_COMPUTE_SHADER;
+  throw GlError("shader '" + file + "': unknown stage extension");
+}
+
+std::string infoLog(GLuint object, bool program) {
+  GLint length = 0;
+  if (program) {
+    glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length);
+  } else {
+    glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
+  }
+  std::string log(size_t(length > 0 ? length : 1), '\0');
+  if (program) {
+    glGetProgramInfoLog(object, length, nullptr, log.data());
+  } else {
+    glGetShaderInfoLog(object, length, nullptr, log.data());
+  }
+  return log.c_str();
+}
+
+}  // namespace
+
+std::string shaderSource(const std::string& name, const std::vector<std::string>& defines) {
+  const char* text = embeddedShader(name.c_str());
+  if (!text) throw GlError("shader '" + name + "' is not among the embedded shaders/");
+  std::string source = text;
+  GLenum stage = stageOf(name);
+  size_t versionEnd = source.find('\n', source.find("#version"));
+  if (source.find("#version") == std::string::npos || versionEnd == std::string::npos) {
+    throw GlError("shader '" + name + "': no #version line");
+  }
+  std::string inserted;
+  for (const std::string& d : defines) inserted += "#define " + d + "\n";
+  if (stage == GL_FRAGMENT_SHADER || stage == GL_COMPUTE_SHADER) {
+    // Two shims so the header, written for both languages, compiles as GLSL:
+    // `packed` is a reserved word in GLSL (Mesa rejects it) but a parameter
+    // name in the header, and GLSL spells atan2 as atan(y, x), undefined at
+    // (0, 0), where C++ follows IEEE signed zeros (+-0 or +-pi); the shim does too.
+    inserted +=
+        "#define packed lo_packed_\n"
+        "float atan2(float y, float x) {\n"
+        "  if (x != 0.0 || y != 0.0) return atan(y, x);\n"
+        "  bool negX = (floatBitsToUint(x) >> 31u) != 0u, negY = (floatBitsToUint(y) >> 31u) != "
+        "0u;\n"
+        "  return negX ? (negY ? -3.14159265358979323846 : 3.14159265358979323846) : y;\n"
+        "}\n";
+    inserted += embeddedShader("octree_layout.h");
+    inserted += "\n#undef packed\n";
+  }
+  // Keep the shader's own line numbers in compiler messages.
+  inserted += "#line 2\n";
+  source.insert(versionEnd + 1, inserted);
+  return source;
+}
+
+GLuint buildProgram(const std::vector<std::string>& files,
+                    const std::vector<std::string>& defines) {
+  GLuint program = glCreateProgram();
+  std::vector<GLuint> shaders;
+  auto cleanup = [&]() {
+    for (GLuint s : shaders) glDeleteShader(s);
+  };
+  for (const std::string& file : files) {
+    std::string source = shaderSource(file, defines);
+    GLuint shader = glCreateShader(stageOf(file));
+    shaders.push_back(shader);
+    const char* text = source.c_str();
+    glShaderSource(shader, 1, &text, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      std::string log = infoLog(shader, false);
+      cleanup();
+      glDeleteProgram(program);
+      throw GlError("shaders/" + file + " does not compile:\n" + log);
+    }
+    glAttachShader(program, shader);
+  }
+  glLinkProgram(program);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  cleanup();
+  if (!ok) {
+    std::string log = infoLog(program, true);
+    glDeleteProgram(program);
+    std::string names;
+    for (const std::string& f : files) names += (names.empty() ? "" : " + ") + f;
+    throw GlError("program " + names + " does not link:\n" + log);
+  }
+  return program;
+}
+
+std::vector<std::vector<std::string>> allPrograms() {
+  return {{"render_scene.vert", "render_scene.frag"},
+          {"render_shadow.vert", "render_shadow.frag"},
+          {"render_fullscreen.vert", "render_layout_probe.frag"}};
+}
+
+void checkGl(const char* what) {
+  GLenum e = glGetError();
+  if (e != GL_NO_ERROR) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "0x%04x", e);
+    throw GlError(std::string(what) + ": GL error " + buf);
+  }
+}
+
+}  // namespace lo::render_internal

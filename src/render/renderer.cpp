@@ -1,0 +1,651 @@
+// Renderer: scene + light octree -> linear HDR pixels (paper §3.2, §4.2).
+
+#include "render/renderer.h"
+
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <sstream>
+
+#include "core/error.h"
+#include "render/context.h"
+#include "render/gl_util.h"
+#include "render/layout_probe.h"
+
+namespace lo {
+namespace render_internal {
+
+constexpr int kMaxLights = 32;        // = kMaxLights in render_scene.frag
+constexpr int kMaxShadowLayers = 96;  // = kMaxShadowLayers in render_scene.frag
+
+enum LightType { kPoint = 0, kSpot = 1, kDirectional = 2, kEmitter = 3 };
+
+/// std140 twin of `struct Light` in shaders/render_scene.frag.
+struct GpuLight {
+  float positionType[4];
+  float directionRange[4];
+  float colorFar[4];
+  float params[4];
+};
+static_assert(sizeof(GpuLight) == 64, "std140 Light is 4 vec4");
+
+/// std140 twin of `uniform LightBlock` in shaders/render_scene.frag.
+struct LightBlock {
+  GpuLight lights[kMaxLights];
+  float shadowMatrices[kMaxShadowLayers][16];
+  int32_t lightCount[4];
+  float shadowParams[4];
+};
+static_assert(sizeof(LightBlock) == kMaxLights * 64 + kMaxShadowLayers * 64 + 16 + 16,
+              "std140 LightBlock layout");
+
+struct Vertex {
+  float position[3];
+  float normal[3];
+  float baseColor[3];
+  float metallicRoughness[2];
+  float emission[3];
+};
+
+glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
+
+void setVec4(float* dst, const Vec3& v, float w) {
+  dst[0] = v.x;
+  dst[1] = v.y;
+  dst[2] = v.z;
+  dst[3] = w;
+}
+
+/// Any unit vector orthogonal to unit d.
+glm::vec3 perpendicular(const glm::vec3& d) {
+  glm::vec3 a = std::fabs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+  return glm::normalize(glm::cross(d, glm::cross(a, d)));
+}
+
+std::string texelCount(int w, int h, int d) {
+  std::ostringstream os;
+  os << w << " x " << h;
+  if (d > 0) os << " x " << d;
+  return os.str();
+}
+
+}  // namespace render_internal
+
+using namespace render_internal;
+
+RenderMode parseRenderMode(const std::string& name) {
+  if (name == "full") return RenderMode::Full;
+  if (name == "direct") return RenderMode::Direct;
+  if (name == "indirect") return RenderMode::Indirect;
+  if (name == "voxels") return RenderMode::Voxels;
+  throw InputError("unknown render mode '" + name + "' (expected full, direct, indirect, voxels)");
+}
+
+std::string toString(RenderMode mode) {
+  switch (mode) {
+    case RenderMode::Full:
+      return "full";
+    case RenderMode::Direct:
+      return "direct";
+    case RenderMode::Indirect:
+      return "indirect";
+    case RenderMode::Voxels:
+      return "voxels";
+  }
+  return "?";
+}
+
+RenderCamera RenderCamera::fromScene(const Camera& camera) {
+  RenderCamera c;
+  c.eye = camera.position;
+  c.forward = normalize(camera.forward);
+  c.up = normalize(camera.up);
+  c.yfov = camera.yfov;
+  c.znear = camera.znear > 0 ? camera.znear : 0.01f;
+  c.zfar = camera.zfar;
+  return c;
+}
+
+RenderCamera RenderCamera::lookAt(const Vec3& eye, const Vec3& target, float yfovRadians) {
+  RenderCamera c;
+  c.eye = eye;
+  c.forward = normalize(target - eye);
+  if (lengthSquared(c.forward) == 0) throw InputError("camera: eye and target are the same point");
+  Vec3 worldUp = std::fabs(c.forward.y) > 0.999f ? Vec3(0, 0, -1) : Vec3(0, 1, 0);
+  Vec3 right = normalize(cross(c.forward, worldUp));
+  c.up = cross(right, c.forward);
+  c.yfov = yfovRadians;
+  c.znear = std::max(1e-4f, 1e-3f * length(target - eye));
+  return c;
+}
+
+RenderCamera RenderCamera::framing(const Bounds3& bounds, float yfovRadians) {
+  Vec3 center = bounds.center();
+  float radius = 0.5f * length(bounds.extent());
+  float distance = radius / std::sin(0.5f * yfovRadians);
+  return lookAt(center + Vec3(0, 0, std::max(distance, 1e-3f)), center, yfovRadians);
+}
+
+struct Renderer::Impl {
+  RendererParams params;
+  Bounds3 bounds;
+  float sceneSize = 1;  // bounds diagonal, world units
+  int depth = 0;
+  Vec3 octreeOrigin;
+  float voxelSize = 1;
+
+  GLuint sceneProgram = 0, shadowProgram = 0, probeProgram = 0;
+  GLuint vao = 0, vbo = 0, emptyVao = 0;
+  GLsizei vertexCount = 0;
+  GLuint octreeTexture = 0, vdlTexture = 0, shadowTexture = 0, lightUbo = 0;
+  GLuint shadowFbo = 0;
+  GLuint targetFbo = 0, targetColor = 0, targetDepth = 0;
+  int targetWidth = 0, targetHeight = 0;
+  int emitterLights = 0;
+
+  LightBlock lightBlock{};
+
+  ~Impl() {
+    GLuint programs[] = {sceneProgram, shadowProgram, probeProgram};
+    for (GLuint p : programs) {
+      if (p) glDeleteProgram(p);
+    }
+    GLuint textures[] = {octreeTexture, vdlTexture, shadowTexture, targetColor};
+    glDeleteTextures(4, textures);
+    glDeleteBuffers(1, &vbo);
+    glDeleteBuffers(1, &lightUbo);
+    glDeleteVertexArrays(1, &vao);
+    glDeleteVertexArrays(1, &emptyVao);
+    glDeleteFramebuffers(1, &shadowFbo);
+    glDeleteFramebuffers(1, &targetFbo);
+    glDeleteRenderbuffers(1, &targetDepth);
+  }
+
+  void checkLimits(const GpuOctree& octree) {
+    GLint max3D = params.max3DTextureSize, max2D = params.max2DTextureSize;
+    if (max3D <= 0) glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3D);
+    if (max2D <= 0) glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max2D);
+    int largest3D = std::max({octree.poolWidth(), octree.poolHeight(), octree.poolDepth()});
+    if (largest3D > max3D) {
+      throw InputError("octree pool of " +
+                       texelCount(octree.poolWidth(), octree.poolHeight(), octree.poolDepth()) +
+                       " texels exceeds GL_MAX_3D_TEXTURE_SIZE = " + std::to_string(max3D) +
+                       " by " + std::to_string(largest3D - max3D) +
+                       " texels: rebake with a smaller --depth");
+    }
+    int largest2D = std::max(octree.vdlWidth, octree.vdlHeight);
+    if (largest2D > max2D) {
+      throw InputError("VDL texture of " + texelCount(octree.vdlWidth, octree.vdlHeight, 0) +
+                       " texels exceeds GL_MAX_TEXTURE_SIZE = " + std::to_string(max2D) + " by " +
+                       std::to_string(largest2D - max2D) +
+                       " texels: rebake with a smaller --depth or fewer --vdls");
+    }
+  }
+
+  void uploadOctree(const GpuOctree& octree) {
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glGenTextures(1, &octreeTexture);
+    glBindTexture(GL_TEXTURE_3D, octreeTexture);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    const uint8_t emptyTexel[4] = {0, 0, 0, 0};  // LO_FLAG_EMPTY: keeps the sampler complete
+    size_t expected = size_t(octree.poolWidth()) * octree.poolHeight() * octree.poolDepth() * 4;
+    bool hasPool = expected > 0;
+    if (hasPool) LO_CHECK_EQ(octree.pool.size(), expected);
+    glTexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8UI, hasPool ? octree.poolWidth() : 1,
+                 hasPool ? octree.poolHeight() : 1, hasPool ? octree.poolDepth() : 1, 0,
+                 GL_RGBA_INTEGER, GL_UNSIGNED_BYTE, hasPool ? octree.pool.data() : emptyTexel);
+    checkGl("uploading the octree pool (GL_TEXTURE_3D, GL_RGBA8UI)");
+
+    glGenTextures(1, &vdlTexture);
+    glBindTexture(GL_TEXTURE_2D, vdlTexture);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    size_t vdlTexels = size_t(octree.vdlWidth) * octree.vdlHeight * 4;
+    const float zero[4] = {0, 0, 0, 0};
+    if (vdlTexels == 0) {
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, 1, 1, 0, GL_RGBA, GL_FLOAT, zero);
+    } else if (octree.halfFloat) {
+      LO_CHECK_EQ(octree.vdlTexelsHalf.size(), vdlTexels);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, octree.vdlWidth, octree.vdlHeight, 0, GL_RGBA,
+                   GL_HALF_FLOAT, octree.vdlTexelsHalf.data());
+    } else {
+      LO_CHECK_EQ(octree.vdlTexels.size(), vdlTexels);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, octree.vdlWidth, octree.vdlHeight, 0, GL_RGBA,
+                   GL_FLOAT, octree.vdlTexels.data());
+    }
+    checkGl("uploading the VDL texture (GL_TEXTURE_2D)");
+    depth = octree.depth;
+    octreeOrigin = octree.origin;
+    voxelSize = octree.depth > 0 ? octree.cubeSize / float(1 << octree.depth) : octree.cubeSize;
+  }
+
+  void uploadScene(const Scene& scene) {
+    std::vector<Vertex> vertices;
+    vertices.reserve(scene.triangleCount() * 3);
+    const Material fallback;
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+      int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+      const Material& mat =
+          m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
+      Vec3 faceN = scene.faceNormal(t);
+      // Base colour texture sampled at the vertices (per-vertex colour): the
+      // renderer has no texture maps yet, see docs/render.md.
+      const float bary[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+      for (int k = 0; k < 3; ++k) {
+        uint32_t index = scene.indices[t * 3 + size_t(k)];
+        Vertex v{};
+        Vec3 p = scene.positions[index];
+        Vec3 n = scene.normals.empty() ? faceN : scene.normals[index];
+        Vec3 albedo = m >= 0 ? scene.albedo(t, bary[k][0], bary[k][1]) : mat.baseColor;
+        std::memcpy(v.position, &p, sizeof v.position);
+        std::memcpy(v.normal, &n, sizeof v.normal);
+        std::memcpy(v.baseColor, &albedo, sizeof v.baseColor);
+        v.metallicRoughness[0] = mat.metallic;
+        v.metallicRoughness[1] = mat.roughness;
+        std::memcpy(v.emission, &mat.emission, sizeof v.emission);
+        vertices.push_back(v);
+      }
+    }
+    vertexCount = GLsizei(vertices.size());
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glGenBuffers(1, &vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)),
+                 vertices.empty() ? nullptr : vertices.data(), GL_STATIC_DRAW);
+    auto attrib = [](GLuint location, GLint size, size_t offset) {
+      glEnableVertexAttribArray(location);
+      glVertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                            reinterpret_cast<const void*>(offset));
+    };
+    attrib(0, 3, offsetof(Vertex, position));
+    attrib(1, 3, offsetof(Vertex, normal));
+    attrib(2, 3, offsetof(Vertex, baseColor));
+    attrib(3, 2, offsetof(Vertex, metallicRoughness));
+    attrib(4, 3, offsetof(Vertex, emission));
+    glBindVertexArray(0);
+    glGenVertexArrays(1, &emptyVao);
+    checkGl("uploading the scene");
+  }
+
+  /// Emissive triangles -> `count` virtual point lights, chosen in proportion
+  /// to emitted power (average emission x area) by stratified, deterministic
+  /// sampling; each carries the power of its stratum as the intensity of a
+  /// Lambertian patch I(theta) = L A cos(theta).
+  std::vector<GpuLight> emitterVpls(const Scene& scene, int count) {
+    std::vector<size_t> tris;
+    std::vector<double> cdf;
+    double total = 0;
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+      int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+      if (m < 0 || size_t(m) >= scene.materials.size()) continue;
+      const Material& mat = scene.materials[size_t(m)];
+      double w = double(average(mat.emission)) * scene.triangleArea(t);
+      if (!(w > 0)) continue;
+      total += w;
+      tris.push_back(t);
+      cdf.push_back(total);
+    }
+    std::vector<GpuLight> out;
+    if (tris.empty() || count <= 0) return out;
+    for (int i = 0; i < count; ++i) {
+      double u = (i + 0.5) / count * total;
+      size_t k = size_t(std::lower_bound(cdf.begin(), cdf.end(), u) - cdf.begin());
+      k = std::min(k, tris.size() - 1);
+      size_t t = tris[k];
+      double lo = k > 0 ? cdf[k - 1] : 0.0;
+      float s = float((u - lo) / (cdf[k] - lo));
+      // Second coordinate from the base-2 radical inverse of i.
+      uint32_t bits = uint32_t(i);
+      bits = (bits << 16u) | (bits >> 16u);
+      bits = ((bits & 0x55555555u) << 1u) | ((bits & 0xAAAAAAAAu) >> 1u);
+      bits = ((bits & 0x33333333u) << 2u) | ((bits & 0xCCCCCCCCu) >> 2u);
+      bits = ((bits & 0x0F0F0F0Fu) << 4u) | ((bits & 0xF0F0F0F0u) >> 4u);
+      bits = ((bits & 0x00FF00FFu) << 8u) | ((bits & 0xFF00FF00u) >> 8u);
+      float r = float(bits) * 2.3283064365386963e-10f;
+      float su = std::sqrt(std::clamp(s, 0.0f, 1.0f));
+      float b1 = su * (1 - r), b2 = su * r;
+      const Vec3& p0 = scene.positions[scene.indices[t * 3]];
+      const Vec3& p1 = scene.positions[scene.indices[t * 3 + 1]];
+      const Vec3& p2 = scene.positions[scene.indices[t * 3 + 2]];
+      Vec3 n = scene.faceNormal(t);
+      Vec3 p = p0 * (1 - b1 - b2) + p1 * b1 + p2 * b2 + n * (1e-3f * sceneSize);
+      const Material& mat = scene.materials[size_t(scene.triangleMaterial[t])];
+      // Area this sample stands for: the whole emitter power shared by count.
+      float area = float(total / double(average(mat.emission)) / count);
+      GpuLight l{};
+      setVec4(l.positionType, p, float(kEmitter));
+      setVec4(l.directionRange, n, 0);
+      setVec4(l.colorFar, mat.emission * area, 0);
+      setVec4(l.params, Vec3(-1, 1, -1), area);
+      out.push_back(l);
+    }
+    return out;
+  }
+
+  void setupLights(const Scene& scene) {
+    std::vector<GpuLight> lights;
+    for (const Light& light : scene.lights) {
+      GpuLight l{};
+      Vec3 color = light.color * light.intensity;
+      int type = light.type == Light::Type::Point  ? kPoint
+                 : light.type == Light::Type::Spot ? kSpot
+                                                   : kDirectional;
+      setVec4(l.positionType, light.position, float(type));
+      setVec4(l.directionRange, normalize(light.direction), light.range);
+      setVec4(l.colorFar, color, 0);
+      setVec4(l.params, Vec3(std::cos(light.outerConeAngle), std::cos(light.innerConeAngle), -1),
+              0);
+      lights.push_back(l);
+    }
+    std::vector<GpuLight> vpls = emitterVpls(scene, params.emitterLights);
+    emitterLights = int(vpls.size());
+    lights.insert(lights.end(), vpls.begin(), vpls.end());
+    if (lights.size() > size_t(kMaxLights)) {
+      throw InputError("scene has " + std::to_string(lights.size()) +
+                       " punctual + emitter lights; the renderer draws at most " +
+                       std::to_string(kMaxLights) + " (lower --emitter-lights)");
+    }
+
+    // Shadow map layers: 6 per point light / emitter VPL (cube faces), 1 per
+    // spot or directional light, while layers last (further lights unshadowed).
+    int layers = 0;
+    glm::vec3 center = toGlm(bounds.center());
+    float radius = 0.5f * sceneSize;
+    float nearPlane = 1e-3f * sceneSize;
+    for (GpuLight& l : lights) {
+      int type = int(l.positionType[3]);
+      int need = type == kPoint || type == kEmitter ? 6 : 1;
+      if (layers + need > kMaxShadowLayers) continue;
+      glm::vec3 pos(l.positionType[0], l.positionType[1], l.positionType[2]);
+      glm::vec3 dir(l.directionRange[0], l.directionRange[1], l.directionRange[2]);
+      float far = glm::length(pos - center) + radius + nearPlane;
+      l.params[2] = float(layers);
+      if (type == kPoint || type == kEmitter) {
+        const glm::vec3 axes[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                   {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+        glm::mat4 proj = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, far);
+        for (int f = 0; f < 6; ++f) {
+          glm::mat4 m = proj * glm::lookAt(pos, pos + axes[f], perpendicular(axes[f]));
+          std::memcpy(lightBlock.shadowMatrices[layers + f], glm::value_ptr(m), 64);
+        }
+        l.colorFar[3] = far;
+      } else if (type == kSpot) {
+        float fov = std::min(2.0f * std::acos(std::clamp(l.params[0], -1.0f, 1.0f)) + 0.05f, 3.0f);
+        glm::mat4 m = glm::perspective(fov, 1.0f, nearPlane, far) *
+                      glm::lookAt(pos, pos + dir, perpendicular(dir));
+        std::memcpy(lightBlock.shadowMatrices[layers], glm::value_ptr(m), 64);
+        l.colorFar[3] = far;
+      } else {
+        glm::vec3 eye = center - dir * (2.0f * radius);
+        glm::mat4 m = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
+                      glm::lookAt(eye, center, perpendicular(dir));
+        std::memcpy(lightBlock.shadowMatrices[layers], glm::value_ptr(m), 64);
+        l.colorFar[3] = 0;
+      }
+      layers += need;
+    }
+    std::copy(lights.begin(), lights.end(), lightBlock.lights);
+    lightBlock.lightCount[0] = int32_t(lights.size());
+    // Depth bias as a fraction of the far plane and a normal offset, both
+    // about one shadow texel at the scene's scale.
+    float texel = 2.0f * sceneSize / float(params.shadowMapSize);
+    lightBlock.shadowParams[0] = 0.5f * texel / std::max(sceneSize, 1e-6f);
+    lightBlock.shadowParams[1] = 1.5f * texel;
+
+    glGenBuffers(1, &lightUbo);
+    glBindBuffer(GL_UNIFORM_BUFFER, lightUbo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(LightBlock), &lightBlock, GL_STATIC_DRAW);
+    glBindBuffer(GL_UNIFORM_BUFFER, 0);
+
+    glGenTextures(1, &shadowTexture);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, shadowTexture);
+    int size = layers > 0 ? params.shadowMapSize : 1;
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT24, size, size, std::max(layers, 1), 0,
+                 GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    checkGl("allocating the shadow maps");
+
+    glGenFramebuffers(1, &shadowFbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    glViewport(0, 0, size, size);
+    glEnable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(shadowProgram);
+    glBindVertexArray(vao);
+    for (int i = 0; i < lightBlock.lightCount[0]; ++i) {
+      const GpuLight& l = lightBlock.lights[i];
+      if (l.params[2] < 0) continue;
+      int type = int(l.positionType[3]);
+      int n = type == kPoint || type == kEmitter ? 6 : 1;
+      glUniform3fv(glGetUniformLocation(shadowProgram, "uLightPosition"), 1, l.positionType);
+      glUniform1f(glGetUniformLocation(shadowProgram, "uFar"), l.colorFar[3]);
+      for (int f = 0; f < n; ++f) {
+        int layer = int(l.params[2]) + f;
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadowTexture, 0, layer);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+          throw GlError("shadow map framebuffer incomplete");
+        }
+        glClear(GL_DEPTH_BUFFER_BIT);
+        glUniformMatrix4fv(glGetUniformLocation(shadowProgram, "uViewProj"), 1, GL_FALSE,
+                           lightBlock.shadowMatrices[layer]);
+        glDrawArrays(GL_TRIANGLES, 0, vertexCount);
+      }
+    }
+    glBindVertexArray(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    checkGl("rendering the shadow maps");
+  }
+
+  void ensureTarget(int width, int height) {
+    if (targetFbo && width == targetWidth && height == targetHeight) return;
+    if (!targetFbo) {
+      glGenFramebuffers(1, &targetFbo);
+      glGenTextures(1, &targetColor);
+      glGenRenderbuffers(1, &targetDepth);
+    }
+    glBindTexture(GL_TEXTURE_2D, targetColor);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindRenderbuffer(GL_RENDERBUFFER, targetDepth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, targetFbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, targetColor, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, targetDepth);
+    GLenum drawBuffer = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &drawBuffer);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw GlError("render target framebuffer (RGBA32F " + texelCount(width, height, 0) +
+                    ") incomplete");
+    }
+    targetWidth = width;
+    targetHeight = height;
+  }
+
+  void draw(const RenderCamera& camera, const RenderParams& rp, int width, int height,
+            float exposureScale, bool encodeSrgb) {
+    if (width < 1 || height < 1) throw InputError("render: image size must be at least 1 x 1");
+    if (rp.maxVdls < 1 || rp.maxVdls > 8) {
+      throw InputError("render: VDLs per voxel must be 1..8, got " + std::to_string(rp.maxVdls));
+    }
+    glm::vec3 eye = toGlm(camera.eye);
+    float zfar = camera.zfar > 0 ? camera.zfar
+                                 : glm::length(eye - toGlm(bounds.center())) + sceneSize + 1e-3f;
+    float znear = std::min(camera.znear > 0 ? camera.znear : 0.01f, 0.5f * zfar);
+    glm::mat4 viewProj = glm::perspective(camera.yfov, float(width) / float(height), znear, zfar) *
+                         glm::lookAt(eye, eye + toGlm(camera.forward), toGlm(camera.up));
+
+    glViewport(0, 0, width, height);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    GLuint p = sceneProgram;
+    glUseProgram(p);
+    auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
+    glUniformMatrix4fv(loc("uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
+    glUniform3f(loc("uOctreeOrigin"), octreeOrigin.x, octreeOrigin.y, octreeOrigin.z);
+    glUniform1f(loc("uVoxelSize"), voxelSize);
+    glUniform1i(loc("uDepth"), depth);
+    glUniform3f(loc("uEye"), camera.eye.x, camera.eye.y, camera.eye.z);
+    glUniform1i(loc("uMode"), int(rp.mode));
+    glUniform1i(loc("uInterpolation"), rp.interpolation ? 1 : 0);
+    glUniform1i(loc("uSpecular"), rp.specular ? 1 : 0);
+    glUniform1i(loc("uMaxVdls"), rp.maxVdls);
+    glUniform1f(loc("uNormalOffset"), rp.normalOffset);
+    glUniform1f(loc("uExposureScale"), exposureScale);
+    glUniform1i(loc("uEncodeSrgb"), encodeSrgb ? 1 : 0);
+    glUniform1i(loc("uOctree"), 0);
+    glUniform1i(loc("uVdls"), 1);
+    glUniform1i(loc("uShadowMaps"), 2);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_3D, octreeTexture);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, vdlTexture);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, shadowTexture);
+    glActiveTexture(GL_TEXTURE0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo);
+    glBindVertexArray(vao);
+    glDrawArrays(GL_TRIANGLES, 0, vertexCount);
+    glBindVertexArray(0);
+    checkGl("drawing the scene");
+  }
+};
+
+Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererParams& params)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& r = *impl_;
+  r.params = params;
+  if (params.shadowMapSize < 1 || params.shadowMapSize > 16384) {
+    throw InputError("shadow map size must be 1..16384, got " +
+                     std::to_string(params.shadowMapSize));
+  }
+  if (params.emitterLights < 0) throw InputError("emitter lights must be >= 0");
+  r.checkLimits(octree);
+  r.bounds = scene.bounds();
+  if (r.bounds.empty()) r.bounds.extend(Vec3(0, 0, 0));
+  r.sceneSize = std::max(length(r.bounds.extent()), 1e-3f);
+  r.sceneProgram = buildProgram({"render_scene.vert", "render_scene.frag"});
+  glUniformBlockBinding(r.sceneProgram, glGetUniformBlockIndex(r.sceneProgram, "LightBlock"), 0);
+  r.shadowProgram = buildProgram({"render_shadow.vert", "render_shadow.frag"});
+  r.uploadOctree(octree);
+  r.uploadScene(scene);
+  r.setupLights(scene);
+}
+
+Renderer::~Renderer() = default;
+
+int Renderer::emitterLightCount() const { return impl_->emitterLights; }
+
+Image Renderer::render(const RenderCamera& camera, const RenderParams& params) {
+  Impl& r = *impl_;
+  r.ensureTarget(params.width, params.height);
+  glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo);
+  r.draw(camera, params, params.width, params.height, 1.0f, false);
+  Image image;
+  image.width = params.width;
+  image.height = params.height;
+  std::vector<float> raw(size_t(params.width) * params.height * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, params.width, params.height, GL_RGBA, GL_FLOAT, raw.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  checkGl("reading back the image");
+  // GL rows go bottom-up; Image rows top-down.
+  image.rgba.resize(raw.size());
+  size_t row = size_t(params.width) * 4;
+  for (int y = 0; y < params.height; ++y) {
+    std::memcpy(image.rgba.data() + size_t(y) * row,
+                raw.data() + size_t(params.height - 1 - y) * row, row * sizeof(float));
+  }
+  return image;
+}
+
+void Renderer::drawToScreen(const RenderCamera& camera, const RenderParams& params,
+                            float exposure) {
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  impl_->draw(camera, params, params.width, params.height, std::exp2(exposure), true);
+}
+
+double Renderer::timeFrames(const RenderCamera& camera, const RenderParams& params, int frames) {
+  Impl& r = *impl_;
+  r.ensureTarget(params.width, params.height);
+  glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo);
+  r.draw(camera, params, params.width, params.height, 1.0f, false);  // warm-up
+  glFinish();
+  auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < frames; ++i) {
+    r.draw(camera, params, params.width, params.height, 1.0f, false);
+    glFinish();
+  }
+  auto stop = std::chrono::steady_clock::now();
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return std::chrono::duration<double>(stop - start).count();
+}
+
+void compileAllShaders() {
+  for (const std::vector<std::string>& files : allPrograms()) {
+    glDeleteProgram(buildProgram(files));
+  }
+}
+
+std::vector<std::array<float, 4>> runLayoutProbe(LayoutProbe function,
+                                                 const std::vector<std::array<float, 4>>& inputs) {
+  int n = int(inputs.size());
+  std::vector<std::array<float, 4>> out(inputs.size());
+  if (n == 0) return out;
+  GLuint program = buildProgram({"render_fullscreen.vert", "render_layout_probe.frag"});
+  GLuint textures[2], fbo, vao;
+  glGenTextures(2, textures);
+  glBindTexture(GL_TEXTURE_2D, textures[0]);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, n, 1, 0, GL_RGBA, GL_FLOAT, inputs.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glBindTexture(GL_TEXTURE_2D, textures[1]);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, n, 1, 0, GL_RGBA, GL_FLOAT, nullptr);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glGenFramebuffers(1, &fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, textures[1], 0);
+  GLenum drawBuffer = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &drawBuffer);
+  glGenVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glViewport(0, 0, n, 1);
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(program);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, textures[0]);
+  glUniform1i(glGetUniformLocation(program, "uInputs"), 0);
+  glUniform1i(glGetUniformLocation(program, "uFunction"), int(function));
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, n, 1, GL_RGBA, GL_FLOAT, out.data());
+  glBindVertexArray(0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteVertexArrays(1, &vao);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(2, textures);
+  glDeleteProgram(program);
+  checkGl("layout probe");
+  return out;
+}
+
+}  // namespace lo

@@ -1,0 +1,107 @@
+#pragma once
+/// @file render/renderer.h
+/// @brief Real-time rendering of a scene lit by its light octree (paper §3.2,
+/// §4.2): indirect light from the VDLs of the voxel under each fragment, plus
+/// (hybrid, paper §3) direct light from punctual lights and emitters with
+/// shadow maps. Needs a current GlContext (render/context.h). Output is linear
+/// HDR radiance, W/(m^2 sr) in the scene's light units. See docs/render.md.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+#include "octree/gpu_octree.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+enum class RenderMode {
+  Full,      ///< emission + direct + indirect
+  Direct,    ///< emission + punctual lights + emitter lights (shadow-mapped)
+  Indirect,  ///< the light octree only
+  Voxels,    ///< leaves coloured by a hash of their voxel coordinate; empty = black
+};
+/// "full" | "direct" | "indirect" | "voxels". @throws InputError naming the value.
+RenderMode parseRenderMode(const std::string& name);
+std::string toString(RenderMode mode);
+
+/// Per-frame settings (cheap to change between frames).
+struct RenderParams {
+  int width = 800, height = 600;  ///< pixels
+  RenderMode mode = RenderMode::Full;
+  bool interpolation = true;  ///< trilinear over the 8 neighbouring voxels (paper §4.2.1)
+  bool specular = true;       ///< GGX lobe of the glTF BRDF; off = diffuse only
+  int maxVdls = 8;            ///< VDLs used per voxel, 1..8 (the strongest come first)
+  /// Lookup point offset along the surface normal, in voxel sizes (see
+  /// docs/render.md: picks the voxel in front of a surface lying on a voxel face).
+  float normalOffset = 0.01f;
+};
+
+/// Set once: resources built for the scene.
+struct RendererParams {
+  int shadowMapSize = 1024;  ///< texels per side of every shadow map layer
+  /// Emissive triangles become this many shadowed virtual point lights for the
+  /// direct pass (0 = none: then bake with --include-direct to see their light).
+  int emitterLights = 8;
+  /// Texture limits to respect; 0 = query the current context.
+  int max3DTextureSize = 0, max2DTextureSize = 0;
+};
+
+/// A pinhole camera in world space.
+struct RenderCamera {
+  Vec3 eye{0, 0, 1};
+  Vec3 forward{0, 0, -1};  ///< unit
+  Vec3 up{0, 1, 0};        ///< unit, orthogonal to forward
+  float yfov = 0.8f;       ///< vertical field of view, radians
+  float znear = 0.01f;     ///< scene units
+  float zfar = 0;          ///< 0 = from the scene bounds
+
+  static RenderCamera fromScene(const Camera& camera);
+  /// Looks at `target` from `eye`; world up is +Y unless the view is along it.
+  static RenderCamera lookAt(const Vec3& eye, const Vec3& target, float yfovRadians);
+  /// Frames the scene bounds from the +Z side.
+  static RenderCamera framing(const Bounds3& bounds, float yfovRadians);
+};
+
+/// Linear float RGBA pixels, row 0 at the top.
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgba;  ///< width * height * 4
+  const float* pixel(int x, int y) const { return rgba.data() + (size_t(y) * width + x) * 4; }
+};
+
+class Renderer {
+ public:
+  /// Uploads the scene geometry, the octree textures and renders the shadow
+  /// maps. Requires a current GL context.
+  /// @throws InputError naming GL_MAX_3D_TEXTURE_SIZE / GL_MAX_TEXTURE_SIZE and
+  /// by how much when the octree's textures exceed the context's limits;
+  /// GlError on a GL failure.
+  Renderer(const Scene& scene, const GpuOctree& octree, const RendererParams& params = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  /// Renders into an offscreen RGBA32F target and reads it back.
+  Image render(const RenderCamera& camera, const RenderParams& params);
+  /// Renders into the currently bound framebuffer (a window); `exposure` in EV
+  /// scales the radiance, then a clamp and sRGB encoding are applied.
+  void drawToScreen(const RenderCamera& camera, const RenderParams& params, float exposure);
+
+  /// Seconds of GPU+CPU time for `frames` offscreen frames (glFinish after
+  /// each), without the read-back: the real-time cost.
+  double timeFrames(const RenderCamera& camera, const RenderParams& params, int frames);
+
+  int emitterLightCount() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Compiles and links every shader program the renderer ships; throws GlError
+/// naming the file on the first failure. For tests and `--check-shaders`.
+void compileAllShaders();
+
+}  // namespace lo

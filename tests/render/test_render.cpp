@@ -1,0 +1,482 @@
+// Renderer tests under OSMesa (software GL, no display): shaders compile, the
+// C++ and GLSL builds of the octree layout agree, analytic images, limits.
+
+#include <gtest/gtest.h>
+#include <octree_layout.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <sstream>
+
+#include "../test_util.h"
+#include "core/error.h"
+#include "render/context.h"
+#include "render/image_io.h"
+#include "render/layout_probe.h"
+#include "render/renderer.h"
+
+namespace lo {
+namespace {
+
+/// One OSMesa context for the whole binary; tests skip if there is none.
+GlContext* osmesa() {
+  static std::unique_ptr<GlContext> context;
+  static bool tried = false;
+  static std::string why;
+  if (!tried) {
+    tried = true;
+    try {
+      context = createGlContext({GlBackend::OSMesa});
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+  }
+  if (context) context->makeCurrent();
+  return context.get();
+}
+
+#define REQUIRE_OSMESA()                                          \
+  do {                                                            \
+    if (!osmesa()) GTEST_SKIP() << "no OSMesa context available"; \
+  } while (0)
+
+using VdlsOf = std::function<int(const Coord&, Vdl*)>;
+
+/// A light octree built by hand (independent of buildGpuOctree): depth
+/// `depth` over the cube [origin, origin + cubeSize]^3; tiles laid out along x.
+GpuOctree makeOctree(int depth, const Vec3& origin, float cubeSize, const VdlsOf& vdlsOf) {
+  namespace L = layout;
+  struct Tile {
+    uint8_t texels[8][4];
+  };
+  std::vector<Tile> tiles;
+  std::vector<float> vdls;  // RGBA per VDL
+  size_t leaves = 0;
+  std::function<int(int, Coord)> build = [&](int level, Coord base) -> int {
+    int index = int(tiles.size());
+    tiles.push_back({});
+    bool any = false;
+    for (int child = 0; child < 8; ++child) {
+      int cx = child & 1, cy = (child >> 1) & 1, cz = (child >> 2) & 1;
+      Coord c{base.x * 2 + cx, base.y * 2 + cy, base.z * 2 + cz};
+      uint8_t texel[4] = {0, 0, 0, uint8_t(L::LO_FLAG_EMPTY)};
+      if (level + 1 == depth) {
+        Vdl v[kMaxVdls];
+        int n = vdlsOf(c, v);
+        if (n > 0) {
+          uint32_t address = uint32_t(vdls.size() / 4);
+          for (int i = 0; i < n; ++i) {
+            const Vdl& d = v[i];
+            vdls.insert(vdls.end(),
+                        {d.irradiance.x, d.irradiance.y, d.irradiance.z,
+                         L::loPackDirection(d.direction.x, d.direction.y, d.direction.z)});
+          }
+          texel[0] = uint8_t(L::loPackAddressR(address));
+          texel[1] = uint8_t(L::loPackAddressG(address));
+          texel[2] = uint8_t(L::loPackAddressB(address));
+          texel[3] = uint8_t(n);
+          ++leaves;
+        }
+      } else {
+        int t = build(level + 1, c);
+        if (t >= 0) {
+          texel[0] = uint8_t(t);
+          texel[3] = uint8_t(L::LO_FLAG_INNER);
+        }
+      }
+      if (texel[3] != L::LO_FLAG_EMPTY) any = true;
+      int slot = cx + 2 * cy + 4 * cz;
+      std::copy(texel, texel + 4, tiles[size_t(index)].texels[slot]);
+    }
+    if (!any && level > 0) {
+      tiles.pop_back();  // only the last-built tile can be empty here
+      return -1;
+    }
+    return index;
+  };
+  build(0, Coord{0, 0, 0});
+  GpuOctree o;
+  o.depth = depth;
+  o.origin = origin;
+  o.cubeSize = cubeSize;
+  o.tilesX = int(tiles.size());
+  o.tilesY = o.tilesZ = 1;
+  int w = o.poolWidth();
+  o.pool.assign(size_t(w) * 2 * 2 * 4, 0);
+  for (size_t t = 0; t < tiles.size(); ++t) {
+    for (int slot = 0; slot < 8; ++slot) {
+      int x = int(t) * 2 + (slot & 1), y = (slot >> 1) & 1, z = (slot >> 2) & 1;
+      std::copy(tiles[t].texels[slot], tiles[t].texels[slot] + 4,
+                o.pool.begin() + ((size_t(z) * 2 + y) * w + x) * 4);
+    }
+  }
+  size_t count = vdls.size() / 4;
+  o.vdlWidth = int(std::min<size_t>(std::max<size_t>(count, 1), L::LO_VDL_TEXTURE_WIDTH));
+  o.vdlHeight =
+      int((std::max<size_t>(count, 1) + L::LO_VDL_TEXTURE_WIDTH - 1) / L::LO_VDL_TEXTURE_WIDTH);
+  o.vdlTexels.assign(size_t(o.vdlWidth) * o.vdlHeight * 4, 0.0f);
+  std::copy(vdls.begin(), vdls.end(), o.vdlTexels.begin());
+  o.leafCount = leaves;
+  o.nodeCount = tiles.size();
+  o.vdlCount = count;
+  return o;
+}
+
+/// A direction the 8+8-bit packing represents exactly (what the shader sees).
+Vec3 latticeDirection(uint32_t thetaQ, uint32_t phiQ) {
+  float packed = float(thetaQ * 256u + phiQ);
+  return {layout::loUnpackDirectionX(packed), layout::loUnpackDirectionY(packed),
+          layout::loUnpackDirectionZ(packed)};
+}
+
+struct Comparison {
+  float maxAbsDiff = 0;
+  double failingFraction = 0;
+};
+
+/// Compares RGB of every pixel; on failure writes rendered/expected/diff EXRs.
+Comparison compareImages(const Image& rendered, const Image& expected, float tolerance,
+                         const std::string& name) {
+  Comparison c;
+  Image diff = expected;
+  size_t failing = 0, pixels = size_t(rendered.width) * rendered.height;
+  for (size_t i = 0; i < pixels; ++i) {
+    float worst = 0;
+    for (int k = 0; k < 3; ++k) {
+      float d = std::fabs(rendered.rgba[i * 4 + k] - expected.rgba[i * 4 + k]);
+      if (!std::isfinite(d)) d = INFINITY;
+      diff.rgba[i * 4 + k] = d;
+      worst = std::max(worst, d);
+    }
+    c.maxAbsDiff = std::max(c.maxAbsDiff, worst);
+    if (worst > tolerance && failing++ == 0) {
+      std::ostringstream os;
+      os << "first failing pixel (" << i % size_t(rendered.width) << ", "
+         << i / size_t(rendered.width) << "): rendered " << rendered.rgba[i * 4] << " "
+         << rendered.rgba[i * 4 + 1] << " " << rendered.rgba[i * 4 + 2] << ", expected "
+         << expected.rgba[i * 4] << " " << expected.rgba[i * 4 + 1] << " "
+         << expected.rgba[i * 4 + 2];
+      ADD_FAILURE() << name << ": " << os.str();
+    }
+  }
+  c.failingFraction = double(failing) / double(pixels);
+  if (failing > 0) {
+    std::string dir = test::outputDir(name);
+    writeImage(dir + "/rendered.exr", rendered);
+    writeImage(dir + "/expected.exr", expected);
+    writeImage(dir + "/diff.exr", diff);
+    ADD_FAILURE() << name << ": images written to " << dir;
+  }
+  return c;
+}
+
+/// A 2x2 quad in the plane z = 0, normal +z, facing a camera on +z whose view
+/// the quad fills; the octree cube [-1.5, 1.5]^3 has its voxel faces at z = 0
+/// (depth 2: voxel size 0.75).
+struct QuadSetup {
+  Scene scene;
+  Vec3 albedo{0.5f, 0.25f, 0.8f};
+  RenderCamera camera =
+      RenderCamera::lookAt({0.1f, -0.05f, 2.0f}, {0.1f, -0.05f, 0.0f}, 36.0f * kPi / 180.0f);
+  QuadSetup() {
+    Material m;
+    m.baseColor = albedo;
+    m.roughness = 1.0f;
+    scene.materials.push_back(m);
+    test::addQuad(scene, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 0);
+  }
+  static RenderParams params(bool interpolation) {
+    RenderParams p;
+    p.width = 64;
+    p.height = 48;
+    p.mode = RenderMode::Indirect;
+    p.specular = false;
+    p.interpolation = interpolation;
+    return p;
+  }
+};
+
+TEST(Render, EveryShaderCompilesAndLinks) {
+  REQUIRE_OSMESA();
+  EXPECT_NO_THROW(compileAllShaders());
+}
+
+TEST(Render, ContextReportsTextureLimits) {
+  REQUIRE_OSMESA();
+  const GlInfo& info = osmesa()->info();
+  EXPECT_GE(info.major * 10 + info.minor, 33) << info.ToString();
+  EXPECT_GE(info.max3DTextureSize, 256) << info.ToString();
+  EXPECT_GE(info.max2DTextureSize, 4096) << info.ToString();
+}
+
+TEST(Render, BackendAndModeNamesRoundTrip) {
+  for (const char* name : {"osmesa", "egl", "glfw"})
+    EXPECT_EQ(toString(parseGlBackend(name)), name);
+  for (const char* name : {"full", "direct", "indirect", "voxels"}) {
+    EXPECT_EQ(toString(parseRenderMode(name)), name);
+  }
+  EXPECT_THROW(parseGlBackend("vulkan"), InputError);
+  EXPECT_THROW(parseRenderMode("pretty"), InputError);
+}
+
+TEST(RenderLayout, GlslPackDirectionMatchesCpp) {
+  REQUIRE_OSMESA();
+  namespace L = layout;
+  std::vector<std::array<float, 4>> in;
+  // Lattice directions pack back to their own code in any correct build, so
+  // the two builds must agree exactly; plus the axes and a few off-lattice ones.
+  for (uint32_t t = 0; t <= 255; t += 17) {
+    for (uint32_t p = 0; p < 256; p += 29) {
+      Vec3 d = latticeDirection(t, p);
+      in.push_back({d.x, d.y, d.z, float(t * 256 + p)});
+    }
+  }
+  for (Vec3 d : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1),
+                 Vec3(0, 0, -1), normalize(Vec3(0.3f, -0.5f, 0.8f))}) {
+    in.push_back({d.x, d.y, d.z, 0.0f});
+  }
+  auto out = runLayoutProbe(LayoutProbe::PackDirection, in);
+  ASSERT_EQ(out.size(), in.size());
+  for (size_t i = 0; i < in.size(); ++i) {
+    SCOPED_TRACE("input " + std::to_string(i) + ": " +
+                 Vec3(in[i][0], in[i][1], in[i][2]).ToString());
+    EXPECT_EQ(out[i][0], L::loPackDirection(in[i][0], in[i][1], in[i][2]));
+    EXPECT_EQ(out[i][1], L::loPackedTheta(in[i][3]));
+    EXPECT_EQ(out[i][2], L::loPackedPhi(in[i][3]));
+  }
+}
+
+TEST(RenderLayout, GlslUnpackDirectionMatchesCpp) {
+  REQUIRE_OSMESA();
+  namespace L = layout;
+  std::vector<std::array<float, 4>> in;
+  for (uint32_t t = 0; t <= 255; t += 5) {
+    for (uint32_t p = 0; p < 256; p += 7) in.push_back({float(t * 256 + p), 0, 0, 0});
+  }
+  auto out = runLayoutProbe(LayoutProbe::UnpackDirection, in);
+  ASSERT_EQ(out.size(), in.size());
+  // sin/cos are not correctly rounded in either build: the decoded directions
+  // agree to a few ulps, and re-packing them gives the same code exactly.
+  for (size_t i = 0; i < in.size(); ++i) {
+    float packed = in[i][0];
+    SCOPED_TRACE("packed " + std::to_string(int(packed)));
+    EXPECT_NEAR(out[i][0], L::loUnpackDirectionX(packed), 2e-6f);
+    EXPECT_NEAR(out[i][1], L::loUnpackDirectionY(packed), 2e-6f);
+    EXPECT_NEAR(out[i][2], L::loUnpackDirectionZ(packed), 2e-6f);
+    uint32_t code = uint32_t(packed);
+    bool pole = code / 256 == 0 || code / 256 == 255;  // phi is arbitrary at the poles
+    if (!pole) {
+      EXPECT_EQ(out[i][3], packed);
+    }
+  }
+}
+
+TEST(RenderLayout, GlslAddressesMatchCpp) {
+  REQUIRE_OSMESA();
+  namespace L = layout;
+  std::vector<std::array<float, 4>> in;
+  uint32_t x = 12345;
+  for (int i = 0; i < 200; ++i) {
+    x = x * 1664525u + 1013904223u;
+    uint32_t address = i == 0 ? L::LO_MAX_ADDRESS : (i == 1 ? 0u : (x >> 8));
+    in.push_back({float(L::loPackAddressR(address)), float(L::loPackAddressG(address)),
+                  float(L::loPackAddressB(address)), float(address)});
+  }
+  auto out = runLayoutProbe(LayoutProbe::Address, in);
+  ASSERT_EQ(out.size(), in.size());
+  for (size_t i = 0; i < in.size(); ++i) {
+    uint32_t address = uint32_t(in[i][3]);
+    SCOPED_TRACE("address " + std::to_string(address));
+    EXPECT_EQ(out[i][0], float(L::loUnpackAddress(uint32_t(in[i][0]), uint32_t(in[i][1]),
+                                                  uint32_t(in[i][2]))));
+    EXPECT_EQ(out[i][0], float(address));
+    EXPECT_EQ(out[i][1], float(L::loPackAddressR(address) + 256u * L::loPackAddressG(address)));
+    EXPECT_EQ(out[i][2], float(L::loVdlTexelX(address)));
+    EXPECT_EQ(out[i][3], float(L::loVdlTexelY(address)));
+  }
+}
+
+/// Expected radiance of the Lambertian quad lit by `vdls`: albedo/pi * sum E_i max(0, n.d_i).
+Image expectedQuad(const QuadSetup& s, const RenderParams& p, const std::vector<Vdl>& vdls) {
+  Vec3 radiance{0, 0, 0};
+  for (const Vdl& v : vdls) {
+    Vec3 d = normalize(v.direction);
+    float packed = layout::loPackDirection(d.x, d.y, d.z);
+    float cosine = std::max(0.0f, layout::loUnpackDirectionZ(packed));
+    radiance += s.albedo * kInvPi * v.irradiance * cosine;
+  }
+  Image e;
+  e.width = p.width;
+  e.height = p.height;
+  e.rgba.resize(size_t(p.width) * p.height * 4);
+  for (size_t i = 0; i < size_t(p.width) * p.height; ++i) {
+    e.rgba[i * 4 + 0] = radiance.x;
+    e.rgba[i * 4 + 1] = radiance.y;
+    e.rgba[i * 4 + 2] = radiance.z;
+    e.rgba[i * 4 + 3] = 1;
+  }
+  return e;
+}
+
+void checkQuad(const GpuOctree& octree, const std::vector<Vdl>& vdls, bool interpolation,
+               const std::string& name) {
+  QuadSetup s;
+  Renderer renderer(s.scene, octree);
+  RenderParams p = QuadSetup::params(interpolation);
+  Image image = renderer.render(s.camera, p);
+  Comparison c = compareImages(image, expectedQuad(s, p, vdls), 1e-3f, name);
+  EXPECT_LE(c.maxAbsDiff, 1e-3f) << name;
+  EXPECT_EQ(c.failingFraction, 0.0) << name;
+}
+
+TEST(RenderImage, ConstantVdlAlongNormalGivesAlbedoOverPiTimesE) {
+  REQUIRE_OSMESA();
+  Vdl v;
+  v.irradiance = {2.0f, 1.0f, 0.5f};
+  v.direction = {0, 0, 1};
+  GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [&](const Coord&, Vdl* out) {
+    out[0] = v;
+    return 1;
+  });
+  checkQuad(octree, {v}, false, "render_constant_vdl_nearest");
+  checkQuad(octree, {v}, true, "render_constant_vdl_trilinear");
+}
+
+TEST(RenderImage, SeveralVdlsAddWithTheirCosines) {
+  REQUIRE_OSMESA();
+  std::vector<Vdl> vdls(3);
+  vdls[0] = {{1.0f, 0.5f, 0.25f}, {0, 0, 1}};
+  vdls[1] = {{0.5f, 2.0f, 1.0f}, latticeDirection(60, 40)};   // oblique, facing the quad
+  vdls[2] = {{3.0f, 3.0f, 3.0f}, latticeDirection(200, 10)};  // from below: no light
+  GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [&](const Coord&, Vdl* out) {
+    std::copy(vdls.begin(), vdls.end(), out);
+    return 3;
+  });
+  checkQuad(octree, vdls, true, "render_three_vdls");
+}
+
+TEST(RenderImage, SurfaceOnAVoxelFaceFindsTheVoxelOnEitherSide) {
+  REQUIRE_OSMESA();
+  // Only one layer of voxels is lit: the one in front of the quad (z in
+  // [0, 0.75], coordinate 2) or the one behind it (coordinate 1).
+  Vdl v{{1.0f, 1.0f, 1.0f}, {0, 0, 1}};
+  for (int layer : {1, 2}) {
+    GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [&](const Coord& c, Vdl* out) {
+      if (c.z != layer) return 0;
+      out[0] = v;
+      return 1;
+    });
+    for (bool interpolation : {false, true}) {
+      checkQuad(octree, {v}, interpolation,
+                "render_voxel_face_layer" + std::to_string(layer) +
+                    (interpolation ? "_trilinear" : "_nearest"));
+    }
+  }
+}
+
+TEST(RenderImage, DirectPointLightMatchesInverseSquareLaw) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Light light;
+  light.type = Light::Type::Point;
+  light.position = {0.1f, -0.05f, 1.0f};
+  light.intensity = 2.0f;  // W/sr
+  s.scene.lights.push_back(light);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  Renderer renderer(s.scene, octree);
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  Image image = renderer.render(s.camera, p);
+  // Center pixel sees the point right below the light: E = I / h^2.
+  const float* c = image.pixel(p.width / 2, p.height / 2);
+  float tanHalf = std::tan(0.5f * s.camera.yfov);
+  // The pixel centre's offset from the view axis, in world units on the quad.
+  float py = (0.5f / (p.height / 2.0f)) * tanHalf * 2.0f;
+  float px = py;
+  float r2 = 1.0f + px * px + py * py;
+  float expected = s.albedo.x * kInvPi * 2.0f / r2 * (1.0f / std::sqrt(r2));
+  EXPECT_NEAR(c[0], expected, 2e-3f * expected);
+  // A small blocker just below the light casts a shadow on the quad about
+  // 1 unit wide (x in [-0.4, 0.6]); the camera sees the blocker only near the
+  // centre (within ~0.05 units at the quad's depth).
+  test::addQuad(s.scene, {0.05f, -0.1f, 0.9f}, {0.1f, 0, 0}, {0, 0.1f, 0}, {0, 0, 1}, 0);
+  Renderer shadowed(s.scene, octree);
+  Image dark = shadowed.render(s.camera, p);
+  float worldPerPixel = 2.0f * 2.0f * tanHalf / float(p.height);
+  int inShadow = p.width / 2 + int(0.3f / worldPerPixel);  // x = 0.4 on the quad
+  int lit = p.width / 2 + int(0.75f / worldPerPixel);      // x = 0.85
+  EXPECT_LT(dark.pixel(inShadow, p.height / 2)[0], 1e-4f);
+  EXPECT_GT(dark.pixel(lit, p.height / 2)[0], 0.05f);
+}
+
+TEST(RenderImage, VoxelModeColoursLeavesAndLeavesEmptySpaceBlack) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  // Only voxels with x coordinate 2 (x in [0, 0.75]) exist.
+  GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord& c, Vdl* out) {
+    if (c.x != 2) return 0;
+    out[0] = {{1, 1, 1}, {0, 0, 1}};
+    return 1;
+  });
+  Renderer renderer(s.scene, octree);
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Voxels;
+  Image image = renderer.render(s.camera, p);
+  // Camera x centre 0.1; half width at distance 2 ~ 0.97: x = 0 is left of
+  // centre by ~0.1/0.97 of the half width.
+  const float* left = image.pixel(2, p.height / 2);
+  const float* right = image.pixel(p.width / 2 + 4, p.height / 2);
+  EXPECT_EQ(left[0] + left[1] + left[2], 0.0f);
+  EXPECT_GT(right[0] + right[1] + right[2], 0.1f);
+}
+
+TEST(RenderLimits, OctreeTooLargeForTheContextFailsNamingTheLimit) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl* out) {
+    out[0] = {{1, 1, 1}, {0, 0, 1}};
+    return 1;
+  });
+  RendererParams tiny;
+  tiny.max3DTextureSize = 4;  // the pool is 18 x 2 x 2 texels
+  try {
+    Renderer r(s.scene, octree, tiny);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("GL_MAX_3D_TEXTURE_SIZE = 4"), std::string::npos)
+        << e.what();
+  }
+  RendererParams tiny2D;
+  tiny2D.max2DTextureSize = 16;  // 64 VDLs in one row
+  try {
+    Renderer r(s.scene, octree, tiny2D);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("GL_MAX_TEXTURE_SIZE = 16"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(RenderImageIo, WritesPngAndExrAtomicallyAndRejectsOtherExtensions) {
+  Image image;
+  image.width = 3;
+  image.height = 2;
+  image.rgba.assign(24, 0.5f);
+  std::string dir = test::outputDir("render_image_io");
+  writeImage(dir + "/a.png", image, 0.0f);
+  writeImage(dir + "/a.exr", image);
+  EXPECT_TRUE(std::filesystem::exists(dir + "/a.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/a.exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/a.png.tmp"));
+  EXPECT_THROW(writeImage(dir + "/a.jpg", image), InputError);
+  EXPECT_EQ(encodeSrgb8(0.0f), 0);
+  EXPECT_EQ(encodeSrgb8(1.0f), 255);
+  EXPECT_EQ(encodeSrgb8(0.5f), 188);  // 0.7354 * 255
+}
+
+}  // namespace
+}  // namespace lo
