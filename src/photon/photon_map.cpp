@@ -250,7 +250,10 @@ struct EmittedRay {
 
 inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
   const Scene& scene = *ctx.scene;
-  double pick = double(rng.uniform()) * ctx.emitterCdf.back();
+  // 53 random bits: a 24-bit float would never pick an emitter whose share of
+  // the power is below 2^-24 (scenes with millions of emissive triangles).
+  uint64_t bits = (uint64_t(rng.next()) << 21) ^ uint64_t(rng.next());
+  double pick = double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53 * ctx.emitterCdf.back();
   size_t k = size_t(std::upper_bound(ctx.emitterCdf.begin(), ctx.emitterCdf.end(), pick) -
                     ctx.emitterCdf.begin());
   k = std::min(k, ctx.emitters.size() - 1);
@@ -565,6 +568,12 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
     ctx.triangles[t].normal = scene.faceNormal(t);
     ctx.triangles[t].material = uint32_t(m);
   }
+  for (size_t i = 0; i < 3 * scene.triangleCount(); ++i) {
+    if (scene.indices[i] >= scene.positions.size())
+      throw InputError("triangle " + std::to_string(i / 3) + " has vertex index " +
+                       std::to_string(scene.indices[i]) + " outside [0, " +
+                       std::to_string(scene.positions.size()) + ")");
+  }
   ctx.materials.resize(scene.materials.size());
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
@@ -630,9 +639,10 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
     // Next batch: the paths the photons-per-path ratio so far says are still
     // needed, plus a margin. Only the amount of wasted work depends on it.
     size_t have = map.photons.size();
-    size_t need = have > 0 ? size_t(double(target - have) * double(emitted) / double(have) * 1.1)
-                           : 4 * emitted;
-    batch = std::min(maxEmitted - emitted, std::clamp(need, kMinBatchPaths, kMaxBatchPaths));
+    double need = have > 0 ? double(target - have) * double(emitted) / double(have) * 1.03 + 1024
+                           : 4.0 * double(emitted);
+    need = std::clamp(need, double(kMinBatchPaths), double(kMaxBatchPaths));
+    batch = std::min(maxEmitted - emitted, size_t(need));
   }
 
   map.emittedPaths = emitted;

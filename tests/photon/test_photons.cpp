@@ -437,6 +437,31 @@ TEST(Photons, DirectionalLightFluxThroughFloor) {
   EXPECT_NEAR(sum, sun.intensity * 4.0, 4.0 * stdErr + full / double(map.emittedPaths));
 }
 
+struct RecordingSink : ProgressSink {
+  size_t total = 0, last = 0, updates = 0;
+  bool monotonic = true, ended = false;
+  void begin(const std::string&, size_t t) override { total = t; }
+  void update(size_t done, size_t) override {
+    monotonic = monotonic && done >= last;
+    last = done;
+    ++updates;
+  }
+  void end() override { ended = true; }
+};
+
+TEST(Photons, ReportsProgressInStoredPhotons) {
+  Scene scene = mixedScene();
+  PhotonParams params;
+  params.storedPhotons = 30000;
+  RecordingSink sink;
+  tracePhotons(scene, params, &sink);
+  EXPECT_EQ(sink.total, params.storedPhotons);
+  EXPECT_EQ(sink.last, params.storedPhotons);
+  EXPECT_GT(sink.updates, 0u);
+  EXPECT_TRUE(sink.monotonic);
+  EXPECT_TRUE(sink.ended);
+}
+
 TEST(Photons, RejectsNegativeMaxBounces) {
   Scene scene = litBox({0.5f, 0.5f, 0.5f}, {1, 1, 1}, 1.0f);
   PhotonParams params;
