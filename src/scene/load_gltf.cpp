@@ -284,7 +284,10 @@ std::string glbJson(const std::string& path, const std::vector<unsigned char>& b
 std::string firstLine(std::string s) {
   while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
   size_t nl = s.find('\n');
-  return nl == std::string::npos ? s : s.substr(0, nl) + " (...)";
+  if (nl != std::string::npos) s = s.substr(0, nl) + " (...)";
+  // tinygltf quotes whole data: URIs; keep messages readable.
+  if (s.size() > 240) s = s.substr(0, 240) + "...";
+  return s;
 }
 
 // ---------------------------------------------------------------------------

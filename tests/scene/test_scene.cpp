@@ -413,6 +413,22 @@ TEST(SceneGltf, NonIndexedStripAndFan) {
   EXPECT_NEAR(fan.triangleArea(0) + fan.triangleArea(1), 1.0f, 1e-6f);
 }
 
+TEST(SceneGltf, SparseAccessor) {
+  std::string dir = test::outputDir("SceneGltf_Sparse");
+  MiniGltf g = oneTriangle();
+  std::string j = g.json();
+  // POSITION gets one sparse substitute: index 0 (the first uint32 of the
+  // index view) takes the value (0, 0, 1) (the first normal).
+  std::string from = "\"count\": 3, \"type\": \"VEC3\"}";
+  j.replace(j.find(from), from.size(),
+            "\"count\": 3, \"type\": \"VEC3\", \"sparse\": {\"count\": 1, \"indices\": "
+            "{\"bufferView\": 2, \"componentType\": 5125}, \"values\": {\"bufferView\": 1}}}");
+  writeFile(dir + "/sparse.gltf", j);
+  Scene s = loadScene(dir + "/sparse.gltf");
+  expectNear(s.positions[0], {0, 0, 1}, 1e-6f, "substituted");
+  expectNear(s.positions[1], {1, 0, 0}, 1e-6f, "kept");
+}
+
 TEST(SceneGltf, GlbAndDefaultMaterial) {
   std::string dir = test::outputDir("SceneGltf_Glb");
   MiniGltf g = oneTriangle();
