@@ -319,6 +319,23 @@ TEST(Photons, NormalFacesDirectionAndDirectionIsUnit) {
   EXPECT_GT(backOfPanel, 0u);  // the normal check above met a back face
 }
 
+TEST(Photons, StoresOnRoughButNotOnMirrorSurfaces) {
+  Scene scene = mixedScene();
+  PhotonParams params;
+  params.storedPhotons = 50000;
+  params.includeDirect = true;
+  PhotonMap map = tracePhotons(scene, params);
+  size_t onMirror = 0, onRoughMetal = 0;
+  for (const Photon& p : map.photons) {
+    onMirror += std::fabs(p.position.x - 0.99f) < 1e-4f && p.normal.x < 0;
+    // Top face of the rough metal box (roughness 0.4 > 0.2 stores photons).
+    onRoughMetal += std::fabs(p.position.y + 0.4f) < 1e-4f && p.position.x < -0.3f &&
+                    p.position.z < -0.3f && p.normal.y > 0;
+  }
+  EXPECT_EQ(onMirror, 0u);
+  EXPECT_GT(onRoughMetal, 0u);
+}
+
 TEST(Photons, GlassStoresNothingAndConservesEnergy) {
   // Grey closed box with a glass slab below the light: glass only redirects,
   // so the stored total is the same as without it, phi (1 - a^(K+1)) / (1 - a).
