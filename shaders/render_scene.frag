@@ -25,7 +25,9 @@ in vec3 vEmission;
 out vec4 fragColor;
 
 uniform usampler3D uOctree;  // RGBA8UI pool of 2x2x2 tiles
-uniform sampler2D uVdls;     // RGBA32F/16F: irradiance, packed direction
+uniform sampler2D uVdls;       // RGBA32F: irradiance, packed direction
+uniform usampler2D uVdlsHalf;  // RGBA16UI: half-float bits of irradiance, packed direction
+uniform bool uHalfVdls;        // which of the two holds the VDLs
 uniform sampler2DArrayShadow uShadowMaps;
 uniform vec3 uOctreeOrigin;  // world
 uniform float uVoxelSize;    // world units
@@ -95,6 +97,24 @@ bool lookupLeaf(ivec3 c, out uvec4 leaf) {
   return false;
 }
 
+// IEEE binary16 bits -> float (unpackHalf2x16 needs GLSL 4.20; this is 3.30).
+float halfToFloat(uint h) {
+  uint e = (h >> 10u) & 31u;
+  float m = float(h & 1023u);
+  float v = e == 0u ? m * exp2(-24.0) : (1.0 + m / 1024.0) * exp2(float(e) - 15.0);
+  return (h & 32768u) != 0u ? -v : v;
+}
+
+// One VDL texel: rgb irradiance (W/m^2), a packed direction (octree_layout.h).
+vec4 fetchVdl(uint index) {
+  ivec2 p = ivec2(int(loVdlTexelX(index)), int(loVdlTexelY(index)));
+  if (uHalfVdls) {
+    uvec4 t = texelFetch(uVdlsHalf, p, 0);
+    return vec4(halfToFloat(t.r), halfToFloat(t.g), halfToFloat(t.b), float(t.a));
+  }
+  return texelFetch(uVdls, p, 0);
+}
+
 // Paper §4.2.2: c = sum_i brdf(d_i, v, n) c_i, each VDL a directional light of
 // irradiance c_i (on a surface facing d_i), so the cosine n.d_i is applied here.
 vec3 shadeLeaf(uvec4 leaf, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughness) {
@@ -102,8 +122,7 @@ vec3 shadeLeaf(uvec4 leaf, vec3 n, vec3 v, vec3 baseColor, float metallic, float
   int count = min(int(leaf.a), uMaxVdls);
   vec3 sum = vec3(0.0);
   for (int i = 0; i < count; ++i) {
-    uint index = first + uint(i);
-    vec4 t = texelFetch(uVdls, ivec2(int(loVdlTexelX(index)), int(loVdlTexelY(index))), 0);
+    vec4 t = fetchVdl(first + uint(i));
     vec3 d = vec3(loUnpackDirectionX(t.a), loUnpackDirectionY(t.a), loUnpackDirectionZ(t.a));
     sum += brdfCos(n, v, d, baseColor, metallic, roughness) * t.rgb;
   }

@@ -14,4 +14,7 @@ namespace lo::tool {
 /// `lightoctree bake SCENE -o OUT.vdb ...`
 std::function<int()> addBakeCommand(CLI::App& app);
 
+/// `lightoctree render SCENE LIGHTS.vdb -o IMAGE.{png,exr} ...`
+std::function<int()> addRenderCommand(CLI::App& app);
+
 }  // namespace lo::tool

@@ -18,6 +18,7 @@ int run(int argc, char** argv) {
   app.set_version_flag("--version", LO_VERSION);
   std::vector<std::function<int()>> commands;
   commands.push_back(lo::tool::addBakeCommand(app));
+  commands.push_back(lo::tool::addRenderCommand(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -143,11 +143,12 @@ struct Renderer::Impl {
   GLuint sceneProgram = 0, shadowProgram = 0, probeProgram = 0;
   GLuint vao = 0, vbo = 0, emptyVao = 0;
   GLsizei vertexCount = 0;
-  GLuint octreeTexture = 0, vdlTexture = 0, shadowTexture = 0, lightUbo = 0;
+  GLuint octreeTexture = 0, vdlTexture = 0, vdlHalfTexture = 0, shadowTexture = 0, lightUbo = 0;
   GLuint shadowFbo = 0;
   GLuint targetFbo = 0, targetColor = 0, targetDepth = 0;
   int targetWidth = 0, targetHeight = 0;
   int emitterLights = 0;
+  bool halfVdls = false;
 
   LightBlock lightBlock{};
 
@@ -156,8 +157,8 @@ struct Renderer::Impl {
     for (GLuint p : programs) {
       if (p) glDeleteProgram(p);
     }
-    GLuint textures[] = {octreeTexture, vdlTexture, shadowTexture, targetColor};
-    glDeleteTextures(4, textures);
+    GLuint textures[] = {octreeTexture, vdlTexture, vdlHalfTexture, shadowTexture, targetColor};
+    glDeleteTextures(5, textures);
     glDeleteBuffers(1, &vbo);
     glDeleteBuffers(1, &lightUbo);
     glDeleteVertexArrays(1, &vao);
@@ -203,22 +204,34 @@ struct Renderer::Impl {
                  GL_RGBA_INTEGER, GL_UNSIGNED_BYTE, hasPool ? octree.pool.data() : emptyTexel);
     checkGl("uploading the octree pool (GL_TEXTURE_3D, GL_RGBA8UI)");
 
-    glGenTextures(1, &vdlTexture);
-    glBindTexture(GL_TEXTURE_2D, vdlTexture);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    // Both VDL samplers get a texture of their type (the unused one a 1x1
+    // dummy), so that the program is valid whichever precision is in use.
+    auto makeTexture = [](GLuint& texture) {
+      glGenTextures(1, &texture);
+      glBindTexture(GL_TEXTURE_2D, texture);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    };
     size_t vdlTexels = size_t(octree.vdlWidth) * octree.vdlHeight * 4;
+    halfVdls = octree.halfFloat && vdlTexels > 0;
     const float zero[4] = {0, 0, 0, 0};
-    if (vdlTexels == 0) {
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, 1, 1, 0, GL_RGBA, GL_FLOAT, zero);
-    } else if (octree.halfFloat) {
-      LO_CHECK_EQ(octree.vdlTexelsHalf.size(), vdlTexels);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, octree.vdlWidth, octree.vdlHeight, 0, GL_RGBA,
-                   GL_HALF_FLOAT, octree.vdlTexelsHalf.data());
-    } else {
+    const uint16_t zeroHalf[4] = {0, 0, 0, 0};
+    makeTexture(vdlTexture);
+    if (vdlTexels > 0 && !halfVdls) {
       LO_CHECK_EQ(octree.vdlTexels.size(), vdlTexels);
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, octree.vdlWidth, octree.vdlHeight, 0, GL_RGBA,
                    GL_FLOAT, octree.vdlTexels.data());
+    } else {
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, 1, 1, 0, GL_RGBA, GL_FLOAT, zero);
+    }
+    makeTexture(vdlHalfTexture);
+    if (halfVdls) {
+      LO_CHECK_EQ(octree.vdlTexelsHalf.size(), vdlTexels);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16UI, octree.vdlWidth, octree.vdlHeight, 0,
+                   GL_RGBA_INTEGER, GL_UNSIGNED_SHORT, octree.vdlTexelsHalf.data());
+    } else {
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16UI, 1, 1, 0, GL_RGBA_INTEGER, GL_UNSIGNED_SHORT,
+                   zeroHalf);
     }
     checkGl("uploading the VDL texture (GL_TEXTURE_2D)");
     depth = octree.depth;
@@ -514,12 +527,16 @@ struct Renderer::Impl {
     glUniform1i(loc("uOctree"), 0);
     glUniform1i(loc("uVdls"), 1);
     glUniform1i(loc("uShadowMaps"), 2);
+    glUniform1i(loc("uVdlsHalf"), 3);
+    glUniform1i(loc("uHalfVdls"), halfVdls ? 1 : 0);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_3D, octreeTexture);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, vdlTexture);
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_2D_ARRAY, shadowTexture);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, vdlHalfTexture);
     glActiveTexture(GL_TEXTURE0);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo);
     glBindVertexArray(vao);

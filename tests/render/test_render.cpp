@@ -343,6 +343,16 @@ TEST(RenderImage, ConstantVdlAlongNormalGivesAlbedoOverPiTimesE) {
   });
   checkQuad(octree, {v}, false, "render_constant_vdl_nearest");
   checkQuad(octree, {v}, true, "render_constant_vdl_trilinear");
+  // Half precision (RGBA16UI: half bits + packed direction); 2, 1, 0.5 are exact halves.
+  GpuOctree half = octree;
+  half.halfFloat = true;
+  half.vdlTexelsHalf.resize(half.vdlTexels.size());
+  for (size_t i = 0; i < half.vdlTexels.size(); ++i) {
+    half.vdlTexelsHalf[i] =
+        i % 4 == 3 ? uint16_t(half.vdlTexels[i]) : floatToHalf(half.vdlTexels[i]);
+  }
+  half.vdlTexels.clear();
+  checkQuad(half, {v}, true, "render_constant_vdl_half");
 }
 
 TEST(RenderImage, SeveralVdlsAddWithTheirCosines) {

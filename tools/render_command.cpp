@@ -1,0 +1,205 @@
+// `lightoctree render`: scene + baked .vdb -> GPU light octree -> image.
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include "commands.h"
+#include "core/error.h"
+#include "octree/gpu_octree.h"
+#include "render/context.h"
+#include "render/image_io.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+#include "vdb/vdb_io.h"
+
+namespace lo::tool {
+namespace {
+
+struct RenderOptions {
+  std::string scene;
+  std::string lights;
+  std::string output;
+  std::string camera;
+  std::string eye, target;
+  float fovDegrees = 0;  // 0 = the scene camera's, else 45
+  int width = 800, height = 600;
+  std::string mode = "full";
+  std::string interpolation = "on";
+  std::string specular = "on";
+  float exposure = 0;
+  std::string backend = "osmesa";
+  int vdls = 8;
+  int emitterLights = 8;
+  int shadowMapSize = 1024;
+  bool halfFloat = false;
+  int frames = 0;
+  bool quiet = false;
+};
+
+/// "x,y,z" -> Vec3; the message names the flag.
+Vec3 parseVec3(const std::string& text, const char* flag) {
+  Vec3 v;
+  char c1 = 0, c2 = 0;
+  std::istringstream is(text);
+  if (!(is >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !is.eof() ||
+      !isFinite(v)) {
+    throw InputError(std::string(flag) + ": expected three numbers x,y,z, got '" + text + "'");
+  }
+  return v;
+}
+
+RenderCamera chooseCamera(const RenderOptions& opt, const Scene& scene) {
+  float fov = (opt.fovDegrees > 0 ? opt.fovDegrees : 45.0f) * kPi / 180.0f;
+  if (!opt.eye.empty()) {
+    Vec3 eye = parseVec3(opt.eye, "--eye"), target = parseVec3(opt.target, "--target");
+    if (eye == target) throw InputError("--eye and --target: the same point");
+    return RenderCamera::lookAt(eye, target, fov);
+  }
+  const Camera* chosen = nullptr;
+  for (const Camera& c : scene.cameras) {
+    if (opt.camera.empty() || c.name == opt.camera) {
+      chosen = &c;
+      break;
+    }
+  }
+  if (!opt.camera.empty() && !chosen) {
+    std::string names;
+    for (const Camera& c : scene.cameras) names += (names.empty() ? "" : ", ") + c.name;
+    throw InputError("--camera: no camera named '" + opt.camera + "' in " + opt.scene +
+                     (names.empty() ? " (it has none)" : " (it has: " + names + ")"));
+  }
+  if (!chosen) return RenderCamera::framing(scene.bounds(), fov);
+  RenderCamera camera = RenderCamera::fromScene(*chosen);
+  if (opt.fovDegrees > 0) camera.yfov = fov;
+  return camera;
+}
+
+int runRender(const RenderOptions& opt) {
+  // Everything that can be checked before the work is checked first.
+  std::filesystem::path parent = std::filesystem::path(opt.output).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw InputError("--output: folder '" + parent.string() + "' does not exist");
+  }
+  std::string ext = std::filesystem::path(opt.output).extension().string();
+  if (ext != ".png" && ext != ".exr") {
+    throw InputError("--output: '" + opt.output + "' must end in .png or .exr");
+  }
+  if (!opt.eye.empty() != !opt.target.empty()) {
+    throw InputError("--eye and --target must be given together");
+  }
+  if (!opt.eye.empty()) {
+    parseVec3(opt.eye, "--eye");
+    parseVec3(opt.target, "--target");
+  }
+  RenderParams params;
+  params.width = opt.width;
+  params.height = opt.height;
+  params.mode = parseRenderMode(opt.mode);
+  params.interpolation = opt.interpolation == "on";
+  params.specular = opt.specular == "on";
+  params.maxVdls = opt.vdls;
+
+  Scene scene = loadScene(opt.scene);
+  LoadedVdl baked = readVdlGrid(opt.lights);
+  RenderCamera camera = chooseCamera(opt, scene);
+
+  GlContextParams contextParams;
+  contextParams.backend = parseGlBackend(opt.backend);
+  std::unique_ptr<GlContext> context = createGlContext(contextParams);
+  if (!opt.quiet) std::printf("%s: %s\n", opt.backend.c_str(), context->info().ToString().c_str());
+
+  GpuOctreeParams octreeParams;
+  octreeParams.halfFloat = opt.halfFloat;
+  octreeParams.max3DTextureSize = context->info().max3DTextureSize;
+  octreeParams.max2DTextureSize = context->info().max2DTextureSize;
+  GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
+  if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
+
+  RendererParams rendererParams;
+  rendererParams.emitterLights = opt.emitterLights;
+  rendererParams.shadowMapSize = opt.shadowMapSize;
+  Renderer renderer(scene, octree, rendererParams);
+  Image image = renderer.render(camera, params);
+  writeImage(opt.output, image, opt.exposure);
+
+  if (opt.frames > 0) {
+    double seconds = renderer.timeFrames(camera, params, opt.frames);
+    std::printf("frame time: %.2f ms (%d x %d, mode %s, mean of %d frames, glFinish each)\n",
+                1000.0 * seconds / opt.frames, opt.width, opt.height, opt.mode.c_str(), opt.frames);
+  }
+  if (!opt.quiet) std::printf("wrote %s\n", opt.output.c_str());
+  return 0;
+}
+
+CLI::Validator onOff() { return CLI::IsMember({"on", "off"}); }
+
+}  // namespace
+
+std::function<int()> addRenderCommand(CLI::App& app) {
+  auto opt = std::make_shared<RenderOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "render",
+      "Render a scene lit by its baked light octree (GPU octree of VDLs) plus direct light, "
+      "headless, to a PNG or EXR image.");
+  cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("lights", opt->lights, "Baked VDL grid (.vdb from `lightoctree bake`)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", opt->output,
+                  "Image: .exr (linear float radiance) or .png (exposure, sRGB)")
+      ->required();
+  auto* camera = cmd->add_option("--camera", opt->camera, "Scene camera by name (default: first)");
+  auto* eye = cmd->add_option("--eye", opt->eye, "Camera position x,y,z (with --target)");
+  cmd->add_option("--target", opt->target, "Point the camera looks at, x,y,z (with --eye)");
+  camera->excludes(eye);
+  cmd->add_option("--fov", opt->fovDegrees, "Vertical field of view in degrees (default 45)")
+      ->check(CLI::Range(1.0f, 179.0f));
+  cmd->add_option("--width", opt->width, "Image width in pixels")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--height", opt->height, "Image height in pixels")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--mode", opt->mode,
+                  "full | direct (emission + lights) | indirect (octree only) | voxels")
+      ->check(CLI::IsMember({"full", "direct", "indirect", "voxels"}))
+      ->capture_default_str();
+  cmd->add_option("--interpolation", opt->interpolation,
+                  "Trilinear interpolation between the 8 neighbouring voxels")
+      ->check(onOff())
+      ->capture_default_str();
+  cmd->add_option("--specular", opt->specular, "GGX lobe of the glTF BRDF (off: diffuse only)")
+      ->check(onOff())
+      ->capture_default_str();
+  cmd->add_option("--exposure", opt->exposure, "PNG exposure in EV (radiance * 2^EV)")
+      ->check(CLI::Range(-30.0f, 30.0f))
+      ->capture_default_str();
+  cmd->add_option("--backend", opt->backend, "Headless OpenGL: osmesa (software) or egl")
+      ->check(CLI::IsMember({"osmesa", "egl"}))
+      ->capture_default_str();
+  cmd->add_option("--vdls", opt->vdls, "VDLs used per voxel, strongest first")
+      ->check(CLI::Range(1, 8))
+      ->capture_default_str();
+  cmd->add_option("--emitter-lights", opt->emitterLights,
+                  "Shadowed virtual point lights sampled on emissive triangles (0: none)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  cmd->add_option("--shadow-map-size", opt->shadowMapSize, "Shadow map resolution per face")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  cmd->add_flag("--half-float", opt->halfFloat,
+                "VDL texture with half-float irradiance (RGBA16UI) instead of RGBA32F");
+  cmd->add_option("--frames", opt->frames,
+                  "Also time this many frames (no read-back) and print the mean frame time")
+      ->check(CLI::Range(0, 100000));
+  cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
+  return [cmd, opt]() -> int { return cmd->parsed() ? runRender(*opt) : -1; };
+}
+
+}  // namespace lo::tool
