@@ -247,9 +247,12 @@ vec3 srgbEncode(vec3 c) {
 void main() {
   vec3 v = normalize(uEye - vPosition);
   vec3 n = normalize(vNormal);
-  // Surfaces keep their own (interpolated) normal; seen from behind, the side
-  // facing the viewer is shaded.
-  if (!gl_FrontFacing) n = -n;
+  // Surfaces keep their own (interpolated) normal, turned to the side the
+  // viewer sees. The side is taken from the geometric normal (screen-space
+  // derivatives), not from gl_FrontFacing: scene files do not agree on winding.
+  vec3 ng = cross(dFdx(vPosition), dFdy(vPosition));
+  if (dot(ng, v) < 0.0) ng = -ng;
+  if (dot(n, ng) < 0.0) n = -n;
   vec3 baseColor = vBaseColor;
   float metallic = vMetallicRoughness.x;
   float roughness = vMetallicRoughness.y;
