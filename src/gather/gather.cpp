@@ -255,8 +255,7 @@ void Gatherer::gather(size_t voxel, GatherResult& out) {
       }
     }
   };
-  gatherWith(grid_, photons_, voxel, params_, radius_, candidates_, backCandidates_, out,
-             collect);
+  gatherWith(grid_, photons_, voxel, params_, radius_, candidates_, backCandidates_, out, collect);
 }
 
 GatherResult gatherBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,

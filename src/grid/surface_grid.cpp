@@ -152,11 +152,11 @@ inline Coord coordFromKey(uint64_t key) {
 
 /// One triangle's share of one voxel.
 struct Contribution {
-  uint64_t key;      ///< canonicalKey of the voxel
+  uint64_t key;  ///< canonicalKey of the voxel
   uint32_t triangle;
-  double area;       ///< clipped area, world units^2
-  D3 centroid;       ///< area * clipped centroid, or (area 0) the voxel-clamped triangle centroid;
-                     ///< relative to the voxel centre
+  double area;  ///< clipped area, world units^2
+  D3 centroid;  ///< area * clipped centroid, or (area 0) the voxel-clamped triangle centroid;
+                ///< relative to the voxel centre
   bool operator<(const Contribution& o) const {
     return key != o.key ? key < o.key : triangle < o.triangle;
   }
@@ -457,44 +457,45 @@ size_t splatPhotons(SurfaceGrid& grid, const std::vector<Photon>& photons) {
   const FrameD frame(grid.frame);
   std::vector<uint32_t> target(photons.size());
   tbb::enumerable_thread_specific<double> margins(0.0);
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, photons.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-        double& margin = margins.local();
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-          const Vec3& p = photons[i].position;
-          target[i] = kDropped;
-          if (!isFinite(p)) continue;
-          const Coord c = grid.frame.coordOf(p);
-          const int64_t v = grid.find(c);
-          if (v >= 0) {
-            target[i] = uint32_t(v);
-            continue;
-          }
-          // Numeric edge case (a hit point a rounding error off its surface):
-          // the nearest active neighbour by distance from p to the voxel box,
-          // ties to the lower voxel index.
-          double best = INFINITY;
-          for (int dx = -1; dx <= 1; ++dx) {
-            for (int dy = -1; dy <= 1; ++dy) {
-              for (int dz = -1; dz <= 1; ++dz) {
-                const Coord nc{c.x + dx, c.y + dy, c.z + dz};
-                const int64_t w = grid.find(nc);
-                if (w < 0) continue;
-                const D3 rel = D3(p) - frame.center(nc);
-                const double hv = 0.5 * frame.voxelSize;
-                const D3 out(std::max(0.0, std::abs(rel.x) - hv), std::max(0.0, std::abs(rel.y) - hv),
-                             std::max(0.0, std::abs(rel.z) - hv));
-                const double d = length(out);
-                if (d < best || (d == best && uint32_t(w) < target[i])) {
-                  best = d;
-                  target[i] = uint32_t(w);
-                }
-              }
-            }
-          }
-          if (target[i] != kDropped) margin = std::max(margin, best);
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, photons.size(), 4096),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      double& margin = margins.local();
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        const Vec3& p = photons[i].position;
+                        target[i] = kDropped;
+                        if (!isFinite(p)) continue;
+                        const Coord c = grid.frame.coordOf(p);
+                        const int64_t v = grid.find(c);
+                        if (v >= 0) {
+                          target[i] = uint32_t(v);
+                          continue;
+                        }
+                        // Numeric edge case (a hit point a rounding error off its surface):
+                        // the nearest active neighbour by distance from p to the voxel box,
+                        // ties to the lower voxel index.
+                        double best = INFINITY;
+                        for (int dx = -1; dx <= 1; ++dx) {
+                          for (int dy = -1; dy <= 1; ++dy) {
+                            for (int dz = -1; dz <= 1; ++dz) {
+                              const Coord nc{c.x + dx, c.y + dy, c.z + dz};
+                              const int64_t w = grid.find(nc);
+                              if (w < 0) continue;
+                              const D3 rel = D3(p) - frame.center(nc);
+                              const double hv = 0.5 * frame.voxelSize;
+                              const D3 out(std::max(0.0, std::abs(rel.x) - hv),
+                                           std::max(0.0, std::abs(rel.y) - hv),
+                                           std::max(0.0, std::abs(rel.z) - hv));
+                              const double d = length(out);
+                              if (d < best || (d == best && uint32_t(w) < target[i])) {
+                                best = d;
+                                target[i] = uint32_t(w);
+                              }
+                            }
+                          }
+                        }
+                        if (target[i] != kDropped) margin = std::max(margin, best);
+                      }
+                    });
   double margin = 0;
   for (double m : margins) margin = std::max(margin, m);
   // Round up so the float margin is never below the double one.

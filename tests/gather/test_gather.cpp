@@ -94,7 +94,8 @@ void expectSameAsBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& 
   for (size_t v = 0; v < grid.size(); v += stride) {
     gatherer.gather(v, g);
     GatherResult b = gatherBruteForce(grid, photons, v, params);
-    ASSERT_EQ(sorted(g.photons), sorted(b.photons)) << "voxel " << v << " " << grid.coords[v].ToString();
+    ASSERT_EQ(sorted(g.photons), sorted(b.photons))
+        << "voxel " << v << " " << grid.coords[v].ToString();
     EXPECT_EQ(g.radius, b.radius) << "voxel " << v;
     EXPECT_EQ(g.normal, b.normal) << "voxel " << v;
     // The same photons summed in a different order: equal up to rounding.
@@ -269,7 +270,8 @@ TEST(Gather, PhotonsBehindAThinWallAreRejected) {
     size_t tested = 0;
     for (size_t v = 0; v < grid.size(); ++v) {
       const Vec3 c = grid.centroids[v];
-      if (c.y < 0.35f || c.y > 0.65f || c.z < 0.35f || c.z > 0.65f || c.x > x0 + 0.5f * vs) continue;
+      if (c.y < 0.35f || c.y > 0.65f || c.z < 0.35f || c.z > 0.65f || c.x > x0 + 0.5f * vs)
+        continue;
       if (grid.normals[v].y != 0) continue;  // not a wall voxel
       g.gather(v, r);
       ++tested;
@@ -374,10 +376,9 @@ TEST(Gather, SameResultForAnyThreadCount) {
 }
 
 // Timing, not a test: run with --gtest_also_run_disabled_tests. The paper's
-// setting: 600k photons, depth 6, k = 300, in a Cornell-like box.
-TEST(Gather, DISABLED_Benchmark) {
-  Scene scene = cornellLikeBox();
-  std::vector<Photon> photons = uniformPhotons(scene, 600000, 1);
+// setting: 600k photons, depth 6, k = 300.
+void benchmark(const char* label, const Scene& scene, const std::vector<Photon>& photons) {
+  std::printf("%s\n", label);
   using Clock = std::chrono::steady_clock;
   auto t0 = Clock::now();
   GridParams gp;
@@ -422,12 +423,27 @@ TEST(Gather, DISABLED_Benchmark) {
   auto s = [](Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double>(b - a).count();
   };
-  std::printf("| voxels | photons | k | voxelize s | splat s | gather 1 thread s | CPU us/voxel | "
-              "gather all threads s | mean gathered |\n");
+  std::printf(
+      "| voxels | photons | k | voxelize s | splat s | gather 1 thread s | CPU us/voxel | "
+      "gather all threads s | mean gathered |\n");
   std::printf("| %zu | %zu | %d | %.3f | %.3f | %.3f | %.1f | %.3f | %.1f |\n", grid.size(),
               photons.size(), params.k, s(t0, t1), s(t1, t2), s(t2, t3),
-              1e6 * cpu / double(grid.size()), s(t3, t4),
-              double(gathered) / double(grid.size()));
+              1e6 * cpu / double(grid.size()), s(t3, t4), double(gathered) / double(grid.size()));
+}
+
+// Photons spread uniformly over the in-code box: no light transport.
+TEST(Gather, DISABLED_BenchmarkUniformBox) {
+  Scene scene = cornellLikeBox();
+  benchmark("Cornell-like box, 600k uniform photons", scene, uniformPhotons(scene, 600000, 1));
+}
+
+// The shared Cornell box with traced photons (indirect only, the bake's default).
+TEST(Gather, DISABLED_BenchmarkCornellBox) {
+  Scene scene = loadScene(test::sharedScenesDir() + "/composed/cornell-box.glb");
+  PhotonParams pp;
+  pp.storedPhotons = 600000;
+  PhotonMap map = tracePhotons(scene, pp);
+  benchmark("cornell-box.glb, 600k traced photons", scene, map.photons);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "../test_util.h"
@@ -111,8 +112,10 @@ TEST(TriangleBox, AgreesWithClippingReference) {
     if (i % 50 == 0) b = c = a;                        // a point
     const Bounds3 box = unitBox();
     const bool sat = triangleOverlapsBox(a, b, c, box);
-    const bool grown = referenceOverlap(a, b, c, {-1e-6, -1e-6, -1e-6}, {1 + 1e-6, 1 + 1e-6, 1 + 1e-6});
-    const bool shrunk = referenceOverlap(a, b, c, {1e-6, 1e-6, 1e-6}, {1 - 1e-6, 1 - 1e-6, 1 - 1e-6});
+    const bool grown =
+        referenceOverlap(a, b, c, {-1e-6, -1e-6, -1e-6}, {1 + 1e-6, 1 + 1e-6, 1 + 1e-6});
+    const bool shrunk =
+        referenceOverlap(a, b, c, {1e-6, 1e-6, 1e-6}, {1 - 1e-6, 1 - 1e-6, 1 - 1e-6});
     if (shrunk) {
       ASSERT_TRUE(sat) << i << " " << a.ToString() << b.ToString() << c.ToString();
     }
@@ -418,8 +421,8 @@ TEST(SurfaceGrid, FarAndTinyScenesVoxelizeConsistently) {
     float centroidTol;
     float normalTol;  ///< voxels holding several faces mix them by area
   };
-  for (const Case& k : {Case{1.0f, Vec3(1e5f, -1e5f, 1e5f), 0.01f, 0.15f},
-                        Case{1e-4f, Vec3{}, 1e-9f, 1e-5f}}) {
+  for (const Case& k :
+       {Case{1.0f, Vec3(1e5f, -1e5f, 1e5f), 0.01f, 0.15f}, Case{1e-4f, Vec3{}, 1e-9f, 1e-5f}}) {
     SCOPED_TRACE(k.scale);
     const Scene scene = cornellLikeBox(k.scale, k.offset);
     const SurfaceGrid g = buildSurfaceGrid(scene, p);
@@ -529,6 +532,25 @@ TEST(SurfaceGrid, SplatPhotons) {
     }
   }
   for (size_t i = 0; i < photons.size(); ++i) EXPECT_EQ(seen[i], i < 5001 ? 1 : 0) << i;
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+// The shared Cornell box scene, through the scene loader.
+TEST(SurfaceGrid, ActiveSetEqualsBruteForceInCornellBoxScene) {
+  const std::string path = test::sharedScenesDir() + "/composed/cornell-box.glb";
+  Scene scene = loadScene(path);
+  GridParams p;
+  p.depth = 4;
+  SurfaceGrid grid = buildSurfaceGrid(scene, p);
+  std::set<Coord> expected = bruteForceActive(scene, grid.frame);
+  std::set<Coord> got(grid.coords.begin(), grid.coords.end());
+  EXPECT_TRUE(got == expected) << got.size() << " vs " << expected.size();
+  expectConsistent(scene, grid);
 }
 
 }  // namespace
