@@ -38,7 +38,6 @@ namespace lo {
 namespace layout {
 using uint = uint32_t;
 using std::acos;
-using std::atan2;
 using std::cos;
 using std::floor;
 using std::min;
@@ -59,6 +58,18 @@ const uint LO_THETA_STEPS = 255u; /* thetaQ in [0, 255] maps to [0, pi] */
 const uint LO_PHI_STEPS = 256u;   /* phiQ in [0, 255] maps to [0, 2pi), wraps */
 const float LO_PI = 3.14159265358979323846;
 
+/* atan2 with C++'s IEEE behaviour at (0, 0) (GLSL's atan(y, x) is undefined
+ * there, and GLSL has no atan2). */
+#ifdef __cplusplus
+inline float loAtan2(float y, float x) { return std::atan2(y, x); }
+#else
+float loAtan2(float y, float x) {
+  if (x != 0.0 || y != 0.0) return atan(y, x);
+  bool negX = (floatBitsToUint(x) >> 31u) != 0u;
+  return negX ? ((floatBitsToUint(y) >> 31u) != 0u ? -LO_PI : LO_PI) : y;
+}
+#endif
+
 LO_LAYOUT_FN bool loIsLeaf(uint flag) { return flag >= 1u && flag <= LO_MAX_VDLS; }
 
 /* 24-bit address <-> three 8-bit channels. */
@@ -75,7 +86,7 @@ LO_LAYOUT_FN uint loVdlTexelY(uint index) { return index / LO_VDL_TEXTURE_WIDTH;
 LO_LAYOUT_FN float loPackDirection(float x, float y, float z) {
   float c = z < -1.0 ? -1.0 : (z > 1.0 ? 1.0 : z);
   float theta = acos(c);
-  float phi = atan2(y, x);
+  float phi = loAtan2(y, x);
   if (phi < 0.0) phi += 2.0 * LO_PI;
   /* min(): a GPU acos may return a little more than pi; thetaQ must stay 8-bit. */
   uint thetaQ = min(uint(floor(theta / LO_PI * float(LO_THETA_STEPS) + 0.5)), LO_THETA_STEPS);
@@ -83,23 +94,23 @@ LO_LAYOUT_FN float loPackDirection(float x, float y, float z) {
   return float(thetaQ * 256u + phiQ);
 }
 
-LO_LAYOUT_FN float loPackedTheta(float packed) {
-  uint p = uint(packed);
+LO_LAYOUT_FN float loPackedTheta(float code) {
+  uint p = uint(code);
   return float(p / 256u) * (LO_PI / float(LO_THETA_STEPS));
 }
 
-LO_LAYOUT_FN float loPackedPhi(float packed) {
-  uint p = uint(packed);
+LO_LAYOUT_FN float loPackedPhi(float code) {
+  uint p = uint(code);
   return float(p % 256u) * (2.0 * LO_PI / float(LO_PHI_STEPS));
 }
 
-LO_LAYOUT_FN float loUnpackDirectionX(float packed) {
-  return sin(loPackedTheta(packed)) * cos(loPackedPhi(packed));
+LO_LAYOUT_FN float loUnpackDirectionX(float code) {
+  return sin(loPackedTheta(code)) * cos(loPackedPhi(code));
 }
-LO_LAYOUT_FN float loUnpackDirectionY(float packed) {
-  return sin(loPackedTheta(packed)) * sin(loPackedPhi(packed));
+LO_LAYOUT_FN float loUnpackDirectionY(float code) {
+  return sin(loPackedTheta(code)) * sin(loPackedPhi(code));
 }
-LO_LAYOUT_FN float loUnpackDirectionZ(float packed) { return cos(loPackedTheta(packed)); }
+LO_LAYOUT_FN float loUnpackDirectionZ(float code) { return cos(loPackedTheta(code)); }
 
 #ifdef __cplusplus
 #undef LO_LAYOUT_FN

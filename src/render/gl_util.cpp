@@ -49,20 +49,7 @@ std::string shaderSource(const std::string& name, const std::vector<std::string>
   std::string inserted;
   for (const std::string& d : defines) inserted += "#define " + d + "\n";
   if (stage == GL_FRAGMENT_SHADER || stage == GL_COMPUTE_SHADER) {
-    // Two shims so the header, written for both languages, compiles as GLSL:
-    // `packed` is a reserved word in GLSL (Mesa rejects it) but a parameter
-    // name in the header, and GLSL spells atan2 as atan(y, x), undefined at
-    // (0, 0), where C++ follows IEEE signed zeros (+-0 or +-pi); the shim does too.
-    inserted +=
-        "#define packed lo_packed_\n"
-        "float atan2(float y, float x) {\n"
-        "  if (x != 0.0 || y != 0.0) return atan(y, x);\n"
-        "  bool negX = (floatBitsToUint(x) >> 31u) != 0u, negY = (floatBitsToUint(y) >> 31u) != "
-        "0u;\n"
-        "  return negX ? (negY ? -3.14159265358979323846 : 3.14159265358979323846) : y;\n"
-        "}\n";
     inserted += embeddedShader("octree_layout.h");
-    inserted += "\n#undef packed\n";
   }
   // Keep the shader's own line numbers in compiler messages.
   inserted += "#line 2\n";
