@@ -4,7 +4,7 @@
 #include <cmath>
 #include <vector>
 
-#include "../test_util.h"
+#include "test_util.h"
 #include "cluster/vdl_grid.h"
 #include "core/error.h"
 #include "core/rng.h"

@@ -11,7 +11,7 @@
 #include <ctime>
 #include <vector>
 
-#include "../test_util.h"
+#include "test_util.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "gather/gather.h"

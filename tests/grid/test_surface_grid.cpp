@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "../test_util.h"
+#include "test_util.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "grid/surface_grid.h"

@@ -13,7 +13,7 @@
 #include <cstring>
 #include <vector>
 
-#include "../test_util.h"
+#include "test_util.h"
 #include "core/error.h"
 #include "photon/photon_map.h"
 

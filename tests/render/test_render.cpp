@@ -11,7 +11,7 @@
 #include <memory>
 #include <sstream>
 
-#include "../test_util.h"
+#include "test_util.h"
 #include "core/error.h"
 #include "render/context.h"
 #include "render/image_io.h"

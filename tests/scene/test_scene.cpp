@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "../test_util.h"
+#include "test_util.h"
 #include "core/error.h"
 #include "scene/scene.h"
 

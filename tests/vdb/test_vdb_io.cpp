@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "../test_util.h"
+#include "test_util.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "vdb/vdb_internal.h"
