@@ -41,4 +41,14 @@ void addClosedBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material) {
   addQuad(scene, lo + ez, ex, ey, {0, 0, -1}, material);                // z = hi, facing -z
 }
 
+void addBlock(Scene& scene, const Vec3& lo, const Vec3& hi, int material) {
+  Vec3 d = hi - lo;
+  Vec3 ex{d.x, 0, 0}, ey{0, d.y, 0}, ez{0, 0, d.z};
+  addQuad(scene, lo + ey, ex, ez, {0, 1, 0}, material);
+  addQuad(scene, lo, ey, ez, {-1, 0, 0}, material);
+  addQuad(scene, lo + ex, ey, ez, {1, 0, 0}, material);
+  addQuad(scene, lo, ex, ey, {0, 0, -1}, material);
+  addQuad(scene, lo + ez, ex, ey, {0, 0, 1}, material);
+}
+
 }  // namespace lo::test

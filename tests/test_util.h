@@ -23,4 +23,7 @@ void addQuad(Scene& scene, const Vec3& corner, const Vec3& edgeU, const Vec3& ed
 /// Closed cube [lo, hi]^3 of six inward-facing quads with material `material`.
 void addClosedBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
 
+/// A block standing on y = lo.y: five outward-facing quads (no bottom face).
+void addBlock(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
+
 }  // namespace lo::test

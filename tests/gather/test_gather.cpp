@@ -26,15 +26,7 @@ Scene cornellLikeBox() {
   Scene scene;
   scene.materials.push_back(Material{});
   test::addClosedBox(scene, {0, 0, 0}, {1, 1, 1}, 0);
-  auto addBlock = [&](Vec3 lo, Vec3 hi) {
-    Vec3 d = hi - lo;
-    Vec3 ex{d.x, 0, 0}, ey{0, d.y, 0}, ez{0, 0, d.z};
-    test::addQuad(scene, lo + ey, ex, ez, {0, 1, 0}, 0);
-    test::addQuad(scene, lo, ey, ez, {-1, 0, 0}, 0);
-    test::addQuad(scene, lo + ex, ey, ez, {1, 0, 0}, 0);
-    test::addQuad(scene, lo, ex, ey, {0, 0, -1}, 0);
-    test::addQuad(scene, lo + ez, ex, ey, {0, 0, 1}, 0);
-  };
+  auto addBlock = [&](Vec3 lo, Vec3 hi) { test::addBlock(scene, lo, hi, 0); };
   addBlock({0.13f, 0.0f, 0.097f}, {0.43f, 0.3f, 0.41f});
   addBlock({0.551f, 0.0f, 0.523f}, {0.847f, 0.61f, 0.83f});
   return scene;
