@@ -1,5 +1,6 @@
 /// @file photon/photon_map.cpp
-/// @brief Photon tracing with Embree 3 (paper §4.1). See docs/photon.md for
+/// @brief Photon tracing (paper §4.1) through photon/ray_tracer.h (Embree 3)
+/// and the shared material model photon/bsdf.h. See docs/photon.md for
 /// the method, units and the determinism scheme.
 ///
 /// Units: photon power is flux in W (RGB). A path starts with the power of its
@@ -9,7 +10,6 @@
 
 #include "photon/photon_map.h"
 
-#include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
@@ -21,17 +21,13 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "photon/bsdf.h"
+#include "photon/ray_tracer.h"
 
 namespace lo {
 
 namespace photon_internal {
 
-/// Photons are stored only where the material has a diffuse lobe or a metal
-/// lobe at least this rough (perceptual roughness); sharper lobes are treated
-/// as specular and only redirect the path.
-constexpr float kGlossyRoughness = 0.2f;
-/// GGX alpha below which a metal is sampled as a perfect mirror.
-constexpr float kMirrorAlpha = 1e-3f;
 /// Ray origins move off the surface by this fraction of the scene's size
 /// (diagonal plus largest absolute coordinate, so far-from-origin scenes keep
 /// enough float precision).
@@ -48,18 +44,6 @@ struct TriangleInfo {
   uint32_t material = 0;
 };
 
-/// Lobe weights of a glTF metallic-roughness material with transmission
-/// (KHR_materials_transmission: transmission replaces the diffuse part of the
-/// dielectric base; the metal part is unaffected). They sum to 1 and are the
-/// probabilities of choosing each lobe, so a lobe's throughput is its tint.
-struct MaterialInfo {
-  float transmissionWeight = 0;
-  float metalWeight = 0;
-  float alpha = 1;  ///< GGX alpha = roughness^2
-  float ior = 1.5f;
-  bool storesPhotons = true;
-};
-
 struct Emitter {
   enum class Kind { Point, Spot, Directional, Triangle };
   Kind kind = Kind::Point;
@@ -73,9 +57,9 @@ struct Emitter {
 
 struct Context {
   const Scene* scene = nullptr;
-  RTCScene rtcScene = nullptr;
+  const RayTracer* tracer = nullptr;
   std::vector<TriangleInfo> triangles;
-  std::vector<MaterialInfo> materials;
+  std::vector<BsdfLobes> materials;
   std::vector<Emitter> emitters;
   std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
   Bounds3 bounds;
@@ -92,64 +76,6 @@ struct ChunkResult {
   std::vector<uint32_t> pathRays;     ///< rays per path
 };
 
-/// Owns the Embree device and scene.
-class EmbreeScene {
- public:
-  explicit EmbreeScene(const Scene& scene) {
-    device_ = rtcNewDevice(nullptr);
-    if (!device_) throw InternalError("rtcNewDevice failed (error " + errorCode(nullptr) + ")");
-    scene_ = rtcNewScene(device_);
-    // Robust traversal: the dragon has coincident opposite-winding triangles
-    // and the closed test boxes must not leak photons through shared edges.
-    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    // Copied into Embree-owned buffers: Embree reads vertices as 16 bytes,
-    // past the end of a tightly packed Vec3 array.
-    auto* vertices = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                3 * sizeof(float), scene.positions.size()));
-    auto* indices = static_cast<uint32_t*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                3 * sizeof(uint32_t), scene.triangleCount()));
-    if (!vertices || !indices) {
-      rtcReleaseGeometry(geom);
-      throw InternalError("Embree buffer allocation failed (error " + errorCode(device_) + ")");
-    }
-    for (size_t i = 0; i < scene.positions.size(); ++i) {
-      vertices[3 * i] = scene.positions[i].x;
-      vertices[3 * i + 1] = scene.positions[i].y;
-      vertices[3 * i + 2] = scene.positions[i].z;
-    }
-    std::copy(scene.indices.begin(), scene.indices.begin() + 3 * scene.triangleCount(), indices);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(scene_, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(scene_);
-    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE)
-      throw InternalError("Embree scene build failed (error " + errorCode(device_) + ")");
-  }
-  ~EmbreeScene() {
-    if (scene_) rtcReleaseScene(scene_);
-    if (device_) rtcReleaseDevice(device_);
-  }
-  EmbreeScene(const EmbreeScene&) = delete;
-  EmbreeScene& operator=(const EmbreeScene&) = delete;
-
-  RTCScene scene() const { return scene_; }
-
- private:
-  static std::string errorCode(RTCDevice device) {
-    return std::to_string(int(rtcGetDeviceError(device)));
-  }
-  RTCDevice device_ = nullptr;
-  RTCScene scene_ = nullptr;
-};
-
-inline Vec3 fromLocal(const Vec3& v, const Vec3& t, const Vec3& b, const Vec3& n) {
-  return t * v.x + b * v.y + n * v.z;
-}
-
 inline Vec3 uniformSphere(float u1, float u2) {
   float z = 1.0f - 2.0f * u1;
   float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
@@ -165,20 +91,6 @@ inline Vec3 uniformCone(float u1, float u2, float cosMax) {
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
-/// Cosine-weighted direction around +z (Malley: uniform disc, projected up).
-inline Vec3 cosineHemisphere(float u1, float u2) {
-  float r = std::sqrt(u1);
-  float phi = 2.0f * kPi * u2;
-  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u1))};
-}
-
-/// glTF KHR_lights_punctual spot falloff: ((cos - cosOuter) / (cosInner - cosOuter))^2, clamped.
-inline float spotFalloff(float cosTheta, float cosInner, float cosOuter) {
-  float scale = 1.0f / std::max(1e-3f, cosInner - cosOuter);
-  float a = std::clamp((cosTheta - cosOuter) * scale, 0.0f, 1.0f);
-  return a * a;
-}
-
 /// Power of a spot light with the glTF falloff integrated over the cone:
 /// 2 pi I [(1 - cosInner) + (cosInner - cosOuter) / 3]. Light::power ignores
 /// the falloff; the photons follow the falloff, so this is what they carry.
@@ -188,55 +100,6 @@ inline Vec3 spotPower(const Light& light) {
   float solid = 2.0f * kPi * ((1.0f - cosInner) + (cosInner - cosOuter) / 3.0f);
   return light.color * light.intensity * solid;
 }
-
-/// glTF range window: clamp(1 - (d / range)^4, 0, 1); 1 for range <= 0.
-inline float rangeWindow(float distance, float range) {
-  if (range <= 0) return 1.0f;
-  float q = distance / range;
-  q *= q;
-  return std::clamp(1.0f - q * q, 0.0f, 1.0f);
-}
-
-/// Unpolarised Fresnel reflectance of a smooth dielectric interface, n1 -> n2.
-/// cosT receives the cosine of the refracted direction (0 at total reflection).
-inline float fresnelDielectric(float cosI, float n1, float n2, float& cosT) {
-  float eta = n1 / n2;
-  float sin2T = eta * eta * std::max(0.0f, 1.0f - cosI * cosI);
-  if (sin2T >= 1.0f) {
-    cosT = 0;
-    return 1.0f;
-  }
-  cosT = std::sqrt(1.0f - sin2T);
-  float rs = (n1 * cosI - n2 * cosT) / (n1 * cosI + n2 * cosT);
-  float rp = (n2 * cosI - n1 * cosT) / (n2 * cosI + n1 * cosT);
-  return 0.5f * (rs * rs + rp * rp);
-}
-
-/// Smith Lambda for GGX, w in the local frame (z = normal).
-inline float smithLambda(const Vec3& w, float alpha) {
-  float z2 = w.z * w.z;
-  if (z2 <= 0) return 0;
-  float tan2 = std::max(0.0f, 1.0f - z2) / z2;
-  return 0.5f * (-1.0f + std::sqrt(1.0f + alpha * alpha * tan2));
-}
-
-/// GGX visible-normal sample (Heitz 2018) for local outgoing direction wo (wo.z > 0).
-inline Vec3 sampleGgxVisibleNormal(const Vec3& wo, float alpha, float u1, float u2) {
-  Vec3 vh = normalize(Vec3{alpha * wo.x, alpha * wo.y, wo.z});
-  float lensq = vh.x * vh.x + vh.y * vh.y;
-  Vec3 t1 = lensq > 0 ? Vec3{-vh.y, vh.x, 0} / std::sqrt(lensq) : Vec3{1, 0, 0};
-  Vec3 t2 = cross(vh, t1);
-  float r = std::sqrt(u1);
-  float phi = 2.0f * kPi * u2;
-  float p1 = r * std::cos(phi);
-  float p2 = r * std::sin(phi);
-  float s = 0.5f * (1.0f + vh.z);
-  p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
-  Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
-  return normalize(Vec3{alpha * nh.x, alpha * nh.y, std::max(0.0f, nh.z)});
-}
-
-inline Vec3 reflect(const Vec3& wo, const Vec3& n) { return n * (2.0f * dot(wo, n)) - wo; }
 
 inline Vec3 abs3(const Vec3& v) { return {std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}; }
 
@@ -327,23 +190,6 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
   return false;
 }
 
-inline void setRay(RTCRayHit& rh, const Vec3& org, const Vec3& dir) {
-  rh.ray.org_x = org.x;
-  rh.ray.org_y = org.y;
-  rh.ray.org_z = org.z;
-  rh.ray.tnear = 0.0f;
-  rh.ray.dir_x = dir.x;
-  rh.ray.dir_y = dir.y;
-  rh.ray.dir_z = dir.z;
-  rh.ray.time = 0.0f;
-  rh.ray.tfar = std::numeric_limits<float>::infinity();
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-}
-
 /// Russian roulette on the tint of one scattering event: survive with
 /// probability min(1, max(tint)) and divide by it, so the expected power
 /// after the event is exactly power * tint. Returns false if the path ends.
@@ -365,16 +211,12 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
   if (!emit(ctx, rng, start)) return;
   Vec3 org = start.origin, dir = start.direction, power = start.power;
 
-  RTCIntersectContext ictx;
-  rtcInitIntersectContext(&ictx);
-  RTCRayHit rh;
+  Hit hit;
   for (uint32_t bounce = 0;; ++bounce) {
-    setRay(rh, org, dir);
-    rtcIntersect1(ctx.rtcScene, &ictx, &rh);
     ++rayCount;
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return;
+    if (!ctx.tracer->intersect(org, dir, hit)) return;
 
-    float t = rh.ray.tfar;
+    float t = hit.t;
     // glTF range cut-off of punctual lights, applied as roulette at the first hit.
     if (bounce == 0 && start.punctual && start.range > 0 &&
         rng.uniform() >= rangeWindow(t, start.range))
@@ -382,10 +224,11 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     // From the ray parameter rather than the barycentrics: exactly coincident
     // triangles give the same t whichever of them Embree reports.
     Vec3 p = org + dir * t;
-    const TriangleInfo& tri = ctx.triangles[rh.hit.primID];
-    const MaterialInfo& mat = ctx.materials[tri.material];
-    bool frontFace = dot(dir, tri.normal) < 0;
-    Vec3 n = frontFace ? tri.normal : -tri.normal;  // faces the incoming side
+    const TriangleInfo& tri = ctx.triangles[hit.triangle];
+    const BsdfLobes& mat = ctx.materials[tri.material];
+    const Vec3& normal = hit.geometricNormal;
+    bool frontFace = dot(dir, normal) < 0;
+    Vec3 n = frontFace ? normal : -normal;  // faces the incoming side
     Vec3 wo = -dir;
 
     if (mat.storesPhotons && (bounce > 0 || ctx.includeDirect)) {
@@ -400,57 +243,17 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     }
     if (int(bounce) >= ctx.maxBounces) return;
 
-    Vec3 albedo = ctx.scene->albedo(rh.hit.primID, rh.hit.u, rh.hit.v);
-    Vec3 tint;
-    Vec3 newDir;
-    float lobe = rng.uniform();
-    if (lobe < mat.transmissionWeight) {
-      // Smooth dielectric: reflect with the Fresnel probability, else refract.
-      // Flux needs no eta^2 factor (that applies to radiance).
-      float n1 = frontFace ? 1.0f : mat.ior, n2 = frontFace ? mat.ior : 1.0f;
-      float cosI = std::min(1.0f, dot(wo, n)), cosT = 0;
-      float f = fresnelDielectric(cosI, n1, n2, cosT);
-      if (rng.uniform() < f) {
-        newDir = reflect(wo, n);
-        tint = Vec3{1, 1, 1};
-      } else {
-        float eta = n1 / n2;
-        newDir = -wo * eta + n * (eta * cosI - cosT);
-        tint = albedo;  // KHR_materials_transmission tints transmitted light by baseColor
-      }
-    } else if (lobe < mat.transmissionWeight + mat.metalWeight) {
-      // Metal: GGX reflection, Schlick Fresnel with F0 = baseColor.
-      if (mat.alpha < kMirrorAlpha) {
-        newDir = reflect(wo, n);
-        float c = 1.0f - std::max(0.0f, dot(wo, n));
-        tint = albedo + (Vec3{1, 1, 1} - albedo) * (c * c * c * c * c);
-      } else {
-        Vec3 tt, bb;
-        orthonormalBasis(n, tt, bb);
-        Vec3 woLocal{dot(wo, tt), dot(wo, bb), std::max(1e-6f, dot(wo, n))};
-        float u1 = rng.uniform(), u2 = rng.uniform();
-        Vec3 m = sampleGgxVisibleNormal(woLocal, mat.alpha, u1, u2);
-        Vec3 wiLocal = reflect(woLocal, m);
-        if (wiLocal.z <= 0) return;  // below the surface: the lobe's energy loss
-        float c = 1.0f - std::max(0.0f, dot(woLocal, m));
-        Vec3 fresnel = albedo + (Vec3{1, 1, 1} - albedo) * (c * c * c * c * c);
-        // f cos / pdf of VNDF sampling = F * G2 / G1(wo) (height-correlated Smith).
-        float lo = smithLambda(woLocal, mat.alpha), li = smithLambda(wiLocal, mat.alpha);
-        tint = fresnel * ((1.0f + lo) / (1.0f + lo + li));
-        newDir = fromLocal(wiLocal, tt, bb, n);
-      }
-    } else {
-      Vec3 tt, bb;
-      orthonormalBasis(n, tt, bb);
-      float u1 = rng.uniform(), u2 = rng.uniform();
-      newDir = fromLocal(cosineHemisphere(u1, u2), tt, bb, n);
-      tint = albedo;
-    }
+    Vec3 albedo = ctx.scene->albedo(hit.triangle, hit.b1, hit.b2);
+    BsdfSample sample;
+    // A lost sample (GGX reflection below the surface) is the lobe's energy loss.
+    if (!sampleBsdf(mat, albedo, wo, n, frontFace, rng, sample)) return;
+    const Vec3& tint = sample.weight;
+    const Vec3& newDir = sample.wi;
     if (!roulette(rng, tint, power)) return;
     dir = normalize(newDir);
     if (lengthSquared(dir) == 0) return;
     // Offset to the side the new ray leaves on (refraction crosses over).
-    org = p + (dot(dir, tri.normal) > 0 ? tri.normal : -tri.normal) * ctx.epsilon;
+    org = p + (dot(dir, normal) > 0 ? normal : -normal) * ctx.epsilon;
   }
 }
 
@@ -576,17 +379,7 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   }
   ctx.materials.resize(scene.materials.size());
   for (size_t i = 0; i < scene.materials.size(); ++i) {
-    const Material& m = scene.materials[i];
-    MaterialInfo& info = ctx.materials[i];
-    float metallic = std::clamp(m.metallic, 0.0f, 1.0f);
-    float transmission = std::clamp(m.transmission, 0.0f, 1.0f);
-    float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
-    info.metalWeight = metallic;
-    info.transmissionWeight = (1.0f - metallic) * transmission;
-    float diffuseWeight = (1.0f - metallic) * (1.0f - transmission);
-    info.alpha = roughness * roughness;
-    info.ior = m.ior > 0 ? m.ior : 1.5f;
-    info.storesPhotons = diffuseWeight > 0 || (metallic > 0 && roughness > kGlossyRoughness);
+    ctx.materials[i] = bsdfLobes(scene.materials[i]);
   }
 
   PhotonMap map;
@@ -597,8 +390,8 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   float scale = length(ext) + maxComponent(max(abs3(ctx.bounds.lower), abs3(ctx.bounds.upper)));
   ctx.epsilon = kRayEpsilonScale * std::max(scale, 1e-6f);
 
-  EmbreeScene embree(scene);
-  ctx.rtcScene = embree.scene();
+  RayTracer tracer(scene);
+  ctx.tracer = &tracer;
 
   const size_t target = params.storedPhotons;
   const size_t maxEmitted = params.maxEmitted ? params.maxEmitted : 64 * target;

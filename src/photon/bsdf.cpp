@@ -1,0 +1,169 @@
+/// @file photon/bsdf.cpp
+/// @brief The shared diffuse + GGX metal + Fresnel glass material model.
+
+#include "photon/bsdf.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lo {
+
+namespace {
+
+/// Smith Lambda for GGX, w in the local frame (z = normal).
+float smithLambda(const Vec3& w, float alpha) {
+  float z2 = w.z * w.z;
+  if (z2 <= 0) return 0;
+  float tan2 = std::max(0.0f, 1.0f - z2) / z2;
+  return 0.5f * (-1.0f + std::sqrt(1.0f + alpha * alpha * tan2));
+}
+
+/// GGX normal distribution D(m), m in the local frame.
+float ggxD(const Vec3& m, float alpha) {
+  if (m.z <= 0) return 0;
+  float a2 = alpha * alpha;
+  float d = m.z * m.z * (a2 - 1.0f) + 1.0f;
+  return a2 / (kPi * d * d);
+}
+
+/// GGX visible-normal sample (Heitz 2018) for local outgoing direction wo (wo.z > 0).
+Vec3 sampleGgxVisibleNormal(const Vec3& wo, float alpha, float u1, float u2) {
+  Vec3 vh = normalize(Vec3{alpha * wo.x, alpha * wo.y, wo.z});
+  float lensq = vh.x * vh.x + vh.y * vh.y;
+  Vec3 t1 = lensq > 0 ? Vec3{-vh.y, vh.x, 0} / std::sqrt(lensq) : Vec3{1, 0, 0};
+  Vec3 t2 = cross(vh, t1);
+  float r = std::sqrt(u1);
+  float phi = 2.0f * kPi * u2;
+  float p1 = r * std::cos(phi);
+  float p2 = r * std::sin(phi);
+  float s = 0.5f * (1.0f + vh.z);
+  p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
+  Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
+  return normalize(Vec3{alpha * nh.x, alpha * nh.y, std::max(0.0f, nh.z)});
+}
+
+Vec3 reflect(const Vec3& wo, const Vec3& n) { return n * (2.0f * dot(wo, n)) - wo; }
+
+Vec3 schlick(const Vec3& f0, float cosine) {
+  float c = 1.0f - std::max(0.0f, cosine);
+  return f0 + (Vec3{1, 1, 1} - f0) * (c * c * c * c * c);
+}
+
+}  // namespace
+
+BsdfLobes bsdfLobes(const Material& m) {
+  BsdfLobes info;
+  float metallic = std::clamp(m.metallic, 0.0f, 1.0f);
+  float transmission = std::clamp(m.transmission, 0.0f, 1.0f);
+  float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+  info.metalWeight = metallic;
+  info.transmissionWeight = (1.0f - metallic) * transmission;
+  info.diffuseWeight = (1.0f - metallic) * (1.0f - transmission);
+  info.alpha = roughness * roughness;
+  info.ior = m.ior > 0 ? m.ior : 1.5f;
+  info.storesPhotons = info.diffuseWeight > 0 || (metallic > 0 && roughness > kGlossyRoughness);
+  return info;
+}
+
+float fresnelDielectric(float cosI, float n1, float n2, float& cosT) {
+  float eta = n1 / n2;
+  float sin2T = eta * eta * std::max(0.0f, 1.0f - cosI * cosI);
+  if (sin2T >= 1.0f) {
+    cosT = 0;
+    return 1.0f;
+  }
+  cosT = std::sqrt(1.0f - sin2T);
+  float rs = (n1 * cosI - n2 * cosT) / (n1 * cosI + n2 * cosT);
+  float rp = (n2 * cosI - n1 * cosT) / (n2 * cosI + n1 * cosT);
+  return 0.5f * (rs * rs + rp * rp);
+}
+
+bool sampleBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& n,
+                bool frontFace, Rng& rng, BsdfSample& out) {
+  float lobe = rng.uniform();
+  out.delta = false;
+  if (lobe < lobes.transmissionWeight) {
+    // Smooth dielectric: reflect with the Fresnel probability, else refract.
+    // Flux needs no eta^2 factor; radiance would, but the path tracer follows
+    // importance from the camera, where the two factors cancel over a
+    // round trip, so none is applied in either direction.
+    float n1 = frontFace ? 1.0f : lobes.ior, n2 = frontFace ? lobes.ior : 1.0f;
+    float cosI = std::min(1.0f, dot(wo, n)), cosT = 0;
+    float f = fresnelDielectric(cosI, n1, n2, cosT);
+    out.delta = true;
+    if (rng.uniform() < f) {
+      out.wi = reflect(wo, n);
+      out.weight = Vec3{1, 1, 1};
+    } else {
+      float eta = n1 / n2;
+      out.wi = -wo * eta + n * (eta * cosI - cosT);
+      out.weight = albedo;  // KHR_materials_transmission tints transmitted light by baseColor
+    }
+    return true;
+  }
+  if (lobe < lobes.transmissionWeight + lobes.metalWeight) {
+    // Metal: GGX reflection, Schlick Fresnel with F0 = baseColor.
+    if (lobes.alpha < kMirrorAlpha) {
+      out.wi = reflect(wo, n);
+      out.weight = schlick(albedo, dot(wo, n));
+      out.delta = true;
+      return true;
+    }
+    Vec3 tt, bb;
+    orthonormalBasis(n, tt, bb);
+    Vec3 woLocal{dot(wo, tt), dot(wo, bb), std::max(1e-6f, dot(wo, n))};
+    float u1 = rng.uniform(), u2 = rng.uniform();
+    Vec3 m = sampleGgxVisibleNormal(woLocal, lobes.alpha, u1, u2);
+    Vec3 wiLocal = reflect(woLocal, m);
+    if (wiLocal.z <= 0) return false;
+    // f cos / pdf of VNDF sampling = F * G2 / G1(wo) (height-correlated Smith).
+    float lo = smithLambda(woLocal, lobes.alpha), li = smithLambda(wiLocal, lobes.alpha);
+    out.weight = schlick(albedo, dot(woLocal, m)) * ((1.0f + lo) / (1.0f + lo + li));
+    out.wi = fromLocal(wiLocal, tt, bb, n);
+    return true;
+  }
+  Vec3 tt, bb;
+  orthonormalBasis(n, tt, bb);
+  float u1 = rng.uniform(), u2 = rng.uniform();
+  out.wi = fromLocal(cosineHemisphere(u1, u2), tt, bb, n);
+  out.weight = albedo;
+  return true;
+}
+
+Vec3 evalBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
+              const Vec3& n) {
+  float cosI = dot(wi, n), cosO = dot(wo, n);
+  if (cosI <= 0 || cosO <= 0) return Vec3{0, 0, 0};
+  Vec3 f = albedo * (lobes.diffuseWeight * kInvPi * cosI);
+  if (lobes.metalWeight > 0 && lobes.alpha >= kMirrorAlpha) {
+    Vec3 h = normalize(wo + wi);
+    Vec3 tt, bb;
+    orthonormalBasis(n, tt, bb);
+    Vec3 woL{dot(wo, tt), dot(wo, bb), cosO}, wiL{dot(wi, tt), dot(wi, bb), cosI};
+    Vec3 m{dot(h, tt), dot(h, bb), dot(h, n)};
+    float g2 = 1.0f / (1.0f + smithLambda(woL, lobes.alpha) + smithLambda(wiL, lobes.alpha));
+    // f cos(wi) = F D G2 / (4 cos(wo)).
+    f += schlick(albedo, dot(wo, h)) *
+         (lobes.metalWeight * ggxD(m, lobes.alpha) * g2 / (4.0f * cosO));
+  }
+  return f;
+}
+
+float pdfBsdf(const BsdfLobes& lobes, const Vec3& wo, const Vec3& wi, const Vec3& n) {
+  float cosI = dot(wi, n), cosO = dot(wo, n);
+  if (cosI <= 0 || cosO <= 0) return 0;
+  float pdf = lobes.diffuseWeight * cosI * kInvPi;
+  if (lobes.metalWeight > 0 && lobes.alpha >= kMirrorAlpha) {
+    Vec3 h = normalize(wo + wi);
+    Vec3 tt, bb;
+    orthonormalBasis(n, tt, bb);
+    Vec3 woL{dot(wo, tt), dot(wo, bb), cosO};
+    Vec3 m{dot(h, tt), dot(h, bb), dot(h, n)};
+    // VNDF: D_wo(m) / (4 wo.m) = G1(wo) D(m) / (4 cos(wo)).
+    float g1 = 1.0f / (1.0f + smithLambda(woL, lobes.alpha));
+    pdf += lobes.metalWeight * g1 * ggxD(m, lobes.alpha) / (4.0f * cosO);
+  }
+  return pdf;
+}
+
+}  // namespace lo

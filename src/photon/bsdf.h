@@ -1,0 +1,103 @@
+#pragma once
+/// @file photon/bsdf.h
+/// @brief The material model the photon tracer scatters with, shared with the
+/// reference path tracer (src/reference) so both estimate the same transport.
+///
+/// A glTF metallic-roughness material with KHR_materials_transmission is a
+/// mixture of three lobes whose weights sum to 1 (transmission replaces the
+/// diffuse part of the dielectric base; the metal part is unaffected):
+///   - diffuse (weight (1-metallic)(1-transmission)): Lambert, baseColor / pi;
+///   - metal (weight metallic): GGX (alpha = roughness^2), height-correlated
+///     Smith G2, Schlick Fresnel with F0 = baseColor; alpha < kMirrorAlpha is a
+///     perfect mirror (a delta lobe);
+///   - glass (weight (1-metallic) transmission): smooth dielectric, Fresnel
+///     reflection or refraction tinted by baseColor (a delta lobe).
+/// There is no dielectric specular layer on the diffuse lobe (unlike the GL
+/// renderer's BRDF, docs/render.md). Shading uses the geometric normal only.
+///
+/// Directions are unit, world space, pointing away from the surface: wo
+/// towards the viewer (or where a photon came from), wi towards the light.
+
+#include "core/math.h"
+#include "core/rng.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+/// Metal lobes at least this rough (perceptual roughness) count as glossy:
+/// the photon tracer stores photons on them; sharper lobes only redirect.
+constexpr float kGlossyRoughness = 0.2f;
+/// GGX alpha below which a metal is sampled as a perfect mirror.
+constexpr float kMirrorAlpha = 1e-3f;
+
+/// Lobe weights (probabilities of choosing each lobe; they sum to 1).
+struct BsdfLobes {
+  float transmissionWeight = 0;
+  float metalWeight = 0;
+  float diffuseWeight = 1;
+  float alpha = 1;  ///< GGX alpha = roughness^2
+  float ior = 1.5f;
+  bool storesPhotons = true;  ///< diffuse lobe, or metal rougher than kGlossyRoughness
+  /// Whether any lobe is not a delta distribution (light sampling can help).
+  bool hasSmoothLobe() const {
+    return diffuseWeight > 0 || (metalWeight > 0 && alpha >= kMirrorAlpha);
+  }
+};
+BsdfLobes bsdfLobes(const Material& material);
+
+/// One sampled scattering direction.
+struct BsdfSample {
+  Vec3 wi;             ///< new direction, not normalised (callers normalise)
+  Vec3 weight;         ///< the chosen lobe's f * |cos| / pdf: what the throughput is multiplied by
+  bool delta = false;  ///< mirror or glass: evalBsdf/pdfBsdf do not cover it
+};
+
+/// Chooses a lobe by its weight and samples it: diffuse cosine-weighted,
+/// metal by GGX visible normals (Heitz 2018), glass by the Fresnel
+/// probability. `n` is the unit geometric normal turned to wo's side,
+/// `frontFace` whether that is the winding side (so the ray enters the
+/// material when it refracts). Returns false if the sample is lost (a GGX
+/// reflection below the surface: the lobe's energy loss). Consumes the random
+/// numbers in a fixed order (photon maps depend on it).
+bool sampleBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& n,
+                bool frontFace, Rng& rng, BsdfSample& out);
+
+/// Sum over the smooth lobes (diffuse, rough metal) of weight * f(wo, wi) *
+/// cos(n, wi); zero when wi is below the surface. Delta lobes give zero.
+Vec3 evalBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
+              const Vec3& n);
+/// Solid-angle density with which sampleBsdf produces wi through a smooth
+/// lobe (lobe weight times the lobe's pdf, summed). Used for MIS weights.
+float pdfBsdf(const BsdfLobes& lobes, const Vec3& wo, const Vec3& wi, const Vec3& n);
+
+/// Unpolarised Fresnel reflectance of a smooth dielectric interface, n1 -> n2.
+/// cosT receives the cosine of the refracted direction (0 at total reflection).
+float fresnelDielectric(float cosI, float n1, float n2, float& cosT);
+
+/// Cosine-weighted direction around +z (Malley: uniform disc, projected up).
+inline Vec3 cosineHemisphere(float u1, float u2) {
+  float r = std::sqrt(u1);
+  float phi = 2.0f * kPi * u2;
+  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u1))};
+}
+
+inline Vec3 fromLocal(const Vec3& v, const Vec3& t, const Vec3& b, const Vec3& n) {
+  return t * v.x + b * v.y + n * v.z;
+}
+
+/// glTF KHR_lights_punctual spot falloff: ((cos - cosOuter) / (cosInner - cosOuter))^2, clamped.
+inline float spotFalloff(float cosTheta, float cosInner, float cosOuter) {
+  float scale = 1.0f / std::max(1e-3f, cosInner - cosOuter);
+  float a = std::clamp((cosTheta - cosOuter) * scale, 0.0f, 1.0f);
+  return a * a;
+}
+
+/// glTF range window: clamp(1 - (d / range)^4, 0, 1); 1 for range <= 0.
+inline float rangeWindow(float distance, float range) {
+  if (range <= 0) return 1.0f;
+  float q = distance / range;
+  q *= q;
+  return std::clamp(1.0f - q * q, 0.0f, 1.0f);
+}
+
+}  // namespace lo
