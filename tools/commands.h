@@ -17,4 +17,10 @@ std::function<int()> addBakeCommand(CLI::App& app);
 /// `lightoctree render SCENE LIGHTS.vdb -o IMAGE.{png,exr} ...`
 std::function<int()> addRenderCommand(CLI::App& app);
 
+/// `lightoctree convert IN.vdb -o OUT.vdb [--depth D] [--vdls K|auto] ...`
+std::function<int()> addConvertCommand(CLI::App& app);
+
+/// `lightoctree inspect IN.vdb [--json]`
+std::function<int()> addInspectCommand(CLI::App& app);
+
 }  // namespace lo::tool

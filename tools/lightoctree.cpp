@@ -19,6 +19,8 @@ int run(int argc, char** argv) {
   std::vector<std::function<int()>> commands;
   commands.push_back(lo::tool::addBakeCommand(app));
   commands.push_back(lo::tool::addRenderCommand(app));
+  commands.push_back(lo::tool::addConvertCommand(app));
+  commands.push_back(lo::tool::addInspectCommand(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

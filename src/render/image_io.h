@@ -1,22 +1,24 @@
 #pragma once
 /// @file render/image_io.h
-/// @brief Writing rendered images: OpenEXR (linear float RGB, what the
-/// renderer computed) or PNG (exposure, clamp, sRGB-encoded 8-bit).
+/// @brief Rendered frames as files: OpenEXR (linear float RGB, what the
+/// renderer computed) or PNG (exposure, clamp, sRGB-encoded 8-bit). The file
+/// formats themselves live in src/image.
 
 #include <string>
 
+#include "image/image.h"
 #include "render/renderer.h"
 
 namespace lo {
 
-/// Writes `image` by the extension of `path`: .exr (32-bit float R, G, B,
-/// linear radiance; `exposureEv` ignored) or .png (radiance * 2^exposureEv,
-/// clamped to [0,1], sRGB transfer function, 8 bits). Written to a temporary
-/// name beside `path` and renamed. @throws InputError for another extension,
-/// IoError when writing fails.
-void writeImage(const std::string& path, const Image& image, float exposureEv = 0.0f);
+/// The RGB channels of a rendered RGBA frame.
+RgbImage toRgbImage(const Image& image);
 
-/// The 8-bit sRGB encoding PNG output uses, for one linear value.
-unsigned char encodeSrgb8(float linear);
+/// Writes `image` by the extension of `path` (image/image.h writeImage):
+/// .exr (32-bit float R, G, B, linear radiance; `exposureEv` ignored) or .png
+/// (radiance * 2^exposureEv, clamped to [0,1], sRGB, 8 bits). Written to a
+/// temporary name beside `path` and renamed. @throws InputError for another
+/// extension or an empty image, IoError when writing fails.
+void writeImage(const std::string& path, const Image& image, float exposureEv = 0.0f);
 
 }  // namespace lo

@@ -16,6 +16,10 @@ struct Damage {
   std::string omitGrid;          ///< leave this grid out of the file ("" = none)
   std::string shiftGrid;         ///< give this grid a transform shifted by one voxel ("" = none)
   bool rotateTransform = false;  ///< every grid gets the same transform with a rotation
+  VdlWriteOptions options;       ///< half floats / dropped grids, as writeVdlGrid
+  /// Write this int32 as the file's format_version instead of kVdlFormatVersion
+  /// (0 = leave the key out, as files written before it existed).
+  int formatVersion = kVdlFormatVersion;
 };
 
 /// writeVdlGrid with damage applied (same metadata, same temp + rename).

@@ -207,6 +207,10 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   m.insertMeta("scene_bounds_max", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.upper)));
   m.insertMeta("units", openvdb::StringMetadata(meta.units));
   m.insertMeta("max_vdls", openvdb::Int32Metadata(grid.maxVdls));
+  m.insertMeta("format_version", openvdb::Int32Metadata(kVdlFormatVersion));
+  if (!meta.convertedFrom.empty()) {
+    m.insertMeta("converted_from", openvdb::StringMetadata(meta.convertedFrom));
+  }
   return m;
 }
 
@@ -237,9 +241,31 @@ openvdb::GridPtrVec buildVdlGrids(const VdlGrid& g, const Transform::Ptr& xform)
   return grids;
 }
 
+bool isOptionalGrid(const std::string& name) {
+  const auto& names = optionalVdlGridNames();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+// Counts and areas stay 32-bit in half-float files (see VdlWriteOptions).
+bool keepsFullPrecision(const std::string& name) {
+  return name == kVdlCount || name == kPhotonCount || name == kArea;
+}
+
 void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
-              const Damage* damage) {
+              const VdlWriteOptions& options, const Damage* damage) {
   initOpenVdb();
+  for (const std::string& name : options.drop) {
+    if (!isOptionalGrid(name)) {
+      std::string list;
+      for (const auto& o : optionalVdlGridNames()) list += (list.empty() ? "" : ", ") + o;
+      throw InputError("--drop: grid '" + name + "' " +
+                       (name == kIrradiance || name == kNormal || name == kVdlCount ||
+                                name.rfind("vdl", 0) == 0
+                            ? "is required by the VDL file contract"
+                            : "is not a grid of the VDL file contract") +
+                       "; only optional grids can be dropped: " + list);
+    }
+  }
   checkArrays(grid);
   LO_CHECK(grid.maxVdls >= 1 && grid.maxVdls <= kMaxVdls);
   if (meta.depth != 0) LO_CHECK_EQ(meta.depth, grid.frame.depth);
@@ -253,6 +279,10 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
   openvdb::GridCPtrVec out;
   for (const auto& g : grids) {
     if (damage && g->getName() == damage->omitGrid) continue;
+    if (std::find(options.drop.begin(), options.drop.end(), g->getName()) != options.drop.end()) {
+      continue;
+    }
+    if (options.halfFloat && !keepsFullPrecision(g->getName())) g->setSaveFloatAsHalf(true);
     if (damage && g->getName() == damage->shiftGrid) {
       Transform::Ptr shifted = xform->copy();
       shifted->postTranslate(openvdb::Vec3d(grid.frame.voxelSize, 0, 0));
@@ -260,7 +290,14 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
     }
     out.push_back(g);
   }
-  writeAtomically(path, out, fileMetadata(meta, grid));
+  openvdb::MetaMap fileMeta = fileMetadata(meta, grid);
+  if (damage && damage->formatVersion != kVdlFormatVersion) {
+    fileMeta.removeMeta("format_version");
+    if (damage->formatVersion != 0) {
+      fileMeta.insertMeta("format_version", openvdb::Int32Metadata(damage->formatVersion));
+    }
+  }
+  writeAtomically(path, out, fileMeta);
 }
 
 // ---------------------------------------------------------------------------
@@ -357,6 +394,8 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.sceneBounds.upper = fromVdb(
       metaValue<openvdb::Vec3s>(path, m, "scene_bounds_max", false, openvdb::Vec3s(-INFINITY)));
   meta.units = metaValue<std::string>(path, m, "units", false, "");
+  meta.formatVersion = metaValue<int32_t>(path, m, "format_version", false, 0);
+  meta.convertedFrom = metaValue<std::string>(path, m, "converted_from", false, "");
   return meta;
 }
 
@@ -382,7 +421,7 @@ GridFrame readFrame(const std::string& path, const Transform& xform, int depth) 
 
 void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
                          const Damage& damage) {
-  writeVdl(path, grid, meta, &damage);
+  writeVdl(path, grid, meta, damage.options, &damage);
 }
 
 namespace {
@@ -391,6 +430,18 @@ LoadedVdl readVdl(const std::string& path) {
   OpenedFile f = openFile(path);
   LoadedVdl out;
   out.meta = readMetadata(path, *f.meta);
+  if (out.meta.formatVersion == 0) {
+    // Files baked before the key existed follow version 1 of the contract.
+    out.meta.formatVersion = 1;
+    out.notes.push_back("no format_version metadata: read as format version 1");
+  } else if (out.meta.formatVersion > kVdlFormatVersion || out.meta.formatVersion < 1) {
+    throw InputError(path + ": format_version " + std::to_string(out.meta.formatVersion) +
+                     " is not supported: this lightoctree (" LO_VERSION ") reads VDL files up to "
+                     "format version " +
+                     std::to_string(kVdlFormatVersion) +
+                     (out.meta.formatVersion > kVdlFormatVersion ? "; use a newer lightoctree"
+                                                                 : ""));
+  }
   const int maxVdls = metaValue<int32_t>(path, *f.meta, "max_vdls", true, 0);
   if (maxVdls < 1 || maxVdls > kMaxVdls) {
     throw InputError(path + ": file metadata max_vdls = " + std::to_string(maxVdls) +
@@ -400,18 +451,29 @@ LoadedVdl readVdl(const std::string& path) {
   // Every grid of the contract, typed, before anything is interpreted.
   auto irradiance = requireGrid<Vec3SGrid>(path, f, kIrradiance);
   auto normal = requireGrid<Vec3SGrid>(path, f, kNormal);
-  auto photonCount = requireGrid<FloatGrid>(path, f, kPhotonCount);
-  auto angularError = requireGrid<FloatGrid>(path, f, kAngularError);
   auto vdlCount = requireGrid<FloatGrid>(path, f, kVdlCount);
-  auto radius = requireGrid<FloatGrid>(path, f, kRadius);
-  auto area = requireGrid<FloatGrid>(path, f, kArea);
+  // Optional grids: absent ones read as 0 (a file converted with --drop).
+  auto optionalGrid = [&](const char* name) -> FloatGrid::Ptr {
+    if (!findGrid(f, name)) {
+      out.absentGrids.push_back(name);
+      return nullptr;
+    }
+    return requireGrid<FloatGrid>(path, f, name);
+  };
+  auto photonCount = optionalGrid(kPhotonCount);
+  auto angularError = optionalGrid(kAngularError);
+  auto radius = optionalGrid(kRadius);
+  auto area = optionalGrid(kArea);
+  out.halfFloat = irradiance->saveFloatAsHalf();
   std::vector<Vec3SGrid::Ptr> vdlIrr, vdlDir;
   for (int i = 0; i < maxVdls; ++i) {
     vdlIrr.push_back(requireGrid<Vec3SGrid>(path, f, vdlIrradianceName(i)));
     vdlDir.push_back(requireGrid<Vec3SGrid>(path, f, vdlDirectionName(i)));
   }
-  std::vector<openvdb::GridBase::Ptr> all = {irradiance, normal, photonCount, angularError,
-                                             vdlCount,   radius, area};
+  std::vector<openvdb::GridBase::Ptr> all = {irradiance, normal, vdlCount};
+  for (const FloatGrid::Ptr& g : {photonCount, angularError, radius, area}) {
+    if (g) all.push_back(g);
+  }
   all.insert(all.end(), vdlIrr.begin(), vdlIrr.end());
   all.insert(all.end(), vdlDir.begin(), vdlDir.end());
 
@@ -451,19 +513,20 @@ LoadedVdl readVdl(const std::string& path) {
 
   auto irrAcc = irradiance->getConstAccessor();
   auto nAcc = normal->getConstAccessor();
-  auto pcAcc = photonCount->getConstAccessor();
-  auto aeAcc = angularError->getConstAccessor();
   auto vcAcc = vdlCount->getConstAccessor();
-  auto rAcc = radius->getConstAccessor();
-  auto arAcc = area->getConstAccessor();
+  auto readOptional = [&](const FloatGrid::Ptr& grid, std::vector<float>& dst) {
+    if (!grid) return;
+    auto acc = grid->getConstAccessor();
+    for (size_t v = 0; v < n; ++v) dst[v] = acc.getValue(toVdb(g.coords[v]));
+  };
+  readOptional(photonCount, g.photonCount);
+  readOptional(angularError, g.angularError);
+  readOptional(radius, g.radius);
+  readOptional(area, g.areas);
   for (size_t v = 0; v < n; ++v) {
     const openvdb::Coord c = toVdb(g.coords[v]);
     g.irradiance[v] = fromVdb(irrAcc.getValue(c));
     g.normals[v] = fromVdb(nAcc.getValue(c));
-    g.photonCount[v] = pcAcc.getValue(c);
-    g.angularError[v] = aeAcc.getValue(c);
-    g.radius[v] = rAcc.getValue(c);
-    g.areas[v] = arAcc.getValue(c);
     const float count = vcAcc.getValue(c);
     if (!(count >= 0 && count <= float(maxVdls)) || count != std::floor(count)) {
       throw InputError(path + ": vdl_count at " + g.coords[v].ToString() + " is " +
@@ -539,6 +602,51 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   writeAtomically(path, openvdb::GridCPtrVec{grid}, meta);
 }
 
+std::vector<Photon> readPoints(const std::string& path) {
+  namespace pts = openvdb::points;
+  OpenedFile f = openFile(path);
+  auto grid = requireGrid<pts::PointDataGrid>(path, f, "photons");
+  std::vector<Photon> out;
+  out.reserve(size_t(pts::pointCount(grid->tree())));
+  auto leaf = grid->tree().cbeginLeaf();
+  if (!leaf) return out;
+  const auto& descriptor = leaf->attributeSet().descriptor();
+  auto attribute = [&](const char* name) {
+    const size_t index = descriptor.find(name);
+    if (index == pts::AttributeSet::INVALID_POS) {
+      throw InputError(path + ": photon grid has no attribute '" + name + "'");
+    }
+    return index;
+  };
+  const size_t pIndex = attribute("P"), cdIndex = attribute("Cd");
+  const size_t dIndex = attribute("direction"), nIndex = attribute("N");
+  const size_t bIndex = attribute("bounce");
+  const Transform& xform = grid->transform();
+  try {
+    for (; leaf; ++leaf) {
+      pts::AttributeHandle<openvdb::Vec3f> pHandle(leaf->constAttributeArray(pIndex));
+      pts::AttributeHandle<openvdb::Vec3s> cdHandle(leaf->constAttributeArray(cdIndex));
+      pts::AttributeHandle<openvdb::Vec3s> dHandle(leaf->constAttributeArray(dIndex));
+      pts::AttributeHandle<openvdb::Vec3s> nHandle(leaf->constAttributeArray(nIndex));
+      pts::AttributeHandle<int32_t> bHandle(leaf->constAttributeArray(bIndex));
+      for (auto idx = leaf->beginIndexOn(); idx; ++idx) {
+        const openvdb::Vec3d world =
+            xform.indexToWorld(pHandle.get(*idx) + idx.getCoord().asVec3d());
+        Photon p;
+        p.position = Vec3(float(world.x()), float(world.y()), float(world.z()));
+        p.power = fromVdb(cdHandle.get(*idx));
+        p.direction = fromVdb(dHandle.get(*idx));
+        p.normal = fromVdb(nHandle.get(*idx));
+        p.bounce = uint32_t(std::max(0, bHandle.get(*idx)));
+        out.push_back(p);
+      }
+    }
+  } catch (const openvdb::Exception& e) {
+    throw InputError(path + ": cannot read the photon attributes: " + e.what());
+  }
+  return out;
+}
+
 }  // namespace
 
 PointFileInfo inspectPointFile(const std::string& path) {
@@ -575,8 +683,20 @@ PointFileInfo inspectPointFile(const std::string& path) {
 
 }  // namespace vdb_internal
 
-void writeVdlGrid(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta) {
-  vdb_internal::writeVdl(path, grid, meta, nullptr);
+const std::vector<std::string>& optionalVdlGridNames() {
+  static const std::vector<std::string> names = {vdb_internal::kPhotonCount,
+                                                 vdb_internal::kAngularError,
+                                                 vdb_internal::kRadius, vdb_internal::kArea};
+  return names;
+}
+
+void writeVdlGrid(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
+                  const VdlWriteOptions& options) {
+  vdb_internal::writeVdl(path, grid, meta, options, nullptr);
+}
+
+std::vector<Photon> readPhotonPoints(const std::string& path) {
+  return vdb_internal::readPoints(path);
 }
 
 LoadedVdl readVdlGrid(const std::string& path) { return vdb_internal::readVdl(path); }

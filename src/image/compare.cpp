@@ -1,0 +1,146 @@
+/// @file image/compare.cpp
+/// @brief Image error metrics (image/compare.h).
+
+#include "image/compare.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace lo {
+namespace {
+
+void checkSizes(const RgbImage& test, const RgbImage& reference, const CompareParams& params) {
+  if (test.pixelCount() == 0 || reference.pixelCount() == 0)
+    throw InputError("compare: empty image");
+  if (test.width != reference.width || test.height != reference.height)
+    throw InputError("compare: image sizes differ: " + std::to_string(test.width) + " x " +
+                     std::to_string(test.height) + " vs reference " +
+                     std::to_string(reference.width) + " x " + std::to_string(reference.height));
+  if (params.mask && (params.mask->width != reference.width ||
+                      params.mask->height != reference.height))
+    throw InputError("compare: mask is " + std::to_string(params.mask->width) + " x " +
+                     std::to_string(params.mask->height) + ", images are " +
+                     std::to_string(reference.width) + " x " + std::to_string(reference.height));
+}
+
+enum class PixelUse { Compare, Ignore, NonFinite };
+
+PixelUse pixelUse(const RgbImage& test, const RgbImage& reference, const CompareParams& params,
+                  size_t i) {
+  if (params.mask && maxComponent(params.mask->at(i)) == 0) return PixelUse::Ignore;
+  Vec3 b = reference.at(i);
+  if (params.ignoreBackground && b == Vec3{0, 0, 0}) return PixelUse::Ignore;
+  if (!isFinite(b) || !isFinite(test.at(i))) return PixelUse::NonFinite;
+  return PixelUse::Compare;
+}
+
+struct Accumulator {
+  double sumSqDiff = 0, sumSqRef = 0, sumAbsDiff = 0, sumAbsRef = 0, maxAbs = 0;
+  void add(double a, double b) {
+    double d = a - b;
+    sumSqDiff += d * d;
+    sumSqRef += b * b;
+    sumAbsDiff += std::fabs(d);
+    sumAbsRef += std::fabs(b);
+    maxAbs = std::max(maxAbs, std::fabs(d));
+  }
+  static double ratio(double num, double den) {
+    if (den > 0) return num / den;
+    return num > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  }
+  ChannelError result() const {
+    ChannelError e;
+    e.relRmse = std::sqrt(ratio(sumSqDiff, sumSqRef));
+    e.relMae = ratio(sumAbsDiff, sumAbsRef);
+    e.maxAbs = maxAbs;
+    return e;
+  }
+};
+
+}  // namespace
+
+CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
+                            const CompareParams& params) {
+  checkSizes(test, reference, params);
+  CompareResult r;
+  Accumulator acc[4];
+  double maxLum = -1, sumLum = 0;
+  for (size_t i = 0; i < reference.pixelCount(); ++i) {
+    PixelUse use = pixelUse(test, reference, params, i);
+    if (use == PixelUse::Ignore) {
+      ++r.ignoredPixels;
+      continue;
+    }
+    if (use == PixelUse::NonFinite) {
+      ++r.nonFinitePixels;
+      continue;
+    }
+    ++r.comparedPixels;
+    Vec3 a = test.at(i), b = reference.at(i);
+    for (int c = 0; c < 3; ++c) acc[c].add(a[c], b[c]);
+    double ya = luminance(a), yb = luminance(b);
+    acc[3].add(ya, yb);
+    sumLum += yb;
+    if (std::fabs(ya - yb) > maxLum) {
+      maxLum = std::fabs(ya - yb);
+      r.maxErrorX = int(i % size_t(reference.width));
+      r.maxErrorY = int(i / size_t(reference.width));
+    }
+  }
+  for (int c = 0; c < 3; ++c) r.channel[c] = acc[c].result();
+  r.luminance = acc[3].result();
+  r.meanReferenceLuminance = r.comparedPixels ? sumLum / double(r.comparedPixels) : 0.0;
+  return r;
+}
+
+std::string CompareResult::ToString() const {
+  std::ostringstream os;
+  char line[160];
+  os << "channel    rel.RMSE    rel.MAE     max.abs\n";
+  const char* names[4] = {"R", "G", "B", "Y"};
+  for (int c = 0; c < 4; ++c) {
+    const ChannelError& e = c < 3 ? channel[c] : luminance;
+    std::snprintf(line, sizeof line, "%-8s %10.5f %10.5f %11.5g\n", names[c], e.relRmse, e.relMae,
+                  e.maxAbs);
+    os << line;
+  }
+  os << "pixels: " << comparedPixels << " compared, " << ignoredPixels << " ignored, "
+     << nonFinitePixels << " non-finite; largest Y error at (" << maxErrorX << ", " << maxErrorY
+     << "); mean reference Y " << meanReferenceLuminance;
+  return os.str();
+}
+
+RgbImage differenceImage(const RgbImage& test, const RgbImage& reference,
+                         const CompareParams& params, float scale) {
+  checkSizes(test, reference, params);
+  if (!(scale > 0)) {
+    double mean = compareImages(test, reference, params).meanReferenceLuminance;
+    scale = float(0.25 * mean);
+    if (!(scale > 0)) scale = 1.0f;
+  }
+  static const Vec3 kRamp[5] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}};
+  RgbImage out(reference.width, reference.height);
+  for (size_t i = 0; i < reference.pixelCount(); ++i) {
+    PixelUse use = pixelUse(test, reference, params, i);
+    if (use == PixelUse::Ignore) {
+      out.set(i, Vec3{0.2f, 0.2f, 0.2f});
+      continue;
+    }
+    if (use == PixelUse::NonFinite) {
+      out.set(i, Vec3{1, 0, 1});  // magenta: NaN or inf
+      continue;
+    }
+    float t = std::fabs(luminance(test.at(i)) - luminance(reference.at(i))) / scale;
+    float x = std::clamp(t, 0.0f, 1.0f) * 4.0f;
+    int k = std::min(3, int(x));
+    float f = x - float(k);
+    out.set(i, kRamp[k] * (1.0f - f) + kRamp[k + 1] * f);
+  }
+  return out;
+}
+
+}  // namespace lo

@@ -1,0 +1,59 @@
+#pragma once
+/// @file image/compare.h
+/// @brief Error metrics between a test image and a reference image, and a
+/// false-colour difference image. Used by `lightoctree compare` and tests.
+///
+/// Over the set P of compared pixels, with a the test value and b the
+/// reference value of one channel (R, G, B, or Rec. 709 luminance Y):
+///   relative RMSE = sqrt( sum_P (a - b)^2 / sum_P b^2 )
+///                 = sqrt( mean_P (a - b)^2 / mean_P b^2 )
+///   relative MAE  = sum_P |a - b| / sum_P |b|
+///   max error     = max_P |a - b|      (absolute, in the images' units)
+/// A relative metric whose denominator is 0 is 0 if the images agree on P,
+/// else +infinity.
+
+#include <cstddef>
+#include <string>
+
+#include "image/image.h"
+
+namespace lo {
+
+struct CompareParams {
+  /// Optional mask of the same size: pixels whose mask is 0 in every channel
+  /// are left out. Null = compare every pixel.
+  const RgbImage* mask = nullptr;
+  /// Also leave out pixels where the reference is exactly (0, 0, 0): the
+  /// background of a scene that does not fill the frame.
+  bool ignoreBackground = false;
+};
+
+struct ChannelError {
+  double relRmse = 0;
+  double relMae = 0;
+  double maxAbs = 0;
+};
+
+struct CompareResult {
+  ChannelError channel[3];  ///< R, G, B
+  ChannelError luminance;   ///< Rec. 709 Y of each pixel
+  size_t comparedPixels = 0;
+  size_t ignoredPixels = 0;    ///< by the mask or as background
+  size_t nonFinitePixels = 0;  ///< NaN/inf in either image: left out and counted
+  int maxErrorX = -1, maxErrorY = -1;  ///< pixel of the largest luminance error
+  double meanReferenceLuminance = 0;   ///< over the compared pixels
+  std::string ToString() const;        ///< a small table
+};
+
+/// @throws InputError if the sizes (or the mask's) differ or an image is empty.
+CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
+                            const CompareParams& params = {});
+
+/// False colour of |Y(test) - Y(reference)| / scale: black 0, blue 0.25,
+/// green 0.5, yellow 0.75, red >= 1; ignored pixels mid grey. scale <= 0
+/// means 0.25 x the mean reference luminance over the compared pixels (so red
+/// marks an error of a quarter of the mean brightness or more).
+RgbImage differenceImage(const RgbImage& test, const RgbImage& reference,
+                         const CompareParams& params = {}, float scale = 0);
+
+}  // namespace lo

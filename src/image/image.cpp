@@ -1,0 +1,159 @@
+/// @file image/image.cpp
+/// @brief OpenEXR and PNG files for image/image.h.
+
+#include "image/image.h"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "core/error.h"
+
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb_image_write.h>
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC  // src/scene has its own copy for glTF textures
+#define STBI_ONLY_PNG
+#define STBI_ONLY_JPEG
+#include <stb_image.h>
+
+namespace lo {
+namespace {
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+void checkImage(const std::string& path, const RgbImage& image) {
+  if (image.width < 1 || image.height < 1 || image.rgb.size() != image.pixelCount() * 3)
+    throw InputError(path + ": empty or inconsistent image (" + std::to_string(image.width) +
+                     " x " + std::to_string(image.height) + ")");
+}
+
+/// Runs `write(tmp)` and renames tmp to path; removes tmp on failure.
+template <typename F>
+void writeThroughTemporary(const std::string& path, F&& write) {
+  std::string tmp = path + ".tmp";
+  try {
+    write(tmp);
+    std::filesystem::rename(tmp, path);
+  } catch (const std::exception& e) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw IoError(path + ": cannot write (" + e.what() + ")");
+  }
+}
+
+float srgbToLinear(float s) {
+  return s <= 0.04045f ? s / 12.92f : std::pow((s + 0.055f) / 1.055f, 2.4f);
+}
+
+RgbImage readExr(const std::string& path) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i& dw = file.header().dataWindow();
+    RgbImage image(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1);
+    const Imf::ChannelList& channels = file.header().channels();
+    const char* names[3] = {"R", "G", "B"};
+    const char* first = channels.findChannel("R") ? "R" : (channels.findChannel("Y") ? "Y" : nullptr);
+    if (!first) throw InputError(path + ": no R or Y channel");
+    Imf::FrameBuffer fb;
+    // Slices are addressed from the data window's origin, which may not be (0, 0).
+    char* base = reinterpret_cast<char*>(image.rgb.data()) -
+                 (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * image.width) * 3 *
+                     ptrdiff_t(sizeof(float));
+    size_t yStride = size_t(image.width) * 3 * sizeof(float);
+    fb.insert(first, Imf::Slice(Imf::FLOAT, base, 3 * sizeof(float), yStride));
+    for (int c = 1; c < 3; ++c) {
+      if (channels.findChannel(names[c]))
+        fb.insert(names[c],
+                  Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float), yStride));
+    }
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    // Single-channel files (masks): G and B copy the first channel.
+    for (int c = 1; c < 3; ++c) {
+      if (channels.findChannel(names[c])) continue;
+      for (size_t i = 0; i < image.pixelCount(); ++i) image.rgb[3 * i + c] = image.rgb[3 * i];
+    }
+    return image;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot read EXR (" + e.what() + ")");
+  }
+}
+
+}  // namespace
+
+unsigned char encodeSrgb8(float linear) {
+  float c = std::isfinite(linear) ? std::clamp(linear, 0.0f, 1.0f) : 0.0f;
+  float s = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+  return static_cast<unsigned char>(std::lround(s * 255.0f));
+}
+
+void writeExr(const std::string& path, const RgbImage& image) {
+  checkImage(path, image);
+  writeThroughTemporary(path, [&](const std::string& tmp) {
+    Imf::Header header(image.width, image.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    const char* names[3] = {"R", "G", "B"};
+    for (const char* name : names) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    Imf::OutputFile file(tmp.c_str(), header);
+    Imf::FrameBuffer fb;
+    char* base = reinterpret_cast<char*>(const_cast<float*>(image.rgb.data()));
+    for (int c = 0; c < 3; ++c) {
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float),
+                                     size_t(image.width) * 3 * sizeof(float)));
+    }
+    file.setFrameBuffer(fb);
+    file.writePixels(image.height);
+  });
+}
+
+void writePng(const std::string& path, const RgbImage& image, float exposureEv) {
+  checkImage(path, image);
+  float scale = std::exp2(exposureEv);
+  std::vector<unsigned char> rgb(image.pixelCount() * 3);
+  for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = encodeSrgb8(image.rgb[i] * scale);
+  writeThroughTemporary(path, [&](const std::string& tmp) {
+    if (!stbi_write_png(tmp.c_str(), image.width, image.height, 3, rgb.data(), image.width * 3))
+      throw IoError("stbi_write_png failed");
+  });
+}
+
+void writeImage(const std::string& path, const RgbImage& image, float exposureEv) {
+  const std::string ext = lowerExtension(path);
+  if (ext == ".exr") return writeExr(path, image);
+  if (ext == ".png") return writePng(path, image, exposureEv);
+  throw InputError(path + ": unsupported image extension '" + ext + "' (expected .exr or .png)");
+}
+
+RgbImage readImage(const std::string& path, bool linear8Bit) {
+  std::string ext = lowerExtension(path);
+  if (ext == ".exr") return readExr(path);
+  if (ext != ".png" && ext != ".jpg" && ext != ".jpeg")
+    throw InputError(path + ": unsupported image extension '" + ext +
+                     "' (expected .exr, .png or .jpg)");
+  int w = 0, h = 0, n = 0;
+  unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 3);
+  if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
+  RgbImage image(w, h);
+  for (size_t i = 0; i < image.rgb.size(); ++i) {
+    float v = float(data[i]) / 255.0f;
+    image.rgb[i] = linear8Bit ? v : srgbToLinear(v);
+  }
+  stbi_image_free(data);
+  return image;
+}
+
+}  // namespace lo

@@ -1,0 +1,51 @@
+#pragma once
+/// @file image/image.h
+/// @brief Linear RGB float images and their files: OpenEXR (read/write, FLOAT
+/// or HALF channels R, G, B read, FLOAT written) and PNG (8-bit sRGB write;
+/// read for masks). OpenEXR and stb_image(_write) stay in src/image, which
+/// both the GL renderer and the reference renderer write through, so that
+/// neither links the other's libraries (the reference renderer and `compare`
+/// run where no OpenGL exists).
+
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+
+namespace lo {
+
+/// Linear RGB, row-major, row 0 at the top (as render::Image).
+struct RgbImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  ///< width * height * 3
+
+  RgbImage() = default;
+  RgbImage(int w, int h) : width(w), height(h), rgb(size_t(w) * size_t(h) * 3, 0.0f) {}
+  size_t pixelCount() const { return size_t(width) * size_t(height); }
+  Vec3 at(size_t i) const { return {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]}; }
+  void set(size_t i, const Vec3& v) {
+    rgb[3 * i] = v.x;
+    rgb[3 * i + 1] = v.y;
+    rgb[3 * i + 2] = v.z;
+  }
+};
+
+/// Writes 32-bit float channels R, G, B (ZIP, lossless) to
+/// `path` through `path.tmp` and a rename. @throws IoError naming the file.
+void writeExr(const std::string& path, const RgbImage& image);
+/// Writes radiance * 2^exposureEv, clamped, sRGB-encoded, 8-bit RGB.
+void writePng(const std::string& path, const RgbImage& image, float exposureEv = 0.0f);
+/// Reads an EXR's R, G, B channels (missing G/B copy R: single-channel masks
+/// written as Y or R work too) or a PNG/JPEG (8-bit, sRGB decoded to linear
+/// unless `linear8Bit`, in which case v/255). Dispatch by extension.
+/// @throws InputError naming the file for an unknown extension or a failed read.
+RgbImage readImage(const std::string& path, bool linear8Bit = false);
+/// Dispatch by extension: .exr (linear, `exposureEv` ignored) or .png.
+/// @throws InputError naming the file for another extension.
+void writeImage(const std::string& path, const RgbImage& image, float exposureEv = 0.0f);
+
+/// The 8-bit sRGB encoding PNG output uses, for one linear value (clamped;
+/// NaN and Inf encode as 0).
+unsigned char encodeSrgb8(float linear);
+
+}  // namespace lo

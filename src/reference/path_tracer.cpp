@@ -1,0 +1,480 @@
+/// @file reference/path_tracer.cpp
+/// @brief Path tracing with next-event estimation and multiple importance
+/// sampling (Veach 1997, §9.2, power heuristic beta = 2) over photon/ray_tracer.h
+/// and the photon tracer's material model photon/bsdf.h.
+
+#include "reference/path_tracer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "core/error.h"
+#include "core/rng.h"
+#include "photon/bsdf.h"
+#include "photon/ray_tracer.h"
+
+namespace lo {
+
+ReferencePart parseReferencePart(const std::string& name) {
+  if (name == "direct") return ReferencePart::Direct;
+  if (name == "indirect") return ReferencePart::Indirect;
+  if (name == "full") return ReferencePart::Full;
+  if (name == "irradiance") return ReferencePart::Irradiance;
+  throw InputError("unknown reference part '" + name +
+                   "' (expected direct, indirect, full or irradiance)");
+}
+
+std::string toString(ReferencePart part) {
+  switch (part) {
+    case ReferencePart::Direct: return "direct";
+    case ReferencePart::Indirect: return "indirect";
+    case ReferencePart::Full: return "full";
+    case ReferencePart::Irradiance: return "irradiance";
+  }
+  return "?";
+}
+
+ReferenceCamera ReferenceCamera::fromScene(const Camera& camera) {
+  ReferenceCamera c;
+  c.eye = camera.position;
+  c.forward = normalize(camera.forward);
+  c.up = normalize(camera.up);
+  c.yfov = camera.yfov;
+  return c;
+}
+
+ReferenceCamera ReferenceCamera::lookAt(const Vec3& eye, const Vec3& target, float yfovRadians) {
+  ReferenceCamera c;
+  c.eye = eye;
+  c.forward = normalize(target - eye);
+  if (lengthSquared(c.forward) == 0) throw InputError("camera: eye and target are the same point");
+  Vec3 worldUp = std::fabs(c.forward.y) > 0.999f ? Vec3(0, 0, -1) : Vec3(0, 1, 0);
+  Vec3 right = normalize(cross(c.forward, worldUp));
+  c.up = cross(right, c.forward);
+  c.yfov = yfovRadians;
+  return c;
+}
+
+ReferenceCamera ReferenceCamera::framing(const Bounds3& bounds, float yfovRadians) {
+  Vec3 center = bounds.center();
+  float radius = 0.5f * length(bounds.extent());
+  float distance = radius / std::sin(0.5f * yfovRadians);
+  return lookAt(center + Vec3(0, 0, std::max(distance, 1e-3f)), center, yfovRadians);
+}
+
+namespace reference_internal {
+
+/// Ray origins move off the surface by this fraction of the scene's size, as
+/// in the photon tracer (photon_map.cpp kRayEpsilonScale).
+constexpr float kRayEpsilonScale = 1e-5f;
+constexpr int kTileSize = 16;
+
+struct Context {
+  const Scene* scene = nullptr;
+  const RayTracer* tracer = nullptr;
+  std::vector<BsdfLobes> lobes;            ///< per material
+  std::vector<uint32_t> emitters;          ///< emissive triangles
+  std::vector<double> emitterCdf;          ///< cumulative power, back() = total
+  std::vector<float> emitterPickPdf;       ///< per triangle: pick probability / area (0 = not an emitter)
+  std::vector<const Light*> lights;        ///< punctual lights with positive intensity
+  float epsilon = 0;
+  int maxBounces = 0;
+  int rouletteStart = 0;
+};
+
+/// One path's radiance, split by where the light was last emitted relative
+/// to vertex 1 (see ReferencePart).
+struct PathRadiance {
+  Vec3 emitted;   ///< emission at vertex 1
+  Vec3 direct;    ///< emitter -> vertex 1 (NEE at vertex 1, emission hit at vertex 2)
+  Vec3 indirect;  ///< everything else
+  uint32_t rays = 0;
+};
+
+inline float powerHeuristic(float a, float b) {
+  float a2 = a * a, b2 = b * b;
+  return a2 + b2 > 0 ? a2 / (a2 + b2) : 0.0f;
+}
+
+/// Radiance emitted by triangle `tri` towards direction `w` (unit, away from
+/// the surface): one-sided emitters emit on the winding side only, as the
+/// photon tracer's emitters do.
+inline Vec3 emittedRadiance(const Context& ctx, uint32_t tri, const Vec3& normal, const Vec3& w) {
+  const Material& m = ctx.scene->materials[ctx.scene->triangleMaterial[tri]];
+  if (!m.isEmissive()) return Vec3{0, 0, 0};
+  if (!m.doubleSided && dot(w, normal) <= 0) return Vec3{0, 0, 0};
+  return m.emission;
+}
+
+inline Vec3 offsetOrigin(const Context& ctx, const Vec3& p, const Vec3& normal, const Vec3& dir) {
+  return p + (dot(dir, normal) > 0 ? normal : -normal) * ctx.epsilon;
+}
+
+/// Next-event estimation at a surface point: every punctual light, plus one
+/// emissive triangle picked by power, MIS-weighted against BSDF sampling.
+/// Returns the reflected radiance towards wo (without path throughput).
+inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, const Vec3& n,
+                         const Vec3& wo, const BsdfLobes& lobes, const Vec3& albedo, Rng& rng,
+                         uint32_t& rays) {
+  Vec3 sum{0, 0, 0};
+  for (const Light* light : ctx.lights) {
+    Vec3 wi;
+    float dist = std::numeric_limits<float>::infinity();
+    Vec3 irradiance;  // W/m^2 perpendicular to wi, before the cosine
+    if (light->type == Light::Type::Directional) {
+      wi = -normalize(light->direction);
+      irradiance = light->color * light->intensity;
+    } else {
+      Vec3 d = light->position - p;
+      dist = length(d);
+      if (!(dist > 0)) continue;
+      wi = d / dist;
+      float scale = rangeWindow(dist, light->range) / (dist * dist);
+      if (light->type == Light::Type::Spot) {
+        float cosOuter = std::cos(light->outerConeAngle);
+        float cosInner = std::max(cosOuter, std::cos(light->innerConeAngle));
+        scale *= spotFalloff(dot(-wi, normalize(light->direction)), cosInner, cosOuter);
+      }
+      irradiance = light->color * (light->intensity * scale);
+    }
+    if (maxComponent(irradiance) <= 0) continue;
+    Vec3 f = evalBsdf(lobes, albedo, wo, wi, n);
+    if (maxComponent(f) <= 0) continue;
+    Vec3 org = offsetOrigin(ctx, p, normal, wi);
+    ++rays;
+    if (ctx.tracer->occluded(org, wi, std::isinf(dist) ? dist : dist * (1.0f - 1e-4f))) continue;
+    sum += f * irradiance;
+  }
+
+  if (!ctx.emitters.empty()) {
+    const Scene& scene = *ctx.scene;
+    uint64_t bits = (uint64_t(rng.next()) << 21) ^ uint64_t(rng.next());
+    double pick = double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53 * ctx.emitterCdf.back();
+    size_t k = size_t(std::upper_bound(ctx.emitterCdf.begin(), ctx.emitterCdf.end(), pick) -
+                      ctx.emitterCdf.begin());
+    uint32_t tri = ctx.emitters[std::min(k, ctx.emitters.size() - 1)];
+    float s = std::sqrt(rng.uniform());
+    float b1 = 1.0f - s, b2 = rng.uniform() * s;
+    const Vec3& p0 = scene.positions[scene.indices[3 * tri]];
+    const Vec3& p1 = scene.positions[scene.indices[3 * tri + 1]];
+    const Vec3& p2 = scene.positions[scene.indices[3 * tri + 2]];
+    Vec3 q = p0 + (p1 - p0) * b1 + (p2 - p0) * b2;
+    Vec3 d = q - p;
+    float dist2 = lengthSquared(d);
+    float dist = std::sqrt(dist2);
+    if (dist > 0) {
+      Vec3 wi = d / dist;
+      Vec3 lightNormal = scene.faceNormal(tri);
+      Vec3 le = emittedRadiance(ctx, tri, lightNormal, -wi);
+      float cosLight = std::fabs(dot(lightNormal, wi));
+      Vec3 f = maxComponent(le) > 0 && cosLight > 0 ? evalBsdf(lobes, albedo, wo, wi, n) : Vec3{};
+      if (maxComponent(f) > 0) {
+        float pdfLight = ctx.emitterPickPdf[tri] * dist2 / cosLight;  // solid angle
+        float w = powerHeuristic(pdfLight, pdfBsdf(lobes, wo, wi, n));
+        Vec3 org = offsetOrigin(ctx, p, normal, wi);
+        ++rays;
+        // Stop short of the emitter by twice the offset so it does not occlude itself.
+        if (!ctx.tracer->occluded(org, wi, std::max(0.0f, dist - 2.0f * ctx.epsilon)))
+          sum += f * le * (w / pdfLight);
+      }
+    }
+  }
+  return sum;
+}
+
+/// Traces one path from (org, dir) and splits its radiance by PathRadiance's
+/// rules. The first surface hit is vertex 1.
+inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) {
+  PathRadiance out;
+  Vec3 beta{1, 1, 1};
+  bool prevDelta = true;  // the camera ray: emission at vertex 1 counts fully
+  float prevPdf = 0;
+  Hit hit;
+  for (int depth = 1;; ++depth) {
+    ++out.rays;
+    if (!ctx.tracer->intersect(org, dir, hit)) break;
+    Vec3 p = org + dir * hit.t;
+    const Vec3& normal = hit.geometricNormal;
+    bool frontFace = dot(dir, normal) < 0;
+    Vec3 n = frontFace ? normal : -normal;
+    Vec3 wo = -dir;
+    Vec3 le = emittedRadiance(ctx, hit.triangle, normal, wo);
+    if (maxComponent(le) > 0) {
+      float w = 1;
+      if (!prevDelta) {
+        float cosLight = std::fabs(dot(normal, dir));
+        float pdfLight = cosLight > 0 ? ctx.emitterPickPdf[hit.triangle] * hit.t * hit.t / cosLight
+                                      : 0.0f;
+        w = powerHeuristic(prevPdf, pdfLight);
+      }
+      Vec3 c = beta * le * w;
+      (depth == 1 ? out.emitted : depth == 2 ? out.direct : out.indirect) += c;
+    }
+    // depth - 1 scattering events so far; one more is allowed below the cap.
+    if (depth - 1 >= ctx.maxBounces) break;
+
+    const BsdfLobes& lobes = ctx.lobes[ctx.scene->triangleMaterial[hit.triangle]];
+    Vec3 albedo = ctx.scene->albedo(hit.triangle, hit.b1, hit.b2);
+    if (lobes.hasSmoothLobe()) {
+      Vec3 l = sampleLights(ctx, p, normal, n, wo, lobes, albedo, rng, out.rays);
+      (depth == 1 ? out.direct : out.indirect) += beta * l;
+    }
+    BsdfSample sample;
+    if (!sampleBsdf(lobes, albedo, wo, n, frontFace, rng, sample)) break;
+    Vec3 newDir = normalize(sample.wi);
+    if (lengthSquared(newDir) == 0) break;
+    beta *= sample.weight;
+    prevDelta = sample.delta;
+    prevPdf = sample.delta ? 0.0f : pdfBsdf(lobes, wo, newDir, n);
+    if (depth >= ctx.rouletteStart) {
+      // Survive with probability min(1, max(beta)); the division keeps the
+      // estimator unbiased.
+      float q = std::min(1.0f, maxComponent(beta));
+      if (!(q > 0) || rng.uniform() >= q) break;
+      beta /= q;
+    }
+    org = offsetOrigin(ctx, p, normal, newDir);
+    dir = newDir;
+  }
+  return out;
+}
+
+/// One sample of pixel (x, y) for `part`.
+inline Vec3 samplePixel(const Context& ctx, const ReferenceCamera& cam, const Vec3& right,
+                        float tanHalf, float aspect, int x, int y, int width, int height,
+                        ReferencePart part, Rng& rng, uint32_t& rays) {
+  float u = rng.uniform(), v = rng.uniform();
+  float sx = (2.0f * (float(x) + u) / float(width) - 1.0f) * tanHalf * aspect;
+  float sy = (1.0f - 2.0f * (float(y) + v) / float(height)) * tanHalf;
+  Vec3 dir = normalize(cam.forward + right * sx + cam.up * sy);
+  if (part != ReferencePart::Irradiance) {
+    PathRadiance r = tracePath(ctx, cam.eye, dir, rng);
+    rays += r.rays;
+    switch (part) {
+      case ReferencePart::Direct: return r.emitted + r.direct;
+      case ReferencePart::Indirect: return r.indirect;
+      default: return r.emitted + r.direct + r.indirect;
+    }
+  }
+  // Irradiance at vertex 1 on the camera's side, from light that scattered
+  // at least once: cosine-sample a direction (cos/pdf = pi), and take the
+  // radiance arriving along it minus the emission of the surface it hits.
+  Hit hit;
+  ++rays;
+  if (!ctx.tracer->intersect(cam.eye, dir, hit)) return Vec3{0, 0, 0};
+  Vec3 p = cam.eye + dir * hit.t;
+  const Vec3& normal = hit.geometricNormal;
+  Vec3 n = dot(dir, normal) < 0 ? normal : -normal;
+  Vec3 t, b;
+  orthonormalBasis(n, t, b);
+  float u1 = rng.uniform(), u2 = rng.uniform();
+  Vec3 wi = normalize(fromLocal(cosineHemisphere(u1, u2), t, b, n));
+  PathRadiance r = tracePath(ctx, offsetOrigin(ctx, p, normal, wi), wi, rng);
+  rays += r.rays;
+  return (r.direct + r.indirect) * kPi;
+}
+
+void buildContext(const Scene& scene, const ReferenceParams& params, Context& ctx) {
+  ctx.scene = &scene;
+  ctx.maxBounces = params.maxBounces;
+  ctx.rouletteStart = params.rouletteStart;
+  ctx.lobes.resize(scene.materials.size());
+  for (size_t i = 0; i < scene.materials.size(); ++i) ctx.lobes[i] = bsdfLobes(scene.materials[i]);
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    int32_t m = scene.triangleMaterial[t];
+    if (m < 0 || size_t(m) >= scene.materials.size())
+      throw InputError("triangle " + std::to_string(t) + " has material index " +
+                       std::to_string(m) + " outside [0, " +
+                       std::to_string(scene.materials.size()) + ")");
+  }
+  ctx.emitterPickPdf.assign(scene.triangleCount(), 0.0f);
+  double total = 0;
+  std::vector<double> power;
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const Material& m = scene.materials[scene.triangleMaterial[t]];
+    float area = scene.triangleArea(t);
+    if (!m.isEmissive() || !(area > 0)) continue;
+    // Picked in proportion to power, as the photon tracer picks emitters.
+    double w = double(average(m.emission)) * area * (m.doubleSided ? 2.0 : 1.0);
+    if (!(w > 0) || !std::isfinite(w)) continue;
+    total += w;
+    ctx.emitters.push_back(uint32_t(t));
+    ctx.emitterCdf.push_back(total);
+    power.push_back(w);
+  }
+  for (size_t i = 0; i < ctx.emitters.size(); ++i) {
+    uint32_t t = ctx.emitters[i];
+    ctx.emitterPickPdf[t] = float(power[i] / total) / scene.triangleArea(t);
+  }
+  for (const Light& light : scene.lights)
+    if (light.intensity > 0 && maxComponent(light.color) > 0) ctx.lights.push_back(&light);
+  Bounds3 bounds = scene.bounds();
+  if (!bounds.empty()) {
+    Vec3 lo = bounds.lower, hi = bounds.upper;
+    Vec3 a{std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z)};
+    Vec3 c{std::fabs(hi.x), std::fabs(hi.y), std::fabs(hi.z)};
+    float scale = length(bounds.extent()) + maxComponent(max(a, c));
+    ctx.epsilon = kRayEpsilonScale * std::max(scale, 1e-6f);
+  }
+}
+
+/// Per-pixel running sums in double, in sample order.
+struct PixelSums {
+  double sum[3] = {0, 0, 0};
+  double sumSq[3] = {0, 0, 0};
+};
+
+/// TBB body: `passSpp` more samples for every pixel of tiles [r.begin(), r.end()).
+struct RenderTiles {
+  const Context* ctx;
+  const ReferenceCamera* cam;
+  Vec3 right;
+  float tanHalf, aspect;
+  int width, height, tilesX, passSpp;
+  ReferencePart part;
+  std::vector<Rng>* rngs;
+  std::vector<PixelSums>* sums;
+  std::atomic<uint64_t>* rays;
+  Progress* progress;
+
+  void operator()(const tbb::blocked_range<size_t>& r) const {
+    uint64_t localRays = 0;
+    for (size_t tile = r.begin(); tile != r.end(); ++tile) {
+      int x0 = int(tile % size_t(tilesX)) * kTileSize, y0 = int(tile / size_t(tilesX)) * kTileSize;
+      for (int y = y0; y < std::min(height, y0 + kTileSize); ++y) {
+        for (int x = x0; x < std::min(width, x0 + kTileSize); ++x) {
+          size_t i = size_t(y) * size_t(width) + size_t(x);
+          Rng& rng = (*rngs)[i];
+          PixelSums& s = (*sums)[i];
+          for (int k = 0; k < passSpp; ++k) {
+            uint32_t n = 0;
+            Vec3 v = samplePixel(*ctx, *cam, right, tanHalf, aspect, x, y, width, height, part,
+                                 rng, n);
+            localRays += n;
+            if (!isFinite(v)) v = Vec3{0, 0, 0};  // never expected; keeps one NaN from spreading
+            for (int c = 0; c < 3; ++c) {
+              s.sum[c] += double(v[c]);
+              s.sumSq[c] += double(v[c]) * double(v[c]);
+            }
+          }
+        }
+      }
+      if (progress) progress->advance(1);
+    }
+    rays->fetch_add(localRays, std::memory_order_relaxed);
+  }
+};
+
+}  // namespace reference_internal
+
+ReferenceImage renderReference(const Scene& scene, const ReferenceCamera& camera,
+                               const ReferenceParams& params, ProgressSink* progress) {
+  using namespace reference_internal;
+  if (params.width < 1 || params.height < 1)
+    throw InputError("ReferenceParams: image size " + std::to_string(params.width) + " x " +
+                     std::to_string(params.height) + " must be at least 1 x 1");
+  if (!(params.timeBudgetSeconds > 0) && params.samplesPerPixel < 1)
+    throw InputError("ReferenceParams.samplesPerPixel must be >= 1, got " +
+                     std::to_string(params.samplesPerPixel));
+  if (params.maxBounces < 0)
+    throw InputError("ReferenceParams.maxBounces must be >= 0, got " +
+                     std::to_string(params.maxBounces));
+  if (!(camera.yfov > 0 && camera.yfov < kPi))
+    throw InputError("camera: vertical field of view " + std::to_string(camera.yfov) +
+                     " rad outside (0, pi)");
+  LO_CHECK_EQ(scene.indices.size() % 3, size_t(0));
+  LO_CHECK_EQ(scene.triangleMaterial.size(), scene.triangleCount());
+
+  auto start = std::chrono::steady_clock::now();
+  Context ctx;
+  buildContext(scene, params, ctx);
+  RayTracer tracer(scene);
+  ctx.tracer = &tracer;
+
+  const size_t pixels = size_t(params.width) * size_t(params.height);
+  std::vector<Rng> rngs;
+  rngs.reserve(pixels);
+  for (size_t i = 0; i < pixels; ++i) rngs.emplace_back(params.seed, i);
+  std::vector<PixelSums> sums(pixels);
+  std::atomic<uint64_t> rays{0};
+
+  const int tilesX = (params.width + kTileSize - 1) / kTileSize;
+  const int tilesY = (params.height + kTileSize - 1) / kTileSize;
+  const size_t tiles = size_t(tilesX) * size_t(tilesY);
+  RenderTiles body;
+  body.ctx = &ctx;
+  body.cam = &camera;
+  body.right = normalize(cross(camera.forward, camera.up));
+  body.tanHalf = std::tan(0.5f * camera.yfov);
+  body.aspect = float(params.width) / float(params.height);
+  body.width = params.width;
+  body.height = params.height;
+  body.tilesX = tilesX;
+  body.part = params.part;
+  body.rngs = &rngs;
+  body.sums = &sums;
+  body.rays = &rays;
+
+  const bool budget = params.timeBudgetSeconds > 0;
+  // Passes only change how often progress is reported: each pixel's samples
+  // and sums happen in the same order whatever the pass size.
+  const int passSpp = budget ? 1 : std::min(params.samplesPerPixel, 4);
+  const int passes = budget ? 0 : (params.samplesPerPixel + passSpp - 1) / passSpp;
+  int done = 0;
+  {
+    Progress bar(progress, budget ? "Path tracing (time budget, passes of 1 spp)" : "Path tracing",
+                 budget ? tiles : tiles * size_t(passes));
+    body.progress = budget ? nullptr : &bar;
+    size_t reportedTiles = 0;
+    for (int pass = 0;; ++pass) {
+      if (budget) {
+        double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (pass > 0 && elapsed >= params.timeBudgetSeconds) break;
+      } else if (done >= params.samplesPerPixel) {
+        break;
+      }
+      body.passSpp = budget ? 1 : std::min(passSpp, params.samplesPerPixel - done);
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), body,
+                        tbb::simple_partitioner());
+      done += body.passSpp;
+      if (budget) {
+        double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        size_t target = std::min(
+            tiles, size_t(double(tiles) * std::min(1.0, elapsed / params.timeBudgetSeconds)));
+        if (target > reportedTiles) {
+          bar.advance(target - reportedTiles);
+          reportedTiles = target;
+        }
+      }
+    }
+  }
+
+  ReferenceImage result;
+  result.image = RgbImage(params.width, params.height);
+  result.stdError = RgbImage(params.width, params.height);
+  result.samplesPerPixel = done;
+  double n = double(done);
+  for (size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      double mean = sums[i].sum[c] / n;
+      double var = done > 1 ? std::max(0.0, (sums[i].sumSq[c] - n * mean * mean) / (n - 1.0)) : 0.0;
+      result.image.rgb[3 * i + c] = float(mean);
+      result.stdError.rgb[3 * i + c] = float(std::sqrt(var / n));
+    }
+  }
+  result.raysTraced = rays.load();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace lo

@@ -1,0 +1,88 @@
+#pragma once
+/// @file reference/path_tracer.h
+/// @brief Unbiased reference renderer: a path tracer over the same Scene and
+/// the same material model (photon/bsdf.h) as the photon tracer, to measure
+/// the light octree's error. See docs/reference.md for the estimator.
+///
+/// Output is linear radiance W/(m^2 sr) in the scene's light units
+/// (scene/scene.h), or, for Part::Irradiance, irradiance W/m^2.
+
+#include <cstdint>
+#include <string>
+
+#include "core/math.h"
+#include "core/progress.h"
+#include "image/image.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+/// Which light paths a reference image contains. Vertex 1 is the first
+/// surface the camera ray hits.
+enum class ReferencePart {
+  /// Emission seen at vertex 1, plus light that reaches vertex 1 straight
+  /// from an emitter (punctual light, or emissive triangle at vertex 2).
+  Direct,
+  /// Everything else: light that scattered at least once before vertex 1.
+  /// The quantity `render --mode indirect` approximates with the octree.
+  Indirect,
+  Full,  ///< Direct + Indirect (one estimator: the sum is exact)
+  /// Irradiance at vertex 1 from indirect light only, on the side facing the
+  /// camera: E = integral of L_indirect cos over the hemisphere, W/m^2.
+  Irradiance,
+};
+/// "direct" | "indirect" | "full" | "irradiance". @throws InputError naming the value.
+ReferencePart parseReferencePart(const std::string& name);
+std::string toString(ReferencePart part);
+
+/// A pinhole camera with the conventions of `lightoctree render`
+/// (render/renderer.h RenderCamera, glm::perspective + lookAt): the image
+/// spans yfov vertically, width/height sets the horizontal extent, row 0 is
+/// the top. Duplicated rather than shared because lo_render links OpenGL.
+struct ReferenceCamera {
+  Vec3 eye{0, 0, 1};
+  Vec3 forward{0, 0, -1};  ///< unit
+  Vec3 up{0, 1, 0};        ///< unit, orthogonal to forward
+  float yfov = 0.8f;       ///< vertical field of view, radians
+
+  static ReferenceCamera fromScene(const Camera& camera);
+  /// World up is +Y unless the view is along it (then -Z), as RenderCamera::lookAt.
+  static ReferenceCamera lookAt(const Vec3& eye, const Vec3& target, float yfovRadians);
+  /// Frames the scene bounds from the +Z side, as RenderCamera::framing.
+  static ReferenceCamera framing(const Bounds3& bounds, float yfovRadians);
+};
+
+struct ReferenceParams {
+  int width = 256, height = 256;  ///< pixels
+  ReferencePart part = ReferencePart::Full;
+  /// Samples per pixel; ignored when timeBudgetSeconds > 0.
+  int samplesPerPixel = 64;
+  /// > 0: render passes of 1 sample per pixel until this many seconds have
+  /// passed (at least one pass). Not byte-reproducible across machines: the
+  /// number of passes depends on speed. A budget run that made N passes
+  /// equals an spp = N run byte for byte.
+  double timeBudgetSeconds = 0;
+  /// Path length cap in scattering events after vertex 1. Russian roulette
+  /// ends almost every path long before; the cap only bounds the worst case.
+  int maxBounces = 256;
+  /// Russian roulette starts after this many scattering events.
+  int rouletteStart = 3;
+  uint64_t seed = 1;
+};
+
+struct ReferenceImage {
+  RgbImage image;     ///< the mean over samples
+  RgbImage stdError;  ///< per pixel and channel: standard error of that mean
+  int samplesPerPixel = 0;
+  double seconds = 0;      ///< wall-clock rendering time
+  uint64_t raysTraced = 0; ///< closest-hit plus shadow rays
+};
+
+/// Renders `part` of `scene` seen by `camera`. Parallel over tiles (TBB);
+/// pixel i draws its random numbers from Rng(seed, i), so the result is the
+/// same bytes for any thread count (spp mode).
+/// @throws InputError for bad params (sizes, spp) or bad triangle indices.
+ReferenceImage renderReference(const Scene& scene, const ReferenceCamera& camera,
+                               const ReferenceParams& params, ProgressSink* progress = nullptr);
+
+}  // namespace lo

@@ -1,0 +1,398 @@
+// `lightoctree inspect`: a generic report of an OpenVDB file and the checks of
+// the VDL contract. Own translation unit so that vdb_io.cpp and this file
+// compile in parallel; both include OpenVDB, nothing outside src/vdb does.
+
+#include "vdb/vdb_inspect.h"
+
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointDataGrid.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <sstream>
+
+#include "cluster/vdl_grid.h"
+#include "core/error.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+namespace vdb_inspect_internal {
+namespace {
+
+namespace fs = std::filesystem;
+using openvdb::FloatGrid;
+using openvdb::Vec3SGrid;
+
+std::string metaText(const openvdb::Metadata& m) {
+  std::string s = m.str();
+  if (s.size() > 200) s = s.substr(0, 200) + "...";
+  return s;
+}
+
+std::vector<std::pair<std::string, std::string>> metaList(const openvdb::MetaMap& meta) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it) {
+    if (it->second) out.emplace_back(it->first, metaText(*it->second));
+  }
+  return out;
+}
+
+template <typename T>
+bool finiteValue(const T& v) {
+  if constexpr (std::is_same_v<T, float>) {
+    return std::isfinite(v);
+  } else {
+    return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+  }
+}
+
+template <typename GridT>
+void summarizeValues(const GridT& grid, GridSummary& s) {
+  using V = typename GridT::ValueType;
+  constexpr int kComponents = std::is_same_v<V, float> ? 1 : 3;
+  std::vector<double> lo(kComponents, std::numeric_limits<double>::infinity());
+  std::vector<double> hi(kComponents, -std::numeric_limits<double>::infinity());
+  bool any = false;
+  for (auto it = grid.cbeginValueOn(); it; ++it) {
+    const V v = *it;
+    if (!finiteValue(v)) {
+      ++s.nonFinite;
+      continue;
+    }
+    any = true;
+    for (int c = 0; c < kComponents; ++c) {
+      double x;
+      if constexpr (std::is_same_v<V, float>) {
+        x = v;
+      } else {
+        x = v[c];
+      }
+      lo[size_t(c)] = std::min(lo[size_t(c)], x);
+      hi[size_t(c)] = std::max(hi[size_t(c)], x);
+    }
+  }
+  if (any) {
+    s.min = lo;
+    s.max = hi;
+  }
+}
+
+GridSummary summarize(const openvdb::GridBase& g) {
+  GridSummary s;
+  s.name = g.getName();
+  s.type = g.type();
+  s.valueType = g.valueType();
+  s.activeVoxels = g.activeVoxelCount();
+  s.memoryBytes = g.memUsage();
+  s.halfFloat = g.saveFloatAsHalf();
+  const openvdb::Vec3d vs = g.voxelSize();
+  s.voxelSize = {vs.x(), vs.y(), vs.z()};
+  const openvdb::Vec3d o = g.transform().indexToWorld(openvdb::Vec3d(0.0));
+  s.origin = {o.x(), o.y(), o.z()};
+  s.metadata = metaList(g);
+  if (const auto* f = dynamic_cast<const FloatGrid*>(&g)) summarizeValues(*f, s);
+  if (const auto* v = dynamic_cast<const Vec3SGrid*>(&g)) summarizeValues(*v, s);
+  return s;
+}
+
+struct Opened {
+  openvdb::GridPtrVecPtr grids;
+  openvdb::MetaMap::Ptr meta;
+};
+
+Opened openAll(const std::string& path) {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(path + ": file does not exist");
+  if (!fs::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
+  Opened f;
+  try {
+    openvdb::io::File file(path);
+    file.open(false);  // no delayed loading: read errors surface here
+    f.meta = file.getMetadata();
+    f.grids = file.getGrids();
+    file.close();
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot read as an OpenVDB file: " + e.what());
+  }
+  if (!f.grids || !f.meta) throw InputError(path + ": cannot read as an OpenVDB file");
+  // OpenVDB reads a file cut inside its header as an empty file; no file we
+  // write is empty (even an empty bake has its grids), so say what it is.
+  if (f.grids->empty() && f.meta->metaCount() == 0) {
+    throw InputError(path + ": holds no grids and no metadata (truncated?)");
+  }
+  return f;
+}
+
+std::string coordText(const openvdb::Coord& c) {
+  return "(" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) +
+         ")";
+}
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+
+/// The VDL contract checks; `add` records one result.
+class VdlChecker {
+ public:
+  VdlChecker(const Opened& f, VdbReport& r) : f_(f), r_(r) {}
+
+  void run() {
+    const int maxVdls = readMaxVdls();
+    const bool contract = checkContract(maxVdls);
+    checkFormatVersion();
+    checkFinite();
+    checkSameTransform();
+    checkSameActive();
+    if (!contract) return;  // the value checks need every required grid
+    checkValues(maxVdls);
+  }
+
+ private:
+  void add(const std::string& name, bool passed, const std::string& detail) {
+    r_.checks.push_back({name, passed, detail});
+  }
+
+  openvdb::GridBase::Ptr find(const std::string& name) const {
+    for (const auto& g : *f_.grids) {
+      if (g && g->getName() == name) return g;
+    }
+    return nullptr;
+  }
+
+  int readMaxVdls() const {
+    auto m = (*f_.meta)["max_vdls"];
+    auto typed = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m);
+    return typed ? typed->value() : -1;
+  }
+
+  bool checkContract(int maxVdls) {
+    std::string problems;
+    auto need = [&](const std::string& name, const char* valueType, bool required) {
+      auto g = find(name);
+      if (!g) {
+        if (required) problems += (problems.empty() ? "" : "; ") + ("missing grid '" + name + "'");
+        return;
+      }
+      if (g->valueType() != valueType) {
+        problems += (problems.empty() ? "" : "; ") +
+                    ("grid '" + name + "' has type " + g->valueType() + ", expected " + valueType);
+      }
+    };
+    if (maxVdls < 1 || maxVdls > kMaxVdls) {
+      problems = "file metadata max_vdls is " +
+                 (maxVdls < 0 ? std::string("missing or not int32") : std::to_string(maxVdls)) +
+                 ", expected 1.." + std::to_string(kMaxVdls);
+    } else {
+      for (int i = 0; i < maxVdls; ++i) {
+        need("vdl" + std::to_string(i) + "_irradiance", "vec3s", true);
+        need("vdl" + std::to_string(i) + "_direction", "vec3s", true);
+      }
+    }
+    need("irradiance", "vec3s", true);
+    need("normal", "vec3s", true);
+    need("vdl_count", "float", true);
+    std::string absent;
+    for (const std::string& name : optionalVdlGridNames()) {
+      need(name, "float", false);
+      if (!find(name)) absent += (absent.empty() ? "" : ", ") + name;
+    }
+    add("contract", problems.empty(),
+        problems.empty()
+            ? "all required grids present with their types" +
+                  (absent.empty() ? std::string() : "; optional grids absent: " + absent)
+            : problems);
+    return problems.empty();
+  }
+
+  void checkFormatVersion() {
+    auto m = (*f_.meta)["format_version"];
+    if (!m) {
+      add("format_version", true, "absent: a file written before format_version 1 (read as 1)");
+      return;
+    }
+    auto typed = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m);
+    if (!typed) {
+      add("format_version", false, "has type " + m->typeName() + ", expected int32");
+      return;
+    }
+    const int v = typed->value();
+    add("format_version", v >= 1 && v <= kVdlFormatVersion,
+        std::to_string(v) + " (this lightoctree reads 1.." + std::to_string(kVdlFormatVersion) +
+            ")");
+  }
+
+  void checkFinite() {
+    uint64_t bad = 0;
+    std::string first;
+    for (const GridSummary& s : r_.grids) {
+      if (s.nonFinite && first.empty()) first = s.name;
+      bad += s.nonFinite;
+    }
+    add("finite", bad == 0,
+        bad == 0 ? "no NaN or Inf"
+                 : std::to_string(bad) + " active values with NaN/Inf (first in '" + first + "')");
+  }
+
+  void checkSameTransform() {
+    const openvdb::GridBase* ref = nullptr;
+    for (const auto& g : *f_.grids) {
+      if (!g) continue;
+      if (!ref) {
+        ref = g.get();
+      } else if (!(g->transform() == ref->transform())) {
+        add("same_transform", false,
+            "grid '" + g->getName() + "' differs from '" + ref->getName() + "'");
+        return;
+      }
+    }
+    add("same_transform", true, "every grid on one transform");
+  }
+
+  void checkSameActive() {
+    const openvdb::GridBase* ref = nullptr;
+    for (const auto& g : *f_.grids) {
+      if (!g) continue;
+      if (!ref) {
+        ref = g.get();
+      } else if (g->activeVoxelCount() != ref->activeVoxelCount() ||
+                 g->evalActiveVoxelBoundingBox() != ref->evalActiveVoxelBoundingBox()) {
+        add("same_active_voxels", false,
+            "grid '" + g->getName() + "' has " + std::to_string(g->activeVoxelCount()) +
+                " active voxels, '" + ref->getName() + "' " +
+                std::to_string(ref->activeVoxelCount()));
+        return;
+      }
+    }
+    add("same_active_voxels", true,
+        std::to_string(ref ? ref->activeVoxelCount() : 0) + " in every grid");
+  }
+
+  void checkValues(int maxVdls) {
+    auto irr = openvdb::gridPtrCast<Vec3SGrid>(find("irradiance"));
+    auto count = openvdb::gridPtrCast<FloatGrid>(find("vdl_count"));
+    std::vector<Vec3SGrid::Ptr> vi, vd;
+    for (int i = 0; i < maxVdls; ++i) {
+      vi.push_back(
+          openvdb::gridPtrCast<Vec3SGrid>(find("vdl" + std::to_string(i) + "_irradiance")));
+      vd.push_back(openvdb::gridPtrCast<Vec3SGrid>(find("vdl" + std::to_string(i) + "_direction")));
+    }
+    const bool half = irr->saveFloatAsHalf() || vi[0]->saveFloatAsHalf();
+    const double sumTol = half ? kVdlSumToleranceHalf : kVdlSumTolerance;
+
+    uint64_t badCount = 0, negative = 0, notUnit = 0, badSum = 0, voxels = 0;
+    std::string firstCount, firstNegative, firstNotUnit, firstSum;
+    double worstUnit = 0, worstSum = 0;
+    auto irrAcc = irr->getConstAccessor();
+    std::vector<Vec3SGrid::ConstAccessor> ia, da;
+    for (int i = 0; i < maxVdls; ++i) {
+      ia.push_back(vi[size_t(i)]->getConstAccessor());
+      da.push_back(vd[size_t(i)]->getConstAccessor());
+    }
+    auto negativeIn = [](const openvdb::Vec3s& v) { return v[0] < 0 || v[1] < 0 || v[2] < 0; };
+    // Voxels in vdl_count's active order: deterministic "first offending voxel".
+    for (auto it = count->cbeginValueOn(); it; ++it) {
+      ++voxels;
+      const openvdb::Coord c = it.getCoord();
+      const float n = *it;
+      if (!(n >= 0 && n <= float(maxVdls)) || n != std::floor(n)) {
+        if (badCount++ == 0) firstCount = coordText(c) + " holds " + num(n);
+        continue;
+      }
+      const openvdb::Vec3s e = irrAcc.getValue(c);
+      bool neg = negativeIn(e);
+      double sum[3] = {0, 0, 0};
+      double scale = std::max({double(e[0]), double(e[1]), double(e[2])});
+      for (int i = 0; i < maxVdls; ++i) {
+        const openvdb::Vec3s vIrr = ia[size_t(i)].getValue(c);
+        neg = neg || negativeIn(vIrr);
+        for (int k = 0; k < 3; ++k) {
+          sum[k] += vIrr[k];
+          scale = std::max(scale, double(std::abs(vIrr[k])));
+        }
+        if (i < int(n)) {
+          const double len = da[size_t(i)].getValue(c).length();
+          const double dev = std::abs(len - 1.0);
+          worstUnit = std::max(worstUnit, std::isfinite(dev) ? dev : 1e30);
+          if (!(dev < kUnitDirectionTolerance) && notUnit++ == 0) {
+            firstNotUnit = "vdl" + std::to_string(i) + "_direction at " + coordText(c) +
+                           " has length " + num(len);
+          }
+        }
+      }
+      if (neg && negative++ == 0) firstNegative = coordText(c);
+      double diff = 0;
+      for (int k = 0; k < 3; ++k) diff = std::max(diff, std::abs(sum[k] - double(e[k])));
+      const double rel = scale > 0 ? diff / scale : (diff > 0 ? 1e30 : 0.0);
+      if (std::isfinite(rel)) worstSum = std::max(worstSum, rel);
+      if (!(rel <= sumTol) && badSum++ == 0) {
+        firstSum = coordText(c) + ": sum of VDLs differs by " + num(rel) + " of the irradiance";
+      }
+    }
+    const std::string of = " of " + std::to_string(voxels) + " voxels";
+    add("vdl_count", badCount == 0,
+        badCount ? std::to_string(badCount) + of + " not an integer in [0, " +
+                       std::to_string(maxVdls) + "]; first " + firstCount
+                 : "integers in [0, " + std::to_string(maxVdls) + "]");
+    add("irradiance_non_negative", negative == 0,
+        negative
+            ? std::to_string(negative) + of + " with a negative channel; first " + firstNegative
+            : "irradiance and VDL irradiance >= 0");
+    add("unit_directions", notUnit == 0,
+        (notUnit ? std::to_string(notUnit) + " used VDL slots not unit; first " + firstNotUnit
+                 : std::string("used VDL slots unit")) +
+            " (largest |length - 1| " + num(worstUnit) + ", allowed " +
+            num(kUnitDirectionTolerance) + ")");
+    add("vdl_sum", badSum == 0,
+        (badSum ? std::to_string(badSum) + of + " off; first " + firstSum
+                : std::string("VDLs sum to the irradiance")) +
+            " (largest relative difference " + num(worstSum) + ", allowed " + num(sumTol) +
+            (half ? ", half floats)" : ")"));
+  }
+
+  const Opened& f_;
+  VdbReport& r_;
+};
+
+}  // namespace
+}  // namespace vdb_inspect_internal
+
+VdbReport inspectVdb(const std::string& path) {
+  using namespace vdb_inspect_internal;
+  Opened f = openAll(path);
+  VdbReport r;
+  r.path = path;
+  std::error_code ec;
+  r.fileBytes = uint64_t(fs::file_size(path, ec));
+  r.metadata = metaList(*f.meta);
+  for (const auto& g : *f.grids) {
+    if (g) r.grids.push_back(summarize(*g));
+  }
+  bool hasIrradiance = false, hasPhotons = false;
+  for (const auto& g : *f.grids) {
+    if (!g) continue;
+    hasIrradiance = hasIrradiance || g->getName() == "irradiance";
+    hasPhotons =
+        hasPhotons || (g->getName() == "photons" && g->isType<openvdb::points::PointDataGrid>());
+  }
+  if (hasPhotons && !hasIrradiance) {
+    r.kind = "photons";
+    r.checks.push_back({"photons", true, "a lightoctree photon file (point grid 'photons')"});
+    return r;
+  }
+  r.kind = hasIrradiance ? "vdl" : "other";
+  VdlChecker(f, r).run();
+  return r;
+}
+
+}  // namespace lo

@@ -1,0 +1,105 @@
+// Image files and comparison metrics: known errors on constructed images,
+// masks, EXR round trips.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "core/error.h"
+#include "image/compare.h"
+#include "image/image.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+RgbImage ramp(int w, int h) {
+  RgbImage img(w, h);
+  for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] = 0.1f + 0.01f * float(i % 97);
+  return img;
+}
+
+TEST(Compare, ScaledImageHasKnownErrors) {
+  RgbImage ref = ramp(7, 5), test = ref;
+  for (float& v : test.rgb) v *= 1.1f;
+  CompareResult r = compareImages(test, ref);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(r.channel[c].relRmse, 0.1, 1e-5);
+    EXPECT_NEAR(r.channel[c].relMae, 0.1, 1e-5);
+  }
+  EXPECT_NEAR(r.luminance.relRmse, 0.1, 1e-5);
+  for (int c = 0; c < 3; ++c) {
+    float maxRef = 0;
+    for (size_t i = 0; i < ref.pixelCount(); ++i) maxRef = std::max(maxRef, ref.rgb[3 * i + c]);
+    EXPECT_NEAR(r.channel[c].maxAbs, 0.1 * maxRef, 1e-5);
+  }
+  EXPECT_EQ(r.comparedPixels, size_t(35));
+  EXPECT_EQ(compareImages(ref, ref).luminance.relRmse, 0.0);
+}
+
+TEST(Compare, OffsetErrorRmseVsMae) {
+  // Reference 1 everywhere; test 1 + e on half the pixels, 1 elsewhere:
+  // rel. RMSE = sqrt(e^2 / 2), rel. MAE = e / 2.
+  RgbImage ref(4, 4), test(4, 4);
+  std::fill(ref.rgb.begin(), ref.rgb.end(), 1.0f);
+  test = ref;
+  for (size_t i = 0; i < 8; ++i) test.set(i, Vec3(1.5f));
+  CompareResult r = compareImages(test, ref);
+  EXPECT_NEAR(r.channel[1].relRmse, std::sqrt(0.25 / 2), 1e-6);
+  EXPECT_NEAR(r.channel[1].relMae, 0.25, 1e-6);
+  EXPECT_NEAR(r.channel[1].maxAbs, 0.5, 1e-6);
+}
+
+TEST(Compare, MaskAndBackgroundAreIgnored) {
+  RgbImage ref(4, 1), test(4, 1), mask(4, 1);
+  ref.set(0, Vec3(1));
+  ref.set(1, Vec3(1));
+  ref.set(2, Vec3(0));  // background
+  ref.set(3, Vec3(1));
+  test = ref;
+  test.set(2, Vec3(5));  // error only in the background pixel ...
+  test.set(3, Vec3(9));  // ... and in the masked pixel
+  mask.set(0, Vec3(1));
+  mask.set(1, Vec3(1));
+  mask.set(2, Vec3(1));
+  mask.set(3, Vec3(0));
+  CompareParams params;
+  params.mask = &mask;
+  EXPECT_GT(compareImages(test, ref, params).luminance.relRmse, 1.0);
+  params.ignoreBackground = true;
+  CompareResult r = compareImages(test, ref, params);
+  EXPECT_EQ(r.luminance.relRmse, 0.0);
+  EXPECT_EQ(r.comparedPixels, size_t(2));
+  EXPECT_EQ(r.ignoredPixels, size_t(2));
+  RgbImage diff = differenceImage(test, ref, params);
+  EXPECT_EQ(diff.at(3), Vec3(0.2f));  // ignored: grey
+  EXPECT_EQ(diff.at(0), Vec3(0.0f));  // no error: black
+}
+
+TEST(Compare, RejectsSizeMismatch) {
+  EXPECT_THROW(compareImages(RgbImage(2, 2), RgbImage(2, 3)), InputError);
+  RgbImage mask(1, 1);
+  CompareParams params;
+  params.mask = &mask;
+  EXPECT_THROW(compareImages(RgbImage(2, 2), RgbImage(2, 2), params), InputError);
+}
+
+TEST(Compare, ExrRoundTripIsExact) {
+  std::string dir = test::outputDir("ExrRoundTrip");
+  RgbImage img = ramp(5, 3);
+  img.rgb[4] = 1e-30f;
+  img.rgb[7] = 12345.678f;
+  writeExr(dir + "/a.exr", img);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/a.exr.tmp"));
+  RgbImage back = readImage(dir + "/a.exr");
+  EXPECT_EQ(back.width, 5);
+  EXPECT_EQ(back.height, 3);
+  EXPECT_EQ(back.rgb, img.rgb);
+  EXPECT_THROW(readImage(dir + "/missing.exr"), InputError);
+  EXPECT_THROW(readImage(dir + "/a.tif"), InputError);
+}
+
+}  // namespace
+}  // namespace lo

@@ -1,0 +1,252 @@
+// Reference path tracer: analytic answers (furnace, point light, area light),
+// determinism, part decomposition.
+//
+// Tolerances come from the sample count: the renderer returns each pixel's
+// standard error of the mean (from the sample variance), so an image mean is
+// checked against the analytic value within 5 standard errors of that mean
+// (plus float slack).
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+#include "core/error.h"
+#include "image/image.h"
+#include "reference/path_tracer.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+using test::addClosedBox;
+using test::addQuad;
+
+int addMaterial(Scene& scene, const Vec3& baseColor, const Vec3& emission = {0, 0, 0}) {
+  Material m;
+  m.baseColor = baseColor;
+  m.emission = emission;
+  m.name = "m" + std::to_string(scene.materials.size());
+  scene.materials.push_back(m);
+  return int(scene.materials.size()) - 1;
+}
+
+/// Mean over all pixels of channel c and the standard error of that mean.
+void imageMean(const ReferenceImage& r, int c, double& mean, double& stdErr) {
+  double sum = 0, var = 0;
+  size_t n = r.image.pixelCount();
+  for (size_t i = 0; i < n; ++i) {
+    sum += r.image.rgb[3 * i + c];
+    var += double(r.stdError.rgb[3 * i + c]) * r.stdError.rgb[3 * i + c];
+  }
+  mean = sum / double(n);
+  stdErr = std::sqrt(var) / double(n);
+}
+
+/// Closed box [-1, 1]^3, every wall albedo a and emission Le: the radiance
+/// everywhere is Le / (1 - a) (a furnace: L = Le + a L).
+Scene furnace(float albedo, float emission) {
+  Scene scene;
+  int m = addMaterial(scene, Vec3(albedo), Vec3(emission));
+  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, m);
+  return scene;
+}
+
+ReferenceImage renderFurnace(ReferencePart part, int spp = 64) {
+  Scene scene = furnace(0.5f, 1.0f);
+  ReferenceParams params;
+  params.width = params.height = 16;
+  params.samplesPerPixel = spp;
+  params.part = part;
+  params.seed = 3;
+  return renderReference(scene, ReferenceCamera::lookAt({0.2f, 0.1f, 0.3f}, {0, 0, -1}, 1.2f),
+                         params);
+}
+
+void expectMean(const ReferenceImage& r, double expected, const char* what) {
+  for (int c = 0; c < 3; ++c) {
+    double mean = 0, se = 0;
+    imageMean(r, c, mean, se);
+    EXPECT_NEAR(mean, expected, 5.0 * se + 1e-5 * expected)
+        << what << " channel " << c << " (standard error " << se << ")";
+  }
+}
+
+TEST(Reference, FurnaceFullIsEmissionOverOneMinusAlbedo) {
+  ReferenceImage r = renderFurnace(ReferencePart::Full);
+  EXPECT_EQ(r.samplesPerPixel, 64);
+  expectMean(r, 1.0 / (1.0 - 0.5), "full");
+  // Per pixel: the error over the pixel's own standard error is roughly
+  // normal, so few pixels lie beyond 3 (0.3 % if normal; the estimated
+  // standard error of a skewed sum is noisy, so allow 3 %).
+  size_t outliers = 0;
+  for (size_t i = 0; i < r.image.pixelCount(); ++i)
+    outliers += std::fabs(r.image.rgb[3 * i] - 2.0) > 3.0 * r.stdError.rgb[3 * i] + 1e-4;
+  EXPECT_LE(outliers, r.image.pixelCount() * 3 / 100);
+}
+
+TEST(Reference, FurnaceParts) {
+  // Direct: Le seen + a * Le reflected straight from the walls; indirect the rest.
+  expectMean(renderFurnace(ReferencePart::Direct), 1.0 + 0.5, "direct");
+  expectMean(renderFurnace(ReferencePart::Indirect), 2.0 - 1.5, "indirect");
+  // Indirect irradiance: incoming radiance that scattered at least once is
+  // L - Le = 1 from every direction, so E = pi.
+  expectMean(renderFurnace(ReferencePart::Irradiance), kPi, "irradiance");
+}
+
+TEST(Reference, DirectPlusIndirectIsFull) {
+  Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
+  ReferenceParams params;
+  params.width = params.height = 16;
+  params.samplesPerPixel = 4;
+  ReferenceCamera camera = ReferenceCamera::fromScene(scene.cameras.at(0));
+  params.part = ReferencePart::Full;
+  ReferenceImage full = renderReference(scene, camera, params);
+  params.part = ReferencePart::Direct;
+  ReferenceImage direct = renderReference(scene, camera, params);
+  params.part = ReferencePart::Indirect;
+  ReferenceImage indirect = renderReference(scene, camera, params);
+  double sumIndirect = 0;
+  for (size_t i = 0; i < full.image.rgb.size(); ++i) {
+    float sum = direct.image.rgb[i] + indirect.image.rgb[i];
+    ASSERT_NEAR(sum, full.image.rgb[i], 1e-5f * std::max(1.0f, full.image.rgb[i])) << i;
+    sumIndirect += indirect.image.rgb[i];
+  }
+  EXPECT_GT(sumIndirect, 0.0);  // the Cornell box has indirect light
+}
+
+/// Diffuse floor y = 0 (albedo 0.5), camera looking down at the origin with a
+/// narrow field of view.
+Scene floorScene() {
+  Scene scene;
+  int floor = addMaterial(scene, Vec3(0.5f));
+  addQuad(scene, {-10, 0, -10}, {20, 0, 0}, {0, 0, 20}, {0, 1, 0}, floor);
+  return scene;
+}
+
+/// Mean of f over a 4x4 grid of points inside each pixel's footprint on y = 0.
+template <typename F>
+double expectedPixel(const ReferenceCamera& cam, int x, int y, int w, int h, F&& f) {
+  Vec3 right = normalize(cross(cam.forward, cam.up));
+  float tanHalf = std::tan(0.5f * cam.yfov), aspect = float(w) / float(h);
+  double sum = 0;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      float sx = (2.0f * (x + (i + 0.5f) / 4) / w - 1) * tanHalf * aspect;
+      float sy = (1 - 2.0f * (y + (j + 0.5f) / 4) / h) * tanHalf;
+      Vec3 d = normalize(cam.forward + right * sx + cam.up * sy);
+      Vec3 p = cam.eye + d * (-cam.eye.y / d.y);
+      sum += f(p);
+    }
+  return sum / 16;
+}
+
+TEST(Reference, PointLightOverDiffusePlane) {
+  Scene scene = floorScene();
+  Light light;
+  light.position = {0.3f, 1.0f, 0.0f};
+  light.intensity = 2.0f;  // W/sr
+  scene.lights.push_back(light);
+  ReferenceCamera cam = ReferenceCamera::lookAt({0, 3, 1}, {0, 0, 0}, 0.3f);
+  ReferenceParams params;
+  params.width = params.height = 8;
+  params.samplesPerPixel = 16;
+  params.part = ReferencePart::Direct;
+  ReferenceImage r = renderReference(scene, cam, params);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      // L = albedo / pi * I cos(theta) / d^2.
+      double expected = expectedPixel(cam, x, y, 8, 8, [&](const Vec3& p) {
+        Vec3 d = light.position - p;
+        float dist = length(d);
+        return 0.5 / kPi * light.intensity * (d.y / dist) / (dist * dist);
+      });
+      size_t i = size_t(y) * 8 + x;
+      EXPECT_NEAR(r.image.rgb[3 * i], expected, 5.0 * r.stdError.rgb[3 * i] + 2e-3 * expected)
+          << "pixel " << x << "," << y;
+    }
+  // A plane cannot light itself: no indirect light at all.
+  params.part = ReferencePart::Indirect;
+  ReferenceImage ind = renderReference(scene, cam, params);
+  for (float v : ind.image.rgb) ASSERT_EQ(v, 0.0f);
+}
+
+/// Irradiance under the centre of a parallel square emitter of half-side s at
+/// height h: four corner rectangles, each pi L F with the differential
+/// form factor F = 1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + (X <-> Y)].
+double squareEmitterIrradiance(double radiance, double s, double h) {
+  double x = s / h, y = s / h;
+  double f = (x / std::sqrt(1 + x * x) * std::atan(y / std::sqrt(1 + x * x)) +
+              y / std::sqrt(1 + y * y) * std::atan(x / std::sqrt(1 + y * y))) /
+             (2 * kPi);
+  return 4 * kPi * radiance * f;
+}
+
+TEST(Reference, AreaLightOverDiffusePlaneWithMis) {
+  Scene scene = floorScene();
+  // Black emitter facing down (one-sided): the floor's bounce light that hits
+  // its back is absorbed, so the floor sees only direct light.
+  int emitter = addMaterial(scene, Vec3(0.0f), Vec3(3.0f));
+  addQuad(scene, {-0.5f, 1, -0.5f}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, emitter);
+  ReferenceCamera cam = ReferenceCamera::lookAt({0, 0.5f, 3}, {0, 0, 0}, 0.004f);
+  ReferenceParams params;
+  params.width = params.height = 4;
+  params.samplesPerPixel = 1024;
+  params.part = ReferencePart::Full;
+  ReferenceImage r = renderReference(scene, cam, params);
+  double expected = 0.5 / kPi * squareEmitterIrradiance(3.0, 0.5, 1.0);
+  expectMean(r, expected, "area light");
+  // The direct part is all of it.
+  params.part = ReferencePart::Indirect;
+  ReferenceImage ind = renderReference(scene, cam, params);
+  for (float v : ind.image.rgb) ASSERT_EQ(v, 0.0f);
+}
+
+TEST(Reference, DeterministicAcrossThreadCounts) {
+  Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
+  ReferenceParams params;
+  params.width = 24;
+  params.height = 20;
+  params.samplesPerPixel = 3;
+  params.seed = 11;
+  ReferenceCamera camera = ReferenceCamera::fromScene(scene.cameras.at(0));
+  std::vector<float> images[2];
+  for (int threads = 1; threads <= 2; ++threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    images[threads - 1] = renderReference(scene, camera, params).image.rgb;
+  }
+  ASSERT_EQ(images[0].size(), images[1].size());
+  EXPECT_EQ(std::memcmp(images[0].data(), images[1].data(), images[0].size() * sizeof(float)), 0);
+}
+
+TEST(Reference, TimeBudgetEqualsSameSppRun) {
+  Scene scene = furnace(0.5f, 1.0f);
+  ReferenceCamera cam = ReferenceCamera::lookAt({0, 0, 0}, {0, 0, -1}, 1.0f);
+  ReferenceParams params;
+  params.width = params.height = 8;
+  params.timeBudgetSeconds = 0.05;
+  ReferenceImage budget = renderReference(scene, cam, params);
+  ASSERT_GE(budget.samplesPerPixel, 1);
+  params.timeBudgetSeconds = 0;
+  params.samplesPerPixel = budget.samplesPerPixel;
+  ReferenceImage fixed = renderReference(scene, cam, params);
+  EXPECT_EQ(budget.image.rgb, fixed.image.rgb);
+}
+
+TEST(Reference, RejectsBadParams) {
+  Scene scene = furnace(0.5f, 1.0f);
+  ReferenceCamera cam;
+  ReferenceParams params;
+  params.samplesPerPixel = 0;
+  EXPECT_THROW(renderReference(scene, cam, params), InputError);
+  params.samplesPerPixel = 1;
+  params.width = 0;
+  EXPECT_THROW(renderReference(scene, cam, params), InputError);
+  EXPECT_THROW(parseReferencePart("bounce"), InputError);
+  EXPECT_EQ(parseReferencePart("irradiance"), ReferencePart::Irradiance);
+}
+
+}  // namespace
+}  // namespace lo

@@ -1,0 +1,350 @@
+// File-level checks of conversion: format_version, optional and dropped grids,
+// half-float storage, photon read-back, `inspect` on good, damaged and
+// corrupted files, vdb_print on a converted file.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "cluster/resample.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "test_util.h"
+#include "vdb/vdb_inspect.h"
+#include "vdb/vdb_internal.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small consistent grid: an 8x8 floor at y = 0 in one depth-4 frame, each
+// voxel with `maxVdls` VDLs that sum to its irradiance.
+VdlGrid floorGrid(int maxVdls = 3) {
+  VdlGrid g;
+  g.frame.origin = {-0.5f, -0.25f, 0.125f};
+  g.frame.voxelSize = 0.0625f;
+  g.frame.depth = 4;
+  g.maxVdls = maxVdls;
+  Rng rng(5, 0);
+  for (int x = 0; x < 8; ++x) {
+    for (int z = 0; z < 8; ++z) {
+      g.coords.push_back({x, 0, z});
+      g.normals.push_back({0, 1, 0});
+      g.areas.push_back(0.0625f * 0.0625f * (0.5f + rng.uniform()));
+      g.photonCount.push_back(float(100 + rng.uniformInt(200)));
+      g.radius.push_back(0.2f);
+      g.angularError.push_back(0.2f * rng.uniform());
+      const uint8_t count = uint8_t(1 + rng.uniformInt(uint32_t(maxVdls)));
+      g.vdlCount.push_back(count);
+      Vec3 total{};
+      for (int i = 0; i < maxVdls; ++i) {
+        Vdl vdl;
+        if (i < count) {
+          vdl.irradiance = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 3.0f;
+          vdl.direction = normalize(Vec3(rng.uniform() - 0.5f, 1.0f, rng.uniform() - 0.5f));
+          total += vdl.irradiance;
+        }
+        g.vdls.push_back(vdl);
+      }
+      g.irradiance.push_back(total);
+    }
+  }
+  return g;
+}
+
+BakeMetadata meta() {
+  BakeMetadata m;
+  m.sourceScene = "floor.gltf";
+  m.depth = 4;
+  m.knn = 100;
+  m.vdls = "3";
+  return m;
+}
+
+const VdbCheck* findCheck(const VdbReport& r, const std::string& name) {
+  for (const VdbCheck& c : r.checks) {
+    if (c.name == name) return &c;
+  }
+  return nullptr;
+}
+
+void expectCheck(const VdbReport& r, const std::string& name, bool passed) {
+  const VdbCheck* c = findCheck(r, name);
+  ASSERT_NE(c, nullptr) << "no check " << name;
+  EXPECT_EQ(c->passed, passed) << name << ": " << c->detail;
+}
+
+std::string readError(const std::string& path) {
+  try {
+    readVdlGrid(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected InputError for " << path;
+  return "";
+}
+
+TEST(FormatVersion, WrittenReadAndNewerRefused) {
+  std::string dir = test::outputDir("Convert.FormatVersion");
+  VdlGrid g = floorGrid();
+  writeVdlGrid(dir + "/v1.vdb", g, meta());
+  LoadedVdl v1 = readVdlGrid(dir + "/v1.vdb");
+  EXPECT_EQ(v1.meta.formatVersion, 1);
+  EXPECT_TRUE(v1.notes.empty());
+  VdbReport r = inspectVdb(dir + "/v1.vdb");
+  auto it = std::find_if(r.metadata.begin(), r.metadata.end(),
+                         [](const auto& kv) { return kv.first == "format_version"; });
+  ASSERT_NE(it, r.metadata.end());
+  EXPECT_EQ(it->second, "1");
+
+  // A file written by a future lightoctree.
+  vdb_internal::Damage newer;
+  newer.formatVersion = 2;
+  vdb_internal::writeVdlGridDamaged(dir + "/v2.vdb", g, meta(), newer);
+  std::string msg = readError(dir + "/v2.vdb");
+  EXPECT_NE(msg.find("format_version 2 is not supported"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("newer lightoctree"), std::string::npos) << msg;
+  expectCheck(inspectVdb(dir + "/v2.vdb"), "format_version", false);
+
+  // A file written before the key existed: read as version 1, with a note.
+  vdb_internal::Damage older;
+  older.formatVersion = 0;
+  vdb_internal::writeVdlGridDamaged(dir + "/v0.vdb", g, meta(), older);
+  LoadedVdl v0 = readVdlGrid(dir + "/v0.vdb");
+  EXPECT_EQ(v0.meta.formatVersion, 1);
+  ASSERT_EQ(v0.notes.size(), 1u);
+  EXPECT_NE(v0.notes[0].find("format version 1"), std::string::npos) << v0.notes[0];
+  EXPECT_EQ(v0.grid.irradiance, g.irradiance);
+  expectCheck(inspectVdb(dir + "/v0.vdb"), "format_version", true);
+}
+
+TEST(OptionalGrids, DroppedGridsReadAsZero) {
+  std::string dir = test::outputDir("Convert.Drop");
+  VdlGrid g = floorGrid();
+  VdlWriteOptions opt;
+  opt.drop = {"angular_error", "photon_count", "radius", "area"};
+  writeVdlGrid(dir + "/d.vdb", g, meta(), opt);
+  LoadedVdl d = readVdlGrid(dir + "/d.vdb");
+  EXPECT_EQ(d.absentGrids.size(), 4u);
+  EXPECT_EQ(d.grid.irradiance, g.irradiance);
+  EXPECT_EQ(d.grid.coords, g.coords);
+  for (size_t v = 0; v < g.size(); ++v) {
+    ASSERT_EQ(d.grid.areas[v], 0.0f);
+    ASSERT_EQ(d.grid.photonCount[v], 0.0f);
+  }
+  VdbReport r = inspectVdb(dir + "/d.vdb");
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.grids.size(), 3u + 2u * 3u);
+
+  for (const char* bad : {"irradiance", "vdl0_direction", "vdl_count", "bogus"}) {
+    VdlWriteOptions o;
+    o.drop = {bad};
+    EXPECT_THROW(writeVdlGrid(dir + "/bad.vdb", g, meta(), o), InputError) << bad;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/bad.vdb"));
+  EXPECT_FALSE(fs::exists(dir + "/bad.vdb.tmp"));
+}
+
+TEST(HalfFloat, ReadsBackWithinHalfPrecisionAndPassesInspect) {
+  std::string dir = test::outputDir("Convert.Half");
+  VdlGrid g = floorGrid(4);
+  writeVdlGrid(dir + "/full.vdb", g, meta());
+  VdlWriteOptions opt;
+  opt.halfFloat = true;
+  writeVdlGrid(dir + "/half.vdb", g, meta(), opt);
+  LoadedVdl h = readVdlGrid(dir + "/half.vdb");
+  EXPECT_TRUE(h.halfFloat);
+  EXPECT_FALSE(readVdlGrid(dir + "/full.vdb").halfFloat);
+  double worst = 0;
+  for (size_t v = 0; v < g.size(); ++v) {
+    for (int k = 0; k < 3; ++k) {
+      worst = std::max(worst, std::abs(double(h.grid.irradiance[v][k]) - g.irradiance[v][k]) /
+                                  g.irradiance[v][k]);
+    }
+    // Counts and areas stay 32-bit.
+    ASSERT_EQ(h.grid.photonCount[v], g.photonCount[v]);
+    ASSERT_EQ(h.grid.areas[v], g.areas[v]);
+    ASSERT_EQ(h.grid.vdlCount[v], g.vdlCount[v]);
+  }
+  std::printf("[ half ] largest relative irradiance error %.3g (2^-11 = %.3g); %ju vs %ju bytes\n",
+              worst, std::ldexp(1.0, -11), uintmax_t(fs::file_size(dir + "/half.vdb")),
+              uintmax_t(fs::file_size(dir + "/full.vdb")));
+  EXPECT_GT(worst, 0.0) << "half storage must round";
+  EXPECT_LE(worst, std::ldexp(1.0, -11));
+  EXPECT_LT(fs::file_size(dir + "/half.vdb"), fs::file_size(dir + "/full.vdb"));
+  VdbReport r = inspectVdb(dir + "/half.vdb");
+  EXPECT_TRUE(r.ok());
+  for (const GridSummary& s : r.grids) {
+    const bool full = s.name == "vdl_count" || s.name == "photon_count" || s.name == "area";
+    EXPECT_EQ(s.halfFloat, !full) << s.name;
+  }
+}
+
+TEST(Inspect, GoodFileReportsGridsAndPasses) {
+  std::string dir = test::outputDir("Inspect.Good");
+  VdlGrid g = floorGrid(2);
+  writeVdlGrid(dir + "/g.vdb", g, meta());
+  VdbReport r = inspectVdb(dir + "/g.vdb");
+  EXPECT_EQ(r.kind, "vdl");
+  EXPECT_TRUE(r.ok());
+  ASSERT_EQ(r.grids.size(), 7u + 2u * 2u);
+  for (const GridSummary& s : r.grids) {
+    EXPECT_EQ(s.activeVoxels, g.size()) << s.name;
+    EXPECT_GT(s.memoryBytes, 0u) << s.name;
+    EXPECT_NEAR(s.voxelSize[0], g.frame.voxelSize, 1e-9) << s.name;
+  }
+  auto irr = std::find_if(r.grids.begin(), r.grids.end(),
+                          [](const GridSummary& s) { return s.name == "irradiance"; });
+  ASSERT_NE(irr, r.grids.end());
+  ASSERT_EQ(irr->min.size(), 3u);
+  float lo = INFINITY, hi = -INFINITY;
+  for (const Vec3& e : g.irradiance) lo = std::min(lo, e.x), hi = std::max(hi, e.x);
+  EXPECT_EQ(irr->min[0], lo);
+  EXPECT_EQ(irr->max[0], hi);
+  for (const char* name :
+       {"contract", "format_version", "finite", "same_transform", "same_active_voxels", "vdl_count",
+        "irradiance_non_negative", "unit_directions", "vdl_sum"}) {
+    expectCheck(r, name, true);
+  }
+}
+
+TEST(Inspect, DamagedFilesFailTheirCheck) {
+  std::string dir = test::outputDir("Inspect.Damaged");
+  {
+    vdb_internal::Damage d;
+    d.omitGrid = "vdl1_irradiance";
+    vdb_internal::writeVdlGridDamaged(dir + "/omit.vdb", floorGrid(), meta(), d);
+    VdbReport r = inspectVdb(dir + "/omit.vdb");
+    expectCheck(r, "contract", false);
+    EXPECT_FALSE(r.ok());
+    EXPECT_NE(readError(dir + "/omit.vdb").find("missing grid 'vdl1_irradiance'"),
+              std::string::npos);
+  }
+  {
+    vdb_internal::Damage d;
+    d.shiftGrid = "normal";
+    vdb_internal::writeVdlGridDamaged(dir + "/shift.vdb", floorGrid(), meta(), d);
+    expectCheck(inspectVdb(dir + "/shift.vdb"), "same_transform", false);
+    EXPECT_NE(readError(dir + "/shift.vdb").find("mismatched transforms"), std::string::npos);
+  }
+  auto damaged = [&](const char* name, auto edit) {
+    VdlGrid g = floorGrid();
+    edit(g);
+    writeVdlGrid(dir + "/" + name + ".vdb", g, meta());
+    return inspectVdb(dir + "/" + name + ".vdb");
+  };
+  expectCheck(damaged("short", [](VdlGrid& g) { g.vdls[0].direction *= 0.5f; }), "unit_directions",
+              false);
+  // An unused slot (>= vdl_count) may hold anything: zeros are the rule.
+  expectCheck(damaged("unused", [](VdlGrid& g) { g.vdlCount[0] = 0; }), "unit_directions", true);
+  expectCheck(damaged("sum", [](VdlGrid& g) { g.irradiance[5] *= 1.01f; }), "vdl_sum", false);
+  expectCheck(damaged("negative", [](VdlGrid& g) { g.vdls[3].irradiance.y = -0.1f; }),
+              "irradiance_non_negative", false);
+  expectCheck(damaged("nan", [](VdlGrid& g) { g.radius[7] = NAN; }), "finite", false);
+}
+
+TEST(Inspect, CorruptedFilesAreInputErrors) {
+  std::string dir = test::outputDir("Inspect.Corrupted");
+  writeVdlGrid(dir + "/g.vdb", floorGrid(), meta());
+  std::ifstream in(dir + "/g.vdb", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  auto write = [&](const std::string& name, const std::string& content) {
+    std::ofstream f(dir + "/" + name, std::ios::binary);
+    f.write(content.data(), std::streamsize(content.size()));
+    return dir + "/" + name;
+  };
+  std::string magic = bytes;
+  magic[0] ^= 0x55;
+  for (const std::string& path :
+       {write("truncated.vdb", bytes.substr(0, bytes.size() / 2)),
+        write("header-only.vdb", bytes.substr(0, 40)), write("magic.vdb", magic),
+        write("text.vdb", "not a vdb file\n"), dir + "/missing.vdb"}) {
+    try {
+      inspectVdb(path);
+      ADD_FAILURE() << "expected InputError for " << path;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(PhotonPoints, ReadBackEqualsWritten) {
+  std::string dir = test::outputDir("Convert.Photons");
+  std::vector<Photon> photons(2000);
+  Rng rng(9, 0);
+  for (Photon& p : photons) {
+    p.position = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0f - Vec3(1.0f);
+    p.direction = normalize(Vec3(rng.uniform() - 0.5f, rng.uniform(), rng.uniform() - 0.5f));
+    p.normal = Vec3(0, 1, 0);
+    p.power = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 1e-4f;
+    p.bounce = rng.uniformInt(4);
+  }
+  writePhotonPoints(dir + "/p.vdb", photons, 0.05f);
+  std::vector<Photon> back = readPhotonPoints(dir + "/p.vdb");
+  ASSERT_EQ(back.size(), photons.size());
+  auto key = [](const Photon& p) {
+    return std::make_tuple(p.position.x, p.position.y, p.position.z);
+  };
+  auto byPos = [&](const Photon& a, const Photon& b) { return key(a) < key(b); };
+  std::sort(photons.begin(), photons.end(), byPos);
+  std::sort(back.begin(), back.end(), byPos);
+  double worstPos = 0;
+  for (size_t i = 0; i < photons.size(); ++i) {
+    worstPos = std::max(worstPos, double(length(back[i].position - photons[i].position)));
+    ASSERT_EQ(back[i].power, photons[i].power);
+    ASSERT_EQ(back[i].direction, photons[i].direction);
+    ASSERT_EQ(back[i].bounce, photons[i].bounce);
+  }
+  EXPECT_LE(worstPos, 1e-6);
+  EXPECT_THROW(readPhotonPoints(dir + "/missing.vdb"), InputError);
+  writeVdlGrid(dir + "/vdl.vdb", floorGrid(), meta());
+  EXPECT_THROW(readPhotonPoints(dir + "/vdl.vdb"), InputError);
+  EXPECT_EQ(inspectVdb(dir + "/p.vdb").kind, "photons");
+}
+
+std::string runCommand(const std::string& cmd) {
+  std::string out;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return out;
+  char buffer[4096];
+  size_t got;
+  while ((got = fread(buffer, 1, sizeof(buffer), pipe)) > 0) out.append(buffer, got);
+  pclose(pipe);
+  return out;
+}
+
+TEST(Convert, VdbPrintListsTheGridsOfAConvertedFile) {
+  const char* vdbPrint = "/usr/bin/vdb_print";
+  if (!fs::exists(vdbPrint)) GTEST_SKIP() << vdbPrint << " not installed";
+  std::string dir = test::outputDir("Convert.VdbPrint");
+  ClusterParams params;
+  params.vdls = 2;
+  VdlGrid coarse = coarsenVdlGrid(floorGrid(), 3, params);
+  VdlWriteOptions opt;
+  opt.halfFloat = true;
+  opt.drop = {"angular_error"};
+  BakeMetadata m = meta();
+  m.depth = coarse.frame.depth;
+  writeVdlGrid(dir + "/c.vdb", coarse, m, opt);
+  std::string out = runCommand(std::string(vdbPrint) + " -l -m " + dir + "/c.vdb 2>&1");
+  for (const char* name : {"irradiance", "normal", "photon_count", "vdl_count", "radius", "area",
+                           "vdl0_irradiance", "vdl0_direction", "vdl1_direction"}) {
+    EXPECT_NE(out.find("\n" + std::string(name) + " "), std::string::npos) << name << "\n" << out;
+  }
+  EXPECT_EQ(out.find("angular_error"), std::string::npos) << out;
+  EXPECT_NE(out.find("is_saved_as_half_float: true"), std::string::npos) << out;
+  EXPECT_NE(out.find("format_version: 1"), std::string::npos) << out;
+  EXPECT_TRUE(readVdlGrid(dir + "/c.vdb").grid.size() == coarse.size());
+}
+
+}  // namespace
+}  // namespace lo
