@@ -17,6 +17,8 @@ PACKAGES=(
   libnanoflann-dev libeigen3-dev libcli11-dev libgtest-dev
   # images and GL rendering (OSMesa headless, EGL, GLFW window), math
   libopenexr-dev libglm-dev libglfw3-dev libosmesa6-dev libegl-dev libgl-dev python3-glad
+  # plots of the parameter sweep (lightoctree sweep)
+  gnuplot-nox
 )
 
 missing=()
