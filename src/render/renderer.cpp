@@ -190,6 +190,9 @@ struct Renderer::Impl {
   }
 
   void uploadOctree(const GpuOctree& octree) {
+    GLuint old[] = {octreeTexture, vdlTexture, vdlHalfTexture};  // 0 the first time: no-op
+    glDeleteTextures(3, old);
+    octreeTexture = vdlTexture = vdlHalfTexture = 0;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glGenTextures(1, &octreeTexture);
     glBindTexture(GL_TEXTURE_3D, octreeTexture);
@@ -570,6 +573,11 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
 Renderer::~Renderer() = default;
 
 int Renderer::emitterLightCount() const { return impl_->emitterLights; }
+
+void Renderer::setOctree(const GpuOctree& octree) {
+  impl_->checkLimits(octree);
+  impl_->uploadOctree(octree);
+}
 
 Image Renderer::render(const RenderCamera& camera, const RenderParams& params) {
   Impl& r = *impl_;

@@ -83,6 +83,13 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
+  /// Replaces the light octree (e.g. a finer level of a progressive bake):
+  /// uploads its textures in place of the old ones; geometry, lights and
+  /// shadow maps stay. Requires the renderer's GL context to be current.
+  /// @throws InputError like the constructor when the textures exceed the
+  /// context's limits (the old octree is kept then).
+  void setOctree(const GpuOctree& octree);
+
   /// Renders into an offscreen RGBA32F target and reads it back.
   Image render(const RenderCamera& camera, const RenderParams& params);
   /// Renders into the currently bound framebuffer (a window); `exposure` in EV

@@ -1,0 +1,122 @@
+// Renderer::setOctree (the progressive viewer's level swap): an empty octree
+// gives no indirect light, and swapping a level in gives the same pixels as a
+// renderer built with that level from the start.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+
+#include "cluster/bake_level.h"
+#include "core/error.h"
+#include "octree/gpu_octree.h"
+#include "render/context.h"
+#include "render/renderer.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+GlContext* context() {
+  static std::unique_ptr<GlContext> ctx;
+  static bool tried = false;
+  if (!tried) {
+    tried = true;
+    try {
+      ctx = createGlContext({GlBackend::OSMesa});
+    } catch (const std::exception&) {
+    }
+  }
+  if (ctx) ctx->makeCurrent();
+  return ctx.get();
+}
+
+Scene litRoom() {
+  Scene scene;
+  Material grey;
+  grey.baseColor = Vec3(0.6f);
+  scene.materials.push_back(grey);
+  test::addClosedBox(scene, Vec3(0.0f), Vec3(1.0f), 0);
+  test::addBlock(scene, Vec3(0.2f, 0.0f, 0.3f), Vec3(0.5f, 0.4f, 0.6f), 0);
+  Light light;
+  light.position = Vec3(0.5f, 0.8f, 0.5f);
+  light.intensity = 1.0f;
+  scene.lights.push_back(light);
+  return scene;
+}
+
+GpuOctree bakeOctree(const Scene& scene, const std::vector<Photon>& photons, int depth) {
+  LevelParams params;
+  params.grid.depth = depth;
+  params.gather.k = 40;
+  return buildGpuOctree(bakeLevel(scene, photons, params));
+}
+
+float maxValue(const Image& image) {
+  float m = 0;
+  for (size_t i = 0; i < image.rgba.size(); i += 4) {
+    m = std::max({m, image.rgba[i], image.rgba[i + 1], image.rgba[i + 2]});
+  }
+  return m;
+}
+
+TEST(RendererSetOctree, SwappedLevelRendersLikeAFreshRenderer) {
+  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  Scene scene = litRoom();
+  PhotonParams pp;
+  pp.storedPhotons = 20000;
+  std::vector<Photon> photons = tracePhotons(scene, pp).photons;
+  GpuOctree coarse = bakeOctree(scene, photons, 3);
+  GpuOctree fine = bakeOctree(scene, photons, 4);
+
+  RenderParams params;
+  params.width = 64;
+  params.height = 48;
+  params.mode = RenderMode::Indirect;
+  RenderCamera camera = RenderCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
+
+  Renderer swapped(scene, GpuOctree(), {});
+  EXPECT_EQ(maxValue(swapped.render(camera, params)), 0.0f) << "empty octree: no indirect light";
+  swapped.setOctree(coarse);
+  swapped.setOctree(fine);
+  Image a = swapped.render(camera, params);
+  EXPECT_GT(maxValue(a), 0.0f);
+
+  Renderer fresh(scene, fine, {});
+  Image b = fresh.render(camera, params);
+  ASSERT_EQ(a.rgba.size(), b.rgba.size());
+  EXPECT_EQ(a.rgba, b.rgba);
+
+  // Depth 3 and depth 4 differ somewhere: the swap did change the textures.
+  swapped.setOctree(coarse);
+  EXPECT_NE(swapped.render(camera, params).rgba, b.rgba);
+  swapped.setOctree(GpuOctree());
+  EXPECT_EQ(maxValue(swapped.render(camera, params)), 0.0f);
+}
+
+TEST(RendererSetOctree, TooLargeForTheLimitsKeepsTheOldOctree) {
+  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  Scene scene = litRoom();
+  PhotonParams pp;
+  pp.storedPhotons = 5000;
+  std::vector<Photon> photons = tracePhotons(scene, pp).photons;
+  GpuOctree octree = bakeOctree(scene, photons, 3);
+  RendererParams limits;
+  limits.max3DTextureSize = std::max({octree.poolWidth(), octree.poolHeight(), octree.poolDepth()});
+  limits.max2DTextureSize = 16384;
+  Renderer renderer(scene, octree, limits);
+  RenderParams params;
+  params.width = 32;
+  params.height = 24;
+  params.mode = RenderMode::Indirect;
+  RenderCamera camera = RenderCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
+  Image before = renderer.render(camera, params);
+  GpuOctree larger = bakeOctree(scene, photons, 5);
+  ASSERT_GT(std::max({larger.poolWidth(), larger.poolHeight(), larger.poolDepth()}),
+            limits.max3DTextureSize);
+  EXPECT_THROW(renderer.setOctree(larger), InputError);
+  EXPECT_EQ(renderer.render(camera, params).rgba, before.rgba);
+}
+
+}  // namespace
+}  // namespace lo
