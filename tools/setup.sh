@@ -19,6 +19,8 @@ PACKAGES=(
   libopenexr-dev libglm-dev libglfw3-dev libosmesa6-dev libegl-dev libgl-dev python3-glad
   # plots of the parameter sweep (lightoctree sweep)
   gnuplot-nox
+  # a virtual display for the `lightoctree view` window tests (xvfb-run)
+  xvfb xauth
 )
 
 missing=()
