@@ -20,8 +20,8 @@ void checkSizes(const RgbImage& test, const RgbImage& reference, const ComparePa
     throw InputError("compare: image sizes differ: " + std::to_string(test.width) + " x " +
                      std::to_string(test.height) + " vs reference " +
                      std::to_string(reference.width) + " x " + std::to_string(reference.height));
-  if (params.mask && (params.mask->width != reference.width ||
-                      params.mask->height != reference.height))
+  if (params.mask &&
+      (params.mask->width != reference.width || params.mask->height != reference.height))
     throw InputError("compare: mask is " + std::to_string(params.mask->width) + " x " +
                      std::to_string(params.mask->height) + ", images are " +
                      std::to_string(reference.width) + " x " + std::to_string(reference.height));

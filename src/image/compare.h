@@ -38,8 +38,8 @@ struct CompareResult {
   ChannelError channel[3];  ///< R, G, B
   ChannelError luminance;   ///< Rec. 709 Y of each pixel
   size_t comparedPixels = 0;
-  size_t ignoredPixels = 0;    ///< by the mask or as background
-  size_t nonFinitePixels = 0;  ///< NaN/inf in either image: left out and counted
+  size_t ignoredPixels = 0;            ///< by the mask or as background
+  size_t nonFinitePixels = 0;          ///< NaN/inf in either image: left out and counted
   int maxErrorX = -1, maxErrorY = -1;  ///< pixel of the largest luminance error
   double meanReferenceLuminance = 0;   ///< over the compared pixels
   std::string ToString() const;        ///< a small table

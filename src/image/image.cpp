@@ -64,13 +64,14 @@ RgbImage readExr(const std::string& path) {
     RgbImage image(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1);
     const Imf::ChannelList& channels = file.header().channels();
     const char* names[3] = {"R", "G", "B"};
-    const char* first = channels.findChannel("R") ? "R" : (channels.findChannel("Y") ? "Y" : nullptr);
+    const char* first =
+        channels.findChannel("R") ? "R" : (channels.findChannel("Y") ? "Y" : nullptr);
     if (!first) throw InputError(path + ": no R or Y channel");
     Imf::FrameBuffer fb;
     // Slices are addressed from the data window's origin, which may not be (0, 0).
-    char* base = reinterpret_cast<char*>(image.rgb.data()) -
-                 (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * image.width) * 3 *
-                     ptrdiff_t(sizeof(float));
+    char* base =
+        reinterpret_cast<char*>(image.rgb.data()) -
+        (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * image.width) * 3 * ptrdiff_t(sizeof(float));
     size_t yStride = size_t(image.width) * 3 * sizeof(float);
     fb.insert(first, Imf::Slice(Imf::FLOAT, base, 3 * sizeof(float), yStride));
     for (int c = 1; c < 3; ++c) {

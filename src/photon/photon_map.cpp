@@ -344,10 +344,25 @@ struct TraceChunks {
   }
 };
 
+PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params, ProgressSink* progress);
+
 }  // namespace photon_internal
 
 PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressSink* progress) {
-  using namespace photon_internal;
+  // Far from the origin, trace in a frame centred on the scene (see
+  // Scene::tracingOrigin) and move the stored photons back: only their final
+  // positions round to world floats.
+  const Vec3 origin = scene.tracingOrigin();
+  if (origin == Vec3{0, 0, 0}) return photon_internal::traceInSceneFrame(scene, params, progress);
+  PhotonMap map = photon_internal::traceInSceneFrame(scene.translated(-origin), params, progress);
+  for (Photon& photon : map.photons) photon.position += origin;
+  return map;
+}
+
+namespace photon_internal {
+
+PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params,
+                            ProgressSink* progress) {
   if (params.maxBounces < 0)
     throw InputError("PhotonParams.maxBounces must be >= 0, got " +
                      std::to_string(params.maxBounces));
@@ -445,4 +460,5 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   return map;
 }
 
+}  // namespace photon_internal
 }  // namespace lo

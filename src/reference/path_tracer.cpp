@@ -34,10 +34,14 @@ ReferencePart parseReferencePart(const std::string& name) {
 
 std::string toString(ReferencePart part) {
   switch (part) {
-    case ReferencePart::Direct: return "direct";
-    case ReferencePart::Indirect: return "indirect";
-    case ReferencePart::Full: return "full";
-    case ReferencePart::Irradiance: return "irradiance";
+    case ReferencePart::Direct:
+      return "direct";
+    case ReferencePart::Indirect:
+      return "indirect";
+    case ReferencePart::Full:
+      return "full";
+    case ReferencePart::Irradiance:
+      return "irradiance";
   }
   return "?";
 }
@@ -80,11 +84,12 @@ constexpr int kTileSize = 16;
 struct Context {
   const Scene* scene = nullptr;
   const RayTracer* tracer = nullptr;
-  std::vector<BsdfLobes> lobes;            ///< per material
-  std::vector<uint32_t> emitters;          ///< emissive triangles
-  std::vector<double> emitterCdf;          ///< cumulative power, back() = total
-  std::vector<float> emitterPickPdf;       ///< per triangle: pick probability / area (0 = not an emitter)
-  std::vector<const Light*> lights;        ///< punctual lights with positive intensity
+  std::vector<BsdfLobes> lobes;    ///< per material
+  std::vector<uint32_t> emitters;  ///< emissive triangles
+  std::vector<double> emitterCdf;  ///< cumulative power, back() = total
+  std::vector<float>
+      emitterPickPdf;                ///< per triangle: pick probability / area (0 = not an emitter)
+  std::vector<const Light*> lights;  ///< punctual lights with positive intensity
   float epsilon = 0;
   int maxBounces = 0;
   int rouletteStart = 0;
@@ -211,8 +216,8 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
       float w = 1;
       if (!prevDelta) {
         float cosLight = std::fabs(dot(normal, dir));
-        float pdfLight = cosLight > 0 ? ctx.emitterPickPdf[hit.triangle] * hit.t * hit.t / cosLight
-                                      : 0.0f;
+        float pdfLight =
+            cosLight > 0 ? ctx.emitterPickPdf[hit.triangle] * hit.t * hit.t / cosLight : 0.0f;
         w = powerHeuristic(prevPdf, pdfLight);
       }
       Vec3 c = beta * le * w;
@@ -259,9 +264,12 @@ inline Vec3 samplePixel(const Context& ctx, const ReferenceCamera& cam, const Ve
     PathRadiance r = tracePath(ctx, cam.eye, dir, rng);
     rays += r.rays;
     switch (part) {
-      case ReferencePart::Direct: return r.emitted + r.direct;
-      case ReferencePart::Indirect: return r.indirect;
-      default: return r.emitted + r.direct + r.indirect;
+      case ReferencePart::Direct:
+        return r.emitted + r.direct;
+      case ReferencePart::Indirect:
+        return r.indirect;
+      default:
+        return r.emitted + r.direct + r.indirect;
     }
   }
   // Irradiance at vertex 1 on the camera's side, from light that scattered
@@ -356,8 +364,8 @@ struct RenderTiles {
           PixelSums& s = (*sums)[i];
           for (int k = 0; k < passSpp; ++k) {
             uint32_t n = 0;
-            Vec3 v = samplePixel(*ctx, *cam, right, tanHalf, aspect, x, y, width, height, part,
-                                 rng, n);
+            Vec3 v =
+                samplePixel(*ctx, *cam, right, tanHalf, aspect, x, y, width, height, part, rng, n);
             localRays += n;
             if (!isFinite(v)) v = Vec3{0, 0, 0};  // never expected; keeps one NaN from spreading
             for (int c = 0; c < 3; ++c) {
@@ -377,6 +385,14 @@ struct RenderTiles {
 
 ReferenceImage renderReference(const Scene& scene, const ReferenceCamera& camera,
                                const ReferenceParams& params, ProgressSink* progress) {
+  // Far from the origin, render in a frame centred on the scene (see
+  // Scene::tracingOrigin); a translation changes no radiance.
+  const Vec3 origin = scene.tracingOrigin();
+  if (!(origin == Vec3{0, 0, 0})) {
+    ReferenceCamera local = camera;
+    local.eye -= origin;
+    return renderReference(scene.translated(-origin), local, params, progress);
+  }
   using namespace reference_internal;
   if (params.width < 1 || params.height < 1)
     throw InputError("ReferenceParams: image size " + std::to_string(params.width) + " x " +
@@ -443,8 +459,7 @@ ReferenceImage renderReference(const Scene& scene, const ReferenceCamera& camera
         break;
       }
       body.passSpp = budget ? 1 : std::min(passSpp, params.samplesPerPixel - done);
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), body,
-                        tbb::simple_partitioner());
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), body, tbb::simple_partitioner());
       done += body.passSpp;
       if (budget) {
         double elapsed =

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -59,6 +60,22 @@ Bounds3 Scene::bounds() const {
   Bounds3 b;
   for (uint32_t i : indices) b.extend(positions[i]);
   return b;
+}
+
+Vec3 Scene::tracingOrigin() const {
+  const Bounds3 b = bounds();
+  if (b.empty()) return {0, 0, 0};
+  const Vec3 c = b.center();
+  const float distance = std::max({std::fabs(c.x), std::fabs(c.y), std::fabs(c.z)});
+  return distance > 4.0f * length(b.extent()) ? c : Vec3{0, 0, 0};
+}
+
+Scene Scene::translated(const Vec3& offset) const {
+  Scene out = *this;
+  for (Vec3& p : out.positions) p += offset;
+  for (Light& light : out.lights) light.position += offset;
+  for (Camera& camera : out.cameras) camera.position += offset;
+  return out;
 }
 
 Vec3 Scene::faceNormal(size_t t) const {

@@ -25,7 +25,7 @@ namespace lo {
 struct Texture {
   std::string name;
   int width = 0, height = 0;
-  std::vector<Vec3> texels;  ///< width * height, already converted from sRGB to linear
+  std::vector<Vec3> texels;             ///< width * height, already converted from sRGB to linear
   Vec3 lookup(float u, float v) const;  ///< nearest texel, repeat wrap
 };
 
@@ -33,13 +33,13 @@ struct Texture {
 struct Material {
   std::string name;
   Vec3 baseColor{0.8f, 0.8f, 0.8f};  ///< linear RGB albedo factor
-  int baseColorTexture = -1;          ///< index into Scene::textures, -1 = none
-  int baseColorTexCoord = 0;          ///< which UV set (0 or 1) the texture uses
-  float metallic = 0.0f;              ///< [0,1]
-  float roughness = 1.0f;             ///< [0,1], perceptual (alpha = roughness^2)
-  Vec3 emission{0, 0, 0};             ///< radiance W/(m^2 sr): emissiveFactor * strength
-  float transmission = 0.0f;          ///< KHR_materials_transmission, [0,1]
-  float ior = 1.5f;                   ///< KHR_materials_ior
+  int baseColorTexture = -1;         ///< index into Scene::textures, -1 = none
+  int baseColorTexCoord = 0;         ///< which UV set (0 or 1) the texture uses
+  float metallic = 0.0f;             ///< [0,1]
+  float roughness = 1.0f;            ///< [0,1], perceptual (alpha = roughness^2)
+  Vec3 emission{0, 0, 0};            ///< radiance W/(m^2 sr): emissiveFactor * strength
+  float transmission = 0.0f;         ///< KHR_materials_transmission, [0,1]
+  float ior = 1.5f;                  ///< KHR_materials_ior
   bool doubleSided = false;
 
   bool isEmissive() const { return maxComponent(emission) > 0; }
@@ -51,13 +51,13 @@ struct Light {
   enum class Type { Point, Spot, Directional };
   Type type = Type::Point;
   std::string name;
-  Vec3 position{0, 0, 0};     ///< world space (point, spot)
-  Vec3 direction{0, 0, -1};   ///< unit, world space, the way the light travels (spot, directional)
-  Vec3 color{1, 1, 1};        ///< linear RGB
-  float intensity = 1.0f;     ///< point/spot: W/sr (cd); directional: W/m^2 (lx)
-  float range = 0.0f;         ///< 0 = infinite
-  float innerConeAngle = 0.0f;           ///< radians (spot)
-  float outerConeAngle = kPi / 4.0f;     ///< radians (spot)
+  Vec3 position{0, 0, 0};    ///< world space (point, spot)
+  Vec3 direction{0, 0, -1};  ///< unit, world space, the way the light travels (spot, directional)
+  Vec3 color{1, 1, 1};       ///< linear RGB
+  float intensity = 1.0f;    ///< point/spot: W/sr (cd); directional: W/m^2 (lx)
+  float range = 0.0f;        ///< 0 = infinite
+  float innerConeAngle = 0.0f;        ///< radians (spot)
+  float outerConeAngle = kPi / 4.0f;  ///< radians (spot)
 
   /// Total emitted power in W (RGB). Directional lights need the scene's
   /// bounds: their power is the flux through the scene's bounding disc.
@@ -74,17 +74,17 @@ struct Camera {
   float yfov = 0.8f;       ///< vertical field of view, radians
   float aspectRatio = 0;   ///< width/height; 0 = take it from the image
   float znear = 0.01f;
-  float zfar = 0;          ///< 0 = infinite
+  float zfar = 0;  ///< 0 = infinite
 };
 
 /// Triangle soup in world space, one material index per triangle.
 struct Scene {
   std::string sourcePath;
-  std::vector<Vec3> positions;        ///< world space
-  std::vector<Vec3> normals;          ///< per vertex, unit, world space; empty = use face normals
-  std::vector<float> texcoords0;      ///< 2 floats per vertex, or empty
-  std::vector<float> texcoords1;      ///< 2 floats per vertex, or empty
-  std::vector<uint32_t> indices;      ///< 3 per triangle, into positions
+  std::vector<Vec3> positions;    ///< world space
+  std::vector<Vec3> normals;      ///< per vertex, unit, world space; empty = use face normals
+  std::vector<float> texcoords0;  ///< 2 floats per vertex, or empty
+  std::vector<float> texcoords1;  ///< 2 floats per vertex, or empty
+  std::vector<uint32_t> indices;  ///< 3 per triangle, into positions
   std::vector<int32_t> triangleMaterial;  ///< one per triangle, into materials
   std::vector<Material> materials;
   std::vector<Texture> textures;
@@ -99,6 +99,15 @@ struct Scene {
   /// Base colour of triangle t at barycentrics (b1, b2), texture applied.
   Vec3 albedo(size_t t, float b1, float b2) const;
   std::string ToString() const;  ///< one-line summary
+
+  /// Where ray tracing in float should put its origin: the bounds' centre
+  /// when the scene lies farther from the world origin than 4x its own size
+  /// (a float coordinate of magnitude m is only m * 2^-23 precise, so a small
+  /// scene far away loses its geometry to rounding), else (0, 0, 0).
+  Vec3 tracingOrigin() const;
+  /// A copy moved by `offset`: vertex positions, light and camera positions
+  /// (directions, areas and powers are unchanged by a translation).
+  Scene translated(const Vec3& offset) const;
 };
 
 /// Loads a .gltf, .glb or .obj file. External resources (buffers, images,

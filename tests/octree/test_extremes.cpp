@@ -57,7 +57,9 @@ Bake bake(const Scene& scene, int depth, size_t photons, int vdls = 4, int knn =
   return b;
 }
 
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 /// No NaN/Inf anywhere; directions unit; VDLs sum to the voxel's irradiance.
 void expectSane(const VdlGrid& g, float energyTolerance = 1e-4f) {
@@ -190,8 +192,8 @@ TEST(Extremes, MoreClustersThanPhotonsOneDirectionAndAntipodes) {
   EXPECT_NEAR(one.vdls[0].irradiance.x, 3.0f, 1e-6f);
   EXPECT_NEAR(one.angularError, 0.0f, 1e-6f);
 
-  std::vector<DirectionSample> antipodes = {{{0, 0, 1}, {1, 0, 0}}, {{0, 0, -1}, {0, 1, 0}},
-                                            {{0, 0, 1}, {1, 0, 0}}};
+  std::vector<DirectionSample> antipodes = {
+      {{0, 0, 1}, {1, 0, 0}}, {{0, 0, -1}, {0, 1, 0}}, {{0, 0, 1}, {1, 0, 0}}};
   ClusterResult two = clusterDirections(antipodes.data(), antipodes.size(), 8, params, 0);
   ASSERT_EQ(two.count, 2);
   Vec3 sum = two.vdls[0].irradiance + two.vdls[1].irradiance;

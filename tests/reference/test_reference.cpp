@@ -79,12 +79,38 @@ TEST(Reference, FurnaceFullIsEmissionOverOneMinusAlbedo) {
   EXPECT_EQ(r.samplesPerPixel, 64);
   expectMean(r, 1.0 / (1.0 - 0.5), "full");
   // Per pixel: the error over the pixel's own standard error is roughly
-  // normal, so few pixels lie beyond 3 (0.3 % if normal; the estimated
-  // standard error of a skewed sum is noisy, so allow 3 %).
-  size_t outliers = 0;
-  for (size_t i = 0; i < r.image.pixelCount(); ++i)
-    outliers += std::fabs(r.image.rgb[3 * i] - 2.0) > 3.0 * r.stdError.rgb[3 * i] + 1e-4;
-  EXPECT_LE(outliers, r.image.pixelCount() * 3 / 100);
+  // normal once the sample variance itself is well estimated. The furnace's
+  // path weights are skewed (Russian roulette), so at 64 samples the variance
+  // is often underestimated (measured: 13 of 256 pixels beyond 3 standard
+  // errors, mean squared z 1.9); at 256 samples it settles (2 of 256, 1.18).
+  // Allow 3 % beyond 3 (0.3 % if normal) and none beyond 5.
+  ReferenceImage fine = renderFurnace(ReferencePart::Full, 256);
+  size_t outliers = 0, far = 0;
+  for (size_t i = 0; i < fine.image.pixelCount(); ++i) {
+    const double z = std::fabs(fine.image.rgb[3 * i] - 2.0) / (fine.stdError.rgb[3 * i] + 1e-9);
+    outliers += z > 3.0;
+    far += z > 5.0;
+  }
+  EXPECT_LE(outliers, fine.image.pixelCount() * 3 / 100);
+  EXPECT_EQ(far, 0u);
+}
+
+TEST(Reference, FurnaceFarFromTheOriginKeepsItsRadiance) {
+  // A 2 m furnace 1e5 m away: float spacing there is 0.008 m, so tracing in
+  // world coordinates would lose the walls; the renderer traces around the
+  // scene instead and the analytic answer holds.
+  const Vec3 offset{1e5f, -1e5f, 1e5f};
+  Scene scene = furnace(0.5f, 1.0f).translated(offset);
+  ASSERT_EQ(scene.tracingOrigin(), scene.bounds().center());
+  ReferenceParams params;
+  params.width = params.height = 16;
+  params.samplesPerPixel = 64;
+  params.seed = 3;
+  ReferenceImage r = renderReference(
+      scene,
+      ReferenceCamera::lookAt(Vec3{0.2f, 0.1f, 0.3f} + offset, Vec3{0, 0, -1} + offset, 1.2f),
+      params);
+  expectMean(r, 1.0 / (1.0 - 0.5), "far full");
 }
 
 TEST(Reference, FurnaceParts) {

@@ -338,7 +338,8 @@ TEST(Convert, VdbPrintListsTheGridsOfAConvertedFile) {
   std::string out = runCommand(std::string(vdbPrint) + " -l -m " + dir + "/c.vdb 2>&1");
   for (const char* name : {"irradiance", "normal", "photon_count", "vdl_count", "radius", "area",
                            "vdl0_irradiance", "vdl0_direction", "vdl1_direction"}) {
-    EXPECT_NE(out.find("\n" + std::string(name) + " "), std::string::npos) << name << "\n" << out;
+    EXPECT_NE(out.find("\nName: " + std::string(name) + "\n"), std::string::npos) << name << "\n"
+                                                                                  << out;
   }
   EXPECT_EQ(out.find("angular_error"), std::string::npos) << out;
   EXPECT_NE(out.find("is_saved_as_half_float: true"), std::string::npos) << out;
