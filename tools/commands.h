@@ -23,4 +23,13 @@ std::function<int()> addConvertCommand(CLI::App& app);
 /// `lightoctree inspect IN.vdb [--json]`
 std::function<int()> addInspectCommand(CLI::App& app);
 
+/// `lightoctree reference SCENE -o REF.exr [--part ...] [--spp N | --time-budget S] ...`
+std::function<int()> addReferenceCommand(CLI::App& app);
+
+/// `lightoctree compare TEST REF [--mask M] [--diff D.png] [--json FILE]`
+std::function<int()> addCompareCommand(CLI::App& app);
+
+/// `lightoctree sweep SCENE --out DIR [--quick]`
+std::function<int()> addSweepCommand(CLI::App& app);
+
 }  // namespace lo::tool

@@ -21,6 +21,9 @@ int run(int argc, char** argv) {
   commands.push_back(lo::tool::addRenderCommand(app));
   commands.push_back(lo::tool::addConvertCommand(app));
   commands.push_back(lo::tool::addInspectCommand(app));
+  commands.push_back(lo::tool::addReferenceCommand(app));
+  commands.push_back(lo::tool::addCompareCommand(app));
+  commands.push_back(lo::tool::addSweepCommand(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

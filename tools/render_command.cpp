@@ -7,9 +7,12 @@
 #include <memory>
 #include <sstream>
 
+#include "camera_options.h"
 #include "commands.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
+#include "octree/octree_irradiance.h"
+#include "reference/first_hit.h"
 #include "render/context.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
@@ -23,9 +26,7 @@ struct RenderOptions {
   std::string scene;
   std::string lights;
   std::string output;
-  std::string camera;
-  std::string eye, target;
-  float fovDegrees = 0;  // 0 = the scene camera's, else 45
+  CameraOptions camera;
   int width = 800, height = 600;
   std::string mode = "full";
   std::string interpolation = "on";
@@ -40,42 +41,34 @@ struct RenderOptions {
   bool quiet = false;
 };
 
-/// "x,y,z" -> Vec3; the message names the flag.
-Vec3 parseVec3(const std::string& text, const char* flag) {
-  Vec3 v;
-  char c1 = 0, c2 = 0;
-  std::istringstream is(text);
-  if (!(is >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !is.eof() ||
-      !isFinite(v)) {
-    throw InputError(std::string(flag) + ": expected three numbers x,y,z, got '" + text + "'");
-  }
-  return v;
-}
-
-RenderCamera chooseCamera(const RenderOptions& opt, const Scene& scene) {
-  float fov = (opt.fovDegrees > 0 ? opt.fovDegrees : 45.0f) * kPi / 180.0f;
-  if (!opt.eye.empty()) {
-    Vec3 eye = parseVec3(opt.eye, "--eye"), target = parseVec3(opt.target, "--target");
-    if (eye == target) throw InputError("--eye and --target: the same point");
-    return RenderCamera::lookAt(eye, target, fov);
-  }
-  const Camera* chosen = nullptr;
-  for (const Camera& c : scene.cameras) {
-    if (opt.camera.empty() || c.name == opt.camera) {
-      chosen = &c;
-      break;
-    }
-  }
-  if (!opt.camera.empty() && !chosen) {
-    std::string names;
-    for (const Camera& c : scene.cameras) names += (names.empty() ? "" : ", ") + c.name;
-    throw InputError("--camera: no camera named '" + opt.camera + "' in " + opt.scene +
-                     (names.empty() ? " (it has none)" : " (it has: " + names + ")"));
-  }
-  if (!chosen) return RenderCamera::framing(scene.bounds(), fov);
-  RenderCamera camera = RenderCamera::fromScene(*chosen);
-  if (opt.fovDegrees > 0) camera.yfov = fov;
-  return camera;
+/// `--mode irradiance`: the octree's indirect irradiance at the first hit,
+/// evaluated on the CPU (octree/octree_irradiance.h: the shader's lookup and
+/// interpolation with the cosine alone) at the reference renderer's first-hit
+/// points, so that it compares with `reference --part irradiance`. Needs no
+/// OpenGL. 4 jittered rays per pixel average over the pixel's footprint as
+/// the reference's samples do.
+int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedVdl& baked) {
+  if (opt.frames > 0) throw InputError("--frames: not with --mode irradiance (no GL frame)");
+  ReferenceCamera camera = chooseCamera<ReferenceCamera>(opt.camera, scene, opt.scene);
+  GpuOctreeParams octreeParams;
+  octreeParams.halfFloat = opt.halfFloat;
+  // No GL context to ask: the limits of the GL 3.3 contexts we render with.
+  GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
+  if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
+  OctreeShadeParams shade;
+  shade.interpolation = opt.interpolation == "on";
+  shade.maxVdls = opt.vdls;
+  shade.normalOffset = RenderParams().normalOffset;
+  FirstHitParams params;
+  params.width = opt.width;
+  params.height = opt.height;
+  params.samplesPerPixel = 4;
+  RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {
+    return octreeIrradiance(octree, hit.position, hit.normal, shade);
+  });
+  writeImage(opt.output, image, opt.exposure);
+  if (!opt.quiet) std::printf("wrote %s\n", opt.output.c_str());
+  return 0;
 }
 
 int runRender(const RenderOptions& opt) {
@@ -88,12 +81,10 @@ int runRender(const RenderOptions& opt) {
   if (ext != ".png" && ext != ".exr") {
     throw InputError("--output: '" + opt.output + "' must end in .png or .exr");
   }
-  if (!opt.eye.empty() != !opt.target.empty()) {
-    throw InputError("--eye and --target must be given together");
-  }
-  if (!opt.eye.empty()) {
-    parseVec3(opt.eye, "--eye");
-    parseVec3(opt.target, "--target");
+  checkCameraOptions(opt.camera);
+  if (opt.mode == "irradiance") {
+    Scene scene = loadScene(opt.scene);
+    return renderIrradiance(opt, scene, readVdlGrid(opt.lights));
   }
   RenderParams params;
   params.width = opt.width;
@@ -105,7 +96,7 @@ int runRender(const RenderOptions& opt) {
 
   Scene scene = loadScene(opt.scene);
   LoadedVdl baked = readVdlGrid(opt.lights);
-  RenderCamera camera = chooseCamera(opt, scene);
+  RenderCamera camera = chooseCamera<RenderCamera>(opt.camera, scene, opt.scene);
 
   GlContextParams contextParams;
   contextParams.backend = parseGlBackend(opt.backend);
@@ -154,12 +145,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   cmd->add_option("-o,--output", opt->output,
                   "Image: .exr (linear float radiance) or .png (exposure, sRGB)")
       ->required();
-  auto* camera = cmd->add_option("--camera", opt->camera, "Scene camera by name (default: first)");
-  auto* eye = cmd->add_option("--eye", opt->eye, "Camera position x,y,z (with --target)");
-  cmd->add_option("--target", opt->target, "Point the camera looks at, x,y,z (with --eye)");
-  camera->excludes(eye);
-  cmd->add_option("--fov", opt->fovDegrees, "Vertical field of view in degrees (default 45)")
-      ->check(CLI::Range(1.0f, 179.0f));
+  addCameraOptions(cmd, opt->camera);
   cmd->add_option("--width", opt->width, "Image width in pixels")
       ->check(CLI::Range(1, 16384))
       ->capture_default_str();
@@ -167,8 +153,10 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->check(CLI::Range(1, 16384))
       ->capture_default_str();
   cmd->add_option("--mode", opt->mode,
-                  "full | direct (emission + lights) | indirect (octree only) | voxels")
-      ->check(CLI::IsMember({"full", "direct", "indirect", "voxels"}))
+                  "full | direct (emission + lights) | indirect (octree only) | voxels | "
+                  "irradiance (the octree's indirect irradiance at the first hit, W/m^2, "
+                  "on the CPU: compares with `reference --part irradiance`)")
+      ->check(CLI::IsMember({"full", "direct", "indirect", "voxels", "irradiance"}))
       ->capture_default_str();
   cmd->add_option("--interpolation", opt->interpolation,
                   "Trilinear interpolation between the 8 neighbouring voxels")

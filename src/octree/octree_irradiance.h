@@ -1,0 +1,29 @@
+#pragma once
+/// @file octree/octree_irradiance.h
+/// @brief The light octree's indirect irradiance at a surface point, in C++:
+///   E(p, n) = sum_i c_i max(0, n . d_i)          (W/m^2)
+/// over the VDLs (c_i, d_i) of the voxel under p, i.e. the fragment shader's
+/// indirect() (shaders/render_scene.frag) with the BRDF times cosine replaced
+/// by the cosine alone: the same normal offset, the same trilinear
+/// interpolation over the 8 surrounding voxels with empty ones left out and
+/// the weights renormalized, the same fallback to the voxel behind. For a
+/// Lambertian surface of albedo a, the shader's radiance is a / pi * E.
+/// This is the quantity the reference's ReferencePart::Irradiance estimates.
+
+#include "core/math.h"
+#include "octree/gpu_octree.h"
+
+namespace lo {
+
+struct OctreeShadeParams {
+  bool interpolation = true;   ///< trilinear over the 8 neighbouring voxels (paper §4.2.1)
+  int maxVdls = kMaxVdls;      ///< VDLs used per voxel, the strongest first
+  float normalOffset = 0.01f;  ///< voxel sizes along n (RenderParams::normalOffset)
+};
+
+/// E(p, n) as above. `position` in world space, `normal` unit. Zero where no
+/// voxel is found (empty space, outside the cube).
+Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3& normal,
+                      const OctreeShadeParams& params = {});
+
+}  // namespace lo

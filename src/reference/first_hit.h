@@ -1,0 +1,44 @@
+#pragma once
+/// @file reference/first_hit.h
+/// @brief Images of a quantity evaluated at the first surface each camera ray
+/// hits (vertex 1 of renderReference), with the reference camera and pixel
+/// sampling. Used to evaluate the light octree's irradiance at exactly the
+/// points where the reference's ReferencePart::Irradiance is estimated, so
+/// that the two are compared on the same quantity (docs/accuracy.md).
+
+#include <cstdint>
+#include <functional>
+
+#include "core/math.h"
+#include "core/progress.h"
+#include "image/image.h"
+#include "reference/path_tracer.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+/// The first surface a camera ray hits.
+struct FirstHit {
+  Vec3 position;          ///< world space
+  Vec3 normal;            ///< unit geometric normal turned to the camera's side (as the reference)
+  uint32_t triangle = 0;  ///< index into the Scene's triangles
+};
+
+struct FirstHitParams {
+  int width = 256, height = 256;  ///< pixels
+  /// Jittered camera rays per pixel (the reference's pixel footprint);
+  /// the value is their mean, misses counting 0.
+  int samplesPerPixel = 4;
+  uint64_t seed = 1;
+};
+
+/// For every pixel, the mean of shade(hit) over samplesPerPixel jittered
+/// camera rays. Parallel (TBB) and deterministic: pixel i draws its jitter
+/// from Rng(seed, i). `shade` is called from several threads at once.
+/// @throws InputError for bad sizes, sample counts or field of view.
+RgbImage renderFirstHits(const Scene& scene, const ReferenceCamera& camera,
+                         const FirstHitParams& params,
+                         const std::function<Vec3(const FirstHit&)>& shade,
+                         ProgressSink* progress = nullptr);
+
+}  // namespace lo

@@ -1,0 +1,189 @@
+// The octree's irradiance (octree/octree_irradiance.h) against analytic
+// answers: a block of voxels with one constant VDL gives c * max(0, n.d)
+// everywhere on it, through the lookup, the interpolation (empty neighbours
+// left out) and the half-float texels; and, through reference/first_hit.h, the
+// same value at every pixel of a camera looking at a lit plane.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "octree/gpu_octree.h"
+#include "octree/octree_irradiance.h"
+#include "reference/first_hit.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+constexpr float kVoxel = 0.25f;
+
+/// A slab of voxels [0, res) x [0, res) x {z0..z1} of a depth-`depth` grid at
+/// the origin, every voxel with the same VDLs.
+VdlGrid constantGrid(int depth, int z0, int z1, const std::vector<Vdl>& vdls) {
+  VdlGrid g;
+  g.frame.origin = {0, 0, 0};
+  g.frame.voxelSize = kVoxel;
+  g.frame.depth = depth;
+  g.maxVdls = kMaxVdls;
+  const int res = 1 << depth;
+  for (int z = z0; z <= z1; ++z)
+    for (int y = 0; y < res; ++y)
+      for (int x = 0; x < res; ++x) {
+        g.coords.push_back({x, y, z});
+        g.normals.push_back({0, 0, 1});
+        g.vdlCount.push_back(uint8_t(vdls.size()));
+        for (int i = 0; i < kMaxVdls; ++i) g.vdls.push_back(i < int(vdls.size()) ? vdls[i] : Vdl{});
+      }
+  return g;
+}
+
+Vdl vdl(const Vec3& irradiance, const Vec3& direction) {
+  Vdl v;
+  v.irradiance = irradiance;
+  v.direction = normalize(direction);
+  return v;
+}
+
+/// The decoded direction (8+8-bit packing) of the octree's first VDL, so that
+/// the expected value uses what the shader sees.
+Vec3 decodedDirection(const GpuOctree& o, int k) {
+  OctreeSample s = lookupOctree(o, Vec3{1.5f, 1.5f, 0.5f} * kVoxel);
+  EXPECT_TRUE(s.found);
+  return s.vdls[k].direction;
+}
+
+TEST(OctreeIrradiance, ConstantVdlGivesTheCosineLawEverywhereOnTheSlab) {
+  const Vec3 c{2.0f, 1.0f, 0.5f};
+  const Vec3 d = normalize(Vec3{0.3f, -0.2f, 1.0f});
+  const GpuOctree o = buildGpuOctree(constantGrid(3, 0, 1, {vdl(c, d)}));
+  const Vec3 dq = decodedDirection(o, 0);
+  EXPECT_NEAR(dot(dq, d), 1.0f, 1e-3f);
+  const Vec3 normals[] = {{0, 0, 1}, normalize(Vec3{1, 0, 1}), normalize(Vec3{0.2f, 0.9f, 0.1f})};
+  for (bool interpolation : {true, false}) {
+    OctreeShadeParams p;
+    p.interpolation = interpolation;
+    // Points inside the slab (z < 2 voxels), including its edges and corners
+    // where most interpolation neighbours are empty.
+    for (const Vec3& q : {Vec3{1.3f, 4.7f, 1.0f}, Vec3{0.01f, 0.01f, 0.2f}, Vec3{7.99f, 3.5f, 1.9f},
+                          Vec3{4.0f, 4.0f, 1.0f}}) {
+      for (const Vec3& n : normals) {
+        const Vec3 e = octreeIrradiance(o, q * kVoxel, n, p);
+        const Vec3 expected = c * std::max(0.0f, dot(n, dq));
+        for (int ch = 0; ch < 3; ++ch)
+          EXPECT_NEAR(e[ch], expected[ch], 1e-5f * (1 + expected[ch]))
+              << "interpolation " << interpolation << " at " << q.ToString() << " n "
+              << n.ToString();
+      }
+    }
+    // A normal facing away from the VDL receives nothing.
+    EXPECT_EQ(octreeIrradiance(o, Vec3{2, 2, 1} * kVoxel, -d, p), Vec3(0, 0, 0));
+    // Empty space and outside the cube: nothing.
+    EXPECT_EQ(octreeIrradiance(o, Vec3{2, 2, 5} * kVoxel, {0, 0, 1}, p), Vec3(0, 0, 0));
+    EXPECT_EQ(octreeIrradiance(o, Vec3{-3, 2, 1} * kVoxel, {0, 0, 1}, p), Vec3(0, 0, 0));
+  }
+}
+
+TEST(OctreeIrradiance, InterpolationBlendsNeighboursTrilinearly) {
+  // Two slabs of different irradiance, z = 0 and z = 1: between their centres
+  // (z = 0.5 .. 1.5 voxels) the value is linear in z.
+  VdlGrid g = constantGrid(3, 0, 1, {vdl({1, 1, 1}, {0, 0, 1})});
+  for (size_t v = 0; v < g.size(); ++v)
+    if (g.coords[v].z == 1) g.vdls[v * kMaxVdls].irradiance = {3, 3, 3};
+  const GpuOctree o = buildGpuOctree(g);
+  OctreeShadeParams p;
+  p.normalOffset = 0;
+  for (float z : {0.5f, 0.75f, 1.0f, 1.25f, 1.5f}) {
+    const float expected = 1.0f + 2.0f * (z - 0.5f);
+    EXPECT_NEAR(octreeIrradiance(o, Vec3{3.5f, 3.5f, z} * kVoxel, {0, 0, 1}, p).x, expected, 1e-4f)
+        << z;
+  }
+  p.interpolation = false;
+  EXPECT_NEAR(octreeIrradiance(o, Vec3{3.5f, 3.5f, 0.75f} * kVoxel, {0, 0, 1}, p).x, 1.0f, 1e-6f);
+  EXPECT_NEAR(octreeIrradiance(o, Vec3{3.5f, 3.5f, 1.25f} * kVoxel, {0, 0, 1}, p).x, 3.0f, 1e-6f);
+}
+
+TEST(OctreeIrradiance, MaxVdlsAndHalfFloatTexels) {
+  const GpuOctree full =
+      buildGpuOctree(constantGrid(3, 0, 0, {vdl({4, 4, 4}, {0, 0, 1}), vdl({1, 2, 3}, {1, 0, 1})}));
+  GpuOctreeParams hp;
+  hp.halfFloat = true;
+  const GpuOctree half = buildGpuOctree(
+      constantGrid(3, 0, 0, {vdl({4, 4, 4}, {0, 0, 1}), vdl({1, 2, 3}, {1, 0, 1})}), hp);
+  const Vec3 p = Vec3{2.5f, 2.5f, 0.5f} * kVoxel, n{0, 0, 1};
+  const float c1 = std::max(0.0f, decodedDirection(full, 1).z);
+  OctreeShadeParams one;
+  one.maxVdls = 1;
+  EXPECT_NEAR(octreeIrradiance(full, p, n, one).y, 4.0f * decodedDirection(full, 0).z, 1e-5f);
+  const Vec3 both = octreeIrradiance(full, p, n);
+  EXPECT_NEAR(both.z, 4.0f * decodedDirection(full, 0).z + 3.0f * c1, 1e-5f);
+  // Half floats: 11 significant bits.
+  const Vec3 h = octreeIrradiance(half, p, n);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(h[ch], both[ch], 1e-3f * both[ch]);
+}
+
+TEST(OctreeIrradiance, FirstHitImageOfALitPlaneIsTheAnalyticValueAtEveryPixel) {
+  // A plane z = 0.3 (inside the first voxel layer) seen from above; every
+  // voxel holds one VDL of irradiance c from 60 degrees off the normal.
+  Scene scene;
+  Material m;
+  scene.materials.push_back(m);
+  test::addQuad(scene, {0, 0, 0.3f * kVoxel}, {8 * kVoxel, 0, 0}, {0, 8 * kVoxel, 0}, {0, 0, 1}, 0);
+  const Vec3 c{0.8f, 0.5f, 0.2f};
+  const Vec3 d{std::sin(kPi / 3), 0, std::cos(kPi / 3)};
+  const GpuOctree o = buildGpuOctree(constantGrid(3, 0, 0, {vdl(c, d)}));
+  const Vec3 expected = c * dot(Vec3{0, 0, 1}, decodedDirection(o, 0));
+  EXPECT_NEAR(expected.x, 0.4f, 0.01f);
+  // Camera above the middle of the plane, looking down at part of it.
+  const ReferenceCamera camera =
+      ReferenceCamera::lookAt(Vec3{1, 1, 3}, Vec3{1, 1, 0}, 20.0f * kPi / 180.0f);
+  FirstHitParams params;
+  params.width = 24;
+  params.height = 16;
+  params.samplesPerPixel = 2;
+  const RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& h) {
+    EXPECT_NEAR(h.position.z, 0.3f * kVoxel, 1e-5f);
+    EXPECT_GT(h.normal.z, 0.999f);  // turned to the camera's side
+    return octreeIrradiance(o, h.position, h.normal);
+  });
+  for (size_t i = 0; i < image.pixelCount(); ++i)
+    for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(image.at(i)[ch], expected[ch], 1e-5f) << i;
+
+  // The same plane turned over (normal -z): the camera still sees the side
+  // facing it, and the VDL from above lights it.
+  Scene flipped;
+  flipped.materials.push_back(m);
+  test::addQuad(flipped, {0, 0, 0.3f * kVoxel}, {0, 8 * kVoxel, 0}, {8 * kVoxel, 0, 0}, {0, 0, -1},
+                0);
+  const RgbImage image2 = renderFirstHits(flipped, camera, params, [&](const FirstHit& h) {
+    return octreeIrradiance(o, h.position, h.normal);
+  });
+  EXPECT_NEAR(image2.at(5).x, expected.x, 1e-5f);
+}
+
+TEST(FirstHit, MissesCountZeroAndBadParamsAreRefused) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  // A quad covering the left half of the view only.
+  test::addQuad(scene, {-10, -10, 0}, {10, 0, 0}, {0, 20, 0}, {0, 0, 1}, 0);
+  const ReferenceCamera camera = ReferenceCamera::lookAt({0, 0, 5}, {0, 0, 0}, 0.5f);
+  FirstHitParams params;
+  params.width = 8;
+  params.height = 4;
+  params.samplesPerPixel = 1;
+  const RgbImage image = renderFirstHits(scene, camera, params, [](const FirstHit&) {
+    return Vec3{1, 1, 1};
+  });
+  for (int y = 0; y < 4; ++y) {
+    EXPECT_EQ(image.at(size_t(y) * 8 + 0).x, 1.0f);
+    EXPECT_EQ(image.at(size_t(y) * 8 + 7).x, 0.0f);
+  }
+  params.samplesPerPixel = 0;
+  EXPECT_THROW(renderFirstHits(scene, camera, params, [](const FirstHit&) { return Vec3{}; }),
+               InputError);
+}
+
+}  // namespace
+}  // namespace lo

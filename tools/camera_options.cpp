@@ -1,0 +1,52 @@
+#include "camera_options.h"
+
+#include <CLI/CLI.hpp>
+#include <sstream>
+
+namespace lo::tool {
+
+void addCameraOptions(CLI::App* cmd, CameraOptions& opt) {
+  auto* camera = cmd->add_option("--camera", opt.camera, "Scene camera by name (default: first)");
+  auto* eye = cmd->add_option("--eye", opt.eye, "Camera position x,y,z (with --target)");
+  cmd->add_option("--target", opt.target, "Point the camera looks at, x,y,z (with --eye)");
+  camera->excludes(eye);
+  cmd->add_option("--fov", opt.fovDegrees, "Vertical field of view in degrees (default 45)")
+      ->check(CLI::Range(1.0f, 179.0f));
+}
+
+Vec3 parseVec3(const std::string& text, const char* flag) {
+  Vec3 v;
+  char c1 = 0, c2 = 0;
+  std::istringstream is(text);
+  if (!(is >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !is.eof() ||
+      !isFinite(v)) {
+    throw InputError(std::string(flag) + ": expected three numbers x,y,z, got '" + text + "'");
+  }
+  return v;
+}
+
+void checkCameraOptions(const CameraOptions& opt) {
+  if (!opt.eye.empty() != !opt.target.empty()) {
+    throw InputError("--eye and --target must be given together");
+  }
+  if (!opt.eye.empty()) {
+    parseVec3(opt.eye, "--eye");
+    parseVec3(opt.target, "--target");
+  }
+}
+
+const Camera* findSceneCamera(const CameraOptions& opt, const Scene& scene,
+                              const std::string& scenePath) {
+  for (const Camera& c : scene.cameras) {
+    if (opt.camera.empty() || c.name == opt.camera) return &c;
+  }
+  if (!opt.camera.empty()) {
+    std::string names;
+    for (const Camera& c : scene.cameras) names += (names.empty() ? "" : ", ") + c.name;
+    throw InputError("--camera: no camera named '" + opt.camera + "' in " + scenePath +
+                     (names.empty() ? " (it has none)" : " (it has: " + names + ")"));
+  }
+  return nullptr;
+}
+
+}  // namespace lo::tool

@@ -1,0 +1,124 @@
+// `lightoctree compare`: error of a test image against a reference image.
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "core/error.h"
+#include "image/compare.h"
+#include "image/image.h"
+#include "text_file.h"
+
+namespace lo::tool {
+namespace {
+
+struct CompareOptions {
+  std::string test;
+  std::string reference;
+  std::string mask;
+  bool ignoreBackground = false;
+  std::string diff;
+  float diffScale = 0;
+  std::string json;
+  bool quiet = false;
+};
+
+nlohmann::json toJson(const ChannelError& e) {
+  return {{"rel_rmse", e.relRmse}, {"rel_mae", e.relMae}, {"max_abs", e.maxAbs}};
+}
+
+int runCompare(const CompareOptions& opt) {
+  if (!opt.diff.empty()) {
+    checkOutputFolder(opt.diff, "--diff");
+    std::string ext = std::filesystem::path(opt.diff).extension().string();
+    if (ext != ".png" && ext != ".exr") {
+      throw InputError("--diff: '" + opt.diff + "' must end in .png or .exr");
+    }
+  }
+  if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
+  RgbImage test = readImage(opt.test);
+  RgbImage reference = readImage(opt.reference);
+  RgbImage mask;
+  CompareParams params;
+  params.ignoreBackground = opt.ignoreBackground;
+  if (!opt.mask.empty()) {
+    // 8-bit masks are read as plain numbers: any non-zero value selects.
+    mask = readImage(opt.mask, /*linear8Bit=*/true);
+    params.mask = &mask;
+  }
+  if (test.width != reference.width || test.height != reference.height) {
+    throw InputError(opt.test + " is " + std::to_string(test.width) + " x " +
+                     std::to_string(test.height) + " but " + opt.reference + " is " +
+                     std::to_string(reference.width) + " x " + std::to_string(reference.height));
+  }
+  if (params.mask && (mask.width != reference.width || mask.height != reference.height)) {
+    throw InputError("--mask: " + opt.mask + " is " + std::to_string(mask.width) + " x " +
+                     std::to_string(mask.height) + ", the images are " +
+                     std::to_string(reference.width) + " x " + std::to_string(reference.height));
+  }
+  CompareResult result = compareImages(test, reference, params);
+  if (!opt.quiet) {
+    std::printf("%s against %s\n%s\n", opt.test.c_str(), opt.reference.c_str(),
+                result.ToString().c_str());
+  }
+  if (!opt.diff.empty()) {
+    // Linear float values in an EXR; PNG keeps the false colour as it is.
+    writeImage(opt.diff, differenceImage(test, reference, params, opt.diffScale));
+    if (!opt.quiet) std::printf("wrote %s\n", opt.diff.c_str());
+  }
+  if (!opt.json.empty()) {
+    nlohmann::json j;
+    j["test"] = opt.test;
+    j["reference"] = opt.reference;
+    j["width"] = reference.width;
+    j["height"] = reference.height;
+    j["channels"] = {{"R", toJson(result.channel[0])},
+                     {"G", toJson(result.channel[1])},
+                     {"B", toJson(result.channel[2])},
+                     {"Y", toJson(result.luminance)}};
+    j["compared_pixels"] = result.comparedPixels;
+    j["ignored_pixels"] = result.ignoredPixels;
+    j["non_finite_pixels"] = result.nonFinitePixels;
+    j["max_error_pixel"] = {result.maxErrorX, result.maxErrorY};
+    j["mean_reference_luminance"] = result.meanReferenceLuminance;
+    writeTextAtomically(opt.json, j.dump(2) + "\n");
+    if (!opt.quiet) std::printf("wrote %s\n", opt.json.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> addCompareCommand(CLI::App& app) {
+  auto opt = std::make_shared<CompareOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "compare",
+      "Relative RMSE, relative mean absolute error and maximum error of a test image against "
+      "a reference (per channel and luminance), a false-colour difference image, JSON.");
+  cmd->add_option("test", opt->test, "Test image (.exr, or .png decoded to linear)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("reference", opt->reference, "Reference image, e.g. from `lightoctree reference`")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--mask", opt->mask,
+                  "Image of the same size; pixels that are 0 in every channel are left out")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--ignore-background", opt->ignoreBackground,
+                "Leave out pixels where the reference is exactly black");
+  cmd->add_option("--diff", opt->diff,
+                  "Write |Y(test) - Y(reference)| in false colour (.png or .exr): black 0, blue, "
+                  "green, yellow, red at --diff-scale; ignored pixels grey");
+  cmd->add_option("--diff-scale", opt->diffScale,
+                  "Error shown red in --diff, in the images' units (default: a quarter of the "
+                  "mean reference luminance)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--json", opt->json, "Write the figures as JSON for scripts");
+  cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing (use with --json)");
+  return [cmd, opt]() -> int { return cmd->parsed() ? runCompare(*opt) : -1; };
+}
+
+}  // namespace lo::tool

@@ -1,0 +1,144 @@
+// `lightoctree reference`: scene -> unbiased path-traced image (the ground truth).
+
+#include <tbb/global_control.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "camera_options.h"
+#include "commands.h"
+#include "core/error.h"
+#include "image/image.h"
+#include "reference/path_tracer.h"
+#include "report.h"
+#include "scene/scene.h"
+
+namespace lo::tool {
+namespace {
+
+struct ReferenceOptions {
+  std::string scene;
+  std::string output;
+  std::string stdErrorOutput;
+  CameraOptions camera;
+  int width = 800, height = 600;  // as `render`, so that the images compare pixel for pixel
+  int spp = 64;
+  double timeBudget = 0;
+  std::string part = "full";
+  uint64_t seed = 1;
+  int threads = 0;
+  int maxBounces = 256;
+  bool quiet = false;
+};
+
+void checkImageOutput(const std::string& path, const char* flag) {
+  std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw InputError(std::string(flag) + ": folder '" + parent.string() + "' does not exist");
+  }
+  std::string ext = std::filesystem::path(path).extension().string();
+  if (ext != ".exr" && ext != ".png") {
+    throw InputError(std::string(flag) + ": '" + path + "' must end in .exr or .png");
+  }
+}
+
+int runReference(const ReferenceOptions& opt) {
+  checkImageOutput(opt.output, "--output");
+  if (!opt.stdErrorOutput.empty()) checkImageOutput(opt.stdErrorOutput, "--std-error");
+  checkCameraOptions(opt.camera);
+  std::unique_ptr<tbb::global_control> threadLimit;
+  if (opt.threads > 0) {
+    threadLimit = std::make_unique<tbb::global_control>(
+        tbb::global_control::max_allowed_parallelism, size_t(opt.threads));
+  }
+
+  Scene scene = loadScene(opt.scene);
+  ReferenceCamera camera = chooseCamera<ReferenceCamera>(opt.camera, scene, opt.scene);
+  ReferenceParams params;
+  params.width = opt.width;
+  params.height = opt.height;
+  params.part = parseReferencePart(opt.part);
+  params.samplesPerPixel = opt.spp;
+  params.timeBudgetSeconds = opt.timeBudget;
+  params.maxBounces = opt.maxBounces;
+  params.seed = opt.seed;
+
+  ConsoleProgress progress(opt.quiet);
+  ReferenceImage result = renderReference(scene, camera, params, &progress);
+  writeImage(opt.output, result.image);
+  if (!opt.stdErrorOutput.empty()) writeImage(opt.stdErrorOutput, result.stdError);
+
+  if (!opt.quiet) {
+    // The mean standard error relative to the mean value: how far the
+    // reference itself is from converged, to weigh errors measured against it.
+    double sum = 0, se2 = 0;
+    for (size_t i = 0; i < result.image.rgb.size(); ++i) {
+      sum += result.image.rgb[i];
+      se2 += double(result.stdError.rgb[i]) * result.stdError.rgb[i];
+    }
+    const double n = double(result.image.rgb.size());
+    const double mean = sum / n, rmsSe = std::sqrt(se2 / n);
+    std::printf(
+        "%s %s: %d x %d, %d spp, %.2f s, %s rays, mean %.5g, RMS std. error %.5g (%.2f%%)\n",
+        toString(params.part).c_str(), opt.scene.c_str(), opt.width, opt.height,
+        result.samplesPerPixel, result.seconds, formatCount(result.raysTraced).c_str(), mean, rmsSe,
+        mean > 0 ? 100.0 * rmsSe / mean : 0.0);
+    std::printf("wrote %s%s%s\n", opt.output.c_str(), opt.stdErrorOutput.empty() ? "" : " and ",
+                opt.stdErrorOutput.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> addReferenceCommand(CLI::App& app) {
+  auto opt = std::make_shared<ReferenceOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "reference",
+      "Path-trace the ground truth (unbiased, Embree) with the camera conventions of `render`: "
+      "direct, indirect or full radiance, or the indirect irradiance at the first hit.");
+  cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", opt->output,
+                  "Image: .exr (linear float) or .png (sRGB, for a quick look)")
+      ->required();
+  addCameraOptions(cmd, opt->camera);
+  cmd->add_option("--width", opt->width, "Image width in pixels")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--height", opt->height, "Image height in pixels")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  auto* spp = cmd->add_option("--spp", opt->spp, "Samples per pixel")
+                  ->check(CLI::Range(1, 1000000))
+                  ->capture_default_str();
+  cmd->add_option("--time-budget", opt->timeBudget,
+                  "Render passes of 1 sample per pixel until this many seconds have passed "
+                  "(instead of --spp)")
+      ->check(CLI::Range(1e-3, 1e7))
+      ->excludes(spp);
+  cmd->add_option("--part", opt->part,
+                  "full | direct | indirect (what `render --mode indirect` approximates) | "
+                  "irradiance (indirect irradiance at the first hit, W/m^2)")
+      ->check(CLI::IsMember({"full", "direct", "indirect", "irradiance"}))
+      ->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Random seed (same seed and --spp, same bytes)")
+      ->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  cmd->add_option("--max-bounces", opt->maxBounces,
+                  "Cap on scattering events after the first hit (Russian roulette ends "
+                  "paths long before)")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  cmd->add_option("--std-error", opt->stdErrorOutput,
+                  "Also write the per-pixel standard error of the mean (.exr or .png)");
+  cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
+  return [cmd, opt]() -> int { return cmd->parsed() ? runReference(*opt) : -1; };
+}
+
+}  // namespace lo::tool

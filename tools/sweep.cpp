@@ -1,0 +1,695 @@
+#include "sweep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/resources.h"
+#include "grid/surface_grid.h"
+#include "image/compare.h"
+#include "image/image.h"
+#include "octree/gpu_octree.h"
+#include "octree/octree_irradiance.h"
+#include "reference/first_hit.h"
+#include "reference/path_tracer.h"
+#include "report.h"
+#include "scene/scene.h"
+#include "text_file.h"
+#include "vdb/vdb_io.h"
+
+namespace fs = std::filesystem;
+
+namespace lo::tool {
+namespace sweep_internal {
+
+std::string photonsText(size_t n) {
+  if (n >= 1000000 && n % 100000 == 0) {
+    std::ostringstream os;
+    os << double(n) / 1e6 << "M";
+    return os.str();
+  }
+  if (n >= 1000 && n % 1000 == 0) return std::to_string(n / 1000) + "k";
+  return std::to_string(n);
+}
+
+std::string numberText(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+/// Single quotes for /bin/sh; a quote inside becomes '\''.
+std::string shellQuote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+/// Runs `command` with stdout and stderr in `logFile`. @throws IoError with the
+/// command and the log's last lines on a non-zero exit.
+void runChild(const std::string& command, const std::string& logFile) {
+  const std::string full = command + " > " + shellQuote(logFile) + " 2>&1";
+  const int rc = std::system(full.c_str());
+  if (rc != 0) {
+    std::ifstream f(logFile);
+    std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    if (text.size() > 2000) text = "..." + text.substr(text.size() - 2000);
+    throw IoError("sweep: command failed (status " + std::to_string(rc) + "): " + command + "\n" +
+                  text);
+  }
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw IoError(path + ": cannot open");
+  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+/// Luminance standard error relative to the reference's RMS luminance: the
+/// noise floor of any relative RMSE measured against it. Channels of one
+/// path are correlated, so the luminance error is bounded by the weighted sum.
+double relativeNoise(const ReferenceImage& ref) {
+  double se2 = 0, y2 = 0;
+  for (size_t i = 0; i < ref.image.pixelCount(); ++i) {
+    const Vec3 v = ref.image.at(i), s = ref.stdError.at(i);
+    const double y = 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
+    const double se = 0.2126 * s.x + 0.7152 * s.y + 0.0722 * s.z;
+    if (v.x == 0 && v.y == 0 && v.z == 0) continue;  // background, left out as in compare
+    se2 += se * se;
+    y2 += y * y;
+  }
+  return y2 > 0 ? std::sqrt(se2 / y2) : 0.0;
+}
+
+struct References {
+  RgbImage irradiance, indirect;
+  double irradianceNoise = 0, indirectNoise = 0;
+  double seconds = 0;
+};
+
+/// Path-traced references, cached in cacheDir with the settings they were
+/// rendered with; re-rendered when those differ.
+References loadOrRenderReferences(const SweepParams& params, const Scene& scene,
+                                  const ReferenceCamera& camera, const std::string& cacheDir,
+                                  std::FILE* log) {
+  nlohmann::json key = {{"scene", fs::path(params.scene).filename().string()},
+                        {"width", params.width},
+                        {"height", params.height},
+                        {"spp", params.referenceSpp},
+                        {"seed", params.seed},
+                        {"indirect", params.frames > 0}};
+  const std::string keyFile = cacheDir + "/reference.json";
+  const std::string irrFile = cacheDir + "/reference-irradiance.exr";
+  const std::string indFile = cacheDir + "/reference-indirect.exr";
+  References refs;
+  if (fs::exists(keyFile) && fs::exists(irrFile) && (params.frames == 0 || fs::exists(indFile))) {
+    nlohmann::json cached = nlohmann::json::parse(readText(keyFile));
+    if (cached["key"] == key) {
+      refs.irradiance = readImage(irrFile);
+      if (params.frames > 0) refs.indirect = readImage(indFile);
+      refs.irradianceNoise = cached.value("irradiance_noise", 0.0);
+      refs.indirectNoise = cached.value("indirect_noise", 0.0);
+      refs.seconds = cached.value("seconds", 0.0);
+      if (log) std::fprintf(log, "reference: cached in %s\n", cacheDir.c_str());
+      return refs;
+    }
+  }
+  ReferenceParams rp;
+  rp.width = params.width;
+  rp.height = params.height;
+  rp.samplesPerPixel = params.referenceSpp;
+  rp.seed = params.seed;
+  ConsoleProgress progress(params.quiet);
+  rp.part = ReferencePart::Irradiance;
+  ReferenceImage irr = renderReference(scene, camera, rp, &progress);
+  refs.irradiance = irr.image;
+  refs.irradianceNoise = relativeNoise(irr);
+  refs.seconds = irr.seconds;
+  writeExr(irrFile, irr.image);
+  if (params.frames > 0) {
+    rp.part = ReferencePart::Indirect;
+    ReferenceImage ind = renderReference(scene, camera, rp, &progress);
+    refs.indirect = ind.image;
+    refs.indirectNoise = relativeNoise(ind);
+    refs.seconds += ind.seconds;
+    writeExr(indFile, ind.image);
+  }
+  nlohmann::json j = {{"key", key},
+                      {"irradiance_noise", refs.irradianceNoise},
+                      {"indirect_noise", refs.indirectNoise},
+                      {"seconds", refs.seconds}};
+  writeTextAtomically(keyFile, j.dump(2) + "\n");
+  if (log) {
+    std::fprintf(log,
+                 "reference: %d x %d, %d spp, %.1f s; noise (rel. RMS std. error) "
+                 "irradiance %.2f%%, indirect %.2f%%\n",
+                 params.width, params.height, params.referenceSpp, refs.seconds,
+                 100 * refs.irradianceNoise, 100 * refs.indirectNoise);
+  }
+  return refs;
+}
+
+nlohmann::json pointJson(const SweepPoint& p) {
+  return {{"group", p.group},
+          {"depth", p.depth},
+          {"photons", p.photons},
+          {"knn", p.knn},
+          {"radius_voxels", p.radiusVoxels},
+          {"vdls", p.vdls},
+          {"interpolation", p.interpolation},
+          {"half_float", p.halfFloat}};
+}
+
+nlohmann::json resultJson(const SweepResult& r) {
+  return {{"point", pointJson(r.point)},
+          {"trace_s", r.traceSeconds},
+          {"voxelize_s", r.voxelizeSeconds},
+          {"splat_s", r.splatSeconds},
+          {"cluster_s", r.clusterSeconds},
+          {"bake_s", r.bakeSeconds},
+          {"peak_rss_bytes", r.peakRssBytes},
+          {"vdb_bytes", r.vdbBytes},
+          {"gpu_bytes", r.gpuBytes},
+          {"active_voxels", r.activeVoxels},
+          {"dense_voxels", r.denseVoxels},
+          {"vdl_texels", r.vdlTexels},
+          {"frame_ms", r.frameMs},
+          {"irradiance_rel_rmse", r.irradianceRelRmse},
+          {"irradiance_rel_mae", r.irradianceRelMae},
+          {"indirect_rel_rmse", r.indirectRelRmse}};
+}
+
+SweepResult resultFromJson(const nlohmann::json& j, const SweepPoint& point) {
+  SweepResult r;
+  r.point = point;
+  r.traceSeconds = j.at("trace_s");
+  r.voxelizeSeconds = j.at("voxelize_s");
+  r.splatSeconds = j.at("splat_s");
+  r.clusterSeconds = j.at("cluster_s");
+  r.bakeSeconds = j.at("bake_s");
+  r.peakRssBytes = j.at("peak_rss_bytes");
+  r.vdbBytes = j.at("vdb_bytes");
+  r.gpuBytes = j.at("gpu_bytes");
+  r.activeVoxels = j.at("active_voxels");
+  r.denseVoxels = j.at("dense_voxels");
+  r.vdlTexels = j.at("vdl_texels");
+  r.frameMs = j.at("frame_ms");
+  r.irradianceRelRmse = j.at("irradiance_rel_rmse");
+  r.irradianceRelMae = j.at("irradiance_rel_mae");
+  r.indirectRelRmse = j.at("indirect_rel_rmse");
+  return r;
+}
+
+/// Puts images side by side with a gap of `gap` black pixels.
+RgbImage sideBySide(const std::vector<const RgbImage*>& images, int gap) {
+  int width = 0, height = 0;
+  for (const RgbImage* im : images) {
+    width += im->width + (width > 0 ? gap : 0);
+    height = std::max(height, im->height);
+  }
+  RgbImage out(width, height);
+  int x0 = 0;
+  for (const RgbImage* im : images) {
+    for (int y = 0; y < im->height; ++y)
+      for (int x = 0; x < im->width; ++x)
+        out.set(size_t(y) * size_t(width) + size_t(x0 + x), im->at(size_t(y) * im->width + x));
+    x0 += im->width + gap;
+  }
+  return out;
+}
+
+/// PNG exposure that puts the reference's mean luminance near mid grey.
+float exposureFor(const RgbImage& reference) {
+  double sum = 0;
+  size_t n = 0;
+  for (size_t i = 0; i < reference.pixelCount(); ++i) {
+    const Vec3 v = reference.at(i);
+    const double y = 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
+    if (y > 0) {
+      sum += y;
+      ++n;
+    }
+  }
+  return n && sum > 0 ? float(std::log2(0.3 * double(n) / sum)) : 0.0f;
+}
+
+}  // namespace sweep_internal
+
+std::string SweepPoint::label() const {
+  using namespace sweep_internal;
+  std::string s = "d" + std::to_string(depth) + " " + photonsText(photons) + " k" +
+                  std::to_string(knn) + " r" + numberText(radiusVoxels) + " v" + vdls;
+  if (!interpolation) s += " no-interp";
+  if (halfFloat) s += " half";
+  return s;
+}
+
+std::string SweepPoint::bakeKey() const {
+  using namespace sweep_internal;
+  return "d" + std::to_string(depth) + "-p" + std::to_string(photons) + "-k" + std::to_string(knn) +
+         "-r" + numberText(radiusVoxels) + "-v" + vdls;
+}
+
+std::string SweepPoint::key() const {
+  return bakeKey() + (interpolation ? "-i1" : "-i0") + (halfFloat ? "-h1" : "-h0");
+}
+
+SweepPoint paperPoint() { return SweepPoint{}; }
+
+std::vector<SweepPoint> sweepPoints(SweepScale scale) {
+  std::vector<SweepPoint> points;
+  auto add = [&points](SweepPoint p) {
+    for (const SweepPoint& q : points)
+      if (q.sameSettings(p)) return;
+    points.push_back(p);
+  };
+  auto vary = [&](const char* group, auto setter) {
+    SweepPoint p = paperPoint();
+    p.group = group;
+    setter(p);
+    add(p);
+  };
+  if (scale == SweepScale::Tiny) {
+    SweepPoint p;
+    p.group = "depth";
+    p.photons = 20000;
+    p.knn = 20;
+    p.depth = 3;
+    add(p);
+    p.depth = 4;
+    add(p);
+    p.group = "interpolation";
+    p.interpolation = false;
+    add(p);
+    return points;
+  }
+  add(paperPoint());
+  const bool full = scale == SweepScale::Full;
+  const std::vector<int> depths = full ? std::vector<int>{3, 4, 5, 7, 8} : std::vector<int>{4, 5};
+  const std::vector<size_t> photons =
+      full ? std::vector<size_t>{50000, 150000, 300000, 1200000, 2500000, 5000000}
+           : std::vector<size_t>{150000, 300000};
+  const std::vector<int> knns =
+      full ? std::vector<int>{10, 30, 100, 150, 600, 1000} : std::vector<int>{30, 100};
+  const std::vector<float> radii = full ? std::vector<float>{1.5f, 2, 4, 6} : std::vector<float>{};
+  const std::vector<std::string> vdls = full ? std::vector<std::string>{"1", "2", "8", "auto"}
+                                             : std::vector<std::string>{"1", "auto"};
+  for (int d : depths) vary("depth", [d](SweepPoint& p) { p.depth = d; });
+  for (size_t n : photons) vary("photons", [n](SweepPoint& p) { p.photons = n; });
+  for (int k : knns) vary("knn", [k](SweepPoint& p) { p.knn = k; });
+  for (float r : radii) vary("radius", [r](SweepPoint& p) { p.radiusVoxels = r; });
+  for (const std::string& v : vdls) vary("vdls", [v](SweepPoint& p) { p.vdls = v; });
+  vary("interpolation", [](SweepPoint& p) { p.interpolation = false; });
+  vary("texels", [](SweepPoint& p) { p.halfFloat = true; });
+  // Combined points: cheaper photon maps with a matching k (the photon
+  // density per voxel falls with the count), coarser and finer grids.
+  vary("combined", [](SweepPoint& p) {
+    p.photons = 300000;
+    p.knn = 150;
+  });
+  vary("combined", [](SweepPoint& p) {
+    p.depth = 5;
+    p.photons = 300000;
+    p.knn = 300;
+  });
+  if (full) {
+    vary("combined", [](SweepPoint& p) {
+      p.photons = 150000;
+      p.knn = 100;
+      p.vdls = "2";
+      p.halfFloat = true;
+    });
+    vary("combined", [](SweepPoint& p) {
+      p.depth = 5;
+      p.photons = 1200000;
+      p.knn = 600;
+    });
+    vary("combined", [](SweepPoint& p) {
+      p.depth = 7;
+      p.photons = 2500000;
+      p.knn = 300;
+    });
+  }
+  return points;
+}
+
+std::vector<bool> paretoFront(const std::vector<double>& cost, const std::vector<double>& error) {
+  LO_CHECK_EQ(cost.size(), error.size());
+  std::vector<bool> front(cost.size(), true);
+  for (size_t i = 0; i < cost.size(); ++i) {
+    for (size_t j = 0; j < cost.size() && front[i]; ++j) {
+      const bool noWorse = cost[j] <= cost[i] && error[j] <= error[i];
+      const bool better = cost[j] < cost[i] || error[j] < error[i];
+      if (j != i && noWorse && better) front[i] = false;
+    }
+  }
+  return front;
+}
+
+void markParetoFronts(std::vector<SweepResult>& results) {
+  std::vector<double> time, memory, error;
+  for (const SweepResult& r : results) {
+    time.push_back(r.bakeSeconds);
+    memory.push_back(r.gpuBytes);
+    error.push_back(r.irradianceRelRmse);
+  }
+  std::vector<bool> t = paretoFront(time, error), m = paretoFront(memory, error);
+  for (size_t i = 0; i < results.size(); ++i) {
+    results[i].paretoTime = t[i];
+    results[i].paretoMemory = m[i];
+  }
+}
+
+SweepParams sweepDefaults(SweepScale scale) {
+  SweepParams p;
+  p.scale = scale;
+  switch (scale) {
+    case SweepScale::Full:
+      p.width = 320, p.height = 240, p.referenceSpp = 1024, p.frames = 5;
+      break;
+    case SweepScale::Quick:
+      p.width = 160, p.height = 120, p.referenceSpp = 256, p.frames = 2;
+      break;
+    case SweepScale::Tiny:
+      p.width = 24, p.height = 18, p.referenceSpp = 8, p.frames = 1;
+      break;
+  }
+  return p;
+}
+
+std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
+  using namespace sweep_internal;
+  if (params.executable.empty() || !fs::exists(params.executable))
+    throw InputError("sweep: lightoctree executable '" + params.executable + "' not found");
+  if (!fs::is_directory(params.outDir))
+    throw InputError("--out: folder '" + params.outDir + "' does not exist");
+  const std::string cacheDir = params.outDir + "/cache";
+  fs::create_directories(cacheDir);
+  // Bakes, images and logs stay out of version control; tables and plots are
+  // the results.
+  if (!fs::exists(params.outDir + "/.gitignore"))
+    writeTextAtomically(params.outDir + "/.gitignore", "cache/\n");
+
+  const Scene scene = loadScene(params.scene);
+  const ReferenceCamera camera = scene.cameras.empty()
+                                     ? ReferenceCamera::framing(scene.bounds(), kPi / 4)
+                                     : ReferenceCamera::fromScene(scene.cameras.front());
+  const References refs = loadOrRenderReferences(params, scene, camera, cacheDir, log);
+  CompareParams compareParams;
+  compareParams.ignoreBackground = true;
+
+  const std::vector<SweepPoint> points =
+      params.points.empty() ? sweepPoints(params.scale) : params.points;
+  const nlohmann::json context = {{"scene", fs::path(params.scene).filename().string()},
+                                  {"width", params.width},
+                                  {"height", params.height},
+                                  {"spp", params.referenceSpp},
+                                  {"frames", params.frames},
+                                  {"threads", params.threads},
+                                  {"seed", params.seed}};
+  const std::string exe = shellQuote(params.executable);
+  std::vector<SweepResult> results;
+  for (size_t pi = 0; pi < points.size(); ++pi) {
+    const SweepPoint& point = points[pi];
+    const std::string base = cacheDir + "/" + point.key();
+    const std::string resultFile = base + ".json";
+    if (fs::exists(resultFile)) {
+      nlohmann::json cached = nlohmann::json::parse(readText(resultFile));
+      if (cached["context"] == context) {
+        SweepResult r = resultFromJson(cached["result"], point);
+        r.point.group = point.group;
+        results.push_back(r);
+        if (log)
+          std::fprintf(log, "[%zu/%zu] %s: cached\n", pi + 1, points.size(), point.label().c_str());
+        continue;
+      }
+    }
+    // Bake (shared by points that differ only in the lookup).
+    const std::string bakeBase = cacheDir + "/" + point.bakeKey();
+    const std::string vdb = bakeBase + ".vdb", stats = bakeBase + "-bake.json";
+    if (!fs::exists(stats) || !fs::exists(vdb) ||
+        nlohmann::json::parse(readText(stats)).value("context", nlohmann::json()) != context) {
+      std::string cmd = exe + " bake " + shellQuote(params.scene) + " -o " + shellQuote(vdb) +
+                        " --depth " + std::to_string(point.depth) + " --photons " +
+                        std::to_string(point.photons) + " --knn " + std::to_string(point.knn) +
+                        " --vdls " + point.vdls + " --seed " + std::to_string(params.seed) +
+                        " --threads " + std::to_string(params.threads) + " --quiet --stats-json " +
+                        shellQuote(stats + ".raw");
+      if (point.radiusVoxels != 3.0f) {
+        const GridFrame frame = makeGridFrame(scene.bounds(), point.depth);
+        cmd += " --radius " + numberText(double(point.radiusVoxels * frame.voxelSize));
+      }
+      runChild(cmd, bakeBase + "-bake.log");
+      nlohmann::json j = nlohmann::json::parse(readText(stats + ".raw"));
+      j["context"] = context;
+      writeTextAtomically(stats, j.dump(2) + "\n");
+      fs::remove(stats + ".raw");
+    }
+    SweepResult r;
+    r.point = point;
+    {
+      const nlohmann::json j = nlohmann::json::parse(readText(stats));
+      for (const auto& stage : j.at("stages")) {
+        const std::string name = stage.at("name");
+        const double s = stage.at("seconds");
+        if (name == "trace photons") r.traceSeconds = s;
+        if (name == "voxelize") r.voxelizeSeconds = s;
+        if (name == "splat photons") r.splatSeconds = s;
+        if (name == "gather + cluster") r.clusterSeconds = s;
+      }
+      r.bakeSeconds = j.at("total_seconds");
+      r.peakRssBytes = j.at("peak_rss_bytes");
+      r.vdbBytes = j.at("counts").at("vdb_bytes");
+      r.activeVoxels = j.at("counts").at("active_voxels");
+      r.denseVoxels = j.at("counts").at("dense_voxels");
+    }
+    // The octree's irradiance at the reference's first hits.
+    const LoadedVdl baked = readVdlGrid(vdb);
+    GpuOctreeParams octreeParams;
+    octreeParams.halfFloat = point.halfFloat;
+    const GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
+    r.gpuBytes = double(octree.poolBytes() + octree.vdlBytes());
+    r.vdlTexels = double(octree.vdlCount);
+    OctreeShadeParams shade;
+    shade.interpolation = point.interpolation;
+    FirstHitParams hitParams;
+    hitParams.width = params.width;
+    hitParams.height = params.height;
+    hitParams.samplesPerPixel = 4;
+    hitParams.seed = params.seed;
+    const RgbImage irradiance = renderFirstHits(scene, camera, hitParams, [&](const FirstHit& h) {
+      return octreeIrradiance(octree, h.position, h.normal, shade);
+    });
+    writeExr(base + "-irradiance.exr", irradiance);
+    const CompareResult irrError = compareImages(irradiance, refs.irradiance, compareParams);
+    r.irradianceRelRmse = irrError.luminance.relRmse;
+    r.irradianceRelMae = irrError.luminance.relMae;
+    // The indirect image through the GL renderer, and its frame time.
+    if (params.frames > 0) {
+      const std::string image = base + "-indirect.exr", renderLog = base + "-render.log";
+      std::string cmd = exe + " render " + shellQuote(params.scene) + " " + shellQuote(vdb) +
+                        " -o " + shellQuote(image) + " --mode indirect --width " +
+                        std::to_string(params.width) + " --height " +
+                        std::to_string(params.height) + " --frames " +
+                        std::to_string(params.frames) + " --interpolation " +
+                        (point.interpolation ? "on" : "off") +
+                        (point.halfFloat ? " --half-float" : "") + " --quiet";
+      if (!scene.cameras.empty()) cmd += " --camera " + shellQuote(scene.cameras.front().name);
+      if (scene.cameras.empty()) cmd += " --fov 45";
+      runChild(cmd, renderLog);
+      const std::string text = readText(renderLog);
+      const size_t at = text.find("frame time: ");
+      if (at != std::string::npos) r.frameMs = std::atof(text.c_str() + at + 12);
+      const RgbImage indirect = readImage(image);
+      r.indirectRelRmse = compareImages(indirect, refs.indirect, compareParams).luminance.relRmse;
+    }
+    writeTextAtomically(
+        resultFile,
+        nlohmann::json({{"context", context}, {"result", resultJson(r)}}).dump(2) + "\n");
+    if (log) {
+      std::fprintf(log, "[%zu/%zu] %s: bake %.2f s, GPU %s, irradiance rel. RMSE %.2f%%\n", pi + 1,
+                   points.size(), point.label().c_str(), r.bakeSeconds,
+                   formatBytes(size_t(r.gpuBytes)).c_str(), 100 * r.irradianceRelRmse);
+      std::fflush(log);
+    }
+    results.push_back(r);
+  }
+  markParetoFronts(results);
+
+  // Pictures of the paper's point and of the most accurate point on the time
+  // front: reference | light octree | difference, as PNGs for the docs.
+  const float ev = exposureFor(refs.irradiance);
+  auto picture = [&](const SweepResult& r, const std::string& name) {
+    const RgbImage octreeImage = readImage(cacheDir + "/" + r.point.key() + "-irradiance.exr");
+    const RgbImage diff = differenceImage(octreeImage, refs.irradiance, compareParams);
+    // The difference image is already display-referred: undo the exposure.
+    RgbImage diffScaled = diff;
+    for (float& v : diffScaled.rgb) v *= std::exp2(-ev);
+    writePng(params.outDir + "/" + name,
+             sideBySide({&refs.irradiance, &octreeImage, &diffScaled}, 4), ev);
+  };
+  for (const SweepResult& r : results) {
+    if (r.point.sameSettings(paperPoint())) picture(r, "irradiance-paper.png");
+  }
+  const SweepResult* best = nullptr;
+  for (const SweepResult& r : results)
+    if (r.paretoTime && (!best || r.irradianceRelRmse < best->irradianceRelRmse)) best = &r;
+  if (best) picture(*best, "irradiance-best.png");
+  return results;
+}
+
+std::string sweepCsv(const std::vector<SweepResult>& results) {
+  std::ostringstream os;
+  os << "label,group,depth,photons,knn,radius_voxels,vdls,interpolation,half_float,"
+        "trace_s,voxelize_s,splat_s,gather_cluster_s,bake_s,peak_rss_mib,vdb_kib,gpu_kib,"
+        "active_voxels,dense_voxels,vdl_texels,frame_ms,irradiance_rel_rmse,"
+        "irradiance_rel_mae,indirect_rel_rmse,pareto_time,pareto_memory,paper\n";
+  for (const SweepResult& r : results) {
+    const SweepPoint& p = r.point;
+    char line[1024];
+    std::snprintf(
+        line, sizeof line,
+        "\"%s\",%s,%d,%zu,%d,%g,%s,%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.1f,%.0f,%.0f,"
+        "%.0f,%.2f,%.5f,%.5f,%.5f,%d,%d,%d\n",
+        p.label().c_str(), p.group.c_str(), p.depth, p.photons, p.knn, double(p.radiusVoxels),
+        p.vdls.c_str(), int(p.interpolation), int(p.halfFloat), r.traceSeconds, r.voxelizeSeconds,
+        r.splatSeconds, r.clusterSeconds, r.bakeSeconds, r.peakRssBytes / 1048576.0,
+        r.vdbBytes / 1024.0, r.gpuBytes / 1024.0, r.activeVoxels, r.denseVoxels, r.vdlTexels,
+        r.frameMs, r.irradianceRelRmse, r.irradianceRelMae, r.indirectRelRmse, int(r.paretoTime),
+        int(r.paretoMemory), int(p.sameSettings(paperPoint())));
+    os << line;
+  }
+  return os.str();
+}
+
+namespace sweep_internal {
+
+std::string markdownTable(const std::vector<SweepResult>& results) {
+  std::ostringstream os;
+  os << "| setting | varies | trace s | voxelize s | splat s | gather+cluster s | bake s | "
+        "peak RSS MiB | .vdb KiB | GPU KiB | active voxels | frame ms | irradiance rel. RMSE | "
+        "rel. MAE | indirect image rel. RMSE | front |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+  for (const SweepResult& r : results) {
+    const bool paper = r.point.sameSettings(paperPoint());
+    char line[1024];
+    std::string front = std::string(r.paretoTime ? "T" : "") + (r.paretoMemory ? "M" : "");
+    std::snprintf(line, sizeof line,
+                  "| %s%s%s | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %.0f | %.0f | %.0f "
+                  "| %s | %.1f%% | %.1f%% | %s | %s |\n",
+                  paper ? "**" : "", r.point.label().c_str(), paper ? "** (paper)" : "",
+                  r.point.group.c_str(), r.traceSeconds, r.voxelizeSeconds, r.splatSeconds,
+                  r.clusterSeconds, r.bakeSeconds, r.peakRssBytes / 1048576.0, r.vdbBytes / 1024.0,
+                  r.gpuBytes / 1024.0, r.activeVoxels,
+                  r.frameMs >= 0 ? numberText(std::round(r.frameMs * 10) / 10).c_str() : "-",
+                  100 * r.irradianceRelRmse, 100 * r.irradianceRelMae,
+                  r.indirectRelRmse >= 0
+                      ? (numberText(std::round(1000 * r.indirectRelRmse) / 10) + "%").c_str()
+                      : "-",
+                  front.c_str());
+    os << line;
+  }
+  return os.str();
+}
+
+/// Data file for gnuplot: x y "label", one point per line, sorted by x.
+std::string plotData(std::vector<std::pair<double, std::pair<double, std::string>>> rows) {
+  std::sort(rows.begin(), rows.end());
+  std::ostringstream os;
+  for (const auto& row : rows)
+    os << row.first << " " << row.second.first << " \"" << row.second.second << "\"\n";
+  return os.str();
+}
+
+}  // namespace sweep_internal
+
+void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>& results,
+                      std::FILE* log) {
+  using namespace sweep_internal;
+  const std::string dir = params.outDir;
+  writeTextAtomically(dir + "/sweep.csv", sweepCsv(results));
+
+  // Plot data: x = bake seconds or GPU KiB, y = irradiance relative RMSE in %.
+  using Rows = std::vector<std::pair<double, std::pair<double, std::string>>>;
+  Rows allTime, allMem, frontTime, frontMem, paperTime, paperMem;
+  for (const SweepResult& r : results) {
+    const double e = 100 * r.irradianceRelRmse, t = r.bakeSeconds, m = r.gpuBytes / 1024.0;
+    const std::string l = r.point.label();
+    allTime.push_back({t, {e, l}});
+    allMem.push_back({m, {e, l}});
+    if (r.paretoTime) frontTime.push_back({t, {e, l}});
+    if (r.paretoMemory) frontMem.push_back({m, {e, l}});
+    if (r.point.sameSettings(paperPoint())) {
+      paperTime.push_back({t, {e, l}});
+      paperMem.push_back({m, {e, l}});
+    }
+  }
+  const std::string dataDir = dir + "/plot-data";
+  fs::create_directories(dataDir);
+  writeTextAtomically(dataDir + "/all-time.dat", plotData(allTime));
+  writeTextAtomically(dataDir + "/all-memory.dat", plotData(allMem));
+  writeTextAtomically(dataDir + "/front-time.dat", plotData(frontTime));
+  writeTextAtomically(dataDir + "/front-memory.dat", plotData(frontMem));
+  writeTextAtomically(dataDir + "/paper-time.dat", plotData(paperTime));
+  writeTextAtomically(dataDir + "/paper-memory.dat", plotData(paperMem));
+  const std::string sceneName = fs::path(params.scene).stem().string();
+  std::ostringstream gp;
+  gp << "# Redraw with: cd " << dir << " && gnuplot sweep.gp\n"
+     << "set terminal pngcairo size 1000,700 font 'sans,10'\n"
+     << "set logscale x\nset grid\nset key top right\n"
+     << "set ylabel 'indirect irradiance: relative RMSE vs reference (%)'\n";
+  auto plot = [&](const char* png, const char* xlabel, const char* which) {
+    gp << "set output '" << png << "'\n"
+       << "set title '" << sceneName << ": error against " << xlabel << "'\n"
+       << "set xlabel '" << xlabel << " (log scale)'\n"
+       << "plot 'plot-data/all-" << which
+       << ".dat' using 1:2 with points pt 7 ps 1 lc rgb '#909090' title 'settings', \\\n"
+       << "     'plot-data/front-" << which
+       << ".dat' using 1:2 with linespoints pt 7 ps 1.2 lw 2 lc rgb '#d62728' title 'Pareto "
+          "front', \\\n"
+       << "     'plot-data/front-" << which
+       << ".dat' using 1:2:3 with labels offset 1,0.6 left font 'sans,8' notitle, \\\n"
+       << "     'plot-data/paper-" << which
+       << ".dat' using 1:2 with points pt 5 ps 2.2 lc rgb '#1f77b4' title 'paper (d6 600k k300 "
+          "v4)'\n";
+  };
+  plot("error-vs-bake-time.png", "bake time, s", "time");
+  plot("error-vs-memory.png", "GPU octree + VDL textures, KiB", "memory");
+  writeTextAtomically(dir + "/sweep.gp", gp.str());
+  const bool plotted =
+      std::system(("cd " + shellQuote(dir) + " && gnuplot sweep.gp > /dev/null 2>&1").c_str()) == 0;
+  if (!plotted && log) std::fprintf(log, "sweep: gnuplot failed or missing; no plots drawn\n");
+
+  std::ostringstream md;
+  md << "# Sweep: " << sceneName << "\n\n"
+     << "Measured by `lightoctree sweep " << fs::path(params.scene).filename().string()
+     << (params.scale == SweepScale::Quick ? " --quick" : "") << "`; images " << params.width
+     << " x " << params.height << " from the scene camera, references path-traced at "
+     << params.referenceSpp
+     << " spp. Errors are luminance relative RMSE / MAE over the pixels that see the scene "
+        "(see docs/accuracy.md for the definitions and the reference's own noise in "
+        "`cache/reference.json`). *front*: T = on the Pareto front of irradiance error vs bake "
+        "time, M = vs GPU bytes. Frame times: OSMesa (software GL), "
+     << params.frames
+     << " frames, indirect mode. Times are wall-clock on this machine "
+        "and include every bake stage.\n\n"
+     << markdownTable(results) << "\n";
+  if (plotted) {
+    md << "![error vs bake time](error-vs-bake-time.png)\n\n"
+       << "![error vs memory](error-vs-memory.png)\n\n";
+  }
+  if (fs::exists(dir + "/irradiance-paper.png"))
+    md << "Paper's settings: reference | light octree | difference (red = a quarter of the "
+          "mean):\n\n![paper](irradiance-paper.png)\n\n";
+  if (fs::exists(dir + "/irradiance-best.png"))
+    md << "Most accurate point on the bake-time front:\n\n![best](irradiance-best.png)\n";
+  writeTextAtomically(dir + "/sweep.md", md.str());
+}
+
+}  // namespace lo::tool

@@ -1,0 +1,111 @@
+#pragma once
+/// @file tools/sweep.h
+/// @brief `lightoctree sweep`: the speed/accuracy trade of the bake, measured.
+/// Each point bakes the scene (a child `lightoctree bake`, so that its peak
+/// memory is its own), evaluates the octree's indirect irradiance at the
+/// reference's first hits (octree/octree_irradiance.h) and renders the
+/// indirect image and its frame time (a child `lightoctree render`), and
+/// compares both with path-traced references rendered once per scene and
+/// cached. Points vary one parameter at a time around the paper's settings
+/// (depth 6, 600k photons, KNN 300, 4 VDLs), plus a few combined points.
+/// Results, tables and gnuplot plots go to one folder; see docs/accuracy.md.
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace lo::tool {
+
+/// One setting of the bake and of the lookup.
+struct SweepPoint {
+  std::string group = "paper";  ///< the parameter this point varies ("paper", "depth", ...)
+  int depth = 6;
+  size_t photons = 600000;
+  int knn = 300;
+  float radiusVoxels = 3.0f;  ///< gather radius in voxel sizes at this depth (bake default: 3)
+  std::string vdls = "4";     ///< "1".."8" or "auto"
+  bool interpolation = true;  ///< trilinear lookup over 8 voxels
+  bool halfFloat = false;     ///< RGBA16UI half-float VDL texels instead of RGBA32F
+
+  /// Short human label, e.g. "d6 600k k300 r3 v4" (+ " no-interp", " half").
+  std::string label() const;
+  /// File-name-safe key of the bake parameters only (points that differ only
+  /// in interpolation or texel format share one bake).
+  std::string bakeKey() const;
+  /// File-name-safe key of the whole point.
+  std::string key() const;
+  bool sameSettings(const SweepPoint& other) const { return key() == other.key(); }
+};
+
+/// The paper's settings (§5: depth 6, 600k photons, KNN 300, 4 VDLs).
+SweepPoint paperPoint();
+
+enum class SweepScale {
+  Full,   ///< every issue range: depth 3-8, photons 50k-5M, k 10-1000, radius, VDLs, lookup
+  Quick,  ///< a reduced set around the paper's point (a few minutes on 2 cores)
+  Tiny,   ///< three cheap points and tiny images: a smoke test of the machinery
+};
+
+/// One point per setting, the paper's point first, duplicates removed.
+std::vector<SweepPoint> sweepPoints(SweepScale scale);
+
+/// What one point costs and how wrong it is.
+struct SweepResult {
+  SweepPoint point;
+  // Bake (from `bake --stats-json`), wall-clock seconds.
+  double traceSeconds = 0, voxelizeSeconds = 0, splatSeconds = 0, clusterSeconds = 0;
+  double bakeSeconds = 0;   ///< every stage, load and write included
+  double peakRssBytes = 0;  ///< peak resident memory of the bake process
+  double vdbBytes = 0;      ///< the .vdb file
+  double gpuBytes = 0;      ///< octree pool + VDL texture as uploaded
+  double activeVoxels = 0, denseVoxels = 0;
+  double vdlTexels = 0;  ///< VDLs stored in the GPU texture
+  double frameMs = -1;   ///< OSMesa frame time, indirect mode; < 0: not measured
+  // Errors against the references (luminance; relative RMSE and MAE).
+  double irradianceRelRmse = 0, irradianceRelMae = 0;
+  double indirectRelRmse = -1;  ///< < 0: not measured
+  bool paretoTime = false;      ///< on the front of irradiance error vs bake time
+  bool paretoMemory = false;    ///< on the front of irradiance error vs GPU bytes
+};
+
+/// Flags of the non-dominated points when minimising both cost and error
+/// (ties in both count as non-dominated). Sizes must match.
+std::vector<bool> paretoFront(const std::vector<double>& cost, const std::vector<double>& error);
+
+/// Sets paretoTime / paretoMemory of every result.
+void markParetoFronts(std::vector<SweepResult>& results);
+
+struct SweepParams {
+  std::string scene;       ///< .gltf, .glb or .obj
+  std::string outDir;      ///< results; bulky files go to outDir/cache
+  std::string executable;  ///< the `lightoctree` binary the bakes and renders run
+  SweepScale scale = SweepScale::Full;
+  std::vector<SweepPoint> points;  ///< empty = sweepPoints(scale)
+  int width = 320, height = 240;   ///< images compared (scene camera, else framed)
+  int referenceSpp = 1024;         ///< path-traced samples per pixel of each reference
+  int frames = 5;                  ///< frames timed per point (0: no indirect render)
+  int threads = 0;                 ///< bake / reference threads (0 = all cores)
+  uint64_t seed = 1;
+  bool quiet = false;
+};
+
+/// Standard parameters for a scale (image size, reference samples, frames).
+SweepParams sweepDefaults(SweepScale scale);
+
+/// Runs every point (reusing outDir/cache results of an earlier run with the
+/// same settings, so an interrupted sweep resumes), prints one line per point
+/// to `log` (may be null). @throws InputError / IoError naming the file or
+/// the failed child command.
+std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log);
+
+/// Writes outDir/sweep.csv, outDir/sweep.md and, if gnuplot is found,
+/// outDir/error-vs-bake-time.png and outDir/error-vs-memory.png (with the
+/// data and script beside them so that the plots can be redrawn).
+void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>& results,
+                      std::FILE* log);
+
+/// The CSV text of the results (header line first).
+std::string sweepCsv(const std::vector<SweepResult>& results);
+
+}  // namespace lo::tool

@@ -1,0 +1,91 @@
+// `lightoctree sweep`: the speed/accuracy trade of the bake, measured (tools/sweep.h).
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "commands.h"
+#include "core/error.h"
+#include "sweep.h"
+
+namespace lo::tool {
+namespace {
+
+struct SweepOptions {
+  std::string scene;
+  std::string out;
+  bool quick = false;
+  bool tiny = false;
+  int width = 0, height = 0, spp = 0, frames = -1;  // 0 / -1: the scale's default
+  int threads = 0;
+  uint64_t seed = 1;
+  bool quiet = false;
+};
+
+int runSweepCommand(const SweepOptions& opt) {
+  if (opt.quick && opt.tiny) throw InputError("--quick and --tiny: choose one");
+  const SweepScale scale = opt.tiny    ? SweepScale::Tiny
+                           : opt.quick ? SweepScale::Quick
+                                       : SweepScale::Full;
+  SweepParams params = sweepDefaults(scale);
+  params.scene = opt.scene;
+  params.outDir = opt.out;
+  if (opt.width > 0) params.width = opt.width;
+  if (opt.height > 0) params.height = opt.height;
+  if (opt.spp > 0) params.referenceSpp = opt.spp;
+  if (opt.frames >= 0) params.frames = opt.frames;
+  params.threads = opt.threads;
+  params.seed = opt.seed;
+  params.quiet = opt.quiet;
+  // The bakes and renders run as child processes of this same binary.
+  params.executable = std::filesystem::read_symlink("/proc/self/exe").string();
+  const std::filesystem::path parent = std::filesystem::path(opt.out).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    throw InputError("--out: folder '" + parent.string() + "' does not exist");
+  }
+  std::filesystem::create_directories(opt.out);
+  std::FILE* log = opt.quiet ? nullptr : stdout;
+  std::vector<SweepResult> results = runSweep(params, log);
+  writeSweepReport(params, results, log);
+  if (log) std::fprintf(log, "wrote %s/sweep.md, sweep.csv and plots\n", opt.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> addSweepCommand(CLI::App& app) {
+  auto opt = std::make_shared<SweepOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "sweep",
+      "Measure the speed/accuracy trade: bake at settings around the paper's (depth, photons, "
+      "KNN k, radius, VDLs, interpolation, half floats), compare each with a path-traced "
+      "reference, write a table, CSV and plots with the Pareto front.");
+  cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", opt->out,
+                  "Results folder (created); bakes and images go to its cache/ subfolder, "
+                  "which a rerun reuses")
+      ->required();
+  cmd->add_flag("--quick", opt->quick, "A reduced sweep: fewer points, smaller images");
+  cmd->add_flag("--tiny", opt->tiny, "Three tiny points (a smoke test)")->group("");
+  cmd->add_option("--width", opt->width, "Image width (default: 320, quick 160)")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--height", opt->height, "Image height (default: 240, quick 120)")
+      ->check(CLI::Range(1, 4096));
+  cmd->add_option("--spp", opt->spp, "Reference samples per pixel (default: 1024, quick 256)")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--frames", opt->frames,
+                  "Frames timed per point with OSMesa (0: no GL render; default 5, quick 2)")
+      ->check(CLI::Range(0, 1000));
+  cmd->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Random seed of bakes and references")
+      ->capture_default_str();
+  cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
+  return [cmd, opt]() -> int { return cmd->parsed() ? runSweepCommand(*opt) : -1; };
+}
+
+}  // namespace lo::tool
