@@ -32,4 +32,7 @@ std::function<int()> addCompareCommand(CLI::App& app);
 /// `lightoctree sweep SCENE --out DIR [--quick]`
 std::function<int()> addSweepCommand(CLI::App& app);
 
+/// `lightoctree view SCENE LIGHTS.vdb | SCENE --progressive [--camera-path F --save-frames D]`
+std::function<int()> addViewCommand(CLI::App& app);
+
 }  // namespace lo::tool

@@ -24,6 +24,7 @@ int run(int argc, char** argv) {
   commands.push_back(lo::tool::addReferenceCommand(app));
   commands.push_back(lo::tool::addCompareCommand(app));
   commands.push_back(lo::tool::addSweepCommand(app));
+  commands.push_back(lo::tool::addViewCommand(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
