@@ -37,6 +37,7 @@ struct RenderOptions {
   int emitterLights = 8;
   int shadowMapSize = 1024;
   bool halfFloat = false;
+  std::string cosineCorrection = "on";
   int frames = 0;
   bool quiet = false;
 };
@@ -52,6 +53,7 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
   ReferenceCamera camera = chooseCamera<ReferenceCamera>(opt.camera, scene, opt.scene);
   GpuOctreeParams octreeParams;
   octreeParams.halfFloat = opt.halfFloat;
+  octreeParams.cosineCorrection = opt.cosineCorrection == "on";
   // No GL context to ask: the limits of the GL 3.3 contexts we render with.
   GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
@@ -105,6 +107,7 @@ int runRender(const RenderOptions& opt) {
 
   GpuOctreeParams octreeParams;
   octreeParams.halfFloat = opt.halfFloat;
+  octreeParams.cosineCorrection = opt.cosineCorrection == "on";
   octreeParams.max3DTextureSize = context->info().max3DTextureSize;
   octreeParams.max2DTextureSize = context->info().max2DTextureSize;
   GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
@@ -180,6 +183,12 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--shadow-map-size", opt->shadowMapSize, "Shadow map resolution per face")
       ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  cmd->add_option("--cosine-correction", opt->cosineCorrection,
+                  "Divide each VDL by the cosine to its voxel's normal on upload, so that the "
+                  "shader's max(0, n.d) does not count the baked cosine twice (off: the paper's "
+                  "form, darker; see docs/accuracy.md)")
+      ->check(onOff())
       ->capture_default_str();
   cmd->add_flag("--half-float", opt->halfFloat,
                 "VDL texture with half-float irradiance (RGBA16UI) instead of RGBA32F");

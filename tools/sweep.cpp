@@ -163,7 +163,8 @@ nlohmann::json pointJson(const SweepPoint& p) {
           {"radius_voxels", p.radiusVoxels},
           {"vdls", p.vdls},
           {"interpolation", p.interpolation},
-          {"half_float", p.halfFloat}};
+          {"half_float", p.halfFloat},
+          {"cosine_correction", p.cosineCorrection}};
 }
 
 nlohmann::json resultJson(const SweepResult& r) {
@@ -247,6 +248,7 @@ std::string SweepPoint::label() const {
                   std::to_string(knn) + " r" + numberText(radiusVoxels) + " v" + vdls;
   if (!interpolation) s += " no-interp";
   if (halfFloat) s += " half";
+  if (!cosineCorrection) s += " paper-cosine";
   return s;
 }
 
@@ -257,7 +259,8 @@ std::string SweepPoint::bakeKey() const {
 }
 
 std::string SweepPoint::key() const {
-  return bakeKey() + (interpolation ? "-i1" : "-i0") + (halfFloat ? "-h1" : "-h0");
+  return bakeKey() + (interpolation ? "-i1" : "-i0") + (halfFloat ? "-h1" : "-h0") +
+         (cosineCorrection ? "" : "-c0");
 }
 
 SweepPoint paperPoint() { return SweepPoint{}; }
@@ -307,6 +310,7 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale) {
   for (const std::string& v : vdls) vary("vdls", [v](SweepPoint& p) { p.vdls = v; });
   vary("interpolation", [](SweepPoint& p) { p.interpolation = false; });
   vary("texels", [](SweepPoint& p) { p.halfFloat = true; });
+  vary("cosine", [](SweepPoint& p) { p.cosineCorrection = false; });
   // Combined points: cheaper photon maps with a matching k (the photon
   // density per voxel falls with the count), coarser and finer grids.
   vary("combined", [](SweepPoint& p) {
@@ -473,6 +477,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     const LoadedVdl baked = readVdlGrid(vdb);
     GpuOctreeParams octreeParams;
     octreeParams.halfFloat = point.halfFloat;
+    octreeParams.cosineCorrection = point.cosineCorrection;
     const GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
     r.gpuBytes = double(octree.poolBytes() + octree.vdlBytes());
     r.vdlTexels = double(octree.vdlCount);
@@ -493,13 +498,13 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     // The indirect image through the GL renderer, and its frame time.
     if (params.frames > 0) {
       const std::string image = base + "-indirect.exr", renderLog = base + "-render.log";
-      std::string cmd = exe + " render " + shellQuote(params.scene) + " " + shellQuote(vdb) +
-                        " -o " + shellQuote(image) + " --mode indirect --width " +
-                        std::to_string(params.width) + " --height " +
-                        std::to_string(params.height) + " --frames " +
-                        std::to_string(params.frames) + " --interpolation " +
-                        (point.interpolation ? "on" : "off") +
-                        (point.halfFloat ? " --half-float" : "") + " --quiet";
+      std::string cmd =
+          exe + " render " + shellQuote(params.scene) + " " + shellQuote(vdb) + " -o " +
+          shellQuote(image) + " --mode indirect --width " + std::to_string(params.width) +
+          " --height " + std::to_string(params.height) + " --frames " +
+          std::to_string(params.frames) + " --interpolation " +
+          (point.interpolation ? "on" : "off") + (point.halfFloat ? " --half-float" : "") +
+          " --cosine-correction " + (point.cosineCorrection ? "on" : "off") + " --quiet";
       if (!scene.cameras.empty()) cmd += " --camera " + shellQuote(scene.cameras.front().name);
       if (scene.cameras.empty()) cmd += " --fov 45";
       runChild(cmd, renderLog);
@@ -547,7 +552,8 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
 std::string sweepCsv(const std::vector<SweepResult>& results) {
   std::ostringstream os;
   os << "label,group,depth,photons,knn,radius_voxels,vdls,interpolation,half_float,"
-        "trace_s,voxelize_s,splat_s,gather_cluster_s,bake_s,peak_rss_mib,vdb_kib,gpu_kib,"
+        "cosine_correction,trace_s,voxelize_s,splat_s,gather_cluster_s,bake_s,peak_rss_mib,vdb_kib,"
+        "gpu_kib,"
         "active_voxels,dense_voxels,vdl_texels,frame_ms,irradiance_rel_rmse,"
         "irradiance_rel_mae,indirect_rel_rmse,pareto_time,pareto_memory,paper\n";
   for (const SweepResult& r : results) {
@@ -555,14 +561,15 @@ std::string sweepCsv(const std::vector<SweepResult>& results) {
     char line[1024];
     std::snprintf(
         line, sizeof line,
-        "\"%s\",%s,%d,%zu,%d,%g,%s,%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.1f,%.0f,%.0f,"
+        "\"%s\",%s,%d,%zu,%d,%g,%s,%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.1f,%.0f,%.0f,"
         "%.0f,%.2f,%.5f,%.5f,%.5f,%d,%d,%d\n",
         p.label().c_str(), p.group.c_str(), p.depth, p.photons, p.knn, double(p.radiusVoxels),
-        p.vdls.c_str(), int(p.interpolation), int(p.halfFloat), r.traceSeconds, r.voxelizeSeconds,
-        r.splatSeconds, r.clusterSeconds, r.bakeSeconds, r.peakRssBytes / 1048576.0,
-        r.vdbBytes / 1024.0, r.gpuBytes / 1024.0, r.activeVoxels, r.denseVoxels, r.vdlTexels,
-        r.frameMs, r.irradianceRelRmse, r.irradianceRelMae, r.indirectRelRmse, int(r.paretoTime),
-        int(r.paretoMemory), int(p.sameSettings(paperPoint())));
+        p.vdls.c_str(), int(p.interpolation), int(p.halfFloat), int(p.cosineCorrection),
+        r.traceSeconds, r.voxelizeSeconds, r.splatSeconds, r.clusterSeconds, r.bakeSeconds,
+        r.peakRssBytes / 1048576.0, r.vdbBytes / 1024.0, r.gpuBytes / 1024.0, r.activeVoxels,
+        r.denseVoxels, r.vdlTexels, r.frameMs, r.irradianceRelRmse, r.irradianceRelMae,
+        r.indirectRelRmse, int(r.paretoTime), int(r.paretoMemory),
+        int(p.sameSettings(paperPoint())));
     os << line;
   }
   return os.str();

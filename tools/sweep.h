@@ -23,12 +23,14 @@ struct SweepPoint {
   int depth = 6;
   size_t photons = 600000;
   int knn = 300;
-  float radiusVoxels = 3.0f;  ///< gather radius in voxel sizes at this depth (bake default: 3)
-  std::string vdls = "4";     ///< "1".."8" or "auto"
-  bool interpolation = true;  ///< trilinear lookup over 8 voxels
-  bool halfFloat = false;     ///< RGBA16UI half-float VDL texels instead of RGBA32F
+  float radiusVoxels = 3.0f;     ///< gather radius in voxel sizes at this depth (bake default: 3)
+  std::string vdls = "4";        ///< "1".."8" or "auto"
+  bool interpolation = true;     ///< trilinear lookup over 8 voxels
+  bool halfFloat = false;        ///< RGBA16UI half-float VDL texels instead of RGBA32F
+  bool cosineCorrection = true;  ///< GpuOctreeParams::cosineCorrection (off: the paper's form)
 
-  /// Short human label, e.g. "d6 600k k300 r3 v4" (+ " no-interp", " half").
+  /// Short human label, e.g. "d6 600k k300 r3 v4" (+ " no-interp", " half",
+  /// " paper-cosine").
   std::string label() const;
   /// File-name-safe key of the bake parameters only (points that differ only
   /// in interpolation or texel format share one bake).

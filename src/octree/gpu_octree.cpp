@@ -278,17 +278,25 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
                  z = 2 * tz + ((child >> 2) & 1u);
     return &out.pool[((z * poolH + y) * poolW + x) * 4];
   };
-  auto writeVdl = [&](size_t index, const Vdl& vdl) {
+  // `normal`: the voxel's normal for params.cosineCorrection, else zero.
+  auto writeVdl = [&](size_t index, const Vdl& vdl, const Vec3& normal) {
     const size_t offset =
         (size_t(loVdlTexelY(uint(index))) * width + size_t(loVdlTexelX(uint(index)))) * 4;
     const Vec3 d = normalize(vdl.direction);
     const float packed = loPackDirection(d.x, d.y, d.z);
+    Vec3 irradiance = vdl.irradiance;
+    if (lengthSquared(normal) > 0.5f) {
+      // The cosine the shader will apply: with the decoded direction.
+      const Vec3 dq{loUnpackDirectionX(packed), loUnpackDirectionY(packed),
+                    loUnpackDirectionZ(packed)};
+      irradiance = irradiance / std::max(std::fabs(dot(normal, dq)), kMinCorrectionCosine);
+    }
     if (out.halfFloat) {
       for (int c = 0; c < 3; ++c)
-        out.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(vdl.irradiance[c]);
+        out.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(irradiance[c]);
       out.vdlTexelsHalf[offset + 3] = uint16_t(packed);
     } else {
-      for (int c = 0; c < 3; ++c) out.vdlTexels[offset + size_t(c)] = vdl.irradiance[c];
+      for (int c = 0; c < 3; ++c) out.vdlTexels[offset + size_t(c)] = irradiance[c];
       out.vdlTexels[offset + 3] = packed;
     }
   };
@@ -321,7 +329,10 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
         t[2] = uint8_t(loPackAddressB(address));
         t[3] = uint8_t(count);
         const Vdl* vdls = grid.vdlsOf(leaf.voxel);
-        for (int i = 0; i < count; ++i) writeVdl(nextVdl++, vdls[i]);
+        const Vec3 normal = params.cosineCorrection && grid.normals.size() == grid.size()
+                                ? normalize(grid.normals[leaf.voxel])
+                                : Vec3{0, 0, 0};
+        for (int i = 0; i < count; ++i) writeVdl(nextVdl++, vdls[i], normal);
       }
     }
   }

@@ -18,12 +18,24 @@ struct GpuOctreeParams {
   bool halfFloat = false;        ///< VDL texels as RGBA16UI (half RGB bits) instead of RGBA32F
   int max3DTextureSize = 2048;   ///< GL_MAX_3D_TEXTURE_SIZE of the target context
   int max2DTextureSize = 16384;  ///< GL_MAX_TEXTURE_SIZE of the target context
+  /// The bake stores each VDL's share c_i of the irradiance *on the voxel's
+  /// surface* (already cosine-weighted: the VDLs sum to the estimate), while
+  /// the shader applies max(0, n.d_i) to c_i as the paper does (§4.2.2),
+  /// counting the cosine twice: ~30% too dark in the Cornell box
+  /// (docs/accuracy.md). On: each texel holds c_i / max(|n_v.d_i|,
+  /// kMinCorrectionCosine), n_v the voxel's normal, so that the shader returns
+  /// the baked estimate on the baked surface. Voxels without a normal keep c_i.
+  bool cosineCorrection = false;
 };
 
+/// Smallest cosine cosineCorrection divides by: bounds the gain of grazing
+/// VDLs to 4x (they carry little light on the baked surface).
+constexpr float kMinCorrectionCosine = 0.25f;
+
 struct GpuOctree {
-  int depth = 0;                ///< leaves at this depth (= the VDL grid's depth)
-  Vec3 origin{0, 0, 0};         ///< world position of the octree cube's lower corner
-  float cubeSize = 1.0f;        ///< world edge length of the octree cube (voxelSize * 2^depth)
+  int depth = 0;          ///< leaves at this depth (= the VDL grid's depth)
+  Vec3 origin{0, 0, 0};   ///< world position of the octree cube's lower corner
+  float cubeSize = 1.0f;  ///< world edge length of the octree cube (voxelSize * 2^depth)
 
   /// Indirection pool: tilesX * tilesY * tilesZ tiles of 2x2x2 texels, stored
   /// as a (2*tilesX) x (2*tilesY) x (2*tilesZ) RGBA8 3D texture, x fastest.
@@ -38,17 +50,15 @@ struct GpuOctree {
   std::vector<float> vdlTexels;
   std::vector<uint16_t> vdlTexelsHalf;
 
-  size_t leafCount = 0;   ///< non-empty voxels
-  size_t nodeCount = 0;   ///< tiles in the pool (inner nodes incl. root)
-  size_t vdlCount = 0;    ///< VDL texels used
+  size_t leafCount = 0;  ///< non-empty voxels
+  size_t nodeCount = 0;  ///< tiles in the pool (inner nodes incl. root)
+  size_t vdlCount = 0;   ///< VDL texels used
 
   int poolWidth() const { return 2 * tilesX; }
   int poolHeight() const { return 2 * tilesY; }
   int poolDepth() const { return 2 * tilesZ; }
   size_t poolBytes() const { return pool.size(); }
-  size_t vdlBytes() const {
-    return halfFloat ? vdlTexelsHalf.size() * 2 : vdlTexels.size() * 4;
-  }
+  size_t vdlBytes() const { return halfFloat ? vdlTexelsHalf.size() * 2 : vdlTexels.size() * 4; }
   std::string ToString() const;  ///< sizes and memory per leaf
 };
 
@@ -72,10 +82,10 @@ float halfToFloat(uint16_t bits);
 
 /// Result of the C++ reference of the shader's lookup.
 struct OctreeSample {
-  bool found = false;   ///< false in empty space or outside the cube
-  Coord voxel;          ///< the leaf's voxel coordinate at the octree depth
+  bool found = false;  ///< false in empty space or outside the cube
+  Coord voxel;         ///< the leaf's voxel coordinate at the octree depth
   int vdlCount = 0;
-  Vdl vdls[kMaxVdls];   ///< decoded (directions through the 8+8-bit packing)
+  Vdl vdls[kMaxVdls];  ///< decoded (directions through the 8+8-bit packing)
 };
 
 /// The same descent the fragment shader does (depth texel fetches, then the VDL

@@ -124,6 +124,41 @@ TEST(OctreeIrradiance, MaxVdlsAndHalfFloatTexels) {
   for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(h[ch], both[ch], 1e-3f * both[ch]);
 }
 
+TEST(OctreeIrradiance, CosineCorrectionReturnsTheBakedEstimateOnTheBakedSurface) {
+  // The bake's VDLs sum to the irradiance on the voxel's surface (normal +z):
+  // c1 + c2. The paper's form returns c1 cos1 + c2 cos2; corrected, the sum.
+  const Vdl a = vdl({1.0f, 2.0f, 3.0f}, {std::sin(kPi / 3), 0, std::cos(kPi / 3)});
+  const Vdl b = vdl({0.5f, 0.5f, 0.5f}, {0, 0.2f, 1});
+  const Vdl grazing = vdl({2, 2, 2}, {std::cos(0.1f), 0, std::sin(0.1f)});  // ~84 degrees
+  VdlGrid g = constantGrid(3, 0, 0, {a, b, grazing});
+  GpuOctreeParams on;
+  on.cosineCorrection = true;
+  const GpuOctree paper = buildGpuOctree(g), corrected = buildGpuOctree(g, on);
+  const Vec3 p = Vec3{3.5f, 3.5f, 0.5f} * kVoxel, up{0, 0, 1};
+  const float cosGrazing = decodedDirection(paper, 2).z;
+  ASSERT_LT(cosGrazing, kMinCorrectionCosine);
+  const Vec3 expected =
+      a.irradiance + b.irradiance + grazing.irradiance * (cosGrazing / kMinCorrectionCosine);
+  const Vec3 e = octreeIrradiance(corrected, p, up);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(e[ch], expected[ch], 1e-5f * expected[ch]);
+  const Vec3 ePaper = octreeIrradiance(paper, p, up);
+  EXPECT_LT(ePaper.x, 0.8f * e.x);
+  // Another normal: each VDL scaled by cos(n, d) / cos(n_v, d).
+  const Vec3 n = normalize(Vec3{1, 0, 1});
+  Vec3 other{0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 d = decodedDirection(paper, k);
+    other += g.vdls[size_t(k)].irradiance *
+             (std::max(0.0f, dot(n, d)) / std::max(std::fabs(d.z), kMinCorrectionCosine));
+  }
+  const Vec3 eOther = octreeIrradiance(corrected, p, n);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(eOther[ch], other[ch], 1e-5f * other[ch]);
+  // A voxel without a normal (opposite faces cancelled) keeps the baked values.
+  for (Vec3& normal : g.normals) normal = {0, 0, 0};
+  const Vec3 eNoNormal = octreeIrradiance(buildGpuOctree(g, on), p, up);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(eNoNormal[ch], ePaper[ch], 1e-6f);
+}
+
 TEST(OctreeIrradiance, FirstHitImageOfALitPlaneIsTheAnalyticValueAtEveryPixel) {
   // A plane z = 0.3 (inside the first voxel layer) seen from above; every
   // voxel holds one VDL of irradiance c from 60 degrees off the normal.

@@ -22,6 +22,7 @@ std::set<std::string> differences(const SweepPoint& a, const SweepPoint& b) {
   if (a.vdls != b.vdls) d.insert("vdls");
   if (a.interpolation != b.interpolation) d.insert("interpolation");
   if (a.halfFloat != b.halfFloat) d.insert("texels");
+  if (a.cosineCorrection != b.cosineCorrection) d.insert("cosine");
   return d;
 }
 
@@ -48,7 +49,7 @@ TEST(SweepPoints, OneParameterAtATimeAroundThePaper) {
         EXPECT_EQ(d, std::set<std::string>{p.group}) << p.label();
       }
     }
-    for (const char* g : {"depth", "photons", "knn", "vdls", "interpolation", "texels"})
+    for (const char* g : {"depth", "photons", "knn", "vdls", "interpolation", "texels", "cosine"})
       EXPECT_TRUE(groups.count(g)) << g;
   }
   // The full sweep covers the ranges.
