@@ -375,10 +375,10 @@ SweepParams sweepDefaults(SweepScale scale) {
   p.scale = scale;
   switch (scale) {
     case SweepScale::Full:
-      p.width = 320, p.height = 240, p.referenceSpp = 1024, p.frames = 5;
+      p.width = 160, p.height = 120, p.referenceSpp = 8192, p.frames = 5;
       break;
     case SweepScale::Quick:
-      p.width = 160, p.height = 120, p.referenceSpp = 256, p.frames = 2;
+      p.width = 96, p.height = 72, p.referenceSpp = 2048, p.frames = 2;
       break;
     case SweepScale::Tiny:
       p.width = 24, p.height = 18, p.referenceSpp = 8, p.frames = 1;
@@ -524,6 +524,10 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
       std::fflush(log);
     }
     results.push_back(r);
+  }
+  for (SweepResult& r : results) {
+    r.referenceIrradianceNoise = refs.irradianceNoise;
+    r.referenceIndirectNoise = refs.indirectNoise;
   }
   markParetoFronts(results);
 
@@ -680,12 +684,17 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
      << " x " << params.height << " from the scene camera, references path-traced at "
      << params.referenceSpp
      << " spp. Errors are luminance relative RMSE / MAE over the pixels that see the scene "
-        "(see docs/accuracy.md for the definitions and the reference's own noise in "
-        "`cache/reference.json`). *front*: T = on the Pareto front of irradiance error vs bake "
+        "(docs/accuracy.md). "
+        "*front*: T = on the Pareto front of irradiance error vs bake "
         "time, M = vs GPU bytes. Frame times: OSMesa (software GL), "
      << params.frames
      << " frames, indirect mode. Times are wall-clock on this machine "
         "and include every bake stage.\n\n"
+     << "The references' own noise, the floor under these errors (relative RMS standard "
+        "error of luminance): irradiance "
+     << (results.empty() ? 0.0 : 100 * results.front().referenceIrradianceNoise)
+     << "%, indirect image "
+     << (results.empty() ? 0.0 : 100 * results.front().referenceIndirectNoise) << "%.\n\n"
      << markdownTable(results) << "\n";
   if (plotted) {
     md << "![error vs bake time](error-vs-bake-time.png)\n\n"

@@ -67,8 +67,11 @@ struct SweepResult {
   // Errors against the references (luminance; relative RMSE and MAE).
   double irradianceRelRmse = 0, irradianceRelMae = 0;
   double indirectRelRmse = -1;  ///< < 0: not measured
-  bool paretoTime = false;      ///< on the front of irradiance error vs bake time
-  bool paretoMemory = false;    ///< on the front of irradiance error vs GPU bytes
+  /// The references' own noise (relative RMS standard error of luminance):
+  /// the floor under the two errors above.
+  double referenceIrradianceNoise = 0, referenceIndirectNoise = 0;
+  bool paretoTime = false;    ///< on the front of irradiance error vs bake time
+  bool paretoMemory = false;  ///< on the front of irradiance error vs GPU bytes
 };
 
 /// Flags of the non-dominated points when minimising both cost and error
@@ -84,10 +87,14 @@ struct SweepParams {
   std::string executable;  ///< the `lightoctree` binary the bakes and renders run
   SweepScale scale = SweepScale::Full;
   std::vector<SweepPoint> points;  ///< empty = sweepPoints(scale)
-  int width = 320, height = 240;   ///< images compared (scene camera, else framed)
-  int referenceSpp = 1024;         ///< path-traced samples per pixel of each reference
-  int frames = 5;                  ///< frames timed per point (0: no indirect render)
-  int threads = 0;                 ///< bake / reference threads (0 = all cores)
+  int width = 160, height = 120;   ///< images compared (scene camera, else framed)
+  /// Path-traced samples per pixel of each reference. Irradiance is smooth, so
+  /// small images with many samples: the reference's own noise (relative RMS
+  /// standard error, printed and stored in cache/reference.json) is the floor
+  /// of every error measured against it.
+  int referenceSpp = 8192;
+  int frames = 5;   ///< frames timed per point (0: no indirect render)
+  int threads = 0;  ///< bake / reference threads (0 = all cores)
   uint64_t seed = 1;
   bool quiet = false;
 };

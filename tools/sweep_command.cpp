@@ -70,11 +70,11 @@ std::function<int()> addSweepCommand(CLI::App& app) {
       ->required();
   cmd->add_flag("--quick", opt->quick, "A reduced sweep: fewer points, smaller images");
   cmd->add_flag("--tiny", opt->tiny, "Three tiny points (a smoke test)")->group("");
-  cmd->add_option("--width", opt->width, "Image width (default: 320, quick 160)")
+  cmd->add_option("--width", opt->width, "Image width (default: 160, quick 96)")
       ->check(CLI::Range(1, 4096));
-  cmd->add_option("--height", opt->height, "Image height (default: 240, quick 120)")
+  cmd->add_option("--height", opt->height, "Image height (default: 120, quick 72)")
       ->check(CLI::Range(1, 4096));
-  cmd->add_option("--spp", opt->spp, "Reference samples per pixel (default: 1024, quick 256)")
+  cmd->add_option("--spp", opt->spp, "Reference samples per pixel (default: 8192, quick 2048)")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--frames", opt->frames,
                   "Frames timed per point with OSMesa (0: no GL render; default 5, quick 2)")
