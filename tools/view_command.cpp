@@ -69,6 +69,7 @@ struct ViewOptions {
   std::string saveFrames;
   int frames = 0;
   std::string record = "camera-path.txt";
+  bool continuous = false;
   bool progressive = false;
   size_t photons = 600000;
   int depth = 6;
@@ -89,6 +90,7 @@ struct ViewState {
   float pendingYaw = 0, pendingPitch = 0;  // radians, from the mouse since the last frame
   bool appendKey = false;                  // P pressed: handled in the frame loop
   bool printHelp = false;
+  bool damaged = false;  // the window needs a redraw (exposed, resized)
 };
 
 constexpr float kMouseRadiansPerPixel = 0.0025f;
@@ -200,6 +202,19 @@ void onCursor(GLFWwindow* window, double x, double y) {
   s.cursorX = x;
   s.cursorY = y;
   s.haveCursor = true;
+}
+
+void onRefresh(GLFWwindow* window) { stateOf(window).damaged = true; }
+
+bool sameView(const RenderCamera& a, const RenderCamera& b) {
+  return a.eye == b.eye && a.forward == b.forward && a.up == b.up && a.yfov == b.yfov &&
+         a.znear == b.znear && a.zfar == b.zfar;
+}
+
+bool sameParams(const RenderParams& a, const RenderParams& b) {
+  return a.width == b.width && a.height == b.height && a.mode == b.mode &&
+         a.interpolation == b.interpolation && a.specular == b.specular && a.maxVdls == b.maxVdls &&
+         a.normalOffset == b.normalOffset;
 }
 
 bool held(GLFWwindow* window, int key) { return glfwGetKey(window, key) == GLFW_PRESS; }
@@ -382,13 +397,18 @@ int runView(const ViewOptions& opt) {
   glfwSetScrollCallback(window, onScroll);
   glfwSetMouseButtonCallback(window, onMouseButton);
   glfwSetCursorPosCallback(window, onCursor);
+  glfwSetWindowRefreshCallback(window, onRefresh);
   if (!opt.quiet && !path) std::printf("%s", kKeys);
 
   PathRecorder recorder(opt.record);
   Stopwatch clock;
   double lastTime = 0, titleTime = 0, pathStart = 0;
   int titleFrames = 0, framesDrawn = 0, framesCounted = 0, savedFrames = 0;
-  double titleMs = 0;
+  double titleMs = 0, titleDrawSeconds = 0;
+  const bool alwaysDraw = opt.continuous || path || opt.frames > 0 || !opt.saveFrames.empty();
+  RenderCamera lastCamera;
+  RenderParams lastParams;
+  float lastExposure = 0;
   // A level that went on screen: reported once its first frame is drawn.
   std::optional<ProgressiveLevel> justShown;
   bool pathDone = false;
@@ -441,13 +461,30 @@ int runView(const ViewOptions& opt) {
     }
     state.params.width = width;
     state.params.height = height;
-    renderer.drawToScreen(camera, state.params, state.exposure);
-    if (!opt.saveFrames.empty()) {
-      writeImage(framePath(opt.saveFrames, savedFrames++), renderer.render(camera, state.params),
-                 state.exposure);
+
+    // On demand: a frame is drawn only when something on screen would change
+    // (camera, settings, window, a new level), so that a still view leaves
+    // the cores to the bake; paths, --frames and --save-frames draw every
+    // iteration, as does --continuous.
+    bool draw = alwaysDraw || framesDrawn == 0 || state.damaged || justShown ||
+                !sameView(camera, lastCamera) || !sameParams(state.params, lastParams) ||
+                state.exposure != lastExposure;
+    if (draw) {
+      Stopwatch frameClock;
+      renderer.drawToScreen(camera, state.params, state.exposure);
+      if (!opt.saveFrames.empty()) {
+        writeImage(framePath(opt.saveFrames, savedFrames++), renderer.render(camera, state.params),
+                   state.exposure);
+      }
+      context->swapBuffers();
+      titleDrawSeconds += frameClock.seconds();
+      ++titleFrames;
+      ++framesDrawn;
+      state.damaged = false;
+      lastCamera = camera;
+      lastParams = state.params;
+      lastExposure = state.exposure;
     }
-    context->swapBuffers();
-    ++framesDrawn;
     double frameEnd = clock.seconds();
 
     if (justShown) {
@@ -481,12 +518,14 @@ int runView(const ViewOptions& opt) {
 
     // Frames that count towards --frames: in progressive mode only those at
     // the target depth (earlier ones are drawn, and saved, but not counted).
-    if (!refining) ++framesCounted;
-    ++titleFrames;
+    if (draw && !refining) ++framesCounted;
     if (frameEnd - titleTime >= 0.5 || framesDrawn == 1) {
-      titleMs = 1000.0 * (frameEnd - titleTime) / titleFrames;
+      // Mean draw time of the frames drawn since the last update: what a
+      // frame costs, whether frames are drawn continuously or on demand.
+      if (titleFrames > 0) titleMs = 1000.0 * titleDrawSeconds / titleFrames;
       titleTime = frameEnd;
       titleFrames = 0;
+      titleDrawSeconds = 0;
       std::string octreeText;
       if (bake) {
         ProgressiveStatus st = bake->status();
@@ -505,6 +544,7 @@ int runView(const ViewOptions& opt) {
     }
     if (opt.frames > 0 && framesCounted >= opt.frames) break;
     if (pathDone) break;
+    if (!draw) glfwWaitEventsTimeout(bake && !bake->finished() ? 0.02 : 0.25);
   }
   double seconds = clock.seconds();
   if (!opt.quiet) {
@@ -580,6 +620,9 @@ std::function<int()> addViewCommand(CLI::App& app) {
                   "Exit after N frames (with --camera-path: N frames evenly spaced along it; "
                   "with --progressive: N frames at the target depth)")
       ->check(CLI::Range(0, 10000000));
+  cmd->add_flag("--continuous", opt->continuous,
+                "Redraw every iteration, even when nothing changed (by default a still view "
+                "is not redrawn, which leaves the CPU to a --progressive bake)");
   cmd->add_option("--record", opt->record, "Path file the P key appends keyframes to")
       ->capture_default_str();
   cmd->add_flag("--progressive", opt->progressive,
