@@ -202,6 +202,7 @@ int main(int argc, char** argv) {
     params.photons.storedPhotons = photons;
     params.firstDepth = 4;
     params.targetDepth = depth;
+    params.octree.cosineCorrection = true;  // as `view` (and `render`) by default
     lo::RenderParams renderParams;
     renderParams.width = width;
     renderParams.height = height;  // full mode, interpolation on: the viewer's defaults

@@ -64,6 +64,7 @@ struct ViewOptions {
   int emitterLights = 8;
   int shadowMapSize = 1024;
   bool halfFloat = false;
+  std::string cosineCorrection = "on";
   float speed = 0;  // 0 = a quarter of the scene's diagonal per second
   std::string cameraPath;
   std::string saveFrames;
@@ -267,7 +268,7 @@ class PathRecorder {
       started_ = true;
       last_ = -INFINITY;
     }
-    float t = base_ + float(clock_.seconds());
+    float t = base_ + float(last_ == -INFINITY ? 0.0 : clock_.seconds());
     t = std::max(t, last_ + 0.001f);  // strictly increasing, even for two presses in a frame
     appendCameraKey(path_, keyOf(camera, t));
     last_ = t;
@@ -356,6 +357,7 @@ int runView(const ViewOptions& opt) {
 
   GpuOctreeParams octreeParams;
   octreeParams.halfFloat = opt.halfFloat;
+  octreeParams.cosineCorrection = opt.cosineCorrection == "on";
   octreeParams.max3DTextureSize = context->info().max3DTextureSize;
   octreeParams.max2DTextureSize = context->info().max2DTextureSize;
 
@@ -437,7 +439,7 @@ int runView(const ViewOptions& opt) {
     RenderCamera camera;
     std::string pathText;
     if (path) {
-      if (framesDrawn == 0) pathStart = now;
+      if (framesDrawn == 0 || refining) pathStart = now;  // real time starts at the target depth
       float t = opt.frames > 0 ? path->frameTime(framesCounted, opt.frames)
                                : path->startTime() + float(now - pathStart);
       if (refining) t = path->startTime();
@@ -607,6 +609,10 @@ std::function<int()> addViewCommand(CLI::App& app) {
       ->check(CLI::Range(16, 8192))
       ->capture_default_str();
   cmd->add_flag("--half-float", opt->halfFloat, "VDL texture with half-float irradiance");
+  cmd->add_option("--cosine-correction", opt->cosineCorrection,
+                  "Divide each VDL by the cosine to its voxel's normal on upload (as `render`)")
+      ->check(onOff())
+      ->capture_default_str();
   cmd->add_option("--speed", opt->speed,
                   "Movement speed, scene units per second (default: a quarter of the scene's "
                   "diagonal)")
