@@ -13,6 +13,7 @@
 #include "core/math.h"
 #include "core/progress.h"
 #include "image/image.h"
+#include "scene/pinhole_camera.h"
 #include "scene/scene.h"
 
 namespace lo {
@@ -35,22 +36,9 @@ enum class ReferencePart {
 ReferencePart parseReferencePart(const std::string& name);
 std::string toString(ReferencePart part);
 
-/// A pinhole camera with the conventions of `lightoctree render`
-/// (render/renderer.h RenderCamera, glm::perspective + lookAt): the image
-/// spans yfov vertically, width/height sets the horizontal extent, row 0 is
-/// the top. Duplicated rather than shared because lo_render links OpenGL.
-struct ReferenceCamera {
-  Vec3 eye{0, 0, 1};
-  Vec3 forward{0, 0, -1};  ///< unit
-  Vec3 up{0, 1, 0};        ///< unit, orthogonal to forward
-  float yfov = 0.8f;       ///< vertical field of view, radians
-
-  static ReferenceCamera fromScene(const Camera& camera);
-  /// World up is +Y unless the view is along it (then -Z), as RenderCamera::lookAt.
-  static ReferenceCamera lookAt(const Vec3& eye, const Vec3& target, float yfovRadians);
-  /// Frames the scene bounds from the +Z side, as RenderCamera::framing.
-  static ReferenceCamera framing(const Bounds3& bounds, float yfovRadians);
-};
+/// The same camera as `lightoctree render` (scene/pinhole_camera.h); the
+/// near and far planes are ignored.
+using ReferenceCamera = PinholeCamera;
 
 struct ReferenceParams {
   int width = 256, height = 256;  ///< pixels

@@ -12,6 +12,7 @@
 
 #include "core/math.h"
 #include "octree/gpu_octree.h"
+#include "scene/pinhole_camera.h"
 #include "scene/scene.h"
 
 namespace lo {
@@ -48,21 +49,9 @@ struct RendererParams {
   int max3DTextureSize = 0, max2DTextureSize = 0;
 };
 
-/// A pinhole camera in world space.
-struct RenderCamera {
-  Vec3 eye{0, 0, 1};
-  Vec3 forward{0, 0, -1};  ///< unit
-  Vec3 up{0, 1, 0};        ///< unit, orthogonal to forward
-  float yfov = 0.8f;       ///< vertical field of view, radians
-  float znear = 0.01f;     ///< scene units
-  float zfar = 0;          ///< 0 = from the scene bounds
-
-  static RenderCamera fromScene(const Camera& camera);
-  /// Looks at `target` from `eye`; world up is +Y unless the view is along it.
-  static RenderCamera lookAt(const Vec3& eye, const Vec3& target, float yfovRadians);
-  /// Frames the scene bounds from the +Z side.
-  static RenderCamera framing(const Bounds3& bounds, float yfovRadians);
-};
+/// The GL renderer's camera is the scene's pinhole camera (shared with the
+/// reference renderer so that images line up).
+using RenderCamera = PinholeCamera;
 
 /// Linear float RGBA pixels, row 0 at the top.
 struct Image {
