@@ -45,6 +45,9 @@ std::string numberText(double v) {
 }
 
 /// Single quotes for /bin/sh; a quote inside becomes '\''.
+/// A fraction as a percentage rounded to 2 decimals.
+double percent2(double fraction) { return std::round(10000.0 * fraction) / 100.0; }
+
 std::string shellQuote(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -692,9 +695,10 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
         "and include every bake stage.\n\n"
      << "The references' own noise, the floor under these errors (relative RMS standard "
         "error of luminance): irradiance "
-     << (results.empty() ? 0.0 : 100 * results.front().referenceIrradianceNoise)
+     << numberText(results.empty() ? 0.0 : percent2(results.front().referenceIrradianceNoise))
      << "%, indirect image "
-     << (results.empty() ? 0.0 : 100 * results.front().referenceIndirectNoise) << "%.\n\n"
+     << numberText(results.empty() ? 0.0 : percent2(results.front().referenceIndirectNoise))
+     << "%.\n\n"
      << markdownTable(results) << "\n";
   if (plotted) {
     md << "![error vs bake time](error-vs-bake-time.png)\n\n"
