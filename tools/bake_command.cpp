@@ -5,7 +5,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -17,6 +16,7 @@
 #include "photon/photon_map.h"
 #include "report.h"
 #include "scene/scene.h"
+#include "text_file.h"
 #include "vdb/vdb_io.h"
 
 namespace lo::tool {
@@ -38,33 +38,12 @@ struct BakeOptions {
   bool quiet = false;
 };
 
-void writeTextAtomically(const std::string& path, const std::string& text) {
-  std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw IoError(path + ": cannot open for writing");
-    f << text;
-    if (!f.flush()) {
-      std::filesystem::remove(tmp);
-      throw IoError(path + ": write failed");
-    }
-  }
-  std::filesystem::rename(tmp, path);
-}
-
-/// Refuses an output whose folder does not exist before any work is done,
-/// rather than after a long bake.
-void checkOutputPath(const std::string& path, const char* flag) {
-  std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw InputError(std::string(flag) + ": folder '" + parent.string() + "' does not exist");
-  }
 }
 
 int runBake(const BakeOptions& opt) {
-  checkOutputPath(opt.output, "--output");
-  if (!opt.photonMap.empty()) checkOutputPath(opt.photonMap, "--photon-map");
-  if (!opt.statsJson.empty()) checkOutputPath(opt.statsJson, "--stats-json");
+  checkOutputFolder(opt.output, "--output");
+  if (!opt.photonMap.empty()) checkOutputFolder(opt.photonMap, "--photon-map");
+  if (!opt.statsJson.empty()) checkOutputFolder(opt.statsJson, "--stats-json");
 
   std::unique_ptr<tbb::global_control> threadLimit;
   if (opt.threads > 0) {
