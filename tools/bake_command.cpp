@@ -38,8 +38,6 @@ struct BakeOptions {
   bool quiet = false;
 };
 
-}
-
 int runBake(const BakeOptions& opt) {
   checkOutputFolder(opt.output, "--output");
   if (!opt.photonMap.empty()) checkOutputFolder(opt.photonMap, "--photon-map");
