@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -125,7 +126,8 @@ int main(int argc, char** argv) {
   std::string out = std::string(LO_SOURCE_DIR) + "/docs/results/bake-times.md";
   size_t photons = 600000;
   std::vector<int> depths{4, 5, 6};
-  app.add_option("--scenes", scenesDir, "Folder with cornell-box.glb, cornell-bunny.glb, cornell-dragon.glb")
+  app.add_option("--scenes", scenesDir,
+                 "Folder with cornell-box.glb, cornell-bunny.glb, cornell-dragon.glb")
       ->capture_default_str();
   app.add_option("--out", out, "Markdown table to write")->capture_default_str();
   app.add_option("--photons", photons, "Stored photons")->capture_default_str();
@@ -144,8 +146,10 @@ int main(int argc, char** argv) {
      << "| scene | triangles | depth | active voxels | trace 600k photons | voxelize | splat | "
         "gather + cluster | **compression** | paper (compression) | speed-up | peak RSS |\n"
      << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  std::printf("%-7s %5s %9s %8s %9s %8s %9s %12s %10s %9s\n", "scene", "depth", "voxels", "trace",
-              "voxelize", "splat", "gath+clu", "compression", "paper", "peak");
+  std::printf("%-7s %5s %9s %8s %9s %8s %9s %9s %9s %12s %10s %9s\n", "scene", "depth", "voxels",
+              "trace", "voxelize", "splat", "gath+clu", "gath cpu", "clu cpu", "compression",
+              "paper", "peak");
+  double worst4 = 0, worst6 = 0, worstTrace = 0;
   for (const SceneSpec& s : kScenes) {
     std::string path = scenesDir + "/" + s.file;
     if (!std::filesystem::exists(path)) {
@@ -159,18 +163,24 @@ int main(int argc, char** argv) {
         continue;
       }
       double compression = r.voxelize + r.splat + r.gatherCluster;
+      if (depth == 4) worst4 = std::max(worst4, compression);
+      if (depth == 6) worst6 = std::max(worst6, compression);
+      worstTrace = std::max(worstTrace, r.trace);
       const char* paper = (depth >= 4 && depth <= 6) ? s.paper[depth - 4] : "-";
       double paperSeconds = 0;
       {
         int m = 0, sec = 0;
-        if (std::sscanf(paper, "%d m %d s", &m, &sec) == 2) paperSeconds = m * 60 + sec;
-        else if (std::sscanf(paper, "%d s", &sec) == 1) paperSeconds = sec;
+        if (std::sscanf(paper, "%d m %d s", &m, &sec) == 2)
+          paperSeconds = m * 60 + sec;
+        else if (std::sscanf(paper, "%d s", &sec) == 1)
+          paperSeconds = sec;
       }
       char speedup[32] = "-";
-      if (paperSeconds > 0) std::snprintf(speedup, sizeof speedup, "%.0fx", paperSeconds / compression);
-      std::printf("%-7s %5d %9zu %7.3fs %8.3fs %7.3fs %8.3fs %11.3fs %10s %9s\n", s.label, depth,
-                  r.voxels, r.trace, r.voxelize, r.splat, r.gatherCluster, compression, paper,
-                  mib(r.peakBytes).c_str());
+      if (paperSeconds > 0)
+        std::snprintf(speedup, sizeof speedup, "%.0fx", paperSeconds / compression);
+      std::printf("%-7s %5d %9zu %7.3fs %8.3fs %7.3fs %8.3fs %8.3fs %8.3fs %11.3fs %10s %9s\n",
+                  s.label, depth, r.voxels, r.trace, r.voxelize, r.splat, r.gatherCluster,
+                  r.gatherThread, r.clusterThread, compression, paper, mib(r.peakBytes).c_str());
       std::fflush(stdout);
       char line[512];
       std::snprintf(line, sizeof line,
@@ -181,8 +191,16 @@ int main(int argc, char** argv) {
       md << line;
     }
   }
-  md << "\nTargets on this 2-core machine: compression at depth 6 <= 2 s, at depth 4 <= 0.2 s, "
-        "600k stored photons traced in <= 0.5 s.\n";
+  auto verdict = [](double worst, double target) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "worst %.3f s: %s", worst, worst <= target ? "met" : "MISSED");
+    return std::string(buf);
+  };
+  md << "\nTargets on this 2-core machine: compression at depth 6 <= 2 s (" << verdict(worst6, 2.0)
+     << "), at depth 4 <= 0.2 s (" << verdict(worst4, 0.2)
+     << "), 600k stored photons traced in <= 0.5 s (" << verdict(worstTrace, 0.5) << ").\n"
+     << "\nThe machine is a shared virtual machine: the same run varies by about 30% from one "
+        "minute to the next, so compare rows of one run rather than runs.\n";
   std::filesystem::create_directories(std::filesystem::path(out).parent_path());
   std::ofstream(out) << md.str();
   std::printf("wrote %s\n", out.c_str());

@@ -8,7 +8,9 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -19,8 +21,9 @@ namespace vdl_grid_internal {
 // Per-thread state: the gatherer holds candidate scratch; the sample buffer
 // and result are reused from voxel to voxel so the loop does not allocate.
 struct Worker {
-  Worker(const SurfaceGrid& grid, const std::vector<Photon>& photons, const GatherParams& params)
-      : gatherer(grid, photons, params) {}
+  Worker(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+         std::shared_ptr<const BinnedPhotons> binned, const GatherParams& params)
+      : gatherer(grid, photons, std::move(binned), params) {}
   Gatherer gatherer;
   GatherResult gathered;
   std::vector<DirectionSample> samples;
@@ -114,7 +117,10 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
   out.vdlCount.assign(n, 0);
   out.vdls.assign(n * size_t(out.maxVdls), Vdl{});  // unused slots stay zero
 
-  tbb::enumerable_thread_specific<Worker> workers([&] { return Worker(grid, photons, gather); });
+  // One copy of the binned photons, read by every thread's gatherer.
+  std::shared_ptr<const BinnedPhotons> binned = binPhotonsForGather(grid, photons);
+  tbb::enumerable_thread_specific<Worker> workers(
+      [&] { return Worker(grid, photons, binned, gather); });
   {
     Progress bar(progress, "gather + cluster", n);
     // Every voxel writes only its own slots and seeds its K-means with its

@@ -4,6 +4,7 @@
 /// radius r, distances measured in an ellipsoid aligned with the voxel normal.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/math.h"
@@ -13,7 +14,7 @@
 namespace lo {
 
 struct GatherParams {
-  int k = 300;           ///< nearest neighbours (paper: 300)
+  int k = 300;  ///< nearest neighbours (paper: 300)
   /// Gathering radius in world units; 0 = kDefaultRadiusVoxels * voxel size.
   float radius = 0.0f;
   /// Ellipsoid axis ratio: a photon's offset along the voxel normal counts
@@ -29,50 +30,88 @@ constexpr float kDefaultRadiusVoxels = 3.0f;
 float resolveRadius(const GatherParams& params, const GridFrame& frame);
 
 struct GatherResult {
-  std::vector<uint32_t> photons;  ///< indices of the gathered photons (<= k), nearest first not required
-  float radius = 0.0f;            ///< r_k: distance (ellipsoid metric) of the k-th photon, or r if fewer found
-  Vec3 normal{0, 0, 0};           ///< voxel normal oriented towards the side the light arrives from
-  Vec3 irradiance{0, 0, 0};       ///< sum(power) / (pi r_k^2), W/m^2
+  std::vector<uint32_t> photons;  ///< indices of the gathered photons (<= k), in no particular (but
+                                  ///< deterministic) order
+  float radius =
+      0.0f;  ///< r_k: distance (ellipsoid metric) of the k-th photon, or r if fewer found
+  Vec3 normal{0, 0, 0};      ///< voxel normal oriented towards the side the light arrives from
+  Vec3 irradiance{0, 0, 0};  ///< sum(power) / (pi r_k^2), W/m^2
 };
+
+/// The photons of a surface grid's bins, copied contiguously in bin order
+/// (grid.binPhotons order: bin v is entries[grid.binStart[v] ..
+/// grid.binStart[v + 1])), with just what the gather reads. Built once per
+/// (grid, photons) and shared read-only by the gatherers of all threads.
+struct BinnedPhotons {
+  struct Entry {
+    Vec3 position;   ///< world space
+    Vec3 normal;     ///< the photon's normal (facing its arrival side)
+    float weight;    ///< average(power), W: the orientation vote's weight
+    uint32_t index;  ///< into the photon array
+  };
+  std::vector<Entry> entries;
+  /// Per bin (grid voxel): the bounds of its photons' positions and, when its
+  /// photons carry at most kMaxGroups distinct normals, their summed weight
+  /// per normal. A bin whose bounds lie wholly within the gather radius then
+  /// votes per normal instead of per photon.
+  static constexpr int kMaxGroups = 4;
+  struct Bin {
+    Vec3 lower{0, 0, 0}, upper{0, 0, 0};
+    int groups = 0;  ///< 0: vote per photon
+    Vec3 normal[kMaxGroups];
+    double weight[kMaxGroups] = {0, 0, 0, 0};
+  };
+  std::vector<Bin> bins;
+};
+
+/// @throws InputError if splatPhotons has not filled the grid's bins.
+std::shared_ptr<const BinnedPhotons> binPhotonsForGather(const SurfaceGrid& grid,
+                                                         const std::vector<Photon>& photons);
 
 /// Grid-coherent gatherer: candidates come from the photon bins of the voxels
 /// within the radius, so no kd-tree is built. One per thread (holds scratch).
+/// See docs/grid-and-gather.md for the two passes (orientation vote over the
+/// radius, then nearest bins first until the k-th distance is bounded).
 class Gatherer {
  public:
+  /// Builds its own BinnedPhotons (one thread, or tests).
   Gatherer(const SurfaceGrid& grid, const std::vector<Photon>& photons, const GatherParams& params);
+  /// Shares `binned` (from binPhotonsForGather on the same grid and photons).
+  Gatherer(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+           std::shared_ptr<const BinnedPhotons> binned, const GatherParams& params);
   void gather(size_t voxel, GatherResult& out);
 
  private:
   const SurfaceGrid& grid_;
   const std::vector<Photon>& photons_;
+  std::shared_ptr<const BinnedPhotons> binned_;
   GatherParams params_;
   float radius_;
   int reachVoxels_;
-  /// Photons within r as (float bits of d^2) << 32 | photon index, so that one
-  /// integer comparison orders by distance with ties broken by index; split by
-  /// the side they arrived from relative to the unoriented voxel normal.
-  std::vector<uint64_t> candidates_;
-  std::vector<uint64_t> backCandidates_;
+  /// The k nearest so far as (float bits of d^2) << 32 | photon index (one
+  /// integer comparison orders by distance with ties broken by index).
+  std::vector<uint64_t> keys_;
 
-  /// The photons of the active voxels near the 8^3 block of the last gathered
-  /// voxel, copied contiguously once per block (grid.find + bins) and scanned
-  /// by every voxel of the block: the scan then reads cache-resident memory
-  /// instead of photons scattered over the whole map.
-  struct LocalPhoton {
-    Vec3 position;
-    Vec3 normal;
-    Vec3 power;
-    uint32_t index;
-  };
+  /// Active voxels with photons near the 8^3 block of the last gathered voxel
+  /// (looked up once per block with grid.find); each voxel prunes them by the
+  /// distance from its query point to their box.
   struct Neighbour {
     Coord coord;
-    uint32_t begin, end;  ///< range in blockPhotons_
+    uint32_t voxel;       ///< grid index = bin
+    uint32_t begin, end;  ///< range in binned_->entries
+  };
+  struct Near {
+    double bound2;  ///< lower bound of d^2 (world units^2) of any photon in the bin
+    uint32_t neighbour;
+    bool operator<(const Near& o) const {
+      return bound2 < o.bound2 || (bound2 == o.bound2 && neighbour < o.neighbour);
+    }
   };
   void updateBlock(const Coord& voxelCoord);
   Coord blockCoord_{};
   bool blockValid_ = false;
   std::vector<Neighbour> blockNeighbours_;
-  std::vector<LocalPhoton> blockPhotons_;
+  std::vector<Near> near_;  ///< this voxel's neighbours within reach, nearest first
 };
 
 /// Reference: the same selection by scanning every photon. For tests.
