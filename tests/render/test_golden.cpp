@@ -1,0 +1,181 @@
+// Golden images of the bundled Cornell box under OSMesa: the committed bake
+// tests/golden/cornell-box-d4.vdb rendered at 128x128 from the scene camera in
+// modes full, indirect and direct, compared with tests/golden/cornell-box-<mode>.png.
+//
+// Compared in the PNGs' own 8-bit sRGB values (what a person sees): a pixel
+// fails when a channel differs by more than kPixelTolerance; the test fails
+// when more than kMaxFailingFraction of the pixels fail or any pixel differs
+// by more than kMaxAbsDiff. On failure the rendered image, the reference and
+// an amplified difference are written to the test's output folder and their
+// paths printed.
+//
+// Regenerate the references (after an intended change of the renderer, and
+// look at them):  LO_UPDATE_GOLDEN=1 build/tests/lightoctree_tests --gtest_filter='Golden*'
+// Regenerate the bake itself (after a change of the VDL file format):
+//   lightoctree bake data/cornell-box.gltf -o tests/golden/cornell-box-d4.vdb --depth 4
+//     --photons 50000 --knn 50 --seed 1
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "image/image.h"
+#include "octree/gpu_octree.h"
+#include "render/context.h"
+#include "render/image_io.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+#include "test_util.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+namespace {
+
+constexpr int kSize = 128;
+constexpr float kPixelTolerance = 8.0f / 255.0f;  // per channel, 8-bit sRGB
+constexpr double kMaxFailingFraction = 0.005;     // 82 of 16384 pixels
+constexpr float kMaxAbsDiff = 64.0f / 255.0f;     // no pixel may be grossly wrong
+
+std::string goldenDir() { return test::dataDir() + "/../tests/golden"; }
+
+bool updating() {
+  const char* v = std::getenv("LO_UPDATE_GOLDEN");
+  return v && std::string(v) == "1";
+}
+
+GlContext* context() {
+  static std::unique_ptr<GlContext> c;
+  static bool tried = false;
+  if (!tried) {
+    tried = true;
+    try {
+      c = createGlContext({GlBackend::OSMesa});
+    } catch (const std::exception&) {
+    }
+  }
+  if (c) c->makeCurrent();
+  return c.get();
+}
+
+struct Setup {
+  Scene scene;
+  GpuOctree octree;
+  RenderCamera camera;
+  Setup() {
+    scene = loadScene(test::dataDir() + "/cornell-box.gltf");
+    LoadedVdl baked = readVdlGrid(goldenDir() + "/cornell-box-d4.vdb");
+    octree = buildGpuOctree(baked.grid);
+    camera = RenderCamera::fromScene(scene.cameras.at(0));
+  }
+};
+
+const Setup& setup() {
+  static const Setup s;
+  return s;
+}
+
+/// Exposure per mode so that every reference uses the 8-bit range.
+float exposureOf(RenderMode mode) { return mode == RenderMode::Indirect ? 1.0f : 0.0f; }
+
+/// The rendered frame as the PNG would store it: 8-bit sRGB, read back as v/255.
+RgbImage asPng(const Image& image, float exposure, const std::string& path) {
+  writeImage(path, image, exposure);
+  return readImage(path, true);
+}
+
+struct Mismatch {
+  float maxAbsDiff = 0;
+  double failingFraction = 0;
+  bool failed() const { return failingFraction > kMaxFailingFraction || maxAbsDiff > kMaxAbsDiff; }
+};
+
+Mismatch compare(const RgbImage& a, const RgbImage& b, RgbImage* diff) {
+  Mismatch m;
+  size_t failing = 0;
+  if (diff) *diff = RgbImage(a.width, a.height);
+  for (size_t i = 0; i < a.pixelCount(); ++i) {
+    float worst = 0;
+    for (int k = 0; k < 3; ++k) {
+      const float d = std::fabs(a.rgb[3 * i + k] - b.rgb[3 * i + k]);
+      worst = std::max(worst, d);
+      if (diff) diff->rgb[3 * i + k] = std::min(1.0f, 8.0f * d);  // amplified to be seen
+    }
+    m.maxAbsDiff = std::max(m.maxAbsDiff, worst);
+    failing += worst > kPixelTolerance;
+  }
+  m.failingFraction = double(failing) / double(std::max<size_t>(a.pixelCount(), 1));
+  return m;
+}
+
+/// Renders `mode`; compares with (or, when updating, writes) the golden PNG.
+Mismatch renderAndCompare(RenderMode mode, bool interpolation, const std::string& reference,
+                          const std::string& name) {
+  const Setup& s = setup();
+  Renderer renderer(s.scene, s.octree);
+  RenderParams p;
+  p.width = p.height = kSize;
+  p.mode = mode;
+  p.interpolation = interpolation;
+  Image frame = renderer.render(s.camera, p);
+  const std::string dir = test::outputDir(name);
+  const std::string rendered = dir + "/rendered.png";
+  RgbImage got = asPng(frame, exposureOf(mode), rendered);
+  if (updating()) {
+    writeImage(reference, frame, exposureOf(mode));
+    std::printf("wrote %s\n", reference.c_str());
+    return {};
+  }
+  RgbImage expected = readImage(reference, true);
+  EXPECT_EQ(got.width, expected.width);
+  EXPECT_EQ(got.height, expected.height);
+  if (got.width != expected.width || got.height != expected.height) return {1.0f, 1.0};
+  RgbImage diff;
+  Mismatch m = compare(got, expected, &diff);
+  if (m.failed()) {
+    std::filesystem::copy_file(reference, dir + "/reference.png",
+                               std::filesystem::copy_options::overwrite_existing);
+    writePng(dir + "/difference.png", diff);
+    std::printf(
+        "[ golden %s ] rendered %s\n[ golden %s ] reference %s\n[ golden %s ] difference "
+        "(x8) %s\n",
+        name.c_str(), rendered.c_str(), name.c_str(), (dir + "/reference.png").c_str(),
+        name.c_str(), (dir + "/difference.png").c_str());
+  }
+  return m;
+}
+
+void checkGolden(RenderMode mode) {
+  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  const std::string name = "golden_cornell_" + toString(mode);
+  const std::string reference = goldenDir() + "/cornell-box-" + toString(mode) + ".png";
+  Mismatch m = renderAndCompare(mode, true, reference, name);
+  if (updating()) return;
+  EXPECT_LE(m.failingFraction, kMaxFailingFraction)
+      << name << ": fraction of pixels off by more than 8/255 (max abs diff " << m.maxAbsDiff
+      << ")";
+  EXPECT_LE(m.maxAbsDiff, kMaxAbsDiff) << name;
+}
+
+TEST(Golden, CornellBoxFull) { checkGolden(RenderMode::Full); }
+TEST(Golden, CornellBoxIndirect) { checkGolden(RenderMode::Indirect); }
+TEST(Golden, CornellBoxDirect) { checkGolden(RenderMode::Direct); }
+
+// The tolerances must catch a real change: the indirect image without
+// interpolation (blocky voxels) must fail against the interpolated reference.
+TEST(Golden, ToleranceDetectsInterpolationOff) {
+  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (updating()) GTEST_SKIP() << "updating the references";
+  Mismatch m =
+      renderAndCompare(RenderMode::Indirect, false, goldenDir() + "/cornell-box-indirect.png",
+                       "golden_cornell_indirect_nearest");
+  EXPECT_TRUE(m.failed()) << "failing fraction " << m.failingFraction << ", max abs diff "
+                          << m.maxAbsDiff;
+}
+
+}  // namespace
+}  // namespace lo
