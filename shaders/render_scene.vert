@@ -8,6 +8,7 @@ layout(location = 3) in vec2 aMetallicRoughness;
 layout(location = 4) in vec3 aEmission;  // W/(m^2 sr)
 
 uniform mat4 uViewProj;
+invariant gl_Position;  // as render_depth.vert: the depth pre-pass must match exactly
 
 out vec3 vPosition;
 out vec3 vNormal;

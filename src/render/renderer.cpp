@@ -109,7 +109,7 @@ struct Renderer::Impl {
   Vec3 octreeOrigin;
   float voxelSize = 1;
 
-  GLuint sceneProgram = 0, shadowProgram = 0, probeProgram = 0;
+  GLuint sceneProgram = 0, shadowProgram = 0, depthProgram = 0, probeProgram = 0;
   GLuint vao = 0, vbo = 0, emptyVao = 0;
   GLsizei vertexCount = 0;
   GLuint octreeTexture = 0, vdlTexture = 0, vdlHalfTexture = 0, shadowTexture = 0, lightUbo = 0;
@@ -122,7 +122,7 @@ struct Renderer::Impl {
   LightBlock lightBlock{};
 
   ~Impl() {
-    GLuint programs[] = {sceneProgram, shadowProgram, probeProgram};
+    GLuint programs[] = {sceneProgram, shadowProgram, depthProgram, probeProgram};
     for (GLuint p : programs) {
       if (p) glDeleteProgram(p);
     }
@@ -479,8 +479,20 @@ struct Renderer::Impl {
     glClearColor(0, 0, 0, 1);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
     glDisable(GL_CULL_FACE);
+    // Depth pre-pass: the scene shader (octree descent, up to 8 x 8 VDL
+    // fetches, shadow lookups) then shades each pixel once, not once per
+    // overlapping surface; scenes with depth complexity gain the most.
+    glDepthFunc(GL_LESS);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glUseProgram(depthProgram);
+    glUniformMatrix4fv(glGetUniformLocation(depthProgram, "uViewProj"), 1, GL_FALSE,
+                       glm::value_ptr(viewProj));
+    glBindVertexArray(vao);
+    glDrawArrays(GL_TRIANGLES, 0, vertexCount);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
     GLuint p = sceneProgram;
     glUseProgram(p);
     auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
@@ -514,6 +526,8 @@ struct Renderer::Impl {
     glBindVertexArray(vao);
     glDrawArrays(GL_TRIANGLES, 0, vertexCount);
     glBindVertexArray(0);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
     checkGl("drawing the scene");
   }
 };
@@ -534,6 +548,7 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.sceneProgram = buildProgram({"render_scene.vert", "render_scene.frag"});
   glUniformBlockBinding(r.sceneProgram, glGetUniformBlockIndex(r.sceneProgram, "LightBlock"), 0);
   r.shadowProgram = buildProgram({"render_shadow.vert", "render_shadow.frag"});
+  r.depthProgram = buildProgram({"render_depth.vert", "render_depth.frag"});
   r.uploadOctree(octree);
   r.uploadScene(scene);
   r.setupLights(scene);

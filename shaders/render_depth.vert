@@ -1,0 +1,9 @@
+#version 330 core
+// Depth pre-pass: the scene pass's position transform alone, so that the
+// expensive scene shader runs once per pixel (GL_LEQUAL against this depth)
+// instead of once per overlapping surface. `invariant` on both shaders makes
+// the two passes produce bit-identical depths.
+layout(location = 0) in vec3 aPosition;
+uniform mat4 uViewProj;
+invariant gl_Position;
+void main() { gl_Position = uViewProj * vec4(aPosition, 1.0); }
