@@ -177,7 +177,7 @@ std::function<int()> addBakeCommand(CLI::App& app) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--radius", opt->radius,
-                  "Gathering radius in scene units (default: 3 voxel sizes)")
+                  "Gathering radius in scene units (default: 1.5 voxel sizes)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--vdls", opt->vdls,
                   "VDLs per voxel, 1-8, or 'auto' for the fewest that keep the angular error "

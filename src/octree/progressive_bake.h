@@ -24,7 +24,7 @@ struct ProgressiveParams {
   PhotonParams photons;    ///< photon tracing (stored photons, seed)
   int firstDepth = 4;      ///< first level shown (the paper's "rough visualisation")
   int targetDepth = 6;     ///< last level baked, >= firstDepth
-  GatherParams gather;     ///< as `bake` (k = 300; radius 0 = 3 voxels of each level)
+  GatherParams gather;     ///< as `bake` (k = 300; radius 0 = kDefaultRadiusVoxels of each level)
   ClusterParams cluster;   ///< as `bake` (4 VDLs per voxel)
   GpuOctreeParams octree;  ///< texture limits of the context that will draw it
 };
