@@ -14,7 +14,7 @@ PACKAGES=(
   # sparse grids and .vdb files (OpenVDB's CMake module needs boost-iostreams)
   libopenvdb-dev libboost-iostreams-dev libblosc-dev libopenvdb-tools
   # nearest neighbours, linear algebra, CLI, tests
-  libnanoflann-dev libeigen3-dev libcli11-dev libgtest-dev
+  libnanoflann-dev libcli11-dev libgtest-dev
   # images and GL rendering (OSMesa headless, EGL, GLFW window), math
   libopenexr-dev libglm-dev libglfw3-dev libosmesa6-dev libegl-dev libgl-dev python3-glad
   # plots of the parameter sweep (lightoctree sweep)
