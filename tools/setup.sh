@@ -13,7 +13,7 @@ PACKAGES=(
   libembree-dev libtbb-dev
   # sparse grids and .vdb files (OpenVDB's CMake module needs boost-iostreams)
   libopenvdb-dev libboost-iostreams-dev libblosc-dev libopenvdb-tools
-  # nearest neighbours, linear algebra, CLI, tests
+  # kd-tree baseline of the gather benchmark, CLI, tests
   libnanoflann-dev libcli11-dev libgtest-dev
   # images and GL rendering (OSMesa headless, EGL, GLFW window), math
   libopenexr-dev libglm-dev libglfw3-dev libosmesa6-dev libegl-dev libgl-dev python3-glad
