@@ -480,19 +480,25 @@ struct Renderer::Impl {
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
-    // Depth pre-pass: the scene shader (octree descent, up to 8 x 8 VDL
-    // fetches, shadow lookups) then shades each pixel once, not once per
-    // overlapping surface; scenes with depth complexity gain the most.
+    // Depth pre-pass: the scene shader then shades each pixel once, not once
+    // per overlapping surface. It pays where shading is dear (shadow lookups
+    // of the direct pass, 8-voxel interpolation); for the cheap modes the
+    // second geometry pass costs more than the overdraw it saves (measured,
+    // docs/results/render.md), so they draw with a plain depth test.
+    const bool prePass =
+        rp.interpolation || rp.mode == RenderMode::Full || rp.mode == RenderMode::Direct;
     glDepthFunc(GL_LESS);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    glUseProgram(depthProgram);
-    glUniformMatrix4fv(glGetUniformLocation(depthProgram, "uViewProj"), 1, GL_FALSE,
-                       glm::value_ptr(viewProj));
-    glBindVertexArray(vao);
-    glDrawArrays(GL_TRIANGLES, 0, vertexCount);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDepthFunc(GL_LEQUAL);
-    glDepthMask(GL_FALSE);
+    if (prePass) {
+      glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+      glUseProgram(depthProgram);
+      glUniformMatrix4fv(glGetUniformLocation(depthProgram, "uViewProj"), 1, GL_FALSE,
+                         glm::value_ptr(viewProj));
+      glBindVertexArray(vao);
+      glDrawArrays(GL_TRIANGLES, 0, vertexCount);
+      glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+      glDepthFunc(GL_LEQUAL);
+      glDepthMask(GL_FALSE);
+    }
     GLuint p = sceneProgram;
     glUseProgram(p);
     auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
