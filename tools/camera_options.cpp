@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <sstream>
 
+#include "core/error.h"
+
 namespace lo::tool {
 
 void addCameraOptions(CLI::App* cmd, CameraOptions& opt) {
@@ -47,6 +49,21 @@ const Camera* findSceneCamera(const CameraOptions& opt, const Scene& scene,
                      (names.empty() ? " (it has none)" : " (it has: " + names + ")"));
   }
   return nullptr;
+}
+
+PinholeCamera chooseCamera(const CameraOptions& opt, const Scene& scene,
+                           const std::string& scenePath) {
+  const float fov = (opt.fovDegrees > 0 ? opt.fovDegrees : 45.0f) * kPi / 180.0f;
+  if (!opt.eye.empty()) {
+    const Vec3 eye = parseVec3(opt.eye, "--eye"), target = parseVec3(opt.target, "--target");
+    if (eye == target) throw InputError("--eye and --target: the same point");
+    return PinholeCamera::lookAt(eye, target, fov);
+  }
+  const Camera* chosen = findSceneCamera(opt, scene, scenePath);
+  if (!chosen) return PinholeCamera::framing(scene.bounds(), fov);
+  PinholeCamera camera = PinholeCamera::fromScene(*chosen);
+  if (opt.fovDegrees > 0) camera.yfov = fov;
+  return camera;
 }
 
 }  // namespace lo::tool

@@ -6,8 +6,8 @@
 
 #include <string>
 
-#include "core/error.h"
 #include "core/math.h"
+#include "scene/pinhole_camera.h"
 #include "scene/scene.h"
 
 namespace CLI {
@@ -37,22 +37,10 @@ Vec3 parseVec3(const std::string& text, const char* flag);
 const Camera* findSceneCamera(const CameraOptions& opt, const Scene& scene,
                               const std::string& scenePath);
 
-/// The view the flags select, in the conventions both renderers share
-/// (`Cam` is RenderCamera or ReferenceCamera: fromScene, lookAt, framing).
-/// Without --eye or a scene camera, the scene bounds are framed from +Z.
-template <typename Cam>
-Cam chooseCamera(const CameraOptions& opt, const Scene& scene, const std::string& scenePath) {
-  const float fov = (opt.fovDegrees > 0 ? opt.fovDegrees : 45.0f) * kPi / 180.0f;
-  if (!opt.eye.empty()) {
-    const Vec3 eye = parseVec3(opt.eye, "--eye"), target = parseVec3(opt.target, "--target");
-    if (eye == target) throw InputError("--eye and --target: the same point");
-    return Cam::lookAt(eye, target, fov);
-  }
-  const Camera* chosen = findSceneCamera(opt, scene, scenePath);
-  if (!chosen) return Cam::framing(scene.bounds(), fov);
-  Cam camera = Cam::fromScene(*chosen);
-  if (opt.fovDegrees > 0) camera.yfov = fov;
-  return camera;
-}
+/// The view the flags select (the GL renderer, the reference renderer and
+/// the viewer share the camera type). Without --eye or a scene camera, the
+/// scene bounds are framed from +Z. @throws InputError naming the flag.
+PinholeCamera chooseCamera(const CameraOptions& opt, const Scene& scene,
+                           const std::string& scenePath);
 
 }  // namespace lo::tool

@@ -55,7 +55,7 @@ int runReference(const ReferenceOptions& opt) {
   }
 
   Scene scene = loadScene(opt.scene);
-  ReferenceCamera camera = chooseCamera<ReferenceCamera>(opt.camera, scene, opt.scene);
+  ReferenceCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   ReferenceParams params;
   params.width = opt.width;
   params.height = opt.height;

@@ -50,7 +50,7 @@ struct RenderOptions {
 /// the reference's samples do.
 int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedVdl& baked) {
   if (opt.frames > 0) throw InputError("--frames: not with --mode irradiance (no GL frame)");
-  ReferenceCamera camera = chooseCamera<ReferenceCamera>(opt.camera, scene, opt.scene);
+  ReferenceCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   GpuOctreeParams octreeParams;
   octreeParams.halfFloat = opt.halfFloat;
   octreeParams.cosineCorrection = opt.cosineCorrection == "on";
@@ -98,7 +98,7 @@ int runRender(const RenderOptions& opt) {
 
   Scene scene = loadScene(opt.scene);
   LoadedVdl baked = readVdlGrid(opt.lights);
-  RenderCamera camera = chooseCamera<RenderCamera>(opt.camera, scene, opt.scene);
+  RenderCamera camera = chooseCamera(opt.camera, scene, opt.scene);
 
   GlContextParams contextParams;
   contextParams.backend = parseGlBackend(opt.backend);

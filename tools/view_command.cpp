@@ -332,7 +332,7 @@ int runView(const ViewOptions& opt) {
   std::optional<LoadedVdl> baked;
   if (!opt.progressive) baked = readVdlGrid(opt.lights);
 
-  RenderCamera startCamera = chooseCamera<RenderCamera>(opt.camera, scene, opt.scene);
+  RenderCamera startCamera = chooseCamera(opt.camera, scene, opt.scene);
   float defaultFovDegrees = opt.camera.fovDegrees > 0 ? opt.camera.fovDegrees : 45.0f;
   state.start = FlyCamera::lookingAt(startCamera.eye, startCamera.eye + startCamera.forward,
                                      startCamera.yfov);
