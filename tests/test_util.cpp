@@ -51,4 +51,18 @@ void addBlock(Scene& scene, const Vec3& lo, const Vec3& hi, int material) {
   addQuad(scene, lo + ez, ex, ey, {0, 0, 1}, material);
 }
 
+Scene pointLitRoom() {
+  Scene scene;
+  Material grey;
+  grey.baseColor = Vec3(0.6f);
+  scene.materials.push_back(grey);
+  addClosedBox(scene, Vec3(0.0f), Vec3(1.0f), 0);
+  addBlock(scene, Vec3(0.2f, 0.0f, 0.3f), Vec3(0.5f, 0.4f, 0.6f), 0);
+  Light light;
+  light.position = Vec3(0.5f, 0.8f, 0.5f);
+  light.intensity = 1.0f;
+  scene.lights.push_back(light);
+  return scene;
+}
+
 }  // namespace lo::test

@@ -26,4 +26,8 @@ void addClosedBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
 /// A block standing on y = lo.y: five outward-facing quads (no bottom face).
 void addBlock(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
 
+/// The unit room (albedo 0.6) with a block on the floor, lit by a point light
+/// of intensity 1 at (0.5, 0.8, 0.5): a small scene for whole-bake tests.
+Scene pointLitRoom();
+
 }  // namespace lo::test

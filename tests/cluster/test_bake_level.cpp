@@ -12,20 +12,6 @@
 namespace lo {
 namespace {
 
-Scene litRoom() {
-  Scene scene;
-  Material grey;
-  grey.baseColor = Vec3(0.6f);
-  scene.materials.push_back(grey);
-  test::addClosedBox(scene, Vec3(0.0f), Vec3(1.0f), 0);
-  test::addBlock(scene, Vec3(0.2f, 0.0f, 0.3f), Vec3(0.5f, 0.4f, 0.6f), 0);
-  Light light;
-  light.position = Vec3(0.5f, 0.8f, 0.5f);
-  light.intensity = 1.0f;
-  scene.lights.push_back(light);
-  return scene;
-}
-
 const PhotonMap& photons(const Scene& scene) {
   static const PhotonMap map = [&] {
     PhotonParams p;
@@ -52,7 +38,7 @@ void expectSameGrid(const VdlGrid& a, const VdlGrid& b) {
 }
 
 TEST(BakeLevel, IsTheStagesInSequence) {
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   const PhotonMap& map = photons(scene);
   LevelParams params;
   params.grid.depth = 4;
@@ -76,7 +62,7 @@ TEST(BakeLevel, IsTheStagesInSequence) {
 }
 
 TEST(BakeLevel, SameBytesWhateverTheThreadCount) {
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   const PhotonMap& map = photons(scene);
   LevelParams params;
   params.grid.depth = 5;

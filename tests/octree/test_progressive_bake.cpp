@@ -15,20 +15,6 @@
 namespace lo {
 namespace {
 
-Scene litRoom() {
-  Scene scene;
-  Material grey;
-  grey.baseColor = Vec3(0.6f);
-  scene.materials.push_back(grey);
-  test::addClosedBox(scene, Vec3(0.0f), Vec3(1.0f), 0);
-  test::addBlock(scene, Vec3(0.2f, 0.0f, 0.3f), Vec3(0.5f, 0.4f, 0.6f), 0);
-  Light light;
-  light.position = Vec3(0.5f, 0.8f, 0.5f);
-  light.intensity = 1.0f;
-  scene.lights.push_back(light);
-  return scene;
-}
-
 ProgressiveParams smallParams() {
   ProgressiveParams p;
   p.photons.storedPhotons = 20000;
@@ -52,7 +38,7 @@ void expectSameOctree(const GpuOctree& a, const GpuOctree& b) {
 }
 
 TEST(ProgressiveBake, FinalLevelEqualsAOneOffBakeOfTheSamePhotons) {
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   ProgressiveParams params = smallParams();
   PhotonMap photons = tracePhotons(scene, params.photons);
   std::vector<Photon> copy = photons.photons;
@@ -90,7 +76,7 @@ TEST(ProgressiveBake, FinalLevelEqualsAOneOffBakeOfTheSamePhotons) {
 }
 
 TEST(ProgressiveBake, PollingSeesIncreasingDepthsEndingAtTheTarget) {
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   ProgressiveParams params = smallParams();
   ProgressiveBake bake(scene, params);  // traces its own photons
   std::vector<int> seen;
@@ -108,7 +94,7 @@ TEST(ProgressiveBake, PollingSeesIncreasingDepthsEndingAtTheTarget) {
 }
 
 TEST(ProgressiveBake, ALevelTooLargeForTheTextureLimitsFailsOnce) {
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   ProgressiveParams params = smallParams();
   params.octree.max3DTextureSize = 2;  // room for the root tile only
   ProgressiveBake bake(scene, params);
@@ -121,7 +107,7 @@ TEST(ProgressiveBake, ALevelTooLargeForTheTextureLimitsFailsOnce) {
 }
 
 TEST(ProgressiveBake, CancelStopsTheThread) {
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   ProgressiveParams params = smallParams();
   params.photons.storedPhotons = 5000000;  // seconds of tracing: cancel arrives well before
   params.targetDepth = 8;
@@ -134,7 +120,7 @@ TEST(ProgressiveBake, CancelStopsTheThread) {
 }
 
 TEST(ProgressiveBake, CancelDuringALevelStopsBeforeTheTarget) {
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   ProgressiveParams params = smallParams();
   params.targetDepth = 9;  // depth 9 alone takes seconds: cancel arrives before the end
   ProgressiveBake bake(scene, params);
@@ -151,7 +137,7 @@ TEST(ProgressiveBake, CancelDuringALevelStopsBeforeTheTarget) {
 }
 
 TEST(ProgressiveBake, RefusesBadDepths) {
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   ProgressiveParams params = smallParams();
   params.firstDepth = 5;
   params.targetDepth = 4;

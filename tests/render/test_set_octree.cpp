@@ -31,20 +31,6 @@ GlContext* context() {
   return ctx.get();
 }
 
-Scene litRoom() {
-  Scene scene;
-  Material grey;
-  grey.baseColor = Vec3(0.6f);
-  scene.materials.push_back(grey);
-  test::addClosedBox(scene, Vec3(0.0f), Vec3(1.0f), 0);
-  test::addBlock(scene, Vec3(0.2f, 0.0f, 0.3f), Vec3(0.5f, 0.4f, 0.6f), 0);
-  Light light;
-  light.position = Vec3(0.5f, 0.8f, 0.5f);
-  light.intensity = 1.0f;
-  scene.lights.push_back(light);
-  return scene;
-}
-
 GpuOctree bakeOctree(const Scene& scene, const std::vector<Photon>& photons, int depth) {
   LevelParams params;
   params.grid.depth = depth;
@@ -62,7 +48,7 @@ float maxValue(const Image& image) {
 
 TEST(RendererSetOctree, SwappedLevelRendersLikeAFreshRenderer) {
   if (!context()) GTEST_SKIP() << "no OSMesa context available";
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   PhotonParams pp;
   pp.storedPhotons = 20000;
   std::vector<Photon> photons = tracePhotons(scene, pp).photons;
@@ -96,7 +82,7 @@ TEST(RendererSetOctree, SwappedLevelRendersLikeAFreshRenderer) {
 
 TEST(RendererSetOctree, TooLargeForTheLimitsKeepsTheOldOctree) {
   if (!context()) GTEST_SKIP() << "no OSMesa context available";
-  Scene scene = litRoom();
+  Scene scene = test::pointLitRoom();
   PhotonParams pp;
   pp.storedPhotons = 5000;
   std::vector<Photon> photons = tracePhotons(scene, pp).photons;
