@@ -13,11 +13,11 @@
 #include <filesystem>
 #include <limits>
 #include <map>
-#include <mutex>
 #include <sstream>
 
 #include "cluster/vdl_grid.h"
 #include "core/error.h"
+#include "vdb/vdb_file.h"
 #include "vdb/vdb_io.h"
 
 namespace lo {
@@ -100,28 +100,10 @@ GridSummary summarize(const openvdb::GridBase& g) {
   return s;
 }
 
-struct Opened {
-  openvdb::GridPtrVecPtr grids;
-  openvdb::MetaMap::Ptr meta;
-};
+using vdb_internal::OpenedFile;
 
-Opened openAll(const std::string& path) {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(path + ": file does not exist");
-  if (!fs::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
-  Opened f;
-  try {
-    openvdb::io::File file(path);
-    file.open(false);  // no delayed loading: read errors surface here
-    f.meta = file.getMetadata();
-    f.grids = file.getGrids();
-    file.close();
-  } catch (const std::exception& e) {
-    throw InputError(path + ": cannot read as an OpenVDB file: " + e.what());
-  }
-  if (!f.grids || !f.meta) throw InputError(path + ": cannot read as an OpenVDB file");
+OpenedFile openAll(const std::string& path) {
+  OpenedFile f = vdb_internal::openFile(path);
   // OpenVDB reads a file cut inside its header as an empty file; no file we
   // write is empty (even an empty bake has its grids), so say what it is.
   if (f.grids->empty() && f.meta->metaCount() == 0) {
@@ -145,7 +127,7 @@ std::string num(double v) {
 /// The VDL contract checks; `add` records one result.
 class VdlChecker {
  public:
-  VdlChecker(const Opened& f, VdbReport& r) : f_(f), r_(r) {}
+  VdlChecker(const OpenedFile& f, VdbReport& r) : f_(f), r_(r) {}
 
   void run() {
     const int maxVdls = readMaxVdls();
@@ -360,7 +342,7 @@ class VdlChecker {
             (half ? ", half floats)" : ")"));
   }
 
-  const Opened& f_;
+  const OpenedFile& f_;
   VdbReport& r_;
 };
 
@@ -369,7 +351,7 @@ class VdlChecker {
 
 VdbReport inspectVdb(const std::string& path) {
   using namespace vdb_inspect_internal;
-  Opened f = openAll(path);
+  OpenedFile f = openAll(path);
   VdbReport r;
   r.path = path;
   std::error_code ec;

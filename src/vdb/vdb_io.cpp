@@ -21,21 +21,44 @@
 #include <vector>
 
 #include "core/error.h"
+#include "vdb/vdb_file.h"
 #include "vdb/vdb_internal.h"
 
 namespace lo {
 namespace vdb_internal {
+
+void initOpenVdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+OpenedFile openFile(const std::string& path) {
+  initOpenVdb();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path + ": file does not exist");
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
+  OpenedFile f;
+  try {
+    openvdb::io::File file(path);
+    // No delayed loading: every read error surfaces here, inside the try,
+    // rather than on first access to a leaf.
+    file.open(false);
+    f.meta = file.getMetadata();
+    f.grids = file.getGrids();
+    file.close();
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot read as an OpenVDB file: " + e.what());
+  }
+  if (!f.grids || !f.meta) throw InputError(path + ": cannot read as an OpenVDB file");
+  return f;
+}
+
 namespace {
 
 namespace fs = std::filesystem;
 using openvdb::FloatGrid;
 using openvdb::Vec3SGrid;
 using openvdb::math::Transform;
-
-void initOpenVdb() {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
 
 // ---------------------------------------------------------------------------
 // Grid names and units of the contract (docs/vdb-contract.md).
@@ -258,12 +281,12 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
     if (!isOptionalGrid(name)) {
       std::string list;
       for (const auto& o : optionalVdlGridNames()) list += (list.empty() ? "" : ", ") + o;
-      throw InputError("--drop: grid '" + name + "' " +
-                       (name == kIrradiance || name == kNormal || name == kVdlCount ||
-                                name.rfind("vdl", 0) == 0
-                            ? "is required by the VDL file contract"
-                            : "is not a grid of the VDL file contract") +
-                       "; only optional grids can be dropped: " + list);
+      throw InputError(
+          "--drop: grid '" + name + "' " +
+          (name == kIrradiance || name == kNormal || name == kVdlCount || name.rfind("vdl", 0) == 0
+               ? "is required by the VDL file contract"
+               : "is not a grid of the VDL file contract") +
+          "; only optional grids can be dropped: " + list);
     }
   }
   checkArrays(grid);
@@ -311,32 +334,6 @@ bool canonicalLess(const Coord& a, const Coord& b) {
   if (ba != bb) return ba < bb;
   Coord oa{a.x & 7, a.y & 7, a.z & 7}, ob{b.x & 7, b.y & 7, b.z & 7};
   return oa < ob;
-}
-
-struct OpenedFile {
-  openvdb::GridPtrVecPtr grids;
-  openvdb::MetaMap::Ptr meta;
-};
-
-OpenedFile openFile(const std::string& path) {
-  initOpenVdb();
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(path + ": file does not exist");
-  if (!fs::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
-  OpenedFile f;
-  try {
-    openvdb::io::File file(path);
-    // No delayed loading: every read error surfaces here, inside the try,
-    // rather than on first access to a leaf.
-    file.open(false);
-    f.meta = file.getMetadata();
-    f.grids = file.getGrids();
-    file.close();
-  } catch (const std::exception& e) {
-    throw InputError(path + ": cannot read as an OpenVDB file: " + e.what());
-  }
-  if (!f.grids || !f.meta) throw InputError(path + ": cannot read as an OpenVDB file");
-  return f;
 }
 
 openvdb::GridBase::Ptr findGrid(const OpenedFile& f, const std::string& name) {
@@ -435,12 +432,13 @@ LoadedVdl readVdl(const std::string& path) {
     out.meta.formatVersion = 1;
     out.notes.push_back("no format_version metadata: read as format version 1");
   } else if (out.meta.formatVersion > kVdlFormatVersion || out.meta.formatVersion < 1) {
-    throw InputError(path + ": format_version " + std::to_string(out.meta.formatVersion) +
-                     " is not supported: this lightoctree (" LO_VERSION ") reads VDL files up to "
-                     "format version " +
-                     std::to_string(kVdlFormatVersion) +
-                     (out.meta.formatVersion > kVdlFormatVersion ? "; use a newer lightoctree"
-                                                                 : ""));
+    throw InputError(
+        path + ": format_version " + std::to_string(out.meta.formatVersion) +
+        " is not supported: this lightoctree (" LO_VERSION
+        ") reads VDL files up to "
+        "format version " +
+        std::to_string(kVdlFormatVersion) +
+        (out.meta.formatVersion > kVdlFormatVersion ? "; use a newer lightoctree" : ""));
   }
   const int maxVdls = metaValue<int32_t>(path, *f.meta, "max_vdls", true, 0);
   if (maxVdls < 1 || maxVdls > kMaxVdls) {
@@ -685,8 +683,8 @@ PointFileInfo inspectPointFile(const std::string& path) {
 
 const std::vector<std::string>& optionalVdlGridNames() {
   static const std::vector<std::string> names = {vdb_internal::kPhotonCount,
-                                                 vdb_internal::kAngularError,
-                                                 vdb_internal::kRadius, vdb_internal::kArea};
+                                                 vdb_internal::kAngularError, vdb_internal::kRadius,
+                                                 vdb_internal::kArea};
   return names;
 }
 
