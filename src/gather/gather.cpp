@@ -61,21 +61,27 @@ inline float candidateDistance2(uint64_t key) {
   return d2;
 }
 
-/// Pass 1: one photon's vote (if within r).
-inline void votePhoton(const Vec3& position, const Vec3& normal, float weight, const Query& q,
-                       Scan& scan) {
-  const float d2 = ellipsoidDistance2(position, q.point, q.normal, q.squash2m1);
-  if (!(d2 <= q.radius2)) return;  // also drops NaN positions
+/// Pass 1 for photons known to lie within r that share one normal, with
+/// their weights summed: the votes each of them gives.
+inline void voteGroup(const Vec3& normal, double weight, const Query& q, Scan& scan) {
   const float c = dot(normal, q.normal);
   if (c > 0) {
     scan.orientation += weight;
   } else if (c < 0) {
     scan.orientation -= weight;
   } else if (q.normal == Vec3{}) {
-    scan.mean[0] += double(weight) * normal.x;
-    scan.mean[1] += double(weight) * normal.y;
-    scan.mean[2] += double(weight) * normal.z;
+    scan.mean[0] += weight * normal.x;
+    scan.mean[1] += weight * normal.y;
+    scan.mean[2] += weight * normal.z;
   }
+}
+
+/// Pass 1: one photon's vote (if within r).
+inline void votePhoton(const Vec3& position, const Vec3& normal, float weight, const Query& q,
+                       Scan& scan) {
+  const float d2 = ellipsoidDistance2(position, q.point, q.normal, q.squash2m1);
+  if (!(d2 <= q.radius2)) return;  // also drops NaN positions
+  voteGroup(normal, double(weight), q, scan);
 }
 
 /// Pass 1 over a run of binned photons with a non-zero query normal: the sum
@@ -96,20 +102,6 @@ inline double voteRange(const BinnedPhotons::Entry* begin, const BinnedPhotons::
   return (sum[0] + sum[1]) + (sum[2] + sum[3]);
 }
 
-/// Pass 1 for photons known to lie within r that share one normal, with
-/// their weights summed: the votes votePhoton would give each of them.
-inline void voteGroup(const Vec3& normal, double weight, const Query& q, Scan& scan) {
-  const float c = dot(normal, q.normal);
-  if (c > 0) {
-    scan.orientation += weight;
-  } else if (c < 0) {
-    scan.orientation -= weight;
-  } else if (q.normal == Vec3{}) {
-    scan.mean[0] += weight * normal.x;
-    scan.mean[1] += weight * normal.y;
-    scan.mean[2] += weight * normal.z;
-  }
-}
 
 /// Collects candidate keys and keeps an upper bound of the k-th smallest:
 /// once the buffer holds 2k keys it is cut to the k smallest (nth_element), so
