@@ -21,11 +21,8 @@
 #include <thread>
 #include <vector>
 
-#include "cluster/vdl_grid.h"
+#include "bake/bake.h"
 #include "core/resources.h"
-#include "gather/gather.h"
-#include "grid/surface_grid.h"
-#include "photon/photon_map.h"
 #include "scene/scene.h"
 
 namespace {
@@ -54,34 +51,21 @@ Row runOne(const std::string& path, int depth, size_t photons) {
   Row row;
   lo::Scene scene = lo::loadScene(path);
   row.triangles = scene.triangleCount();
-  lo::Stopwatch clock;
-  lo::PhotonParams pp;
-  pp.storedPhotons = photons;
-  lo::PhotonMap map = lo::tracePhotons(scene, pp);
-  row.trace = clock.seconds();
-  row.photons = map.photons.size();
-
-  clock.reset();
-  lo::GridParams gp;
-  gp.depth = depth;
-  lo::SurfaceGrid grid = lo::buildSurfaceGrid(scene, gp);
-  row.voxelize = clock.seconds();
-  row.voxels = grid.size();
-
-  clock.reset();
-  lo::splatPhotons(grid, map.photons);
-  row.splat = clock.seconds();
-
-  clock.reset();
-  lo::GatherParams gather;
-  lo::ClusterParams cluster;
-  lo::BakeTimings t;
-  lo::VdlGrid vdls = lo::buildVdlGrid(grid, map.photons, gather, cluster, nullptr, &t);
-  row.gatherCluster = clock.seconds();
-  row.gatherThread = t.gatherSeconds;
-  row.clusterThread = t.clusterSeconds;
+  lo::BakeParams params;
+  params.depth = depth;
+  params.photons = photons;
+  lo::BakeResult baked = lo::bake(scene, params);
+  const lo::BakeStats& s = baked.stats;
+  row.trace = s.traceSeconds;
+  row.photons = s.storedPhotons;
+  row.voxelize = s.level.voxelizeSeconds;
+  row.voxels = s.level.activeVoxels;
+  row.splat = s.level.splatSeconds;
+  row.gatherCluster = s.level.gatherClusterSeconds;
+  row.gatherThread = s.level.threadSeconds.gatherSeconds;
+  row.clusterThread = s.level.threadSeconds.clusterSeconds;
   row.peakBytes = lo::peakRssBytes();
-  row.ok = vdls.size() == grid.size();
+  row.ok = baked.grid.size() == s.level.activeVoxels;
   return row;
 }
 

@@ -20,10 +20,9 @@
 #include <nanoflann.hpp>
 #include <sstream>
 
+#include "bake/bake.h"
 #include "core/resources.h"
 #include "gather/gather.h"
-#include "grid/surface_grid.h"
-#include "photon/photon_map.h"
 #include "scene/scene.h"
 
 namespace {
@@ -75,13 +74,11 @@ int main(int argc, char** argv) {
     std::string path = scenesDir + "/" + file;
     if (!std::filesystem::exists(path)) continue;
     lo::Scene scene = lo::loadScene(path);
-    lo::PhotonParams pp;
-    pp.storedPhotons = photons;
-    lo::PhotonMap map = lo::tracePhotons(scene, pp);
-    lo::GridParams gp;
-    gp.depth = depth;
-    lo::SurfaceGrid grid = lo::buildSurfaceGrid(scene, gp);
-    lo::splatPhotons(grid, map.photons);
+    lo::BakeParams bake;
+    bake.photons = photons;
+    bake.depth = depth;
+    lo::PhotonMap map = lo::tracePhotons(scene, bake.photonParams());
+    lo::SurfaceGrid grid = lo::voxelizeAndSplat(scene, map.photons, bake.gridParams());
     const size_t n = grid.size();
 
     double c0 = cpuSeconds();

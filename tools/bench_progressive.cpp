@@ -24,7 +24,8 @@
 #include <vector>
 
 #include "core/resources.h"
-#include "octree/progressive_bake.h"
+#include "bake/progressive_bake.h"
+#include "core/file.h"
 #include "render/context.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -296,13 +297,7 @@ int main(int argc, char** argv) {
     md << "\n";
     std::printf("\n%s", md.str().c_str());
     if (!out.empty()) {
-      std::string tmp = out + ".tmp";
-      {
-        std::ofstream f(tmp, std::ios::trunc);
-        f << md.str();
-        if (!f.flush()) throw std::runtime_error(out + ": write failed");
-      }
-      std::filesystem::rename(tmp, out);
+      lo::writeTextAtomically(out, md.str());
       std::printf("wrote %s\n", out.c_str());
     }
     return 0;

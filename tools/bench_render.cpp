@@ -3,9 +3,11 @@
 // memory per leaf (paper §4.2.1: 512 KiB octree + 4 MiB VDLs for 100k leaves
 // of a depth-6 octree with 4 VDLs), written to docs/results/render.md.
 //
-// Each scene is baked in memory at the paper's settings (600,000 photons,
-// KNN 300, 4 VDLs, depth 6), turned into the GPU octree and rendered from its
-// own camera in every mode, with interpolation on and off, at each resolution.
+// Each scene's bake is read from a .vdb file (`lightoctree bake` at the
+// paper's settings: 600,000 photons, KNN 300, 4 VDLs, depth 6; this program
+// only draws, so it links no bake stage), turned into the GPU octree and
+// rendered from its own camera in every mode, with interpolation on and off,
+// at each resolution.
 // A frame is a draw into the offscreen RGBA32F target followed by glFinish,
 // without read-back (Renderer::timeFrames).
 
@@ -22,21 +24,21 @@
 #include <thread>
 #include <vector>
 
-#include "cluster/vdl_grid.h"
+#include "core/error.h"
+#include "core/file.h"
 #include "core/resources.h"
-#include "gather/gather.h"
-#include "grid/surface_grid.h"
 #include "octree/gpu_octree.h"
-#include "photon/photon_map.h"
 #include "render/context.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
+#include "vdb/vdb_io.h"
 
 namespace {
 
 struct SceneSpec {
   const char* label;
   std::string path;
+  std::string vdb;  ///< its bake
 };
 
 struct Resolution {
@@ -65,28 +67,22 @@ struct Baked {
   lo::Scene scene;
   lo::GpuOctree octree;
   lo::GpuOctree octreeHalf;
-  double bakeSeconds = 0;
+  lo::BakeMetadata meta;
 };
 
-Baked bake(const std::string& path, int depth, size_t photons, int knn) {
+Baked load(const std::string& scenePath, const std::string& vdbPath) {
+  if (!std::filesystem::exists(vdbPath)) {
+    throw lo::InputError(vdbPath + ": no bake; make it with `lightoctree bake " + scenePath +
+                         " -o " + vdbPath + "` (the paper's settings are the defaults)");
+  }
   Baked b;
-  b.scene = lo::loadScene(path);
-  lo::Stopwatch clock;
-  lo::PhotonParams pp;
-  pp.storedPhotons = photons;
-  lo::PhotonMap map = lo::tracePhotons(b.scene, pp);
-  lo::GridParams gp;
-  gp.depth = depth;
-  lo::SurfaceGrid grid = lo::buildSurfaceGrid(b.scene, gp);
-  lo::splatPhotons(grid, map.photons);
-  lo::GatherParams gather;
-  gather.k = knn;
-  lo::VdlGrid vdls = lo::buildVdlGrid(grid, map.photons, gather, lo::ClusterParams{});
-  b.bakeSeconds = clock.seconds();
-  b.octree = lo::buildGpuOctree(vdls);
+  b.scene = lo::loadScene(scenePath);
+  lo::LoadedVdl vdl = lo::readVdlGrid(vdbPath);
+  b.meta = vdl.meta;
+  b.octree = lo::buildGpuOctree(vdl.grid);
   lo::GpuOctreeParams half;
   half.halfFloat = true;
-  b.octreeHalf = lo::buildGpuOctree(vdls, half);
+  b.octreeHalf = lo::buildGpuOctree(vdl.grid, half);
   return b;
 }
 
@@ -132,8 +128,8 @@ int main(int argc, char** argv) try {
   std::string scenesDir = std::string(LO_SOURCE_DIR) + "/../shared/scenes/composed";
   std::string out = std::string(LO_SOURCE_DIR) + "/docs/results/render.md";
   std::string backendName = "osmesa";
-  size_t photons = 600000;
-  int depth = 6, knn = 300, minFrames = 3;
+  std::string bakesDir = "out/bench-bakes";
+  int minFrames = 3;
   double minSeconds = 1.0;
   bool quick = false;
   app.add_option("--scenes", scenesDir, "Folder with cornell-bunny.glb and cornell-dragon.glb")
@@ -142,12 +138,9 @@ int main(int argc, char** argv) try {
   app.add_option("--backend", backendName, "osmesa (software) or egl (GPU, or Mesa without one)")
       ->check(CLI::IsMember({"osmesa", "egl"}))
       ->capture_default_str();
-  app.add_option("--photons", photons, "Stored photons of each bake")->capture_default_str();
-  app.add_option("--depth", depth, "Octree depth of each bake")
-      ->check(CLI::Range(2, 10))
-      ->capture_default_str();
-  app.add_option("--knn", knn, "KNN of each bake")
-      ->check(CLI::Range(1, 10000))
+  app.add_option("--bakes", bakesDir,
+                 "Folder with cornell-box.vdb, cornell-bunny.vdb and cornell-dragon.vdb, baked by "
+                 "`lightoctree bake` (docs/results/render.md says how)")
       ->capture_default_str();
   app.add_option("--min-frames", minFrames, "Frames timed per measurement, at least")
       ->check(CLI::Range(1, 1000))
@@ -158,11 +151,13 @@ int main(int argc, char** argv) try {
   app.add_flag("--quick", quick, "Only the Cornell box at 800x600 (a smoke run)");
   CLI11_PARSE(app, argc, argv);
 
-  std::vector<SceneSpec> scenes = {
-      {"Cornell box", std::string(LO_SOURCE_DIR) + "/data/cornell-box.gltf"}};
+  std::vector<SceneSpec> scenes = {{"Cornell box",
+                                     std::string(LO_SOURCE_DIR) + "/data/cornell-box.gltf",
+                                     bakesDir + "/cornell-box.vdb"}};
   if (!quick) {
-    scenes.push_back({"Bunny", scenesDir + "/cornell-bunny.glb"});
-    scenes.push_back({"Dragon", scenesDir + "/cornell-dragon.glb"});
+    scenes.push_back({"Bunny", scenesDir + "/cornell-bunny.glb", bakesDir + "/cornell-bunny.vdb"});
+    scenes.push_back(
+        {"Dragon", scenesDir + "/cornell-dragon.glb", bakesDir + "/cornell-dragon.vdb"});
   }
 
   lo::GlContextParams cp;
@@ -183,15 +178,19 @@ int main(int argc, char** argv) try {
          "512 KiB + 4 MiB = 4.5 MiB | - |\n";
 
   double worstFullFps = 1e30, worstIndirectFps = 1e30;
+  std::vector<std::string> bakeSettings;
   for (const SceneSpec& s : scenes) {
     if (!std::filesystem::exists(s.path)) {
       std::fprintf(stderr, "bench_render: %s not found, skipped\n", s.path.c_str());
       continue;
     }
-    Baked b = bake(s.path, depth, photons, knn);
+    Baked b = load(s.path, s.vdb);
     const lo::GpuOctree& o = b.octree;
     const double leaves = double(std::max<size_t>(o.leafCount, 1));
-    std::printf("%s: baked in %.2f s; %s\n", s.label, b.bakeSeconds, o.ToString().c_str());
+    std::printf("%s: %s; %s\n", s.label, s.vdb.c_str(), o.ToString().c_str());
+    bakeSettings.push_back(std::string(s.label) + ": " + lo::formatCount(size_t(b.meta.photons)) +
+                           " stored photons, KNN " + std::to_string(b.meta.knn) + ", " +
+                           b.meta.vdls + " VDLs, depth " + std::to_string(b.meta.depth));
     {
       double pool = double(o.poolBytes()) / leaves, vdl = double(o.vdlBytes()) / leaves;
       double vdlHalf = double(b.octreeHalf.vdlBytes()) / leaves;
@@ -239,9 +238,10 @@ int main(int argc, char** argv) try {
      << info.renderer << ", OpenGL " << info.version
      << "; llvmpipe threads: " << (lpThreads ? lpThreads : "Mesa's default (one per core)")
      << ".\n\n"
-     << "Each scene is baked in memory at the paper's settings (" << photons
-     << " stored photons, KNN " << knn << ", 4 VDLs, depth " << depth
-     << "), converted to the GPU octree (RGBA32F VDL texels) and drawn from the scene's own "
+     << "Each scene's bake is read from `" << bakesDir << "` (made by `lightoctree bake` at the "
+        "defaults, the paper's settings; this program only draws): ";
+  for (size_t i = 0; i < bakeSettings.size(); ++i) md << (i ? "; " : "") << bakeSettings[i];
+  md << ". Each is converted to the GPU octree (RGBA32F VDL texels) and drawn from the scene's own "
         "camera. A frame is one draw into the offscreen RGBA32F target followed by `glFinish`, "
         "without read-back; each figure is the mean over at least "
      << minFrames << " frames and " << minSeconds
@@ -268,13 +268,7 @@ int main(int argc, char** argv) try {
         "paper's leaf count.\n\n"
      << memory.str();
   std::filesystem::create_directories(std::filesystem::path(out).parent_path());
-  std::string tmp = out + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << md.str();
-    if (!f) throw std::runtime_error("cannot write " + tmp);
-  }
-  std::filesystem::rename(tmp, out);
+  lo::writeTextAtomically(out, md.str());
   std::printf("wrote %s\n", out.c_str());
   return 0;
 } catch (const std::exception& e) {

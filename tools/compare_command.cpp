@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "image/compare.h"
 #include "image/image.h"
-#include "text_file.h"
+#include "core/file.h"
 
 namespace lo::tool {
 namespace {

@@ -1,8 +1,6 @@
 // `lightoctree convert`: a baked .vdb to another depth, VDL count or storage
-// (docs/convert.md). The methods live in src/cluster/resample.h; this file
-// parses, picks the method, reports.
-
-#include <tbb/global_control.h>
+// (docs/convert.md). convertLightGrid (src/bake) picks the method
+// and runs it; this file parses, reads, writes and reports.
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -12,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "cluster/resample.h"
-#include "cluster/vdl_grid.h"
+#include "bake/convert.h"
+#include "cli_checks.h"
 #include "commands.h"
 #include "core/error.h"
-#include "gather/gather.h"
-#include "grid/surface_grid.h"
+#include "core/file.h"
+#include "core/threads.h"
 #include "report.h"
 #include "scene/scene.h"
 #include "vdb/vdb_io.h"
@@ -39,19 +37,8 @@ struct ConvertOptions {
   bool quiet = false;
 };
 
-double energy(const VdlGrid& g) {
-  double e = 0;
-  for (size_t v = 0; v < g.size(); ++v) e += double(average(g.irradiance[v])) * g.areas[v];
-  return e;
-}
-
 int runConvert(const ConvertOptions& opt) {
-  {
-    std::filesystem::path parent = std::filesystem::path(opt.output).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-      throw InputError("--output: folder '" + parent.string() + "' does not exist");
-    }
-  }
+  checkOutputFolder(opt.output, "--output");
   const auto& optional = optionalVdlGridNames();
   for (const std::string& name : opt.drop) {
     if (std::find(optional.begin(), optional.end(), name) == optional.end()) {
@@ -61,122 +48,55 @@ int runConvert(const ConvertOptions& opt) {
                        " can be dropped (the others are required by the VDL file contract)");
     }
   }
-  std::unique_ptr<tbb::global_control> threadLimit;
-  if (opt.threads > 0) {
-    threadLimit = std::make_unique<tbb::global_control>(
-        tbb::global_control::max_allowed_parallelism, size_t(opt.threads));
-  }
+  ThreadLimit threadLimit(opt.threads);
   ConsoleProgress progress(opt.quiet);
 
   LoadedVdl in = readVdlGrid(opt.input);
-  const int inDepth = in.grid.frame.depth;
-  const size_t inVoxels = in.grid.size();
-  const double inEnergy = energy(in.grid);
-  const int depth = opt.depth > 0 ? opt.depth : inDepth;
   if (!opt.quiet) {
     for (const std::string& note : in.notes)
       std::printf("note: %s: %s\n", opt.input.c_str(), note.c_str());
   }
-  if (depth > inDepth && opt.scene.empty()) {
-    throw InputError("--depth " + std::to_string(depth) + " is finer than the input's depth " +
-                     std::to_string(inDepth) +
-                     ": converting to a finer grid needs --scene SCENE to know which voxels "
-                     "hold geometry");
-  }
-  if (!opt.photonMap.empty() && opt.scene.empty()) {
-    throw InputError(
-        "--photon-map needs --scene SCENE: re-gathering voxelizes the scene at depth " +
-        std::to_string(depth));
-  }
-
-  ClusterParams cluster;
-  cluster.seed = opt.seed;
-  std::string vdls = opt.vdls.empty() ? in.meta.vdls : opt.vdls;
-  if (vdls == "auto") {
-    cluster.autoCount = true;
-    cluster.vdls = opt.vdls.empty() ? in.grid.maxVdls : kMaxVdls;
-  } else {
-    cluster.vdls = opt.vdls.empty() ? in.grid.maxVdls : std::stoi(opt.vdls);
-    vdls = std::to_string(cluster.vdls);
-  }
-
-  BakeMetadata meta = in.meta;
-  meta.depth = depth;
-  meta.vdls = vdls;
-  meta.convertedFrom = std::filesystem::path(opt.input).filename().string() + " (depth " +
-                       std::to_string(inDepth) + ", " + std::to_string(in.grid.maxVdls) +
-                       " VDL slots)";
-
   std::vector<StageReport> rows;
-  VdlGrid out;
-  std::string method;
-  if (!opt.scene.empty() && (depth != inDepth || !opt.photonMap.empty())) {
-    StageTimer loadTimer(rows, "load + voxelize scene");
-    Scene scene = loadScene(opt.scene);
-    GridParams gridParams;
-    gridParams.depth = depth;
-    SurfaceGrid grid = buildSurfaceGrid(scene, gridParams, &progress);
-    // The bake voxelized the same scene with makeGridFrame, whose origin does
-    // not depend on the depth: a different scene shows up here.
-    checkNestedFrames(in.grid.frame, grid.frame, ("--scene " + opt.scene).c_str());
-    loadTimer.finish(formatCount(grid.size()) + " voxels active at depth " + std::to_string(depth));
-    if (!opt.photonMap.empty()) {
-      StageTimer gatherTimer(rows, "re-gather");
-      std::vector<Photon> photons = readPhotonPoints(opt.photonMap);
-      splatPhotons(grid, photons);
-      GatherParams gather;
-      gather.k = in.meta.knn > 0 ? in.meta.knn : GatherParams{}.k;
-      gather.radius = 0;  // the default for the new depth: kDefaultRadiusVoxels voxels
-      out = buildVdlGrid(grid, photons, gather, cluster, &progress);
-      meta.knn = gather.k;
-      meta.radius = resolveRadius(gather, grid.frame);
-      meta.photons = int64_t(photons.size());
-      method = "re-gathered " + formatCount(photons.size()) + " photons";
-      gatherTimer.finish(method);
-    } else if (depth > inDepth) {
-      StageTimer refineTimer(rows, "interpolate");
-      RefineStats stats;
-      out = refineVdlGrid(in.grid, grid, cluster, &stats);
-      method = "trilinear interpolation of the parents";
-      refineTimer.finish(stats.withoutParent
-                             ? formatCount(stats.withoutParent) + " voxels without a parent (dark)"
-                             : "");
-    } else {
-      StageTimer mergeTimer(rows, "merge");
-      out = coarsenVdlGrid(in.grid, depth, cluster);
-      method = "area-weighted merge of the children";
-      mergeTimer.finish("");
-    }
-  } else if (depth < inDepth) {
-    StageTimer mergeTimer(rows, "merge");
-    out = coarsenVdlGrid(in.grid, depth, cluster);
-    method = "area-weighted merge of the children";
-    mergeTimer.finish("");
-  } else if (cluster.vdls != in.grid.maxVdls || cluster.autoCount != (in.meta.vdls == "auto") ||
-             !opt.vdls.empty()) {
-    StageTimer clusterTimer(rows, "re-cluster");
-    out = reclusterVdlGrid(in.grid, cluster);
-    method = "re-clustered the VDLs";
-    clusterTimer.finish("");
-  } else {
-    out = std::move(in.grid);
-    method = "same grid";
+  ConvertParams params;
+  params.depth = opt.depth;
+  params.vdls = opt.vdls;
+  params.seed = opt.seed;
+  Scene scene;
+  const bool needsScene = (opt.depth > 0 && opt.depth != in.grid.frame.depth) || !opt.photonMap.empty();
+  if (!opt.scene.empty() && needsScene) {
+    StageTimer loadTimer(rows, "load scene");
+    scene = loadScene(opt.scene);
+    params.scene = &scene;
+    loadTimer.finish(formatCount(scene.triangleCount()) + " triangles");
   }
+  std::vector<Photon> photons;
+  if (!opt.photonMap.empty()) {
+    StageTimer readTimer(rows, "read photon map");
+    photons = readPhotonPoints(opt.photonMap);
+    params.photons = &photons;
+    readTimer.finish(formatCount(photons.size()) + " photons");
+  }
+  ConvertResult out = convertLightGrid(in.grid, in.meta, params, &progress);
+  rows.insert(rows.end(), out.stages.begin(), out.stages.end());
+  const int inDepth = in.grid.frame.depth;
+  out.metadata.convertedFrom = std::filesystem::path(opt.input).filename().string() + " (depth " +
+                               std::to_string(inDepth) + ", " + std::to_string(in.grid.maxVdls) +
+                               " VDL slots)";
 
   StageTimer writeTimer(rows, "write .vdb");
   VdlWriteOptions write;
   write.halfFloat = opt.half;
   write.drop = opt.drop;
-  writeVdlGrid(opt.output, out, meta, write);
+  writeVdlGrid(opt.output, out.grid, out.metadata, write);
   writeTimer.finish(opt.output + " (" +
                     formatBytes(size_t(std::filesystem::file_size(opt.output))) + ")");
   if (!opt.quiet) {
     printSummary(stdout, rows);
     std::printf("\n%s: depth %d -> %d, %s -> %s voxels, %s VDLs; %s\n", opt.input.c_str(), inDepth,
-                depth, formatCount(inVoxels).c_str(), formatCount(out.size()).c_str(), vdls.c_str(),
-                method.c_str());
-    std::printf("sum of irradiance x area (W, channel mean): %.6g in, %.6g out\n", inEnergy,
-                energy(out));
+                out.metadata.depth, formatCount(in.grid.size()).c_str(),
+                formatCount(out.grid.size()).c_str(), out.vdls.c_str(), out.method.c_str());
+    std::printf("sum of irradiance x area (W, channel mean): %.6g in, %.6g out\n",
+                lightGridEnergy(in.grid), lightGridEnergy(out.grid));
     std::printf("wrote %s\n", opt.output.c_str());
   }
   return 0;
@@ -195,20 +115,9 @@ std::function<int()> addConvertCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", opt->output, "Output .vdb file (written atomically)")->required();
   cmd->add_option("--depth", opt->depth, "Output depth (default: the input's)")
-      ->check(CLI::Range(1, 12));
+      ->check(depthValidator());
   cmd->add_option("--vdls", opt->vdls, "VDLs per voxel, 1-8 or 'auto' (default: the input's)")
-      ->check(CLI::Validator(
-          [](std::string& s) -> std::string {
-            if (s == "auto") return {};
-            try {
-              size_t used = 0;
-              int v = std::stoi(s, &used);
-              if (used == s.size() && v >= 1 && v <= 8) return {};
-            } catch (const std::exception&) {
-            }
-            return "must be an integer from 1 to 8 or 'auto', got '" + s + "'";
-          },
-          "1..8|auto", "VdlCount"));
+      ->check(vdlCountValidator());
   cmd->add_flag("--half", opt->half,
                 "Store irradiance, normal, VDL, angular_error and radius grids as half floats");
   cmd->add_option("--drop", opt->drop,

@@ -1,6 +1,5 @@
 // `lightoctree reference`: scene -> unbiased path-traced image (the ground truth).
 
-#include <tbb/global_control.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -9,6 +8,7 @@
 
 #include "camera_options.h"
 #include "commands.h"
+#include "core/threads.h"
 #include "core/error.h"
 #include "image/image.h"
 #include "reference/path_tracer.h"
@@ -48,11 +48,7 @@ int runReference(const ReferenceOptions& opt) {
   checkImageOutput(opt.output, "--output");
   if (!opt.stdErrorOutput.empty()) checkImageOutput(opt.stdErrorOutput, "--std-error");
   checkCameraOptions(opt.camera);
-  std::unique_ptr<tbb::global_control> threadLimit;
-  if (opt.threads > 0) {
-    threadLimit = std::make_unique<tbb::global_control>(
-        tbb::global_control::max_allowed_parallelism, size_t(opt.threads));
-  }
+  ThreadLimit threadLimit(opt.threads);
 
   Scene scene = loadScene(opt.scene);
   ReferenceCamera camera = chooseCamera(opt.camera, scene, opt.scene);

@@ -50,32 +50,6 @@ void ConsoleProgress::end() {
   }
 }
 
-StageTimer::StageTimer(std::vector<StageReport>& rows, std::string name)
-    : rows_(rows), name_(std::move(name)) {}
-
-void StageTimer::finish(std::string detail) {
-  rows_.push_back({name_, clock_.seconds(), currentRssBytes(), peakRssBytes(), std::move(detail)});
-}
-
-std::string formatBytes(size_t bytes) {
-  char buf[32];
-  double b = double(bytes);
-  if (b >= 1024.0 * 1024.0 * 1024.0) {
-    std::snprintf(buf, sizeof buf, "%.2f GiB", b / (1024.0 * 1024.0 * 1024.0));
-  } else if (b >= 1024.0 * 1024.0) {
-    std::snprintf(buf, sizeof buf, "%.1f MiB", b / (1024.0 * 1024.0));
-  } else {
-    std::snprintf(buf, sizeof buf, "%.1f KiB", b / 1024.0);
-  }
-  return buf;
-}
-
-std::string formatCount(size_t n) {
-  std::string s = std::to_string(n);
-  for (int i = int(s.size()) - 3; i > 0; i -= 3) s.insert(size_t(i), ",");
-  return s;
-}
-
 void printSummary(std::FILE* out, const std::vector<StageReport>& rows) {
   double total = 0;
   std::fprintf(out, "\n%-18s %10s %12s %12s  %s\n", "stage", "time", "RSS after", "peak RSS",

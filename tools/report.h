@@ -29,29 +29,6 @@ class ConsoleProgress : public ProgressSink {
   Stopwatch clock_;
 };
 
-/// One row of the closing summary.
-struct StageReport {
-  std::string name;
-  double seconds = 0;
-  size_t rssBytes = 0;   ///< resident set size after the stage
-  size_t peakBytes = 0;  ///< peak resident set size so far
-  std::string detail;    ///< e.g. "612,004 photons"
-};
-
-/// Times a stage and appends its row on finish().
-class StageTimer {
- public:
-  StageTimer(std::vector<StageReport>& rows, std::string name);
-  void finish(std::string detail = "");
-
- private:
-  std::vector<StageReport>& rows_;
-  std::string name_;
-  Stopwatch clock_;
-};
-
 void printSummary(std::FILE* out, const std::vector<StageReport>& rows);
-std::string formatBytes(size_t bytes);
-std::string formatCount(size_t n);  ///< 1234567 -> "1,234,567"
 
 }  // namespace lo::tool

@@ -20,7 +20,7 @@
 #include "reference/path_tracer.h"
 #include "report.h"
 #include "scene/scene.h"
-#include "text_file.h"
+#include "core/file.h"
 #include "vdb/vdb_io.h"
 
 namespace fs = std::filesystem;

@@ -19,11 +19,12 @@
 #include <string>
 
 #include "camera_options.h"
+#include "cli_checks.h"
 #include "commands.h"
 #include "core/error.h"
 #include "core/resources.h"
 #include "octree/gpu_octree.h"
-#include "octree/progressive_bake.h"
+#include "bake/progressive_bake.h"
 #include "render/camera_path.h"
 #include "render/context.h"
 #include "render/fly_camera.h"
@@ -638,7 +639,7 @@ std::function<int()> addViewCommand(CLI::App& app) {
       ->check(CLI::Range(size_t(1), size_t(200000000)))
       ->capture_default_str();
   cmd->add_option("--depth", opt->depth, "Progressive: target octree depth")
-      ->check(CLI::Range(1, 12))
+      ->check(depthValidator())
       ->capture_default_str();
   cmd->add_option("--knn", opt->knn, "Progressive: nearest photons gathered per voxel")
       ->check(CLI::Range(1, 100000))

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "cluster/kmeans_internal.h"
-#include "cluster/vdl_grid.h"
+#include "cluster/vdl_cluster.h"
 #include "core/error.h"
 #include "core/rng.h"
 

@@ -6,7 +6,7 @@
 
 #include <cstddef>
 
-#include "cluster/vdl_grid.h"
+#include "cluster/vdl_cluster.h"
 
 namespace lo::kmeans_internal {
 

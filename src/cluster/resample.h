@@ -7,7 +7,7 @@
 
 #include <cstddef>
 
-#include "cluster/vdl_grid.h"
+#include "cluster/vdl_cluster.h"
 #include "grid/surface_grid.h"
 
 namespace lo {

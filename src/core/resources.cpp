@@ -4,6 +4,9 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <utility>
 
 namespace lo {
 
@@ -21,6 +24,56 @@ size_t currentRssBytes() {
   std::fclose(f);
   if (n != 2) return 0;
   return size_t(resident) * size_t(sysconf(_SC_PAGESIZE));
+}
+
+bool resetPeakRss() {
+  FILE* f = std::fopen("/proc/self/clear_refs", "w");
+  if (!f) return false;
+  const bool ok = std::fputs("5", f) >= 0;
+  return std::fclose(f) == 0 && ok;
+}
+
+size_t peakRssSinceResetBytes() {
+  FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return 0;
+  char line[256];
+  size_t kib = 0;
+  while (std::fgets(line, sizeof line, f)) {
+    if (std::strncmp(line, "VmHWM:", 6) == 0) {
+      kib = size_t(std::strtoull(line + 6, nullptr, 10));
+      break;
+    }
+  }
+  std::fclose(f);
+  return kib * 1024;
+}
+
+StageTimer::StageTimer(std::vector<StageReport>& rows, std::string name)
+    : rows_(rows), name_(std::move(name)) {}
+
+double StageTimer::finish(std::string detail) {
+  const double seconds = clock_.seconds();
+  rows_.push_back({name_, seconds, currentRssBytes(), peakRssBytes(), std::move(detail)});
+  return seconds;
+}
+
+std::string formatBytes(size_t bytes) {
+  char buf[32];
+  double b = double(bytes);
+  if (b >= 1024.0 * 1024.0 * 1024.0) {
+    std::snprintf(buf, sizeof buf, "%.2f GiB", b / (1024.0 * 1024.0 * 1024.0));
+  } else if (b >= 1024.0 * 1024.0) {
+    std::snprintf(buf, sizeof buf, "%.1f MiB", b / (1024.0 * 1024.0));
+  } else {
+    std::snprintf(buf, sizeof buf, "%.1f KiB", b / 1024.0);
+  }
+  return buf;
+}
+
+std::string formatCount(size_t n) {
+  std::string s = std::to_string(n);
+  for (int i = int(s.size()) - 3; i > 0; i -= 3) s.insert(size_t(i), ",");
+  return s;
 }
 
 }  // namespace lo

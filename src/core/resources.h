@@ -1,9 +1,12 @@
 #pragma once
 /// @file core/resources.h
-/// @brief Wall-clock stopwatch and process memory figures for stage reports.
+/// @brief Wall-clock stopwatch, process memory figures and the per-stage rows
+/// that stages record and the front end prints.
 
 #include <chrono>
 #include <cstddef>
+#include <string>
+#include <vector>
 
 namespace lo {
 
@@ -23,5 +26,38 @@ class Stopwatch {
 size_t peakRssBytes();
 /// Current resident set size, bytes (/proc/self/statm); 0 if unavailable.
 size_t currentRssBytes();
+/// Resets the kernel's peak resident set size of this process to the current
+/// one (Linux >= 4.0, /proc/self/clear_refs), so that peakRssSinceResetBytes
+/// measures one piece of work in a process that did others before. False when
+/// the kernel refuses (then the peak is the process's whole life).
+bool resetPeakRss();
+/// Peak resident set size since the last resetPeakRss (VmHWM of
+/// /proc/self/status), bytes; 0 if unavailable.
+size_t peakRssSinceResetBytes();
+
+/// One stage's row in a report.
+struct StageReport {
+  std::string name;
+  double seconds = 0;
+  size_t rssBytes = 0;   ///< resident set size after the stage
+  size_t peakBytes = 0;  ///< peak resident set size so far
+  std::string detail;    ///< e.g. "612,004 photons"
+};
+
+/// Times a stage and appends its row to `rows` on finish().
+class StageTimer {
+ public:
+  StageTimer(std::vector<StageReport>& rows, std::string name);
+  /// Appends the row; returns the stage's seconds.
+  double finish(std::string detail = "");
+
+ private:
+  std::vector<StageReport>& rows_;
+  std::string name_;
+  Stopwatch clock_;
+};
+
+std::string formatBytes(size_t bytes);  ///< "12.3 MiB"
+std::string formatCount(size_t n);      ///< 1234567 -> "1,234,567"
 
 }  // namespace lo

@@ -9,7 +9,7 @@
 
 #include "core/math.h"
 #include "grid/surface_grid.h"
-#include "photon/photon_map.h"
+#include "lightgrid/photon.h"
 
 namespace lo {
 
@@ -22,6 +22,12 @@ struct GatherParams {
   /// behind a thin wall fall outside the search region.
   float normalSquash = 4.0f;
 };
+
+/// Fills grid.binStart / grid.binPhotons / grid.binMargin: the photons whose
+/// position lies in each active voxel, in photon order. Photons outside any
+/// active voxel are put in the nearest active voxel of their 3x3x3
+/// neighbourhood, or dropped (counted in the return value). Deterministic.
+size_t splatPhotons(SurfaceGrid& grid, const std::vector<Photon>& photons);
 
 /// Default radius in voxels. Chosen from the measured sweeps (docs/accuracy.md):
 /// at the paper's settings (600k photons, depth 6, k = 300) a 1.5-voxel radius

@@ -14,29 +14,10 @@
 
 #include "core/math.h"
 #include "core/progress.h"
-#include "photon/photon_map.h"
+#include "lightgrid/grid_frame.h"
 #include "scene/scene.h"
 
 namespace lo {
-
-/// Index space <-> world space of a cubic grid. Voxel (i,j,k) covers the world
-/// box [origin + (i,j,k) * voxelSize, origin + (i+1,j+1,k+1) * voxelSize].
-struct GridFrame {
-  Vec3 origin{0, 0, 0};   ///< world position of the lower corner of voxel (0,0,0)
-  float voxelSize = 1.0f; ///< world units (edge length of the cube / 2^depth)
-  int depth = 0;          ///< 2^depth voxels per axis
-
-  int resolution() const { return 1 << depth; }
-  Vec3 voxelCenter(const Coord& c) const;
-  Bounds3 voxelBounds(const Coord& c) const;
-  /// Voxel containing world point p (may lie outside [0, resolution)).
-  Coord coordOf(const Vec3& p) const;
-};
-
-/// The padded bounding cube of `sceneBounds` (edge = largest extent * (1 + 2 * padding),
-/// centred on the scene) divided into 2^depth voxels per axis.
-/// @throws InputError if depth is outside [1, 12] or the bounds are empty/degenerate.
-GridFrame makeGridFrame(const Bounds3& sceneBounds, int depth, float padding = 0.01f);
 
 struct GridParams {
   int depth = 6;          ///< 2^depth voxels per axis (paper's delta)
@@ -53,7 +34,7 @@ class SurfaceGrid {
   std::vector<Vec3> centroids;   ///< area-weighted centroid of the geometry inside the voxel, world space
   std::vector<float> areas;      ///< area of the geometry clipped to the voxel, world units^2
 
-  /// Photon bins (CSR), filled by splatPhotons: the photons whose position lies
+  /// Photon bins (CSR), filled by the gather's splatPhotons (gather/gather.h): the photons whose position lies
   /// in voxel v are binPhotons[binStart[v] .. binStart[v+1]), in photon order.
   std::vector<uint32_t> binStart;
   std::vector<uint32_t> binPhotons;
@@ -87,10 +68,5 @@ SurfaceGrid buildSurfaceGrid(const Scene& scene, const GridParams& params,
 /// Exact overlap test of a triangle and a closed axis-aligned box
 /// (Akenine-Möller's separating axis theorem). Exposed for tests.
 bool triangleOverlapsBox(const Vec3& a, const Vec3& b, const Vec3& c, const Bounds3& box);
-
-/// Fills grid.binStart / grid.binPhotons. Photons outside any active voxel are
-/// put in the nearest active voxel of their 3x3x3 neighbourhood, or dropped
-/// (counted in the return value).
-size_t splatPhotons(SurfaceGrid& grid, const std::vector<Photon>& photons);
 
 }  // namespace lo

@@ -14,6 +14,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/file.h"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
@@ -26,31 +27,10 @@
 namespace lo {
 namespace {
 
-std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
-
 void checkImage(const std::string& path, const RgbImage& image) {
   if (image.width < 1 || image.height < 1 || image.rgb.size() != image.pixelCount() * 3)
     throw InputError(path + ": empty or inconsistent image (" + std::to_string(image.width) +
                      " x " + std::to_string(image.height) + ")");
-}
-
-/// Runs `write(tmp)` and renames tmp to path; removes tmp on failure.
-template <typename F>
-void writeThroughTemporary(const std::string& path, F&& write) {
-  std::string tmp = path + ".tmp";
-  try {
-    write(tmp);
-    std::filesystem::rename(tmp, path);
-  } catch (const std::exception& e) {
-    std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
-    throw IoError(path + ": cannot write (" + e.what() + ")");
-  }
 }
 
 float srgbToLinear(float s) {
@@ -104,7 +84,7 @@ unsigned char encodeSrgb8(float linear) {
 
 void writeExr(const std::string& path, const RgbImage& image) {
   checkImage(path, image);
-  writeThroughTemporary(path, [&](const std::string& tmp) {
+  writeAtomically(path, [&](const std::string& tmp) {
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
     const char* names[3] = {"R", "G", "B"};
@@ -126,9 +106,9 @@ void writePng(const std::string& path, const RgbImage& image, float exposureEv) 
   float scale = std::exp2(exposureEv);
   std::vector<unsigned char> rgb(image.pixelCount() * 3);
   for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = encodeSrgb8(image.rgb[i] * scale);
-  writeThroughTemporary(path, [&](const std::string& tmp) {
+  writeAtomically(path, [&](const std::string& tmp) {
     if (!stbi_write_png(tmp.c_str(), image.width, image.height, 3, rgb.data(), image.width * 3))
-      throw IoError("stbi_write_png failed");
+      throw std::runtime_error("stbi_write_png failed");
   });
 }
 

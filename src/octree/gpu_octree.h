@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "cluster/vdl_grid.h"
+#include "lightgrid/vdl_grid.h"
 #include "core/math.h"
 
 namespace lo {

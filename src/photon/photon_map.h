@@ -8,18 +8,10 @@
 
 #include "core/math.h"
 #include "core/progress.h"
+#include "lightgrid/photon.h"
 #include "scene/scene.h"
 
 namespace lo {
-
-/// One stored photon hit on a non-specular surface.
-struct Photon {
-  Vec3 position;   ///< world space hit point
-  Vec3 direction;  ///< unit, world space, from the hit point TOWARDS where the photon came from (wi)
-  Vec3 power;      ///< RGB flux carried, W
-  Vec3 normal;     ///< unit geometric normal at the hit, facing the side the photon arrived from
-  uint32_t bounce = 0;  ///< 0 = direct from a light, 1 = after one diffuse/glossy bounce, ...
-};
 
 struct PhotonParams {
   size_t storedPhotons = 600000;  ///< photons to store (exact count unless the scene stores none)

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file.h"
 
 namespace lo {
 namespace {
@@ -159,23 +160,7 @@ void appendCameraKey(const std::string& path, const CameraKey& key) {
         "# Light Octree camera path (lightoctree view --camera-path): one keyframe per line\n"
         "# t(seconds)  eye x y z  target x y z  [vertical fov, degrees]\n";
   }
-  std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw IoError(path + ": cannot open " + tmp + " for writing");
-    f << old << key.ToString() << "\n";
-    if (!f.flush()) {
-      f.close();
-      std::filesystem::remove(tmp);
-      throw IoError(path + ": write failed");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp);
-    throw IoError(path + ": cannot rename " + tmp + " (" + ec.message() + ")");
-  }
+  writeTextAtomically(path, old + key.ToString() + "\n");
 }
 
 }  // namespace lo

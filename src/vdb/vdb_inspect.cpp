@@ -15,7 +15,7 @@
 #include <map>
 #include <sstream>
 
-#include "cluster/vdl_grid.h"
+#include "lightgrid/vdl_grid.h"
 #include "core/error.h"
 #include "vdb/vdb_file.h"
 #include "vdb/vdb_io.h"

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/file.h"
 #include "vdb/vdb_file.h"
 #include "vdb/vdb_internal.h"
 
@@ -123,31 +124,20 @@ void makeUuidDeterministic(const std::string& file) {
   if (!f) throw std::runtime_error("cannot rewrite the file header");
 }
 
-// Writes to path + ".tmp", then renames: a reader never sees a half file.
-void writeAtomically(const std::string& path, const openvdb::GridCPtrVec& grids,
-                     const openvdb::MetaMap& meta) {
+// Writes through a temporary file (core/file.h): a reader never sees a half file.
+void writeVdbFile(const std::string& path, const openvdb::GridCPtrVec& grids,
+                  const openvdb::MetaMap& meta) {
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty() && !fs::is_directory(parent)) {
     throw IoError(path + ": cannot write: folder '" + parent.string() + "' does not exist");
   }
-  const std::string tmp = path + ".tmp";
-  try {
+  writeAtomically(path, [&](const std::string& tmp) {
     openvdb::io::File file(tmp);
     // Default compression: active mask + Blosc (libopenvdb is built with it).
     file.write(grids, meta);
     file.close();
     makeUuidDeterministic(tmp);
-  } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw IoError(path + ": cannot write: " + e.what());
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    int err = errno;
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw IoError(path + ": cannot rename '" + tmp + "': " + std::strerror(err));
-  }
+  });
 }
 
 // ---------------------------------------------------------------------------
@@ -320,7 +310,7 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
       fileMeta.insertMeta("format_version", openvdb::Int32Metadata(damage->formatVersion));
     }
   }
-  writeAtomically(path, out, fileMeta);
+  writeVdbFile(path, out, fileMeta);
 }
 
 // ---------------------------------------------------------------------------
@@ -597,7 +587,7 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   meta.insertMeta("generator", openvdb::StringMetadata("lightoctree"));
   meta.insertMeta("version", openvdb::StringMetadata(LO_VERSION));
   meta.insertMeta("photons", openvdb::Int64Metadata(int64_t(n)));
-  writeAtomically(path, openvdb::GridCPtrVec{grid}, meta);
+  writeVdbFile(path, openvdb::GridCPtrVec{grid}, meta);
 }
 
 std::vector<Photon> readPoints(const std::string& path) {

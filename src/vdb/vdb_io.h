@@ -8,35 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "cluster/vdl_grid.h"
-#include "photon/photon_map.h"
+#include "lightgrid/photon.h"
+#include "lightgrid/vdl_grid.h"
 
 namespace lo {
-
-/// Version of the VDL file contract, written as the int32 file metadata
-/// `format_version`. Readers refuse files with a higher number and read files
-/// without the key (written before it existed) as version 1.
-constexpr int kVdlFormatVersion = 1;
-
-/// File-level metadata written beside the grids.
-struct BakeMetadata {
-  std::string generator = "lightoctree";
-  std::string version = LO_VERSION;
-  std::string sourceScene;
-  int depth = 0;
-  int64_t photons = 0;       ///< stored photons
-  int64_t emittedPaths = 0;
-  int knn = 0;
-  float radius = 0;          ///< world units
-  std::string vdls;          ///< "4" or "auto"
-  int64_t seed = 0;
-  Bounds3 sceneBounds;
-  std::string units = "length: scene units (glTF metres); irradiance: W/m^2 (scene light units)";
-  /// Always written as kVdlFormatVersion; on reading, the file's value (1 when absent).
-  int formatVersion = kVdlFormatVersion;
-  /// Set by `convert`: what the file was converted from, e.g. "cornell.vdb (depth 6)".
-  std::string convertedFrom;
-};
 
 /// Grids of the contract a file may leave out (`convert --drop`): readVdlGrid
 /// fills them with 0. The others (irradiance, normal, vdl_count, vdl<i>_*) are

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "cluster/resample.h"
-#include "cluster/vdl_grid.h"
+#include "cluster/vdl_cluster.h"
 #include "core/error.h"
 #include "grid/surface_grid.h"
 #include "photon/photon_map.h"

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <vector>
 
-#include "cluster/vdl_grid.h"
+#include "cluster/vdl_cluster.h"
 #include "core/error.h"
 #include "grid/surface_grid.h"
 #include "octree/gpu_octree.h"

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <memory>
 
-#include "cluster/bake_level.h"
+#include "bake/bake.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "render/context.h"

@@ -1,11 +1,11 @@
 #pragma once
-/// @file octree/progressive_bake.h
+/// @file bake/progressive_bake.h
 /// @brief Coarse-to-fine preview (paper §5.2): traces the photon map once,
 /// then bakes octree levels firstDepth, firstDepth + 1, ..., targetDepth from
 /// it in a background thread and hands each finished GpuOctree to the caller,
 /// who polls from its frame loop (no GL here: the caller uploads on its own
 /// GL thread). Levels are independent bakes of the same photons
-/// (cluster/bake_level.h), not refinements of each other.
+/// (bake/bake.h, bakeLevel), not refinements of each other.
 
 #include <chrono>
 #include <memory>
@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "cluster/bake_level.h"
+#include "bake/bake.h"
 #include "octree/gpu_octree.h"
 #include "photon/photon_map.h"
 #include "scene/scene.h"

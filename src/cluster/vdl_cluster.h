@@ -1,7 +1,8 @@
 #pragma once
-/// @file cluster/vdl_grid.h
+/// @file cluster/vdl_cluster.h
 /// @brief K-means of photon directions into virtual directional lights
-/// (paper §3.1.2), and the per-voxel VDL grid the bake produces.
+/// (paper §3.1.2), and the gather + cluster pass over every voxel that fills
+/// a VdlGrid (lightgrid/vdl_grid.h).
 
 #include <array>
 #include <cstdint>
@@ -12,17 +13,10 @@
 #include "core/progress.h"
 #include "gather/gather.h"
 #include "grid/surface_grid.h"
-#include "photon/photon_map.h"
+#include "lightgrid/photon.h"
+#include "lightgrid/vdl_grid.h"
 
 namespace lo {
-
-constexpr int kMaxVdls = 8;  ///< paper §3.1.2: "we fixed the maximum number of VDLs to 8"
-
-/// A virtual directional light: irradiance arriving from one direction.
-struct Vdl {
-  Vec3 irradiance{0, 0, 0};  ///< RGB, W/m^2
-  Vec3 direction{0, 0, 0};   ///< unit, world space, towards the light (like wi)
-};
 
 struct ClusterParams {
   int vdls = 4;               ///< clusters per voxel, 1..kMaxVdls (paper: 4)
@@ -51,25 +45,6 @@ struct ClusterResult {
 /// Handles n < k, identical directions, empty clusters and zero weights.
 ClusterResult clusterDirections(const DirectionSample* samples, size_t n, int k,
                                 const ClusterParams& params, uint64_t stream);
-
-/// The bake's result: per active voxel, the total irradiance and up to
-/// `maxVdls` VDLs (unused slots are zero).
-struct VdlGrid {
-  GridFrame frame;
-  int maxVdls = 4;
-  std::vector<Coord> coords;
-  std::vector<Vec3> normals;        ///< unit (oriented towards the light), or zero
-  std::vector<float> areas;         ///< geometry area in the voxel
-  std::vector<Vec3> irradiance;     ///< total RGB irradiance, W/m^2 (= sum of the VDLs)
-  std::vector<float> photonCount;   ///< photons gathered for the estimate
-  std::vector<float> radius;        ///< r_k reached, world units
-  std::vector<float> angularError;
-  std::vector<uint8_t> vdlCount;
-  std::vector<Vdl> vdls;            ///< coords.size() * maxVdls
-
-  size_t size() const { return coords.size(); }
-  const Vdl* vdlsOf(size_t v) const { return vdls.data() + v * size_t(maxVdls); }
-};
 
 struct BakeTimings {
   double gatherSeconds = 0;   ///< summed over threads

@@ -1,6 +1,6 @@
 // ProgressiveBake: photons once, then octree levels coarse to fine in a thread.
 
-#include "octree/progressive_bake.h"
+#include "bake/progressive_bake.h"
 
 #include <atomic>
 #include <exception>
@@ -153,8 +153,8 @@ namespace {
 
 void checkDepths(const ProgressiveParams& params) {
   for (int d : {params.firstDepth, params.targetDepth}) {
-    if (d < 1 || d > 12) {
-      throw InputError("progressive bake: depth " + std::to_string(d) + " is outside 1..12");
+    if (d < 1 || d > kMaxGridDepth) {
+      throw InputError("progressive bake: depth " + std::to_string(d) + " is outside 1.." + std::to_string(kMaxGridDepth));
     }
   }
   if (params.firstDepth > params.targetDepth) {

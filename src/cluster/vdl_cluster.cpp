@@ -1,7 +1,7 @@
 // The bake's per-voxel loop: KNN gather (src/gather) then K-means into VDLs
 // (paper §3.1.1 and §3.1.2), TBB-parallel over runs of consecutive voxels.
 
-#include "cluster/vdl_grid.h"
+#include "cluster/vdl_cluster.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "octree/progressive_bake.h"
+#include "bake/progressive_bake.h"
 #include "test_util.h"
 
 namespace lo {

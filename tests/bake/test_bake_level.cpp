@@ -6,7 +6,7 @@
 
 #include <cstring>
 
-#include "cluster/bake_level.h"
+#include "bake/bake.h"
 #include "test_util.h"
 
 namespace lo {

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "test_util.h"
-#include "cluster/vdl_grid.h"
+#include "cluster/vdl_cluster.h"
 #include "core/error.h"
 #include "core/rng.h"
 

@@ -1,0 +1,171 @@
+// bake(): the stages of paper §3.1 in order, timed, with the defaults of
+// `lightoctree bake`.
+
+#include "bake/bake.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.h"
+
+namespace lo {
+
+std::string VdlCount::ToString() const { return automatic ? "auto" : std::to_string(count); }
+
+std::string vdlCountError(const std::string& text) {
+  if (text == "auto") return {};
+  try {
+    size_t used = 0;
+    const int v = std::stoi(text, &used);
+    if (used == text.size() && v >= 1 && v <= kMaxVdls) return {};
+  } catch (const std::exception&) {
+  }
+  return "must be an integer from 1 to " + std::to_string(kMaxVdls) + " or 'auto', got '" + text +
+         "'";
+}
+
+VdlCount parseVdlCount(const std::string& text, const char* flag) {
+  const std::string error = vdlCountError(text);
+  if (!error.empty()) throw InputError(std::string(flag) + ": " + error);
+  VdlCount c;
+  if (text == "auto") {
+    c.automatic = true;
+    c.count = kMaxVdls;
+  } else {
+    c.count = std::stoi(text);
+  }
+  return c;
+}
+
+PhotonParams BakeParams::photonParams() const {
+  PhotonParams p;
+  p.storedPhotons = photons;
+  p.includeDirect = includeDirect;
+  p.seed = seed;
+  return p;
+}
+
+GridParams BakeParams::gridParams() const {
+  GridParams p;
+  p.depth = depth;
+  return p;
+}
+
+GatherParams BakeParams::gatherParams() const {
+  GatherParams p;
+  p.k = knn;
+  p.radius = radius;
+  return p;
+}
+
+ClusterParams BakeParams::clusterParams() const {
+  ClusterParams p;
+  p.seed = seed;
+  p.vdls = vdls.count;
+  p.autoCount = vdls.automatic;
+  return p;
+}
+
+std::string BakeParams::ToString() const {
+  return "BakeParams{depth " + std::to_string(depth) + ", photons " + std::to_string(photons) +
+         ", knn " + std::to_string(knn) + ", radius " + std::to_string(radius) + ", vdls " +
+         vdls.ToString() + ", seed " + std::to_string(seed) +
+         (includeDirect ? ", include direct" : "") + "}";
+}
+
+SurfaceGrid voxelizeAndSplat(const Scene& scene, const std::vector<Photon>& photons,
+                             const GridParams& params, ProgressSink* progress, LevelStats* stats,
+                             std::vector<StageReport>* stages) {
+  std::vector<StageReport> ignored;
+  std::vector<StageReport>& rows = stages ? *stages : ignored;
+  LevelStats s;
+
+  StageTimer voxelize(rows, "voxelize");
+  SurfaceGrid grid = buildSurfaceGrid(scene, params, progress);
+  s.activeVoxels = grid.size();
+  const size_t dense = size_t(1) << (3 * params.depth);
+  s.voxelizeSeconds =
+      voxelize.finish(formatCount(grid.size()) + " of " + formatCount(dense) + " voxels active");
+
+  StageTimer splat(rows, "splat photons");
+  s.droppedPhotons = splatPhotons(grid, photons);
+  s.splatSeconds =
+      splat.finish(s.droppedPhotons ? formatCount(s.droppedPhotons) + " photons outside the grid"
+                                    : "");
+  if (stats) *stats = s;
+  return grid;
+}
+
+VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const LevelParams& params,
+                  ProgressSink* progress, LevelStats* stats, std::vector<StageReport>* stages) {
+  std::vector<StageReport> ignored;
+  std::vector<StageReport>& rows = stages ? *stages : ignored;
+  LevelStats s;
+  SurfaceGrid grid = voxelizeAndSplat(scene, photons, params.grid, progress, &s, &rows);
+
+  StageTimer cluster(rows, "gather + cluster");
+  VdlGrid vdls =
+      buildVdlGrid(grid, photons, params.gather, params.cluster, progress, &s.threadSeconds);
+  char split[128];
+  std::snprintf(split, sizeof split, "thread-seconds: gather %.3f, K-means %.3f",
+                s.threadSeconds.gatherSeconds, s.threadSeconds.clusterSeconds);
+  s.gatherClusterSeconds = cluster.finish(split);
+  s.radius = resolveRadius(params.gather, grid.frame);
+  if (stats) *stats = s;
+  return vdls;
+}
+
+namespace {
+
+void checkParams(const BakeParams& p) {
+  if (p.depth < 1 || p.depth > kMaxGridDepth) {
+    throw InputError("--depth " + std::to_string(p.depth) + " is outside [1, " +
+                     std::to_string(kMaxGridDepth) + "]");
+  }
+  if (p.photons < 1) throw InputError("--photons must be at least 1");
+  if (p.knn < 1) throw InputError("--knn " + std::to_string(p.knn) + " must be at least 1");
+  if (!(p.radius >= 0.0f) || !std::isfinite(p.radius)) {
+    throw InputError("--radius " + std::to_string(p.radius) + " must be a finite positive length");
+  }
+  if (!p.vdls.automatic && (p.vdls.count < 1 || p.vdls.count > kMaxVdls)) {
+    throw InputError("--vdls " + std::to_string(p.vdls.count) + " is outside [1, " +
+                     std::to_string(kMaxVdls) + "]");
+  }
+}
+
+}  // namespace
+
+BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* progress) {
+  checkParams(params);
+  BakeResult r;
+  BakeStats& s = r.stats;
+  s.triangles = scene.triangleCount();
+  s.denseVoxels = size_t(1) << (3 * params.depth);
+
+  StageTimer trace(s.stages, "trace photons");
+  PhotonMap photons = tracePhotons(scene, params.photonParams(), progress);
+  s.storedPhotons = photons.photons.size();
+  s.emittedPaths = photons.emittedPaths;
+  s.traceSeconds = trace.finish(formatCount(photons.photons.size()) + " photons from " +
+                                formatCount(photons.emittedPaths) + " paths");
+
+  LevelParams level;
+  level.grid = params.gridParams();
+  level.gather = params.gatherParams();
+  level.cluster = params.clusterParams();
+  r.grid = bakeLevel(scene, photons.photons, level, progress, &s.level, &s.stages);
+
+  BakeMetadata& meta = r.metadata;
+  meta.depth = params.depth;
+  meta.photons = int64_t(photons.photons.size());
+  meta.emittedPaths = int64_t(photons.emittedPaths);
+  meta.knn = params.knn;
+  meta.radius = s.level.radius;
+  meta.vdls = params.vdls.ToString();
+  meta.seed = int64_t(params.seed);
+  meta.sceneBounds = scene.bounds();
+  if (params.keepPhotons) r.photons = std::move(photons);
+  return r;
+}
+
+}  // namespace lo

@@ -1,0 +1,120 @@
+#pragma once
+/// @file bake/bake.h
+/// @brief The one entry point of the bake (paper §3.1, Fig. 4): scene ->
+/// photon map -> surface grid -> photon bins -> KNN gather + K-means VDLs ->
+/// VdlGrid. Commands, benchmarks, the sweep and the progressive preview all
+/// bake through this header (or bake/progressive_bake.h, which uses it), so
+/// the stages are chained, timed and defaulted in one place.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cluster/vdl_cluster.h"
+#include "core/progress.h"
+#include "core/resources.h"
+#include "gather/gather.h"
+#include "grid/surface_grid.h"
+#include "lightgrid/vdl_grid.h"
+#include "photon/photon_map.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+/// VDLs per voxel: a fixed count 1..kMaxVdls, or "auto" (the fewest, up to
+/// kMaxVdls, whose angular error is under ClusterParams::autoThreshold).
+struct VdlCount {
+  int count = 4;           ///< paper §5.3.2: 4
+  bool automatic = false;  ///< "auto"
+  std::string ToString() const;  ///< "4" or "auto": the text of `--vdls` and of the file metadata
+};
+
+/// Parses "1".."8" or "auto". @throws InputError naming `flag` and the text.
+VdlCount parseVdlCount(const std::string& text, const char* flag = "--vdls");
+/// The same check for a CLI validator: "" when valid, else the message.
+std::string vdlCountError(const std::string& text);
+
+/// Every setting of a bake, with the defaults of `lightoctree bake`.
+struct BakeParams {
+  int depth = 6;            ///< 2^depth voxels across the padded bounding cube (paper's delta)
+  size_t photons = 600000;  ///< photons stored in the photon map (paper: 600k)
+  int knn = 300;            ///< nearest photons gathered per voxel (paper: 300)
+  /// Gathering radius, world units; 0 = kDefaultRadiusVoxels voxel sizes.
+  float radius = 0.0f;
+  VdlCount vdls;
+  uint64_t seed = 1;           ///< same inputs and seed, same bytes, whatever the thread count
+  bool includeDirect = false;  ///< also store bounce-0 photons (the renderer draws direct light)
+  bool keepPhotons = false;    ///< return the photon map in BakeResult::photons
+
+  PhotonParams photonParams() const;
+  GridParams gridParams() const;
+  GatherParams gatherParams() const;
+  ClusterParams clusterParams() const;
+  std::string ToString() const;
+};
+
+/// One octree level from a traced photon map (what the progressive preview
+/// bakes once per depth): voxelize, splat, gather + cluster.
+struct LevelParams {
+  GridParams grid;        ///< depth (paper's delta) and padding of the bounding cube
+  GatherParams gather;    ///< KNN k, radius (0 = kDefaultRadiusVoxels voxels at this depth)
+  ClusterParams cluster;  ///< VDLs per voxel, seed
+};
+
+/// What bakeLevel did, for reports and benchmarks. Seconds are wall time.
+struct LevelStats {
+  size_t activeVoxels = 0;    ///< voxels that touch geometry
+  size_t droppedPhotons = 0;  ///< photons outside every active voxel's neighbourhood
+  float radius = 0;           ///< gathering radius used, world units
+  double voxelizeSeconds = 0, splatSeconds = 0, gatherClusterSeconds = 0;
+  BakeTimings threadSeconds;  ///< gather / K-means split, summed over threads
+  double seconds() const { return voxelizeSeconds + splatSeconds + gatherClusterSeconds; }
+};
+
+/// The first two stages of bakeLevel: the surface grid at `params.depth` with
+/// `photons` splatted into its bins, i.e. what the gather reads (benchmarks
+/// of the gather start here). Fills the voxelize / splat fields of `stats`.
+SurfaceGrid voxelizeAndSplat(const Scene& scene, const std::vector<Photon>& photons,
+                             const GridParams& params, ProgressSink* progress = nullptr,
+                             LevelStats* stats = nullptr,
+                             std::vector<StageReport>* stages = nullptr);
+
+/// Voxelizes `scene` (buildSurfaceGrid), splats `photons` (splatPhotons) and
+/// gathers + clusters every active voxel (buildVdlGrid). Deterministic: the
+/// same inputs give the same grid whatever the thread count. `progress` gets
+/// the voxelize and gather + cluster tasks; a sink may throw to abandon the
+/// bake (the exception propagates, nothing is left behind). `stages`, when
+/// given, receives one row per stage.
+VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const LevelParams& params,
+                  ProgressSink* progress = nullptr, LevelStats* stats = nullptr,
+                  std::vector<StageReport>* stages = nullptr);
+
+/// Figures of a whole bake.
+struct BakeStats {
+  size_t triangles = 0;
+  size_t storedPhotons = 0, emittedPaths = 0;
+  size_t denseVoxels = 0;  ///< 8^depth
+  double traceSeconds = 0;
+  LevelStats level;        ///< voxelize / splat / gather + cluster
+  /// One row per stage ("trace photons", "voxelize", "splat photons",
+  /// "gather + cluster"), with the process's memory after each.
+  std::vector<StageReport> stages;
+  double seconds() const { return traceSeconds + level.seconds(); }
+};
+
+struct BakeResult {
+  VdlGrid grid;
+  /// Everything the file metadata records (sourceScene is left to the caller,
+  /// which knows the file name).
+  BakeMetadata metadata;
+  BakeStats stats;
+  PhotonMap photons;  ///< filled when BakeParams::keepPhotons
+};
+
+/// @brief Bakes `scene` with `params` (paper §3.1). Deterministic.
+/// @throws InputError for out-of-range parameters (naming them) and the
+/// stages' errors (a scene without light, a grid too deep).
+BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* progress = nullptr);
+
+}  // namespace lo

@@ -1,0 +1,110 @@
+// convertLightGrid: the method of a conversion chosen from what is asked and
+// what is given (docs/convert.md), then run.
+
+#include "bake/convert.h"
+
+#include "cluster/resample.h"
+#include "core/error.h"
+
+namespace lo {
+
+double lightGridEnergy(const LightGridVoxels& g) {
+  double e = 0;
+  for (size_t v = 0; v < g.size(); ++v) e += double(average(g.irradiance[v])) * g.areas[v];
+  return e;
+}
+
+ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
+                               const ConvertParams& params, ProgressSink* progress) {
+  const int inDepth = in.frame.depth;
+  const int depth = params.depth > 0 ? params.depth : inDepth;
+  if (depth < 1 || depth > kMaxGridDepth) {
+    throw InputError("--depth " + std::to_string(depth) + " is outside [1, " +
+                     std::to_string(kMaxGridDepth) + "]");
+  }
+  if (depth > inDepth && !params.scene) {
+    throw InputError("--depth " + std::to_string(depth) + " is finer than the input's depth " +
+                     std::to_string(inDepth) +
+                     ": converting to a finer grid needs --scene SCENE to know which voxels "
+                     "hold geometry");
+  }
+  if (params.photons && !params.scene) {
+    throw InputError(
+        "--photon-map needs --scene SCENE: re-gathering voxelizes the scene at depth " +
+        std::to_string(depth));
+  }
+
+  ClusterParams cluster;
+  cluster.seed = params.seed;
+  std::string vdls = params.vdls.empty() ? inMeta.vdls : params.vdls;
+  if (vdls == "auto") {
+    cluster.autoCount = true;
+    cluster.vdls = params.vdls.empty() ? in.maxVdls : kMaxVdls;
+  } else {
+    cluster.vdls = params.vdls.empty() ? in.maxVdls : parseVdlCount(params.vdls).count;
+    vdls = std::to_string(cluster.vdls);
+  }
+
+  ConvertResult r;
+  r.vdls = vdls;
+  r.metadata = inMeta;
+  r.metadata.depth = depth;
+  r.metadata.vdls = vdls;
+  std::vector<StageReport>& rows = r.stages;
+
+  if (params.scene && (depth != inDepth || params.photons)) {
+    StageTimer voxelize(rows, "voxelize scene");
+    GridParams gridParams;
+    gridParams.depth = depth;
+    SurfaceGrid grid = buildSurfaceGrid(*params.scene, gridParams, progress);
+    // The bake voxelized the same scene with makeGridFrame, whose origin does
+    // not depend on the depth: a different scene shows up here.
+    checkNestedFrames(in.frame, grid.frame, "--scene");
+    voxelize.finish(formatCount(grid.size()) + " voxels active at depth " + std::to_string(depth));
+    if (params.photons) {
+      StageTimer gatherTimer(rows, "re-gather");
+      const std::vector<Photon>& photons = *params.photons;
+      splatPhotons(grid, photons);
+      GatherParams gather;
+      gather.k = inMeta.knn > 0 ? inMeta.knn : GatherParams{}.k;
+      gather.radius = 0;  // the default for the new depth: kDefaultRadiusVoxels voxels
+      r.grid = buildVdlGrid(grid, photons, gather, cluster, progress);
+      r.metadata.knn = gather.k;
+      r.metadata.radius = resolveRadius(gather, grid.frame);
+      r.metadata.photons = int64_t(photons.size());
+      r.method = "re-gathered " + formatCount(photons.size()) + " photons";
+      gatherTimer.finish(r.method);
+    } else if (depth > inDepth) {
+      StageTimer refineTimer(rows, "interpolate");
+      RefineStats stats;
+      r.grid = refineVdlGrid(in, grid, cluster, &stats);
+      r.withoutParent = stats.withoutParent;
+      r.method = "trilinear interpolation of the parents";
+      refineTimer.finish(stats.withoutParent
+                             ? formatCount(stats.withoutParent) + " voxels without a parent (dark)"
+                             : "");
+    } else {
+      StageTimer mergeTimer(rows, "merge");
+      r.grid = coarsenVdlGrid(in, depth, cluster);
+      r.method = "area-weighted merge of the children";
+      mergeTimer.finish("");
+    }
+  } else if (depth < inDepth) {
+    StageTimer mergeTimer(rows, "merge");
+    r.grid = coarsenVdlGrid(in, depth, cluster);
+    r.method = "area-weighted merge of the children";
+    mergeTimer.finish("");
+  } else if (cluster.vdls != in.maxVdls || cluster.autoCount != (inMeta.vdls == "auto") ||
+             !params.vdls.empty()) {
+    StageTimer clusterTimer(rows, "re-cluster");
+    r.grid = reclusterVdlGrid(in, cluster);
+    r.method = "re-clustered the VDLs";
+    clusterTimer.finish("");
+  } else {
+    r.grid = in;
+    r.method = "same grid";
+  }
+  return r;
+}
+
+}  // namespace lo

@@ -1,0 +1,24 @@
+#pragma once
+/// @file core/threads.h
+/// @brief The worker-thread limit of a command (`--threads N`): one place
+/// that talks to TBB's global control, so tools do not.
+
+#include <memory>
+
+namespace lo {
+
+/// Limits TBB's parallelism to `threads` while alive; 0 = all cores. Results
+/// never depend on it (every parallel stage is deterministic).
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads);
+  ~ThreadLimit();
+  ThreadLimit(const ThreadLimit&) = delete;
+  ThreadLimit& operator=(const ThreadLimit&) = delete;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lo

@@ -1,0 +1,22 @@
+#pragma once
+/// @file lightgrid/photon.h
+/// @brief The stored photon record: photon tracing (src/photon) makes it, the
+/// gather reads it and the photon `.vdb` file (src/vdb) stores it. Plain data
+/// here, so that reading a photon file does not link the tracer (Embree).
+
+#include <cstdint>
+
+#include "core/math.h"
+
+namespace lo {
+
+/// One stored photon hit on a non-specular surface.
+struct Photon {
+  Vec3 position;   ///< world space hit point
+  Vec3 direction;  ///< unit, world space, from the hit point TOWARDS where the photon came from (wi)
+  Vec3 power;      ///< RGB flux carried, W
+  Vec3 normal;     ///< unit geometric normal at the hit, facing the side the photon arrived from
+  uint32_t bounce = 0;  ///< 0 = direct from a light, 1 = after one diffuse/glossy bounce, ...
+};
+
+}  // namespace lo

@@ -1,0 +1,87 @@
+#pragma once
+/// @file lightgrid/vdl_grid.h
+/// @brief The bake's product, read by every later stage (.vdb files, the GPU
+/// octree, the renderers, the sweep): per active voxel the data every light
+/// representation shares, plus the representation's payload, here the
+/// virtual directional lights (VDLs, paper §3.1.2). Depends on core only.
+///
+/// The seam for a second representation (spherical harmonics, surface layers)
+/// is LightGridVoxels: a new payload derives from it the way VdlGrid does, and
+/// the stages that only need positions, normals and total irradiance take the
+/// base. See docs/architecture.md, "Where to add a stage".
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+#include "lightgrid/grid_frame.h"
+
+namespace lo {
+
+/// Paper §3.1.2: "we fixed the maximum number of VDLs to 8". The one constant
+/// of the VDL limit in C++; shaders/octree_layout.h has LO_MAX_VDLS, and a
+/// test asserts that both agree.
+constexpr int kMaxVdls = 8;
+
+/// A virtual directional light: irradiance arriving from one direction.
+struct Vdl {
+  Vec3 irradiance{0, 0, 0};  ///< RGB, W/m^2
+  Vec3 direction{0, 0, 0};   ///< unit, world space, towards the light (like wi)
+};
+
+/// What every light representation stores per active voxel, in the surface
+/// grid's canonical order (sorted by 8^3 block, then position in the block).
+struct LightGridVoxels {
+  GridFrame frame;
+  std::vector<Coord> coords;
+  std::vector<Vec3> normals;        ///< unit (oriented towards the light), or zero
+  std::vector<float> areas;         ///< geometry area in the voxel, world units^2
+  std::vector<Vec3> irradiance;     ///< total RGB irradiance, W/m^2
+  std::vector<float> photonCount;   ///< photons gathered for the estimate
+  std::vector<float> radius;        ///< r_k reached, world units
+
+  size_t size() const { return coords.size(); }
+};
+
+/// LightGridVoxels with up to `maxVdls` VDLs per voxel (paper §3.1.2); the
+/// total irradiance is the sum of the voxel's VDLs. Unused slots are zero.
+struct VdlGrid : LightGridVoxels {
+  int maxVdls = 4;
+  std::vector<float> angularError;  ///< weighted std. deviation of chord length (paper §5.3.2)
+  std::vector<uint8_t> vdlCount;
+  std::vector<Vdl> vdls;            ///< size() * maxVdls, strongest first per voxel
+
+  const Vdl* vdlsOf(size_t v) const { return vdls.data() + v * size_t(maxVdls); }
+};
+
+/// Version of the light-grid file contract (docs/vdb-contract.md), written as
+/// the int32 file metadata `format_version`. Readers refuse files with a
+/// higher number and read files without the key (written before it existed)
+/// as version 1.
+constexpr int kVdlFormatVersion = 1;
+
+/// What a light grid means: the settings that made it, stored beside the grids
+/// as file metadata.
+struct BakeMetadata {
+  std::string generator = "lightoctree";
+  std::string version = LO_VERSION;
+  std::string sourceScene;
+  int depth = 0;
+  int64_t photons = 0;       ///< stored photons
+  int64_t emittedPaths = 0;
+  int knn = 0;
+  float radius = 0;          ///< world units
+  std::string vdls;          ///< "4" or "auto"
+  int64_t seed = 0;
+  Bounds3 sceneBounds;
+  std::string units = "length: scene units (glTF metres); irradiance: W/m^2 (scene light units)";
+  /// Always written as kVdlFormatVersion; on reading, the file's value (1 when absent).
+  int formatVersion = kVdlFormatVersion;
+  /// Set by `convert`: what the file was converted from, e.g. "cornell.vdb (depth 6)".
+  std::string convertedFrom;
+};
+
+}  // namespace lo

@@ -1,0 +1,20 @@
+#pragma once
+/// @file tools/cli_checks.h
+/// @brief CLI11 validators the commands share, each a thin wrapper of the
+/// library's own check, so a flag and the library accept the same values.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace lo::tool {
+
+/// `--vdls`: 1..kMaxVdls or "auto" (lo::vdlCountError).
+CLI::Validator vdlCountValidator();
+
+/// `--depth`: 1..kMaxGridDepth.
+CLI::Validator depthValidator();
+
+/// Shortest text of a number for help strings and labels ("1.5", "600000").
+std::string numberText(double v);
+
+}  // namespace lo::tool
