@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "octree/gpu_octree.h"
 #include "scene/scene.h"
 
 namespace lo::test {
@@ -29,5 +30,14 @@ void addBlock(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
 /// The unit room (albedo 0.6) with a block on the floor, lit by a point light
 /// of intensity 1 at (0.5, 0.8, 0.5): a small scene for whole-bake tests.
 Scene pointLitRoom();
+
+/// GPU octree parameters with the texels of the paper's form (no cosine
+/// correction): tests of the layout and the lookup compare texels with the
+/// grid's VDLs, and the golden images were made with it.
+inline GpuOctreeParams paperCosine() {
+  GpuOctreeParams p;
+  p.cosineCorrection = false;
+  return p;
+}
 
 }  // namespace lo::test

@@ -138,7 +138,7 @@ std::function<int()> addBakeCommand(CLI::App& app) {
                   "Gathering radius in scene units (default: " + numberText(kDefaultRadiusVoxels) + " voxel sizes)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--vdls", opt->vdls,
-                  "VDLs per voxel, 1-8, or 'auto' for the fewest that keep the angular error "
+                  "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest that keep the angular error "
                   "under 0.35 (about 20 degrees)")
       ->check(vdlCountValidator())
       ->capture_default_str();

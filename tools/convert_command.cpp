@@ -116,7 +116,7 @@ std::function<int()> addConvertCommand(CLI::App& app) {
   cmd->add_option("-o,--output", opt->output, "Output .vdb file (written atomically)")->required();
   cmd->add_option("--depth", opt->depth, "Output depth (default: the input's)")
       ->check(depthValidator());
-  cmd->add_option("--vdls", opt->vdls, "VDLs per voxel, 1-8 or 'auto' (default: the input's)")
+  cmd->add_option("--vdls", opt->vdls, "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + " or 'auto' (default: the input's)")
       ->check(vdlCountValidator());
   cmd->add_flag("--half", opt->half,
                 "Store irradiance, normal, VDL, angular_error and radius grids as half floats");

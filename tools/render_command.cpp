@@ -175,7 +175,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"osmesa", "egl"}))
       ->capture_default_str();
   cmd->add_option("--vdls", opt->vdls, "VDLs used per voxel, strongest first")
-      ->check(CLI::Range(1, 8))
+      ->check(CLI::Range(1, kMaxVdls))
       ->capture_default_str();
   cmd->add_option("--emitter-lights", opt->emitterLights,
                   "Shadowed virtual point lights sampled on emissive triangles (0: none)")

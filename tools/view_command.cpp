@@ -599,8 +599,8 @@ std::function<int()> addViewCommand(CLI::App& app) {
   cmd->add_option("--exposure", opt->exposure, "Exposure in EV (radiance * 2^EV; keys , .)")
       ->check(CLI::Range(-30.0f, 30.0f))
       ->capture_default_str();
-  cmd->add_option("--vdls", opt->vdls, "VDLs used per voxel at the start, 1-8 (keys [ ])")
-      ->check(CLI::Range(1, 8))
+  cmd->add_option("--vdls", opt->vdls, "VDLs used per voxel at the start, 1-" + std::to_string(kMaxVdls) + " (keys [ ])")
+      ->check(CLI::Range(1, kMaxVdls))
       ->capture_default_str();
   cmd->add_option("--emitter-lights", opt->emitterLights,
                   "Shadowed virtual point lights sampled on emissive triangles (0: none)")

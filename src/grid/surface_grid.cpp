@@ -287,22 +287,7 @@ bool triangleOverlapsBox(const Vec3& a, const Vec3& b, const Vec3& c, const Boun
 SurfaceGrid buildSurfaceGrid(const Scene& scene, const GridParams& params, ProgressSink* progress) {
   using namespace surface_grid_internal;
   const size_t triangles = scene.triangleCount();
-  if (scene.indices.size() % 3 != 0) {
-    throw InputError("scene index count " + std::to_string(scene.indices.size()) +
-                     " is not a multiple of 3");
-  }
-  if (triangles >= size_t(std::numeric_limits<uint32_t>::max())) {
-    throw InputError("scene has too many triangles (" + std::to_string(triangles) + ")");
-  }
-  for (uint32_t i : scene.indices) {
-    if (i >= scene.positions.size()) {
-      throw InputError("scene vertex index " + std::to_string(i) + " is out of range (" +
-                       std::to_string(scene.positions.size()) + " vertices)");
-    }
-    if (!isFinite(scene.positions[i])) {
-      throw InputError("scene vertex " + std::to_string(i) + " is not finite");
-    }
-  }
+  checkSceneIndices(scene);
 
   SurfaceGrid grid;
   grid.frame = makeGridFrame(scene.bounds(), params.depth, params.padding);

@@ -19,6 +19,9 @@
 
 namespace lo {
 
+// The one VDL limit of the C++ side (lightgrid/vdl_grid.h) is the shader's.
+static_assert(kMaxVdls == int(layout::LO_MAX_VDLS), "kMaxVdls and LO_MAX_VDLS disagree");
+
 namespace gpu_octree_internal {
 
 using namespace layout;

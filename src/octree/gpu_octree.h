@@ -25,7 +25,9 @@ struct GpuOctreeParams {
   /// (docs/accuracy.md). On: each texel holds c_i / max(|n_v.d_i|,
   /// kMinCorrectionCosine), n_v the voxel's normal, so that the shader returns
   /// the baked estimate on the baked surface. Voxels without a normal keep c_i.
-  bool cosineCorrection = false;
+  /// On by default, as in every command; off gives the paper's form (the
+  /// sweep's "paper-cosine" point).
+  bool cosineCorrection = true;
 };
 
 /// Smallest cosine cosineCorrection divides by: bounds the gain of grazing

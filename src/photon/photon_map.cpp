@@ -366,8 +366,7 @@ PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params,
   if (params.maxBounces < 0)
     throw InputError("PhotonParams.maxBounces must be >= 0, got " +
                      std::to_string(params.maxBounces));
-  LO_CHECK_EQ(scene.indices.size() % 3, size_t(0));
-  LO_CHECK_EQ(scene.triangleMaterial.size(), scene.triangleCount());
+  checkSceneIndices(scene);
 
   Context ctx;
   ctx.scene = &scene;
@@ -378,19 +377,9 @@ PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params,
 
   ctx.triangles.resize(scene.triangleCount());
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    int32_t m = scene.triangleMaterial[t];
-    if (m < 0 || size_t(m) >= scene.materials.size())
-      throw InputError("triangle " + std::to_string(t) + " has material index " +
-                       std::to_string(m) + " outside [0, " +
-                       std::to_string(scene.materials.size()) + ")");
+    const int32_t m = scene.triangleMaterial[t];
     ctx.triangles[t].normal = scene.faceNormal(t);
     ctx.triangles[t].material = uint32_t(m);
-  }
-  for (size_t i = 0; i < 3 * scene.triangleCount(); ++i) {
-    if (scene.indices[i] >= scene.positions.size())
-      throw InputError("triangle " + std::to_string(i / 3) + " has vertex index " +
-                       std::to_string(scene.indices[i]) + " outside [0, " +
-                       std::to_string(scene.positions.size()) + ")");
   }
   ctx.materials.resize(scene.materials.size());
   for (size_t i = 0; i < scene.materials.size(); ++i) {

@@ -31,12 +31,7 @@ std::string errorCode(RTCDevice device) { return std::to_string(int(rtcGetDevice
 }  // namespace
 
 RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
-  for (size_t i = 0; i < 3 * scene.triangleCount(); ++i) {
-    if (scene.indices[i] >= scene.positions.size())
-      throw InputError("triangle " + std::to_string(i / 3) + " has vertex index " +
-                       std::to_string(scene.indices[i]) + " outside [0, " +
-                       std::to_string(scene.positions.size()) + ")");
-  }
+  checkSceneIndices(scene);
   impl_->faceNormals.resize(scene.triangleCount());
   for (size_t t = 0; t < scene.triangleCount(); ++t) impl_->faceNormals[t] = scene.faceNormal(t);
 

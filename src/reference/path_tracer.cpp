@@ -379,8 +379,7 @@ ReferenceImage renderReference(const Scene& scene, const ReferenceCamera& camera
   if (!(camera.yfov > 0 && camera.yfov < kPi))
     throw InputError("camera: vertical field of view " + std::to_string(camera.yfov) +
                      " rad outside (0, pi)");
-  LO_CHECK_EQ(scene.indices.size() % 3, size_t(0));
-  LO_CHECK_EQ(scene.triangleMaterial.size(), scene.triangleCount());
+  checkSceneIndices(scene);
 
   auto start = std::chrono::steady_clock::now();
   Context ctx;

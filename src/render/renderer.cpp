@@ -465,8 +465,9 @@ struct Renderer::Impl {
   void draw(const RenderCamera& camera, const RenderParams& rp, int width, int height,
             float exposureScale, bool encodeSrgb) {
     if (width < 1 || height < 1) throw InputError("render: image size must be at least 1 x 1");
-    if (rp.maxVdls < 1 || rp.maxVdls > 8) {
-      throw InputError("render: VDLs per voxel must be 1..8, got " + std::to_string(rp.maxVdls));
+    if (rp.maxVdls < 1 || rp.maxVdls > kMaxVdls) {
+      throw InputError("render: VDLs per voxel must be 1.." + std::to_string(kMaxVdls) + ", got " +
+                       std::to_string(rp.maxVdls));
     }
     glm::vec3 eye = toGlm(camera.eye);
     float zfar = camera.zfar > 0 ? camera.zfar

@@ -33,7 +33,7 @@ struct RenderParams {
   RenderMode mode = RenderMode::Full;
   bool interpolation = true;  ///< trilinear over the 8 neighbouring voxels (paper §4.2.1)
   bool specular = true;       ///< GGX lobe of the glTF BRDF; off = diffuse only
-  int maxVdls = 8;            ///< VDLs used per voxel, 1..8 (the strongest come first)
+  int maxVdls = kMaxVdls;     ///< VDLs used per voxel, 1..kMaxVdls (the strongest come first)
   /// Lookup point offset along the surface normal, in voxel sizes (see
   /// docs/render.md: picks the voxel in front of a surface lying on a voxel face).
   float normalOffset = 0.01f;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -218,28 +219,50 @@ float srgbToLinear(float c) {
 }
 
 void validateScene(const Scene& scene) {
-  const std::string& path = scene.sourcePath;
-  if (scene.triangleCount() == 0) fail(path, "no triangles in the scene");
-  if (scene.indices.size() % 3 != 0) fail(path, "index count is not a multiple of 3");
-  for (size_t i = 0; i < scene.positions.size(); ++i) {
-    if (!isFinite(scene.positions[i])) {
-      fail(path, "non-finite vertex position (vertex " + std::to_string(i) + " is " +
-                     scene.positions[i].ToString() + ")");
-    }
-  }
-  for (size_t i = 0; i < scene.indices.size(); ++i) {
-    if (scene.indices[i] >= scene.positions.size()) {
-      fail(path, "vertex index " + std::to_string(scene.indices[i]) + " out of range (" +
-                     std::to_string(scene.positions.size()) + " vertices)");
-    }
-  }
-  LO_CHECK_EQ(scene.triangleMaterial.size(), scene.triangleCount());
-  for (int32_t m : scene.triangleMaterial) LO_CHECK(m >= 0 && size_t(m) < scene.materials.size());
+  if (scene.triangleCount() == 0) fail(scene.sourcePath, "no triangles in the scene");
+  checkSceneIndices(scene);
   LO_CHECK(scene.normals.empty() || scene.normals.size() == scene.positions.size());
   LO_CHECK(scene.texcoords0.empty() || scene.texcoords0.size() == 2 * scene.positions.size());
   LO_CHECK(scene.texcoords1.empty() || scene.texcoords1.size() == 2 * scene.positions.size());
 }
 
 }  // namespace scene_internal
+
+void checkSceneIndices(const Scene& scene) {
+  const std::string where = scene.sourcePath.empty() ? "scene" : scene.sourcePath;
+  if (scene.indices.size() % 3 != 0) {
+    throw InputError(where + ": index count " + std::to_string(scene.indices.size()) +
+                     " is not a multiple of 3");
+  }
+  const size_t triangles = scene.triangleCount();
+  if (triangles >= size_t(UINT32_MAX)) {
+    throw InputError(where + ": too many triangles (" + std::to_string(triangles) + ")");
+  }
+  for (size_t i = 0; i < scene.positions.size(); ++i) {
+    if (!isFinite(scene.positions[i])) {
+      throw InputError(where + ": non-finite vertex position (vertex " + std::to_string(i) +
+                       " is " + scene.positions[i].ToString() + ")");
+    }
+  }
+  for (size_t i = 0; i < scene.indices.size(); ++i) {
+    if (scene.indices[i] >= scene.positions.size()) {
+      throw InputError(where + ": triangle " + std::to_string(i / 3) + " has vertex index " +
+                       std::to_string(scene.indices[i]) + " outside [0, " +
+                       std::to_string(scene.positions.size()) + ")");
+    }
+  }
+  if (scene.triangleMaterial.size() != triangles) {
+    throw InputError(where + ": " + std::to_string(scene.triangleMaterial.size()) +
+                     " material indices for " + std::to_string(triangles) + " triangles");
+  }
+  for (size_t t = 0; t < triangles; ++t) {
+    const int32_t m = scene.triangleMaterial[t];
+    if (m < 0 || size_t(m) >= scene.materials.size()) {
+      throw InputError(where + ": triangle " + std::to_string(t) + " has material index " +
+                       std::to_string(m) + " outside [0, " +
+                       std::to_string(scene.materials.size()) + ")");
+    }
+  }
+}
 
 }  // namespace lo

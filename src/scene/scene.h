@@ -110,6 +110,14 @@ struct Scene {
   Scene translated(const Vec3& offset) const;
 };
 
+/// @brief The index checks every stage that walks the triangles relies on:
+/// index count a multiple of 3, fewer than 2^32 - 1 triangles, every vertex
+/// index inside `positions`, every vertex position finite, one material index
+/// per triangle, each inside `materials`. Loaders run it on what they load;
+/// stages run it on scenes built in code. @throws InputError naming the first
+/// offending triangle, index or vertex (and the scene's file, if any).
+void checkSceneIndices(const Scene& scene);
+
 /// Loads a .gltf, .glb or .obj file. External resources (buffers, images,
 /// .mtl files) resolve only inside the scene file's own folder.
 /// @throws InputError naming the file and the problem (missing buffer, index

@@ -19,6 +19,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "octree/gpu_octree.h"
+#include "test_util.h"
 
 namespace lo {
 namespace {
@@ -388,6 +389,7 @@ TEST_P(OctreeRandomGrid, LookupMatchesTheGrid) {
   const auto [depth, half] = GetParam();
   const VdlGrid g = randomGrid(depth, depth == 5 ? 3000 : 6000, uint64_t(depth));
   GpuOctreeParams params;
+  params.cosineCorrection = false;  // the paper's texels: what these checks compare
   params.halfFloat = half;
   const GpuOctree o = buildGpuOctree(g, params);
   SCOPED_TRACE(o.ToString());
@@ -401,7 +403,7 @@ INSTANTIATE_TEST_SUITE_P(DepthAndPrecision, OctreeRandomGrid,
 
 TEST(Octree, SameBytesWhateverTheInputOrder) {
   VdlGrid g = randomGrid(5, 2000, 3);
-  const GpuOctree a = buildGpuOctree(g);
+  const GpuOctree a = buildGpuOctree(g, test::paperCosine());
   // Reverse the voxel order (VDL slots move with their voxel).
   VdlGrid r = g;
   const size_t n = g.size(), k = size_t(g.maxVdls);
@@ -410,7 +412,7 @@ TEST(Octree, SameBytesWhateverTheInputOrder) {
     r.vdlCount[v] = g.vdlCount[n - 1 - v];
     std::copy(g.vdlsOf(n - 1 - v), g.vdlsOf(n - 1 - v) + k, r.vdls.begin() + long(v * k));
   }
-  const GpuOctree b = buildGpuOctree(r);
+  const GpuOctree b = buildGpuOctree(r, test::paperCosine());
   EXPECT_EQ(a.pool, b.pool);
   EXPECT_EQ(a.vdlTexels, b.vdlTexels);
 }
@@ -427,7 +429,7 @@ TEST(Octree, AddressesBeyond16BitsUseTheBlueChannel) {
       g.vdls[v * 4 + size_t(i)].direction = {0, 0, 1};
     }
   }
-  const GpuOctree o = buildGpuOctree(g);
+  const GpuOctree o = buildGpuOctree(g, test::paperCosine());
   EXPECT_EQ(o.vdlCount, 80000u);
   EXPECT_EQ(o.vdlWidth, 4096);
   EXPECT_EQ(o.vdlHeight, 20);  // ceil(80000 / 4096)
@@ -457,6 +459,7 @@ TEST(Octree, HalfPrecisionClampsIrradianceBeyondTheLargestHalf) {
   g.vdls[0].irradiance = {1e6f, 65504.0f, 1.0f};
   g.vdls[0].direction = {0, 1, 0};
   GpuOctreeParams params;
+  params.cosineCorrection = false;  // the paper's texels: what these checks compare
   params.halfFloat = true;
   const GpuOctree o = buildGpuOctree(g, params);
   const OctreeSample s = lookupOctree(o, g.frame.voxelCenter(g.coords[0]));
@@ -470,7 +473,7 @@ TEST(Octree, HalfPrecisionClampsIrradianceBeyondTheLargestHalf) {
 TEST(Octree, GridWithoutLightIsOneEmptyRootTile) {
   VdlGrid g = randomGrid(4, 50, 2);
   std::fill(g.vdlCount.begin(), g.vdlCount.end(), uint8_t(0));
-  const GpuOctree o = buildGpuOctree(g);
+  const GpuOctree o = buildGpuOctree(g, test::paperCosine());
   EXPECT_EQ(o.leafCount, 0u);
   EXPECT_EQ(o.nodeCount, 1u);
   EXPECT_EQ(o.tilesX * o.tilesY * o.tilesZ, 1);
@@ -484,7 +487,7 @@ TEST(Octree, DepthOneIsTheRootTileAlone) {
   VdlGrid g = randomGrid(1, 1, 4, 2);
   g.coords[0] = {1, 0, 1};
   g.vdlCount[0] = 2;
-  const GpuOctree o = buildGpuOctree(g);
+  const GpuOctree o = buildGpuOctree(g, test::paperCosine());
   EXPECT_EQ(o.nodeCount, 1u);
   // Child (1,0,1) of the root tile: texel x=1, y=0, z=1 in a 2x2x2 pool.
   const uint8_t* t = &o.pool[((1 * 2 + 0) * 2 + 1) * 4];
@@ -513,12 +516,15 @@ TEST(OctreeLimits, TooManyTilesForThe3DTexture) {
   int perAxis = 1;
   while (size_t(perAxis) * size_t(perAxis) * size_t(perAxis) < tiles) ++perAxis;
   GpuOctreeParams fits;
+  fits.cosineCorrection = false;  // the paper's texels: what these checks compare
   fits.max3DTextureSize = 2 * perAxis + 1;  // odd sizes round down to whole tiles
   const GpuOctree o = buildGpuOctree(g, fits);
   EXPECT_LE(std::max({o.tilesX, o.tilesY, o.tilesZ}), perAxis);
   checkLookups(g, o, 8);
 
   GpuOctreeParams small;
+
+  small.cosineCorrection = false;  // the paper's texels: what these checks compare
   small.max3DTextureSize = 2 * perAxis - 1;
   const std::string message = errorOf(g, small);
   const size_t capacity = size_t(perAxis - 1) * size_t(perAxis - 1) * size_t(perAxis - 1);
@@ -533,6 +539,7 @@ TEST(OctreeLimits, VdlTextureWiderThanThe2DLimit) {
   VdlGrid g = randomGrid(4, 100, 9, 2);
   std::fill(g.vdlCount.begin(), g.vdlCount.end(), uint8_t(2));  // 200 VDLs
   GpuOctreeParams p;
+  p.cosineCorrection = false;  // the paper's texels: what these checks compare
   p.max2DTextureSize = 150;
   const std::string message = errorOf(g, p);
   EXPECT_NE(message.find("VDL texture"), std::string::npos) << message;
@@ -565,6 +572,7 @@ TEST(OctreeLimits, BadGridsNameTheProblem) {
   g.vdls[0].irradiance.x = INFINITY;
   EXPECT_NE(errorOf(g, {}).find("not finite"), std::string::npos) << errorOf(g, {});
   GpuOctreeParams p;
+  p.cosineCorrection = false;  // the paper's texels: what these checks compare
   p.max3DTextureSize = 1;
   EXPECT_NE(errorOf(good, p).find("3D texture size 1"), std::string::npos) << errorOf(good, p);
 }
@@ -589,7 +597,7 @@ TEST(OctreeMemory, SphereShellAtDepth6) {
       }
     }
   }
-  const GpuOctree o = buildGpuOctree(g);
+  const GpuOctree o = buildGpuOctree(g, test::paperCosine());
   std::cout << o.ToString() << "\n" << octreeMemoryReport(o);
   EXPECT_EQ(o.leafCount, g.size());
   EXPECT_EQ(o.nodeCount, bruteForceTileCount(g));
@@ -607,7 +615,7 @@ TEST(OctreeMemory, SphereShellAtDepth6) {
 
 TEST(OctreeMemory, ReportStatesBytesPerLeafAndThePaper) {
   const VdlGrid g = randomGrid(6, 6000, 12, 4);
-  const GpuOctree o = buildGpuOctree(g);
+  const GpuOctree o = buildGpuOctree(g, test::paperCosine());
   const std::string report = octreeMemoryReport(o);
   EXPECT_NE(report.find("5.24"), std::string::npos) << report;   // 512 KiB / 100k leaves
   EXPECT_NE(report.find("41.94"), std::string::npos) << report;  // 4 MiB / 100k leaves

@@ -58,7 +58,7 @@ Vec3 decodedDirection(const GpuOctree& o, int k) {
 TEST(OctreeIrradiance, ConstantVdlGivesTheCosineLawEverywhereOnTheSlab) {
   const Vec3 c{2.0f, 1.0f, 0.5f};
   const Vec3 d = normalize(Vec3{0.3f, -0.2f, 1.0f});
-  const GpuOctree o = buildGpuOctree(constantGrid(3, 0, 1, {vdl(c, d)}));
+  const GpuOctree o = buildGpuOctree(constantGrid(3, 0, 1, {vdl(c, d)}), test::paperCosine());
   const Vec3 dq = decodedDirection(o, 0);
   EXPECT_NEAR(dot(dq, d), 1.0f, 1e-3f);
   const Vec3 normals[] = {{0, 0, 1}, normalize(Vec3{1, 0, 1}), normalize(Vec3{0.2f, 0.9f, 0.1f})};
@@ -92,7 +92,7 @@ TEST(OctreeIrradiance, InterpolationBlendsNeighboursTrilinearly) {
   VdlGrid g = constantGrid(3, 0, 1, {vdl({1, 1, 1}, {0, 0, 1})});
   for (size_t v = 0; v < g.size(); ++v)
     if (g.coords[v].z == 1) g.vdls[v * kMaxVdls].irradiance = {3, 3, 3};
-  const GpuOctree o = buildGpuOctree(g);
+  const GpuOctree o = buildGpuOctree(g, test::paperCosine());
   OctreeShadeParams p;
   p.normalOffset = 0;
   for (float z : {0.5f, 0.75f, 1.0f, 1.25f, 1.5f}) {
@@ -107,8 +107,10 @@ TEST(OctreeIrradiance, InterpolationBlendsNeighboursTrilinearly) {
 
 TEST(OctreeIrradiance, MaxVdlsAndHalfFloatTexels) {
   const GpuOctree full =
-      buildGpuOctree(constantGrid(3, 0, 0, {vdl({4, 4, 4}, {0, 0, 1}), vdl({1, 2, 3}, {1, 0, 1})}));
+      buildGpuOctree(constantGrid(3, 0, 0, {vdl({4, 4, 4}, {0, 0, 1}), vdl({1, 2, 3}, {1, 0, 1})}),
+                     test::paperCosine());
   GpuOctreeParams hp;
+  hp.cosineCorrection = false;  // the paper's texels: what these checks compare
   hp.halfFloat = true;
   const GpuOctree half = buildGpuOctree(
       constantGrid(3, 0, 0, {vdl({4, 4, 4}, {0, 0, 1}), vdl({1, 2, 3}, {1, 0, 1})}), hp);
@@ -133,7 +135,7 @@ TEST(OctreeIrradiance, CosineCorrectionReturnsTheBakedEstimateOnTheBakedSurface)
   VdlGrid g = constantGrid(3, 0, 0, {a, b, grazing});
   GpuOctreeParams on;
   on.cosineCorrection = true;
-  const GpuOctree paper = buildGpuOctree(g), corrected = buildGpuOctree(g, on);
+  const GpuOctree paper = buildGpuOctree(g, test::paperCosine()), corrected = buildGpuOctree(g, on);
   const Vec3 p = Vec3{3.5f, 3.5f, 0.5f} * kVoxel, up{0, 0, 1};
   const float cosGrazing = decodedDirection(paper, 2).z;
   ASSERT_LT(cosGrazing, kMinCorrectionCosine);
@@ -168,7 +170,7 @@ TEST(OctreeIrradiance, FirstHitImageOfALitPlaneIsTheAnalyticValueAtEveryPixel) {
   test::addQuad(scene, {0, 0, 0.3f * kVoxel}, {8 * kVoxel, 0, 0}, {0, 8 * kVoxel, 0}, {0, 0, 1}, 0);
   const Vec3 c{0.8f, 0.5f, 0.2f};
   const Vec3 d{std::sin(kPi / 3), 0, std::cos(kPi / 3)};
-  const GpuOctree o = buildGpuOctree(constantGrid(3, 0, 0, {vdl(c, d)}));
+  const GpuOctree o = buildGpuOctree(constantGrid(3, 0, 0, {vdl(c, d)}), test::paperCosine());
   const Vec3 expected = c * dot(Vec3{0, 0, 1}, decodedDirection(o, 0));
   EXPECT_NEAR(expected.x, 0.4f, 0.01f);
   // Camera above the middle of the plane, looking down at part of it.

@@ -69,7 +69,7 @@ struct Setup {
   Setup() {
     scene = loadScene(test::dataDir() + "/cornell-box.gltf");
     LoadedVdl baked = readVdlGrid(goldenDir() + "/cornell-box-d4.vdb");
-    octree = buildGpuOctree(baked.grid);
+    octree = buildGpuOctree(baked.grid, test::paperCosine());
     camera = RenderCamera::fromScene(scene.cameras.at(0));
   }
 };
