@@ -1,10 +1,10 @@
 #version 330 core
-// Evaluates the shared layout functions of octree_layout.h (prepended by the
-// renderer) on the texels of uInputs, one result texel per input texel, so a
+// Evaluates the shared layout functions of octree_layout.h on the texels of uInputs, one result texel per input texel, so a
 // test can compare the GLSL results with the same functions compiled as C++.
 uniform sampler2D uInputs;  // RGBA32F
 uniform int uFunction;      // 0: pack direction, 1: unpack direction, 2: addresses
 out vec4 result;
+#include "octree_layout.h"
 
 void main() {
   vec4 v = texelFetch(uInputs, ivec2(gl_FragCoord.xy), 0);

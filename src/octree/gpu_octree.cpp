@@ -346,61 +346,6 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   return out;
 }
 
-OctreeSample lookupOctree(const GpuOctree& octree, const Vec3& worldPosition) {
-  using namespace layout;
-  OctreeSample sample;
-  if (octree.depth < 1 || octree.pool.empty()) return sample;
-  // Normalized octree position; the comparisons are written so that NaN fails.
-  const Vec3 u = (worldPosition - octree.origin) / octree.cubeSize;
-  if (!(u.x >= 0.0f && u.x < 1.0f && u.y >= 0.0f && u.y < 1.0f && u.z >= 0.0f && u.z < 1.0f)) {
-    return sample;
-  }
-  const int res = 1 << octree.depth;
-  auto voxelOf = [res](float t) { return std::min(int(std::floor(t * float(res))), res - 1); };
-  const Coord voxel{voxelOf(u.x), voxelOf(u.y), voxelOf(u.z)};
-
-  const size_t poolW = size_t(octree.poolWidth()), poolH = size_t(octree.poolHeight());
-  uint tx = 0, ty = 0, tz = 0;  // root tile
-  for (int l = 0; l < octree.depth; ++l) {
-    const int bit = octree.depth - 1 - l;
-    const size_t x = 2 * tx + uint((voxel.x >> bit) & 1), y = 2 * ty + uint((voxel.y >> bit) & 1),
-                 z = 2 * tz + uint((voxel.z >> bit) & 1);
-    const uint8_t* t = &octree.pool[((z * poolH + y) * poolW + x) * 4];
-    const uint flag = t[3];
-    if (l + 1 < octree.depth) {
-      if (flag != LO_FLAG_INNER) return sample;  // empty branch
-      tx = t[0];
-      ty = t[1];
-      tz = t[2];
-      continue;
-    }
-    if (!loIsLeaf(flag)) return sample;
-    const uint address = loUnpackAddress(t[0], t[1], t[2]);
-    sample.found = true;
-    sample.voxel = voxel;
-    sample.vdlCount = int(flag);
-    for (uint i = 0; i < flag; ++i) {
-      const uint index = address + i;
-      const size_t offset =
-          (size_t(loVdlTexelY(index)) * size_t(octree.vdlWidth) + size_t(loVdlTexelX(index))) * 4;
-      Vdl& vdl = sample.vdls[i];
-      float packed;
-      if (octree.halfFloat) {
-        const uint16_t* h = &octree.vdlTexelsHalf[offset];
-        vdl.irradiance = {halfToFloat(h[0]), halfToFloat(h[1]), halfToFloat(h[2])};
-        packed = float(h[3]);  // RGBA16UI alpha: the packed integer itself
-      } else {
-        const float* f = &octree.vdlTexels[offset];
-        vdl.irradiance = {f[0], f[1], f[2]};
-        packed = f[3];
-      }
-      vdl.direction = {loUnpackDirectionX(packed), loUnpackDirectionY(packed),
-                       loUnpackDirectionZ(packed)};
-    }
-  }
-  return sample;
-}
-
 std::string GpuOctree::ToString() const {
   using gpu_octree_internal::kib;
   std::ostringstream os;

@@ -1,67 +1,115 @@
+// The C++ build of shaders/octree_lookup.h: the fragment shader's lookup,
+// compiled against the texel arrays of a GpuOctree instead of GL textures.
+// lookupOctree (gpu_octree.h) and octreeIrradiance (octree_irradiance.h) are
+// thin wrappers of it, so the CPU figures (tests, the sweep) are the shader's.
+
 #include "octree/octree_irradiance.h"
+
+#include <glm/glm.hpp>
+#include <octree_layout.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+
+#include "octree/gpu_octree.h"
 
 namespace lo {
-namespace octree_irradiance_internal {
+namespace octree_lookup_internal {
 
-/// The leaf of voxel c (lookupLeaf in the shader), through the C++ descent.
-bool leafAt(const GpuOctree& octree, int cx, int cy, int cz, float voxelSize,
-            OctreeSample& sample) {
-  const int res = 1 << octree.depth;
-  if (cx < 0 || cy < 0 || cz < 0 || cx >= res || cy >= res || cz >= res) return false;
-  const Vec3 centre =
-      octree.origin + Vec3{float(cx) + 0.5f, float(cy) + 0.5f, float(cz) + 0.5f} * voxelSize;
-  sample = lookupOctree(octree, centre);
-  return sample.found;
-}
-
-/// shadeLeaf in the shader with brdfCos -> max(0, n . d).
-Vec3 shadeLeaf(const OctreeSample& sample, const Vec3& n, int maxVdls) {
-  Vec3 sum{0, 0, 0};
-  const int count = std::min(sample.vdlCount, maxVdls);
-  for (int i = 0; i < count; ++i) {
-    sum += sample.vdls[i].irradiance * std::max(0.0f, dot(n, sample.vdls[i].direction));
+/// Pool texel at p, or an empty texel outside the pool (GL returns zero for
+/// out-of-range texelFetch on the implementations we target).
+glm::uvec4 fetchPool(const GpuOctree& o, const glm::ivec3& p) {
+  if (p.x < 0 || p.y < 0 || p.z < 0 || p.x >= o.poolWidth() || p.y >= o.poolHeight() ||
+      p.z >= o.poolDepth()) {
+    return glm::uvec4(0u);
   }
-  return sum;
+  const size_t i =
+      ((size_t(p.z) * size_t(o.poolHeight()) + size_t(p.y)) * size_t(o.poolWidth()) + size_t(p.x)) *
+      4;
+  return {o.pool[i], o.pool[i + 1], o.pool[i + 2], o.pool[i + 3]};
 }
 
-}  // namespace octree_irradiance_internal
+size_t vdlOffset(const GpuOctree& o, const glm::ivec2& p) {
+  return (size_t(p.y) * size_t(o.vdlWidth) + size_t(p.x)) * 4;
+}
+
+glm::vec4 fetchVdlFloat(const GpuOctree& o, const glm::ivec2& p) {
+  const size_t i = vdlOffset(o, p);
+  if (i + 4 > o.vdlTexels.size()) return glm::vec4(0.0f);
+  return {o.vdlTexels[i], o.vdlTexels[i + 1], o.vdlTexels[i + 2], o.vdlTexels[i + 3]};
+}
+
+glm::uvec4 fetchVdlHalf(const GpuOctree& o, const glm::ivec2& p) {
+  const size_t i = vdlOffset(o, p);
+  if (i + 4 > o.vdlTexelsHalf.size()) return glm::uvec4(0u);
+  return {o.vdlTexelsHalf[i], o.vdlTexelsHalf[i + 1], o.vdlTexelsHalf[i + 2],
+          o.vdlTexelsHalf[i + 3]};
+}
+
+}  // namespace octree_lookup_internal
+}  // namespace lo
+
+#define LO_FETCH_POOL(p) ::lo::octree_lookup_internal::fetchPool(tex, p)
+#define LO_FETCH_VDL_FLOAT(p) ::lo::octree_lookup_internal::fetchVdlFloat(tex, p)
+#define LO_FETCH_VDL_HALF(p) ::lo::octree_lookup_internal::fetchVdlHalf(tex, p)
+#define LO_VDLS_HALF tex.halfFloat
+#include <octree_lookup.h>
+
+namespace lo {
+namespace lookup {
+/// E = sum_i c_i max(0, n . d_i): the shader's brdfCos with the BRDF left
+/// out, i.e. irradiance (see octree_irradiance.h).
+vec3 loVdlResponse(LoSurface s, vec3 d) { return vec3(max(0.0f, dot(s.n, d))); }
+}  // namespace lookup
+
+namespace {
+
+glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
+Vec3 fromGlm(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+}  // namespace
+
+OctreeSample lookupOctree(const GpuOctree& octree, const Vec3& worldPosition) {
+  OctreeSample sample;
+  if (octree.depth < 1 || octree.pool.empty()) return sample;
+  // Normalized octree position; the comparisons are written so that NaN fails.
+  const Vec3 u = (worldPosition - octree.origin) / octree.cubeSize;
+  if (!(u.x >= 0.0f && u.x < 1.0f && u.y >= 0.0f && u.y < 1.0f && u.z >= 0.0f && u.z < 1.0f)) {
+    return sample;
+  }
+  const int res = 1 << octree.depth;
+  auto voxelOf = [res](float t) { return std::min(int(std::floor(t * float(res))), res - 1); };
+  const Coord voxel{voxelOf(u.x), voxelOf(u.y), voxelOf(u.z)};
+  glm::uvec4 leaf;
+  if (!lookup::loLookupLeaf(octree, glm::ivec3(voxel.x, voxel.y, voxel.z), octree.depth, leaf)) {
+    return sample;
+  }
+  sample.found = true;
+  sample.voxel = voxel;
+  sample.vdlCount = int(leaf.a);
+  const uint32_t first = layout::loUnpackAddress(leaf.r, leaf.g, leaf.b);
+  for (uint32_t i = 0; i < leaf.a; ++i) {
+    const glm::vec4 t = lookup::loFetchVdl(octree, first + i);
+    sample.vdls[i].irradiance = {t.r, t.g, t.b};
+    sample.vdls[i].direction = fromGlm(lookup::loVdlDirection(t.a));
+  }
+  return sample;
+}
 
 Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3& normal,
                       const OctreeShadeParams& params) {
-  using namespace octree_irradiance_internal;
   if (octree.depth < 1 || octree.pool.empty()) return {0, 0, 0};
   const float voxelSize = octree.cubeSize / float(1 << octree.depth);
-  const Vec3 q = (position - octree.origin) / voxelSize + normal * params.normalOffset;
-  OctreeSample sample;
-  if (params.interpolation) {
-    const Vec3 u = q - Vec3{0.5f, 0.5f, 0.5f};
-    const Vec3 base{std::floor(u.x), std::floor(u.y), std::floor(u.z)};
-    const Vec3 f = u - base;
-    Vec3 sum{0, 0, 0};
-    float weightSum = 0;
-    for (int k = 0; k < 8; ++k) {
-      const int ox = k & 1, oy = (k >> 1) & 1, oz = (k >> 2) & 1;
-      const float w = (ox ? f.x : 1 - f.x) * (oy ? f.y : 1 - f.y) * (oz ? f.z : 1 - f.z);
-      if (w <= 0) continue;
-      if (leafAt(octree, int(base.x) + ox, int(base.y) + oy, int(base.z) + oz, voxelSize, sample)) {
-        sum += shadeLeaf(sample, normal, params.maxVdls) * w;
-        weightSum += w;
-      }
-    }
-    if (weightSum > 0) return sum / weightSum;
-  }
-  // nearestLeaf: the voxel in front of the surface, else the one behind it.
-  const Vec3 front = q, back = q - normal * (2.0f * params.normalOffset);
-  for (const Vec3& p : {front, back}) {
-    if (leafAt(octree, int(std::floor(p.x)), int(std::floor(p.y)), int(std::floor(p.z)), voxelSize,
-               sample)) {
-      return shadeLeaf(sample, normal, params.maxVdls);
-    }
-  }
-  return {0, 0, 0};
+  lookup::LoSurface s;
+  s.n = toGlm(normal);
+  s.v = s.n;
+  s.baseColor = glm::vec3(1.0f);
+  s.metallic = 0.0f;
+  s.roughness = 1.0f;
+  return fromGlm(lookup::loOctreeIndirect(octree, toGlm(position), toGlm(octree.origin), voxelSize,
+                                          octree.depth, params.normalOffset, params.interpolation,
+                                          params.maxVdls, s));
 }
 
 }  // namespace lo

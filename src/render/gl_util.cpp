@@ -37,20 +37,51 @@ std::string infoLog(GLuint object, bool program) {
 
 }  // namespace
 
+namespace {
+
+/// Replaces each line `#include "NAME"` of `text` (a file of shaders/) by the
+/// embedded file NAME, followed by a #line directive that restores the
+/// includer's numbering. One level: included files include nothing.
+std::string expandIncludes(const std::string& name, const std::string& text) {
+  std::string out;
+  size_t pos = 0;
+  int line = 1;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    const std::string l = text.substr(pos, end - pos);
+    if (l.rfind("#include \"", 0) == 0) {
+      const size_t close = l.find('"', 10);
+      if (close == std::string::npos) throw GlError("shader '" + name + "': malformed " + l);
+      const std::string file = l.substr(10, close - 10);
+      const char* included = embeddedShader(file.c_str());
+      if (!included) {
+        throw GlError("shader '" + name + "' includes '" + file +
+                      "', which is not among the embedded shaders/");
+      }
+      out += included;
+      out += "\n#line " + std::to_string(line + 1) + "\n";
+    } else {
+      out += l + "\n";
+    }
+    pos = end + 1;
+    ++line;
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string shaderSource(const std::string& name, const std::vector<std::string>& defines) {
   const char* text = embeddedShader(name.c_str());
   if (!text) throw GlError("shader '" + name + "' is not among the embedded shaders/");
-  std::string source = text;
-  GLenum stage = stageOf(name);
+  std::string source = expandIncludes(name, text);
   size_t versionEnd = source.find('\n', source.find("#version"));
   if (source.find("#version") == std::string::npos || versionEnd == std::string::npos) {
     throw GlError("shader '" + name + "': no #version line");
   }
   std::string inserted;
   for (const std::string& d : defines) inserted += "#define " + d + "\n";
-  if (stage == GL_FRAGMENT_SHADER || stage == GL_COMPUTE_SHADER) {
-    inserted += embeddedShader("octree_layout.h");
-  }
   // Keep the shader's own line numbers in compiler messages.
   inserted += "#line 2\n";
   source.insert(versionEnd + 1, inserted);

@@ -13,6 +13,8 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <sstream>
 
+#include <render_constants.h>
+
 #include "core/error.h"
 #include "render/context.h"
 #include "render/gl_util.h"
@@ -21,10 +23,28 @@
 namespace lo {
 namespace render_internal {
 
-constexpr int kMaxLights = 32;        // = kMaxLights in render_scene.frag
-constexpr int kMaxShadowLayers = 96;  // = kMaxShadowLayers in render_scene.frag
+// Shared with the shader (shaders/render_constants.h).
+constexpr int kMaxLights = shader::LO_MAX_LIGHTS;
+constexpr int kMaxShadowLayers = shader::LO_MAX_SHADOW_LAYERS;
+constexpr int kPoint = shader::LO_LIGHT_POINT;
+constexpr int kSpot = shader::LO_LIGHT_SPOT;
+constexpr int kDirectional = shader::LO_LIGHT_DIRECTIONAL;
+constexpr int kEmitter = shader::LO_LIGHT_EMITTER;
 
-enum LightType { kPoint = 0, kSpot = 1, kDirectional = 2, kEmitter = 3 };
+/// uMode of the scene shader for a render mode.
+int shaderMode(RenderMode mode) {
+  switch (mode) {
+    case RenderMode::Full:
+      return shader::LO_MODE_FULL;
+    case RenderMode::Direct:
+      return shader::LO_MODE_DIRECT;
+    case RenderMode::Indirect:
+      return shader::LO_MODE_INDIRECT;
+    case RenderMode::Voxels:
+      return shader::LO_MODE_VOXELS;
+  }
+  return shader::LO_MODE_FULL;
+}
 
 /// std140 twin of `struct Light` in shaders/render_scene.frag.
 struct GpuLight {
@@ -508,7 +528,7 @@ struct Renderer::Impl {
     glUniform1f(loc("uVoxelSize"), voxelSize);
     glUniform1i(loc("uDepth"), depth);
     glUniform3f(loc("uEye"), camera.eye.x, camera.eye.y, camera.eye.z);
-    glUniform1i(loc("uMode"), int(rp.mode));
+    glUniform1i(loc("uMode"), shaderMode(rp.mode));
     glUniform1i(loc("uInterpolation"), rp.interpolation ? 1 : 0);
     glUniform1i(loc("uSpecular"), rp.specular ? 1 : 0);
     glUniform1i(loc("uMaxVdls"), rp.maxVdls);

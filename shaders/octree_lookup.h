@@ -1,0 +1,187 @@
+/* octree_lookup.h: the light octree lookup, written once for GLSL and C++
+ * (the practice of NanoVDB's PNanoVDB.h). The fragment shader includes it
+ * (render_scene.frag); the C++ build is octree/octree_irradiance.cpp, which
+ * gives lookupOctree() and octreeIrradiance() to the tests, the sweep and the
+ * CPU renderers. Needs octree_layout.h first.
+ *
+ * What it holds (paper §4.2, Fig. 6):
+ *   loLookupLeaf     the descent from the root tile to the leaf of a voxel
+ *                    (at most `depth` texel fetches; a leaf may sit at any level)
+ *   loHalfToFloat    IEEE binary16 bits -> float (half-precision VDL texels)
+ *   loFetchVdl       one VDL texel, decoded: rgb irradiance (W/m^2), a packed direction
+ *   loShadeLeaf      sum_i response(d_i) c_i over a leaf's VDLs (paper §4.2.2)
+ *   loNearestLeaf    the voxel in front of a surface point, else the one behind it
+ *   loOctreeIndirect the indirect light at a surface point: trilinear over the 8
+ *                    voxels around it with empty ones left out and the weights
+ *                    renormalized (§4.2.1), else loNearestLeaf
+ *
+ * The includer defines, before including:
+ *   LO_FETCH_POOL(p)      RGBA8UI texel of the pool at ivec3 p, as uvec4
+ *   LO_FETCH_VDL_FLOAT(p) RGBA32F VDL texel at ivec2 p, as vec4
+ *   LO_FETCH_VDL_HALF(p)  RGBA16UI VDL texel at ivec2 p, as uvec4
+ *   LO_VDLS_HALF          true when the VDL texels are the half ones
+ * and, anywhere in the same unit, the response of a surface to one VDL:
+ *   vec3 loVdlResponse(LoSurface s, vec3 d)   (the BRDF times the cosine in the
+ *   shader; the cosine alone, i.e. irradiance, in C++).
+ * In C++ the functions take the octree as their first argument (LO_TEX_PARAM)
+ * and live in namespace lo::lookup with GLM standing in for GLSL's types.
+ */
+#ifndef LO_OCTREE_LOOKUP_H
+#define LO_OCTREE_LOOKUP_H
+
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace lo {
+struct GpuOctree;
+namespace lookup {
+using namespace glm;
+using namespace ::lo::layout;
+using uint = ::lo::layout::uint;
+/* GLSL's built-ins are GLM's here, ahead of lo's own min/max/dot (core/math.h). */
+using glm::any;
+using glm::dot;
+using glm::exp2;
+using glm::floor;
+using glm::greaterThanEqual;
+using glm::lessThan;
+using glm::max;
+using glm::min;
+using glm::uintBitsToFloat;
+#define LO_LOOKUP_FN inline
+#define LO_TEX_PARAM const ::lo::GpuOctree &tex,
+#define LO_TEX tex,
+#define LO_OUT(T) T &
+#else
+#define LO_LOOKUP_FN
+#define LO_TEX_PARAM
+#define LO_TEX
+#define LO_OUT(T) out T
+#endif
+
+/* What a surface point needs to respond to a VDL. */
+struct LoSurface {
+  vec3 n;         /* unit shading normal, world space */
+  vec3 v;         /* unit direction to the viewer */
+  vec3 baseColor; /* linear RGB */
+  float metallic;
+  float roughness;
+};
+
+vec3 loVdlResponse(LoSurface s, vec3 d); /* defined by the includer */
+
+/* Octree descent (paper Fig. 6): from the root tile to the leaf holding voxel
+ * c. False in empty space or outside the cube. */
+LO_LOOKUP_FN bool loLookupLeaf(LO_TEX_PARAM ivec3 c, int depth, LO_OUT(uvec4) leaf) {
+  leaf = uvec4(0u);
+  int resolution = 1 << depth;
+  if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(resolution)))) return false;
+  ivec3 tile = ivec3(0);
+  for (int level = depth - 1; level >= 0; --level) {
+    ivec3 child = (c >> level) & 1;
+    uvec4 t = LO_FETCH_POOL(tile * 2 + child);
+    if (t.a == LO_FLAG_EMPTY) return false;
+    if (t.a != LO_FLAG_INNER) {
+      leaf = t;
+      return loIsLeaf(t.a);
+    }
+    tile = ivec3(t);
+  }
+  return false;
+}
+
+/* IEEE binary16 bits -> float, exact (unpackHalf2x16 needs GLSL 4.20). */
+LO_LOOKUP_FN float loHalfToFloat(uint h) {
+  uint e = (h >> 10u) & 31u;
+  if (e == 31u) return uintBitsToFloat(((h & 32768u) << 16u) | 2139095040u | ((h & 1023u) << 13u));
+  float m = float(h & 1023u);
+  float v = e == 0u ? m * exp2(-24.0f) : (1.0f + m / 1024.0f) * exp2(float(e) - 15.0f);
+  return (h & 32768u) != 0u ? -v : v;
+}
+
+/* One VDL texel: rgb irradiance (W/m^2), a packed direction (octree_layout.h). */
+LO_LOOKUP_FN vec4 loFetchVdl(LO_TEX_PARAM uint index) {
+  ivec2 p = ivec2(int(loVdlTexelX(index)), int(loVdlTexelY(index)));
+  if (LO_VDLS_HALF) {
+    uvec4 t = LO_FETCH_VDL_HALF(p);
+    return vec4(loHalfToFloat(t.r), loHalfToFloat(t.g), loHalfToFloat(t.b), float(t.a));
+  }
+  return LO_FETCH_VDL_FLOAT(p);
+}
+
+LO_LOOKUP_FN vec3 loVdlDirection(float code) {
+  return vec3(loUnpackDirectionX(code), loUnpackDirectionY(code), loUnpackDirectionZ(code));
+}
+
+/* Paper §4.2.2: c = sum_i brdf(d_i, v, n) c_i over the leaf's first maxVdls
+ * VDLs (the strongest come first), each a directional light of irradiance c_i. */
+LO_LOOKUP_FN vec3 loShadeLeaf(LO_TEX_PARAM uvec4 leaf, int maxVdls, LoSurface s) {
+  uint first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
+  int count = min(int(leaf.a), maxVdls);
+  vec3 sum = vec3(0.0f);
+  for (int i = 0; i < count; ++i) {
+    vec4 t = loFetchVdl(LO_TEX first + uint(i));
+    sum += loVdlResponse(s, loVdlDirection(t.a)) * vec3(t);
+  }
+  return sum;
+}
+
+/* The voxel under a surface point: q is the point in voxel units, already
+ * moved by normalOffset voxels along n towards the viewer, so a surface lying
+ * on a voxel face is looked up in the voxel in front of it; if that one is
+ * empty, in the voxel behind it. */
+LO_LOOKUP_FN bool loNearestLeaf(LO_TEX_PARAM vec3 q, vec3 n, int depth, float normalOffset,
+                                LO_OUT(uvec4) leaf, LO_OUT(ivec3) voxel) {
+  voxel = ivec3(floor(q));
+  if (loLookupLeaf(LO_TEX voxel, depth, leaf)) return true;
+  voxel = ivec3(floor(q - (normalOffset + normalOffset) * n));
+  return loLookupLeaf(LO_TEX voxel, depth, leaf);
+}
+
+/* Position in voxel units of the octree, moved normalOffset voxels along n. */
+LO_LOOKUP_FN vec3 loOctreePosition(vec3 p, vec3 n, vec3 origin, float voxelSize,
+                                   float normalOffset) {
+  return (p - origin) / voxelSize + normalOffset * n;
+}
+
+/* Indirect light at world position p of surface s (paper §3.2, §4.2). */
+LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize, int depth,
+                                   float normalOffset, bool interpolation, int maxVdls,
+                                   LoSurface s) {
+  vec3 q = loOctreePosition(p, s.n, origin, voxelSize, normalOffset);
+  if (interpolation) {
+    /* Trilinear over the 8 voxels around q (paper §4.2.1); empty neighbours
+     * are left out and the remaining weights renormalized, so light never
+     * leaks in from empty space or fades at the edge of the geometry. */
+    vec3 u = q - vec3(0.5f);
+    ivec3 base = ivec3(floor(u));
+    vec3 f = u - floor(u);
+    vec3 sum = vec3(0.0f);
+    float weightSum = 0.0f;
+    for (int k = 0; k < 8; ++k) {
+      ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+      float w = (o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y) *
+                (o.z == 1 ? f.z : 1.0f - f.z);
+      if (w <= 0.0f) continue;
+      uvec4 leaf;
+      if (loLookupLeaf(LO_TEX base + o, depth, leaf)) {
+        sum += w * loShadeLeaf(LO_TEX leaf, maxVdls, s);
+        weightSum += w;
+      }
+    }
+    if (weightSum > 0.0f) return sum / weightSum;
+  }
+  uvec4 leaf;
+  ivec3 voxel;
+  if (loNearestLeaf(LO_TEX q, s.n, depth, normalOffset, leaf, voxel)) {
+    return loShadeLeaf(LO_TEX leaf, maxVdls, s);
+  }
+  return vec3(0.0f);
+}
+
+#ifdef __cplusplus
+}  // namespace lookup
+}  // namespace lo
+#endif
+#undef LO_LOOKUP_FN
+
+#endif /* LO_OCTREE_LOOKUP_H */

@@ -1,0 +1,34 @@
+/* render_constants.h: constants shared by the scene shader and the renderer
+ * (src/render/renderer.cpp), valid in both C++ and GLSL, so that the value of
+ * a mode or a light type is written once: both builds compile this text.
+ */
+#ifndef LO_RENDER_CONSTANTS_H
+#define LO_RENDER_CONSTANTS_H
+
+#ifdef __cplusplus
+namespace lo {
+namespace shader {
+#endif
+
+/* uMode: what the scene pass draws (RenderMode in renderer.h). */
+const int LO_MODE_FULL = 0;     /* emission + direct + indirect */
+const int LO_MODE_DIRECT = 1;   /* emission + direct */
+const int LO_MODE_INDIRECT = 2; /* the light octree alone */
+const int LO_MODE_VOXELS = 3;   /* octree leaves coloured by a hash */
+
+/* Light.positionType.w: the kind of light (std140 LightBlock). */
+const int LO_LIGHT_POINT = 0;
+const int LO_LIGHT_SPOT = 1;
+const int LO_LIGHT_DIRECTIONAL = 2;
+const int LO_LIGHT_EMITTER = 3; /* a virtual point light on an emissive triangle */
+
+/* Array sizes of the std140 LightBlock. */
+const int LO_MAX_LIGHTS = 32;
+const int LO_MAX_SHADOW_LAYERS = 96;
+
+#ifdef __cplusplus
+}  // namespace shader
+}  // namespace lo
+#endif
+
+#endif /* LO_RENDER_CONSTANTS_H */
