@@ -1,26 +1,36 @@
 #include "sweep.h"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "bake/bake.h"
+#include "cli_checks.h"
 #include "core/error.h"
+#include "core/file.h"
 #include "core/resources.h"
-#include "grid/surface_grid.h"
+#include "core/threads.h"
 #include "image/compare.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
 #include "reference/first_hit.h"
 #include "reference/path_tracer.h"
+#include "render/context.h"
+#include "render/image_io.h"
+#include "render/renderer.h"
 #include "report.h"
 #include "scene/scene.h"
-#include "core/file.h"
 #include "vdb/vdb_io.h"
 
 namespace fs = std::filesystem;
@@ -38,34 +48,31 @@ std::string photonsText(size_t n) {
   return std::to_string(n);
 }
 
-std::string numberText(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
-
-/// Single quotes for /bin/sh; a quote inside becomes '\''.
 /// A fraction as a percentage rounded to 2 decimals.
 double percent2(double fraction) { return std::round(10000.0 * fraction) / 100.0; }
 
-std::string shellQuote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-/// Runs `command` with stdout and stderr in `logFile`. @throws IoError with the
-/// command and the log's last lines on a non-zero exit.
-void runChild(const std::string& command, const std::string& logFile) {
-  const std::string full = command + " > " + shellQuote(logFile) + " 2>&1";
-  const int rc = std::system(full.c_str());
-  if (rc != 0) {
-    std::ifstream f(logFile);
-    std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    if (text.size() > 2000) text = "..." + text.substr(text.size() - 2000);
-    throw IoError("sweep: command failed (status " + std::to_string(rc) + "): " + command + "\n" +
-                  text);
-  }
+/// Runs `gnuplot SCRIPT` with `dir` as its working folder (no shell: the
+/// folder and script are arguments), output discarded. False when gnuplot is
+/// missing or fails.
+bool runGnuplot(const std::string& dir, const std::string& script) {
+  std::string quoted;  // gnuplot single-quoted string: '' stands for '
+  for (char c : dir) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+  const std::string cd = "cd '" + quoted + "'";
+  const std::string absolute = fs::absolute(script).string();
+  std::vector<char*> argv = {const_cast<char*>("gnuplot"), const_cast<char*>("-e"),
+                             const_cast<char*>(cd.c_str()), const_cast<char*>(absolute.c_str()),
+                             nullptr};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) return false;
+  int status = 0;
+  if (waitpid(pid, &status, 0) != pid) return false;
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
 std::string readText(const std::string& path) {
@@ -303,7 +310,7 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale) {
            : std::vector<size_t>{150000, 300000};
   const std::vector<int> knns =
       full ? std::vector<int>{10, 30, 100, 150, 600, 1000} : std::vector<int>{30, 100};
-  const std::vector<float> radii = full ? std::vector<float>{1.5f, 2, 4, 6} : std::vector<float>{};
+  const std::vector<float> radii = full ? std::vector<float>{1, 2, 3, 4, 6} : std::vector<float>{};
   const std::vector<std::string> vdls = full ? std::vector<std::string>{"1", "2", "8", "auto"}
                                              : std::vector<std::string>{"1", "auto"};
   for (int d : depths) vary("depth", [d](SweepPoint& p) { p.depth = d; });
@@ -390,10 +397,112 @@ SweepParams sweepDefaults(SweepScale scale) {
   return p;
 }
 
+namespace sweep_internal {
+
+/// The light octree's figures of one bake, as cached beside its .vdb.
+struct BakeFigures {
+  double traceSeconds = 0, voxelizeSeconds = 0, splatSeconds = 0, clusterSeconds = 0;
+  double bakeSeconds = 0, peakRssBytes = 0, vdbBytes = 0, activeVoxels = 0, denseVoxels = 0;
+};
+
+nlohmann::json toJson(const BakeFigures& f) {
+  return {{"trace_seconds", f.traceSeconds},   {"voxelize_seconds", f.voxelizeSeconds},
+          {"splat_seconds", f.splatSeconds},   {"cluster_seconds", f.clusterSeconds},
+          {"bake_seconds", f.bakeSeconds},     {"peak_rss_bytes", f.peakRssBytes},
+          {"vdb_bytes", f.vdbBytes},           {"active_voxels", f.activeVoxels},
+          {"dense_voxels", f.denseVoxels}};
+}
+
+BakeFigures bakeFiguresFromJson(const nlohmann::json& j) {
+  BakeFigures f;
+  f.traceSeconds = j.at("trace_seconds");
+  f.voxelizeSeconds = j.at("voxelize_seconds");
+  f.splatSeconds = j.at("splat_seconds");
+  f.clusterSeconds = j.at("cluster_seconds");
+  f.bakeSeconds = j.at("bake_seconds");
+  f.peakRssBytes = j.at("peak_rss_bytes");
+  f.vdbBytes = j.at("vdb_bytes");
+  f.activeVoxels = j.at("active_voxels");
+  f.denseVoxels = j.at("dense_voxels");
+  return f;
+}
+
+/// The bake parameters of a point; every default comes from the bake module.
+BakeParams bakeParamsOf(const SweepPoint& point, const Scene& scene, uint64_t seed) {
+  BakeParams b;
+  b.depth = point.depth;
+  b.photons = point.photons;
+  b.knn = point.knn;
+  b.vdls = parseVdlCount(point.vdls, "sweep point --vdls");
+  b.seed = seed;
+  // 0 lets the gather apply its own default (kDefaultRadiusVoxels voxels).
+  if (point.radiusVoxels != kDefaultRadiusVoxels) {
+    b.radius = point.radiusVoxels * makeGridFrame(scene.bounds(), point.depth).voxelSize;
+  }
+  return b;
+}
+
+/// Bakes in this process and writes the .vdb; memory is the peak resident
+/// set during the bake above the resident set before it.
+BakeFigures bakeAndWrite(const Scene& scene, const std::string& scenePath, const BakeParams& b,
+                         const std::string& vdb) {
+  const size_t before = currentRssBytes();
+  const bool reset = resetPeakRss();
+  Stopwatch clock;
+  BakeResult baked = bake(scene, b);
+  baked.metadata.sourceScene = fs::path(scenePath).filename().string();
+  writeVdlGrid(vdb, baked.grid, baked.metadata);
+  BakeFigures f;
+  f.bakeSeconds = clock.seconds();
+  const size_t peak = reset ? peakRssSinceResetBytes() : peakRssBytes();
+  f.peakRssBytes = double(peak > before ? peak - before : 0);
+  const BakeStats& st = baked.stats;
+  f.traceSeconds = st.traceSeconds;
+  f.voxelizeSeconds = st.level.voxelizeSeconds;
+  f.splatSeconds = st.level.splatSeconds;
+  f.clusterSeconds = st.level.gatherClusterSeconds;
+  f.vdbBytes = double(fs::file_size(vdb));
+  f.activeVoxels = double(st.level.activeVoxels);
+  f.denseVoxels = double(st.denseVoxels);
+  return f;
+}
+
+/// The GL renderer of the indirect images, made on first use (one context and
+/// one set of scene resources for the whole sweep).
+struct IndirectRenderer {
+  std::unique_ptr<GlContext> context;
+  std::unique_ptr<Renderer> renderer;
+
+  /// The indirect image of `grid` and its mean frame time over `frames`.
+  RgbImage render(const Scene& scene, const VdlGrid& grid, const SweepPoint& point,
+                  const RenderCamera& camera, int width, int height, int frames, double& frameMs) {
+    if (!context) context = createGlContext(GlContextParams{});
+    GpuOctreeParams octreeParams;
+    octreeParams.halfFloat = point.halfFloat;
+    octreeParams.cosineCorrection = point.cosineCorrection;
+    octreeParams.max3DTextureSize = context->info().max3DTextureSize;
+    octreeParams.max2DTextureSize = context->info().max2DTextureSize;
+    const GpuOctree octree = buildGpuOctree(grid, octreeParams);
+    if (!renderer) {
+      renderer = std::make_unique<Renderer>(scene, octree, RendererParams{});
+    } else {
+      renderer->setOctree(octree);
+    }
+    RenderParams rp;
+    rp.width = width;
+    rp.height = height;
+    rp.mode = RenderMode::Indirect;
+    rp.interpolation = point.interpolation;
+    const RgbImage image = toRgbImage(renderer->render(camera, rp));
+    frameMs = 1000.0 * renderer->timeFrames(camera, rp, frames) / frames;
+    return image;
+  }
+};
+
+}  // namespace sweep_internal
+
 std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
   using namespace sweep_internal;
-  if (params.executable.empty() || !fs::exists(params.executable))
-    throw InputError("sweep: lightoctree executable '" + params.executable + "' not found");
   if (!fs::is_directory(params.outDir))
     throw InputError("--out: folder '" + params.outDir + "' does not exist");
   const std::string cacheDir = params.outDir + "/cache";
@@ -403,6 +512,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
   if (!fs::exists(params.outDir + "/.gitignore"))
     writeTextAtomically(params.outDir + "/.gitignore", "cache/\n");
 
+  ThreadLimit threadLimit(params.threads);
   const Scene scene = loadScene(params.scene);
   const ReferenceCamera camera = scene.cameras.empty()
                                      ? ReferenceCamera::framing(scene.bounds(), kPi / 4)
@@ -419,8 +529,9 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
                                   {"spp", params.referenceSpp},
                                   {"frames", params.frames},
                                   {"threads", params.threads},
-                                  {"seed", params.seed}};
-  const std::string exe = shellQuote(params.executable);
+                                  {"seed", params.seed},
+                                  {"version", LO_VERSION}};
+  IndirectRenderer indirectRenderer;
   std::vector<SweepResult> results;
   for (size_t pi = 0; pi < points.size(); ++pi) {
     const SweepPoint& point = points[pi];
@@ -440,42 +551,27 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     // Bake (shared by points that differ only in the lookup).
     const std::string bakeBase = cacheDir + "/" + point.bakeKey();
     const std::string vdb = bakeBase + ".vdb", stats = bakeBase + "-bake.json";
-    if (!fs::exists(stats) || !fs::exists(vdb) ||
-        nlohmann::json::parse(readText(stats)).value("context", nlohmann::json()) != context) {
-      std::string cmd = exe + " bake " + shellQuote(params.scene) + " -o " + shellQuote(vdb) +
-                        " --depth " + std::to_string(point.depth) + " --photons " +
-                        std::to_string(point.photons) + " --knn " + std::to_string(point.knn) +
-                        " --vdls " + point.vdls + " --seed " + std::to_string(params.seed) +
-                        " --threads " + std::to_string(params.threads) + " --quiet --stats-json " +
-                        shellQuote(stats + ".raw");
-      if (point.radiusVoxels != 3.0f) {
-        const GridFrame frame = makeGridFrame(scene.bounds(), point.depth);
-        cmd += " --radius " + numberText(double(point.radiusVoxels * frame.voxelSize));
-      }
-      runChild(cmd, bakeBase + "-bake.log");
-      nlohmann::json j = nlohmann::json::parse(readText(stats + ".raw"));
-      j["context"] = context;
-      writeTextAtomically(stats, j.dump(2) + "\n");
-      fs::remove(stats + ".raw");
+    BakeFigures figures;
+    if (fs::exists(stats) && fs::exists(vdb) &&
+        nlohmann::json::parse(readText(stats)).value("context", nlohmann::json()) == context) {
+      figures = bakeFiguresFromJson(nlohmann::json::parse(readText(stats)).at("bake"));
+    } else {
+      figures = bakeAndWrite(scene, params.scene, bakeParamsOf(point, scene, params.seed), vdb);
+      writeTextAtomically(stats,
+                          nlohmann::json({{"context", context}, {"bake", toJson(figures)}}).dump(2) +
+                              "\n");
     }
     SweepResult r;
     r.point = point;
-    {
-      const nlohmann::json j = nlohmann::json::parse(readText(stats));
-      for (const auto& stage : j.at("stages")) {
-        const std::string name = stage.at("name");
-        const double s = stage.at("seconds");
-        if (name == "trace photons") r.traceSeconds = s;
-        if (name == "voxelize") r.voxelizeSeconds = s;
-        if (name == "splat photons") r.splatSeconds = s;
-        if (name == "gather + cluster") r.clusterSeconds = s;
-      }
-      r.bakeSeconds = j.at("total_seconds");
-      r.peakRssBytes = j.at("peak_rss_bytes");
-      r.vdbBytes = j.at("counts").at("vdb_bytes");
-      r.activeVoxels = j.at("counts").at("active_voxels");
-      r.denseVoxels = j.at("counts").at("dense_voxels");
-    }
+    r.traceSeconds = figures.traceSeconds;
+    r.voxelizeSeconds = figures.voxelizeSeconds;
+    r.splatSeconds = figures.splatSeconds;
+    r.clusterSeconds = figures.clusterSeconds;
+    r.bakeSeconds = figures.bakeSeconds;
+    r.peakRssBytes = figures.peakRssBytes;
+    r.vdbBytes = figures.vdbBytes;
+    r.activeVoxels = figures.activeVoxels;
+    r.denseVoxels = figures.denseVoxels;
     // The octree's irradiance at the reference's first hits.
     const LoadedVdl baked = readVdlGrid(vdb);
     GpuOctreeParams octreeParams;
@@ -486,6 +582,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     r.vdlTexels = double(octree.vdlCount);
     OctreeShadeParams shade;
     shade.interpolation = point.interpolation;
+    shade.normalOffset = RenderParams().normalOffset;
     FirstHitParams hitParams;
     hitParams.width = params.width;
     hitParams.height = params.height;
@@ -500,21 +597,10 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     r.irradianceRelMae = irrError.luminance.relMae;
     // The indirect image through the GL renderer, and its frame time.
     if (params.frames > 0) {
-      const std::string image = base + "-indirect.exr", renderLog = base + "-render.log";
-      std::string cmd =
-          exe + " render " + shellQuote(params.scene) + " " + shellQuote(vdb) + " -o " +
-          shellQuote(image) + " --mode indirect --width " + std::to_string(params.width) +
-          " --height " + std::to_string(params.height) + " --frames " +
-          std::to_string(params.frames) + " --interpolation " +
-          (point.interpolation ? "on" : "off") + (point.halfFloat ? " --half-float" : "") +
-          " --cosine-correction " + (point.cosineCorrection ? "on" : "off") + " --quiet";
-      if (!scene.cameras.empty()) cmd += " --camera " + shellQuote(scene.cameras.front().name);
-      if (scene.cameras.empty()) cmd += " --fov 45";
-      runChild(cmd, renderLog);
-      const std::string text = readText(renderLog);
-      const size_t at = text.find("frame time: ");
-      if (at != std::string::npos) r.frameMs = std::atof(text.c_str() + at + 12);
-      const RgbImage indirect = readImage(image);
+      const RgbImage indirect =
+          indirectRenderer.render(scene, baked.grid, point, camera, params.width, params.height,
+                                  params.frames, r.frameMs);
+      writeExr(base + "-indirect.exr", indirect);
       r.indirectRelRmse = compareImages(indirect, refs.indirect, compareParams).luminance.relRmse;
     }
     writeTextAtomically(
@@ -676,8 +762,7 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
   plot("error-vs-bake-time.png", "bake time, s", "time");
   plot("error-vs-memory.png", "GPU octree + VDL textures, KiB", "memory");
   writeTextAtomically(dir + "/sweep.gp", gp.str());
-  const bool plotted =
-      std::system(("cd " + shellQuote(dir) + " && gnuplot sweep.gp > /dev/null 2>&1").c_str()) == 0;
+  const bool plotted = runGnuplot(dir, dir + "/sweep.gp");
   if (!plotted && log) std::fprintf(log, "sweep: gnuplot failed or missing; no plots drawn\n");
 
   std::ostringstream md;

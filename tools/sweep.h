@@ -1,12 +1,12 @@
 #pragma once
 /// @file tools/sweep.h
 /// @brief `lightoctree sweep`: the speed/accuracy trade of the bake, measured.
-/// Each point bakes the scene (a child `lightoctree bake`, so that its peak
-/// memory is its own), evaluates the octree's indirect irradiance at the
-/// reference's first hits (octree/octree_irradiance.h) and renders the
-/// indirect image and its frame time (a child `lightoctree render`), and
-/// compares both with path-traced references rendered once per scene and
-/// cached. Points vary one parameter at a time around the paper's settings
+/// Each point bakes the scene in this process through the bake module
+/// (bake/bake.h; its peak memory measured from a reset of the kernel's peak
+/// resident set), evaluates the octree's indirect irradiance at the
+/// reference's first hits (octree/octree_irradiance.h), renders the indirect
+/// image and its frame time with the GL renderer, and compares both with
+/// path-traced references rendered once per scene and cached. Points vary one parameter at a time around the paper's settings
 /// (depth 6, 600k photons, KNN 300, 4 VDLs), plus a few combined points.
 /// Results, tables and gnuplot plots go to one folder; see docs/accuracy.md.
 
@@ -15,21 +15,25 @@
 #include <string>
 #include <vector>
 
+#include "bake/bake.h"
+
 namespace lo::tool {
 
-/// One setting of the bake and of the lookup.
+/// One setting of the bake and of the lookup. Every default is the bake
+/// module's (BakeParams, kDefaultRadiusVoxels), so the paper's point is what
+/// `lightoctree bake` does without flags.
 struct SweepPoint {
   std::string group = "paper";  ///< the parameter this point varies ("paper", "depth", ...)
-  int depth = 6;
-  size_t photons = 600000;
-  int knn = 300;
-  float radiusVoxels = 3.0f;     ///< gather radius in voxel sizes at this depth (bake default: 3)
-  std::string vdls = "4";        ///< "1".."8" or "auto"
+  int depth = BakeParams{}.depth;
+  size_t photons = BakeParams{}.photons;
+  int knn = BakeParams{}.knn;
+  float radiusVoxels = kDefaultRadiusVoxels;  ///< gather radius in voxel sizes at this depth
+  std::string vdls = BakeParams{}.vdls.ToString();  ///< "1".."8" or "auto"
   bool interpolation = true;     ///< trilinear lookup over 8 voxels
   bool halfFloat = false;        ///< RGBA16UI half-float VDL texels instead of RGBA32F
   bool cosineCorrection = true;  ///< GpuOctreeParams::cosineCorrection (off: the paper's form)
 
-  /// Short human label, e.g. "d6 600k k300 r3 v4" (+ " no-interp", " half",
+  /// Short human label, e.g. "d6 600k k300 r1.5 v4" (+ " no-interp", " half",
   /// " paper-cosine").
   std::string label() const;
   /// File-name-safe key of the bake parameters only (points that differ only
@@ -55,10 +59,12 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale);
 /// What one point costs and how wrong it is.
 struct SweepResult {
   SweepPoint point;
-  // Bake (from `bake --stats-json`), wall-clock seconds.
+  // Bake, wall-clock seconds.
   double traceSeconds = 0, voxelizeSeconds = 0, splatSeconds = 0, clusterSeconds = 0;
   double bakeSeconds = 0;   ///< every stage, load and write included
-  double peakRssBytes = 0;  ///< peak resident memory of the bake process
+  /// Peak resident memory the bake added: the kernel's peak resident set
+  /// during the bake (reset before it) above the resident set before it.
+  double peakRssBytes = 0;
   double vdbBytes = 0;      ///< the .vdb file
   double gpuBytes = 0;      ///< octree pool + VDL texture as uploaded
   double activeVoxels = 0, denseVoxels = 0;
@@ -84,7 +90,6 @@ void markParetoFronts(std::vector<SweepResult>& results);
 struct SweepParams {
   std::string scene;       ///< .gltf, .glb or .obj
   std::string outDir;      ///< results; bulky files go to outDir/cache
-  std::string executable;  ///< the `lightoctree` binary the bakes and renders run
   SweepScale scale = SweepScale::Full;
   std::vector<SweepPoint> points;  ///< empty = sweepPoints(scale)
   int width = 160, height = 120;   ///< images compared (scene camera, else framed)
@@ -103,9 +108,9 @@ struct SweepParams {
 SweepParams sweepDefaults(SweepScale scale);
 
 /// Runs every point (reusing outDir/cache results of an earlier run with the
-/// same settings, so an interrupted sweep resumes), prints one line per point
-/// to `log` (may be null). @throws InputError / IoError naming the file or
-/// the failed child command.
+/// same settings and program version, so an interrupted sweep resumes),
+/// prints one line per point to `log` (may be null). @throws InputError /
+/// IoError naming the file, or the stage's error.
 std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log);
 
 /// Writes outDir/sweep.csv, outDir/sweep.md and, if gnuplot is found,

@@ -39,7 +39,6 @@ int runSweepCommand(const SweepOptions& opt) {
   params.seed = opt.seed;
   params.quiet = opt.quiet;
   // The bakes and renders run as child processes of this same binary.
-  params.executable = std::filesystem::read_symlink("/proc/self/exe").string();
   const std::filesystem::path parent = std::filesystem::path(opt.out).parent_path();
   if (!parent.empty() && !std::filesystem::is_directory(parent)) {
     throw InputError("--out: folder '" + parent.string() + "' does not exist");

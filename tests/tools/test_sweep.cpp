@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/rng.h"
+#include "octree/gpu_octree.h"
 #include "sweep.h"
 
 namespace lo::tool {
@@ -72,18 +73,31 @@ TEST(SweepPoints, OneParameterAtATimeAroundThePaper) {
   EXPECT_EQ(vdls, (std::set<std::string>{"1", "2", "4", "8", "auto"}));
 }
 
+TEST(SweepPoints, ThePaperPointIsTheBakeDefault) {
+  // The sweep must label and bake its reference point with the settings
+  // `lightoctree bake` uses without flags (it once hard-coded an old radius).
+  const SweepPoint p = paperPoint();
+  const BakeParams b;
+  EXPECT_EQ(p.depth, b.depth);
+  EXPECT_EQ(p.photons, b.photons);
+  EXPECT_EQ(p.knn, b.knn);
+  EXPECT_EQ(p.vdls, b.vdls.ToString());
+  EXPECT_EQ(p.radiusVoxels, kDefaultRadiusVoxels);
+  EXPECT_TRUE(p.cosineCorrection == GpuOctreeParams{}.cosineCorrection);
+}
+
 TEST(SweepPoints, KeysSeparateBakeFromLookup) {
   SweepPoint a = paperPoint(), b = paperPoint();
   b.interpolation = false;
   EXPECT_EQ(a.bakeKey(), b.bakeKey());
   EXPECT_NE(a.key(), b.key());
   b = paperPoint();
-  b.radiusVoxels = 1.5f;
+  b.radiusVoxels = 3.0f;
   EXPECT_NE(a.bakeKey(), b.bakeKey());
-  EXPECT_EQ(a.label(), "d6 600k k300 r3 v4");
+  EXPECT_EQ(a.label(), "d6 600k k300 r1.5 v4");
   b.photons = 2500000;
   b.halfFloat = true;
-  EXPECT_EQ(b.label(), "d6 2.5M k300 r1.5 v4 half");
+  EXPECT_EQ(b.label(), "d6 2.5M k300 r3 v4 half");
 }
 
 TEST(Pareto, MatchesTheDefinitionOnRandomSets) {
@@ -137,7 +151,7 @@ TEST(SweepCsv, OneRowPerResultWithTheFlags) {
   while (std::getline(csv, line)) lines.push_back(line);
   ASSERT_EQ(lines.size(), 4u);
   EXPECT_EQ(lines[0].rfind("label,group,depth", 0), 0u);
-  EXPECT_NE(lines[1].find("\"d6 600k k300 r3 v4\""), std::string::npos);
+  EXPECT_NE(lines[1].find("\"d6 600k k300 r1.5 v4\""), std::string::npos);
   EXPECT_EQ(lines[1].substr(lines[1].size() - 6), ",1,1,1");  // fronts and paper
   EXPECT_EQ(lines[3].substr(lines[3].size() - 6), ",0,0,0");
 }
