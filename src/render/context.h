@@ -37,6 +37,31 @@ struct GlInfo {
   std::string ToString() const;
 };
 
+/// Keys a window reports (the window back end translates its own codes), so
+/// that input handling needs no windowing library's header.
+enum class Key {
+  Unknown, Escape, Space, LeftShift, RightShift, LeftControl, RightControl,
+  Left, Right, Up, Down,
+  A, D, E, G, H, I, P, Q, R, S, V, W,
+  Num0, Num1, Num2, Num3, Num4,
+  LeftBracket, RightBracket, Equal, Minus, KeypadAdd, KeypadSubtract, Comma, Period,
+};
+enum class MouseButton { Left, Right, Other };
+
+/// Receives a window's input events, on the thread that polls them.
+class InputHandler {
+ public:
+  virtual ~InputHandler() = default;
+  /// A key went down (`repeat` false) or auto-repeats while held (true).
+  virtual void onKey(Key key, bool repeat) = 0;
+  virtual void onScroll(double dy) = 0;
+  virtual void onMouseButton(MouseButton button, bool pressed) = 0;
+  /// Cursor position in screen pixels (unbounded while the cursor is captured).
+  virtual void onCursor(double x, double y) = 0;
+  /// The window must be redrawn (exposed, resized).
+  virtual void onDamage() = 0;
+};
+
 class GlContext {
  public:
   virtual ~GlContext() = default;
@@ -55,8 +80,17 @@ class GlContext {
   virtual void setTitle(const std::string&) {}
   /// Framebuffer size of the window in pixels; headless: 0 x 0.
   virtual void framebufferSize(int& width, int& height) const { width = height = 0; }
-  /// The GLFWwindow* of the GLFW back end (input handling), else nullptr.
-  virtual void* nativeWindow() const { return nullptr; }
+  /// Input: events go to `handler` (may be null) during pollEvents / waitEvents.
+  virtual void setInputHandler(InputHandler*) {}
+  virtual void pollEvents() {}
+  /// Waits up to `seconds` for an event, then handles what came.
+  virtual void waitEvents(double /*seconds*/) {}
+  virtual bool keyHeld(Key) const { return false; }
+  virtual bool mouseHeld(MouseButton) const { return false; }
+  /// Hides the cursor and reports unbounded relative motion (mouse look).
+  virtual void setCursorCaptured(bool) {}
+  /// Asks the window to close: shouldClose() becomes true.
+  virtual void requestClose() {}
 
  protected:
   explicit GlContext(GlBackend backend) : backend_(backend) {}

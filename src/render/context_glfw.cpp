@@ -12,6 +12,60 @@
 namespace lo::render_internal {
 namespace {
 
+Key keyOf(int key) {
+  switch (key) {
+    case GLFW_KEY_ESCAPE: return Key::Escape;
+    case GLFW_KEY_SPACE: return Key::Space;
+    case GLFW_KEY_LEFT_SHIFT: return Key::LeftShift;
+    case GLFW_KEY_RIGHT_SHIFT: return Key::RightShift;
+    case GLFW_KEY_LEFT_CONTROL: return Key::LeftControl;
+    case GLFW_KEY_RIGHT_CONTROL: return Key::RightControl;
+    case GLFW_KEY_LEFT: return Key::Left;
+    case GLFW_KEY_RIGHT: return Key::Right;
+    case GLFW_KEY_UP: return Key::Up;
+    case GLFW_KEY_DOWN: return Key::Down;
+    case GLFW_KEY_A: return Key::A;
+    case GLFW_KEY_D: return Key::D;
+    case GLFW_KEY_E: return Key::E;
+    case GLFW_KEY_G: return Key::G;
+    case GLFW_KEY_H: return Key::H;
+    case GLFW_KEY_I: return Key::I;
+    case GLFW_KEY_P: return Key::P;
+    case GLFW_KEY_Q: return Key::Q;
+    case GLFW_KEY_R: return Key::R;
+    case GLFW_KEY_S: return Key::S;
+    case GLFW_KEY_V: return Key::V;
+    case GLFW_KEY_W: return Key::W;
+    case GLFW_KEY_0: return Key::Num0;
+    case GLFW_KEY_1: return Key::Num1;
+    case GLFW_KEY_2: return Key::Num2;
+    case GLFW_KEY_3: return Key::Num3;
+    case GLFW_KEY_4: return Key::Num4;
+    case GLFW_KEY_LEFT_BRACKET: return Key::LeftBracket;
+    case GLFW_KEY_RIGHT_BRACKET: return Key::RightBracket;
+    case GLFW_KEY_EQUAL: return Key::Equal;
+    case GLFW_KEY_MINUS: return Key::Minus;
+    case GLFW_KEY_KP_ADD: return Key::KeypadAdd;
+    case GLFW_KEY_KP_SUBTRACT: return Key::KeypadSubtract;
+    case GLFW_KEY_COMMA: return Key::Comma;
+    case GLFW_KEY_PERIOD: return Key::Period;
+    default: return Key::Unknown;
+  }
+}
+
+int glfwKeyOf(Key key) {
+  for (int k = GLFW_KEY_SPACE; k <= GLFW_KEY_LAST; ++k) {
+    if (keyOf(k) == key) return k;
+  }
+  return GLFW_KEY_UNKNOWN;
+}
+
+int glfwButtonOf(MouseButton b) {
+  return b == MouseButton::Left    ? GLFW_MOUSE_BUTTON_LEFT
+         : b == MouseButton::Right ? GLFW_MOUSE_BUTTON_RIGHT
+                                   : GLFW_MOUSE_BUTTON_MIDDLE;
+}
+
 std::string glfwLastError() {
   const char* description = nullptr;
   glfwGetError(&description);
@@ -52,14 +106,58 @@ class GlfwContext final : public GlContext {
   void framebufferSize(int& width, int& height) const override {
     glfwGetFramebufferSize(window_, &width, &height);
   }
-  void* nativeWindow() const override { return window_; }
+  void setInputHandler(InputHandler* handler) override {
+    handler_ = handler;
+    glfwSetWindowUserPointer(window_, this);
+    glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int, int action, int) {
+      InputHandler* h = self(w)->handler_;
+      if (h && (action == GLFW_PRESS || action == GLFW_REPEAT)) {
+        h->onKey(keyOf(key), action == GLFW_REPEAT);
+      }
+    });
+    glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) {
+      if (InputHandler* h = self(w)->handler_) h->onScroll(dy);
+    });
+    glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int button, int action, int) {
+      InputHandler* h = self(w)->handler_;
+      if (!h) return;
+      const MouseButton b = button == GLFW_MOUSE_BUTTON_LEFT    ? MouseButton::Left
+                            : button == GLFW_MOUSE_BUTTON_RIGHT ? MouseButton::Right
+                                                                : MouseButton::Other;
+      h->onMouseButton(b, action == GLFW_PRESS);
+    });
+    glfwSetCursorPosCallback(window_, [](GLFWwindow* w, double x, double y) {
+      if (InputHandler* h = self(w)->handler_) h->onCursor(x, y);
+    });
+    glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) {
+      if (InputHandler* h = self(w)->handler_) h->onDamage();
+    });
+  }
+  void pollEvents() override { glfwPollEvents(); }
+  void waitEvents(double seconds) override { glfwWaitEventsTimeout(seconds); }
+  bool keyHeld(Key key) const override {
+    const int k = glfwKeyOf(key);
+    return k != GLFW_KEY_UNKNOWN && glfwGetKey(window_, k) == GLFW_PRESS;
+  }
+  bool mouseHeld(MouseButton b) const override {
+    return glfwGetMouseButton(window_, glfwButtonOf(b)) == GLFW_PRESS;
+  }
+  void setCursorCaptured(bool captured) override {
+    glfwSetInputMode(window_, GLFW_CURSOR, captured ? GLFW_CURSOR_DISABLED : GLFW_CURSOR_NORMAL);
+  }
+  void requestClose() override { glfwSetWindowShouldClose(window_, GLFW_TRUE); }
 
  protected:
   void makeCurrentImpl() override { glfwMakeContextCurrent(window_); }
   ProcLoader procLoader() const override { return &glfwGetProcAddress; }
 
  private:
+  static GlfwContext* self(GLFWwindow* w) {
+    return static_cast<GlfwContext*>(glfwGetWindowUserPointer(w));
+  }
+
   GLFWwindow* window_ = nullptr;
+  InputHandler* handler_ = nullptr;
 };
 
 }  // namespace

@@ -1,0 +1,82 @@
+#pragma once
+/// @file render/viewer.h
+/// @brief The walkthrough of `lightoctree view`: the frame loop of a window
+/// (render/context.h, GLFW back end) drawing a Renderer, with key and mouse
+/// handling through the context's input events, the redraw policy (a still
+/// view is not redrawn), camera paths (play, record with P), saved frames and
+/// the window title. New octree levels (a progressive bake) come from an
+/// OctreeLevelSource, so this stage needs no bake. See docs/view.md.
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "octree/gpu_octree.h"
+#include "render/camera_path.h"
+#include "render/context.h"
+#include "render/fly_camera.h"
+#include "render/renderer.h"
+
+namespace lo {
+
+/// The keys of the viewer, as `view --help` and the H key print them.
+const char* viewerKeyHelp();
+
+/// Where finer octree levels come from while the window is open.
+class OctreeLevelSource {
+ public:
+  virtual ~OctreeLevelSource() = default;
+  /// The newest finished level since the last call, if any: its octree
+  /// (moved out) and its depth. @throws the source's failure, once.
+  virtual bool takeNewest(GpuOctree& octree, int& depth) = 0;
+  /// A line for the terminal once the level taken last is on screen.
+  virtual std::string shownReport() const = 0;
+  /// True when no further level will come.
+  virtual bool finished() const = 0;
+  /// What the source is doing, for the window title.
+  virtual std::string status() const = 0;
+};
+
+struct ViewerParams {
+  RenderParams render;       ///< start mode, interpolation, GGX lobe, VDLs (size: the window's)
+  float exposure = 0;        ///< EV at the start (key 0 returns to it)
+  FlyCamera start;           ///< start camera and movement speed
+  float znear = 1e-3f;       ///< near plane, scene units
+  std::optional<CameraPath> path;  ///< play this path instead of the keyboard, exit at its end
+  float defaultFovDegrees = 45;    ///< for path keyframes without a field of view
+  std::string saveFrames;    ///< folder: every frame drawn as frame_00000.png, ...; "" = none
+  int frames = 0;            ///< exit after this many frames (at the target depth); 0 = no limit
+  std::string record = "camera-path.txt";  ///< the file P appends keyframes to
+  bool continuous = false;   ///< redraw every iteration even when nothing changed
+  int shownDepth = 0;        ///< depth of the octree the renderer starts with (0 = none)
+  int firstDepth = 0;        ///< the level source's first depth (progressive)
+  int targetDepth = 0;       ///< the level source's last depth (progressive)
+  bool quiet = false;        ///< no terminal output
+};
+
+struct ViewerStats {
+  int framesDrawn = 0;
+  int framesSaved = 0;
+  double seconds = 0;
+};
+
+class Viewer {
+ public:
+  /// `window` must be a window context (GLFW) and current; `renderer` draws
+  /// into it; `levels` may be null. All must outlive the viewer.
+  Viewer(GlContext& window, Renderer& renderer, const ViewerParams& params,
+         OctreeLevelSource* levels = nullptr);
+  ~Viewer();
+  Viewer(const Viewer&) = delete;
+  Viewer& operator=(const Viewer&) = delete;
+
+  /// Runs the frame loop until the window closes, the camera path ends or
+  /// `frames` frames are drawn.
+  ViewerStats run();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lo
