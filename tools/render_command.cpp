@@ -8,7 +8,9 @@
 #include <sstream>
 
 #include "camera_options.h"
+#include "render_options.h"
 #include "commands.h"
+#include "core/file.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
@@ -29,15 +31,8 @@ struct RenderOptions {
   CameraOptions camera;
   int width = 800, height = 600;
   std::string mode = "full";
-  std::string interpolation = "on";
-  std::string specular = "on";
-  float exposure = 0;
+  ShadingOptions shading;
   std::string backend = "osmesa";
-  int vdls = 8;
-  int emitterLights = 8;
-  int shadowMapSize = 1024;
-  bool halfFloat = false;
-  std::string cosineCorrection = "on";
   int frames = 0;
   bool quiet = false;
 };
@@ -51,15 +46,12 @@ struct RenderOptions {
 int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedVdl& baked) {
   if (opt.frames > 0) throw InputError("--frames: not with --mode irradiance (no GL frame)");
   ReferenceCamera camera = chooseCamera(opt.camera, scene, opt.scene);
-  GpuOctreeParams octreeParams;
-  octreeParams.halfFloat = opt.halfFloat;
-  octreeParams.cosineCorrection = opt.cosineCorrection == "on";
   // No GL context to ask: the limits of the GL 3.3 contexts we render with.
-  GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
+  GpuOctree octree = buildGpuOctree(baked.grid, opt.shading.octreeParams());
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
   OctreeShadeParams shade;
-  shade.interpolation = opt.interpolation == "on";
-  shade.maxVdls = opt.vdls;
+  shade.interpolation = opt.shading.interpolation == "on";
+  shade.maxVdls = opt.shading.vdls;
   shade.normalOffset = RenderParams().normalOffset;
   FirstHitParams params;
   params.width = opt.width;
@@ -68,19 +60,15 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
   RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {
     return octreeIrradiance(octree, hit.position, hit.normal, shade);
   });
-  writeImage(opt.output, image, opt.exposure);
+  writeImage(opt.output, image, opt.shading.exposure);
   if (!opt.quiet) std::printf("wrote %s\n", opt.output.c_str());
   return 0;
 }
 
 int runRender(const RenderOptions& opt) {
   // Everything that can be checked before the work is checked first.
-  std::filesystem::path parent = std::filesystem::path(opt.output).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw InputError("--output: folder '" + parent.string() + "' does not exist");
-  }
-  std::string ext = std::filesystem::path(opt.output).extension().string();
-  if (ext != ".png" && ext != ".exr") {
+  checkOutputFolder(opt.output, "--output");
+  if (!hasExtension(opt.output, ".png") && !hasExtension(opt.output, ".exr")) {
     throw InputError("--output: '" + opt.output + "' must end in .png or .exr");
   }
   checkCameraOptions(opt.camera);
@@ -88,13 +76,9 @@ int runRender(const RenderOptions& opt) {
     Scene scene = loadScene(opt.scene);
     return renderIrradiance(opt, scene, readVdlGrid(opt.lights));
   }
-  RenderParams params;
+  RenderParams params = opt.shading.renderParams(parseRenderMode(opt.mode));
   params.width = opt.width;
   params.height = opt.height;
-  params.mode = parseRenderMode(opt.mode);
-  params.interpolation = opt.interpolation == "on";
-  params.specular = opt.specular == "on";
-  params.maxVdls = opt.vdls;
 
   Scene scene = loadScene(opt.scene);
   LoadedVdl baked = readVdlGrid(opt.lights);
@@ -105,20 +89,12 @@ int runRender(const RenderOptions& opt) {
   std::unique_ptr<GlContext> context = createGlContext(contextParams);
   if (!opt.quiet) std::printf("%s: %s\n", opt.backend.c_str(), context->info().ToString().c_str());
 
-  GpuOctreeParams octreeParams;
-  octreeParams.halfFloat = opt.halfFloat;
-  octreeParams.cosineCorrection = opt.cosineCorrection == "on";
-  octreeParams.max3DTextureSize = context->info().max3DTextureSize;
-  octreeParams.max2DTextureSize = context->info().max2DTextureSize;
-  GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
+  GpuOctree octree = buildGpuOctree(baked.grid, opt.shading.octreeParams(&context->info()));
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
 
-  RendererParams rendererParams;
-  rendererParams.emitterLights = opt.emitterLights;
-  rendererParams.shadowMapSize = opt.shadowMapSize;
-  Renderer renderer(scene, octree, rendererParams);
+  Renderer renderer(scene, octree, opt.shading.rendererParams());
   Image image = renderer.render(camera, params);
-  writeImage(opt.output, image, opt.exposure);
+  writeImage(opt.output, image, opt.shading.exposure);
 
   if (opt.frames > 0) {
     double seconds = renderer.timeFrames(camera, params, opt.frames);
@@ -128,8 +104,6 @@ int runRender(const RenderOptions& opt) {
   if (!opt.quiet) std::printf("wrote %s\n", opt.output.c_str());
   return 0;
 }
-
-CLI::Validator onOff() { return CLI::IsMember({"on", "off"}); }
 
 }  // namespace
 
@@ -161,37 +135,10 @@ std::function<int()> addRenderCommand(CLI::App& app) {
                   "on the CPU: compares with `reference --part irradiance`)")
       ->check(CLI::IsMember({"full", "direct", "indirect", "voxels", "irradiance"}))
       ->capture_default_str();
-  cmd->add_option("--interpolation", opt->interpolation,
-                  "Trilinear interpolation between the 8 neighbouring voxels")
-      ->check(onOff())
-      ->capture_default_str();
-  cmd->add_option("--specular", opt->specular, "GGX lobe of the glTF BRDF (off: diffuse only)")
-      ->check(onOff())
-      ->capture_default_str();
-  cmd->add_option("--exposure", opt->exposure, "PNG exposure in EV (radiance * 2^EV)")
-      ->check(CLI::Range(-30.0f, 30.0f))
-      ->capture_default_str();
+  addShadingOptions(cmd, opt->shading, false);
   cmd->add_option("--backend", opt->backend, "Headless OpenGL: osmesa (software) or egl")
       ->check(CLI::IsMember({"osmesa", "egl"}))
       ->capture_default_str();
-  cmd->add_option("--vdls", opt->vdls, "VDLs used per voxel, strongest first")
-      ->check(CLI::Range(1, kMaxVdls))
-      ->capture_default_str();
-  cmd->add_option("--emitter-lights", opt->emitterLights,
-                  "Shadowed virtual point lights sampled on emissive triangles (0: none)")
-      ->check(CLI::Range(0, 16))
-      ->capture_default_str();
-  cmd->add_option("--shadow-map-size", opt->shadowMapSize, "Shadow map resolution per face")
-      ->check(CLI::Range(16, 8192))
-      ->capture_default_str();
-  cmd->add_option("--cosine-correction", opt->cosineCorrection,
-                  "Divide each VDL by the cosine to its voxel's normal on upload, so that the "
-                  "shader's max(0, n.d) does not count the baked cosine twice (off: the paper's "
-                  "form, darker; see docs/accuracy.md)")
-      ->check(onOff())
-      ->capture_default_str();
-  cmd->add_flag("--half-float", opt->halfFloat,
-                "VDL texture with half-float irradiance (RGBA16UI) instead of RGBA32F");
   cmd->add_option("--frames", opt->frames,
                   "Also time this many frames (no read-back) and print the mean frame time")
       ->check(CLI::Range(0, 100000));

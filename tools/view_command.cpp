@@ -16,6 +16,7 @@
 #include <string>
 
 #include "camera_options.h"
+#include "render_options.h"
 #include "cli_checks.h"
 #include "commands.h"
 #include "core/error.h"
@@ -39,14 +40,7 @@ struct ViewOptions {
   CameraOptions camera;
   int width = 800, height = 600;
   std::string mode = "full";
-  std::string interpolation = "on";
-  std::string specular = "on";
-  float exposure = 0;
-  int vdls = 8;
-  int emitterLights = 8;
-  int shadowMapSize = 1024;
-  bool halfFloat = false;
-  std::string cosineCorrection = "on";
+  ShadingOptions shading;
   float speed = 0;  // 0 = a quarter of the scene's diagonal per second
   std::string cameraPath;
   std::string saveFrames;
@@ -119,11 +113,8 @@ int runView(const ViewOptions& opt) {
     }
   }
   ViewerParams view;
-  view.render.mode = parseRenderMode(opt.mode);
-  view.render.interpolation = opt.interpolation == "on";
-  view.render.specular = opt.specular == "on";
-  view.render.maxVdls = opt.vdls;
-  view.exposure = opt.exposure;
+  view.render = opt.shading.renderParams(parseRenderMode(opt.mode));
+  view.exposure = opt.shading.exposure;
   view.path = std::move(path);
   view.saveFrames = opt.saveFrames;
   view.frames = opt.frames;
@@ -158,11 +149,7 @@ int runView(const ViewOptions& opt) {
   }
   if (!opt.quiet) std::printf("glfw: %s\n", context->info().ToString().c_str());
 
-  GpuOctreeParams octreeParams;
-  octreeParams.halfFloat = opt.halfFloat;
-  octreeParams.cosineCorrection = opt.cosineCorrection == "on";
-  octreeParams.max3DTextureSize = context->info().max3DTextureSize;
-  octreeParams.max2DTextureSize = context->info().max2DTextureSize;
+  const GpuOctreeParams octreeParams = opt.shading.octreeParams(&context->info());
 
   // Progressive: the bake thread starts before the renderer's set-up (scene
   // upload, shadow maps) so that the two overlap; until the first level is
@@ -194,10 +181,7 @@ int runView(const ViewOptions& opt) {
     if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
   }
 
-  RendererParams rendererParams;
-  rendererParams.emitterLights = opt.emitterLights;
-  rendererParams.shadowMapSize = opt.shadowMapSize;
-  Renderer renderer(scene, octree, rendererParams);
+  Renderer renderer(scene, octree, opt.shading.rendererParams());
   octree = GpuOctree();  // uploaded; the CPU copy is not needed any more
   if (!opt.quiet && !view.path) std::printf("%s", viewerKeyHelp());
 
@@ -213,8 +197,6 @@ int runView(const ViewOptions& opt) {
   }
   return 0;
 }
-
-CLI::Validator onOff() { return CLI::IsMember({"on", "off"}); }
 
 }  // namespace
 
@@ -245,30 +227,7 @@ std::function<int()> addViewCommand(CLI::App& app) {
   cmd->add_option("--mode", opt->mode, "Start in full | direct | indirect | voxels (keys 1 2 3 4)")
       ->check(CLI::IsMember({"full", "direct", "indirect", "voxels"}))
       ->capture_default_str();
-  cmd->add_option("--interpolation", opt->interpolation, "Start with interpolation on/off (I)")
-      ->check(onOff())
-      ->capture_default_str();
-  cmd->add_option("--specular", opt->specular, "Start with the GGX lobe on/off (G)")
-      ->check(onOff())
-      ->capture_default_str();
-  cmd->add_option("--exposure", opt->exposure, "Exposure in EV (radiance * 2^EV; keys , .)")
-      ->check(CLI::Range(-30.0f, 30.0f))
-      ->capture_default_str();
-  cmd->add_option("--vdls", opt->vdls, "VDLs used per voxel at the start, 1-" + std::to_string(kMaxVdls) + " (keys [ ])")
-      ->check(CLI::Range(1, kMaxVdls))
-      ->capture_default_str();
-  cmd->add_option("--emitter-lights", opt->emitterLights,
-                  "Shadowed virtual point lights sampled on emissive triangles (0: none)")
-      ->check(CLI::Range(0, 16))
-      ->capture_default_str();
-  cmd->add_option("--shadow-map-size", opt->shadowMapSize, "Shadow map resolution per face")
-      ->check(CLI::Range(16, 8192))
-      ->capture_default_str();
-  cmd->add_flag("--half-float", opt->halfFloat, "VDL texture with half-float irradiance");
-  cmd->add_option("--cosine-correction", opt->cosineCorrection,
-                  "Divide each VDL by the cosine to its voxel's normal on upload (as `render`)")
-      ->check(onOff())
-      ->capture_default_str();
+  addShadingOptions(cmd, opt->shading, true);
   cmd->add_option("--speed", opt->speed,
                   "Movement speed, scene units per second (default: a quarter of the scene's "
                   "diagonal)")

@@ -1,0 +1,71 @@
+#include "render_options.h"
+
+#include <CLI/CLI.hpp>
+
+namespace lo::tool {
+
+RenderParams ShadingOptions::renderParams(RenderMode mode) const {
+  RenderParams p;
+  p.mode = mode;
+  p.interpolation = interpolation == "on";
+  p.specular = specular == "on";
+  p.maxVdls = vdls;
+  return p;
+}
+
+RendererParams ShadingOptions::rendererParams() const {
+  RendererParams p;
+  p.emitterLights = emitterLights;
+  p.shadowMapSize = shadowMapSize;
+  return p;
+}
+
+GpuOctreeParams ShadingOptions::octreeParams(const GlInfo* info) const {
+  GpuOctreeParams p;
+  p.halfFloat = halfFloat;
+  p.cosineCorrection = cosineCorrection == "on";
+  if (info) {
+    p.max3DTextureSize = info->max3DTextureSize;
+    p.max2DTextureSize = info->max2DTextureSize;
+  }
+  return p;
+}
+
+CLI::Validator onOff() { return CLI::IsMember({"on", "off"}); }
+
+void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
+  auto key = [window](const char* keys) { return window ? std::string(" (") + keys + ")" : ""; };
+  cmd->add_option("--interpolation", opt.interpolation,
+                  "Trilinear interpolation between the 8 neighbouring voxels" + key("key I"))
+      ->check(onOff())
+      ->capture_default_str();
+  cmd->add_option("--specular", opt.specular,
+                  "GGX lobe of the glTF BRDF (off: diffuse only)" + key("key G"))
+      ->check(onOff())
+      ->capture_default_str();
+  cmd->add_option("--exposure", opt.exposure,
+                  std::string(window ? "Exposure" : "PNG exposure") +
+                      " in EV (radiance * 2^EV)" + key("keys , . 0"))
+      ->check(CLI::Range(-30.0f, 30.0f))
+      ->capture_default_str();
+  cmd->add_option("--vdls", opt.vdls, "VDLs used per voxel, strongest first" + key("keys [ ]"))
+      ->check(CLI::Range(1, kMaxVdls))
+      ->capture_default_str();
+  cmd->add_option("--emitter-lights", opt.emitterLights,
+                  "Shadowed virtual point lights sampled on emissive triangles (0: none)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  cmd->add_option("--shadow-map-size", opt.shadowMapSize, "Shadow map resolution per face")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  cmd->add_option("--cosine-correction", opt.cosineCorrection,
+                  "Divide each VDL by the cosine to its voxel's normal on upload, so that the "
+                  "shader's max(0, n.d) does not count the baked cosine twice (off: the paper's "
+                  "form, darker; see docs/accuracy.md)")
+      ->check(onOff())
+      ->capture_default_str();
+  cmd->add_flag("--half-float", opt.halfFloat,
+                "VDL texture with half-float irradiance (RGBA16UI) instead of RGBA32F");
+}
+
+}  // namespace lo::tool

@@ -1,0 +1,47 @@
+#pragma once
+/// @file tools/render_options.h
+/// @brief The shading flags `render` and `view` share (--interpolation,
+/// --specular, --exposure, --vdls, --emitter-lights, --shadow-map-size,
+/// --half-float, --cosine-correction): one registration and one translation
+/// into the renderer's parameters, so both commands draw the same picture
+/// from the same flags.
+
+#include <string>
+
+#include "lightgrid/vdl_grid.h"
+#include "octree/gpu_octree.h"
+#include "render/context.h"
+#include "render/renderer.h"
+
+namespace CLI {
+class App;
+class Validator;
+}  // namespace CLI
+
+namespace lo::tool {
+
+struct ShadingOptions {
+  std::string interpolation = "on";
+  std::string specular = "on";
+  float exposure = 0;  ///< EV
+  int vdls = kMaxVdls;
+  int emitterLights = RendererParams{}.emitterLights;
+  int shadowMapSize = RendererParams{}.shadowMapSize;
+  bool halfFloat = false;
+  std::string cosineCorrection = "on";
+
+  /// Mode, interpolation, GGX lobe and VDLs of a frame (size left at default).
+  RenderParams renderParams(RenderMode mode) const;
+  RendererParams rendererParams() const;
+  /// The octree's texel format, within the limits of `info` when given.
+  GpuOctreeParams octreeParams(const GlInfo* info = nullptr) const;
+};
+
+/// Registers the flags on `cmd`; `window` adds the keys that change each one
+/// in the `view` window to the help text.
+void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window);
+
+/// "on" | "off".
+CLI::Validator onOff();
+
+}  // namespace lo::tool
