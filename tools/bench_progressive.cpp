@@ -81,9 +81,9 @@ struct SceneResult {
   std::vector<LevelRow> levels;
 };
 
-lo::RenderCamera sceneCamera(const lo::Scene& scene) {
-  if (!scene.cameras.empty()) return lo::RenderCamera::fromScene(scene.cameras.front());
-  return lo::RenderCamera::framing(scene.bounds(), 45.0f * lo::kPi / 180.0f);
+lo::PinholeCamera sceneCamera(const lo::Scene& scene) {
+  if (!scene.cameras.empty()) return lo::PinholeCamera::fromScene(scene.cameras.front());
+  return lo::PinholeCamera::framing(scene.bounds(), 45.0f * lo::kPi / 180.0f);
 }
 
 SceneResult runScene(const SceneSpec& spec, const std::string& path, lo::GlContext& context,
@@ -96,7 +96,7 @@ SceneResult runScene(const SceneSpec& spec, const std::string& path, lo::GlConte
   lo::PhotonMap photons = lo::tracePhotons(scene, base.photons);
   r.trace = clock.seconds();
   r.photons = photons.photons.size();
-  lo::RenderCamera camera = sceneCamera(scene);
+  lo::PinholeCamera camera = sceneCamera(scene);
 
   lo::ProgressiveParams params = base;
   params.octree.max3DTextureSize = context.info().max3DTextureSize;

@@ -88,7 +88,7 @@ Baked load(const std::string& scenePath, const std::string& vdbPath) {
 
 /// Mean seconds per frame: one frame to size the run, then at least
 /// `minFrames` frames and at least `minSeconds` of frames.
-double secondsPerFrame(lo::Renderer& renderer, const lo::RenderCamera& camera,
+double secondsPerFrame(lo::Renderer& renderer, const lo::PinholeCamera& camera,
                        const lo::RenderParams& params, int minFrames, double minSeconds) {
   double first = renderer.timeFrames(camera, params, 1);
   int frames = std::max(minFrames, int(std::ceil(minSeconds / std::max(first, 1e-4))));
@@ -201,9 +201,9 @@ int main(int argc, char** argv) try {
              << fixed(mib100k(pool + vdl), 2) << " MiB | " << fixed(mib100k(pool + vdlHalf), 2)
              << " MiB |\n";
     }
-    lo::RenderCamera camera =
-        b.scene.cameras.empty() ? lo::RenderCamera::framing(b.scene.bounds(), 45.0f * lo::kPi / 180)
-                                : lo::RenderCamera::fromScene(b.scene.cameras.front());
+    lo::PinholeCamera camera =
+        b.scene.cameras.empty() ? lo::PinholeCamera::framing(b.scene.bounds(), 45.0f * lo::kPi / 180)
+                                : lo::PinholeCamera::fromScene(b.scene.cameras.front());
     lo::Renderer renderer(b.scene, o);
     for (const Resolution& r : kResolutions) {
       if (quick && r.width != 800) continue;

@@ -51,7 +51,7 @@ int runReference(const ReferenceOptions& opt) {
   ThreadLimit threadLimit(opt.threads);
 
   Scene scene = loadScene(opt.scene);
-  ReferenceCamera camera = chooseCamera(opt.camera, scene, opt.scene);
+  PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   ReferenceParams params;
   params.width = opt.width;
   params.height = opt.height;

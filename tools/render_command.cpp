@@ -16,7 +16,7 @@
 #include "octree/octree_irradiance.h"
 #include "reference/first_hit.h"
 #include "render/context.h"
-#include "render/image_io.h"
+#include "image/image.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "vdb/vdb_io.h"
@@ -45,7 +45,7 @@ struct RenderOptions {
 /// the reference's samples do.
 int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedVdl& baked) {
   if (opt.frames > 0) throw InputError("--frames: not with --mode irradiance (no GL frame)");
-  ReferenceCamera camera = chooseCamera(opt.camera, scene, opt.scene);
+  PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   // No GL context to ask: the limits of the GL 3.3 contexts we render with.
   GpuOctree octree = buildGpuOctree(baked.grid, opt.shading.octreeParams());
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
@@ -82,7 +82,7 @@ int runRender(const RenderOptions& opt) {
 
   Scene scene = loadScene(opt.scene);
   LoadedVdl baked = readVdlGrid(opt.lights);
-  RenderCamera camera = chooseCamera(opt.camera, scene, opt.scene);
+  PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
 
   GlContextParams contextParams;
   contextParams.backend = parseGlBackend(opt.backend);
@@ -93,7 +93,7 @@ int runRender(const RenderOptions& opt) {
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
 
   Renderer renderer(scene, octree, opt.shading.rendererParams());
-  Image image = renderer.render(camera, params);
+  RgbImage image = renderer.render(camera, params);
   writeImage(opt.output, image, opt.shading.exposure);
 
   if (opt.frames > 0) {

@@ -27,7 +27,6 @@
 #include "reference/first_hit.h"
 #include "reference/path_tracer.h"
 #include "render/context.h"
-#include "render/image_io.h"
 #include "render/renderer.h"
 #include "report.h"
 #include "scene/scene.h"
@@ -106,7 +105,7 @@ struct References {
 /// Path-traced references, cached in cacheDir with the settings they were
 /// rendered with; re-rendered when those differ.
 References loadOrRenderReferences(const SweepParams& params, const Scene& scene,
-                                  const ReferenceCamera& camera, const std::string& cacheDir,
+                                  const PinholeCamera& camera, const std::string& cacheDir,
                                   std::FILE* log) {
   nlohmann::json key = {{"scene", fs::path(params.scene).filename().string()},
                         {"width", params.width},
@@ -475,7 +474,7 @@ struct IndirectRenderer {
 
   /// The indirect image of `grid` and its mean frame time over `frames`.
   RgbImage render(const Scene& scene, const VdlGrid& grid, const SweepPoint& point,
-                  const RenderCamera& camera, int width, int height, int frames, double& frameMs) {
+                  const PinholeCamera& camera, int width, int height, int frames, double& frameMs) {
     if (!context) context = createGlContext(GlContextParams{});
     GpuOctreeParams octreeParams;
     octreeParams.halfFloat = point.halfFloat;
@@ -493,7 +492,7 @@ struct IndirectRenderer {
     rp.height = height;
     rp.mode = RenderMode::Indirect;
     rp.interpolation = point.interpolation;
-    const RgbImage image = toRgbImage(renderer->render(camera, rp));
+    const RgbImage image = renderer->render(camera, rp);
     frameMs = 1000.0 * renderer->timeFrames(camera, rp, frames) / frames;
     return image;
   }
@@ -514,9 +513,9 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
 
   ThreadLimit threadLimit(params.threads);
   const Scene scene = loadScene(params.scene);
-  const ReferenceCamera camera = scene.cameras.empty()
-                                     ? ReferenceCamera::framing(scene.bounds(), kPi / 4)
-                                     : ReferenceCamera::fromScene(scene.cameras.front());
+  const PinholeCamera camera = scene.cameras.empty()
+                                     ? PinholeCamera::framing(scene.bounds(), kPi / 4)
+                                     : PinholeCamera::fromScene(scene.cameras.front());
   const References refs = loadOrRenderReferences(params, scene, camera, cacheDir, log);
   CompareParams compareParams;
   compareParams.ignoreBackground = true;

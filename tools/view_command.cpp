@@ -126,7 +126,7 @@ int runView(const ViewOptions& opt) {
   std::optional<LoadedVdl> baked;
   if (!opt.progressive) baked = readVdlGrid(opt.lights);
 
-  RenderCamera startCamera = chooseCamera(opt.camera, scene, opt.scene);
+  PinholeCamera startCamera = chooseCamera(opt.camera, scene, opt.scene);
   view.defaultFovDegrees = opt.camera.fovDegrees > 0 ? opt.camera.fovDegrees : 45.0f;
   view.start = FlyCamera::lookingAt(startCamera.eye, startCamera.eye + startCamera.forward,
                                     startCamera.yfov);

@@ -12,16 +12,16 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "core/error.h"
 #include "core/file.h"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
+// The project's one copy of stb_image: scene textures decode through
+// decodeImageBytes too.
 #define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_STATIC  // src/scene has its own copy for glTF textures
-#define STBI_ONLY_PNG
-#define STBI_ONLY_JPEG
 #include <stb_image.h>
 
 namespace lo {
@@ -33,9 +33,6 @@ void checkImage(const std::string& path, const RgbImage& image) {
                      " x " + std::to_string(image.height) + ")");
 }
 
-float srgbToLinear(float s) {
-  return s <= 0.04045f ? s / 12.92f : std::pow((s + 0.055f) / 1.055f, 2.4f);
-}
 
 RgbImage readExr(const std::string& path) {
   try {
@@ -135,6 +132,43 @@ RgbImage readImage(const std::string& path, bool linear8Bit) {
   }
   stbi_image_free(data);
   return image;
+}
+
+float srgbToLinear(float s) {
+  return s <= 0.04045f ? s / 12.92f : std::pow((s + 0.055f) / 1.055f, 2.4f);
+}
+
+DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
+  if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
+    throw InputError("empty or too large");
+  }
+  const int n = int(size);
+  int w = 0, h = 0, comp = 0;
+  DecodedImage out;
+  auto finish = [&](auto* data, float scale) {
+    out.width = w;
+    out.height = h;
+    out.channels = comp;
+    out.values.resize(size_t(w) * size_t(h) * size_t(comp));
+    for (size_t i = 0; i < out.values.size(); ++i) out.values[i] = float(data[i]) * scale;
+    stbi_image_free(data);
+  };
+  if (stbi_is_16_bit_from_memory(bytes, n)) {
+    stbi_us* data = stbi_load_16_from_memory(bytes, n, &w, &h, &comp, 0);
+    if (data && w > 0 && h > 0 && comp >= 1 && comp <= 4) {
+      finish(data, 1.0f / 65535.0f);
+      return out;
+    }
+    if (data) stbi_image_free(data);
+  }
+  stbi_uc* data = stbi_load_from_memory(bytes, n, &w, &h, &comp, 0);
+  if (!data || w <= 0 || h <= 0 || comp < 1 || comp > 4) {
+    if (data) stbi_image_free(data);
+    const char* reason = stbi_failure_reason();
+    throw InputError(reason ? reason : "cannot decode");
+  }
+  finish(data, 1.0f / 255.0f);
+  return out;
 }
 
 }  // namespace lo

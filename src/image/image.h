@@ -14,7 +14,8 @@
 
 namespace lo {
 
-/// Linear RGB, row-major, row 0 at the top (as render::Image).
+/// Linear RGB, row-major, row 0 at the top: the one image type of the
+/// project (GL frames, path-traced references, masks, differences).
 struct RgbImage {
   int width = 0, height = 0;
   std::vector<float> rgb;  ///< width * height * 3
@@ -23,12 +24,28 @@ struct RgbImage {
   RgbImage(int w, int h) : width(w), height(h), rgb(size_t(w) * size_t(h) * 3, 0.0f) {}
   size_t pixelCount() const { return size_t(width) * size_t(height); }
   Vec3 at(size_t i) const { return {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]}; }
+  /// The 3 floats of pixel (x, y), x to the right, y down.
+  const float* pixel(int x, int y) const { return rgb.data() + (size_t(y) * width + x) * 3; }
   void set(size_t i, const Vec3& v) {
     rgb[3 * i] = v.x;
     rgb[3 * i + 1] = v.y;
     rgb[3 * i + 2] = v.z;
   }
 };
+
+/// An image file held in memory (PNG, JPEG, BMP, TGA, GIF, HDR, PNM, PSD:
+/// stb_image), channel values scaled to [0, 1] (8-bit / 255, 16-bit / 65535;
+/// Radiance HDR as stored), no colour conversion.
+struct DecodedImage {
+  int width = 0, height = 0;
+  int channels = 0;           ///< 1..4
+  std::vector<float> values;  ///< width * height * channels, row 0 at the top
+};
+/// @throws InputError with the decoder's reason (the caller names the file).
+DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size);
+
+/// sRGB transfer function (IEC 61966-2-1) to linear, for one channel in [0, 1].
+float srgbToLinear(float s);
 
 /// Writes 32-bit float channels R, G, B (ZIP, lossless) to
 /// `path` through `path.tmp` and a rename. @throws IoError naming the file.

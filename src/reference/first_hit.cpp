@@ -12,7 +12,7 @@
 
 namespace lo {
 
-RgbImage renderFirstHits(const Scene& scene, const ReferenceCamera& camera,
+RgbImage renderFirstHits(const Scene& scene, const PinholeCamera& camera,
                          const FirstHitParams& params,
                          const std::function<Vec3(const FirstHit&)>& shade,
                          ProgressSink* progress) {

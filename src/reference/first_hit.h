@@ -36,7 +36,7 @@ struct FirstHitParams {
 /// camera rays. Parallel (TBB) and deterministic: pixel i draws its jitter
 /// from Rng(seed, i). `shade` is called from several threads at once.
 /// @throws InputError for bad sizes, sample counts or field of view.
-RgbImage renderFirstHits(const Scene& scene, const ReferenceCamera& camera,
+RgbImage renderFirstHits(const Scene& scene, const PinholeCamera& camera,
                          const FirstHitParams& params,
                          const std::function<Vec3(const FirstHit&)>& shade,
                          ProgressSink* progress = nullptr);

@@ -226,7 +226,7 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
 }
 
 /// One sample of pixel (x, y) for `part`.
-inline Vec3 samplePixel(const Context& ctx, const ReferenceCamera& cam, const Vec3& right,
+inline Vec3 samplePixel(const Context& ctx, const PinholeCamera& cam, const Vec3& right,
                         float tanHalf, float aspect, int x, int y, int width, int height,
                         ReferencePart part, Rng& rng, uint32_t& rays) {
   float u = rng.uniform(), v = rng.uniform();
@@ -316,7 +316,7 @@ struct PixelSums {
 /// TBB body: `passSpp` more samples for every pixel of tiles [r.begin(), r.end()).
 struct RenderTiles {
   const Context* ctx;
-  const ReferenceCamera* cam;
+  const PinholeCamera* cam;
   Vec3 right;
   float tanHalf, aspect;
   int width, height, tilesX, passSpp;
@@ -356,13 +356,13 @@ struct RenderTiles {
 
 }  // namespace reference_internal
 
-ReferenceImage renderReference(const Scene& scene, const ReferenceCamera& camera,
+ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
                                const ReferenceParams& params, ProgressSink* progress) {
   // Far from the origin, render in a frame centred on the scene (see
   // Scene::tracingOrigin); a translation changes no radiance.
   const Vec3 origin = scene.tracingOrigin();
   if (!(origin == Vec3{0, 0, 0})) {
-    ReferenceCamera local = camera;
+    PinholeCamera local = camera;
     local.eye -= origin;
     return renderReference(scene.translated(-origin), local, params, progress);
   }

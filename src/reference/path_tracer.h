@@ -36,9 +36,6 @@ enum class ReferencePart {
 ReferencePart parseReferencePart(const std::string& name);
 std::string toString(ReferencePart part);
 
-/// The same camera as `lightoctree render` (scene/pinhole_camera.h); the
-/// near and far planes are ignored.
-using ReferenceCamera = PinholeCamera;
 
 struct ReferenceParams {
   int width = 256, height = 256;  ///< pixels
@@ -70,7 +67,7 @@ struct ReferenceImage {
 /// pixel i draws its random numbers from Rng(seed, i), so the result is the
 /// same bytes for any thread count (spp mode).
 /// @throws InputError for bad params (sizes, spp) or bad triangle indices.
-ReferenceImage renderReference(const Scene& scene, const ReferenceCamera& camera,
+ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
                                const ReferenceParams& params, ProgressSink* progress = nullptr);
 
 }  // namespace lo

@@ -38,9 +38,9 @@ std::string CameraKey::ToString() const {
   return line;
 }
 
-RenderCamera CameraKey::camera(float defaultFovDegrees) const {
+PinholeCamera CameraKey::camera(float defaultFovDegrees) const {
   float fov = fovDegrees > 0 ? fovDegrees : defaultFovDegrees;
-  return RenderCamera::lookAt(eye, target, fov * kPi / 180.0f);
+  return PinholeCamera::lookAt(eye, target, fov * kPi / 180.0f);
 }
 
 CameraKey CameraPath::sample(float time) const {

@@ -33,7 +33,7 @@ struct CameraKey {
   /// The line of the file format (fov omitted when 0); parses back exactly.
   std::string ToString() const;
   /// The pinhole camera of this key; `defaultFovDegrees` when fovDegrees is 0.
-  RenderCamera camera(float defaultFovDegrees) const;
+  PinholeCamera camera(float defaultFovDegrees) const;
 };
 
 struct CameraPath {

@@ -42,8 +42,8 @@ void FlyCamera::turn(float yawRadians, float pitchRadians) {
   pitch = std::clamp(pitch + pitchRadians, -kMaxPitch, kMaxPitch);
 }
 
-RenderCamera FlyCamera::camera() const {
-  RenderCamera c;
+PinholeCamera FlyCamera::camera() const {
+  PinholeCamera c;
   c.eye = position;
   c.forward = forward();
   c.up = up();

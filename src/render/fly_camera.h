@@ -37,7 +37,7 @@ struct FlyCamera {
   /// Adds to yaw (wrapped to [-pi, pi]) and pitch (clamped), radians.
   void turn(float yawRadians, float pitchRadians);
 
-  RenderCamera camera() const;
+  PinholeCamera camera() const;
   /// A camera path keyframe: the target one unit along the view direction.
   CameraKey key(float time) const;
   std::string ToString() const;

@@ -482,7 +482,7 @@ struct Renderer::Impl {
     targetHeight = height;
   }
 
-  void draw(const RenderCamera& camera, const RenderParams& rp, int width, int height,
+  void draw(const PinholeCamera& camera, const RenderParams& rp, int width, int height,
             float exposureScale, bool encodeSrgb) {
     if (width < 1 || height < 1) throw InputError("render: image size must be at least 1 x 1");
     if (rp.maxVdls < 1 || rp.maxVdls > kMaxVdls) {
@@ -590,37 +590,36 @@ void Renderer::setOctree(const GpuOctree& octree) {
   impl_->uploadOctree(octree);
 }
 
-Image Renderer::render(const RenderCamera& camera, const RenderParams& params) {
+RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& params) {
   Impl& r = *impl_;
   r.ensureTarget(params.width, params.height);
   glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo);
   r.draw(camera, params, params.width, params.height, 1.0f, false);
-  Image image;
-  image.width = params.width;
-  image.height = params.height;
+  RgbImage image(params.width, params.height);
   std::vector<float> raw(size_t(params.width) * params.height * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glReadPixels(0, 0, params.width, params.height, GL_RGBA, GL_FLOAT, raw.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   checkGl("reading back the image");
-  // GL rows go bottom-up; Image rows top-down.
-  image.rgba.resize(raw.size());
-  size_t row = size_t(params.width) * 4;
+  // GL rows go bottom-up; image rows top-down. Alpha is dropped.
   for (int y = 0; y < params.height; ++y) {
-    std::memcpy(image.rgba.data() + size_t(y) * row,
-                raw.data() + size_t(params.height - 1 - y) * row, row * sizeof(float));
+    const float* src = raw.data() + size_t(params.height - 1 - y) * size_t(params.width) * 4;
+    float* dst = image.rgb.data() + size_t(y) * size_t(params.width) * 3;
+    for (int x = 0; x < params.width; ++x) {
+      for (int c = 0; c < 3; ++c) dst[3 * x + c] = src[4 * x + c];
+    }
   }
   return image;
 }
 
-void Renderer::drawToScreen(const RenderCamera& camera, const RenderParams& params,
+void Renderer::drawToScreen(const PinholeCamera& camera, const RenderParams& params,
                             float exposure) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   impl_->draw(camera, params, params.width, params.height, std::exp2(exposure), true);
 }
 
-double Renderer::timeFrames(const RenderCamera& camera, const RenderParams& params, int frames) {
+double Renderer::timeFrames(const PinholeCamera& camera, const RenderParams& params, int frames) {
   Impl& r = *impl_;
   r.ensureTarget(params.width, params.height);
   glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "scene/pinhole_camera.h"
 #include "scene/scene.h"
@@ -49,16 +50,6 @@ struct RendererParams {
   int max3DTextureSize = 0, max2DTextureSize = 0;
 };
 
-/// The GL renderer's camera is the scene's pinhole camera (shared with the
-/// reference renderer so that images line up).
-using RenderCamera = PinholeCamera;
-
-/// Linear float RGBA pixels, row 0 at the top.
-struct Image {
-  int width = 0, height = 0;
-  std::vector<float> rgba;  ///< width * height * 4
-  const float* pixel(int x, int y) const { return rgba.data() + (size_t(y) * width + x) * 4; }
-};
 
 class Renderer {
  public:
@@ -79,15 +70,15 @@ class Renderer {
   /// context's limits (the old octree is kept then).
   void setOctree(const GpuOctree& octree);
 
-  /// Renders into an offscreen RGBA32F target and reads it back.
-  Image render(const RenderCamera& camera, const RenderParams& params);
+  /// Renders into an offscreen RGBA32F target and reads its RGB back.
+  RgbImage render(const PinholeCamera& camera, const RenderParams& params);
   /// Renders into the currently bound framebuffer (a window); `exposure` in EV
   /// scales the radiance, then a clamp and sRGB encoding are applied.
-  void drawToScreen(const RenderCamera& camera, const RenderParams& params, float exposure);
+  void drawToScreen(const PinholeCamera& camera, const RenderParams& params, float exposure);
 
   /// Seconds of GPU+CPU time for `frames` offscreen frames (glFinish after
   /// each), without the read-back: the real-time cost.
-  double timeFrames(const RenderCamera& camera, const RenderParams& params, int frames);
+  double timeFrames(const PinholeCamera& camera, const RenderParams& params, int frames);
 
   int emitterLightCount() const;
 

@@ -8,7 +8,7 @@
 #include <filesystem>
 
 #include "core/resources.h"
-#include "render/image_io.h"
+#include "image/image.h"
 
 namespace lo {
 namespace viewer_internal {
@@ -18,7 +18,7 @@ constexpr float kKeyTurnRadiansPerSecond = 1.5f;
 constexpr float kSpeedStep = 1.25f;
 constexpr float kExposureStep = 0.5f;
 
-bool sameView(const RenderCamera& a, const RenderCamera& b) {
+bool sameView(const PinholeCamera& a, const PinholeCamera& b) {
   return a.eye == b.eye && a.forward == b.forward && a.up == b.up && a.yfov == b.yfov &&
          a.znear == b.znear && a.zfar == b.zfar;
 }
@@ -30,7 +30,7 @@ bool sameParams(const RenderParams& a, const RenderParams& b) {
 }
 
 /// The keyframe `P` writes: the camera on screen, `time` seconds into the path.
-CameraKey keyOf(const RenderCamera& camera, float time) {
+CameraKey keyOf(const PinholeCamera& camera, float time) {
   CameraKey k;
   k.time = time;
   k.eye = camera.eye;
@@ -45,7 +45,7 @@ CameraKey keyOf(const RenderCamera& camera, float time) {
 class PathRecorder {
  public:
   explicit PathRecorder(std::string path) : path_(std::move(path)) {}
-  void append(const RenderCamera& camera) {
+  void append(const PinholeCamera& camera) {
     if (!started_) {
       base_ = 0;
       if (std::filesystem::exists(path_)) base_ = readCameraPath(path_).endTime() + 1.0f;
@@ -265,7 +265,7 @@ ViewerStats Viewer::Impl::run() {
   int shownDepth = params.shownDepth;
   const bool alwaysDraw =
       params.continuous || path || params.frames > 0 || !params.saveFrames.empty();
-  RenderCamera lastCamera;
+  PinholeCamera lastCamera;
   RenderParams lastParams;
   float lastExposure = 0;
   bool justShown = false;  // a new level went on screen: reported once its first frame is drawn
@@ -292,7 +292,7 @@ ViewerStats Viewer::Impl::run() {
     }
     const bool refining = levels && !(levels->finished() && shownDepth == params.targetDepth);
 
-    RenderCamera camera;
+    PinholeCamera camera;
     std::string pathText;
     if (path) {
       if (stats.framesDrawn == 0 || refining) pathStart = now;  // real time starts at the target

@@ -9,7 +9,9 @@
 /// to be below the vertex count, before a byte is read.
 
 #define TINYGLTF_IMPLEMENTATION
-#define STB_IMAGE_IMPLEMENTATION
+// Images are decoded by src/image (decodeImageBytes), the project's one copy
+// of stb_image; tinygltf only hands over the encoded bytes (storeEncodedImage).
+#define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
 #include <tiny_gltf.h>
 
@@ -23,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "image/image.h"
 #include "scene/scene_internal.h"
 
 namespace lo::scene_internal {
@@ -862,40 +865,24 @@ class SceneBuilder {
 
 Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
                     const std::string& what) {
-  if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
-    fail(scenePath, "unreadable image " + what + ": empty or too large");
+  DecodedImage d;
+  try {
+    d = decodeImageBytes(bytes, size);
+  } catch (const InputError& e) {
+    fail(scenePath, "unreadable image " + what + ": " + e.what());
   }
-  int w = 0, h = 0, comp = 0;
-  int n = int(size);
   Texture t;
-  auto finish = [&](auto* data, float scale) {
-    t.width = w;
-    t.height = h;
-    t.texels.resize(size_t(w) * size_t(h));
-    for (size_t i = 0; i < t.texels.size(); ++i) {
-      const auto* px = data + i * size_t(comp);
-      float r = float(px[0]) * scale;
-      float g = comp >= 3 ? float(px[1]) * scale : r;
-      float b = comp >= 3 ? float(px[2]) * scale : r;
-      t.texels[i] = {srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)};
-    }
-    stbi_image_free(data);
-  };
-  if (stbi_is_16_bit_from_memory(bytes, n)) {
-    stbi_us* data = stbi_load_16_from_memory(bytes, n, &w, &h, &comp, 0);
-    if (data && w > 0 && h > 0 && comp >= 1 && comp <= 4) {
-      finish(data, 1.0f / 65535.0f);
-      return t;
-    }
-    if (data) stbi_image_free(data);
+  t.width = d.width;
+  t.height = d.height;
+  t.texels.resize(size_t(d.width) * size_t(d.height));
+  const size_t comp = size_t(d.channels);
+  for (size_t i = 0; i < t.texels.size(); ++i) {
+    const float* px = d.values.data() + i * comp;
+    const float r = px[0];
+    const float g = comp >= 3 ? px[1] : r;
+    const float b = comp >= 3 ? px[2] : r;
+    t.texels[i] = {srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)};
   }
-  stbi_uc* data = stbi_load_from_memory(bytes, n, &w, &h, &comp, 0);
-  if (!data || w <= 0 || h <= 0 || comp < 1 || comp > 4) {
-    if (data) stbi_image_free(data);
-    const char* reason = stbi_failure_reason();
-    fail(scenePath, "unreadable image " + what + ": " + (reason ? reason : "cannot decode"));
-  }
-  finish(data, 1.0f / 255.0f);
   return t;
 }
 

@@ -213,11 +213,6 @@ std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std
   return bytes;
 }
 
-float srgbToLinear(float c) {
-  if (c <= 0.04045f) return c / 12.92f;
-  return std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
 void validateScene(const Scene& scene) {
   if (scene.triangleCount() == 0) fail(scene.sourcePath, "no triangles in the scene");
   checkSceneIndices(scene);

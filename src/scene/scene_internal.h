@@ -36,9 +36,6 @@ std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std
 Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
                     const std::string& what);
 
-/// sRGB electro-optical transfer function (IEC 61966-2-1), [0,1] -> [0,1].
-float srgbToLinear(float c);
-
 Scene loadGltf(const std::string& path);
 Scene loadObj(const std::string& path);
 

@@ -174,8 +174,8 @@ TEST(OctreeIrradiance, FirstHitImageOfALitPlaneIsTheAnalyticValueAtEveryPixel) {
   const Vec3 expected = c * dot(Vec3{0, 0, 1}, decodedDirection(o, 0));
   EXPECT_NEAR(expected.x, 0.4f, 0.01f);
   // Camera above the middle of the plane, looking down at part of it.
-  const ReferenceCamera camera =
-      ReferenceCamera::lookAt(Vec3{1, 1, 3}, Vec3{1, 1, 0}, 20.0f * kPi / 180.0f);
+  const PinholeCamera camera =
+      PinholeCamera::lookAt(Vec3{1, 1, 3}, Vec3{1, 1, 0}, 20.0f * kPi / 180.0f);
   FirstHitParams params;
   params.width = 24;
   params.height = 16;
@@ -205,7 +205,7 @@ TEST(FirstHit, MissesCountZeroAndBadParamsAreRefused) {
   scene.materials.push_back(Material{});
   // A quad covering the left half of the view only.
   test::addQuad(scene, {-10, -10, 0}, {10, 0, 0}, {0, 20, 0}, {0, 0, 1}, 0);
-  const ReferenceCamera camera = ReferenceCamera::lookAt({0, 0, 5}, {0, 0, 0}, 0.5f);
+  const PinholeCamera camera = PinholeCamera::lookAt({0, 0, 5}, {0, 0, 0}, 0.5f);
   FirstHitParams params;
   params.width = 8;
   params.height = 4;

@@ -61,7 +61,7 @@ ReferenceImage renderFurnace(ReferencePart part, int spp = 64) {
   params.samplesPerPixel = spp;
   params.part = part;
   params.seed = 3;
-  return renderReference(scene, ReferenceCamera::lookAt({0.2f, 0.1f, 0.3f}, {0, 0, -1}, 1.2f),
+  return renderReference(scene, PinholeCamera::lookAt({0.2f, 0.1f, 0.3f}, {0, 0, -1}, 1.2f),
                          params);
 }
 
@@ -108,7 +108,7 @@ TEST(Reference, FurnaceFarFromTheOriginKeepsItsRadiance) {
   params.seed = 3;
   ReferenceImage r = renderReference(
       scene,
-      ReferenceCamera::lookAt(Vec3{0.2f, 0.1f, 0.3f} + offset, Vec3{0, 0, -1} + offset, 1.2f),
+      PinholeCamera::lookAt(Vec3{0.2f, 0.1f, 0.3f} + offset, Vec3{0, 0, -1} + offset, 1.2f),
       params);
   expectMean(r, 1.0 / (1.0 - 0.5), "far full");
 }
@@ -127,7 +127,7 @@ TEST(Reference, DirectPlusIndirectIsFull) {
   ReferenceParams params;
   params.width = params.height = 16;
   params.samplesPerPixel = 4;
-  ReferenceCamera camera = ReferenceCamera::fromScene(scene.cameras.at(0));
+  PinholeCamera camera = PinholeCamera::fromScene(scene.cameras.at(0));
   params.part = ReferencePart::Full;
   ReferenceImage full = renderReference(scene, camera, params);
   params.part = ReferencePart::Direct;
@@ -154,7 +154,7 @@ Scene floorScene() {
 
 /// Mean of f over a 4x4 grid of points inside each pixel's footprint on y = 0.
 template <typename F>
-double expectedPixel(const ReferenceCamera& cam, int x, int y, int w, int h, F&& f) {
+double expectedPixel(const PinholeCamera& cam, int x, int y, int w, int h, F&& f) {
   Vec3 right = normalize(cross(cam.forward, cam.up));
   float tanHalf = std::tan(0.5f * cam.yfov), aspect = float(w) / float(h);
   double sum = 0;
@@ -175,7 +175,7 @@ TEST(Reference, PointLightOverDiffusePlane) {
   light.position = {0.3f, 1.0f, 0.0f};
   light.intensity = 2.0f;  // W/sr
   scene.lights.push_back(light);
-  ReferenceCamera cam = ReferenceCamera::lookAt({0, 3, 1}, {0, 0, 0}, 0.3f);
+  PinholeCamera cam = PinholeCamera::lookAt({0, 3, 1}, {0, 0, 0}, 0.3f);
   ReferenceParams params;
   params.width = params.height = 8;
   params.samplesPerPixel = 16;
@@ -216,7 +216,7 @@ TEST(Reference, AreaLightOverDiffusePlaneWithMis) {
   // its back is absorbed, so the floor sees only direct light.
   int emitter = addMaterial(scene, Vec3(0.0f), Vec3(3.0f));
   addQuad(scene, {-0.5f, 1, -0.5f}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, emitter);
-  ReferenceCamera cam = ReferenceCamera::lookAt({0, 0.5f, 3}, {0, 0, 0}, 0.004f);
+  PinholeCamera cam = PinholeCamera::lookAt({0, 0.5f, 3}, {0, 0, 0}, 0.004f);
   ReferenceParams params;
   params.width = params.height = 4;
   params.samplesPerPixel = 1024;
@@ -237,7 +237,7 @@ TEST(Reference, DeterministicAcrossThreadCounts) {
   params.height = 20;
   params.samplesPerPixel = 3;
   params.seed = 11;
-  ReferenceCamera camera = ReferenceCamera::fromScene(scene.cameras.at(0));
+  PinholeCamera camera = PinholeCamera::fromScene(scene.cameras.at(0));
   std::vector<float> images[2];
   for (int threads = 1; threads <= 2; ++threads) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -249,7 +249,7 @@ TEST(Reference, DeterministicAcrossThreadCounts) {
 
 TEST(Reference, TimeBudgetEqualsSameSppRun) {
   Scene scene = furnace(0.5f, 1.0f);
-  ReferenceCamera cam = ReferenceCamera::lookAt({0, 0, 0}, {0, 0, -1}, 1.0f);
+  PinholeCamera cam = PinholeCamera::lookAt({0, 0, 0}, {0, 0, -1}, 1.0f);
   ReferenceParams params;
   params.width = params.height = 8;
   params.timeBudgetSeconds = 0.05;
@@ -263,7 +263,7 @@ TEST(Reference, TimeBudgetEqualsSameSppRun) {
 
 TEST(Reference, RejectsBadParams) {
   Scene scene = furnace(0.5f, 1.0f);
-  ReferenceCamera cam;
+  PinholeCamera cam;
   ReferenceParams params;
   params.samplesPerPixel = 0;
   EXPECT_THROW(renderReference(scene, cam, params), InputError);

@@ -1,6 +1,6 @@
 // Camera paths (render/camera_path.h) and the walkthrough camera
 // (render/fly_camera.h): parsing, errors naming the line, interpolation,
-// appending, and the fly camera's frame against RenderCamera::lookAt.
+// appending, and the fly camera's frame against PinholeCamera::lookAt.
 
 #include <gtest/gtest.h>
 
@@ -151,7 +151,7 @@ TEST(CameraPath, CrossingEyeAndTargetKeepsALineOfSight) {
   CameraKey k = path.sample(1.0f);
   expectNear(k.eye, Vec3(0, 0, 0), 1e-6f);
   expectNear(k.target - k.eye, Vec3(2, 0, 0), 1e-6f);
-  RenderCamera c = k.camera(45.0f);
+  PinholeCamera c = k.camera(45.0f);
   expectNear(c.forward, Vec3(1, 0, 0), 1e-6f);
 }
 
@@ -203,8 +203,8 @@ TEST(FlyCamera, LookingAtReproducesTheViewDirection) {
     FlyCamera fly = FlyCamera::lookingAt(eye, target, 0.7f);
     Vec3 expected = normalize(target - eye);
     expectNear(fly.forward(), expected, 1e-5f);
-    // The same frame as RenderCamera::lookAt (the convention `render` uses).
-    RenderCamera a = fly.camera(), b = RenderCamera::lookAt(eye, target, 0.7f);
+    // The same frame as PinholeCamera::lookAt (the convention `render` uses).
+    PinholeCamera a = fly.camera(), b = PinholeCamera::lookAt(eye, target, 0.7f);
     expectNear(a.forward, b.forward, 1e-5f);
     expectNear(a.up, b.up, 1e-5f);
     EXPECT_EQ(a.eye, eye);
@@ -219,7 +219,7 @@ TEST(FlyCamera, LookingAtReproducesTheViewDirection) {
 TEST(FlyCamera, StraightUpIsClampedBelowThePole) {
   FlyCamera fly = FlyCamera::lookingAt(Vec3(0, 0, 0), Vec3(0, 5, 0), 0.7f);
   EXPECT_NEAR(fly.pitch, FlyCamera::kMaxPitch, 1e-6f);
-  RenderCamera c = fly.camera();
+  PinholeCamera c = fly.camera();
   EXPECT_TRUE(isFinite(c.up));
   EXPECT_NEAR(length(c.up), 1.0f, 1e-5f);
   fly.turn(0.0f, 1.0f);
@@ -256,7 +256,7 @@ TEST(FlyCamera, TurnWrapsYawAndKeyRoundTripsThroughAPath) {
   path.keys.push_back(fly.key(0.0f));
   std::istringstream in(path.keys[0].ToString());
   CameraKey back = parseCameraPath(in, "k").keys[0];
-  RenderCamera c = back.camera(45.0f);
+  PinholeCamera c = back.camera(45.0f);
   expectNear(c.eye, fly.position, 1e-6f);
   expectNear(c.forward, fly.forward(), 1e-5f);
   EXPECT_NEAR(c.yfov, 0.9f, 1e-5f);

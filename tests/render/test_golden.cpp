@@ -27,7 +27,6 @@
 #include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "render/context.h"
-#include "render/image_io.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "test_util.h"
@@ -65,12 +64,12 @@ GlContext* context() {
 struct Setup {
   Scene scene;
   GpuOctree octree;
-  RenderCamera camera;
+  PinholeCamera camera;
   Setup() {
     scene = loadScene(test::dataDir() + "/cornell-box.gltf");
     LoadedVdl baked = readVdlGrid(goldenDir() + "/cornell-box-d4.vdb");
     octree = buildGpuOctree(baked.grid, test::paperCosine());
-    camera = RenderCamera::fromScene(scene.cameras.at(0));
+    camera = PinholeCamera::fromScene(scene.cameras.at(0));
   }
 };
 
@@ -83,7 +82,7 @@ const Setup& setup() {
 float exposureOf(RenderMode mode) { return mode == RenderMode::Indirect ? 1.0f : 0.0f; }
 
 /// The rendered frame as the PNG would store it: 8-bit sRGB, read back as v/255.
-RgbImage asPng(const Image& image, float exposure, const std::string& path) {
+RgbImage asPng(const RgbImage& image, float exposure, const std::string& path) {
   writeImage(path, image, exposure);
   return readImage(path, true);
 }
@@ -121,7 +120,7 @@ Mismatch renderAndCompare(RenderMode mode, bool interpolation, const std::string
   p.width = p.height = kSize;
   p.mode = mode;
   p.interpolation = interpolation;
-  Image frame = renderer.render(s.camera, p);
+  RgbImage frame = renderer.render(s.camera, p);
   const std::string dir = test::outputDir(name);
   const std::string rendered = dir + "/rendered.png";
   RgbImage got = asPng(frame, exposureOf(mode), rendered);

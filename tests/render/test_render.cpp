@@ -14,7 +14,7 @@
 #include "test_util.h"
 #include "core/error.h"
 #include "render/context.h"
-#include "render/image_io.h"
+#include "image/image.h"
 #include "render/layout_probe.h"
 #include "render/renderer.h"
 
@@ -138,27 +138,27 @@ struct Comparison {
 };
 
 /// Compares RGB of every pixel; on failure writes rendered/expected/diff EXRs.
-Comparison compareImages(const Image& rendered, const Image& expected, float tolerance,
+Comparison compareImages(const RgbImage& rendered, const RgbImage& expected, float tolerance,
                          const std::string& name) {
   Comparison c;
-  Image diff = expected;
+  RgbImage diff = expected;
   size_t failing = 0, pixels = size_t(rendered.width) * rendered.height;
   for (size_t i = 0; i < pixels; ++i) {
     float worst = 0;
     for (int k = 0; k < 3; ++k) {
-      float d = std::fabs(rendered.rgba[i * 4 + k] - expected.rgba[i * 4 + k]);
+      float d = std::fabs(rendered.rgb[i * 3 + k] - expected.rgb[i * 3 + k]);
       if (!std::isfinite(d)) d = INFINITY;
-      diff.rgba[i * 4 + k] = d;
+      diff.rgb[i * 3 + k] = d;
       worst = std::max(worst, d);
     }
     c.maxAbsDiff = std::max(c.maxAbsDiff, worst);
     if (worst > tolerance && failing++ == 0) {
       std::ostringstream os;
       os << "first failing pixel (" << i % size_t(rendered.width) << ", "
-         << i / size_t(rendered.width) << "): rendered " << rendered.rgba[i * 4] << " "
-         << rendered.rgba[i * 4 + 1] << " " << rendered.rgba[i * 4 + 2] << ", expected "
-         << expected.rgba[i * 4] << " " << expected.rgba[i * 4 + 1] << " "
-         << expected.rgba[i * 4 + 2];
+         << i / size_t(rendered.width) << "): rendered " << rendered.rgb[i * 3] << " "
+         << rendered.rgb[i * 3 + 1] << " " << rendered.rgb[i * 3 + 2] << ", expected "
+         << expected.rgb[i * 3] << " " << expected.rgb[i * 3 + 1] << " "
+         << expected.rgb[i * 3 + 2];
       ADD_FAILURE() << name << ": " << os.str();
     }
   }
@@ -179,8 +179,8 @@ Comparison compareImages(const Image& rendered, const Image& expected, float tol
 struct QuadSetup {
   Scene scene;
   Vec3 albedo{0.5f, 0.25f, 0.8f};
-  RenderCamera camera =
-      RenderCamera::lookAt({0.1f, -0.05f, 2.0f}, {0.1f, -0.05f, 0.0f}, 36.0f * kPi / 180.0f);
+  PinholeCamera camera =
+      PinholeCamera::lookAt({0.1f, -0.05f, 2.0f}, {0.1f, -0.05f, 0.0f}, 36.0f * kPi / 180.0f);
   QuadSetup() {
     Material m;
     m.baseColor = albedo;
@@ -300,7 +300,7 @@ TEST(RenderLayout, GlslAddressesMatchCpp) {
 }
 
 /// Expected radiance of the Lambertian quad lit by `vdls`: albedo/pi * sum E_i max(0, n.d_i).
-Image expectedQuad(const QuadSetup& s, const RenderParams& p, const std::vector<Vdl>& vdls) {
+RgbImage expectedQuad(const QuadSetup& s, const RenderParams& p, const std::vector<Vdl>& vdls) {
   Vec3 radiance{0, 0, 0};
   for (const Vdl& v : vdls) {
     Vec3 d = normalize(v.direction);
@@ -308,16 +308,8 @@ Image expectedQuad(const QuadSetup& s, const RenderParams& p, const std::vector<
     float cosine = std::max(0.0f, layout::loUnpackDirectionZ(packed));
     radiance += s.albedo * kInvPi * v.irradiance * cosine;
   }
-  Image e;
-  e.width = p.width;
-  e.height = p.height;
-  e.rgba.resize(size_t(p.width) * p.height * 4);
-  for (size_t i = 0; i < size_t(p.width) * p.height; ++i) {
-    e.rgba[i * 4 + 0] = radiance.x;
-    e.rgba[i * 4 + 1] = radiance.y;
-    e.rgba[i * 4 + 2] = radiance.z;
-    e.rgba[i * 4 + 3] = 1;
-  }
+  RgbImage e(p.width, p.height);
+  for (size_t i = 0; i < e.pixelCount(); ++i) e.set(i, radiance);
   return e;
 }
 
@@ -326,7 +318,7 @@ void checkQuad(const GpuOctree& octree, const std::vector<Vdl>& vdls, bool inter
   QuadSetup s;
   Renderer renderer(s.scene, octree);
   RenderParams p = QuadSetup::params(interpolation);
-  Image image = renderer.render(s.camera, p);
+  RgbImage image = renderer.render(s.camera, p);
   Comparison c = compareImages(image, expectedQuad(s, p, vdls), 1e-3f, name);
   EXPECT_LE(c.maxAbsDiff, 1e-3f) << name;
   EXPECT_EQ(c.failingFraction, 0.0) << name;
@@ -400,7 +392,7 @@ TEST(RenderImage, DirectPointLightMatchesInverseSquareLaw) {
   Renderer renderer(s.scene, octree);
   RenderParams p = QuadSetup::params(false);
   p.mode = RenderMode::Direct;
-  Image image = renderer.render(s.camera, p);
+  RgbImage image = renderer.render(s.camera, p);
   // Center pixel sees the point right below the light: E = I / h^2.
   const float* c = image.pixel(p.width / 2, p.height / 2);
   float tanHalf = std::tan(0.5f * s.camera.yfov);
@@ -415,7 +407,7 @@ TEST(RenderImage, DirectPointLightMatchesInverseSquareLaw) {
   // centre (within ~0.05 units at the quad's depth).
   test::addQuad(s.scene, {0.05f, -0.1f, 0.9f}, {0.1f, 0, 0}, {0, 0.1f, 0}, {0, 0, 1}, 0);
   Renderer shadowed(s.scene, octree);
-  Image dark = shadowed.render(s.camera, p);
+  RgbImage dark = shadowed.render(s.camera, p);
   float worldPerPixel = 2.0f * 2.0f * tanHalf / float(p.height);
   int inShadow = p.width / 2 + int(0.3f / worldPerPixel);  // x = 0.4 on the quad
   int lit = p.width / 2 + int(0.75f / worldPerPixel);      // x = 0.85
@@ -435,7 +427,7 @@ TEST(RenderImage, VoxelModeColoursLeavesAndLeavesEmptySpaceBlack) {
   Renderer renderer(s.scene, octree);
   RenderParams p = QuadSetup::params(false);
   p.mode = RenderMode::Voxels;
-  Image image = renderer.render(s.camera, p);
+  RgbImage image = renderer.render(s.camera, p);
   // Camera x centre 0.1; half width at distance 2 ~ 0.97: x = 0 is left of
   // centre by ~0.1/0.97 of the half width.
   const float* left = image.pixel(2, p.height / 2);
@@ -472,10 +464,8 @@ TEST(RenderLimits, OctreeTooLargeForTheContextFailsNamingTheLimit) {
 }
 
 TEST(RenderImageIo, WritesPngAndExrAtomicallyAndRejectsOtherExtensions) {
-  Image image;
-  image.width = 3;
-  image.height = 2;
-  image.rgba.assign(24, 0.5f);
+  RgbImage image(3, 2);
+  image.rgb.assign(18, 0.5f);
   std::string dir = test::outputDir("render_image_io");
   writeImage(dir + "/a.png", image, 0.0f);
   writeImage(dir + "/a.exr", image);

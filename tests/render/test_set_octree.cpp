@@ -38,10 +38,10 @@ GpuOctree bakeOctree(const Scene& scene, const std::vector<Photon>& photons, int
   return buildGpuOctree(bakeLevel(scene, photons, params));
 }
 
-float maxValue(const Image& image) {
+float maxValue(const RgbImage& image) {
   float m = 0;
-  for (size_t i = 0; i < image.rgba.size(); i += 4) {
-    m = std::max({m, image.rgba[i], image.rgba[i + 1], image.rgba[i + 2]});
+  for (size_t i = 0; i < image.rgb.size(); i += 3) {
+    m = std::max({m, image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]});
   }
   return m;
 }
@@ -59,23 +59,23 @@ TEST(RendererSetOctree, SwappedLevelRendersLikeAFreshRenderer) {
   params.width = 64;
   params.height = 48;
   params.mode = RenderMode::Indirect;
-  RenderCamera camera = RenderCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
+  PinholeCamera camera = PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
 
   Renderer swapped(scene, GpuOctree(), {});
   EXPECT_EQ(maxValue(swapped.render(camera, params)), 0.0f) << "empty octree: no indirect light";
   swapped.setOctree(coarse);
   swapped.setOctree(fine);
-  Image a = swapped.render(camera, params);
+  RgbImage a = swapped.render(camera, params);
   EXPECT_GT(maxValue(a), 0.0f);
 
   Renderer fresh(scene, fine, {});
-  Image b = fresh.render(camera, params);
-  ASSERT_EQ(a.rgba.size(), b.rgba.size());
-  EXPECT_EQ(a.rgba, b.rgba);
+  RgbImage b = fresh.render(camera, params);
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  EXPECT_EQ(a.rgb, b.rgb);
 
   // Depth 3 and depth 4 differ somewhere: the swap did change the textures.
   swapped.setOctree(coarse);
-  EXPECT_NE(swapped.render(camera, params).rgba, b.rgba);
+  EXPECT_NE(swapped.render(camera, params).rgb, b.rgb);
   swapped.setOctree(GpuOctree());
   EXPECT_EQ(maxValue(swapped.render(camera, params)), 0.0f);
 }
@@ -95,13 +95,13 @@ TEST(RendererSetOctree, TooLargeForTheLimitsKeepsTheOldOctree) {
   params.width = 32;
   params.height = 24;
   params.mode = RenderMode::Indirect;
-  RenderCamera camera = RenderCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
-  Image before = renderer.render(camera, params);
+  PinholeCamera camera = PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
+  RgbImage before = renderer.render(camera, params);
   GpuOctree larger = bakeOctree(scene, photons, 5);
   ASSERT_GT(std::max({larger.poolWidth(), larger.poolHeight(), larger.poolDepth()}),
             limits.max3DTextureSize);
   EXPECT_THROW(renderer.setOctree(larger), InputError);
-  EXPECT_EQ(renderer.render(camera, params).rgba, before.rgba);
+  EXPECT_EQ(renderer.render(camera, params).rgb, before.rgb);
 }
 
 }  // namespace
