@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Bakes the Cornell box, bunny and dragon at the defaults (the paper's
+# settings) into out/bench-bakes/ and runs build/tools/bench_render on them,
+# which writes docs/results/render.md. Extra arguments go to bench_render
+# (e.g. --backend egl --out docs/results/render-egl.md on a GPU).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bakes=out/bench-bakes
+scenes=../shared/scenes/composed
+mkdir -p "$bakes"
+build/tools/lightoctree bake data/cornell-box.gltf -o "$bakes/cornell-box.vdb" --quiet
+for s in cornell-bunny cornell-dragon; do
+  if [ -f "$scenes/$s.glb" ]; then
+    build/tools/lightoctree bake "$scenes/$s.glb" -o "$bakes/$s.vdb" --quiet
+  fi
+done
+exec build/tools/bench_render --bakes "$bakes" "$@"
