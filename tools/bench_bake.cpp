@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "core/file.h"
 #include "core/resources.h"
 #include "scene/scene.h"
 
@@ -186,7 +187,7 @@ int main(int argc, char** argv) {
      << "\nThe machine is a shared virtual machine: the same run varies by about 30% from one "
         "minute to the next, so compare rows of one run rather than runs.\n";
   std::filesystem::create_directories(std::filesystem::path(out).parent_path());
-  std::ofstream(out) << md.str();
+  lo::writeTextAtomically(out, md.str());
   std::printf("wrote %s\n", out.c_str());
   return 0;
 }

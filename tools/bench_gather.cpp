@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "bake/bake.h"
+#include "core/file.h"
 #include "core/resources.h"
 #include "gather/gather.h"
 #include "scene/scene.h"
@@ -130,7 +131,7 @@ int main(int argc, char** argv) {
         "already has, builds no tree, and measures distances in the ellipsoid the paper asks "
         "for. See docs/grid-and-gather.md for how candidates are collected per 8^3 block.\n";
   std::filesystem::create_directories(std::filesystem::path(out).parent_path());
-  std::ofstream(out) << md.str();
+  lo::writeTextAtomically(out, md.str());
   std::printf("wrote %s\n", out.c_str());
   return 0;
 }

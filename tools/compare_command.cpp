@@ -33,8 +33,7 @@ nlohmann::json toJson(const ChannelError& e) {
 int runCompare(const CompareOptions& opt) {
   if (!opt.diff.empty()) {
     checkOutputFolder(opt.diff, "--diff");
-    std::string ext = std::filesystem::path(opt.diff).extension().string();
-    if (ext != ".png" && ext != ".exr") {
+    if (!hasExtension(opt.diff, ".png") && !hasExtension(opt.diff, ".exr")) {
       throw InputError("--diff: '" + opt.diff + "' must end in .png or .exr");
     }
   }

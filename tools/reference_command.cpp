@@ -8,8 +8,9 @@
 
 #include "camera_options.h"
 #include "commands.h"
-#include "core/threads.h"
 #include "core/error.h"
+#include "core/file.h"
+#include "core/threads.h"
 #include "image/image.h"
 #include "reference/path_tracer.h"
 #include "report.h"
@@ -34,12 +35,8 @@ struct ReferenceOptions {
 };
 
 void checkImageOutput(const std::string& path, const char* flag) {
-  std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw InputError(std::string(flag) + ": folder '" + parent.string() + "' does not exist");
-  }
-  std::string ext = std::filesystem::path(path).extension().string();
-  if (ext != ".exr" && ext != ".png") {
+  checkOutputFolder(path, flag);
+  if (!hasExtension(path, ".exr") && !hasExtension(path, ".png")) {
     throw InputError(std::string(flag) + ": '" + path + "' must end in .exr or .png");
   }
 }

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "core/file.h"
 #include "core/error.h"
 #include "sweep.h"
 
@@ -38,11 +39,7 @@ int runSweepCommand(const SweepOptions& opt) {
   params.threads = opt.threads;
   params.seed = opt.seed;
   params.quiet = opt.quiet;
-  // The bakes and renders run as child processes of this same binary.
-  const std::filesystem::path parent = std::filesystem::path(opt.out).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
-    throw InputError("--out: folder '" + parent.string() + "' does not exist");
-  }
+  checkOutputFolder(opt.out, "--out");
   std::filesystem::create_directories(opt.out);
   std::FILE* log = opt.quiet ? nullptr : stdout;
   std::vector<SweepResult> results = runSweep(params, log);
