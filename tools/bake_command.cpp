@@ -135,7 +135,7 @@ std::function<int()> addBakeCommand(CLI::App& app) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--radius", opt->radius,
-                  "Gathering radius in scene units (default: " + numberText(kDefaultRadiusVoxels) + " voxel sizes)")
+                  "Gathering radius in scene units (default: " + formatNumber(kDefaultRadiusVoxels) + " voxel sizes)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--vdls", opt->vdls,
                   "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest that keep the angular error "

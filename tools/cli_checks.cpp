@@ -1,7 +1,5 @@
 #include "cli_checks.h"
 
-#include <sstream>
-
 #include "bake/bake.h"
 
 namespace lo::tool {
@@ -12,11 +10,5 @@ CLI::Validator vdlCountValidator() {
 }
 
 CLI::Validator depthValidator() { return CLI::Range(1, kMaxGridDepth); }
-
-std::string numberText(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 }  // namespace lo::tool

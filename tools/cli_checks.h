@@ -14,7 +14,4 @@ CLI::Validator vdlCountValidator();
 /// `--depth`: 1..kMaxGridDepth.
 CLI::Validator depthValidator();
 
-/// Shortest text of a number for help strings and labels ("1.5", "600000").
-std::string numberText(double v);
-
 }  // namespace lo::tool

@@ -1,4 +1,4 @@
-// `lightoctree sweep`: the speed/accuracy trade of the bake, measured (tools/sweep.h).
+// `lightoctree sweep`: the speed/accuracy trade of the bake, measured (src/sweep/sweep.h).
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -6,9 +6,10 @@
 #include <memory>
 
 #include "commands.h"
-#include "core/file.h"
 #include "core/error.h"
-#include "sweep.h"
+#include "core/file.h"
+#include "report.h"
+#include "sweep/sweep.h"
 
 namespace lo::tool {
 namespace {
@@ -38,7 +39,8 @@ int runSweepCommand(const SweepOptions& opt) {
   if (opt.frames >= 0) params.frames = opt.frames;
   params.threads = opt.threads;
   params.seed = opt.seed;
-  params.quiet = opt.quiet;
+  ConsoleProgress progress(opt.quiet);
+  params.progress = &progress;
   checkOutputFolder(opt.out, "--out");
   std::filesystem::create_directories(opt.out);
   std::FILE* log = opt.quiet ? nullptr : stdout;

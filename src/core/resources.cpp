@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <sstream>
 #include <utility>
 
 namespace lo {
@@ -68,6 +69,12 @@ std::string formatBytes(size_t bytes) {
     std::snprintf(buf, sizeof buf, "%.1f KiB", b / 1024.0);
   }
   return buf;
+}
+
+std::string formatNumber(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
 }
 
 std::string formatCount(size_t n) {

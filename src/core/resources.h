@@ -59,5 +59,6 @@ class StageTimer {
 
 std::string formatBytes(size_t bytes);  ///< "12.3 MiB"
 std::string formatCount(size_t n);      ///< 1234567 -> "1,234,567"
+std::string formatNumber(double v);     ///< shortest text, as std::ostream prints it: "1.5", "600000"
 
 }  // namespace lo

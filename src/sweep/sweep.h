@@ -1,5 +1,5 @@
 #pragma once
-/// @file tools/sweep.h
+/// @file sweep/sweep.h
 /// @brief `lightoctree sweep`: the speed/accuracy trade of the bake, measured.
 /// Each point bakes the scene in this process through the bake module
 /// (bake/bake.h; its peak memory measured from a reset of the kernel's peak
@@ -16,8 +16,9 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "core/progress.h"
 
-namespace lo::tool {
+namespace lo {
 
 /// One setting of the bake and of the lookup. Every default is the bake
 /// module's (BakeParams, kDefaultRadiusVoxels), so the paper's point is what
@@ -101,7 +102,7 @@ struct SweepParams {
   int frames = 5;   ///< frames timed per point (0: no indirect render)
   int threads = 0;  ///< bake / reference threads (0 = all cores)
   uint64_t seed = 1;
-  bool quiet = false;
+  ProgressSink* progress = nullptr;  ///< the references' progress (may be null)
 };
 
 /// Standard parameters for a scale (image size, reference samples, frames).
@@ -122,4 +123,4 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
 /// The CSV text of the results (header line first).
 std::string sweepCsv(const std::vector<SweepResult>& results);
 
-}  // namespace lo::tool
+}  // namespace lo

@@ -1,4 +1,4 @@
-#include "sweep.h"
+#include "sweep/sweep.h"
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -15,7 +15,6 @@
 #include <sstream>
 
 #include "bake/bake.h"
-#include "cli_checks.h"
 #include "core/error.h"
 #include "core/file.h"
 #include "core/resources.h"
@@ -28,13 +27,12 @@
 #include "reference/path_tracer.h"
 #include "render/context.h"
 #include "render/renderer.h"
-#include "report.h"
 #include "scene/scene.h"
 #include "vdb/vdb_io.h"
 
 namespace fs = std::filesystem;
 
-namespace lo::tool {
+namespace lo {
 namespace sweep_internal {
 
 std::string photonsText(size_t n) {
@@ -134,16 +132,15 @@ References loadOrRenderReferences(const SweepParams& params, const Scene& scene,
   rp.height = params.height;
   rp.samplesPerPixel = params.referenceSpp;
   rp.seed = params.seed;
-  ConsoleProgress progress(params.quiet);
   rp.part = ReferencePart::Irradiance;
-  ReferenceImage irr = renderReference(scene, camera, rp, &progress);
+  ReferenceImage irr = renderReference(scene, camera, rp, params.progress);
   refs.irradiance = irr.image;
   refs.irradianceNoise = relativeNoise(irr);
   refs.seconds = irr.seconds;
   writeExr(irrFile, irr.image);
   if (params.frames > 0) {
     rp.part = ReferencePart::Indirect;
-    ReferenceImage ind = renderReference(scene, camera, rp, &progress);
+    ReferenceImage ind = renderReference(scene, camera, rp, params.progress);
     refs.indirect = ind.image;
     refs.indirectNoise = relativeNoise(ind);
     refs.seconds += ind.seconds;
@@ -254,7 +251,7 @@ float exposureFor(const RgbImage& reference) {
 std::string SweepPoint::label() const {
   using namespace sweep_internal;
   std::string s = "d" + std::to_string(depth) + " " + photonsText(photons) + " k" +
-                  std::to_string(knn) + " r" + numberText(radiusVoxels) + " v" + vdls;
+                  std::to_string(knn) + " r" + formatNumber(radiusVoxels) + " v" + vdls;
   if (!interpolation) s += " no-interp";
   if (halfFloat) s += " half";
   if (!cosineCorrection) s += " paper-cosine";
@@ -264,7 +261,7 @@ std::string SweepPoint::label() const {
 std::string SweepPoint::bakeKey() const {
   using namespace sweep_internal;
   return "d" + std::to_string(depth) + "-p" + std::to_string(photons) + "-k" + std::to_string(knn) +
-         "-r" + numberText(radiusVoxels) + "-v" + vdls;
+         "-r" + formatNumber(radiusVoxels) + "-v" + vdls;
 }
 
 std::string SweepPoint::key() const {
@@ -686,10 +683,10 @@ std::string markdownTable(const std::vector<SweepResult>& results) {
                   r.point.group.c_str(), r.traceSeconds, r.voxelizeSeconds, r.splatSeconds,
                   r.clusterSeconds, r.bakeSeconds, r.peakRssBytes / 1048576.0, r.vdbBytes / 1024.0,
                   r.gpuBytes / 1024.0, r.activeVoxels,
-                  r.frameMs >= 0 ? numberText(std::round(r.frameMs * 10) / 10).c_str() : "-",
+                  r.frameMs >= 0 ? formatNumber(std::round(r.frameMs * 10) / 10).c_str() : "-",
                   100 * r.irradianceRelRmse, 100 * r.irradianceRelMae,
                   r.indirectRelRmse >= 0
-                      ? (numberText(std::round(1000 * r.indirectRelRmse) / 10) + "%").c_str()
+                      ? (formatNumber(std::round(1000 * r.indirectRelRmse) / 10) + "%").c_str()
                       : "-",
                   front.c_str());
     os << line;
@@ -779,9 +776,9 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
         "and include every bake stage.\n\n"
      << "The references' own noise, the floor under these errors (relative RMS standard "
         "error of luminance): irradiance "
-     << numberText(results.empty() ? 0.0 : percent2(results.front().referenceIrradianceNoise))
+     << formatNumber(results.empty() ? 0.0 : percent2(results.front().referenceIrradianceNoise))
      << "%, indirect image "
-     << numberText(results.empty() ? 0.0 : percent2(results.front().referenceIndirectNoise))
+     << formatNumber(results.empty() ? 0.0 : percent2(results.front().referenceIndirectNoise))
      << "%.\n\n"
      << markdownTable(results) << "\n";
   if (plotted) {
@@ -796,4 +793,4 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
   writeTextAtomically(dir + "/sweep.md", md.str());
 }
 
-}  // namespace lo::tool
+}  // namespace lo

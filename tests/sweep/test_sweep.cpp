@@ -1,4 +1,4 @@
-// The sweep's logic (tools/sweep.h): the point list, the Pareto front against
+// The sweep's logic (sweep/sweep.h): the point list, the Pareto front against
 // a brute-force definition, the CSV rows.
 
 #include <gtest/gtest.h>
@@ -8,9 +8,9 @@
 
 #include "core/rng.h"
 #include "octree/gpu_octree.h"
-#include "sweep.h"
+#include "sweep/sweep.h"
 
-namespace lo::tool {
+namespace lo {
 namespace {
 
 /// Parameters in which two points differ.
@@ -157,4 +157,4 @@ TEST(SweepCsv, OneRowPerResultWithTheFlags) {
 }
 
 }  // namespace
-}  // namespace lo::tool
+}  // namespace lo
