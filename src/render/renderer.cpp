@@ -123,7 +123,14 @@ std::string toString(RenderMode mode) {
 
 struct Renderer::Impl {
   RendererParams params;
-  Bounds3 bounds;
+  /// World position of render space's origin: the centre of the scene's
+  /// bounds. Everything the GPU sees (vertices, lights, shadow matrices, the
+  /// camera, the octree) is in render space, world - renderOrigin computed in
+  /// double, so that a scene far from the world origin keeps the precision of
+  /// one near it in every shader computation (view transform, depth, shadow
+  /// lookups, the octree lookup, screen-space derivatives).
+  Vec3 renderOrigin{0, 0, 0};
+  Bounds3 bounds;  ///< the scene's bounds, render space
   float sceneSize = 1;  // bounds diagonal, world units
   int depth = 0;
   Vec3 octreeOrigin;
@@ -140,6 +147,13 @@ struct Renderer::Impl {
   bool halfVdls = false;
 
   LightBlock lightBlock{};
+
+  /// World -> render space, in double: exact for points near the scene.
+  Vec3 toRender(const Vec3& world) const {
+    return {float(double(world.x) - double(renderOrigin.x)),
+            float(double(world.y) - double(renderOrigin.y)),
+            float(double(world.z) - double(renderOrigin.z))};
+  }
 
   ~Impl() {
     GLuint programs[] = {sceneProgram, shadowProgram, depthProgram, probeProgram};
@@ -227,7 +241,7 @@ struct Renderer::Impl {
     }
     checkGl("uploading the VDL texture (GL_TEXTURE_2D)");
     depth = octree.depth;
-    octreeOrigin = octree.origin;
+    octreeOrigin = toRender(octree.origin);
     voxelSize = octree.depth > 0 ? octree.cubeSize / float(1 << octree.depth) : octree.cubeSize;
   }
 
@@ -246,7 +260,7 @@ struct Renderer::Impl {
       for (int k = 0; k < 3; ++k) {
         uint32_t index = scene.indices[t * 3 + size_t(k)];
         Vertex v{};
-        Vec3 p = scene.positions[index];
+        Vec3 p = toRender(scene.positions[index]);
         Vec3 n = scene.normals.empty() ? faceN : scene.normals[index];
         Vec3 albedo = m >= 0 ? scene.albedo(t, bary[k][0], bary[k][1]) : mat.baseColor;
         std::memcpy(v.position, &p, sizeof v.position);
@@ -317,9 +331,9 @@ struct Renderer::Impl {
       float r = float(bits) * 2.3283064365386963e-10f;
       float su = std::sqrt(std::clamp(s, 0.0f, 1.0f));
       float b1 = su * (1 - r), b2 = su * r;
-      const Vec3& p0 = scene.positions[scene.indices[t * 3]];
-      const Vec3& p1 = scene.positions[scene.indices[t * 3 + 1]];
-      const Vec3& p2 = scene.positions[scene.indices[t * 3 + 2]];
+      const Vec3 p0 = toRender(scene.positions[scene.indices[t * 3]]);
+      const Vec3 p1 = toRender(scene.positions[scene.indices[t * 3 + 1]]);
+      const Vec3 p2 = toRender(scene.positions[scene.indices[t * 3 + 2]]);
       Vec3 n = scene.faceNormal(t);
       Vec3 p = p0 * (1 - b1 - b2) + p1 * b1 + p2 * b2 + n * (1e-3f * sceneSize);
       const Material& mat = scene.materials[size_t(scene.triangleMaterial[t])];
@@ -343,7 +357,7 @@ struct Renderer::Impl {
       int type = light.type == Light::Type::Point  ? kPoint
                  : light.type == Light::Type::Spot ? kSpot
                                                    : kDirectional;
-      setVec4(l.positionType, light.position, float(type));
+      setVec4(l.positionType, toRender(light.position), float(type));
       setVec4(l.directionRange, normalize(light.direction), light.range);
       setVec4(l.colorFar, color, 0);
       setVec4(l.params, Vec3(std::cos(light.outerConeAngle), std::cos(light.innerConeAngle), -1),
@@ -489,7 +503,8 @@ struct Renderer::Impl {
       throw InputError("render: VDLs per voxel must be 1.." + std::to_string(kMaxVdls) + ", got " +
                        std::to_string(rp.maxVdls));
     }
-    glm::vec3 eye = toGlm(camera.eye);
+    const Vec3 eyeRender = toRender(camera.eye);
+    glm::vec3 eye = toGlm(eyeRender);
     float zfar = camera.zfar > 0 ? camera.zfar
                                  : glm::length(eye - toGlm(bounds.center())) + sceneSize + 1e-3f;
     float znear = std::min(camera.znear > 0 ? camera.znear : 0.01f, 0.5f * zfar);
@@ -527,7 +542,7 @@ struct Renderer::Impl {
     glUniform3f(loc("uOctreeOrigin"), octreeOrigin.x, octreeOrigin.y, octreeOrigin.z);
     glUniform1f(loc("uVoxelSize"), voxelSize);
     glUniform1i(loc("uDepth"), depth);
-    glUniform3f(loc("uEye"), camera.eye.x, camera.eye.y, camera.eye.z);
+    glUniform3f(loc("uEye"), eyeRender.x, eyeRender.y, eyeRender.z);
     glUniform1i(loc("uMode"), shaderMode(rp.mode));
     glUniform1i(loc("uInterpolation"), rp.interpolation ? 1 : 0);
     glUniform1i(loc("uSpecular"), rp.specular ? 1 : 0);
@@ -569,8 +584,11 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   }
   if (params.emitterLights < 0) throw InputError("emitter lights must be >= 0");
   r.checkLimits(octree);
-  r.bounds = scene.bounds();
-  if (r.bounds.empty()) r.bounds.extend(Vec3(0, 0, 0));
+  Bounds3 world = scene.bounds();
+  if (world.empty()) world.extend(Vec3(0, 0, 0));
+  r.renderOrigin = world.center();
+  r.bounds.extend(r.toRender(world.lower));
+  r.bounds.extend(r.toRender(world.upper));
   r.sceneSize = std::max(length(r.bounds.extent()), 1e-3f);
   r.sceneProgram = buildProgram({"render_scene.vert", "render_scene.frag"});
   glUniformBlockBinding(r.sceneProgram, glGetUniformBlockIndex(r.sceneProgram, "LightBlock"), 0);
