@@ -12,6 +12,7 @@ in vec3 vNormal;    // world, interpolated
 in vec3 vBaseColor;
 in vec2 vMetallicRoughness;
 in vec3 vEmission;
+in vec2 vUv;
 out vec4 fragColor;
 
 uniform usampler3D uOctree;  // RGBA8UI pool of 2x2x2 tiles
@@ -30,6 +31,8 @@ uniform int uMaxVdls;
 uniform float uNormalOffset;  // voxel sizes
 uniform float uExposureScale;
 uniform bool uEncodeSrgb;
+uniform sampler2D uBaseColorTexture;  // linear RGB (RGBA16F), mipmapped
+uniform bool uHasBaseColorTexture;
 
 // std140 twin: GpuLight / LightBlock in src/render/renderer.cpp.
 struct Light {
@@ -161,7 +164,10 @@ void main() {
   vec3 ng = cross(dFdx(vPosition), dFdy(vPosition));
   if (dot(ng, v) < 0.0) ng = -ng;
   if (dot(n, ng) < 0.0) n = -n;
+  // glTF: base colour = factor x texture, sampled per pixel (trilinear,
+  // anisotropic where the context has it).
   vec3 baseColor = vBaseColor;
+  if (uHasBaseColorTexture) baseColor *= texture(uBaseColorTexture, vUv).rgb;
   float metallic = vMetallicRoughness.x;
   float roughness = vMetallicRoughness.y;
 

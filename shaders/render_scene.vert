@@ -1,11 +1,13 @@
 #version 330 core
-// Scene pass: a world-space triangle soup with per-vertex material values
-// (triangles never share vertices, so per-triangle materials stay exact).
+// Scene pass: a render-space triangle soup (world minus the scene's centre)
+// with per-vertex material values (triangles never share vertices, so
+// per-triangle materials stay exact).
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
-layout(location = 2) in vec3 aBaseColor;  // linear, base colour texture applied per vertex
+layout(location = 2) in vec3 aBaseColor;  // linear base colour factor
 layout(location = 3) in vec2 aMetallicRoughness;
 layout(location = 4) in vec3 aEmission;  // W/(m^2 sr)
+layout(location = 5) in vec2 aUv;        // the UV set the base colour texture names
 
 uniform mat4 uViewProj;
 invariant gl_Position;  // as render_depth.vert: the depth pre-pass must match exactly
@@ -15,6 +17,7 @@ out vec3 vNormal;
 out vec3 vBaseColor;
 out vec2 vMetallicRoughness;
 out vec3 vEmission;
+out vec2 vUv;
 
 void main() {
   vPosition = aPosition;
@@ -22,5 +25,6 @@ void main() {
   vBaseColor = aBaseColor;
   vMetallicRoughness = aMetallicRoughness;
   vEmission = aEmission;
+  vUv = aUv;
   gl_Position = uViewProj * vec4(aPosition, 1.0);
 }

@@ -68,9 +68,17 @@ static_assert(sizeof(LightBlock) == kMaxLights * 64 + kMaxShadowLayers * 64 + 16
 struct Vertex {
   float position[3];
   float normal[3];
-  float baseColor[3];
+  float baseColor[3];  ///< the material's base colour factor (textures apply per pixel)
   float metallicRoughness[2];
   float emission[3];
+  float uv[2];  ///< the texture coordinates the base colour texture names (TEXCOORD_0 or _1)
+};
+
+/// A run of the vertex buffer drawn with one base colour texture (-1: none).
+struct DrawRange {
+  int texture = -1;  ///< index into Scene::textures
+  GLint first = 0;
+  GLsizei count = 0;
 };
 
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
@@ -139,6 +147,9 @@ struct Renderer::Impl {
   GLuint sceneProgram = 0, shadowProgram = 0, depthProgram = 0, probeProgram = 0;
   GLuint vao = 0, vbo = 0, emptyVao = 0;
   GLsizei vertexCount = 0;
+  std::vector<DrawRange> ranges;        ///< the vertex buffer by base colour texture
+  std::vector<GLuint> textures;         ///< per Scene::textures entry; 0 = not used
+  float maxAnisotropy = 1;              ///< of the context (1: no anisotropic filtering)
   GLuint octreeTexture = 0, vdlTexture = 0, vdlHalfTexture = 0, shadowTexture = 0, lightUbo = 0;
   GLuint shadowFbo = 0;
   GLuint targetFbo = 0, targetColor = 0, targetDepth = 0;
@@ -160,8 +171,9 @@ struct Renderer::Impl {
     for (GLuint p : programs) {
       if (p) glDeleteProgram(p);
     }
-    GLuint textures[] = {octreeTexture, vdlTexture, vdlHalfTexture, shadowTexture, targetColor};
-    glDeleteTextures(5, textures);
+    GLuint own[] = {octreeTexture, vdlTexture, vdlHalfTexture, shadowTexture, targetColor};
+    glDeleteTextures(5, own);
+    if (!textures.empty()) glDeleteTextures(GLsizei(textures.size()), textures.data());
     glDeleteBuffers(1, &vbo);
     glDeleteBuffers(1, &lightUbo);
     glDeleteVertexArrays(1, &vao);
@@ -245,32 +257,96 @@ struct Renderer::Impl {
     voxelSize = octree.depth > 0 ? octree.cubeSize / float(1 << octree.depth) : octree.cubeSize;
   }
 
+  /// The base colour texture triangle t samples per pixel, and its UV set;
+  /// -1 when it has none (or its UV set is missing).
+  static int textureOf(const Scene& scene, size_t t, const std::vector<float>** uv) {
+    const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+    if (m < 0 || size_t(m) >= scene.materials.size()) return -1;
+    const Material& mat = scene.materials[size_t(m)];
+    const int tex = mat.baseColorTexture;
+    if (tex < 0 || size_t(tex) >= scene.textures.size()) return -1;
+    *uv = mat.baseColorTexCoord == 1 ? &scene.texcoords1 : &scene.texcoords0;
+    return (*uv)->size() == 2 * scene.positions.size() ? tex : -1;
+  }
+
+  /// Uploads a texture (linear RGB) with mipmaps, trilinear and anisotropic
+  /// filtering, repeat wrap (glTF's default sampler).
+  GLuint uploadTexture(const Texture& t) {
+    GLuint id = 0;
+    glGenTextures(1, &id);
+    glBindTexture(GL_TEXTURE_2D, id);
+    std::vector<float> rgba(t.texels.size() * 4);
+    for (size_t i = 0; i < t.texels.size(); ++i) {
+      rgba[4 * i] = t.texels[i].x;
+      rgba[4 * i + 1] = t.texels[i].y;
+      rgba[4 * i + 2] = t.texels[i].z;
+      rgba[4 * i + 3] = 1.0f;
+    }
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    // Half floats: linear colour with 11 bits of precision, filterable and
+    // mipmappable on every GL 3.3 context.
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT,
+                 rgba.data());
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    if (maxAnisotropy > 1) glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY, maxAnisotropy);
+    checkGl("uploading a base colour texture");
+    return id;
+  }
+
   void uploadScene(const Scene& scene) {
+    // Anisotropic filtering: core in GL 4.6, an extension before.
+    if (GLAD_GL_ARB_texture_filter_anisotropic || GLAD_GL_EXT_texture_filter_anisotropic) {
+      glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &maxAnisotropy);
+      maxAnisotropy = std::min(maxAnisotropy, 16.0f);
+    }
+    // Triangles in runs of one base colour texture (untextured first), so
+    // that the scene pass binds each texture once.
+    std::vector<std::vector<size_t>> byTexture(scene.textures.size() + 1);
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+      const std::vector<float>* uv = nullptr;
+      byTexture[size_t(textureOf(scene, t, &uv) + 1)].push_back(t);
+    }
     std::vector<Vertex> vertices;
     vertices.reserve(scene.triangleCount() * 3);
     const Material fallback;
-    for (size_t t = 0; t < scene.triangleCount(); ++t) {
-      int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
-      const Material& mat =
-          m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
-      Vec3 faceN = scene.faceNormal(t);
-      // Base colour texture sampled at the vertices (per-vertex colour): the
-      // renderer has no texture maps yet, see docs/render.md.
-      const float bary[3][2] = {{0, 0}, {1, 0}, {0, 1}};
-      for (int k = 0; k < 3; ++k) {
-        uint32_t index = scene.indices[t * 3 + size_t(k)];
-        Vertex v{};
-        Vec3 p = toRender(scene.positions[index]);
-        Vec3 n = scene.normals.empty() ? faceN : scene.normals[index];
-        Vec3 albedo = m >= 0 ? scene.albedo(t, bary[k][0], bary[k][1]) : mat.baseColor;
-        std::memcpy(v.position, &p, sizeof v.position);
-        std::memcpy(v.normal, &n, sizeof v.normal);
-        std::memcpy(v.baseColor, &albedo, sizeof v.baseColor);
-        v.metallicRoughness[0] = mat.metallic;
-        v.metallicRoughness[1] = mat.roughness;
-        std::memcpy(v.emission, &mat.emission, sizeof v.emission);
-        vertices.push_back(v);
+    textures.assign(scene.textures.size(), 0);
+    for (size_t group = 0; group < byTexture.size(); ++group) {
+      if (byTexture[group].empty()) continue;
+      DrawRange range;
+      range.texture = int(group) - 1;
+      range.first = GLint(vertices.size());
+      if (range.texture >= 0) textures[size_t(range.texture)] = uploadTexture(scene.textures[size_t(range.texture)]);
+      for (size_t t : byTexture[group]) {
+        int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+        const Material& mat =
+            m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
+        const std::vector<float>* uv = nullptr;
+        textureOf(scene, t, &uv);
+        Vec3 faceN = scene.faceNormal(t);
+        for (int k = 0; k < 3; ++k) {
+          uint32_t index = scene.indices[t * 3 + size_t(k)];
+          Vertex v{};
+          Vec3 p = toRender(scene.positions[index]);
+          Vec3 n = scene.normals.empty() ? faceN : scene.normals[index];
+          std::memcpy(v.position, &p, sizeof v.position);
+          std::memcpy(v.normal, &n, sizeof v.normal);
+          std::memcpy(v.baseColor, &mat.baseColor, sizeof v.baseColor);
+          v.metallicRoughness[0] = mat.metallic;
+          v.metallicRoughness[1] = mat.roughness;
+          std::memcpy(v.emission, &mat.emission, sizeof v.emission);
+          if (range.texture >= 0) {
+            v.uv[0] = (*uv)[2 * index];
+            v.uv[1] = (*uv)[2 * index + 1];
+          }
+          vertices.push_back(v);
+        }
       }
+      range.count = GLsizei(vertices.size()) - range.first;
+      ranges.push_back(range);
     }
     vertexCount = GLsizei(vertices.size());
     glGenVertexArrays(1, &vao);
@@ -289,6 +365,7 @@ struct Renderer::Impl {
     attrib(2, 3, offsetof(Vertex, baseColor));
     attrib(3, 2, offsetof(Vertex, metallicRoughness));
     attrib(4, 3, offsetof(Vertex, emission));
+    attrib(5, 2, offsetof(Vertex, uv));
     glBindVertexArray(0);
     glGenVertexArrays(1, &emptyVao);
     checkGl("uploading the scene");
@@ -564,9 +641,17 @@ struct Renderer::Impl {
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_2D, vdlHalfTexture);
     glActiveTexture(GL_TEXTURE0);
+    glUniform1i(loc("uBaseColorTexture"), 4);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo);
     glBindVertexArray(vao);
-    glDrawArrays(GL_TRIANGLES, 0, vertexCount);
+    const GLint hasTexture = loc("uHasBaseColorTexture");
+    for (const DrawRange& range : ranges) {
+      glActiveTexture(GL_TEXTURE4);
+      glBindTexture(GL_TEXTURE_2D, range.texture >= 0 ? textures[size_t(range.texture)] : 0);
+      glActiveTexture(GL_TEXTURE0);
+      glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
+      glDrawArrays(GL_TRIANGLES, range.first, range.count);
+    }
     glBindVertexArray(0);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);

@@ -415,6 +415,63 @@ TEST(RenderImage, DirectPointLightMatchesInverseSquareLaw) {
   EXPECT_GT(dark.pixel(lit, p.height / 2)[0], 0.05f);
 }
 
+// glTF base colour textures are sampled per pixel (they were sampled at the
+// vertices, so a checker floor came out one colour): a quad with a red/blue
+// checker (16x16 texels, cells of 4x4) repeated twice across it, under a
+// point light, shows at the centres of two neighbouring cells the colours the
+// bake's own lookup (Scene::albedo) gives there. Cell centres lie two texels
+// from any border, where bilinear filtering returns the cell's colour.
+TEST(RenderImage, BaseColorTextureIsSampledPerPixel) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Texture checker;
+  checker.width = checker.height = 16;
+  const Vec3 red{0.8f, 0.1f, 0.1f}, blue{0.1f, 0.1f, 0.8f};
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 16; ++x) checker.texels.push_back((x / 4 + y / 4) % 2 ? blue : red);
+  }
+  s.scene.textures.push_back(checker);
+  s.scene.materials[0].baseColor = {1, 1, 1};
+  s.scene.materials[0].baseColorTexture = 0;
+  // The quad's corners (-1,-1), (1,-1), (1,1), (-1,1): UV = (x + 1, y + 0.675),
+  // 8 cells per world unit; the row y = -0.05 through the view centre is at
+  // v = 0.625, a cell centre, and so are x = -0.0625 and x = 0.0625.
+  s.scene.texcoords0 = {0, -0.325f, 2, -0.325f, 2, 1.675f, 0, 1.675f};
+  Light light;
+  light.type = Light::Type::Point;
+  light.position = {0.1f, -0.05f, 1.0f};
+  light.intensity = 2.0f;
+  s.scene.lights.push_back(light);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  Renderer renderer(s.scene, octree);
+  RenderParams p = QuadSetup::params(false);
+  p.width = 128;
+  p.height = 96;
+  p.mode = RenderMode::Direct;
+  const RgbImage image = renderer.render(s.camera, p);
+  const std::string dir = test::outputDir("render_checker");
+  writePng(dir + "/rendered.png", image, 1.0f);
+  const float worldPerPixel = 2.0f * 2.0f * std::tan(0.5f * s.camera.yfov) / float(p.height);
+  int cells[2] = {0, 0};  // centres seen red, blue
+  for (float x : {-0.0625f, 0.0625f}) {
+    const float y = -0.05f;
+    const int px = p.width / 2 + int(std::floor((x - 0.1f) / worldPerPixel));
+    const float* c = image.pixel(px, p.height / 2);
+    // Triangle 0 of the quad (corners 0, 1, 2) holds (x, y) when y < x,
+    // triangle 1 (corners 0, 2, 3) otherwise; barycentrics of the point.
+    const Vec3 albedo = y < x ? s.scene.albedo(0, 0.5f * (x - y), 0.5f * (y + 1.0f))
+                              : s.scene.albedo(1, 0.5f * (x + 1.0f), 0.5f * (y - x));
+    ++cells[albedo.x > albedo.z ? 0 : 1];
+    const float ratio = c[0] / c[2], expected = albedo.x / albedo.z;
+    EXPECT_NEAR(ratio, expected, 0.02f * expected)
+        << "at x = " << x << ": rendered " << c[0] << " " << c[1] << " " << c[2] << " (" << dir
+        << "/rendered.png)";
+  }
+  EXPECT_EQ(cells[0], 1);  // one red and one blue cell: the checker appears
+  EXPECT_EQ(cells[1], 1);
+}
+
 TEST(RenderImage, VoxelModeColoursLeavesAndLeavesEmptySpaceBlack) {
   REQUIRE_OSMESA();
   QuadSetup s;
