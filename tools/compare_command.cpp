@@ -20,6 +20,7 @@ struct CompareOptions {
   std::string reference;
   std::string mask;
   bool ignoreBackground = false;
+  int bin = 1;
   std::string diff;
   float diffScale = 0;
   std::string json;
@@ -58,9 +59,17 @@ int runCompare(const CompareOptions& opt) {
                      std::to_string(mask.height) + ", the images are " +
                      std::to_string(reference.width) + " x " + std::to_string(reference.height));
   }
+  if (opt.bin > 1) {
+    test = binImage(test, opt.bin);
+    reference = binImage(reference, opt.bin);
+    if (params.mask) mask = binMask(mask, opt.bin);
+  }
   CompareResult result = compareImages(test, reference, params);
   if (!opt.quiet) {
-    std::printf("%s against %s\n%s\n", opt.test.c_str(), opt.reference.c_str(),
+    std::printf("%s against %s%s\n%s\n", opt.test.c_str(), opt.reference.c_str(),
+                opt.bin > 1 ? (", binned " + std::to_string(opt.bin) + "x" +
+                               std::to_string(opt.bin)).c_str()
+                            : "",
                 result.ToString().c_str());
   }
   if (!opt.diff.empty()) {
@@ -72,6 +81,7 @@ int runCompare(const CompareOptions& opt) {
     nlohmann::json j;
     j["test"] = opt.test;
     j["reference"] = opt.reference;
+    j["bin"] = opt.bin;
     j["width"] = reference.width;
     j["height"] = reference.height;
     j["channels"] = {{"R", toJson(result.channel[0])},
@@ -108,6 +118,12 @@ std::function<int()> addCompareCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--ignore-background", opt->ignoreBackground,
                 "Leave out pixels where the reference is exactly black");
+  cmd->add_option("--bin", opt->bin,
+                  "Average both images (and the mask) over blocks of N x N pixels first: the "
+                  "error at the scale of N pixels, without the reference's per-pixel noise "
+                  "(--diff is then at that resolution too)")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
   cmd->add_option("--diff", opt->diff,
                   "Write |Y(test) - Y(reference)| in false colour (.png or .exr): black 0, blue, "
                   "green, yellow, red at --diff-scale; ignored pixels grey");

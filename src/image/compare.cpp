@@ -3,6 +3,8 @@
 
 #include "image/compare.h"
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -62,6 +64,51 @@ struct Accumulator {
 };
 
 }  // namespace
+
+namespace {
+
+template <typename Combine>
+RgbImage binWith(const RgbImage& image, int bin, float init, Combine combine, bool mean) {
+  if (bin < 1) throw InputError("bin size " + std::to_string(bin) + " must be at least 1");
+  if (bin == 1) return image;
+  const int w = (image.width + bin - 1) / bin, h = (image.height + bin - 1) / bin;
+  RgbImage out(w, h);
+  for (int by = 0; by < h; ++by) {
+    for (int bx = 0; bx < w; ++bx) {
+      double acc[3] = {init, init, init};
+      int n = 0;
+      for (int y = by * bin; y < std::min(image.height, (by + 1) * bin); ++y) {
+        for (int x = bx * bin; x < std::min(image.width, (bx + 1) * bin); ++x) {
+          const float* p = image.pixel(x, y);
+          for (int c = 0; c < 3; ++c) acc[c] = combine(acc[c], double(p[c]));
+          ++n;
+        }
+      }
+      for (int c = 0; c < 3; ++c) {
+        out.rgb[(size_t(by) * size_t(w) + size_t(bx)) * 3 + size_t(c)] =
+            float(mean ? acc[c] / n : acc[c]);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+RgbImage binImage(const RgbImage& image, int bin) {
+  return binWith(image, bin, 0.0f, [](double a, double v) { return a + v; }, true);
+}
+
+RgbImage binMask(const RgbImage& mask, int bin) {
+  // A pixel is selected when any channel is non-zero: its selection is max(|c|).
+  RgbImage selection = mask;
+  for (size_t i = 0; i < selection.pixelCount(); ++i) {
+    const Vec3 v = selection.at(i);
+    const float s = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > 0 ? 1.0f : 0.0f;
+    selection.set(i, Vec3(s));
+  }
+  return binWith(selection, bin, 1.0f, [](double a, double v) { return std::min(a, v); }, false);
+}
 
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
                             const CompareParams& params) {

@@ -45,6 +45,15 @@ struct CompareResult {
   std::string ToString() const;        ///< a small table
 };
 
+/// The image averaged over blocks of `bin` x `bin` pixels (blocks at the right
+/// and bottom edges average the pixels they have): comparing binned images
+/// measures the error of what the eye sees at that scale, without the
+/// per-pixel noise of a Monte Carlo reference. `bin` = 1 returns the image.
+/// @throws InputError if bin < 1.
+RgbImage binImage(const RgbImage& image, int bin);
+/// A mask binned like binImage: a block is selected when every pixel of it is.
+RgbImage binMask(const RgbImage& mask, int bin);
+
 /// @throws InputError if the sizes (or the mask's) differ or an image is empty.
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
                             const CompareParams& params = {});

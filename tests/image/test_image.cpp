@@ -103,3 +103,38 @@ TEST(Compare, ExrRoundTripIsExact) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// binImage averages blocks (partial ones at the edges over what they hold);
+// binMask keeps a block only when all its pixels are selected.
+TEST(Compare, BinningAveragesBlocksAndMasksKeepWholeBlocks) {
+  RgbImage image(3, 2);
+  for (size_t i = 0; i < image.pixelCount(); ++i) image.set(i, Vec3(float(i)));
+  const RgbImage binned = binImage(image, 2);
+  ASSERT_EQ(binned.width, 2);
+  ASSERT_EQ(binned.height, 1);
+  EXPECT_FLOAT_EQ(binned.at(0).x, (0 + 1 + 3 + 4) / 4.0f);
+  EXPECT_FLOAT_EQ(binned.at(1).y, (2 + 5) / 2.0f);  // the right column alone
+  EXPECT_EQ(binImage(image, 1).rgb, image.rgb);
+  EXPECT_THROW(binImage(image, 0), InputError);
+  RgbImage mask(3, 2);
+  for (size_t i = 0; i < mask.pixelCount(); ++i) mask.set(i, Vec3(1));
+  mask.set(4, Vec3(0));  // one pixel of the first block left out
+  const RgbImage m = binMask(mask, 2);
+  EXPECT_EQ(m.at(0).x, 0.0f);
+  EXPECT_EQ(m.at(1).x, 1.0f);
+  // Binned errors: a test image off by +1 and -1 on alternating pixels has
+  // no error at all once two such pixels share a block.
+  RgbImage ref(2, 1), test(2, 1);
+  ref.set(0, Vec3(2));
+  ref.set(1, Vec3(2));
+  test.set(0, Vec3(3));
+  test.set(1, Vec3(1));
+  EXPECT_GT(compareImages(test, ref).luminance.relRmse, 0.4);
+  EXPECT_NEAR(compareImages(binImage(test, 2), binImage(ref, 2)).luminance.relRmse, 0.0, 1e-7);
+}
+
+}  // namespace
+}  // namespace lo
