@@ -21,6 +21,11 @@ const int LO_LIGHT_POINT = 0;
 const int LO_LIGHT_SPOT = 1;
 const int LO_LIGHT_DIRECTIONAL = 2;
 const int LO_LIGHT_EMITTER = 3; /* a virtual point light on an emissive triangle */
+const int LO_LIGHT_AREA = 4;    /* an emissive triangle: exact unshadowed irradiance, soft shadows */
+
+/* Emissive triangles drawn as area lights at most (each takes a cube of 6
+ * shadow layers); a scene with more gets virtual point lights instead. */
+const int LO_MAX_AREA_LIGHTS = 8;
 
 /* Array sizes of the std140 LightBlock. */
 const int LO_MAX_LIGHTS = 32;

@@ -20,6 +20,7 @@ uniform sampler2D uVdls;       // RGBA32F: irradiance, packed direction
 uniform usampler2D uVdlsHalf;  // RGBA16UI: half-float bits of irradiance, packed direction
 uniform bool uHalfVdls;        // which of the two holds the VDLs
 uniform sampler2DArrayShadow uShadowMaps;
+uniform sampler2DArray uShadowDepths;  // the same maps read as depths (PCSS blocker search)
 uniform vec3 uOctreeOrigin;  // world
 uniform float uVoxelSize;    // world units
 uniform int uDepth;
@@ -40,6 +41,9 @@ struct Light {
   vec4 directionRange;  // xyz unit direction light travels (spot, directional, emitter normal), w range (0 = none)
   vec4 colorFar;        // rgb: W/sr (point, spot, emitter at normal incidence) or W/m^2 (directional); w shadow far
   vec4 params;          // x cos outer, y cos inner, z first shadow layer (-1 = none), w near-field area
+  vec4 corner0;         // area light: triangle corners (render space); corner0.w sqrt(area)
+  vec4 corner1;
+  vec4 corner2;
 };
 layout(std140) uniform LightBlock {
   Light uLights[LO_MAX_LIGHTS];
@@ -87,6 +91,136 @@ vec3 hashColor(ivec3 c) {
   return vec3(float(h & 255u), float((h >> 8u) & 255u), float((h >> 16u) & 255u)) / 255.0 * 0.8 + 0.2;
 }
 
+// Cube face of direction d: the layer offset of a point light's six maps.
+int cubeFace(vec3 d) {
+  vec3 ad = abs(d);
+  if (ad.x >= ad.y && ad.x >= ad.z) return d.x > 0.0 ? 0 : 1;
+  if (ad.y >= ad.z) return d.y > 0.0 ? 2 : 3;
+  return d.z > 0.0 ? 4 : 5;
+}
+
+// Irradiance on the surface (p, n) from a Lambertian triangle (a, b, c) of
+// unit radiance: the projected solid angle of the triangle clipped to the
+// surface's upper hemisphere, 1/2 sum_i theta_i n.unit(u_i x u_i+1) over its
+// edges (Lambert's formula; Arvo 1995), exact. `lightCentre` is the clipped
+// polygon's vertex mean, the direction the BRDF is evaluated in.
+float polygonIrradiance(vec3 p, vec3 n, vec3 a, vec3 b, vec3 c, out vec3 lightCentre) {
+  vec3 q[3] = vec3[3](a - p, b - p, c - p);
+  vec3 poly[4];
+  int count = 0;
+  for (int i = 0; i < 3; ++i) {
+    vec3 s = q[i], e = q[(i + 1) % 3];
+    float ds = dot(n, s), de = dot(n, e);
+    if (ds >= 0.0 && count < 4) {
+      poly[count] = s;
+      ++count;
+    }
+    if ((ds >= 0.0) != (de >= 0.0) && count < 4) {
+      poly[count] = mix(s, e, ds / (ds - de));
+      ++count;
+    }
+  }
+  lightCentre = p;
+  if (count < 3) return 0.0;
+  float sum = 0.0;
+  vec3 mean = vec3(0.0);
+  for (int i = 0; i < count; ++i) {
+    vec3 u0 = normalize(poly[i]), u1 = normalize(poly[(i + 1) % count]);
+    vec3 cr = cross(u0, u1);
+    float s = length(cr);
+    if (s > 1e-9) sum += atan(s, dot(u0, u1)) * dot(cr, n) / s;
+    mean += poly[i];
+  }
+  lightCentre = p + mean / float(count);
+  return 0.5 * abs(sum);
+}
+
+// Soft shadow of area light i (PCSS, Fernando 2005) from its shadow cube at
+// the triangle's centre: the blockers found in the region of the map that
+// can hide part of the light from p give their mean distance d_b; the
+// penumbra's angular half-width is then h (d_r - d_b) / (d_r d_b), h half
+// the light's size and d_r the receiver's distance, and the map is filtered
+// over it with hardware-compared taps (a box filter of the shadow edge:
+// smooth and monotonic, no bands). Each tap is compared with the distance of
+// the receiver's tangent plane in the tap's own direction, not with p's, so
+// that a wide kernel on a surface the light sees at a grazing angle does not
+// shadow the surface itself; directions behind the emitter's plane carry no
+// light, so what the map holds there (the ceiling around a ceiling light)
+// blocks nothing.
+float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
+  Light L = uLights[i];
+  int first = int(L.params.z);
+  if (first < 0) return 1.0;
+  float nl = clamp(dot(n, toLight), 0.0, 1.0);
+  vec3 ps = p + n * uShadowParams.y * (1.0 + 2.0 * (1.0 - nl));
+  vec3 lc = L.positionType.xyz;
+  vec3 d = ps - lc;
+  int layer = first + cubeFace(d);
+  vec4 c = uShadowMatrices[layer] * vec4(ps, 1.0);
+  vec2 uv = c.xy / c.w * 0.5 + 0.5;
+  float far = L.colorFar.w;
+  float dr = length(d);
+  if (dr / far > 1.0) return 1.0;
+  mat4 clipToRender = inverse(uShadowMatrices[layer]);
+  float plane = dot(d, n);  // the receiver's tangent plane, as seen from the light centre
+  float h = 0.5 * L.corner0.w;
+  // Blockers from 0.3 d_r out can hide the light: search that cone (in a
+  // cube face, an angle's tangent t spans t/2 in uv).
+  float search = min(0.5 * h * 0.7 / (0.3 * dr), 0.2);
+  // 6 x 6 taps on a grid turned by atan(1/6), so that the blocker estimate,
+  // and with it the filter's width, changes in small steps along any edge.
+  const int kTaps = 6;
+  const vec2 kSearchTurn = vec2(0.986394, 0.164399);  // (cos, sin) of atan(1/6)
+  float blockers = 0.0, blockerSum = 0.0;
+  for (int y = 0; y < kTaps; ++y) {
+    for (int x = 0; x < kTaps; ++x) {
+      vec2 g = (vec2(x, y) + 0.5) / float(kTaps) * 2.0 - 1.0;
+      vec2 t = uv + vec2(kSearchTurn.x * g.x - kSearchTurn.y * g.y,
+                         kSearchTurn.y * g.x + kSearchTurn.x * g.y) * search;
+      vec4 w = clipToRender * vec4(t * 2.0 - 1.0, 0.0, 1.0);
+      vec3 dir = normalize(w.xyz / w.w - lc);
+      // Behind the emitter's plane no light travels: nothing there blocks it.
+      if (dot(dir, L.directionRange.xyz) <= 0.0) continue;
+      float dn = dot(dir, n);
+      float receiver = dn < -1e-4 || dn > 1e-4 ? plane / dn : far;
+      if (receiver <= 0.0) receiver = far;
+      float stored = texture(uShadowDepths, vec3(t, float(layer))).r;
+      if (stored < receiver / far - uShadowParams.x) {
+        blockers += 1.0;
+        blockerSum += stored * far;
+      }
+    }
+  }
+  if (blockers == 0.0) return 1.0;
+  float db = max(blockerSum / blockers, 1e-4 * far);
+  float texel = 1.0 / float(textureSize(uShadowDepths, 0).x);
+  float radius = clamp(0.5 * h * max(dr - db, 0.0) / (dr * db), texel, 0.2);
+  // 8 x 8 taps on a grid turned by atan(1/8) (a rook pattern: every edge
+  // direction but a few sees 64 distinct tap positions, not 8 columns): 64
+  // levels between umbra and light, each blurred by the hardware 2x2
+  // comparison, below what the eye resolves as a band.
+  const int kFilterTaps = 8;
+  const vec2 kTurn = vec2(0.992278, 0.124035);  // (cos, sin) of atan(1/8)
+  float lit = 0.0;
+  for (int y = 0; y < kFilterTaps; ++y) {
+    for (int x = 0; x < kFilterTaps; ++x) {
+      vec2 g = (vec2(x, y) + 0.5) / float(kFilterTaps) * 2.0 - 1.0;
+      vec2 t = uv + vec2(kTurn.x * g.x - kTurn.y * g.y, kTurn.y * g.x + kTurn.x * g.y) * radius;
+      vec4 w = clipToRender * vec4(t * 2.0 - 1.0, 0.0, 1.0);
+      vec3 dir = normalize(w.xyz / w.w - lc);
+      if (dot(dir, L.directionRange.xyz) <= 0.0) {
+        lit += 1.0;
+        continue;
+      }
+      float dn = dot(dir, n);
+      float receiver = dn < -1e-4 || dn > 1e-4 ? plane / dn : far;
+      if (receiver <= 0.0) receiver = far;
+      lit += texture(uShadowMaps, vec4(t, float(layer), min(receiver / far, 1.0) - uShadowParams.x));
+    }
+  }
+  return lit / float(kFilterTaps * kFilterTaps);
+}
+
 float shadow(int i, vec3 p, vec3 n, vec3 toLight) {
   Light L = uLights[i];
   int first = int(L.params.z);
@@ -96,17 +230,7 @@ float shadow(int i, vec3 p, vec3 n, vec3 toLight) {
   float nl = clamp(dot(n, toLight), 0.0, 1.0);
   vec3 ps = p + n * uShadowParams.y * (1.0 + 2.0 * (1.0 - nl));
   int layer = first;
-  if (type == LO_LIGHT_POINT || type == LO_LIGHT_EMITTER) {
-    vec3 d = ps - L.positionType.xyz;
-    vec3 ad = abs(d);
-    if (ad.x >= ad.y && ad.x >= ad.z) {
-      layer += d.x > 0.0 ? 0 : 1;
-    } else if (ad.y >= ad.z) {
-      layer += d.y > 0.0 ? 2 : 3;
-    } else {
-      layer += d.z > 0.0 ? 4 : 5;
-    }
-  }
+  if (type == LO_LIGHT_POINT || type == LO_LIGHT_EMITTER) layer += cubeFace(ps - L.positionType.xyz);
   vec4 c = uShadowMatrices[layer] * vec4(ps, 1.0);
   vec3 ndc = c.xyz / c.w;
   vec2 uv = ndc.xy * 0.5 + 0.5;
@@ -121,6 +245,22 @@ vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughn
   for (int i = 0; i < uLightCount.x; ++i) {
     Light L = uLights[i];
     int type = int(L.positionType.w);
+    if (type == LO_LIGHT_AREA) {
+      // One-sided Lambertian emitter: nothing behind its plane is lit, and
+      // a point in the plane (the ceiling around a ceiling light) sees it at
+      // grazing incidence: nothing either (the clipped edge sum would be
+      // all rounding there).
+      if (dot(p - L.corner0.xyz, L.directionRange.xyz) <= 1e-3 * L.corner0.w) continue;
+      vec3 lightCentre;
+      float solid = polygonIrradiance(p, n, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz, lightCentre);
+      if (solid <= 0.0) continue;
+      vec3 la = normalize(lightCentre - p);
+      // The BRDF times the cosine in the direction of the light's visible
+      // part, over that cosine: exact for the diffuse lobe.
+      vec3 f = brdfCos(n, v, la, baseColor, metallic, roughness) / max(dot(n, la), 1e-4);
+      sum += f * L.colorFar.rgb * solid * areaShadow(i, p, n, la);
+      continue;
+    }
     vec3 l;
     vec3 E = L.colorFar.rgb;  // irradiance on a surface facing the light, W/m^2
     if (type == LO_LIGHT_DIRECTIONAL) {

@@ -15,6 +15,7 @@ RenderParams ShadingOptions::renderParams(RenderMode mode) const {
 
 RendererParams ShadingOptions::rendererParams() const {
   RendererParams p;
+  p.areaLights = areaLights == "on";
   p.emitterLights = emitterLights;
   p.shadowMapSize = shadowMapSize;
   return p;
@@ -51,8 +52,14 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
   cmd->add_option("--vdls", opt.vdls, "VDLs used per voxel, strongest first" + key("keys [ ]"))
       ->check(CLI::Range(1, kMaxVdls))
       ->capture_default_str();
+  cmd->add_option("--area-lights", opt.areaLights,
+                  "Emissive triangles as area lights: exact irradiance, soft shadows (up to 8 "
+                  "triangles; more, or off: --emitter-lights point lights)")
+      ->check(onOff())
+      ->capture_default_str();
   cmd->add_option("--emitter-lights", opt.emitterLights,
-                  "Shadowed virtual point lights sampled on emissive triangles (0: none)")
+                  "Shadowed virtual point lights sampled on emissive triangles when they are not "
+                  "area lights (0: none)")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   cmd->add_option("--shadow-map-size", opt.shadowMapSize, "Shadow map resolution per face")

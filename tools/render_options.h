@@ -25,6 +25,7 @@ struct ShadingOptions {
   std::string specular = "on";
   float exposure = 0;  ///< EV
   int vdls = kMaxVdls;
+  std::string areaLights = "on";
   int emitterLights = RendererParams{}.emitterLights;
   int shadowMapSize = RendererParams{}.shadowMapSize;
   bool halfFloat = false;

@@ -30,6 +30,7 @@ constexpr int kPoint = shader::LO_LIGHT_POINT;
 constexpr int kSpot = shader::LO_LIGHT_SPOT;
 constexpr int kDirectional = shader::LO_LIGHT_DIRECTIONAL;
 constexpr int kEmitter = shader::LO_LIGHT_EMITTER;
+constexpr int kArea = shader::LO_LIGHT_AREA;
 
 /// uMode of the scene shader for a render mode.
 int shaderMode(RenderMode mode) {
@@ -52,8 +53,11 @@ struct GpuLight {
   float directionRange[4];
   float colorFar[4];
   float params[4];
+  float corner0[4];  ///< area lights: the triangle's corners (render space); corner0.w = sqrt(area)
+  float corner1[4];
+  float corner2[4];
 };
-static_assert(sizeof(GpuLight) == 64, "std140 Light is 4 vec4");
+static_assert(sizeof(GpuLight) == 112, "std140 Light is 7 vec4");
 
 /// std140 twin of `uniform LightBlock` in shaders/render_scene.frag.
 struct LightBlock {
@@ -62,7 +66,7 @@ struct LightBlock {
   int32_t lightCount[4];
   float shadowParams[4];
 };
-static_assert(sizeof(LightBlock) == kMaxLights * 64 + kMaxShadowLayers * 64 + 16 + 16,
+static_assert(sizeof(LightBlock) == kMaxLights * 112 + kMaxShadowLayers * 64 + 16 + 16,
               "std140 LightBlock layout");
 
 struct Vertex {
@@ -155,6 +159,8 @@ struct Renderer::Impl {
   GLuint targetFbo = 0, targetColor = 0, targetDepth = 0;
   int targetWidth = 0, targetHeight = 0;
   int emitterLights = 0;
+  int areaLightCount = 0;
+  GLuint depthSampler = 0;  ///< reads the shadow maps' depths (no comparison): PCSS blocker search
   bool halfVdls = false;
 
   LightBlock lightBlock{};
@@ -179,6 +185,7 @@ struct Renderer::Impl {
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &emptyVao);
     glDeleteFramebuffers(1, &shadowFbo);
+    if (depthSampler) glDeleteSamplers(1, &depthSampler);
     glDeleteFramebuffers(1, &targetFbo);
     glDeleteRenderbuffers(1, &targetDepth);
   }
@@ -371,6 +378,37 @@ struct Renderer::Impl {
     checkGl("uploading the scene");
   }
 
+  /// Emissive triangles -> area lights, when there are at most
+  /// LO_MAX_AREA_LIGHTS of them (else empty: they become VPLs). The shader
+  /// integrates each exactly (unshadowed, Lambertian) and softens its shadow
+  /// by the light's size (PCSS, see docs/render.md); the shadow cube sits at
+  /// the triangle's centroid, just in front of it.
+  std::vector<GpuLight> areaLights(const Scene& scene) {
+    std::vector<GpuLight> out;
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+      int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+      if (m < 0 || size_t(m) >= scene.materials.size()) continue;
+      const Material& mat = scene.materials[size_t(m)];
+      const float area = scene.triangleArea(t);
+      if (!(maxComponent(mat.emission) > 0) || !(area > 0)) continue;
+      if (out.size() == size_t(shader::LO_MAX_AREA_LIGHTS)) return {};
+      const Vec3 p0 = toRender(scene.positions[scene.indices[t * 3]]);
+      const Vec3 p1 = toRender(scene.positions[scene.indices[t * 3 + 1]]);
+      const Vec3 p2 = toRender(scene.positions[scene.indices[t * 3 + 2]]);
+      const Vec3 n = scene.faceNormal(t);
+      GpuLight l{};
+      setVec4(l.positionType, (p0 + p1 + p2) / 3.0f + n * (1e-3f * sceneSize), float(kArea));
+      setVec4(l.directionRange, n, 0);
+      setVec4(l.colorFar, mat.emission, 0);
+      setVec4(l.params, Vec3(-1, 1, -1), area);
+      setVec4(l.corner0, p0, std::sqrt(area));
+      setVec4(l.corner1, p1, 0);
+      setVec4(l.corner2, p2, 0);
+      out.push_back(l);
+    }
+    return out;
+  }
+
   /// Emissive triangles -> `count` virtual point lights, chosen in proportion
   /// to emitted power (average emission x area) by stratified, deterministic
   /// sampling; each carries the power of its stratum as the intensity of a
@@ -441,9 +479,14 @@ struct Renderer::Impl {
               0);
       lights.push_back(l);
     }
-    std::vector<GpuLight> vpls = emitterVpls(scene, params.emitterLights);
-    emitterLights = int(vpls.size());
-    lights.insert(lights.end(), vpls.begin(), vpls.end());
+    std::vector<GpuLight> emitters = params.areaLights ? areaLights(scene) : std::vector<GpuLight>{};
+    if (emitters.empty()) {
+      emitters = emitterVpls(scene, params.emitterLights);
+      emitterLights = int(emitters.size());
+    } else {
+      areaLightCount = int(emitters.size());
+    }
+    lights.insert(lights.end(), emitters.begin(), emitters.end());
     if (lights.size() > size_t(kMaxLights)) {
       throw InputError("scene has " + std::to_string(lights.size()) +
                        " punctual + emitter lights; the renderer draws at most " +
@@ -458,13 +501,13 @@ struct Renderer::Impl {
     float nearPlane = 1e-3f * sceneSize;
     for (GpuLight& l : lights) {
       int type = int(l.positionType[3]);
-      int need = type == kPoint || type == kEmitter ? 6 : 1;
+      int need = type == kPoint || type == kEmitter || type == kArea ? 6 : 1;
       if (layers + need > kMaxShadowLayers) continue;
       glm::vec3 pos(l.positionType[0], l.positionType[1], l.positionType[2]);
       glm::vec3 dir(l.directionRange[0], l.directionRange[1], l.directionRange[2]);
       float far = glm::length(pos - center) + radius + nearPlane;
       l.params[2] = float(layers);
-      if (type == kPoint || type == kEmitter) {
+      if (type == kPoint || type == kEmitter || type == kArea) {
         const glm::vec3 axes[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
                                    {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
         glm::mat4 proj = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, far);
@@ -514,6 +557,15 @@ struct Renderer::Impl {
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
     checkGl("allocating the shadow maps");
 
+    // The same maps read as plain depths (PCSS's blocker search): a sampler
+    // object without comparison, bound to its own unit.
+    glGenSamplers(1, &depthSampler);
+    glSamplerParameteri(depthSampler, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glSamplerParameteri(depthSampler, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glSamplerParameteri(depthSampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(depthSampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(depthSampler, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+
     glGenFramebuffers(1, &shadowFbo);
     glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo);
     glDrawBuffer(GL_NONE);
@@ -527,7 +579,7 @@ struct Renderer::Impl {
       const GpuLight& l = lightBlock.lights[i];
       if (l.params[2] < 0) continue;
       int type = int(l.positionType[3]);
-      int n = type == kPoint || type == kEmitter ? 6 : 1;
+      int n = type == kPoint || type == kEmitter || type == kArea ? 6 : 1;
       glUniform3fv(glGetUniformLocation(shadowProgram, "uLightPosition"), 1, l.positionType);
       glUniform1f(glGetUniformLocation(shadowProgram, "uFar"), l.colorFar[3]);
       for (int f = 0; f < n; ++f) {
@@ -642,6 +694,11 @@ struct Renderer::Impl {
     glBindTexture(GL_TEXTURE_2D, vdlHalfTexture);
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(loc("uBaseColorTexture"), 4);
+    glUniform1i(loc("uShadowDepths"), 5);
+    glActiveTexture(GL_TEXTURE5);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, shadowTexture);
+    glBindSampler(5, depthSampler);
+    glActiveTexture(GL_TEXTURE0);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo);
     glBindVertexArray(vao);
     const GLint hasTexture = loc("uHasBaseColorTexture");
@@ -653,6 +710,7 @@ struct Renderer::Impl {
       glDrawArrays(GL_TRIANGLES, range.first, range.count);
     }
     glBindVertexArray(0);
+    glBindSampler(5, 0);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_LESS);
     checkGl("drawing the scene");
@@ -687,6 +745,8 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
 Renderer::~Renderer() = default;
 
 int Renderer::emitterLightCount() const { return impl_->emitterLights; }
+
+int Renderer::areaLightCount() const { return impl_->areaLightCount; }
 
 void Renderer::setOctree(const GpuOctree& octree) {
   impl_->checkLimits(octree);

@@ -43,8 +43,14 @@ struct RenderParams {
 /// Set once: resources built for the scene.
 struct RendererParams {
   int shadowMapSize = 1024;  ///< texels per side of every shadow map layer
+  /// Emissive triangles are drawn as area lights (exact unshadowed irradiance
+  /// of each triangle, soft shadows by its size) when the scene has at most
+  /// LO_MAX_AREA_LIGHTS (shaders/render_constants.h) of them; else, or when
+  /// off, as `emitterLights` shadowed virtual point lights.
+  bool areaLights = true;
   /// Emissive triangles become this many shadowed virtual point lights for the
-  /// direct pass (0 = none: then bake with --include-direct to see their light).
+  /// direct pass when they are not area lights (0 = none: then bake with
+  /// --include-direct to see their light).
   int emitterLights = 8;
   /// Texture limits to respect; 0 = query the current context.
   int max3DTextureSize = 0, max2DTextureSize = 0;
@@ -80,7 +86,8 @@ class Renderer {
   /// each), without the read-back: the real-time cost.
   double timeFrames(const PinholeCamera& camera, const RenderParams& params, int frames);
 
-  int emitterLightCount() const;
+  int emitterLightCount() const;  ///< virtual point lights on emissive triangles
+  int areaLightCount() const;     ///< emissive triangles drawn as area lights
 
  private:
   struct Impl;

@@ -472,6 +472,96 @@ TEST(RenderImage, BaseColorTextureIsSampledPerPixel) {
   EXPECT_EQ(cells[1], 1);
 }
 
+/// Form factor from a point to the rectangle [0, x] x [0, y] in a parallel
+/// plane at height h above it (the point below the corner (0, 0)); odd in x
+/// and in y, so rectangles anywhere are sums of four of these.
+double cornerFormFactor(double x, double y, double h) {
+  const double a = x / h, b = y / h;
+  return (a / std::sqrt(1 + a * a) * std::atan(b / std::sqrt(1 + a * a)) +
+          b / std::sqrt(1 + b * b) * std::atan(a / std::sqrt(1 + b * b))) /
+         (2 * kPi);
+}
+
+/// A square emitter of side `side` centred over (cx, cy) at height z = h,
+/// facing down onto the quad of QuadSetup (z = 0), as two triangles.
+void addSquareEmitter(Scene& scene, float cx, float cy, float h, float side, const Vec3& radiance) {
+  Material e;
+  e.baseColor = {0, 0, 0};
+  e.emission = radiance;
+  scene.materials.push_back(e);
+  test::addQuad(scene, {cx - 0.5f * side, cy - 0.5f * side, h}, {side, 0, 0}, {0, side, 0},
+                {0, 0, -1}, int(scene.materials.size()) - 1);
+}
+
+// Area lights: an emissive square over a Lambertian quad lights it with the
+// exact irradiance of a rectangle, E = pi L F (F the form factor, summed
+// from corner form factors), so each pixel is albedo L F; no shadows here.
+TEST(RenderImage, AreaLightGivesTheExactIrradianceOfTheRectangle) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  const float h = 0.6f, side = 0.4f, cx = 0.1f, cy = -0.05f;
+  const Vec3 radiance{3.0f, 3.0f, 3.0f};
+  addSquareEmitter(s.scene, cx, cy, h, side, radiance);
+  s.camera = PinholeCamera::lookAt({0.1f, -0.05f, 0.5f}, {0.1f, -0.05f, 0.0f}, 36.0f * kPi / 180.0f);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  Renderer renderer(s.scene, octree);
+  ASSERT_EQ(renderer.areaLightCount(), 2);
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const RgbImage image = renderer.render(s.camera, p);
+  const float worldPerPixel = 2.0f * 0.5f * std::tan(0.5f * s.camera.yfov) / float(p.height);
+  for (int px : {p.width / 2, p.width / 2 + 10, p.width / 2 - 20}) {
+    // World position of the pixel centre on the quad (x right, y up).
+    const double x = 0.1 + (px + 0.5 - 0.5 * p.width) * worldPerPixel;
+    const double y = -0.05 - (p.height / 2 + 0.5 - 0.5 * p.height) * worldPerPixel;
+    const double x0 = cx - 0.5 * side - x, x1 = cx + 0.5 * side - x;
+    const double y0 = cy - 0.5 * side - y, y1 = cy + 0.5 * side - y;
+    const double F = cornerFormFactor(x1, y1, h) - cornerFormFactor(x0, y1, h) -
+                     cornerFormFactor(x1, y0, h) + cornerFormFactor(x0, y0, h);
+    const double expected = s.albedo.x * radiance.x * F;
+    EXPECT_NEAR(image.pixel(px, p.height / 2)[0], expected, 2e-3 * expected) << "pixel " << px;
+  }
+}
+
+// Soft shadows: a straight blocker edge under the square light casts a
+// penumbra in which the visible fraction of the light (the image over the
+// image without the blocker) rises without steps (no bands) from the umbra
+// to full light, over as many pixels as the light's size says.
+TEST(RenderImage, AreaLightPenumbraIsSmoothAndMonotonic) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  const float h = 0.6f, side = 0.4f;
+  addSquareEmitter(s.scene, 0.1f, -0.05f, h, side, {3.0f, 3.0f, 3.0f});
+  s.camera = PinholeCamera::lookAt({0.1f, -0.05f, 0.25f}, {0.1f, -0.05f, 0.0f}, 60.0f * kPi / 180.0f);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  RenderParams p = QuadSetup::params(false);
+  p.width = 160;
+  p.height = 120;
+  p.mode = RenderMode::Direct;
+  const RgbImage open = Renderer(s.scene, octree).render(s.camera, p);
+  // Blocker: the half plane x < 0.1 at z = 0.3 (halfway), facing up.
+  test::addQuad(s.scene, {-1.0f, -1.0f, 0.3f}, {1.1f, 0, 0}, {0, 2.0f, 0}, {0, 0, 1}, 0);
+  const RgbImage image = Renderer(s.scene, octree).render(s.camera, p);
+  writePng(test::outputDir("render_penumbra") + "/rendered.png", image, 0.0f);
+  // Along the row through the centre: x from -0.04 to 0.24 on the quad.
+  const int y = p.height / 2;
+  std::vector<float> visible;
+  for (int x = 0; x < p.width; ++x) visible.push_back(image.pixel(x, y)[0] / open.pixel(x, y)[0]);
+  EXPECT_LT(visible.front(), 0.5f) << "the left end is in the shadow's inner half";
+  EXPECT_GT(visible.back(), 0.9f) << "the right end sees nearly all the light";
+  int rising = 0;
+  for (size_t x = 1; x < visible.size(); ++x) {
+    EXPECT_GE(visible[x], visible[x - 1] - 1e-3f) << "step down at pixel " << x;
+    EXPECT_LE(visible[x] - visible[x - 1], 0.05f) << "a band edge at pixel " << x;
+    if (visible[x] > 0.1f && visible[x] < 0.9f) ++rising;
+  }
+  // The geometric penumbra here is side * (h - 0.3) / 0.3 = 0.4 units wide
+  // on the quad: tens of pixels, not a hard edge.
+  EXPECT_GE(rising, 10) << "pixels between 10% and 90% of the light";
+}
+
 TEST(RenderImage, VoxelModeColoursLeavesAndLeavesEmptySpaceBlack) {
   REQUIRE_OSMESA();
   QuadSetup s;
