@@ -34,6 +34,8 @@ uniform float uExposureScale;
 uniform bool uEncodeSrgb;
 uniform sampler2D uBaseColorTexture;  // linear RGB (RGBA16F), mipmapped
 uniform bool uHasBaseColorTexture;
+uniform float uTransmission;  // KHR_materials_transmission of this draw; 0 = opaque
+uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 
 // std140 twin: GpuLight / LightBlock in src/render/renderer.cpp.
 struct Light {
@@ -58,7 +60,7 @@ layout(std140) uniform LightBlock {
 vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
   float nl = dot(n, l);
   if (nl <= 0.0) return vec3(0.0);
-  vec3 diffuse = baseColor * (1.0 - metallic) / LO_PI;
+  vec3 diffuse = baseColor * (1.0 - metallic) * (1.0 - uTransmission) / LO_PI;
   if (!uSpecular) return diffuse * nl;
   float nv = max(dot(n, v), 1e-4);
   vec3 h = normalize(l + v);
@@ -290,6 +292,10 @@ vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughn
   return sum;
 }
 
+vec3 srgbDecode(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+}
+
 vec3 srgbEncode(vec3 c) {
   c = clamp(c, 0.0, 1.0);
   return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
@@ -326,6 +332,17 @@ void main() {
       radiance += loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
                                    uInterpolation, uMaxVdls, s);
     }
+  }
+  if (uTransmission > 0.0) {
+    // Thin-walled transmission (glTF without KHR_materials_volume): the
+    // surface replaces that share of its diffuse lobe by the scene behind
+    // it, seen straight through, tinted by the base colour and weighted by
+    // the Fresnel transmittance at the viewing angle (Schlick, F0 = 0.04).
+    vec3 behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0).rgb;
+    if (uEncodeSrgb) behind = srgbDecode(behind);
+    behind /= uExposureScale;
+    float fresnel = 0.04 + 0.96 * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);
+    radiance += uTransmission * (1.0 - fresnel) * baseColor * behind;
   }
   radiance *= uExposureScale;
   fragColor = vec4(uEncodeSrgb ? srgbEncode(radiance) : radiance, 1.0);

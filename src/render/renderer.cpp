@@ -78,11 +78,13 @@ struct Vertex {
   float uv[2];  ///< the texture coordinates the base colour texture names (TEXCOORD_0 or _1)
 };
 
-/// A run of the vertex buffer drawn with one base colour texture (-1: none).
+/// A run of the vertex buffer drawn with one base colour texture (-1: none)
+/// and, for transmissive surfaces (KHR_materials_transmission), one material.
 struct DrawRange {
   int texture = -1;  ///< index into Scene::textures
   GLint first = 0;
   GLsizei count = 0;
+  float transmission = 0;  ///< > 0: drawn after the opaque scene, see-through
 };
 
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
@@ -151,7 +153,11 @@ struct Renderer::Impl {
   GLuint sceneProgram = 0, shadowProgram = 0, depthProgram = 0, probeProgram = 0;
   GLuint vao = 0, vbo = 0, emptyVao = 0;
   GLsizei vertexCount = 0;
-  std::vector<DrawRange> ranges;        ///< the vertex buffer by base colour texture
+  std::vector<DrawRange> ranges;        ///< the vertex buffer by texture, opaque ranges first
+  GLsizei opaqueCount = 0;              ///< vertices of the opaque ranges (shadows, pre-pass)
+  GLuint behindTexture = 0;             ///< the opaque image, seen through transmissive surfaces
+  int behindWidth = 0, behindHeight = 0;
+  bool behindFloat = false;
   std::vector<GLuint> textures;         ///< per Scene::textures entry; 0 = not used
   float maxAnisotropy = 1;              ///< of the context (1: no anisotropic filtering)
   GLuint octreeTexture = 0, vdlTexture = 0, vdlHalfTexture = 0, shadowTexture = 0, lightUbo = 0;
@@ -180,6 +186,7 @@ struct Renderer::Impl {
     GLuint own[] = {octreeTexture, vdlTexture, vdlHalfTexture, shadowTexture, targetColor};
     glDeleteTextures(5, own);
     if (!textures.empty()) glDeleteTextures(GLsizei(textures.size()), textures.data());
+    if (behindTexture) glDeleteTextures(1, &behindTexture);
     glDeleteBuffers(1, &vbo);
     glDeleteBuffers(1, &lightUbo);
     glDeleteVertexArrays(1, &vao);
@@ -311,11 +318,20 @@ struct Renderer::Impl {
       maxAnisotropy = std::min(maxAnisotropy, 16.0f);
     }
     // Triangles in runs of one base colour texture (untextured first), so
-    // that the scene pass binds each texture once.
-    std::vector<std::vector<size_t>> byTexture(scene.textures.size() + 1);
+    // that the scene pass binds each texture once; transmissive triangles
+    // last, in runs of one material, drawn after the opaque scene they show.
+    auto transmissionOf = [&scene](size_t t) {
+      const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+      return m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)].transmission
+                                                          : 0.0f;
+    };
+    const size_t groups = scene.textures.size() + 1;
+    std::vector<std::vector<size_t>> byTexture(groups * (scene.materials.size() + 1));
     for (size_t t = 0; t < scene.triangleCount(); ++t) {
       const std::vector<float>* uv = nullptr;
-      byTexture[size_t(textureOf(scene, t, &uv) + 1)].push_back(t);
+      const size_t texture = size_t(textureOf(scene, t, &uv) + 1);
+      const size_t material = transmissionOf(t) > 0 ? size_t(scene.triangleMaterial[t]) + 1 : 0;
+      byTexture[material * groups + texture].push_back(t);
     }
     std::vector<Vertex> vertices;
     vertices.reserve(scene.triangleCount() * 3);
@@ -324,7 +340,8 @@ struct Renderer::Impl {
     for (size_t group = 0; group < byTexture.size(); ++group) {
       if (byTexture[group].empty()) continue;
       DrawRange range;
-      range.texture = int(group) - 1;
+      range.texture = int(group % groups) - 1;
+      range.transmission = transmissionOf(byTexture[group].front());
       range.first = GLint(vertices.size());
       if (range.texture >= 0) textures[size_t(range.texture)] = uploadTexture(scene.textures[size_t(range.texture)]);
       for (size_t t : byTexture[group]) {
@@ -354,6 +371,7 @@ struct Renderer::Impl {
       }
       range.count = GLsizei(vertices.size()) - range.first;
       ranges.push_back(range);
+      if (range.transmission <= 0) opaqueCount = GLsizei(vertices.size());
     }
     vertexCount = GLsizei(vertices.size());
     glGenVertexArrays(1, &vao);
@@ -591,7 +609,8 @@ struct Renderer::Impl {
         glClear(GL_DEPTH_BUFFER_BIT);
         glUniformMatrix4fv(glGetUniformLocation(shadowProgram, "uViewProj"), 1, GL_FALSE,
                            lightBlock.shadowMatrices[layer]);
-        glDrawArrays(GL_TRIANGLES, 0, vertexCount);
+        // Transmissive surfaces cast no shadow (light passes; not tinted).
+        glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
       }
     }
     glBindVertexArray(0);
@@ -623,6 +642,26 @@ struct Renderer::Impl {
     }
     targetWidth = width;
     targetHeight = height;
+  }
+
+  /// Copies the bound framebuffer's colour into behindTexture (float for
+  /// the offscreen RGBA32F target, 8-bit for a window's back buffer).
+  void copyBehind(int width, int height, bool floatTarget) {
+    if (!behindTexture || behindWidth != width || behindHeight != height ||
+        behindFloat != floatTarget) {
+      if (!behindTexture) glGenTextures(1, &behindTexture);
+      glBindTexture(GL_TEXTURE_2D, behindTexture);
+      glTexImage2D(GL_TEXTURE_2D, 0, floatTarget ? GL_RGBA32F : GL_RGBA8, width, height, 0,
+                   GL_RGBA, floatTarget ? GL_FLOAT : GL_UNSIGNED_BYTE, nullptr);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      behindWidth = width;
+      behindHeight = height;
+      behindFloat = floatTarget;
+    }
+    glBindTexture(GL_TEXTURE_2D, behindTexture);
+    glCopyTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 0, 0, width, height);
+    checkGl("copying the opaque image for transmissive surfaces");
   }
 
   void draw(const PinholeCamera& camera, const RenderParams& rp, int width, int height,
@@ -659,7 +698,7 @@ struct Renderer::Impl {
       glUniformMatrix4fv(glGetUniformLocation(depthProgram, "uViewProj"), 1, GL_FALSE,
                          glm::value_ptr(viewProj));
       glBindVertexArray(vao);
-      glDrawArrays(GL_TRIANGLES, 0, vertexCount);
+      glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
       glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
       glDepthFunc(GL_LEQUAL);
       glDepthMask(GL_FALSE);
@@ -702,11 +741,26 @@ struct Renderer::Impl {
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo);
     glBindVertexArray(vao);
     const GLint hasTexture = loc("uHasBaseColorTexture");
+    const GLint transmission = loc("uTransmission");
+    glUniform1i(loc("uBehind"), 6);
+    glUniform1f(transmission, 0.0f);
+    bool copied = false;
     for (const DrawRange& range : ranges) {
+      if (range.transmission > 0 && !copied) {
+        // The opaque scene as drawn so far, for the surfaces in front of it
+        // to show (thin-walled transmission: seen straight through).
+        copyBehind(width, height, !encodeSrgb);
+        glActiveTexture(GL_TEXTURE6);
+        glBindTexture(GL_TEXTURE_2D, behindTexture);
+        glDepthMask(GL_TRUE);  // the nearest transmissive surface wins
+        glDepthFunc(GL_LESS);
+        copied = true;
+      }
       glActiveTexture(GL_TEXTURE4);
       glBindTexture(GL_TEXTURE_2D, range.texture >= 0 ? textures[size_t(range.texture)] : 0);
       glActiveTexture(GL_TEXTURE0);
       glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
+      glUniform1f(transmission, range.transmission);
       glDrawArrays(GL_TRIANGLES, range.first, range.count);
     }
     glBindVertexArray(0);

@@ -562,6 +562,40 @@ TEST(RenderImage, AreaLightPenumbraIsSmoothAndMonotonic) {
   EXPECT_GE(rising, 10) << "pixels between 10% and 90% of the light";
 }
 
+// Glass (KHR_materials_transmission): a clear pane between the camera and a
+// lit quad shows the quad through it, dimmed only by the Fresnel reflectance
+// at normal incidence (4%), where it used to be drawn as an opaque white
+// surface; and it casts no shadow on the quad under it.
+TEST(RenderImage, GlassShowsWhatIsBehindAndCastsNoShadow) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Light light;
+  light.type = Light::Type::Point;
+  light.position = {0.6f, 0.5f, 1.5f};  // off to the side: no highlight on the pane at the centre
+  light.intensity = 4.0f;
+  s.scene.lights.push_back(light);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const RgbImage open = Renderer(s.scene, octree).render(s.camera, p);
+  Material glass;
+  glass.baseColor = {1, 1, 1};
+  glass.roughness = 0.05f;
+  glass.transmission = 1.0f;
+  s.scene.materials.push_back(glass);
+  // The pane at z = 0.8 covers the view and lies between the light and the
+  // centre of the quad.
+  test::addQuad(s.scene, {-1, -1, 0.8f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
+  const RgbImage through = Renderer(s.scene, octree).render(s.camera, p);
+  const float* a = open.pixel(p.width / 2, p.height / 2);
+  const float* b = through.pixel(p.width / 2, p.height / 2);
+  ASSERT_GT(a[0], 0.01f);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(b[c] / a[c], 0.96f, 0.01f) << "channel " << c << ": " << b[c] << " vs " << a[c];
+  }
+}
+
 TEST(RenderImage, VoxelModeColoursLeavesAndLeavesEmptySpaceBlack) {
   REQUIRE_OSMESA();
   QuadSetup s;
