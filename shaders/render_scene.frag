@@ -149,6 +149,18 @@ float polygonIrradiance(vec3 p, vec3 n, vec3 a, vec3 b, vec3 c, out vec3 lightCe
 // shadow the surface itself; directions behind the emitter's plane carry no
 // light, so what the map holds there (the ceiling around a ceiling light)
 // blocks nothing.
+// Distance / far of the receiver's tangent plane (through the light centre
+// lc's offset `plane` = (ps - lc).n) along the shadow-map direction of uv t,
+// or a negative value for directions behind the emitter (normal nE).
+float receiverDepth(mat4 clipToRender, vec2 t, vec3 lc, vec3 n, vec3 nE, float plane, float far) {
+  vec4 w = clipToRender * vec4(t * 2.0 - 1.0, 0.0, 1.0);
+  vec3 dir = normalize(w.xyz / w.w - lc);
+  if (dot(dir, nE) <= 0.0) return -1.0;
+  float dn = dot(dir, n);
+  float receiver = dn < -1e-4 || dn > 1e-4 ? plane / dn : far;
+  return receiver > 0.0 ? min(receiver / far, 1.0) : 1.0;
+}
+
 float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
   Light L = uLights[i];
   int first = int(L.params.z);
@@ -179,15 +191,11 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
       vec2 g = (vec2(x, y) + 0.5) / float(kTaps) * 2.0 - 1.0;
       vec2 t = uv + vec2(kSearchTurn.x * g.x - kSearchTurn.y * g.y,
                          kSearchTurn.y * g.x + kSearchTurn.x * g.y) * search;
-      vec4 w = clipToRender * vec4(t * 2.0 - 1.0, 0.0, 1.0);
-      vec3 dir = normalize(w.xyz / w.w - lc);
+      float receiver = receiverDepth(clipToRender, t, lc, n, L.directionRange.xyz, plane, far);
       // Behind the emitter's plane no light travels: nothing there blocks it.
-      if (dot(dir, L.directionRange.xyz) <= 0.0) continue;
-      float dn = dot(dir, n);
-      float receiver = dn < -1e-4 || dn > 1e-4 ? plane / dn : far;
-      if (receiver <= 0.0) receiver = far;
+      if (receiver < 0.0) continue;
       float stored = texture(uShadowDepths, vec3(t, float(layer))).r;
-      if (stored < receiver / far - uShadowParams.x) {
+      if (stored < receiver - uShadowParams.x) {
         blockers += 1.0;
         blockerSum += stored * far;
       }
@@ -208,16 +216,9 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
     for (int x = 0; x < kFilterTaps; ++x) {
       vec2 g = (vec2(x, y) + 0.5) / float(kFilterTaps) * 2.0 - 1.0;
       vec2 t = uv + vec2(kTurn.x * g.x - kTurn.y * g.y, kTurn.y * g.x + kTurn.x * g.y) * radius;
-      vec4 w = clipToRender * vec4(t * 2.0 - 1.0, 0.0, 1.0);
-      vec3 dir = normalize(w.xyz / w.w - lc);
-      if (dot(dir, L.directionRange.xyz) <= 0.0) {
-        lit += 1.0;
-        continue;
-      }
-      float dn = dot(dir, n);
-      float receiver = dn < -1e-4 || dn > 1e-4 ? plane / dn : far;
-      if (receiver <= 0.0) receiver = far;
-      lit += texture(uShadowMaps, vec4(t, float(layer), min(receiver / far, 1.0) - uShadowParams.x));
+      float receiver = receiverDepth(clipToRender, t, lc, n, L.directionRange.xyz, plane, far);
+      lit += receiver < 0.0 ? 1.0
+                            : texture(uShadowMaps, vec4(t, float(layer), receiver - uShadowParams.x));
     }
   }
   return lit / float(kFilterTaps * kFilterTaps);
