@@ -365,6 +365,7 @@ struct Renderer::Impl {
           if (range.texture >= 0) {
             v.uv[0] = (*uv)[2 * index];
             v.uv[1] = (*uv)[2 * index + 1];
+            mat.baseColorTransform.apply(v.uv[0], v.uv[1]);  // affine: per vertex is exact
           }
           vertices.push_back(v);
         }

@@ -531,6 +531,32 @@ class SceneBuilder {
                           " out of range");
         }
         int texCoord = pbr.baseColorTexture.texCoord;
+        auto transform = pbr.baseColorTexture.extensions.find("KHR_texture_transform");
+        if (transform != pbr.baseColorTexture.extensions.end() && transform->second.IsObject()) {
+          const tinygltf::Value& t = transform->second;
+          auto pair = [&](const char* key, float* out) {
+            if (!t.Has(key)) return;
+            const tinygltf::Value& a = t.Get(key);
+            if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) {
+              fail(path_, "material " + std::to_string(i) + ": KHR_texture_transform " + key +
+                              " is not two numbers");
+            }
+            out[0] = float(a.Get(0).GetNumberAsDouble());
+            out[1] = float(a.Get(1).GetNumberAsDouble());
+          };
+          TextureTransform& tt = m.baseColorTransform;
+          pair("offset", tt.offset);
+          pair("scale", tt.scale);
+          if (t.Has("rotation") && t.Get("rotation").IsNumber()) {
+            tt.rotation = float(t.Get("rotation").GetNumberAsDouble());
+          }
+          if (t.Has("texCoord") && t.Get("texCoord").IsInt()) texCoord = t.Get("texCoord").GetNumberAsInt();
+          if (!std::isfinite(tt.offset[0]) || !std::isfinite(tt.offset[1]) ||
+              !std::isfinite(tt.scale[0]) || !std::isfinite(tt.scale[1]) ||
+              !std::isfinite(tt.rotation)) {
+            fail(path_, "material " + std::to_string(i) + ": KHR_texture_transform is not finite");
+          }
+        }
         if (texCoord == 0 || texCoord == 1) {
           m.baseColorTexture = textureFromImage(model_.textures[size_t(tex)].source, tex);
           m.baseColorTexCoord = texCoord;

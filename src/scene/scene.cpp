@@ -22,6 +22,14 @@ Vec3 Texture::lookup(float u, float v) const {
   return texels[size_t(y) * size_t(width) + size_t(x)];
 }
 
+void TextureTransform::apply(float& u, float& v) const {
+  const float c = std::cos(rotation), s = std::sin(rotation);
+  const float su = scale[0] * u, sv = scale[1] * v;
+  const float ru = c * su + s * sv, rv = -s * su + c * sv;
+  u = ru + offset[0];
+  v = rv + offset[1];
+}
+
 std::string Material::ToString() const {
   std::ostringstream os;
   os << "Material{" << name << " base " << baseColor.ToString() << " tex " << baseColorTexture
@@ -102,6 +110,7 @@ Vec3 Scene::albedo(size_t t, float b1, float b2) const {
   uint32_t i0 = indices[3 * t], i1 = indices[3 * t + 1], i2 = indices[3 * t + 2];
   float u = b0 * uv[2 * i0] + b1 * uv[2 * i1] + b2 * uv[2 * i2];
   float v = b0 * uv[2 * i0 + 1] + b1 * uv[2 * i1 + 1] + b2 * uv[2 * i2 + 1];
+  m.baseColorTransform.apply(u, v);
   return m.baseColor * textures[size_t(m.baseColorTexture)].lookup(u, v);
 }
 

@@ -30,11 +30,23 @@ struct Texture {
 };
 
 /// glTF metallic-roughness material (the subset the bake and renderer use).
+/// KHR_texture_transform of a texture reference: (u', v') = offset +
+/// R(rotation) S(scale) (u, v), with R = [cos sin; -sin cos] as the extension
+/// defines it. Affine, so it may be applied to vertex UVs before
+/// interpolation (the renderer) or to interpolated UVs (the bake): the same.
+struct TextureTransform {
+  float offset[2] = {0, 0};
+  float rotation = 0;  ///< radians
+  float scale[2] = {1, 1};
+  void apply(float& u, float& v) const;
+};
+
 struct Material {
   std::string name;
   Vec3 baseColor{0.8f, 0.8f, 0.8f};  ///< linear RGB albedo factor
   int baseColorTexture = -1;         ///< index into Scene::textures, -1 = none
   int baseColorTexCoord = 0;         ///< which UV set (0 or 1) the texture uses
+  TextureTransform baseColorTransform;  ///< KHR_texture_transform of the base colour texture
   float metallic = 0.0f;             ///< [0,1]
   float roughness = 1.0f;            ///< [0,1], perceptual (alpha = roughness^2)
   Vec3 emission{0, 0, 0};            ///< radiance W/(m^2 sr): emissiveFactor * strength

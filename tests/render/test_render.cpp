@@ -415,14 +415,11 @@ TEST(RenderImage, DirectPointLightMatchesInverseSquareLaw) {
   EXPECT_GT(dark.pixel(lit, p.height / 2)[0], 0.05f);
 }
 
-// glTF base colour textures are sampled per pixel (they were sampled at the
-// vertices, so a checker floor came out one colour): a quad with a red/blue
-// checker (16x16 texels, cells of 4x4) repeated twice across it, under a
-// point light, shows at the centres of two neighbouring cells the colours the
-// bake's own lookup (Scene::albedo) gives there. Cell centres lie two texels
-// from any border, where bilinear filtering returns the cell's colour.
-TEST(RenderImage, BaseColorTextureIsSampledPerPixel) {
-  REQUIRE_OSMESA();
+/// Renders QuadSetup's quad with a red/blue checker (16x16 texels, cells of
+/// 4x4) repeated twice across it under a point light, and checks that the
+/// centres of two neighbouring cells show the colours the bake's own lookup
+/// (Scene::albedo) gives there. Returns which of the two was red.
+std::vector<bool> checkCheckerQuad(const TextureTransform& transform, const std::string& name) {
   QuadSetup s;
   Texture checker;
   checker.width = checker.height = 16;
@@ -433,9 +430,12 @@ TEST(RenderImage, BaseColorTextureIsSampledPerPixel) {
   s.scene.textures.push_back(checker);
   s.scene.materials[0].baseColor = {1, 1, 1};
   s.scene.materials[0].baseColorTexture = 0;
+  s.scene.materials[0].baseColorTransform = transform;
   // The quad's corners (-1,-1), (1,-1), (1,1), (-1,1): UV = (x + 1, y + 0.675),
   // 8 cells per world unit; the row y = -0.05 through the view centre is at
-  // v = 0.625, a cell centre, and so are x = -0.0625 and x = 0.0625.
+  // v = 0.625, a cell centre, and so are x = -0.0625 and x = 0.0625. Cell
+  // centres lie two texels from any border, where bilinear filtering
+  // returns the cell's colour.
   s.scene.texcoords0 = {0, -0.325f, 2, -0.325f, 2, 1.675f, 0, 1.675f};
   Light light;
   light.type = Light::Type::Point;
@@ -450,10 +450,10 @@ TEST(RenderImage, BaseColorTextureIsSampledPerPixel) {
   p.height = 96;
   p.mode = RenderMode::Direct;
   const RgbImage image = renderer.render(s.camera, p);
-  const std::string dir = test::outputDir("render_checker");
+  const std::string dir = test::outputDir(name);
   writePng(dir + "/rendered.png", image, 1.0f);
   const float worldPerPixel = 2.0f * 2.0f * std::tan(0.5f * s.camera.yfov) / float(p.height);
-  int cells[2] = {0, 0};  // centres seen red, blue
+  std::vector<bool> isRed;
   for (float x : {-0.0625f, 0.0625f}) {
     const float y = -0.05f;
     const int px = p.width / 2 + int(std::floor((x - 0.1f) / worldPerPixel));
@@ -462,14 +462,33 @@ TEST(RenderImage, BaseColorTextureIsSampledPerPixel) {
     // triangle 1 (corners 0, 2, 3) otherwise; barycentrics of the point.
     const Vec3 albedo = y < x ? s.scene.albedo(0, 0.5f * (x - y), 0.5f * (y + 1.0f))
                               : s.scene.albedo(1, 0.5f * (x + 1.0f), 0.5f * (y - x));
-    ++cells[albedo.x > albedo.z ? 0 : 1];
+    isRed.push_back(albedo.x > albedo.z);
     const float ratio = c[0] / c[2], expected = albedo.x / albedo.z;
     EXPECT_NEAR(ratio, expected, 0.02f * expected)
         << "at x = " << x << ": rendered " << c[0] << " " << c[1] << " " << c[2] << " (" << dir
         << "/rendered.png)";
   }
-  EXPECT_EQ(cells[0], 1);  // one red and one blue cell: the checker appears
-  EXPECT_EQ(cells[1], 1);
+  return isRed;
+}
+
+// glTF base colour textures are sampled per pixel (they were sampled at the
+// vertices, so a checker floor came out one colour).
+TEST(RenderImage, BaseColorTextureIsSampledPerPixel) {
+  REQUIRE_OSMESA();
+  const std::vector<bool> red = checkCheckerQuad(TextureTransform{}, "render_checker");
+  EXPECT_NE(red[0], red[1]) << "one red and one blue cell: the checker appears";
+}
+
+// KHR_texture_transform: an offset of one cell (0.25 in u) swaps the colours
+// of the two cells, in the renderer and in the bake's lookup alike.
+TEST(RenderImage, TextureTransformMovesTheTexture) {
+  REQUIRE_OSMESA();
+  TextureTransform shift;
+  shift.offset[0] = 0.25f;
+  const std::vector<bool> plain = checkCheckerQuad(TextureTransform{}, "render_checker_plain");
+  const std::vector<bool> moved = checkCheckerQuad(shift, "render_checker_moved");
+  EXPECT_NE(plain[0], moved[0]);
+  EXPECT_NE(plain[1], moved[1]);
 }
 
 /// Form factor from a point to the rectangle [0, x] x [0, y] in a parallel

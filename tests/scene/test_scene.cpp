@@ -472,6 +472,35 @@ TEST(SceneGltf, MaterialExtensionsAndTexture) {
   expectNear(t.texels[1], Vec3{0.50289f}, 1e-4f, "grey texel");
 }
 
+// KHR_texture_transform on the base colour texture: offset, rotation, scale
+// and its texCoord override are read; the transform is the extension's
+// offset + R(rotation) S(scale) uv.
+TEST(SceneGltf, TextureTransform) {
+  std::string dir = test::outputDir("SceneGltf_TextureTransform");
+  writeFile(dir + "/tex.ppm", std::string("P6\n2 1\n255\n\xff\x00\x00\xbc\xbc\xbc", 17));
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 0,
+      "extensions": {"KHR_texture_transform": {"offset": [0.5, -0.25], "rotation": 1.5707963,
+        "scale": [2, 3], "texCoord": 1}}}}}])";
+  g.extraTop = R"("textures": [{"source": 0}], "images": [{"uri": "tex.ppm"}], )";
+  Scene s = loadScene(writeGltf(dir, "transform.gltf", g));
+  const Material& m = s.materials.at(0);
+  EXPECT_EQ(m.baseColorTexCoord, 1);
+  EXPECT_FLOAT_EQ(m.baseColorTransform.offset[0], 0.5f);
+  EXPECT_FLOAT_EQ(m.baseColorTransform.offset[1], -0.25f);
+  EXPECT_FLOAT_EQ(m.baseColorTransform.scale[0], 2.0f);
+  EXPECT_FLOAT_EQ(m.baseColorTransform.scale[1], 3.0f);
+  // (1, 0) -> scale (2, 0) -> rotate a quarter turn: (cos 2, -sin 2) = (0, -2) -> + offset.
+  float u = 1, v = 0;
+  m.baseColorTransform.apply(u, v);
+  EXPECT_NEAR(u, 0.5f, 1e-6f);
+  EXPECT_NEAR(v, -2.25f, 1e-6f);
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
+      "extensions": {"KHR_texture_transform": {"offset": [0.5]}}}}}])";
+  expectInputError(writeGltf(dir, "bad-transform.gltf", g), "KHR_texture_transform offset");
+}
+
 // --- lights ---------------------------------------------------------------------
 
 TEST(SceneGltf, PunctualLights) {
