@@ -13,6 +13,7 @@ in vec3 vBaseColor;
 in vec2 vMetallicRoughness;
 in vec3 vEmission;
 in vec2 vUv;
+in vec2 vNormalUv;
 out vec4 fragColor;
 
 uniform usampler3D uOctree;  // RGBA8UI pool of 2x2x2 tiles
@@ -34,6 +35,9 @@ uniform float uExposureScale;
 uniform bool uEncodeSrgb;
 uniform sampler2D uBaseColorTexture;  // linear RGB (RGBA16F), mipmapped
 uniform bool uHasBaseColorTexture;
+uniform sampler2D uNormalTexture;  // tangent-space normal map, linear [0, 1] texels
+uniform bool uHasNormalTexture;
+uniform float uNormalScale;
 uniform float uTransmission;  // KHR_materials_transmission of this draw; 0 = opaque
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 
@@ -293,6 +297,26 @@ vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughn
   return sum;
 }
 
+// The normal map's normal in world space. Tangents are not read from the
+// file: the tangent is the direction of +u on the surface, from screen-space
+// derivatives of the position and the UVs (as the glTF sample viewer does
+// without TANGENT), and the bitangent cross(n, t), glTF's convention for
+// tangent.w = 1 (mirrored UVs are not detected).
+vec3 perturbNormal(vec3 n, vec3 p, vec2 uv) {
+  vec3 dpdx = dFdx(p), dpdy = dFdy(p);
+  vec2 duvdx = dFdx(uv), duvdy = dFdy(uv);
+  float det = duvdx.x * duvdy.y - duvdy.x * duvdx.y;
+  if (abs(det) < 1e-20) return n;
+  vec3 t = (duvdy.y * dpdx - duvdx.y * dpdy) / det;
+  t = t - n * dot(n, t);
+  if (dot(t, t) < 1e-20) return n;
+  t = normalize(t);
+  vec3 b = cross(n, t);
+  vec3 m = texture(uNormalTexture, uv).rgb * 2.0 - 1.0;
+  m.xy *= uNormalScale;
+  return normalize(mat3(t, b, n) * m);
+}
+
 vec3 srgbDecode(vec3 c) {
   return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
 }
@@ -311,6 +335,7 @@ void main() {
   vec3 ng = cross(dFdx(vPosition), dFdy(vPosition));
   if (dot(ng, v) < 0.0) ng = -ng;
   if (dot(n, ng) < 0.0) n = -n;
+  if (uHasNormalTexture) n = perturbNormal(n, vPosition, vNormalUv);
   // glTF: base colour = factor x texture, sampled per pixel (trilinear,
   // anisotropic where the context has it).
   vec3 baseColor = vBaseColor;

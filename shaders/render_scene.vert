@@ -8,6 +8,7 @@ layout(location = 2) in vec3 aBaseColor;  // linear base colour factor
 layout(location = 3) in vec2 aMetallicRoughness;
 layout(location = 4) in vec3 aEmission;  // W/(m^2 sr)
 layout(location = 5) in vec2 aUv;        // the UV set the base colour texture names
+layout(location = 6) in vec2 aNormalUv;  // the UV set the normal map names
 
 uniform mat4 uViewProj;
 invariant gl_Position;  // as render_depth.vert: the depth pre-pass must match exactly
@@ -18,6 +19,7 @@ out vec3 vBaseColor;
 out vec2 vMetallicRoughness;
 out vec3 vEmission;
 out vec2 vUv;
+out vec2 vNormalUv;
 
 void main() {
   vPosition = aPosition;
@@ -26,5 +28,6 @@ void main() {
   vMetallicRoughness = aMetallicRoughness;
   vEmission = aEmission;
   vUv = aUv;
+  vNormalUv = aNormalUv;
   gl_Position = uViewProj * vec4(aPosition, 1.0);
 }

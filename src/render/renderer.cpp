@@ -76,12 +76,14 @@ struct Vertex {
   float metallicRoughness[2];
   float emission[3];
   float uv[2];  ///< the texture coordinates the base colour texture names (TEXCOORD_0 or _1)
+  float normalUv[2];  ///< the texture coordinates of the normal map
 };
 
-/// A run of the vertex buffer drawn with one base colour texture (-1: none)
-/// and, for transmissive surfaces (KHR_materials_transmission), one material.
+/// A run of the vertex buffer drawn with one material's textures.
 struct DrawRange {
-  int texture = -1;  ///< index into Scene::textures
+  int texture = -1;        ///< base colour texture, index into Scene::textures (-1: none)
+  int normalTexture = -1;  ///< normal map, index into Scene::textures (-1: none)
+  float normalScale = 1;
   GLint first = 0;
   GLsizei count = 0;
   float transmission = 0;  ///< > 0: drawn after the opaque scene, see-through
@@ -271,18 +273,6 @@ struct Renderer::Impl {
     voxelSize = octree.depth > 0 ? octree.cubeSize / float(1 << octree.depth) : octree.cubeSize;
   }
 
-  /// The base colour texture triangle t samples per pixel, and its UV set;
-  /// -1 when it has none (or its UV set is missing).
-  static int textureOf(const Scene& scene, size_t t, const std::vector<float>** uv) {
-    const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
-    if (m < 0 || size_t(m) >= scene.materials.size()) return -1;
-    const Material& mat = scene.materials[size_t(m)];
-    const int tex = mat.baseColorTexture;
-    if (tex < 0 || size_t(tex) >= scene.textures.size()) return -1;
-    *uv = mat.baseColorTexCoord == 1 ? &scene.texcoords1 : &scene.texcoords0;
-    return (*uv)->size() == 2 * scene.positions.size() ? tex : -1;
-  }
-
   /// Uploads a texture (linear RGB) with mipmaps, trilinear and anisotropic
   /// filtering, repeat wrap (glTF's default sampler).
   GLuint uploadTexture(const Texture& t) {
@@ -317,39 +307,47 @@ struct Renderer::Impl {
       glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &maxAnisotropy);
       maxAnisotropy = std::min(maxAnisotropy, 16.0f);
     }
-    // Triangles in runs of one base colour texture (untextured first), so
-    // that the scene pass binds each texture once; transmissive triangles
-    // last, in runs of one material, drawn after the opaque scene they show.
-    auto transmissionOf = [&scene](size_t t) {
+    // Triangles in runs of one material (so that the scene pass binds each
+    // material's textures once), opaque first; transmissive runs last, drawn
+    // after the opaque scene they show.
+    const Material fallback;
+    auto materialOf = [&](size_t t) -> const Material& {
       const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
-      return m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)].transmission
-                                                          : 0.0f;
+      return m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
     };
-    const size_t groups = scene.textures.size() + 1;
-    std::vector<std::vector<size_t>> byTexture(groups * (scene.materials.size() + 1));
+    std::vector<std::vector<size_t>> byMaterial(2 * (scene.materials.size() + 1));
     for (size_t t = 0; t < scene.triangleCount(); ++t) {
-      const std::vector<float>* uv = nullptr;
-      const size_t texture = size_t(textureOf(scene, t, &uv) + 1);
-      const size_t material = transmissionOf(t) > 0 ? size_t(scene.triangleMaterial[t]) + 1 : 0;
-      byTexture[material * groups + texture].push_back(t);
+      const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+      const size_t slot = m >= 0 && size_t(m) < scene.materials.size() ? size_t(m) + 1 : 0;
+      const bool transmissive = materialOf(t).transmission > 0;
+      byMaterial[(transmissive ? scene.materials.size() + 1 : 0) + slot].push_back(t);
     }
+    auto uvSet = [&](int texCoord) -> const std::vector<float>& {
+      return texCoord == 1 ? scene.texcoords1 : scene.texcoords0;
+    };
+    auto usable = [&](int texture, int texCoord) {
+      return texture >= 0 && size_t(texture) < scene.textures.size() &&
+             uvSet(texCoord).size() == 2 * scene.positions.size();
+    };
     std::vector<Vertex> vertices;
     vertices.reserve(scene.triangleCount() * 3);
-    const Material fallback;
     textures.assign(scene.textures.size(), 0);
-    for (size_t group = 0; group < byTexture.size(); ++group) {
-      if (byTexture[group].empty()) continue;
+    auto textureId = [&](int texture) {
+      if (!textures[size_t(texture)]) textures[size_t(texture)] = uploadTexture(scene.textures[size_t(texture)]);
+      return texture;
+    };
+    for (const std::vector<size_t>& group : byMaterial) {
+      if (group.empty()) continue;
+      const Material& mat = materialOf(group.front());
       DrawRange range;
-      range.texture = int(group % groups) - 1;
-      range.transmission = transmissionOf(byTexture[group].front());
+      range.transmission = mat.transmission;
+      if (usable(mat.baseColorTexture, mat.baseColorTexCoord)) range.texture = textureId(mat.baseColorTexture);
+      if (usable(mat.normalTexture, mat.normalTexCoord)) {
+        range.normalTexture = textureId(mat.normalTexture);
+        range.normalScale = mat.normalScale;
+      }
       range.first = GLint(vertices.size());
-      if (range.texture >= 0) textures[size_t(range.texture)] = uploadTexture(scene.textures[size_t(range.texture)]);
-      for (size_t t : byTexture[group]) {
-        int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
-        const Material& mat =
-            m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
-        const std::vector<float>* uv = nullptr;
-        textureOf(scene, t, &uv);
+      for (size_t t : group) {
         Vec3 faceN = scene.faceNormal(t);
         for (int k = 0; k < 3; ++k) {
           uint32_t index = scene.indices[t * 3 + size_t(k)];
@@ -362,10 +360,18 @@ struct Renderer::Impl {
           v.metallicRoughness[0] = mat.metallic;
           v.metallicRoughness[1] = mat.roughness;
           std::memcpy(v.emission, &mat.emission, sizeof v.emission);
+          // Texture transforms are affine: applied per vertex they are exact.
           if (range.texture >= 0) {
-            v.uv[0] = (*uv)[2 * index];
-            v.uv[1] = (*uv)[2 * index + 1];
-            mat.baseColorTransform.apply(v.uv[0], v.uv[1]);  // affine: per vertex is exact
+            const std::vector<float>& uv = uvSet(mat.baseColorTexCoord);
+            v.uv[0] = uv[2 * index];
+            v.uv[1] = uv[2 * index + 1];
+            mat.baseColorTransform.apply(v.uv[0], v.uv[1]);
+          }
+          if (range.normalTexture >= 0) {
+            const std::vector<float>& uv = uvSet(mat.normalTexCoord);
+            v.normalUv[0] = uv[2 * index];
+            v.normalUv[1] = uv[2 * index + 1];
+            mat.normalTransform.apply(v.normalUv[0], v.normalUv[1]);
           }
           vertices.push_back(v);
         }
@@ -392,6 +398,7 @@ struct Renderer::Impl {
     attrib(3, 2, offsetof(Vertex, metallicRoughness));
     attrib(4, 3, offsetof(Vertex, emission));
     attrib(5, 2, offsetof(Vertex, uv));
+    attrib(6, 2, offsetof(Vertex, normalUv));
     glBindVertexArray(0);
     glGenVertexArrays(1, &emptyVao);
     checkGl("uploading the scene");
@@ -742,6 +749,9 @@ struct Renderer::Impl {
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, lightUbo);
     glBindVertexArray(vao);
     const GLint hasTexture = loc("uHasBaseColorTexture");
+    const GLint hasNormal = loc("uHasNormalTexture");
+    const GLint normalScale = loc("uNormalScale");
+    glUniform1i(loc("uNormalTexture"), 7);
     const GLint transmission = loc("uTransmission");
     glUniform1i(loc("uBehind"), 6);
     glUniform1f(transmission, 0.0f);
@@ -759,8 +769,13 @@ struct Renderer::Impl {
       }
       glActiveTexture(GL_TEXTURE4);
       glBindTexture(GL_TEXTURE_2D, range.texture >= 0 ? textures[size_t(range.texture)] : 0);
+      glActiveTexture(GL_TEXTURE7);
+      glBindTexture(GL_TEXTURE_2D,
+                    range.normalTexture >= 0 ? textures[size_t(range.normalTexture)] : 0);
       glActiveTexture(GL_TEXTURE0);
       glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
+      glUniform1i(hasNormal, range.normalTexture >= 0 ? 1 : 0);
+      glUniform1f(normalScale, range.normalScale);
       glUniform1f(transmission, range.transmission);
       glDrawArrays(GL_TRIANGLES, range.first, range.count);
     }

@@ -531,42 +531,63 @@ class SceneBuilder {
                           " out of range");
         }
         int texCoord = pbr.baseColorTexture.texCoord;
-        auto transform = pbr.baseColorTexture.extensions.find("KHR_texture_transform");
-        if (transform != pbr.baseColorTexture.extensions.end() && transform->second.IsObject()) {
-          const tinygltf::Value& t = transform->second;
-          auto pair = [&](const char* key, float* out) {
-            if (!t.Has(key)) return;
-            const tinygltf::Value& a = t.Get(key);
-            if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) {
-              fail(path_, "material " + std::to_string(i) + ": KHR_texture_transform " + key +
-                              " is not two numbers");
-            }
-            out[0] = float(a.Get(0).GetNumberAsDouble());
-            out[1] = float(a.Get(1).GetNumberAsDouble());
-          };
-          TextureTransform& tt = m.baseColorTransform;
-          pair("offset", tt.offset);
-          pair("scale", tt.scale);
-          if (t.Has("rotation") && t.Get("rotation").IsNumber()) {
-            tt.rotation = float(t.Get("rotation").GetNumberAsDouble());
-          }
-          if (t.Has("texCoord") && t.Get("texCoord").IsInt()) texCoord = t.Get("texCoord").GetNumberAsInt();
-          if (!std::isfinite(tt.offset[0]) || !std::isfinite(tt.offset[1]) ||
-              !std::isfinite(tt.scale[0]) || !std::isfinite(tt.scale[1]) ||
-              !std::isfinite(tt.rotation)) {
-            fail(path_, "material " + std::to_string(i) + ": KHR_texture_transform is not finite");
-          }
-        }
+        readTextureTransform(pbr.baseColorTexture.extensions, i, m.baseColorTransform, texCoord);
         if (texCoord == 0 || texCoord == 1) {
           m.baseColorTexture = textureFromImage(model_.textures[size_t(tex)].source, tex);
           m.baseColorTexCoord = texCoord;
         }  // other UV sets are not loaded: the factor alone is used
       }
+      const int normal = g.normalTexture.index;
+      if (normal >= 0) {
+        if (size_t(normal) >= model_.textures.size()) {
+          fail(path_, "material " + std::to_string(i) + ": normal texture index " +
+                          std::to_string(normal) + " out of range");
+        }
+        int texCoord = g.normalTexture.texCoord;
+        readTextureTransform(g.normalTexture.extensions, i, m.normalTransform, texCoord);
+        m.normalScale = float(g.normalTexture.scale);
+        if (!std::isfinite(m.normalScale)) {
+          fail(path_, "material " + std::to_string(i) + ": normal texture scale is not finite");
+        }
+        if (texCoord == 0 || texCoord == 1) {
+          m.normalTexture = textureFromImage(model_.textures[size_t(normal)].source, normal, false);
+          m.normalTexCoord = texCoord;
+        }
+      }
       scene_.materials.push_back(std::move(m));
     }
   }
 
-  int textureFromImage(int source, int tex) {
+  /// KHR_texture_transform of a texture reference into `out`; its texCoord
+  /// overrides `texCoord`. @throws InputError naming the material.
+  void readTextureTransform(const tinygltf::ExtensionMap& extensions, size_t i,
+                            TextureTransform& tt, int& texCoord) {
+    auto transform = extensions.find("KHR_texture_transform");
+    if (transform == extensions.end() || !transform->second.IsObject()) return;
+    const tinygltf::Value& t = transform->second;
+    auto pair = [&](const char* key, float* out) {
+      if (!t.Has(key)) return;
+      const tinygltf::Value& a = t.Get(key);
+      if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) {
+        fail(path_, "material " + std::to_string(i) + ": KHR_texture_transform " + key +
+                        " is not two numbers");
+      }
+      out[0] = float(a.Get(0).GetNumberAsDouble());
+      out[1] = float(a.Get(1).GetNumberAsDouble());
+    };
+    pair("offset", tt.offset);
+    pair("scale", tt.scale);
+    if (t.Has("rotation") && t.Get("rotation").IsNumber()) {
+      tt.rotation = float(t.Get("rotation").GetNumberAsDouble());
+    }
+    if (t.Has("texCoord") && t.Get("texCoord").IsInt()) texCoord = t.Get("texCoord").GetNumberAsInt();
+    if (!std::isfinite(tt.offset[0]) || !std::isfinite(tt.offset[1]) || !std::isfinite(tt.scale[0]) ||
+        !std::isfinite(tt.scale[1]) || !std::isfinite(tt.rotation)) {
+      fail(path_, "material " + std::to_string(i) + ": KHR_texture_transform is not finite");
+    }
+  }
+
+  int textureFromImage(int source, int tex, bool srgb = true) {
     std::string what =
         "(texture " + std::to_string(tex) + ", image " + std::to_string(source) + ")";
     if (source < 0 || size_t(source) >= model_.images.size()) {
@@ -575,16 +596,18 @@ class SceneBuilder {
     if (!model_.images[size_t(source)].uri.empty()) {
       what = "'" + model_.images[size_t(source)].uri + "' " + what;
     }
-    auto it = imageToTexture_.find(source);
+    // Colour and data decodings of one image are two textures.
+    const int key = 2 * source + (srgb ? 0 : 1);
+    auto it = imageToTexture_.find(key);
     if (it != imageToTexture_.end()) return it->second;
     const tinygltf::Image& im = model_.images[size_t(source)];
     if (im.image.empty()) fail(path_, "unreadable image: no data " + what);
-    Texture t = decodeImage(path_, im.image.data(), im.image.size(), what);
+    Texture t = decodeImage(path_, im.image.data(), im.image.size(), what, srgb);
     t.name =
         im.name.empty() ? (im.uri.empty() ? "image" + std::to_string(source) : im.uri) : im.name;
     int index = int(scene_.textures.size());
     scene_.textures.push_back(std::move(t));
-    imageToTexture_[source] = index;
+    imageToTexture_[key] = index;
     return index;
   }
 
@@ -890,7 +913,7 @@ class SceneBuilder {
 }  // namespace
 
 Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
-                    const std::string& what) {
+                    const std::string& what, bool srgb) {
   DecodedImage d;
   try {
     d = decodeImageBytes(bytes, size);
@@ -907,7 +930,7 @@ Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, si
     const float r = px[0];
     const float g = comp >= 3 ? px[1] : r;
     const float b = comp >= 3 ? px[2] : r;
-    t.texels[i] = {srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)};
+    t.texels[i] = srgb ? Vec3{srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)} : Vec3{r, g, b};
   }
   return t;
 }

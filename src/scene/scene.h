@@ -25,7 +25,8 @@ namespace lo {
 struct Texture {
   std::string name;
   int width = 0, height = 0;
-  std::vector<Vec3> texels;             ///< width * height, already converted from sRGB to linear
+  std::vector<Vec3> texels;             ///< width * height: colour maps converted from sRGB to
+                                        ///< linear, data maps (normal maps) as stored, in [0, 1]
   Vec3 lookup(float u, float v) const;  ///< nearest texel, repeat wrap
 };
 
@@ -47,6 +48,10 @@ struct Material {
   int baseColorTexture = -1;         ///< index into Scene::textures, -1 = none
   int baseColorTexCoord = 0;         ///< which UV set (0 or 1) the texture uses
   TextureTransform baseColorTransform;  ///< KHR_texture_transform of the base colour texture
+  int normalTexture = -1;            ///< tangent-space normal map (linear texels), -1 = none
+  int normalTexCoord = 0;            ///< its UV set (0 or 1)
+  float normalScale = 1.0f;          ///< glTF normalTexture.scale (scales the map's x and y)
+  TextureTransform normalTransform;  ///< its KHR_texture_transform
   float metallic = 0.0f;             ///< [0,1]
   float roughness = 1.0f;            ///< [0,1], perceptual (alpha = roughness^2)
   Vec3 emission{0, 0, 0};            ///< radiance W/(m^2 sr): emissiveFactor * strength

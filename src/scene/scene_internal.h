@@ -34,7 +34,7 @@ std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std
 /// linear-RGB Texture (sRGB transfer function removed; alpha ignored; grey
 /// replicated). Throws InputError "<scenePath>: unreadable image <what>".
 Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
-                    const std::string& what);
+                    const std::string& what, bool srgb = true);
 
 Scene loadGltf(const std::string& path);
 Scene loadObj(const std::string& path);

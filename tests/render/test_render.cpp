@@ -581,6 +581,41 @@ TEST(RenderImage, AreaLightPenumbraIsSmoothAndMonotonic) {
   EXPECT_GE(rising, 10) << "pixels between 10% and 90% of the light";
 }
 
+// Normal maps: a constant map tilting the normal by theta towards +u (the
+// quad's +x, where u grows) makes the quad as bright as a surface facing a
+// sun that comes from that tilted direction, and cos(2 theta) as bright when
+// the sun comes from the mirrored direction: the map is read, in the right
+// frame and with the right sign.
+TEST(RenderImage, NormalMapTiltsTheShadingNormal) {
+  REQUIRE_OSMESA();
+  const float theta = 0.4f;
+  float brightness[2];
+  for (int side = 0; side < 2; ++side) {
+    QuadSetup s;
+    Texture map;
+    map.width = map.height = 1;
+    map.texels = {Vec3{0.5f * (std::sin(theta) + 1.0f), 0.5f, 0.5f * (std::cos(theta) + 1.0f)}};
+    s.scene.textures.push_back(map);
+    s.scene.materials[0].normalTexture = 0;
+    s.scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};  // u along +x
+    Light sun;
+    sun.type = Light::Type::Directional;
+    const float sx = side == 0 ? std::sin(theta) : -std::sin(theta);
+    sun.direction = -Vec3{sx, 0.0f, std::cos(theta)};  // the way the light travels
+    sun.intensity = 2.0f;                               // W/m^2
+    s.scene.lights.push_back(sun);
+    GpuOctree octree =
+        makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+    Renderer renderer(s.scene, octree);
+    RenderParams p = QuadSetup::params(false);
+    p.mode = RenderMode::Direct;
+    brightness[side] = renderer.render(s.camera, p).pixel(p.width / 2, p.height / 2)[0];
+  }
+  const float facing = 0.5f * kInvPi * 2.0f;  // albedo.x / pi * E
+  EXPECT_NEAR(brightness[0], facing, 0.01f * facing);
+  EXPECT_NEAR(brightness[1], facing * std::cos(2.0f * theta), 0.01f * facing);
+}
+
 // Glass (KHR_materials_transmission): a clear pane between the camera and a
 // lit quad shows the quad through it, dimmed only by the Fresnel reflectance
 // at normal incidence (4%), where it used to be drawn as an opaque white

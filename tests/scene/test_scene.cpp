@@ -501,6 +501,29 @@ TEST(SceneGltf, TextureTransform) {
   expectInputError(writeGltf(dir, "bad-transform.gltf", g), "KHR_texture_transform offset");
 }
 
+// normalTexture: index, scale and UV set are read, and the map is decoded as
+// data (no sRGB curve), a separate texture from the same image used as colour.
+TEST(SceneGltf, NormalTextureIsLinearData) {
+  std::string dir = test::outputDir("SceneGltf_NormalTexture");
+  writeFile(dir + "/tex.ppm", std::string("P6\n2 1\n255\n\xff\x00\x00\xbc\xbc\xbc", 17));
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+      "normalTexture": {"index": 0, "scale": 0.5}}])";
+  g.extraTop = R"("textures": [{"source": 0}], "images": [{"uri": "tex.ppm"}], )";
+  Scene s = loadScene(writeGltf(dir, "normal.gltf", g));
+  const Material& m = s.materials.at(0);
+  ASSERT_GE(m.normalTexture, 0);
+  ASSERT_GE(m.baseColorTexture, 0);
+  EXPECT_NE(m.normalTexture, m.baseColorTexture);
+  EXPECT_FLOAT_EQ(m.normalScale, 0.5f);
+  EXPECT_EQ(m.normalTexCoord, 0);
+  expectNear(s.textures[size_t(m.normalTexture)].texels[1], Vec3{188.0f / 255.0f}, 1e-6f,
+             "data texel");
+  expectNear(s.textures[size_t(m.baseColorTexture)].texels[1], Vec3{0.50289f}, 1e-4f,
+             "colour texel");
+}
+
 // --- lights ---------------------------------------------------------------------
 
 TEST(SceneGltf, PunctualLights) {
