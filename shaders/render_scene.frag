@@ -14,6 +14,8 @@ in vec2 vMetallicRoughness;
 in vec3 vEmission;
 in vec2 vUv;
 in vec2 vNormalUv;
+in vec2 vMetallicRoughnessUv;
+in vec2 vOcclusionUv;
 out vec4 fragColor;
 
 uniform usampler3D uOctree;  // RGBA8UI pool of 2x2x2 tiles
@@ -38,6 +40,11 @@ uniform bool uHasBaseColorTexture;
 uniform sampler2D uNormalTexture;  // tangent-space normal map, linear [0, 1] texels
 uniform bool uHasNormalTexture;
 uniform float uNormalScale;
+uniform sampler2D uMetallicRoughnessTexture;  // linear: G roughness, B metallic
+uniform bool uHasMetallicRoughnessTexture;
+uniform sampler2D uOcclusionTexture;  // linear: R ambient occlusion
+uniform bool uHasOcclusionTexture;
+uniform float uOcclusionStrength;
 uniform float uTransmission;  // KHR_materials_transmission of this draw; 0 = opaque
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 
@@ -342,6 +349,11 @@ void main() {
   if (uHasBaseColorTexture) baseColor *= texture(uBaseColorTexture, vUv).rgb;
   float metallic = vMetallicRoughness.x;
   float roughness = vMetallicRoughness.y;
+  if (uHasMetallicRoughnessTexture) {
+    vec3 mr = texture(uMetallicRoughnessTexture, vMetallicRoughnessUv).rgb;
+    roughness *= mr.g;
+    metallic *= mr.b;
+  }
 
   vec3 radiance = vec3(0.0);
   if (uMode == LO_MODE_VOXELS) {
@@ -355,8 +367,12 @@ void main() {
     }
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_INDIRECT) {
       LoSurface s = LoSurface(n, v, baseColor, metallic, roughness);
-      radiance += loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
-                                   uInterpolation, uMaxVdls, s);
+      // glTF: occlusion darkens the indirect light only.
+      float occlusion = uHasOcclusionTexture
+                            ? 1.0 + uOcclusionStrength * (texture(uOcclusionTexture, vOcclusionUv).r - 1.0)
+                            : 1.0;
+      radiance += occlusion * loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth,
+                                               uNormalOffset, uInterpolation, uMaxVdls, s);
     }
   }
   if (uTransmission > 0.0) {

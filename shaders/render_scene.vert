@@ -9,6 +9,8 @@ layout(location = 3) in vec2 aMetallicRoughness;
 layout(location = 4) in vec3 aEmission;  // W/(m^2 sr)
 layout(location = 5) in vec2 aUv;        // the UV set the base colour texture names
 layout(location = 6) in vec2 aNormalUv;  // the UV set the normal map names
+layout(location = 7) in vec2 aMetallicRoughnessUv;
+layout(location = 8) in vec2 aOcclusionUv;
 
 uniform mat4 uViewProj;
 invariant gl_Position;  // as render_depth.vert: the depth pre-pass must match exactly
@@ -20,6 +22,8 @@ out vec2 vMetallicRoughness;
 out vec3 vEmission;
 out vec2 vUv;
 out vec2 vNormalUv;
+out vec2 vMetallicRoughnessUv;
+out vec2 vOcclusionUv;
 
 void main() {
   vPosition = aPosition;
@@ -29,5 +33,7 @@ void main() {
   vEmission = aEmission;
   vUv = aUv;
   vNormalUv = aNormalUv;
+  vMetallicRoughnessUv = aMetallicRoughnessUv;
+  vOcclusionUv = aOcclusionUv;
   gl_Position = uViewProj * vec4(aPosition, 1.0);
 }

@@ -77,6 +77,8 @@ struct Vertex {
   float emission[3];
   float uv[2];  ///< the texture coordinates the base colour texture names (TEXCOORD_0 or _1)
   float normalUv[2];  ///< the texture coordinates of the normal map
+  float metallicRoughnessUv[2];
+  float occlusionUv[2];
 };
 
 /// A run of the vertex buffer drawn with one material's textures.
@@ -84,6 +86,9 @@ struct DrawRange {
   int texture = -1;        ///< base colour texture, index into Scene::textures (-1: none)
   int normalTexture = -1;  ///< normal map, index into Scene::textures (-1: none)
   float normalScale = 1;
+  int metallicRoughnessTexture = -1;
+  int occlusionTexture = -1;
+  float occlusionStrength = 1;
   GLint first = 0;
   GLsizei count = 0;
   float transmission = 0;  ///< > 0: drawn after the opaque scene, see-through
@@ -346,6 +351,13 @@ struct Renderer::Impl {
         range.normalTexture = textureId(mat.normalTexture);
         range.normalScale = mat.normalScale;
       }
+      if (usable(mat.metallicRoughnessTexture, mat.metallicRoughnessTexCoord)) {
+        range.metallicRoughnessTexture = textureId(mat.metallicRoughnessTexture);
+      }
+      if (usable(mat.occlusionTexture, mat.occlusionTexCoord)) {
+        range.occlusionTexture = textureId(mat.occlusionTexture);
+        range.occlusionStrength = mat.occlusionStrength;
+      }
       range.first = GLint(vertices.size());
       for (size_t t : group) {
         Vec3 faceN = scene.faceNormal(t);
@@ -367,11 +379,19 @@ struct Renderer::Impl {
             v.uv[1] = uv[2 * index + 1];
             mat.baseColorTransform.apply(v.uv[0], v.uv[1]);
           }
-          if (range.normalTexture >= 0) {
-            const std::vector<float>& uv = uvSet(mat.normalTexCoord);
-            v.normalUv[0] = uv[2 * index];
-            v.normalUv[1] = uv[2 * index + 1];
-            mat.normalTransform.apply(v.normalUv[0], v.normalUv[1]);
+          auto setUv = [&](float* out, int texCoord, const TextureTransform& transform) {
+            const std::vector<float>& uv = uvSet(texCoord);
+            out[0] = uv[2 * index];
+            out[1] = uv[2 * index + 1];
+            transform.apply(out[0], out[1]);
+          };
+          if (range.normalTexture >= 0) setUv(v.normalUv, mat.normalTexCoord, mat.normalTransform);
+          if (range.metallicRoughnessTexture >= 0) {
+            setUv(v.metallicRoughnessUv, mat.metallicRoughnessTexCoord,
+                  mat.metallicRoughnessTransform);
+          }
+          if (range.occlusionTexture >= 0) {
+            setUv(v.occlusionUv, mat.occlusionTexCoord, mat.occlusionTransform);
           }
           vertices.push_back(v);
         }
@@ -399,6 +419,8 @@ struct Renderer::Impl {
     attrib(4, 3, offsetof(Vertex, emission));
     attrib(5, 2, offsetof(Vertex, uv));
     attrib(6, 2, offsetof(Vertex, normalUv));
+    attrib(7, 2, offsetof(Vertex, metallicRoughnessUv));
+    attrib(8, 2, offsetof(Vertex, occlusionUv));
     glBindVertexArray(0);
     glGenVertexArrays(1, &emptyVao);
     checkGl("uploading the scene");
@@ -752,6 +774,11 @@ struct Renderer::Impl {
     const GLint hasNormal = loc("uHasNormalTexture");
     const GLint normalScale = loc("uNormalScale");
     glUniform1i(loc("uNormalTexture"), 7);
+    glUniform1i(loc("uMetallicRoughnessTexture"), 8);
+    glUniform1i(loc("uOcclusionTexture"), 9);
+    const GLint hasMr = loc("uHasMetallicRoughnessTexture");
+    const GLint hasOcclusion = loc("uHasOcclusionTexture");
+    const GLint occlusionStrength = loc("uOcclusionStrength");
     const GLint transmission = loc("uTransmission");
     glUniform1i(loc("uBehind"), 6);
     glUniform1f(transmission, 0.0f);
@@ -772,7 +799,17 @@ struct Renderer::Impl {
       glActiveTexture(GL_TEXTURE7);
       glBindTexture(GL_TEXTURE_2D,
                     range.normalTexture >= 0 ? textures[size_t(range.normalTexture)] : 0);
+      glActiveTexture(GL_TEXTURE8);
+      glBindTexture(GL_TEXTURE_2D, range.metallicRoughnessTexture >= 0
+                                       ? textures[size_t(range.metallicRoughnessTexture)]
+                                       : 0);
+      glActiveTexture(GL_TEXTURE9);
+      glBindTexture(GL_TEXTURE_2D,
+                    range.occlusionTexture >= 0 ? textures[size_t(range.occlusionTexture)] : 0);
       glActiveTexture(GL_TEXTURE0);
+      glUniform1i(hasMr, range.metallicRoughnessTexture >= 0 ? 1 : 0);
+      glUniform1i(hasOcclusion, range.occlusionTexture >= 0 ? 1 : 0);
+      glUniform1f(occlusionStrength, range.occlusionStrength);
       glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
       glUniform1i(hasNormal, range.normalTexture >= 0 ? 1 : 0);
       glUniform1f(normalScale, range.normalScale);

@@ -537,22 +537,33 @@ class SceneBuilder {
           m.baseColorTexCoord = texCoord;
         }  // other UV sets are not loaded: the factor alone is used
       }
-      const int normal = g.normalTexture.index;
-      if (normal >= 0) {
-        if (size_t(normal) >= model_.textures.size()) {
-          fail(path_, "material " + std::to_string(i) + ": normal texture index " +
-                          std::to_string(normal) + " out of range");
+      // Data maps (no sRGB curve): normal, metallic-roughness, occlusion.
+      auto dataMap = [&](int index, int texCoord, const tinygltf::ExtensionMap& extensions,
+                         const char* what, int& texture, int& texCoordOut,
+                         TextureTransform& transform) {
+        if (index < 0) return;
+        if (size_t(index) >= model_.textures.size()) {
+          fail(path_, "material " + std::to_string(i) + ": " + what + " index " +
+                          std::to_string(index) + " out of range");
         }
-        int texCoord = g.normalTexture.texCoord;
-        readTextureTransform(g.normalTexture.extensions, i, m.normalTransform, texCoord);
-        m.normalScale = float(g.normalTexture.scale);
-        if (!std::isfinite(m.normalScale)) {
-          fail(path_, "material " + std::to_string(i) + ": normal texture scale is not finite");
-        }
+        readTextureTransform(extensions, i, transform, texCoord);
         if (texCoord == 0 || texCoord == 1) {
-          m.normalTexture = textureFromImage(model_.textures[size_t(normal)].source, normal, false);
-          m.normalTexCoord = texCoord;
+          texture = textureFromImage(model_.textures[size_t(index)].source, index, false);
+          texCoordOut = texCoord;
         }
+      };
+      dataMap(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions,
+              "normal texture", m.normalTexture, m.normalTexCoord, m.normalTransform);
+      m.normalScale = float(g.normalTexture.scale);
+      dataMap(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+              pbr.metallicRoughnessTexture.extensions, "metallic-roughness texture",
+              m.metallicRoughnessTexture, m.metallicRoughnessTexCoord,
+              m.metallicRoughnessTransform);
+      dataMap(g.occlusionTexture.index, g.occlusionTexture.texCoord, g.occlusionTexture.extensions,
+              "occlusion texture", m.occlusionTexture, m.occlusionTexCoord, m.occlusionTransform);
+      m.occlusionStrength = float(g.occlusionTexture.strength);
+      if (!std::isfinite(m.normalScale) || !std::isfinite(m.occlusionStrength)) {
+        fail(path_, "material " + std::to_string(i) + ": a texture scale or strength is not finite");
       }
       scene_.materials.push_back(std::move(m));
     }

@@ -52,6 +52,16 @@ struct Material {
   int normalTexCoord = 0;            ///< its UV set (0 or 1)
   float normalScale = 1.0f;          ///< glTF normalTexture.scale (scales the map's x and y)
   TextureTransform normalTransform;  ///< its KHR_texture_transform
+  /// metallicRoughnessTexture (linear): G scales roughness, B metallic.
+  int metallicRoughnessTexture = -1;
+  int metallicRoughnessTexCoord = 0;
+  TextureTransform metallicRoughnessTransform;
+  /// occlusionTexture (linear): R, weighted by occlusionStrength, darkens the
+  /// indirect light only (glTF).
+  int occlusionTexture = -1;
+  int occlusionTexCoord = 0;
+  float occlusionStrength = 1.0f;
+  TextureTransform occlusionTransform;
   float metallic = 0.0f;             ///< [0,1]
   float roughness = 1.0f;            ///< [0,1], perceptual (alpha = roughness^2)
   Vec3 emission{0, 0, 0};            ///< radiance W/(m^2 sr): emissiveFactor * strength

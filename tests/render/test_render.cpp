@@ -616,6 +616,59 @@ TEST(RenderImage, NormalMapTiltsTheShadingNormal) {
   EXPECT_NEAR(brightness[1], facing * std::cos(2.0f * theta), 0.01f * facing);
 }
 
+// metallicRoughnessTexture: B scales metallic, G roughness. A metal material
+// (factor 1) whose map says metallic 0 renders as the dielectric of the same
+// roughness; and occlusionTexture darkens the octree's light only: R = 0.25
+// at strength 1 leaves a quarter of the indirect image and all of the direct.
+TEST(RenderImage, MetallicRoughnessAndOcclusionMaps) {
+  REQUIRE_OSMESA();
+  auto render = [](bool metalWithMap, float occlusion, RenderMode mode) {
+    QuadSetup s;
+    Material& m = s.scene.materials[0];
+    m.roughness = 0.6f;
+    m.metallic = metalWithMap ? 1.0f : 0.0f;
+    s.scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};
+    if (metalWithMap) {
+      Texture mr;
+      mr.width = mr.height = 1;
+      mr.texels = {Vec3{0.0f, 1.0f, 0.0f}};  // roughness x1, metallic x0
+      s.scene.textures.push_back(mr);
+      m.metallicRoughnessTexture = int(s.scene.textures.size()) - 1;
+    }
+    if (occlusion < 1.0f) {
+      Texture ao;
+      ao.width = ao.height = 1;
+      ao.texels = {Vec3{occlusion, 0.0f, 0.0f}};
+      s.scene.textures.push_back(ao);
+      m.occlusionTexture = int(s.scene.textures.size()) - 1;
+    }
+    Light light;
+    light.type = Light::Type::Point;
+    light.position = {0.3f, 0.1f, 1.0f};
+    light.intensity = 2.0f;
+    s.scene.lights.push_back(light);
+    GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl* out) {
+      out[0] = {{1, 1, 1}, {0, 0, 1}};
+      return 1;
+    });
+    RenderParams p = QuadSetup::params(false);
+    p.specular = true;
+    p.mode = mode;
+    return Renderer(s.scene, octree).render(s.camera, p);
+  };
+  const RgbImage dielectric = render(false, 1.0f, RenderMode::Full);
+  const RgbImage mapped = render(true, 1.0f, RenderMode::Full);
+  const int x = 32, y = 24;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(mapped.pixel(x, y)[c], dielectric.pixel(x, y)[c], 2e-3f * dielectric.pixel(x, y)[c]);
+  }
+  const float indirect = render(false, 1.0f, RenderMode::Indirect).pixel(x, y)[0];
+  EXPECT_NEAR(render(false, 0.25f, RenderMode::Indirect).pixel(x, y)[0], 0.25f * indirect,
+              2e-3f * indirect);
+  const float direct = render(false, 1.0f, RenderMode::Direct).pixel(x, y)[0];
+  EXPECT_NEAR(render(false, 0.25f, RenderMode::Direct).pixel(x, y)[0], direct, 1e-6f + 1e-4f * direct);
+}
+
 // Glass (KHR_materials_transmission): a clear pane between the camera and a
 // lit quad shows the quad through it, dimmed only by the Fresnel reflectance
 // at normal incidence (4%), where it used to be drawn as an opaque white

@@ -501,15 +501,18 @@ TEST(SceneGltf, TextureTransform) {
   expectInputError(writeGltf(dir, "bad-transform.gltf", g), "KHR_texture_transform offset");
 }
 
-// normalTexture: index, scale and UV set are read, and the map is decoded as
-// data (no sRGB curve), a separate texture from the same image used as colour.
+// normalTexture, metallicRoughnessTexture and occlusionTexture: index, scale
+// or strength and UV set are read, and the maps are decoded as data (no sRGB
+// curve), a separate texture from the same image used as colour.
 TEST(SceneGltf, NormalTextureIsLinearData) {
   std::string dir = test::outputDir("SceneGltf_NormalTexture");
   writeFile(dir + "/tex.ppm", std::string("P6\n2 1\n255\n\xff\x00\x00\xbc\xbc\xbc", 17));
   MiniGltf g = oneTriangle();
   g.material = 0;
-  g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
-      "normalTexture": {"index": 0, "scale": 0.5}}])";
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+        "metallicRoughnessTexture": {"index": 0}},
+      "normalTexture": {"index": 0, "scale": 0.5},
+      "occlusionTexture": {"index": 0, "strength": 0.75}}])";
   g.extraTop = R"("textures": [{"source": 0}], "images": [{"uri": "tex.ppm"}], )";
   Scene s = loadScene(writeGltf(dir, "normal.gltf", g));
   const Material& m = s.materials.at(0);
@@ -522,6 +525,10 @@ TEST(SceneGltf, NormalTextureIsLinearData) {
              "data texel");
   expectNear(s.textures[size_t(m.baseColorTexture)].texels[1], Vec3{0.50289f}, 1e-4f,
              "colour texel");
+  // The other data maps share the data decoding of the image.
+  EXPECT_EQ(m.metallicRoughnessTexture, m.normalTexture);
+  EXPECT_EQ(m.occlusionTexture, m.normalTexture);
+  EXPECT_FLOAT_EQ(m.occlusionStrength, 0.75f);
 }
 
 // --- lights ---------------------------------------------------------------------
