@@ -61,7 +61,7 @@ struct Light {
 layout(std140) uniform LightBlock {
   Light uLights[LO_MAX_LIGHTS];
   mat4 uShadowMatrices[LO_MAX_SHADOW_LAYERS];
-  ivec4 uLightCount;     // x
+  ivec4 uLightCount;     // x lights, y of them area lights (the last y)
   vec4 uShadowParams;    // x depth bias (fraction of far), y normal offset (world units)
 };
 
@@ -104,6 +104,10 @@ vec3 hashColor(ivec3 c) {
   return vec3(float(h & 255u), float((h >> 8u) & 255u), float((h >> 16u) & 255u)) / 255.0 * 0.8 + 0.2;
 }
 
+// Direct light (lights, shadow maps, area lights) is compiled only into the
+// program of the modes that draw it (LO_DIRECT_LIGHT, render/renderer.cpp):
+// on a software rasterizer its code alone doubles the cost of the others.
+#ifdef LO_DIRECT_LIGHT
 // Cube face of direction d: the layer offset of a point light's six maps.
 int cubeFace(vec3 d) {
   vec3 ad = abs(d);
@@ -173,7 +177,8 @@ float receiverDepth(mat4 clipToRender, vec2 t, vec3 lc, vec3 n, vec3 nE, float p
 }
 
 float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
-  Light L = uLights[i];
+  // The light read in place (a copy of the 7-vec4 struct is dear on llvmpipe).
+#define L uLights[i]
   int first = int(L.params.z);
   if (first < 0) return 1.0;
   float nl = clamp(dot(n, toLight), 0.0, 1.0);
@@ -192,10 +197,10 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
   // Blockers from 0.3 d_r out can hide the light: search that cone (in a
   // cube face, an angle's tangent t spans t/2 in uv).
   float search = min(0.5 * h * 0.7 / (0.3 * dr), 0.2);
-  // 6 x 6 taps on a grid turned by atan(1/6), so that the blocker estimate,
+  // 4 x 4 taps on a grid turned by atan(1/4), so that the blocker estimate,
   // and with it the filter's width, changes in small steps along any edge.
-  const int kTaps = 6;
-  const vec2 kSearchTurn = vec2(0.986394, 0.164399);  // (cos, sin) of atan(1/6)
+  const int kTaps = 4;
+  const vec2 kSearchTurn = vec2(0.970143, 0.242536);  // (cos, sin) of atan(1/4)
   float blockers = 0.0, blockerSum = 0.0;
   for (int y = 0; y < kTaps; ++y) {
     for (int x = 0; x < kTaps; ++x) {
@@ -216,12 +221,12 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
   float db = max(blockerSum / blockers, 1e-4 * far);
   float texel = 1.0 / float(textureSize(uShadowDepths, 0).x);
   float radius = clamp(0.5 * h * max(dr - db, 0.0) / (dr * db), texel, 0.2);
-  // 8 x 8 taps on a grid turned by atan(1/8) (a rook pattern: every edge
-  // direction but a few sees 64 distinct tap positions, not 8 columns): 64
+  // 6 x 6 taps on a grid turned by atan(1/6) (a rook pattern: every edge
+  // direction but a few sees 36 distinct tap positions, not 6 columns): 36
   // levels between umbra and light, each blurred by the hardware 2x2
   // comparison, below what the eye resolves as a band.
-  const int kFilterTaps = 8;
-  const vec2 kTurn = vec2(0.992278, 0.124035);  // (cos, sin) of atan(1/8)
+  const int kFilterTaps = 6;
+  const vec2 kTurn = vec2(0.986394, 0.164399);  // (cos, sin) of atan(1/6)
   float lit = 0.0;
   for (int y = 0; y < kFilterTaps; ++y) {
     for (int x = 0; x < kFilterTaps; ++x) {
@@ -236,7 +241,8 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
 }
 
 float shadow(int i, vec3 p, vec3 n, vec3 toLight) {
-  Light L = uLights[i];
+  // The light read in place (a copy of the 7-vec4 struct is dear on llvmpipe).
+#define L uLights[i]
   int first = int(L.params.z);
   if (first < 0) return 1.0;
   int type = int(L.positionType.w);
@@ -256,25 +262,30 @@ float shadow(int i, vec3 p, vec3 n, vec3 toLight) {
 
 vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughness) {
   vec3 sum = vec3(0.0);
-  for (int i = 0; i < uLightCount.x; ++i) {
-    Light L = uLights[i];
+  // Area lights come last in the block (uLightCount.y of the uLightCount.x):
+  // their own loop keeps the other lights' loop small, which llvmpipe runs
+  // several times faster.
+  for (int i = uLightCount.x - uLightCount.y; i < uLightCount.x; ++i) {
+#define L uLights[i]
+    // One-sided Lambertian emitter: nothing behind its plane is lit, and
+    // a point in the plane (the ceiling around a ceiling light) sees it at
+    // grazing incidence: nothing either (the clipped edge sum would be
+    // all rounding there).
+    if (dot(p - L.corner0.xyz, L.directionRange.xyz) <= 1e-3 * L.corner0.w) continue;
+    vec3 lightCentre;
+    float solid = polygonIrradiance(p, n, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz, lightCentre);
+    if (solid <= 0.0) continue;
+    vec3 la = normalize(lightCentre - p);
+    // The BRDF times the cosine in the direction of the light's visible
+    // part, over that cosine: exact for the diffuse lobe.
+    vec3 f = brdfCos(n, v, la, baseColor, metallic, roughness) / max(dot(n, la), 1e-4);
+    sum += f * L.colorFar.rgb * solid * areaShadow(i, p, n, la);
+#undef L
+  }
+  for (int i = 0; i < uLightCount.x - uLightCount.y; ++i) {
+    // The light read in place (a copy of the 7-vec4 struct is dear on llvmpipe).
+#define L uLights[i]
     int type = int(L.positionType.w);
-    if (type == LO_LIGHT_AREA) {
-      // One-sided Lambertian emitter: nothing behind its plane is lit, and
-      // a point in the plane (the ceiling around a ceiling light) sees it at
-      // grazing incidence: nothing either (the clipped edge sum would be
-      // all rounding there).
-      if (dot(p - L.corner0.xyz, L.directionRange.xyz) <= 1e-3 * L.corner0.w) continue;
-      vec3 lightCentre;
-      float solid = polygonIrradiance(p, n, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz, lightCentre);
-      if (solid <= 0.0) continue;
-      vec3 la = normalize(lightCentre - p);
-      // The BRDF times the cosine in the direction of the light's visible
-      // part, over that cosine: exact for the diffuse lobe.
-      vec3 f = brdfCos(n, v, la, baseColor, metallic, roughness) / max(dot(n, la), 1e-4);
-      sum += f * L.colorFar.rgb * solid * areaShadow(i, p, n, la);
-      continue;
-    }
     vec3 l;
     vec3 E = L.colorFar.rgb;  // irradiance on a surface facing the light, W/m^2
     if (type == LO_LIGHT_DIRECTIONAL) {
@@ -303,6 +314,8 @@ vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughn
   }
   return sum;
 }
+
+#endif  // LO_DIRECT_LIGHT
 
 // The normal map's normal in world space. Tangents are not read from the
 // file: the tangent is the direction of +u on the surface, from screen-space
@@ -362,9 +375,11 @@ void main() {
     vec3 q = loOctreePosition(vPosition, n, uOctreeOrigin, uVoxelSize, uNormalOffset);
     radiance = loNearestLeaf(q, n, uDepth, uNormalOffset, leaf, voxel) ? hashColor(voxel) : vec3(0.0);
   } else {
+#ifdef LO_DIRECT_LIGHT
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_DIRECT) {
       radiance += vEmission + direct(vPosition, n, v, baseColor, metallic, roughness);
     }
+#endif
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_INDIRECT) {
       LoSurface s = LoSurface(n, v, baseColor, metallic, roughness);
       // glTF: occlusion darkens the indirect light only.

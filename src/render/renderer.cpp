@@ -157,7 +157,11 @@ struct Renderer::Impl {
   Vec3 octreeOrigin;
   float voxelSize = 1;
 
-  GLuint sceneProgram = 0, shadowProgram = 0, depthProgram = 0, probeProgram = 0;
+  /// The scene pass in two variants: with the direct light compiled in (full,
+  /// direct) and without it (indirect, voxels), so the octree-only modes do
+  /// not pay for the lights' code on a software rasterizer.
+  GLuint sceneProgram = 0, sceneIndirectProgram = 0;
+  GLuint shadowProgram = 0, depthProgram = 0, probeProgram = 0;
   GLuint vao = 0, vbo = 0, emptyVao = 0;
   GLsizei vertexCount = 0;
   std::vector<DrawRange> ranges;        ///< the vertex buffer by texture, opaque ranges first
@@ -186,7 +190,8 @@ struct Renderer::Impl {
   }
 
   ~Impl() {
-    GLuint programs[] = {sceneProgram, shadowProgram, depthProgram, probeProgram};
+    GLuint programs[] = {sceneProgram, sceneIndirectProgram, shadowProgram, depthProgram,
+                         probeProgram};
     for (GLuint p : programs) {
       if (p) glDeleteProgram(p);
     }
@@ -581,6 +586,7 @@ struct Renderer::Impl {
     }
     std::copy(lights.begin(), lights.end(), lightBlock.lights);
     lightBlock.lightCount[0] = int32_t(lights.size());
+    lightBlock.lightCount[1] = int32_t(areaLightCount);  // appended last
     // Depth bias as a fraction of the far plane and a normal offset, both
     // about one shadow texel at the scene's scale.
     float texel = 2.0f * sceneSize / float(params.shadowMapSize);
@@ -733,7 +739,8 @@ struct Renderer::Impl {
       glDepthFunc(GL_LEQUAL);
       glDepthMask(GL_FALSE);
     }
-    GLuint p = sceneProgram;
+    GLuint p = rp.mode == RenderMode::Full || rp.mode == RenderMode::Direct ? sceneProgram
+                                                                            : sceneIndirectProgram;
     glUseProgram(p);
     auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
     glUniformMatrix4fv(loc("uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
@@ -840,8 +847,9 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.bounds.extend(r.toRender(world.lower));
   r.bounds.extend(r.toRender(world.upper));
   r.sceneSize = std::max(length(r.bounds.extent()), 1e-3f);
-  r.sceneProgram = buildProgram({"render_scene.vert", "render_scene.frag"});
+  r.sceneProgram = buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT"});
   glUniformBlockBinding(r.sceneProgram, glGetUniformBlockIndex(r.sceneProgram, "LightBlock"), 0);
+  r.sceneIndirectProgram = buildProgram({"render_scene.vert", "render_scene.frag"});
   r.shadowProgram = buildProgram({"render_shadow.vert", "render_shadow.frag"});
   r.depthProgram = buildProgram({"render_depth.vert", "render_depth.frag"});
   r.uploadOctree(octree);
@@ -909,6 +917,7 @@ void compileAllShaders() {
   for (const std::vector<std::string>& files : allPrograms()) {
     glDeleteProgram(buildProgram(files));
   }
+  glDeleteProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT"}));
 }
 
 std::vector<std::array<float, 4>> runLayoutProbe(LayoutProbe function,
