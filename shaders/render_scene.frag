@@ -116,6 +116,14 @@ int cubeFace(vec3 d) {
   return d.z > 0.0 ? 4 : 5;
 }
 
+// The point a shadow map is read at: p moved along n by the normal offset,
+// scaled up at grazing angles (toLight the direction to the light), where
+// shadow acne appears.
+vec3 shadowPoint(vec3 p, vec3 n, vec3 toLight) {
+  float nl = clamp(dot(n, toLight), 0.0, 1.0);
+  return p + n * uShadowParams.y * (1.0 + 2.0 * (1.0 - nl));
+}
+
 // Irradiance on the surface (p, n) from a Lambertian triangle (a, b, c) of
 // unit radiance: the projected solid angle of the triangle clipped to the
 // surface's upper hemisphere, 1/2 sum_i theta_i n.unit(u_i x u_i+1) over its
@@ -181,8 +189,7 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
 #define L uLights[i]
   int first = int(L.params.z);
   if (first < 0) return 1.0;
-  float nl = clamp(dot(n, toLight), 0.0, 1.0);
-  vec3 ps = p + n * uShadowParams.y * (1.0 + 2.0 * (1.0 - nl));
+  vec3 ps = shadowPoint(p, n, toLight);
   vec3 lc = L.positionType.xyz;
   vec3 d = ps - lc;
   int layer = first + cubeFace(d);
@@ -246,9 +253,7 @@ float shadow(int i, vec3 p, vec3 n, vec3 toLight) {
   int first = int(L.params.z);
   if (first < 0) return 1.0;
   int type = int(L.positionType.w);
-  // Normal offset scaled up at grazing angles, where shadow acne appears.
-  float nl = clamp(dot(n, toLight), 0.0, 1.0);
-  vec3 ps = p + n * uShadowParams.y * (1.0 + 2.0 * (1.0 - nl));
+  vec3 ps = shadowPoint(p, n, toLight);
   int layer = first;
   if (type == LO_LIGHT_POINT || type == LO_LIGHT_EMITTER) layer += cubeFace(ps - L.positionType.xyz);
   vec4 c = uShadowMatrices[layer] * vec4(ps, 1.0);

@@ -58,7 +58,8 @@ struct ViewOptions {
 /// The progressive bake as the viewer's source of octree levels.
 class ProgressiveLevels final : public OctreeLevelSource {
  public:
-  explicit ProgressiveLevels(ProgressiveBake& bake) : bake_(bake) {}
+  ProgressiveLevels(ProgressiveBake& bake, int targetDepth)
+      : bake_(bake), targetDepth_(targetDepth) {}
   bool takeNewest(GpuOctree& octree, int& depth) override {
     std::optional<ProgressiveLevel> level = bake_.takeNewest();
     if (!level) return false;
@@ -84,12 +85,11 @@ class ProgressiveLevels final : public OctreeLevelSource {
   }
   bool finished() const override { return bake_.finished(); }
   std::string status() const override { return bake_.status().ToString(); }
-  void setTargetDepth(int depth) { targetDepth_ = depth; }
 
  private:
   ProgressiveBake& bake_;
   std::optional<ProgressiveLevel> last_;
-  int targetDepth_ = 0;
+  int targetDepth_;
 };
 
 int runView(const ViewOptions& opt) {
@@ -167,8 +167,7 @@ int runView(const ViewOptions& opt) {
     pp.cluster.seed = opt.seed;
     pp.octree = octreeParams;
     bake = std::make_unique<ProgressiveBake>(scene, pp);
-    levels = std::make_unique<ProgressiveLevels>(*bake);
-    levels->setTargetDepth(pp.targetDepth);
+    levels = std::make_unique<ProgressiveLevels>(*bake, pp.targetDepth);
     view.firstDepth = pp.firstDepth;
     view.targetDepth = pp.targetDepth;
     if (!opt.quiet) {

@@ -5,6 +5,7 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
+#include <array>
 #include <string>
 
 #include "render/context_internal.h"
@@ -53,11 +54,19 @@ Key keyOf(int key) {
   }
 }
 
+/// GLFW's code of `key`: keyOf inverted once, not searched per call (the
+/// viewer asks for a dozen held keys every frame).
 int glfwKeyOf(Key key) {
-  for (int k = GLFW_KEY_SPACE; k <= GLFW_KEY_LAST; ++k) {
-    if (keyOf(k) == key) return k;
-  }
-  return GLFW_KEY_UNKNOWN;
+  static const std::array<int, size_t(Key::Period) + 1> table = [] {
+    std::array<int, size_t(Key::Period) + 1> t;
+    t.fill(GLFW_KEY_UNKNOWN);
+    for (int k = GLFW_KEY_SPACE; k <= GLFW_KEY_LAST; ++k) {
+      const Key mapped = keyOf(k);
+      if (mapped != Key::Unknown) t[size_t(mapped)] = k;
+    }
+    return t;
+  }();
+  return size_t(key) < table.size() ? table[size_t(key)] : GLFW_KEY_UNKNOWN;
 }
 
 int glfwButtonOf(MouseButton b) {

@@ -32,6 +32,12 @@ constexpr int kDirectional = shader::LO_LIGHT_DIRECTIONAL;
 constexpr int kEmitter = shader::LO_LIGHT_EMITTER;
 constexpr int kArea = shader::LO_LIGHT_AREA;
 
+/// Shadow map layers a light of shader type `type` takes: a cube (6) for
+/// lights that shine all around a point, one for spot and directional lights.
+int shadowLayersOf(int type) {
+  return type == kPoint || type == kEmitter || type == kArea ? 6 : 1;
+}
+
 /// uMode of the scene shader for a render mode.
 int shaderMode(RenderMode mode) {
   switch (mode) {
@@ -163,7 +169,6 @@ struct Renderer::Impl {
   GLuint sceneProgram = 0, sceneIndirectProgram = 0;
   GLuint shadowProgram = 0, depthProgram = 0, probeProgram = 0;
   GLuint vao = 0, vbo = 0, emptyVao = 0;
-  GLsizei vertexCount = 0;
   std::vector<DrawRange> ranges;        ///< the vertex buffer by texture, opaque ranges first
   GLsizei opaqueCount = 0;              ///< vertices of the opaque ranges (shadows, pre-pass)
   GLuint behindTexture = 0;             ///< the opaque image, seen through transmissive surfaces
@@ -368,6 +373,13 @@ struct Renderer::Impl {
         Vec3 faceN = scene.faceNormal(t);
         for (int k = 0; k < 3; ++k) {
           uint32_t index = scene.indices[t * 3 + size_t(k)];
+          // Texture transforms are affine: applied per vertex they are exact.
+          auto setUv = [&](float* out, int texCoord, const TextureTransform& transform) {
+            const std::vector<float>& uv = uvSet(texCoord);
+            out[0] = uv[2 * index];
+            out[1] = uv[2 * index + 1];
+            transform.apply(out[0], out[1]);
+          };
           Vertex v{};
           Vec3 p = toRender(scene.positions[index]);
           Vec3 n = scene.normals.empty() ? faceN : scene.normals[index];
@@ -377,19 +389,7 @@ struct Renderer::Impl {
           v.metallicRoughness[0] = mat.metallic;
           v.metallicRoughness[1] = mat.roughness;
           std::memcpy(v.emission, &mat.emission, sizeof v.emission);
-          // Texture transforms are affine: applied per vertex they are exact.
-          if (range.texture >= 0) {
-            const std::vector<float>& uv = uvSet(mat.baseColorTexCoord);
-            v.uv[0] = uv[2 * index];
-            v.uv[1] = uv[2 * index + 1];
-            mat.baseColorTransform.apply(v.uv[0], v.uv[1]);
-          }
-          auto setUv = [&](float* out, int texCoord, const TextureTransform& transform) {
-            const std::vector<float>& uv = uvSet(texCoord);
-            out[0] = uv[2 * index];
-            out[1] = uv[2 * index + 1];
-            transform.apply(out[0], out[1]);
-          };
+          if (range.texture >= 0) setUv(v.uv, mat.baseColorTexCoord, mat.baseColorTransform);
           if (range.normalTexture >= 0) setUv(v.normalUv, mat.normalTexCoord, mat.normalTransform);
           if (range.metallicRoughnessTexture >= 0) {
             setUv(v.metallicRoughnessUv, mat.metallicRoughnessTexCoord,
@@ -405,7 +405,6 @@ struct Renderer::Impl {
       ranges.push_back(range);
       if (range.transmission <= 0) opaqueCount = GLsizei(vertices.size());
     }
-    vertexCount = GLsizei(vertices.size());
     glGenVertexArrays(1, &vao);
     glBindVertexArray(vao);
     glGenBuffers(1, &vbo);
@@ -554,13 +553,13 @@ struct Renderer::Impl {
     float nearPlane = 1e-3f * sceneSize;
     for (GpuLight& l : lights) {
       int type = int(l.positionType[3]);
-      int need = type == kPoint || type == kEmitter || type == kArea ? 6 : 1;
+      int need = shadowLayersOf(type);
       if (layers + need > kMaxShadowLayers) continue;
       glm::vec3 pos(l.positionType[0], l.positionType[1], l.positionType[2]);
       glm::vec3 dir(l.directionRange[0], l.directionRange[1], l.directionRange[2]);
       float far = glm::length(pos - center) + radius + nearPlane;
       l.params[2] = float(layers);
-      if (type == kPoint || type == kEmitter || type == kArea) {
+      if (need == 6) {
         const glm::vec3 axes[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
                                    {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
         glm::mat4 proj = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, far);
@@ -633,7 +632,7 @@ struct Renderer::Impl {
       const GpuLight& l = lightBlock.lights[i];
       if (l.params[2] < 0) continue;
       int type = int(l.positionType[3]);
-      int n = type == kPoint || type == kEmitter || type == kArea ? 6 : 1;
+      int n = shadowLayersOf(type);
       glUniform3fv(glGetUniformLocation(shadowProgram, "uLightPosition"), 1, l.positionType);
       glUniform1f(glGetUniformLocation(shadowProgram, "uFar"), l.colorFar[3]);
       for (int f = 0; f < n; ++f) {
@@ -801,18 +800,14 @@ struct Renderer::Impl {
         glDepthFunc(GL_LESS);
         copied = true;
       }
-      glActiveTexture(GL_TEXTURE4);
-      glBindTexture(GL_TEXTURE_2D, range.texture >= 0 ? textures[size_t(range.texture)] : 0);
-      glActiveTexture(GL_TEXTURE7);
-      glBindTexture(GL_TEXTURE_2D,
-                    range.normalTexture >= 0 ? textures[size_t(range.normalTexture)] : 0);
-      glActiveTexture(GL_TEXTURE8);
-      glBindTexture(GL_TEXTURE_2D, range.metallicRoughnessTexture >= 0
-                                       ? textures[size_t(range.metallicRoughnessTexture)]
-                                       : 0);
-      glActiveTexture(GL_TEXTURE9);
-      glBindTexture(GL_TEXTURE_2D,
-                    range.occlusionTexture >= 0 ? textures[size_t(range.occlusionTexture)] : 0);
+      auto bind = [this](GLenum unit, int texture) {
+        glActiveTexture(unit);
+        glBindTexture(GL_TEXTURE_2D, texture >= 0 ? textures[size_t(texture)] : 0);
+      };
+      bind(GL_TEXTURE4, range.texture);
+      bind(GL_TEXTURE7, range.normalTexture);
+      bind(GL_TEXTURE8, range.metallicRoughnessTexture);
+      bind(GL_TEXTURE9, range.occlusionTexture);
       glActiveTexture(GL_TEXTURE0);
       glUniform1i(hasMr, range.metallicRoughnessTexture >= 0 ? 1 : 0);
       glUniform1i(hasOcclusion, range.occlusionTexture >= 0 ? 1 : 0);

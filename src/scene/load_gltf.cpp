@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "core/file.h"
 #include "image/image.h"
 #include "scene/scene_internal.h"
 
@@ -950,7 +951,7 @@ Scene loadGltf(const std::string& path) {
   fs::path p(path);
   std::string baseDir = p.parent_path().string();
   if (baseDir.empty()) baseDir = ".";
-  bool binary = p.extension() == ".glb" || p.extension() == ".GLB";
+  bool binary = hasExtension(path, ".glb");
   std::vector<unsigned char> bytes = readFileBytes(path, path, "file");
   if (bytes.size() > size_t(std::numeric_limits<uint32_t>::max())) {
     fail(path, "file larger than 4 GiB");

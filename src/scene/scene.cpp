@@ -1,7 +1,6 @@
 #include "scene/scene.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cstdint>
 #include <cmath>
 #include <filesystem>
@@ -10,6 +9,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file.h"
 #include "scene/scene_internal.h"
 
 namespace lo {
@@ -124,9 +124,7 @@ std::string Scene::ToString() const {
 
 Scene loadScene(const std::string& path) {
   namespace fs = std::filesystem;
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
+  const std::string ext = lowerExtension(path);
   bool gltf = ext == ".gltf" || ext == ".glb";
   if (!gltf && ext != ".obj") {
     scene_internal::fail(path, "unknown extension '" + ext + "' (expected .gltf, .glb or .obj)");
