@@ -463,22 +463,15 @@ BakeFigures bakeAndWrite(const Scene& scene, const std::string& scenePath, const
   return f;
 }
 
-/// The GL renderer of the indirect images, made on first use (one context and
-/// one set of scene resources for the whole sweep).
+/// The GL renderer of the indirect images: one context and one set of scene
+/// resources for the whole sweep (the renderer is made on first use).
 struct IndirectRenderer {
   std::unique_ptr<GlContext> context;
   std::unique_ptr<Renderer> renderer;
 
-  /// The indirect image of `grid` and its mean frame time over `frames`.
-  RgbImage render(const Scene& scene, const VdlGrid& grid, const SweepPoint& point,
+  /// The indirect image of `octree` and its mean frame time over `frames`.
+  RgbImage render(const Scene& scene, const GpuOctree& octree, const SweepPoint& point,
                   const PinholeCamera& camera, int width, int height, int frames, double& frameMs) {
-    if (!context) context = createGlContext(GlContextParams{});
-    GpuOctreeParams octreeParams;
-    octreeParams.halfFloat = point.halfFloat;
-    octreeParams.cosineCorrection = point.cosineCorrection;
-    octreeParams.max3DTextureSize = context->info().max3DTextureSize;
-    octreeParams.max2DTextureSize = context->info().max2DTextureSize;
-    const GpuOctree octree = buildGpuOctree(grid, octreeParams);
     if (!renderer) {
       renderer = std::make_unique<Renderer>(scene, octree, RendererParams{});
     } else {
@@ -528,6 +521,9 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
                                   {"seed", params.seed},
                                   {"version", LO_VERSION}};
   IndirectRenderer indirectRenderer;
+  // The GL context first, when frames are timed: each point's octree is then
+  // built once, within its texture limits, for the CPU lookup and the GPU.
+  if (params.frames > 0) indirectRenderer.context = createGlContext(GlContextParams{});
   std::vector<SweepResult> results;
   for (size_t pi = 0; pi < points.size(); ++pi) {
     const SweepPoint& point = points[pi];
@@ -573,6 +569,10 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     GpuOctreeParams octreeParams;
     octreeParams.halfFloat = point.halfFloat;
     octreeParams.cosineCorrection = point.cosineCorrection;
+    if (const GlContext* gl = indirectRenderer.context.get()) {
+      octreeParams.max3DTextureSize = gl->info().max3DTextureSize;
+      octreeParams.max2DTextureSize = gl->info().max2DTextureSize;
+    }
     const GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
     r.gpuBytes = double(octree.poolBytes() + octree.vdlBytes());
     r.vdlTexels = double(octree.vdlCount);
@@ -594,7 +594,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     // The indirect image through the GL renderer, and its frame time.
     if (params.frames > 0) {
       const RgbImage indirect =
-          indirectRenderer.render(scene, baked.grid, point, camera, params.width, params.height,
+          indirectRenderer.render(scene, octree, point, camera, params.width, params.height,
                                   params.frames, r.frameMs);
       writeExr(base + "-indirect.exr", indirect);
       r.indirectRelRmse = compareImages(indirect, refs.indirect, compareParams).luminance.relRmse;
