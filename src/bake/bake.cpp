@@ -115,13 +115,17 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
   return vdls;
 }
 
+void checkDepth(int depth, const std::string& what) {
+  if (depth < 1 || depth > kMaxGridDepth) {
+    throw InputError(what + " " + std::to_string(depth) + " is outside [1, " +
+                     std::to_string(kMaxGridDepth) + "]");
+  }
+}
+
 namespace {
 
 void checkParams(const BakeParams& p) {
-  if (p.depth < 1 || p.depth > kMaxGridDepth) {
-    throw InputError("--depth " + std::to_string(p.depth) + " is outside [1, " +
-                     std::to_string(kMaxGridDepth) + "]");
-  }
+  checkDepth(p.depth);
   if (p.photons < 1) throw InputError("--photons must be at least 1");
   if (p.knn < 1) throw InputError("--knn " + std::to_string(p.knn) + " must be at least 1");
   if (!(p.radius >= 0.0f) || !std::isfinite(p.radius)) {

@@ -35,6 +35,10 @@ VdlCount parseVdlCount(const std::string& text, const char* flag = "--vdls");
 /// The same check for a CLI validator: "" when valid, else the message.
 std::string vdlCountError(const std::string& text);
 
+/// @throws InputError "<what> N is outside [1, kMaxGridDepth]" unless
+/// 1 <= depth <= kMaxGridDepth: the one depth check of the bake module.
+void checkDepth(int depth, const std::string& what = "--depth");
+
 /// Every setting of a bake, with the defaults of `lightoctree bake`.
 struct BakeParams {
   int depth = 6;            ///< 2^depth voxels across the padded bounding cube (paper's delta)

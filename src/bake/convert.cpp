@@ -18,10 +18,7 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
                                const ConvertParams& params, ProgressSink* progress) {
   const int inDepth = in.frame.depth;
   const int depth = params.depth > 0 ? params.depth : inDepth;
-  if (depth < 1 || depth > kMaxGridDepth) {
-    throw InputError("--depth " + std::to_string(depth) + " is outside [1, " +
-                     std::to_string(kMaxGridDepth) + "]");
-  }
+  checkDepth(depth);
   if (depth > inDepth && !params.scene) {
     throw InputError("--depth " + std::to_string(depth) + " is finer than the input's depth " +
                      std::to_string(inDepth) +

@@ -152,11 +152,7 @@ struct ProgressiveBake::Impl final : ProgressSink {
 namespace {
 
 void checkDepths(const ProgressiveParams& params) {
-  for (int d : {params.firstDepth, params.targetDepth}) {
-    if (d < 1 || d > kMaxGridDepth) {
-      throw InputError("progressive bake: depth " + std::to_string(d) + " is outside 1.." + std::to_string(kMaxGridDepth));
-    }
-  }
+  for (int d : {params.firstDepth, params.targetDepth}) checkDepth(d, "progressive bake: depth");
   if (params.firstDepth > params.targetDepth) {
     throw InputError("progressive bake: first depth " + std::to_string(params.firstDepth) +
                      " is finer than the target depth " + std::to_string(params.targetDepth));

@@ -60,7 +60,7 @@ class ProgressiveBake {
  public:
   /// Starts the background thread, which first traces the photons.
   /// `scene` must outlive this object. @throws InputError (before starting)
-  /// when the depths are outside 1..12 or firstDepth > targetDepth.
+  /// when the depths are outside [1, kMaxGridDepth] or firstDepth > targetDepth.
   ProgressiveBake(const Scene& scene, const ProgressiveParams& params);
   /// Starts from photons already traced (benchmarks, tests); `params.photons`
   /// is not used and photonsTraced is the moment of this call.
