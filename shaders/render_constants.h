@@ -16,6 +16,11 @@ const int LO_MODE_DIRECT = 1;   /* emission + direct */
 const int LO_MODE_INDIRECT = 2; /* the light octree alone */
 const int LO_MODE_VOXELS = 3;   /* octree leaves coloured by a hash */
 
+/* uAlphaMode: glTF alphaMode of the draw (AlphaMode in scene/scene.h). */
+const int LO_ALPHA_OPAQUE = 0;
+const int LO_ALPHA_MASK = 1;
+const int LO_ALPHA_BLEND = 2;
+
 /* Light.positionType.w: the kind of light (std140 LightBlock). */
 const int LO_LIGHT_POINT = 0;
 const int LO_LIGHT_SPOT = 1;

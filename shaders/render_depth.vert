@@ -2,8 +2,14 @@
 // Depth pre-pass: the scene pass's position transform alone, so that the
 // expensive scene shader runs once per pixel (GL_LEQUAL against this depth)
 // instead of once per overlapping surface. `invariant` on both shaders makes
-// the two passes produce bit-identical depths.
+// the two passes produce bit-identical depths. The base colour UV feeds the
+// alpha test of masked materials (render_alpha.h).
 layout(location = 0) in vec3 aPosition;
+layout(location = 5) in vec2 aUv;
 uniform mat4 uViewProj;
 invariant gl_Position;
-void main() { gl_Position = uViewProj * vec4(aPosition, 1.0); }
+out vec2 vUv;
+void main() {
+  vUv = aUv;
+  gl_Position = uViewProj * vec4(aPosition, 1.0);
+}

@@ -16,6 +16,7 @@ in vec2 vUv;
 in vec2 vNormalUv;
 in vec2 vMetallicRoughnessUv;
 in vec2 vOcclusionUv;
+in vec2 vEmissiveUv;
 out vec4 fragColor;
 
 uniform usampler3D uOctree;  // RGBA8UI pool of 2x2x2 tiles
@@ -45,6 +46,11 @@ uniform bool uHasMetallicRoughnessTexture;
 uniform sampler2D uOcclusionTexture;  // linear: R ambient occlusion
 uniform bool uHasOcclusionTexture;
 uniform float uOcclusionStrength;
+uniform sampler2D uEmissiveTexture;  // linear RGB emission map (sRGB decoded at load)
+uniform bool uHasEmissiveTexture;
+uniform int uAlphaMode;      // LO_ALPHA_OPAQUE, LO_ALPHA_MASK or LO_ALPHA_BLEND (glTF alphaMode)
+uniform float uBaseAlpha;    // baseColorFactor's alpha
+uniform float uAlphaCutoff;  // glTF alphaCutoff (mask)
 uniform float uTransmission;  // KHR_materials_transmission of this draw; 0 = opaque
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 
@@ -364,7 +370,21 @@ void main() {
   // glTF: base colour = factor x texture, sampled per pixel (trilinear,
   // anisotropic where the context has it).
   vec3 baseColor = vBaseColor;
-  if (uHasBaseColorTexture) baseColor *= texture(uBaseColorTexture, vUv).rgb;
+  float alpha = uBaseAlpha;
+  if (uHasBaseColorTexture) {
+    vec4 texel = texture(uBaseColorTexture, vUv);
+    baseColor *= texel.rgb;
+    alpha *= texel.a;
+  }
+  // glTF alpha modes: a mask cuts the surface out below the cutoff (the
+  // depth pre-pass and the shadow maps cut the same fragments,
+  // render_alpha.h); a blended surface covers `alpha` of what lies behind it.
+  // The cut is made at the end: implicit-derivative texture reads after a
+  // discard are undefined in non-uniform control flow.
+  bool cutOut = uAlphaMode == LO_ALPHA_MASK && alpha < uAlphaCutoff;
+  float coverage = uAlphaMode == LO_ALPHA_BLEND ? clamp(alpha, 0.0, 1.0) : 1.0;
+  vec3 emission = vEmission;
+  if (uHasEmissiveTexture) emission *= texture(uEmissiveTexture, vEmissiveUv).rgb;
   float metallic = vMetallicRoughness.x;
   float roughness = vMetallicRoughness.y;
   if (uHasMetallicRoughnessTexture) {
@@ -382,7 +402,7 @@ void main() {
   } else {
 #ifdef LO_DIRECT_LIGHT
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_DIRECT) {
-      radiance += vEmission + direct(vPosition, n, v, baseColor, metallic, roughness);
+      radiance += emission + direct(vPosition, n, v, baseColor, metallic, roughness);
     }
 #endif
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_INDIRECT) {
@@ -406,6 +426,7 @@ void main() {
     float fresnel = 0.04 + 0.96 * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);
     radiance += uTransmission * (1.0 - fresnel) * baseColor * behind;
   }
+  if (cutOut) discard;
   radiance *= uExposureScale;
-  fragColor = vec4(uEncodeSrgb ? srgbEncode(radiance) : radiance, 1.0);
+  fragColor = vec4(uEncodeSrgb ? srgbEncode(radiance) : radiance, coverage);
 }

@@ -11,6 +11,7 @@ layout(location = 5) in vec2 aUv;        // the UV set the base colour texture n
 layout(location = 6) in vec2 aNormalUv;  // the UV set the normal map names
 layout(location = 7) in vec2 aMetallicRoughnessUv;
 layout(location = 8) in vec2 aOcclusionUv;
+layout(location = 9) in vec2 aEmissiveUv;
 
 uniform mat4 uViewProj;
 invariant gl_Position;  // as render_depth.vert: the depth pre-pass must match exactly
@@ -24,6 +25,7 @@ out vec2 vUv;
 out vec2 vNormalUv;
 out vec2 vMetallicRoughnessUv;
 out vec2 vOcclusionUv;
+out vec2 vEmissiveUv;
 
 void main() {
   vPosition = aPosition;
@@ -35,5 +37,6 @@ void main() {
   vNormalUv = aNormalUv;
   vMetallicRoughnessUv = aMetallicRoughnessUv;
   vOcclusionUv = aOcclusionUv;
+  vEmissiveUv = aEmissiveUv;
   gl_Position = uViewProj * vec4(aPosition, 1.0);
 }

@@ -3,10 +3,12 @@
 // lookup compares distances, so the bias is in world units whatever the
 // projection); directional lights (uFar == 0) keep the orthographic depth,
 // which is already linear.
+#include "render_alpha.h"
 in vec3 vWorld;
 uniform vec3 uLightPosition;
 uniform float uFar;
 void main() {
+  loAlphaTest();  // cut-out parts of masked materials cast no shadow
   gl_FragDepth = uFar > 0.0 ? clamp(length(vWorld - uLightPosition) / uFar, 0.0, 1.0)
                             : gl_FragCoord.z;
 }

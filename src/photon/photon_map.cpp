@@ -175,6 +175,13 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
       float b1 = 1.0f - s, b2 = rng.uniform() * s;
       Vec3 p = p0 + (p1 - p0) * b1 + (p2 - p0) * b2;
       Vec3 n = ctx.triangles[tri].normal;
+      // An emissive texture: the triangle was picked by its mean radiance;
+      // the photon carries the ratio of the radiance where it starts.
+      if (scene.materials[ctx.triangles[tri].material].emissiveTexture >= 0) {
+        const Vec3 mean = scene.triangleEmission(tri);
+        const Vec3 here = scene.emission(tri, b1, b2);
+        for (int c = 0; c < 3; ++c) out.power[c] *= mean[c] > 0 ? here[c] / mean[c] : 0.0f;
+      }
       // One-sided emitters emit on the side of the winding normal;
       // double-sided ones pick a side (their power counts both).
       if (ctx.scene->materials[ctx.triangles[tri].material].doubleSided && rng.uniform() < 0.5f)
@@ -293,7 +300,7 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
     Emitter e;
     e.kind = Emitter::Kind::Triangle;
     e.index = uint32_t(t);
-    e.power = m.emission * (sides * kPi * scene.triangleArea(t));
+    e.power = scene.triangleEmission(t) * (sides * kPi * scene.triangleArea(t));
     e.samplePower = e.power;
     if (!isFinite(e.power))
       throw InputError("material '" + m.name + "' of triangle " + std::to_string(t) +

@@ -6,6 +6,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,9 @@ struct RayTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::vector<Vec3> faceNormals;
+  /// A copy of the scene when some material has alpha (Mask or Blend): the
+  /// filter below reads its coverage; null otherwise (no filter installed).
+  std::unique_ptr<Scene> alphaScene;
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -27,6 +31,56 @@ struct RayTracer::Impl {
 namespace {
 
 std::string errorCode(RTCDevice device) { return std::to_string(int(rtcGetDeviceError(device))); }
+
+uint32_t floatBits(float f) {
+  uint32_t u;
+  std::memcpy(&u, &f, 4);
+  return u;
+}
+
+/// A uniform number in [0, 1) from the ray and the triangle it hits: the
+/// same ray through the same triangle always decides the same way, so
+/// blended surfaces pass a fixed share of rays whatever the thread count.
+float rayHash(uint32_t prim, const float org[3], const float dir[3]) {
+  uint64_t h = 0x9E3779B97F4A7C15ull ^ prim;
+  auto mix = [&h](uint32_t v) {
+    h ^= v;
+    h *= 0xFF51AFD7ED558CCDull;
+    h ^= h >> 33;
+  };
+  for (int k = 0; k < 3; ++k) {
+    mix(floatBits(org[k]));
+    mix(floatBits(dir[k]));
+  }
+  h *= 0xC4CEB9FE1A85EC53ull;
+  h ^= h >> 33;
+  return float(h >> 40) * 0x1p-24f;
+}
+
+/// Embree filter (intersection and occlusion): a hit where the material's
+/// coverage (Scene::coverage: alpha against the cutoff for Mask, alpha for
+/// Blend) says there is no surface is rejected, and the ray goes on.
+void alphaFilter(const RTCFilterFunctionNArguments* args) {
+  const Scene& scene = *static_cast<const Scene*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    const float b1 = RTCHitN_u(args->hit, args->N, i), b2 = RTCHitN_v(args->hit, args->N, i);
+    if (!scene.materials[size_t(scene.triangleMaterial[prim])].hasAlpha()) continue;
+    const float coverage = scene.coverage(prim, b1, b2);
+    if (coverage >= 1.0f) continue;
+    bool keep = false;
+    if (coverage > 0.0f) {
+      RTCRayN* ray = args->ray;
+      const float org[3] = {RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
+                            RTCRayN_org_z(ray, args->N, i)};
+      const float dir[3] = {RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
+                            RTCRayN_dir_z(ray, args->N, i)};
+      keep = rayHash(prim, org, dir) < coverage;
+    }
+    if (!keep) args->valid[i] = 0;
+  }
+}
 
 }  // namespace
 
@@ -63,6 +117,14 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
       vertices[3 * i + 2] = scene.positions[i].z;
     }
     std::copy(scene.indices.begin(), scene.indices.begin() + 3 * scene.triangleCount(), indices);
+    bool alpha = false;
+    for (const Material& m : scene.materials) alpha = alpha || m.hasAlpha();
+    if (alpha) {
+      impl_->alphaScene = std::make_unique<Scene>(scene);
+      rtcSetGeometryUserData(geom, impl_->alphaScene.get());
+      rtcSetGeometryIntersectFilterFunction(geom, alphaFilter);
+      rtcSetGeometryOccludedFilterFunction(geom, alphaFilter);
+    }
     rtcCommitGeometry(geom);
     rtcAttachGeometry(impl_->scene, geom);
     rtcReleaseGeometry(geom);

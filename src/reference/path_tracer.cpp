@@ -85,11 +85,12 @@ inline float powerHeuristic(float a, float b) {
 /// Radiance emitted by triangle `tri` towards direction `w` (unit, away from
 /// the surface): one-sided emitters emit on the winding side only, as the
 /// photon tracer's emitters do.
-inline Vec3 emittedRadiance(const Context& ctx, uint32_t tri, const Vec3& normal, const Vec3& w) {
+inline Vec3 emittedRadiance(const Context& ctx, uint32_t tri, float b1, float b2,
+                            const Vec3& normal, const Vec3& w) {
   const Material& m = ctx.scene->materials[ctx.scene->triangleMaterial[tri]];
   if (!m.isEmissive()) return Vec3{0, 0, 0};
   if (!m.doubleSided && dot(w, normal) <= 0) return Vec3{0, 0, 0};
-  return m.emission;
+  return m.emissiveTexture >= 0 ? ctx.scene->emission(tri, b1, b2) : m.emission;
 }
 
 inline Vec3 offsetOrigin(const Context& ctx, const Vec3& p, const Vec3& normal, const Vec3& dir) {
@@ -151,7 +152,7 @@ inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, 
     if (dist > 0) {
       Vec3 wi = d / dist;
       Vec3 lightNormal = scene.faceNormal(tri);
-      Vec3 le = emittedRadiance(ctx, tri, lightNormal, -wi);
+      Vec3 le = emittedRadiance(ctx, tri, b1, b2, lightNormal, -wi);
       float cosLight = std::fabs(dot(lightNormal, wi));
       Vec3 f = maxComponent(le) > 0 && cosLight > 0 ? evalBsdf(lobes, albedo, wo, wi, n) : Vec3{};
       if (maxComponent(f) > 0) {
@@ -184,7 +185,7 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
     bool frontFace = dot(dir, normal) < 0;
     Vec3 n = frontFace ? normal : -normal;
     Vec3 wo = -dir;
-    Vec3 le = emittedRadiance(ctx, hit.triangle, normal, wo);
+    Vec3 le = emittedRadiance(ctx, hit.triangle, hit.b1, hit.b2, normal, wo);
     if (maxComponent(le) > 0) {
       float w = 1;
       if (!prevDelta) {
@@ -284,7 +285,7 @@ void buildContext(const Scene& scene, const ReferenceParams& params, Context& ct
     float area = scene.triangleArea(t);
     if (!m.isEmissive() || !(area > 0)) continue;
     // Picked in proportion to power, as the photon tracer picks emitters.
-    double w = double(average(m.emission)) * area * (m.doubleSided ? 2.0 : 1.0);
+    double w = double(average(scene.triangleEmission(t))) * area * (m.doubleSided ? 2.0 : 1.0);
     if (!(w > 0) || !std::isfinite(w)) continue;
     total += w;
     ctx.emitters.push_back(uint32_t(t));

@@ -85,6 +85,7 @@ struct Vertex {
   float normalUv[2];  ///< the texture coordinates of the normal map
   float metallicRoughnessUv[2];
   float occlusionUv[2];
+  float emissiveUv[2];
 };
 
 /// A run of the vertex buffer drawn with one material's textures.
@@ -95,10 +96,39 @@ struct DrawRange {
   int metallicRoughnessTexture = -1;
   int occlusionTexture = -1;
   float occlusionStrength = 1;
+  int emissiveTexture = -1;
+  int alphaMode = shader::LO_ALPHA_OPAQUE;
+  float baseAlpha = 1;
+  float alphaCutoff = 0.5f;
+  bool doubleSided = true;  ///< false: back faces culled from the camera's view (glTF)
   GLint first = 0;
   GLsizei count = 0;
   float transmission = 0;  ///< > 0: drawn after the opaque scene, see-through
 };
+
+/// Draw order of the scene pass: plain opaque ranges first (one call in the
+/// depth-only passes), then alpha-tested ones, then blended ones (sorted back
+/// to front, no depth writes), then transmissive ones over a copy of the rest.
+enum DrawCategory { kSolid = 0, kMasked = 1, kBlended = 2, kTransmissive = 3, kCategories = 4 };
+
+int alphaModeOf(const Material& m) {
+  switch (m.alphaMode) {
+    case AlphaMode::Mask:
+      return shader::LO_ALPHA_MASK;
+    case AlphaMode::Blend:
+      return shader::LO_ALPHA_BLEND;
+    case AlphaMode::Opaque:
+      break;
+  }
+  return shader::LO_ALPHA_OPAQUE;
+}
+
+DrawCategory categoryOf(const Material& m) {
+  if (m.transmission > 0) return kTransmissive;
+  if (m.alphaMode == AlphaMode::Blend) return kBlended;
+  if (m.alphaMode == AlphaMode::Mask) return kMasked;
+  return kSolid;
+}
 
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
 
@@ -169,8 +199,14 @@ struct Renderer::Impl {
   GLuint sceneProgram = 0, sceneIndirectProgram = 0;
   GLuint shadowProgram = 0, depthProgram = 0, probeProgram = 0;
   GLuint vao = 0, vbo = 0, emptyVao = 0;
-  std::vector<DrawRange> ranges;        ///< the vertex buffer by texture, opaque ranges first
-  GLsizei opaqueCount = 0;              ///< vertices of the opaque ranges (shadows, pre-pass)
+  std::vector<DrawRange> ranges;        ///< the vertex buffer by material, in DrawCategory order
+  std::vector<DrawCategory> rangeCategory;  ///< per range
+  GLsizei opaqueCount = 0;              ///< vertices of the kSolid ranges (one call in depth passes)
+  /// Blended triangles' centroids (render space), one per triangle of the
+  /// kBlended ranges, from vertex blendFirst on; sorted per frame into blendEbo.
+  std::vector<glm::vec3> blendCentroids;
+  GLint blendFirst = 0;
+  GLuint blendEbo = 0;
   GLuint behindTexture = 0;             ///< the opaque image, seen through transmissive surfaces
   int behindWidth = 0, behindHeight = 0;
   bool behindFloat = false;
@@ -206,6 +242,7 @@ struct Renderer::Impl {
     if (behindTexture) glDeleteTextures(1, &behindTexture);
     glDeleteBuffers(1, &vbo);
     glDeleteBuffers(1, &lightUbo);
+    if (blendEbo) glDeleteBuffers(1, &blendEbo);
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &emptyVao);
     glDeleteFramebuffers(1, &shadowFbo);
@@ -288,8 +325,9 @@ struct Renderer::Impl {
     voxelSize = octree.depth > 0 ? octree.cubeSize / float(1 << octree.depth) : octree.cubeSize;
   }
 
-  /// Uploads a texture (linear RGB) with mipmaps, trilinear and anisotropic
-  /// filtering, repeat wrap (glTF's default sampler).
+  /// Uploads a texture (linear RGB, and its alpha where it has one) with
+  /// mipmaps, trilinear and anisotropic filtering, repeat wrap (glTF's
+  /// default sampler).
   GLuint uploadTexture(const Texture& t) {
     GLuint id = 0;
     glGenTextures(1, &id);
@@ -299,7 +337,7 @@ struct Renderer::Impl {
       rgba[4 * i] = t.texels[i].x;
       rgba[4 * i + 1] = t.texels[i].y;
       rgba[4 * i + 2] = t.texels[i].z;
-      rgba[4 * i + 3] = 1.0f;
+      rgba[4 * i + 3] = t.alpha.empty() ? 1.0f : t.alpha[i];
     }
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     // Half floats: linear colour with 11 bits of precision, filterable and
@@ -330,12 +368,12 @@ struct Renderer::Impl {
       const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
       return m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
     };
-    std::vector<std::vector<size_t>> byMaterial(2 * (scene.materials.size() + 1));
+    const size_t slots = scene.materials.size() + 1;
+    std::vector<std::vector<size_t>> byMaterial(kCategories * slots);
     for (size_t t = 0; t < scene.triangleCount(); ++t) {
       const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
       const size_t slot = m >= 0 && size_t(m) < scene.materials.size() ? size_t(m) + 1 : 0;
-      const bool transmissive = materialOf(t).transmission > 0;
-      byMaterial[(transmissive ? scene.materials.size() + 1 : 0) + slot].push_back(t);
+      byMaterial[size_t(categoryOf(materialOf(t))) * slots + slot].push_back(t);
     }
     auto uvSet = [&](int texCoord) -> const std::vector<float>& {
       return texCoord == 1 ? scene.texcoords1 : scene.texcoords0;
@@ -355,7 +393,15 @@ struct Renderer::Impl {
       if (group.empty()) continue;
       const Material& mat = materialOf(group.front());
       DrawRange range;
+      const DrawCategory category = categoryOf(mat);
       range.transmission = mat.transmission;
+      range.alphaMode = alphaModeOf(mat);
+      range.baseAlpha = mat.baseAlpha;
+      range.alphaCutoff = mat.alphaCutoff;
+      range.doubleSided = mat.doubleSided;
+      if (usable(mat.emissiveTexture, mat.emissiveTexCoord) && mat.isEmissive()) {
+        range.emissiveTexture = textureId(mat.emissiveTexture);
+      }
       if (usable(mat.baseColorTexture, mat.baseColorTexCoord)) range.texture = textureId(mat.baseColorTexture);
       if (usable(mat.normalTexture, mat.normalTexCoord)) {
         range.normalTexture = textureId(mat.normalTexture);
@@ -398,12 +444,23 @@ struct Renderer::Impl {
           if (range.occlusionTexture >= 0) {
             setUv(v.occlusionUv, mat.occlusionTexCoord, mat.occlusionTransform);
           }
+          if (range.emissiveTexture >= 0) {
+            setUv(v.emissiveUv, mat.emissiveTexCoord, mat.emissiveTransform);
+          }
           vertices.push_back(v);
+        }
+        if (category == kBlended) {
+          const Vertex* tri = &vertices[vertices.size() - 3];
+          blendCentroids.push_back(
+              (glm::make_vec3(tri[0].position) + glm::make_vec3(tri[1].position) +
+               glm::make_vec3(tri[2].position)) / 3.0f);
         }
       }
       range.count = GLsizei(vertices.size()) - range.first;
       ranges.push_back(range);
-      if (range.transmission <= 0) opaqueCount = GLsizei(vertices.size());
+      rangeCategory.push_back(category);
+      if (category == kSolid) opaqueCount = GLsizei(vertices.size());
+      if (category < kBlended) blendFirst = GLsizei(vertices.size());
     }
     glGenVertexArrays(1, &vao);
     glBindVertexArray(vao);
@@ -425,6 +482,8 @@ struct Renderer::Impl {
     attrib(6, 2, offsetof(Vertex, normalUv));
     attrib(7, 2, offsetof(Vertex, metallicRoughnessUv));
     attrib(8, 2, offsetof(Vertex, occlusionUv));
+    attrib(9, 2, offsetof(Vertex, emissiveUv));
+    if (!blendCentroids.empty()) glGenBuffers(1, &blendEbo);
     glBindVertexArray(0);
     glGenVertexArrays(1, &emptyVao);
     checkGl("uploading the scene");
@@ -440,9 +499,9 @@ struct Renderer::Impl {
     for (size_t t = 0; t < scene.triangleCount(); ++t) {
       int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
       if (m < 0 || size_t(m) >= scene.materials.size()) continue;
-      const Material& mat = scene.materials[size_t(m)];
+      const Vec3 emission = scene.triangleEmission(t);
       const float area = scene.triangleArea(t);
-      if (!(maxComponent(mat.emission) > 0) || !(area > 0)) continue;
+      if (!(maxComponent(emission) > 0) || !(area > 0)) continue;
       if (out.size() == size_t(shader::LO_MAX_AREA_LIGHTS)) return {};
       const Vec3 p0 = toRender(scene.positions[scene.indices[t * 3]]);
       const Vec3 p1 = toRender(scene.positions[scene.indices[t * 3 + 1]]);
@@ -451,7 +510,7 @@ struct Renderer::Impl {
       GpuLight l{};
       setVec4(l.positionType, (p0 + p1 + p2) / 3.0f + n * (1e-3f * sceneSize), float(kArea));
       setVec4(l.directionRange, n, 0);
-      setVec4(l.colorFar, mat.emission, 0);
+      setVec4(l.colorFar, emission, 0);  // the mean radiance of a textured emitter
       setVec4(l.params, Vec3(-1, 1, -1), area);
       setVec4(l.corner0, p0, std::sqrt(area));
       setVec4(l.corner1, p1, 0);
@@ -472,8 +531,7 @@ struct Renderer::Impl {
     for (size_t t = 0; t < scene.triangleCount(); ++t) {
       int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
       if (m < 0 || size_t(m) >= scene.materials.size()) continue;
-      const Material& mat = scene.materials[size_t(m)];
-      double w = double(average(mat.emission)) * scene.triangleArea(t);
+      double w = double(average(scene.triangleEmission(t))) * scene.triangleArea(t);
       if (!(w > 0)) continue;
       total += w;
       tris.push_back(t);
@@ -503,13 +561,13 @@ struct Renderer::Impl {
       const Vec3 p2 = toRender(scene.positions[scene.indices[t * 3 + 2]]);
       Vec3 n = scene.faceNormal(t);
       Vec3 p = p0 * (1 - b1 - b2) + p1 * b1 + p2 * b2 + n * (1e-3f * sceneSize);
-      const Material& mat = scene.materials[size_t(scene.triangleMaterial[t])];
+      const Vec3 emission = scene.triangleEmission(t);
       // Area this sample stands for: the whole emitter power shared by count.
-      float area = float(total / double(average(mat.emission)) / count);
+      float area = float(total / double(average(emission)) / count);
       GpuLight l{};
       setVec4(l.positionType, p, float(kEmitter));
       setVec4(l.directionRange, n, 0);
-      setVec4(l.colorFar, mat.emission * area, 0);
+      setVec4(l.colorFar, emission * area, 0);
       setVec4(l.params, Vec3(-1, 1, -1), area);
       out.push_back(l);
     }
@@ -645,12 +703,68 @@ struct Renderer::Impl {
         glUniformMatrix4fv(glGetUniformLocation(shadowProgram, "uViewProj"), 1, GL_FALSE,
                            lightBlock.shadowMatrices[layer]);
         // Transmissive surfaces cast no shadow (light passes; not tinted).
-        glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
+        drawDepthOnly(shadowProgram, true);
       }
     }
     glBindVertexArray(0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     checkGl("rendering the shadow maps");
+  }
+
+  /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
+  /// `program` in use: the solid ranges in one call, then the masked ranges
+  /// alpha-tested one by one, and with `blended` the blended ranges too (a
+  /// shadow map has no partial coverage: they cast a shadow where their
+  /// alpha is at least 1/2). Transmissive ranges are not drawn.
+  void drawDepthOnly(GLuint program, bool blended) {
+    const GLint alphaTest = glGetUniformLocation(program, "uAlphaTest");
+    glUniform1i(alphaTest, 0);
+    glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
+    glUniform1i(glGetUniformLocation(program, "uBaseColorTexture"), 4);
+    const GLint hasTexture = glGetUniformLocation(program, "uHasBaseColorTexture");
+    const GLint baseAlpha = glGetUniformLocation(program, "uBaseAlpha");
+    const GLint cutoff = glGetUniformLocation(program, "uAlphaCutoff");
+    for (size_t i = 0; i < ranges.size(); ++i) {
+      const DrawRange& range = ranges[i];
+      if (rangeCategory[i] != kMasked && !(blended && rangeCategory[i] == kBlended)) continue;
+      glUniform1i(alphaTest, 1);
+      glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
+      glUniform1f(baseAlpha, range.baseAlpha);
+      glUniform1f(cutoff, rangeCategory[i] == kMasked ? range.alphaCutoff : 0.5f);
+      glActiveTexture(GL_TEXTURE4);
+      glBindTexture(GL_TEXTURE_2D, range.texture >= 0 ? textures[size_t(range.texture)] : 0);
+      glDrawArrays(GL_TRIANGLES, range.first, range.count);
+    }
+    glActiveTexture(GL_TEXTURE0);
+  }
+
+  /// Writes the blended triangles' vertex indices into blendEbo, each
+  /// range's triangles from the farthest to the nearest centroid (render
+  /// space distance to `eye`): the order in which blending composes them.
+  void sortBlended(const glm::vec3& eye) {
+    if (blendCentroids.empty()) return;
+    std::vector<uint32_t> order(blendCentroids.size());
+    std::vector<float> distance(blendCentroids.size());
+    for (size_t t = 0; t < blendCentroids.size(); ++t) {
+      order[t] = uint32_t(t);
+      const glm::vec3 d = blendCentroids[t] - eye;
+      distance[t] = glm::dot(d, d);
+    }
+    std::vector<uint32_t> indices(3 * order.size());
+    size_t tri = 0;
+    for (size_t i = 0; i < ranges.size(); ++i) {
+      if (rangeCategory[i] != kBlended) continue;
+      const size_t begin = size_t(ranges[i].first - blendFirst) / 3;
+      const size_t end = begin + size_t(ranges[i].count) / 3;
+      std::stable_sort(order.begin() + long(begin), order.begin() + long(end),
+                       [&](uint32_t a, uint32_t b) { return distance[a] > distance[b]; });
+      for (size_t k = begin; k < end; ++k, ++tri) {
+        for (uint32_t c = 0; c < 3; ++c) indices[3 * tri + c] = uint32_t(blendFirst) + 3 * order[k] + c;
+      }
+    }
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, blendEbo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)),
+                 indices.data(), GL_STREAM_DRAW);
   }
 
   void ensureTarget(int width, int height) {
@@ -733,7 +847,7 @@ struct Renderer::Impl {
       glUniformMatrix4fv(glGetUniformLocation(depthProgram, "uViewProj"), 1, GL_FALSE,
                          glm::value_ptr(viewProj));
       glBindVertexArray(vao);
-      glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
+      drawDepthOnly(depthProgram, false);
       glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
       glDepthFunc(GL_LEQUAL);
       glDepthMask(GL_FALSE);
@@ -787,9 +901,31 @@ struct Renderer::Impl {
     const GLint occlusionStrength = loc("uOcclusionStrength");
     const GLint transmission = loc("uTransmission");
     glUniform1i(loc("uBehind"), 6);
+    glUniform1i(loc("uEmissiveTexture"), 10);
+    const GLint hasEmissive = loc("uHasEmissiveTexture");
+    const GLint alphaMode = loc("uAlphaMode");
+    const GLint baseAlpha = loc("uBaseAlpha");
+    const GLint alphaCutoff = loc("uAlphaCutoff");
     glUniform1f(transmission, 0.0f);
-    bool copied = false;
-    for (const DrawRange& range : ranges) {
+    // glTF: single-sided materials are culled from behind (counter-clockwise
+    // winding in front, as the loader keeps it).
+    glFrontFace(GL_CCW);
+    glCullFace(GL_BACK);
+    bool copied = false, blending = false;
+    for (size_t i = 0; i < ranges.size(); ++i) {
+      const DrawRange& range = ranges[i];
+      const bool blended = rangeCategory[i] == kBlended;
+      if (blended && !blending) {
+        // Over the opaque scene, back to front, without depth writes.
+        sortBlended(eye);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+        glDepthMask(GL_FALSE);
+        blending = true;
+      } else if (!blended && blending) {
+        glDisable(GL_BLEND);
+        blending = false;
+      }
       if (range.transmission > 0 && !copied) {
         // The opaque scene as drawn so far, for the surfaces in front of it
         // to show (thin-walled transmission: seen straight through).
@@ -816,8 +952,26 @@ struct Renderer::Impl {
       glUniform1i(hasNormal, range.normalTexture >= 0 ? 1 : 0);
       glUniform1f(normalScale, range.normalScale);
       glUniform1f(transmission, range.transmission);
-      glDrawArrays(GL_TRIANGLES, range.first, range.count);
+      bind(GL_TEXTURE10, range.emissiveTexture);
+      glActiveTexture(GL_TEXTURE0);
+      glUniform1i(hasEmissive, range.emissiveTexture >= 0 ? 1 : 0);
+      glUniform1i(alphaMode, range.alphaMode);
+      glUniform1f(baseAlpha, range.baseAlpha);
+      glUniform1f(alphaCutoff, range.alphaCutoff);
+      if (range.doubleSided) {
+        glDisable(GL_CULL_FACE);
+      } else {
+        glEnable(GL_CULL_FACE);
+      }
+      if (blended) {
+        glDrawElements(GL_TRIANGLES, range.count, GL_UNSIGNED_INT,
+                       reinterpret_cast<const void*>(size_t(range.first - blendFirst) * 4));
+      } else {
+        glDrawArrays(GL_TRIANGLES, range.first, range.count);
+      }
     }
+    if (blending) glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
     glBindVertexArray(0);
     glBindSampler(5, 0);
     glDepthMask(GL_TRUE);

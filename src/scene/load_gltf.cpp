@@ -512,6 +512,21 @@ class SceneBuilder {
       m.name = g.name.empty() ? "material" + std::to_string(i) : g.name;
       const auto& pbr = g.pbrMetallicRoughness;
       m.baseColor = vec3From(pbr.baseColorFactor, Vec3{1, 1, 1});
+      m.baseAlpha = pbr.baseColorFactor.size() >= 4 ? float(pbr.baseColorFactor[3]) : 1.0f;
+      if (g.alphaMode == "MASK") {
+        m.alphaMode = AlphaMode::Mask;
+      } else if (g.alphaMode == "BLEND") {
+        m.alphaMode = AlphaMode::Blend;
+      } else if (!g.alphaMode.empty() && g.alphaMode != "OPAQUE") {
+        fail(path_, "material " + std::to_string(i) + ": unknown alphaMode '" + g.alphaMode +
+                        "' (expected OPAQUE, MASK or BLEND)");
+      }
+      m.alphaCutoff = float(g.alphaCutoff);
+      if (!std::isfinite(m.baseAlpha) || !std::isfinite(m.alphaCutoff) || m.baseAlpha < 0 ||
+          m.baseAlpha > 1 || m.alphaCutoff < 0) {
+        fail(path_, "material " + std::to_string(i) +
+                        ": base colour alpha must lie in [0, 1] and alphaCutoff be >= 0");
+      }
       m.metallic = float(pbr.metallicFactor);
       m.roughness = float(pbr.roughnessFactor);
       float strength = float(
@@ -553,6 +568,20 @@ class SceneBuilder {
           texCoordOut = texCoord;
         }
       };
+      // Emissive texture: sRGB colour like the base colour.
+      if (g.emissiveTexture.index >= 0) {
+        const int index = g.emissiveTexture.index;
+        if (size_t(index) >= model_.textures.size()) {
+          fail(path_, "material " + std::to_string(i) + ": emissive texture index " +
+                          std::to_string(index) + " out of range");
+        }
+        int texCoord = g.emissiveTexture.texCoord;
+        readTextureTransform(g.emissiveTexture.extensions, i, m.emissiveTransform, texCoord);
+        if (texCoord == 0 || texCoord == 1) {
+          m.emissiveTexture = textureFromImage(model_.textures[size_t(index)].source, index);
+          m.emissiveTexCoord = texCoord;
+        }
+      }
       dataMap(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions,
               "normal texture", m.normalTexture, m.normalTexCoord, m.normalTransform);
       m.normalScale = float(g.normalTexture.scale);
@@ -943,6 +972,12 @@ Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, si
     const float g = comp >= 3 ? px[1] : r;
     const float b = comp >= 3 ? px[2] : r;
     t.texels[i] = srgb ? Vec3{srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)} : Vec3{r, g, b};
+  }
+  // Alpha is linear in glTF whatever the colour encoding; kept only where
+  // the image has it (grey + alpha or RGBA).
+  if (comp == 2 || comp == 4) {
+    t.alpha.resize(t.texels.size());
+    for (size_t i = 0; i < t.alpha.size(); ++i) t.alpha[i] = d.values[i * comp + comp - 1];
   }
   return t;
 }

@@ -22,6 +22,14 @@ Vec3 Texture::lookup(float u, float v) const {
   return texels[size_t(y) * size_t(width) + size_t(x)];
 }
 
+float Texture::lookupAlpha(float u, float v) const {
+  if (width <= 0 || height <= 0 || alpha.empty()) return 1.0f;
+  float fu = u - std::floor(u), fv = v - std::floor(v);
+  int x = std::min(width - 1, std::max(0, int(fu * float(width))));
+  int y = std::min(height - 1, std::max(0, int(fv * float(height))));
+  return alpha[size_t(y) * size_t(width) + size_t(x)];
+}
+
 void TextureTransform::apply(float& u, float& v) const {
   const float c = std::cos(rotation), s = std::sin(rotation);
   const float su = scale[0] * u, sv = scale[1] * v;
@@ -101,17 +109,66 @@ float Scene::triangleArea(size_t t) const {
   return 0.5f * length(cross(b - a, c - a));
 }
 
-Vec3 Scene::albedo(size_t t, float b1, float b2) const {
-  const Material& m = materials[size_t(triangleMaterial[t])];
-  if (m.baseColorTexture < 0) return m.baseColor;
-  const std::vector<float>& uv = m.baseColorTexCoord == 1 ? texcoords1 : texcoords0;
-  if (uv.empty()) return m.baseColor;
+bool Scene::texcoord(size_t t, float b1, float b2, int texCoord, const TextureTransform& transform,
+                     float& u, float& v) const {
+  const std::vector<float>& uv = texCoord == 1 ? texcoords1 : texcoords0;
+  if (uv.size() != 2 * positions.size()) return false;
   float b0 = 1.0f - b1 - b2;
   uint32_t i0 = indices[3 * t], i1 = indices[3 * t + 1], i2 = indices[3 * t + 2];
-  float u = b0 * uv[2 * i0] + b1 * uv[2 * i1] + b2 * uv[2 * i2];
-  float v = b0 * uv[2 * i0 + 1] + b1 * uv[2 * i1 + 1] + b2 * uv[2 * i2 + 1];
-  m.baseColorTransform.apply(u, v);
+  u = b0 * uv[2 * i0] + b1 * uv[2 * i1] + b2 * uv[2 * i2];
+  v = b0 * uv[2 * i0 + 1] + b1 * uv[2 * i1 + 1] + b2 * uv[2 * i2 + 1];
+  transform.apply(u, v);
+  return true;
+}
+
+Vec3 Scene::albedo(size_t t, float b1, float b2) const {
+  const Material& m = materials[size_t(triangleMaterial[t])];
+  float u, v;
+  if (m.baseColorTexture < 0 || !texcoord(t, b1, b2, m.baseColorTexCoord, m.baseColorTransform, u, v))
+    return m.baseColor;
   return m.baseColor * textures[size_t(m.baseColorTexture)].lookup(u, v);
+}
+
+float Scene::coverage(size_t t, float b1, float b2) const {
+  const Material& m = materials[size_t(triangleMaterial[t])];
+  if (m.alphaMode == AlphaMode::Opaque) return 1.0f;
+  float alpha = m.baseAlpha;
+  float u, v;
+  if (m.baseColorTexture >= 0 &&
+      texcoord(t, b1, b2, m.baseColorTexCoord, m.baseColorTransform, u, v)) {
+    alpha *= textures[size_t(m.baseColorTexture)].lookupAlpha(u, v);
+  }
+  if (m.alphaMode == AlphaMode::Mask) return alpha >= m.alphaCutoff ? 1.0f : 0.0f;
+  return std::clamp(alpha, 0.0f, 1.0f);
+}
+
+Vec3 Scene::emission(size_t t, float b1, float b2) const {
+  const Material& m = materials[size_t(triangleMaterial[t])];
+  float u, v;
+  if (m.emissiveTexture < 0 || !texcoord(t, b1, b2, m.emissiveTexCoord, m.emissiveTransform, u, v))
+    return m.emission;
+  return m.emission * textures[size_t(m.emissiveTexture)].lookup(u, v);
+}
+
+Vec3 Scene::triangleEmission(size_t t) const {
+  const Material& m = materials[size_t(triangleMaterial[t])];
+  if (m.emissiveTexture < 0 || !m.isEmissive()) return m.emission;
+  // 64 stratified points: the centroids of the 8 x 8 sub-triangles.
+  constexpr int kSplit = 8;
+  Vec3 sum{0, 0, 0};
+  int count = 0;
+  for (int i = 0; i < kSplit; ++i) {
+    for (int j = 0; j + i < kSplit; ++j) {
+      // Upward sub-triangle (i, j) and, where it exists, the downward one.
+      sum += emission(t, (i + 1.0f / 3.0f) / kSplit, (j + 1.0f / 3.0f) / kSplit);
+      ++count;
+      if (i + j + 1 < kSplit) {
+        sum += emission(t, (i + 2.0f / 3.0f) / kSplit, (j + 2.0f / 3.0f) / kSplit);
+        ++count;
+      }
+    }
+  }
+  return sum / float(count);
 }
 
 std::string Scene::ToString() const {

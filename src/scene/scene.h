@@ -27,7 +27,11 @@ struct Texture {
   int width = 0, height = 0;
   std::vector<Vec3> texels;             ///< width * height: colour maps converted from sRGB to
                                         ///< linear, data maps (normal maps) as stored, in [0, 1]
-  Vec3 lookup(float u, float v) const;  ///< nearest texel, repeat wrap
+  /// width * height alpha values in [0, 1] (linear, as glTF defines alpha),
+  /// or empty when the image has no alpha channel (alpha 1 everywhere).
+  std::vector<float> alpha;
+  Vec3 lookup(float u, float v) const;        ///< nearest texel, repeat wrap
+  float lookupAlpha(float u, float v) const;  ///< nearest texel's alpha, repeat wrap
 };
 
 /// glTF metallic-roughness material (the subset the bake and renderer use).
@@ -42,9 +46,20 @@ struct TextureTransform {
   void apply(float& u, float& v) const;
 };
 
+/// glTF alphaMode: how the base colour's alpha (factor x texture) is read.
+enum class AlphaMode {
+  Opaque,  ///< alpha ignored
+  Mask,    ///< alpha >= alphaCutoff: opaque, else no surface at all
+  Blend,   ///< alpha is the surface's coverage (drawn sorted and blended; the
+           ///< tracers pass through with probability 1 - alpha)
+};
+
 struct Material {
   std::string name;
   Vec3 baseColor{0.8f, 0.8f, 0.8f};  ///< linear RGB albedo factor
+  float baseAlpha = 1.0f;            ///< baseColorFactor's alpha
+  AlphaMode alphaMode = AlphaMode::Opaque;
+  float alphaCutoff = 0.5f;          ///< glTF alphaCutoff (Mask only)
   int baseColorTexture = -1;         ///< index into Scene::textures, -1 = none
   int baseColorTexCoord = 0;         ///< which UV set (0 or 1) the texture uses
   TextureTransform baseColorTransform;  ///< KHR_texture_transform of the base colour texture
@@ -65,11 +80,21 @@ struct Material {
   float metallic = 0.0f;             ///< [0,1]
   float roughness = 1.0f;            ///< [0,1], perceptual (alpha = roughness^2)
   Vec3 emission{0, 0, 0};            ///< radiance W/(m^2 sr): emissiveFactor * strength
+  /// emissiveTexture (sRGB colour, decoded to linear): multiplies `emission`.
+  int emissiveTexture = -1;
+  int emissiveTexCoord = 0;
+  TextureTransform emissiveTransform;
   float transmission = 0.0f;         ///< KHR_materials_transmission, [0,1]
   float ior = 1.5f;                  ///< KHR_materials_ior
+  /// glTF doubleSided. false: the back of the surface is culled from the
+  /// camera's view (render, view), as glTF viewers do. Light transport (bake,
+  /// path tracer, shadows) treats every surface as two-sided except emission,
+  /// which leaves one-sided emitters on their front only.
   bool doubleSided = false;
 
   bool isEmissive() const { return maxComponent(emission) > 0; }
+  /// Whether alpha can hide part of the surface (Mask or Blend).
+  bool hasAlpha() const { return alphaMode != AlphaMode::Opaque; }
   std::string ToString() const;
 };
 
@@ -125,6 +150,20 @@ struct Scene {
   float triangleArea(size_t t) const;
   /// Base colour of triangle t at barycentrics (b1, b2), texture applied.
   Vec3 albedo(size_t t, float b1, float b2) const;
+  /// Coverage of triangle t at (b1, b2) as its material's alpha mode reads
+  /// it: 1 for Opaque; 1 or 0 against the cutoff for Mask; alpha for Blend.
+  float coverage(size_t t, float b1, float b2) const;
+  /// Emitted radiance of triangle t at (b1, b2) (W/(m^2 sr)), emissive
+  /// texture applied.
+  Vec3 emission(size_t t, float b1, float b2) const;
+  /// Mean emitted radiance over triangle t: `emission` of its material
+  /// exactly when it has no emissive texture, else the mean of 64 stratified
+  /// samples (what emitter sampling picks triangles by).
+  Vec3 triangleEmission(size_t t) const;
+  /// Texture coordinates of UV set `texCoord` (0 or 1) of triangle t at
+  /// (b1, b2) after `transform`; false when the set is missing.
+  bool texcoord(size_t t, float b1, float b2, int texCoord, const TextureTransform& transform,
+                float& u, float& v) const;
   std::string ToString() const;  ///< one-line summary
 
   /// Where ray tracing in float should put its origin: the bounds' centre
