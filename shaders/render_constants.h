@@ -32,6 +32,10 @@ const int LO_LIGHT_AREA = 4;    /* an emissive triangle: exact unshadowed irradi
  * shadow layers); a scene with more gets virtual point lights instead. */
 const int LO_MAX_AREA_LIGHTS = 8;
 
+/* Cascaded shadow maps per directional light (layers of the shadow array;
+ * the cascade uniforms are vec4s: at most 4). */
+const int LO_SUN_CASCADES = 4;
+
 /* Array sizes of the std140 LightBlock. */
 const int LO_MAX_LIGHTS = 32;
 const int LO_MAX_SHADOW_LAYERS = 96;

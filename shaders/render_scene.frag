@@ -52,6 +52,10 @@ uniform int uAlphaMode;      // LO_ALPHA_OPAQUE, LO_ALPHA_MASK or LO_ALPHA_BLEND
 uniform float uBaseAlpha;    // baseColorFactor's alpha
 uniform float uAlphaCutoff;  // glTF alphaCutoff (mask)
 uniform float uTransmission;  // KHR_materials_transmission of this draw; 0 = opaque
+uniform vec3 uViewForward;     // the camera's unit view direction (render space)
+uniform vec4 uCascadeFar;      // view depth where each sun cascade ends
+uniform vec4 uCascadeTexel;    // world size of a texel of each cascade
+uniform vec4 uCascadeDepth;    // world depth range of each cascade's map
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 
 // std140 twin: GpuLight / LightBlock in src/render/renderer.cpp.
@@ -253,6 +257,65 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
   return lit / float(kFilterTaps * kFilterTaps);
 }
 
+// Shadow of directional light i from its cascades (render/renderer.cpp
+// fitCascades): the cascade by the point's view depth, a slope-scaled depth
+// bias, and a filter that cannot leak: the map is read as nearest texels, a tap is
+// lit only when the 2 x 2 texels around it all are (an erosion of the lit
+// area by one texel), and 3 x 3 such taps one texel apart are tent-weighted
+// by the point's position between texels (smooth as it moves). A floor point
+// next to the wall of a closed room under the sun thus never reads the lit
+// ground outside the wall through a texel that straddles the wall's base;
+// the price is a shadow one texel larger, on the lit side.
+// The fragment's unit geometric normal, turned to the viewer (set by main):
+// shadow biases follow the surface's real slope, not the normal map's.
+vec3 gGeometricNormal;
+
+float sunShadow(int i, vec3 p, vec3 n, vec3 toLight) {
+  int first = int(L.params.z);
+  if (first < 0) return 1.0;
+  float depth = dot(p - uEye, uViewForward);
+  int c = depth < uCascadeFar.x ? 0 : depth < uCascadeFar.y ? 1 : depth < uCascadeFar.z ? 2 : 3;
+  // Slope-scaled depth bias, no normal offset: a point lifted off the floor
+  // by a normal offset rises above the base of a wall next to it in the
+  // sun's view and reads that wall's texels as lit. The taps reach two
+  // texels out, over which a surface at angle theta to the light changes
+  // depth by 2 tan(theta) texels.
+  float nl = clamp(abs(dot(gGeometricNormal, toLight)), 0.05, 1.0);
+  float slope = min(sqrt(1.0 - nl * nl) / nl, 4.0);
+  int layer = first + c;
+  vec4 clip = uShadowMatrices[layer] * vec4(p, 1.0);
+  vec3 ndc = clip.xyz / clip.w;
+  vec2 uv = ndc.xy * 0.5 + 0.5;
+  float ref = ndc.z * 0.5 + 0.5 - (0.5 + 2.5 * slope) * uCascadeTexel[c] / uCascadeDepth[c];
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || ref > 1.0) return 1.0;
+  int size = textureSize(uShadowDepths, 0).x;
+  vec2 t = uv * float(size) - 0.5;
+  ivec2 base = ivec2(floor(t)) - 1;
+  vec2 f = t - floor(t);
+  // 4 x 4 nearest comparisons around the point.
+  float lit[16];
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      ivec2 q = clamp(base + ivec2(x, y), ivec2(0), ivec2(size - 1));
+      lit[4 * y + x] = texelFetch(uShadowDepths, ivec3(q, layer), 0).r >= ref ? 1.0 : 0.0;
+    }
+  }
+  // Each of the 2 x 2 nearest texel centres is lit only if the 3 x 3 texels
+  // around it all are; the point interpolates those four bilinearly.
+  float e[4];
+  for (int y = 0; y < 2; ++y) {
+    for (int x = 0; x < 2; ++x) {
+      float m = 1.0;
+      for (int dy = 0; dy < 3; ++dy) {
+        for (int dx = 0; dx < 3; ++dx) m = min(m, lit[4 * (y + dy) + x + dx]);
+      }
+      e[2 * y + x] = m;
+    }
+  }
+  float sum = mix(mix(e[0], e[1], f.x), mix(e[2], e[3], f.x), f.y);
+  return sum;
+}
+
 float shadow(int i, vec3 p, vec3 n, vec3 toLight) {
   // The light read in place (a copy of the 7-vec4 struct is dear on llvmpipe).
 #define L uLights[i]
@@ -321,7 +384,8 @@ vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughn
       }
     }
     if (dot(n, l) <= 0.0 || max(E.r, max(E.g, E.b)) <= 0.0) continue;
-    sum += brdfCos(n, v, l, baseColor, metallic, roughness) * E * shadow(i, p, n, l);
+    float visible = type == LO_LIGHT_DIRECTIONAL ? sunShadow(i, p, n, l) : shadow(i, p, n, l);
+    sum += brdfCos(n, v, l, baseColor, metallic, roughness) * E * visible;
   }
   return sum;
 }
@@ -366,6 +430,9 @@ void main() {
   vec3 ng = cross(dFdx(vPosition), dFdy(vPosition));
   if (dot(ng, v) < 0.0) ng = -ng;
   if (dot(n, ng) < 0.0) n = -n;
+#ifdef LO_DIRECT_LIGHT
+  gGeometricNormal = normalize(ng);
+#endif
   if (uHasNormalTexture) n = perturbNormal(n, vPosition, vNormalUv);
   // glTF: base colour = factor x texture, sampled per pixel (trilinear,
   // anisotropic where the context has it).

@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <array>
 #include <sstream>
 
 #include <render_constants.h>
@@ -32,9 +33,13 @@ constexpr int kDirectional = shader::LO_LIGHT_DIRECTIONAL;
 constexpr int kEmitter = shader::LO_LIGHT_EMITTER;
 constexpr int kArea = shader::LO_LIGHT_AREA;
 
+constexpr int kCascades = shader::LO_SUN_CASCADES;
+
 /// Shadow map layers a light of shader type `type` takes: a cube (6) for
-/// lights that shine all around a point, one for spot and directional lights.
+/// lights that shine all around a point, one per cascade for directional
+/// lights, one for spot lights.
 int shadowLayersOf(int type) {
+  if (type == kDirectional) return kCascades;
   return type == kPoint || type == kEmitter || type == kArea ? 6 : 1;
 }
 
@@ -218,6 +223,14 @@ struct Renderer::Impl {
   int targetWidth = 0, targetHeight = 0;
   int emitterLights = 0;
   int areaLightCount = 0;
+  /// Directional lights with cascaded shadow maps (indices into the light
+  /// block), their cascades refitted when the camera moves.
+  std::vector<int> sunLights;
+  float cascadeFar[4] = {0, 0, 0, 0};      ///< view depth where each cascade ends
+  float cascadeTexel[4] = {0, 0, 0, 0};    ///< world size of one texel of each cascade
+  float cascadeDepth[4] = {1, 1, 1, 1};    ///< world depth range of each cascade's map
+  std::array<float, 12> fittedCamera{};    ///< the camera the cascades were fitted to
+
   GLuint depthSampler = 0;  ///< reads the shadow maps' depths (no comparison): PCSS blocker search
   bool halfVdls = false;
 
@@ -633,11 +646,16 @@ struct Renderer::Impl {
         std::memcpy(lightBlock.shadowMatrices[layers], glm::value_ptr(m), 64);
         l.colorFar[3] = far;
       } else {
+        // Cascades fitted to the camera's view each frame (fitCascades); until
+        // the first frame, every cascade covers the whole scene.
         glm::vec3 eye = center - dir * (2.0f * radius);
         glm::mat4 m = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
                       glm::lookAt(eye, center, perpendicular(dir));
-        std::memcpy(lightBlock.shadowMatrices[layers], glm::value_ptr(m), 64);
+        for (int c = 0; c < kCascades; ++c) {
+          std::memcpy(lightBlock.shadowMatrices[layers + c], glm::value_ptr(m), 64);
+        }
         l.colorFar[3] = 0;
+        sunLights.push_back(int(&l - lights.data()));
       }
       layers += need;
     }
@@ -709,6 +727,121 @@ struct Renderer::Impl {
     glBindVertexArray(0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     checkGl("rendering the shadow maps");
+  }
+
+  /// Cascaded shadow maps of the directional lights (Engel 2006; Zhang et
+  /// al. 2006, parallel-split): the camera's view depth up to the scene's far
+  /// end is split into kCascades slices, half logarithmic and half uniform,
+  /// and each slice's frustum gets its own orthographic map around the
+  /// slice's bounding sphere (a square of the sphere's diameter, so the
+  /// texel size does not change as the camera turns), its centre snapped to
+  /// whole texels (no shimmer as the camera moves), its depth range the
+  /// whole scene's along the light (casters outside the slice still cast).
+  /// Re-renders those layers when the camera differs from the last fit.
+  void fitCascades(const glm::vec3& eye, const glm::vec3& forward, const glm::vec3& up,
+                   float yfov, float aspect, float znear, float zfar) {
+    if (sunLights.empty()) return;
+    const std::array<float, 12> key = {eye.x,     eye.y, eye.z, forward.x, forward.y, forward.z,
+                                       up.x,      up.y,  up.z,  yfov,      aspect,    znear};
+    if (key == fittedCamera) return;
+    fittedCamera = key;
+    const glm::vec3 center = toGlm(bounds.center());
+    const float sceneRadius = 0.5f * sceneSize;
+    // The slices end where the scene ends along the view.
+    float farthest = 0;
+    for (int c = 0; c < 8; ++c) {
+      const glm::vec3 corner((c & 1) ? bounds.upper.x : bounds.lower.x,
+                             (c & 2) ? bounds.upper.y : bounds.lower.y,
+                             (c & 4) ? bounds.upper.z : bounds.lower.z);
+      farthest = std::max(farthest, glm::dot(corner - eye, forward));
+    }
+    const float n = std::max(znear, 1e-4f * sceneSize);
+    const float f = std::max(std::min(zfar, farthest), 2.0f * n);
+    float splits[kCascades + 1];
+    splits[0] = n;
+    for (int i = 1; i <= kCascades; ++i) {
+      const float t = float(i) / float(kCascades);
+      splits[i] = 0.5f * n * std::pow(f / n, t) + 0.5f * (n + (f - n) * t);
+    }
+    const glm::vec3 right = glm::normalize(glm::cross(forward, up));
+    const glm::vec3 upOrtho = glm::cross(right, forward);
+    const float th = std::tan(0.5f * yfov), tw = th * aspect;
+    glBindBuffer(GL_UNIFORM_BUFFER, lightUbo);
+    for (int c = 0; c < kCascades; ++c) {
+      // The slice's bounding sphere: centred on the view axis where it is
+      // equidistant from the near and far corners.
+      const float d0 = splits[c], d1 = splits[c + 1];
+      const float k2 = tw * tw + th * th;
+      float z = 0.5f * (d0 + d1) * (1.0f + k2);
+      z = std::min(z, d1);
+      const float r0 = std::sqrt((z - d0) * (z - d0) + d0 * d0 * k2);
+      const float r1 = std::sqrt((d1 - z) * (d1 - z) + d1 * d1 * k2);
+      float radius = std::max(r0, r1);
+      glm::vec3 sphere = eye + forward * z;
+      if (radius >= sceneRadius) {
+        radius = sceneRadius;
+        sphere = center;
+      }
+      cascadeFar[c] = c + 1 == kCascades ? 1e30f : d1;
+      cascadeTexel[c] = 2.0f * radius / float(params.shadowMapSize);
+      for (int light : sunLights) {
+        const GpuLight& l = lightBlock.lights[light];
+        const glm::vec3 dir(l.directionRange[0], l.directionRange[1], l.directionRange[2]);
+        const glm::mat4 view0 = glm::lookAt(glm::vec3(0.0f), dir, perpendicular(dir));
+        // Snap the centre to whole texels in the light's view plane.
+        glm::vec3 ls = glm::vec3(view0 * glm::vec4(sphere, 1.0f));
+        ls.x = std::floor(ls.x / cascadeTexel[c]) * cascadeTexel[c];
+        ls.y = std::floor(ls.y / cascadeTexel[c]) * cascadeTexel[c];
+        const glm::vec3 snapped = glm::vec3(glm::inverse(view0) * glm::vec4(ls, 1.0f));
+        // Depth: the whole scene along the light, from the map's centre.
+        float before = 0, after = 0;
+        for (int k = 0; k < 8; ++k) {
+          const glm::vec3 corner((k & 1) ? bounds.upper.x : bounds.lower.x,
+                                 (k & 2) ? bounds.upper.y : bounds.lower.y,
+                                 (k & 4) ? bounds.upper.z : bounds.lower.z);
+          const float along = glm::dot(corner - snapped, dir);
+          before = std::max(before, -along);
+          after = std::max(after, along);
+        }
+        const float margin = 1e-3f * sceneSize;
+        const glm::vec3 lightEye = snapped - dir * (before + margin);
+        cascadeDepth[c] = before + after + 2.0f * margin;
+        const glm::mat4 m =
+            glm::ortho(-radius, radius, -radius, radius, 0.0f, cascadeDepth[c]) *
+            glm::lookAt(lightEye, snapped, perpendicular(dir));
+        const int layer = int(l.params[2]) + c;
+        std::memcpy(lightBlock.shadowMatrices[layer], glm::value_ptr(m), 64);
+        glBufferSubData(GL_UNIFORM_BUFFER, GLintptr(offsetof(LightBlock, shadowMatrices) + 64 * size_t(layer)),
+                        64, lightBlock.shadowMatrices[layer]);
+      }
+    }
+    glBindBuffer(GL_UNIFORM_BUFFER, 0);
+    // Render the cascades' layers.
+    GLint previous = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo);
+    glViewport(0, 0, params.shadowMapSize, params.shadowMapSize);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(shadowProgram);
+    glBindVertexArray(vao);
+    glUniform1f(glGetUniformLocation(shadowProgram, "uFar"), 0.0f);
+    for (int light : sunLights) {
+      const GpuLight& l = lightBlock.lights[light];
+      for (int c = 0; c < kCascades; ++c) {
+        const int layer = int(l.params[2]) + c;
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadowTexture, 0, layer);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        glUniformMatrix4fv(glGetUniformLocation(shadowProgram, "uViewProj"), 1, GL_FALSE,
+                           lightBlock.shadowMatrices[layer]);
+        drawDepthOnly(shadowProgram, true);
+      }
+    }
+    glBindVertexArray(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
+    checkGl("rendering the cascaded shadow maps");
   }
 
   /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
@@ -827,6 +960,10 @@ struct Renderer::Impl {
     float znear = std::min(camera.znear > 0 ? camera.znear : 0.01f, 0.5f * zfar);
     glm::mat4 viewProj = glm::perspective(camera.yfov, float(width) / float(height), znear, zfar) *
                          glm::lookAt(eye, eye + toGlm(camera.forward), toGlm(camera.up));
+    if (rp.mode == RenderMode::Full || rp.mode == RenderMode::Direct) {
+      fitCascades(eye, glm::normalize(toGlm(camera.forward)), toGlm(camera.up), camera.yfov,
+                  float(width) / float(height), znear, zfar);
+    }
 
     glViewport(0, 0, width, height);
     glClearColor(0, 0, 0, 1);
@@ -862,6 +999,11 @@ struct Renderer::Impl {
     glUniform1i(loc("uDepth"), depth);
     glUniform3f(loc("uEye"), eyeRender.x, eyeRender.y, eyeRender.z);
     glUniform1i(loc("uMode"), shaderMode(rp.mode));
+    const glm::vec3 forward = glm::normalize(toGlm(camera.forward));
+    glUniform3f(loc("uViewForward"), forward.x, forward.y, forward.z);
+    glUniform4fv(loc("uCascadeFar"), 1, cascadeFar);
+    glUniform4fv(loc("uCascadeTexel"), 1, cascadeTexel);
+    glUniform4fv(loc("uCascadeDepth"), 1, cascadeDepth);
     glUniform1i(loc("uInterpolation"), rp.interpolation ? 1 : 0);
     glUniform1i(loc("uSpecular"), rp.specular ? 1 : 0);
     glUniform1i(loc("uMaxVdls"), rp.maxVdls);

@@ -766,5 +766,235 @@ TEST(RenderImageIo, WritesPngAndExrAtomicallyAndRejectsOtherExtensions) {
   EXPECT_EQ(encodeSrgb8(0.5f), 188);  // 0.7354 * 255
 }
 
+
+/// A constant VDL along +z in every voxel of a depth-2 octree over [-1.5, 1.5]^3.
+GpuOctree constantOctree() {
+  return makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl* v) {
+    v[0].irradiance = {1, 1, 1};
+    v[0].direction = {0, 0, 1};
+    return 1;
+  });
+}
+
+/// Pixel column of world x on QuadSetup's quad plane z = `z` (the camera at
+/// z = 2 looks down -z through x = 0.1).
+int columnAt(const QuadSetup& s, const RenderParams& p, float x, float z) {
+  const float worldPerPixel = 2.0f * (2.0f - z) * std::tan(0.5f * s.camera.yfov) / float(p.height);
+  return p.width / 2 + int(std::floor((x - 0.1f) / worldPerPixel));
+}
+
+// glTF MASK: the cut-out half of a card neither hides the quad behind it nor
+// shadows it; the other half does both.
+TEST(RenderImage, MaskedCardCutsOutTheViewAndTheShadow) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Light light;
+  light.type = Light::Type::Point;
+  light.position = {0.1f, -0.05f, 1.0f};
+  light.intensity = 2.0f;
+  s.scene.lights.push_back(light);
+  Texture half;
+  half.width = 2;
+  half.height = 1;
+  half.texels = {Vec3{1, 1, 1}, Vec3{1, 1, 1}};
+  half.alpha = {0.0f, 1.0f};  // u < 0.5 (x < 0) cut out
+  s.scene.textures.push_back(half);
+  Material card;
+  card.baseColor = {1, 1, 1};
+  card.baseColorTexture = 0;
+  card.alphaMode = AlphaMode::Mask;
+  s.scene.materials.push_back(card);
+  test::addQuad(s.scene, {-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
+  s.scene.texcoords0.assign(2 * s.scene.positions.size(), 0.0f);
+  for (size_t v = 0; v < s.scene.positions.size(); ++v) {
+    s.scene.texcoords0[2 * v] = 0.5f * (s.scene.positions[v].x + 1.0f);
+  }
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const GpuOctree octree = constantOctree();
+  const RgbImage masked = Renderer(s.scene, octree).render(s.camera, p);
+  writePng(test::outputDir("render_mask") + "/rendered.png", masked, 1.0f);
+  // x = -0.4 on the quad: seen through the cut-out, lit through it (the
+  // light's ray crosses the card at x = -0.15).
+  const float* behind = masked.pixel(columnAt(s, p, -0.4f, 0.0f), p.height / 2);
+  EXPECT_GT(behind[0], 0.02f) << "lit through the cut-out";
+  EXPECT_NEAR(behind[0] / behind[2], s.albedo.x / s.albedo.z, 0.03f) << "the quad's colour";
+  // x = 0.4 on the card: the card (white).
+  const float* cardPixel = masked.pixel(columnAt(s, p, 0.4f, 0.5f), p.height / 2);
+  EXPECT_NEAR(cardPixel[0] / cardPixel[2], 1.0f, 0.03f) << "the card's colour";
+  // Opaque, the card hides the quad everywhere.
+  s.scene.materials[1].alphaMode = AlphaMode::Opaque;
+  const RgbImage opaque = Renderer(s.scene, octree).render(s.camera, p);
+  const float* hidden = opaque.pixel(columnAt(s, p, -0.4f, 0.0f), p.height / 2);
+  EXPECT_NEAR(hidden[0] / hidden[2], 1.0f, 0.03f);
+}
+
+// glTF BLEND: a pane of alpha 1/4 over the lit quad shows 1/4 of its own
+// radiance and 3/4 of the quad's; below 1/2 it casts no shadow.
+TEST(RenderImage, BlendedPaneCoversItsAlphaOfWhatIsBehind) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Light light;
+  light.type = Light::Type::Point;
+  light.position = {0.6f, 0.5f, 1.5f};
+  light.intensity = 4.0f;
+  s.scene.lights.push_back(light);
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const GpuOctree octree = constantOctree();
+  const RgbImage open = Renderer(s.scene, octree).render(s.camera, p);
+  Material pane;
+  pane.baseColor = {1, 1, 1};
+  pane.baseAlpha = 0.25f;
+  s.scene.materials.push_back(pane);
+  test::addQuad(s.scene, {-1, -1, 0.8f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
+  const RgbImage paneImage = Renderer(s.scene, octree).render(s.camera, p);  // opaque
+  s.scene.materials[1].alphaMode = AlphaMode::Blend;
+  const RgbImage blended = Renderer(s.scene, octree).render(s.camera, p);
+  writePng(test::outputDir("render_blend") + "/rendered.png", blended, 1.0f);
+  for (int x : {p.width / 4, p.width / 2, 3 * p.width / 4}) {
+    const float* a = open.pixel(x, p.height / 2);
+    const float* b = paneImage.pixel(x, p.height / 2);
+    const float* c = blended.pixel(x, p.height / 2);
+    ASSERT_GT(a[0], 0.01f);
+    for (int k = 0; k < 3; ++k) {
+      const float expected = 0.25f * b[k] + 0.75f * a[k];
+      EXPECT_NEAR(c[k], expected, 0.01f * expected) << "pixel " << x << " channel " << k;
+    }
+  }
+}
+
+// The emissive texture multiplies the emissive factor per pixel.
+TEST(RenderImage, EmissiveTextureMultipliesTheEmission) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  // 16 texels: red on the left half, green on the right (bilinear filtering
+  // reads one colour away from the middle).
+  Texture two;
+  two.width = 16;
+  two.height = 1;
+  for (int x = 0; x < 16; ++x) two.texels.push_back(x < 8 ? Vec3{1, 0, 0} : Vec3{0, 0.5f, 0});
+  s.scene.textures.push_back(two);
+  s.scene.materials[0].emission = {2, 2, 2};
+  s.scene.materials[0].emissiveTexture = 0;
+  for (const Vec3& v : s.scene.positions) {
+    s.scene.texcoords0.push_back(0.5f * (v.x + 1.0f));
+    s.scene.texcoords0.push_back(0.5f);
+  }
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const RgbImage image = Renderer(s.scene, constantOctree()).render(s.camera, p);
+  const float* left = image.pixel(columnAt(s, p, -0.4f, 0.0f), p.height / 2);
+  const float* right = image.pixel(columnAt(s, p, 0.6f, 0.0f), p.height / 2);
+  EXPECT_NEAR(left[0], 2.0f, 2e-3f);
+  EXPECT_NEAR(left[1], 0.0f, 2e-3f);
+  EXPECT_NEAR(right[0], 0.0f, 2e-3f);
+  EXPECT_NEAR(right[1], 1.0f, 2e-3f);
+}
+
+// glTF doubleSided false: a surface seen from behind is culled (the quad
+// behind it shows); doubleSided true: it is drawn.
+TEST(RenderImage, SingleSidedSurfaceIsCulledFromBehind) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Material pane;
+  pane.baseColor = {1, 1, 1};
+  s.scene.materials.push_back(pane);
+  // Its winding faces -z, away from the camera.
+  test::addQuad(s.scene, {-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, 1);
+  RenderParams p = QuadSetup::params(false);
+  const GpuOctree octree = constantOctree();
+  const RgbImage culled = Renderer(s.scene, octree).render(s.camera, p);
+  const float* c = culled.pixel(p.width / 2, p.height / 2);
+  EXPECT_NEAR(c[0] / c[2], s.albedo.x / s.albedo.z, 0.02f) << "the quad behind shows";
+  s.scene.materials[1].doubleSided = true;
+  const RgbImage drawn = Renderer(s.scene, octree).render(s.camera, p);
+  const float* d = drawn.pixel(p.width / 2, p.height / 2);
+  EXPECT_NEAR(d[0] / d[2], 1.0f, 0.02f) << "the pane shows";
+}
+
+Light sun(const Vec3& direction, float irradiance) {
+  Light l;
+  l.type = Light::Type::Directional;
+  l.direction = normalize(direction);
+  l.intensity = irradiance;
+  return l;
+}
+
+// A closed room of zero-thickness walls on a lit ground under a sun: no sun
+// light inside but for isolated pixels along the floor-wall seams (where a
+// shadow-map texel straddles the wall's base and half of it sees the lit
+// ground); the old lookup let full sunlight in there.
+TEST(RenderImage, SunDoesNotLeakIntoAClosedRoom) {
+  REQUIRE_OSMESA();
+  Scene scene;
+  Material m;
+  m.baseColor = {0.8f, 0.8f, 0.8f};
+  scene.materials.push_back(m);
+  test::addQuad(scene, {-5, -0.001f, -5}, {0, 0, 10}, {10, 0, 0}, {0, 1, 0}, 0);
+  test::addClosedBox(scene, {-0.5f, 0, -0.5f}, {0.5f, 1, 0.5f}, 0);
+  scene.lights.push_back(sun({0.3f, -1.0f, 0.2f}, 3.0f));
+  RenderParams p;
+  p.width = p.height = 128;
+  p.mode = RenderMode::Direct;
+  p.specular = false;
+  Renderer renderer(scene, constantOctree());
+  float worst = 0;
+  // Two views of the seams of the walls that face the sun (x = -0.5 and
+  // z = -0.5: the sun travels towards +x +z), where the lit ground outside
+  // lies next to the wall's base in the sun's view: down into their corner,
+  // and along the base of one of them.
+  const PinholeCamera views[] = {
+      PinholeCamera::lookAt({0.2f, 0.6f, 0.2f}, {-0.5f, 0.0f, -0.5f}, 70.0f * kPi / 180.0f),
+      PinholeCamera::lookAt({0.4f, 0.3f, 0.0f}, {-0.5f, 0.0f, -0.4f}, 70.0f * kPi / 180.0f)};
+  int k = 0;
+  const std::string dir = test::outputDir("render_sun_room");
+  for (const PinholeCamera& view : views) {
+    const RgbImage image = renderer.render(view, p);
+    writePng(dir + "/view" + std::to_string(k++) + ".png", image, 4.0f);
+    for (size_t i = 0; i < image.pixelCount(); ++i) worst = std::max(worst, image.rgb[3 * i]);
+  }
+  // Lit floor would be 0.8 / pi * 3 * cos(theta) = 0.72. A single map over the
+  // scene with the hardware 2 x 2 comparison let the full 0.72 in along the
+  // seams; the eroded lookup leaves isolated seam pixels with at most 0.124
+  // (measured; docs/render.md): a known remainder, bounded here.
+  EXPECT_LT(worst, 0.2f) << "sun light inside the closed room (" << dir << ")";
+}
+
+// A 50 m ground under a sun, a 10 cm plate 30 cm above it: its shadow, seen
+// from 25 cm, is a sharp square (cascades fitted to the view), not the few
+// texels a map over the whole scene would give it.
+TEST(RenderImage, SunCascadesResolveASmallShadowOnALargeGround) {
+  REQUIRE_OSMESA();
+  Scene scene;
+  Material m;
+  m.baseColor = {0.8f, 0.8f, 0.8f};
+  scene.materials.push_back(m);
+  test::addQuad(scene, {-25, 0, -25}, {0, 0, 50}, {50, 0, 0}, {0, 1, 0}, 0);
+  test::addQuad(scene, {-0.05f, 0.3f, -0.05f}, {0.1f, 0, 0}, {0, 0, 0.1f}, {0, -1, 0}, 0);
+  scene.lights.push_back(sun({1.0f, -1.0f, 0.0f}, 3.0f));
+  RenderParams p;
+  p.width = p.height = 128;
+  p.mode = RenderMode::Direct;
+  p.specular = false;
+  // Straight down at the shadow's centre (x = 0.3), under the plate.
+  const PinholeCamera camera =
+      PinholeCamera::lookAt({0.3f, 0.25f, 0.0f}, {0.3f, 0.0f, 0.0f}, 40.0f * kPi / 180.0f);
+  const RgbImage image = Renderer(scene, constantOctree()).render(camera, p);
+  writePng(test::outputDir("render_sun_cascades") + "/rendered.png", image, 0.0f);
+  const float lit = 0.8f * kInvPi * 3.0f * std::sqrt(0.5f);
+  int dark = 0, between = 0;
+  for (size_t i = 0; i < image.pixelCount(); ++i) {
+    const float v = image.rgb[3 * i];
+    if (v < 0.1f * lit) ++dark;
+    else if (v < 0.9f * lit) ++between;
+  }
+  // The view spans 2 x 0.25 tan(20 deg) = 0.182 m: the 0.1 m square shadow
+  // covers (0.1 / 0.182)^2 = 30% of it; its edges are 4 x 0.1 m = 281 pixels.
+  const double share = double(dark) / double(image.pixelCount());
+  EXPECT_NEAR(share, 0.30, 0.04) << dark << " dark pixels";
+  EXPECT_LT(between, 3 * 281) << "a penumbra wider than 3 pixels on average";
+}
+
 }  // namespace
 }  // namespace lo

@@ -780,3 +780,87 @@ TEST(SceneObj, Rejects) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+/// An uncompressed 32-bit TGA (stb_image reads it with its alpha channel),
+/// pixels RGBA top row first.
+std::string tgaRgba(int width, int height, const std::vector<uint8_t>& rgba) {
+  std::string header(18, '\0');
+  header[2] = 2;  // uncompressed true colour
+  header[12] = char(width & 255);
+  header[13] = char(width >> 8);
+  header[14] = char(height & 255);
+  header[15] = char(height >> 8);
+  header[16] = 32;
+  header[17] = 0x28;  // 8 alpha bits, origin top-left
+  std::string body;
+  for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
+    body += char(rgba[i + 2]);  // TGA stores BGRA
+    body += char(rgba[i + 1]);
+    body += char(rgba[i]);
+    body += char(rgba[i + 3]);
+  }
+  return header + body;
+}
+
+// glTF alphaMode, alphaCutoff, the base colour's alpha, the texture's alpha
+// channel and the emissive texture are read; Scene::coverage and
+// Scene::emission apply them.
+TEST(SceneGltf, AlphaModesAndEmissiveTexture) {
+  std::string dir = test::outputDir("SceneGltf_Alpha");
+  // 2x1: left texel opaque white, right texel alpha 64/255; colours
+  // (255, 0, 0) and (0, 255, 0) for the emissive use.
+  writeFile(dir + "/alpha.tga", tgaRgba(2, 1, {255, 0, 0, 255, 0, 255, 0, 64}));
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"alphaMode": "MASK", "alphaCutoff": 0.4,
+    "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.8], "baseColorTexture": {"index": 0}},
+    "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 0}}])";
+  g.extraTop = R"("textures": [{"source": 0}], "images": [{"uri": "alpha.tga"}], )";
+  Scene s = loadScene(writeGltf(dir, "alpha.gltf", g));
+  ASSERT_EQ(s.materials.size(), 1u);
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.alphaMode, AlphaMode::Mask);
+  EXPECT_FLOAT_EQ(m.alphaCutoff, 0.4f);
+  EXPECT_FLOAT_EQ(m.baseAlpha, 0.8f);
+  ASSERT_EQ(m.emissiveTexture, m.baseColorTexture) << "one sRGB decoding of the image, shared";
+  const Texture& t = s.textures[size_t(m.baseColorTexture)];
+  ASSERT_EQ(t.alpha.size(), 2u);
+  EXPECT_NEAR(t.alpha[0], 1.0f, 1e-6f);
+  EXPECT_NEAR(t.alpha[1], 64.0f / 255.0f, 1e-6f) << "alpha is linear, not sRGB-decoded";
+  // Vertex UVs of oneTriangle: find a barycentric point on each texel.
+  s.texcoords0 = {0.25f, 0.5f, 0.75f, 0.5f, 0.25f, 0.5f};
+  // b1 = 0: u = 0.25 (opaque texel) -> 0.8 >= 0.4: covered.
+  EXPECT_EQ(s.coverage(0, 0, 0), 1.0f);
+  // b1 = 1: u = 0.75: 0.8 * 0.251 = 0.2 < 0.4: cut out.
+  EXPECT_EQ(s.coverage(0, 1, 0), 0.0f);
+  s.materials[0].alphaMode = AlphaMode::Blend;
+  EXPECT_NEAR(s.coverage(0, 1, 0), 0.8f * 64.0f / 255.0f, 1e-6f);
+  s.materials[0].alphaMode = AlphaMode::Opaque;
+  EXPECT_EQ(s.coverage(0, 1, 0), 1.0f);
+  expectNear(s.emission(0, 0, 0), {1, 0, 0}, 1e-6f, "emission on the red texel");
+  expectNear(s.emission(0, 1, 0), {0, 1, 0}, 1e-6f, "emission on the green texel");
+  // Mean over the triangle: u = 0.25 + b1 / 2 is on the red texel where
+  // b1 < 1/2, 3/4 of the triangle's area; 64 stratified samples see both.
+  const Vec3 mean = s.triangleEmission(0);
+  EXPECT_NEAR(mean.x + mean.y, 1.0f, 1e-6f);
+  EXPECT_NEAR(mean.x, 0.75f, 0.05f);
+}
+
+TEST(SceneGltf, UnknownAlphaModeIsRefused) {
+  std::string dir = test::outputDir("SceneGltf_BadAlpha");
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"alphaMode": "DITHER"}])";
+  try {
+    loadScene(writeGltf(dir, "bad.gltf", g));
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("alphaMode 'DITHER'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace lo
