@@ -15,6 +15,8 @@ PACKAGES=(
   libopenvdb-dev libboost-iostreams-dev libblosc-dev libopenvdb-tools
   # kd-tree baseline of the gather benchmark, CLI, tests
   libnanoflann-dev libcli11-dev libgtest-dev
+  # lightmap UVs: the sparse LSCM solve (header-only; stb_rect_pack comes with libstb-dev)
+  libeigen3-dev
   # images and GL rendering (OSMesa headless, EGL, GLFW window), math
   libopenexr-dev libglm-dev libglfw3-dev libosmesa6-dev libegl-dev libgl-dev python3-glad
   # plots of the parameter sweep (lightoctree sweep)
