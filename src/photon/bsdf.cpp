@@ -51,11 +51,13 @@ Vec3 schlick(const Vec3& f0, float cosine) {
 
 }  // namespace
 
-BsdfLobes bsdfLobes(const Material& m) {
+BsdfLobes bsdfLobes(const Material& m) { return bsdfLobes(m, m.metallic, m.roughness); }
+
+BsdfLobes bsdfLobes(const Material& m, float metallicIn, float roughnessIn) {
   BsdfLobes info;
-  float metallic = std::clamp(m.metallic, 0.0f, 1.0f);
+  float metallic = std::clamp(metallicIn, 0.0f, 1.0f);
   float transmission = std::clamp(m.transmission, 0.0f, 1.0f);
-  float roughness = std::clamp(m.roughness, 0.0f, 1.0f);
+  float roughness = std::clamp(roughnessIn, 0.0f, 1.0f);
   info.metalWeight = metallic;
   info.transmissionWeight = (1.0f - metallic) * transmission;
   info.diffuseWeight = (1.0f - metallic) * (1.0f - transmission);

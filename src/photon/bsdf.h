@@ -44,6 +44,19 @@ struct BsdfLobes {
   }
 };
 BsdfLobes bsdfLobes(const Material& material);
+/// The same with metallic and roughness given (a metallic-roughness map's
+/// values at a hit, Scene::metallicRoughness) in place of the factors.
+BsdfLobes bsdfLobes(const Material& material, float metallic, float roughness);
+/// The lobes at a hit of triangle t at (b1, b2): `perMaterial` unless the
+/// material has a metallic-roughness map, else from the map's values there.
+inline BsdfLobes bsdfLobesAt(const Scene& scene, const BsdfLobes& perMaterial, size_t t,
+                             float b1, float b2) {
+  const Material& m = scene.materials[size_t(scene.triangleMaterial[t])];
+  if (m.metallicRoughnessTexture < 0) return perMaterial;
+  float metallic, roughness;
+  scene.metallicRoughness(t, b1, b2, metallic, roughness);
+  return bsdfLobes(m, metallic, roughness);
+}
 
 /// One sampled scattering direction.
 struct BsdfSample {

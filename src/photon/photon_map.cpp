@@ -232,7 +232,8 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     // triangles give the same t whichever of them Embree reports.
     Vec3 p = org + dir * t;
     const TriangleInfo& tri = ctx.triangles[hit.triangle];
-    const BsdfLobes& mat = ctx.materials[tri.material];
+    const BsdfLobes mat =
+        bsdfLobesAt(*ctx.scene, ctx.materials[tri.material], hit.triangle, hit.b1, hit.b2);
     const Vec3& normal = hit.geometricNormal;
     bool frontFace = dot(dir, normal) < 0;
     Vec3 n = frontFace ? normal : -normal;  // faces the incoming side

@@ -200,7 +200,8 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
     // depth - 1 scattering events so far; one more is allowed below the cap.
     if (depth - 1 >= ctx.maxBounces) break;
 
-    const BsdfLobes& lobes = ctx.lobes[ctx.scene->triangleMaterial[hit.triangle]];
+    const BsdfLobes lobes = bsdfLobesAt(*ctx.scene, ctx.lobes[ctx.scene->triangleMaterial[hit.triangle]],
+                                        hit.triangle, hit.b1, hit.b2);
     Vec3 albedo = ctx.scene->albedo(hit.triangle, hit.b1, hit.b2);
     if (lobes.hasSmoothLobe()) {
       Vec3 l = sampleLights(ctx, p, normal, n, wo, lobes, albedo, rng, out.rays);

@@ -142,6 +142,20 @@ float Scene::coverage(size_t t, float b1, float b2) const {
   return std::clamp(alpha, 0.0f, 1.0f);
 }
 
+void Scene::metallicRoughness(size_t t, float b1, float b2, float& metallic,
+                              float& roughness) const {
+  const Material& m = materials[size_t(triangleMaterial[t])];
+  metallic = m.metallic;
+  roughness = m.roughness;
+  float u, v;
+  if (m.metallicRoughnessTexture < 0 ||
+      !texcoord(t, b1, b2, m.metallicRoughnessTexCoord, m.metallicRoughnessTransform, u, v))
+    return;
+  const Vec3 texel = textures[size_t(m.metallicRoughnessTexture)].lookup(u, v);
+  roughness *= texel.y;
+  metallic *= texel.z;
+}
+
 Vec3 Scene::emission(size_t t, float b1, float b2) const {
   const Material& m = materials[size_t(triangleMaterial[t])];
   float u, v;

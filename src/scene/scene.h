@@ -153,6 +153,9 @@ struct Scene {
   /// Coverage of triangle t at (b1, b2) as its material's alpha mode reads
   /// it: 1 for Opaque; 1 or 0 against the cutoff for Mask; alpha for Blend.
   float coverage(size_t t, float b1, float b2) const;
+  /// Metallic and roughness of triangle t at (b1, b2): the factors times the
+  /// metallicRoughnessTexture's B and G channels where there is one.
+  void metallicRoughness(size_t t, float b1, float b2, float& metallic, float& roughness) const;
   /// Emitted radiance of triangle t at (b1, b2) (W/(m^2 sr)), emissive
   /// texture applied.
   Vec3 emission(size_t t, float b1, float b2) const;

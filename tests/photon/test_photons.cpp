@@ -603,3 +603,46 @@ TEST(Photons, EmissiveTextureWeightsThePhotons) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// The photon tracer reads a metallic-roughness map as the renderer does: a
+// mirror by its factors (metallic 1, roughness 0.05) whose map says
+// metallic 0 (B = 0) scatters diffusely and stores photons; without the map
+// it stores none.
+TEST(Photons, MetallicRoughnessMapMakesAMirrorDiffuse) {
+  auto floorPhotons = [](bool withMap) {
+    Scene scene;
+    int wall = addMaterial(scene, {0.5f, 0.5f, 0.5f});
+    int mirror = addMaterial(scene, {0.9f, 0.9f, 0.9f});
+    scene.materials[size_t(mirror)].metallic = 1.0f;
+    scene.materials[size_t(mirror)].roughness = 0.05f;
+    if (withMap) {
+      Texture map;
+      map.width = map.height = 1;
+      map.texels = {Vec3{0, 1, 0}};  // G roughness x1, B metallic x0
+      scene.textures.push_back(map);
+      scene.materials[size_t(mirror)].metallicRoughnessTexture = 0;
+    }
+    addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
+    addQuad(scene, {-0.5f, -0.9f, -0.5f}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, mirror);
+    scene.texcoords0.assign(2 * scene.positions.size(), 0.5f);
+    scene.lights.push_back(pointLight({0, 0.5f, 0}, {1, 1, 1}, 5.0f));
+    PhotonParams params;
+    params.storedPhotons = 20000;
+    params.includeDirect = true;
+    PhotonMap map = tracePhotons(scene, params);
+    size_t onFloor = 0;
+    for (const Photon& p : map.photons) {
+      onFloor += std::fabs(p.position.y + 0.9f) < 1e-4f && std::fabs(p.position.x) < 0.5f &&
+                 std::fabs(p.position.z) < 0.5f && p.normal.y > 0;
+    }
+    return onFloor;
+  };
+  EXPECT_EQ(floorPhotons(false), 0u);
+  EXPECT_GT(floorPhotons(true), 300u);
+}
+
+}  // namespace
+}  // namespace lo
