@@ -36,6 +36,12 @@ const int LO_MAX_AREA_LIGHTS = 8;
  * the cascade uniforms are vec4s: at most 4). */
 const int LO_SUN_CASCADES = 4;
 
+/* Environment reflections: surfaces of roughness up to LO_PROBE_FULL take
+ * their specular indirect light from the probe alone, above LO_PROBE_NONE from
+ * the VDLs alone, in between a mix (shaders/render_scene.frag). */
+const float LO_PROBE_FULL = 0.5;
+const float LO_PROBE_NONE = 0.8;
+
 /* Array sizes of the std140 LightBlock. */
 const int LO_MAX_LIGHTS = 32;
 const int LO_MAX_SHADOW_LAYERS = 96;

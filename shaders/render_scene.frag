@@ -56,6 +56,11 @@ uniform vec3 uViewForward;     // the camera's unit view direction (render space
 uniform vec4 uCascadeFar;      // view depth where each sun cascade ends
 uniform vec4 uCascadeTexel;    // world size of a texel of each cascade
 uniform vec4 uCascadeDepth;    // world depth range of each cascade's map
+uniform bool uHasProbe;        // environment reflections from the probe (RenderParams::reflections)
+uniform samplerCube uProbe;    // the lit scene seen from the render-space origin, mipmapped
+uniform vec3 uProbeBoxMin;     // the scene's bounds (render space): the parallax box
+uniform vec3 uProbeBoxMax;
+uniform float uProbeMaxLod;
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 
 // std140 twin: GpuLight / LightBlock in src/render/renderer.cpp.
@@ -78,7 +83,10 @@ layout(std140) uniform LightBlock {
 // glTF metallic-roughness BRDF times the cosine: Lambert diffuse plus a GGX
 // lobe (height-correlated Smith visibility, Schlick Fresnel). With uSpecular
 // off it is exactly baseColor/pi * (n.l): the analytic tests rely on that.
-vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
+// `specularWeight` scales the GGX lobe alone (the VDLs' share of a surface's
+// specular light when the reflection probe takes the rest).
+vec3 brdfCosWeighted(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness,
+                     float specularWeight) {
   float nl = dot(n, l);
   if (nl <= 0.0) return vec3(0.0);
   vec3 diffuse = baseColor * (1.0 - metallic) * (1.0 - uTransmission) / LO_PI;
@@ -94,7 +102,42 @@ vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float rough
   float vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));
   vec3 f0 = mix(vec3(0.04), baseColor, metallic);
   vec3 F = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
-  return ((1.0 - F) * diffuse + F * (D * vis)) * nl;
+  return ((1.0 - F) * diffuse + specularWeight * F * (D * vis)) * nl;
+}
+
+vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
+  return brdfCosWeighted(n, v, l, baseColor, metallic, roughness, 1.0);
+}
+
+// The probe's share of a surface's specular indirect light: all of it up to
+// roughness LO_PROBE_FULL, none above LO_PROBE_NONE (the VDLs' directions
+// light broad lobes well; a handful of VDLs cannot show a sharp reflection).
+float probeWeight(float roughness) {
+  return uHasProbe && uSpecular ? 1.0 - smoothstep(LO_PROBE_FULL, LO_PROBE_NONE, roughness) : 0.0;
+}
+
+// Specular light from the probe (paper §5.1, Fig. 12: cube maps with the
+// VDLs): the reflected ray is intersected with the scene's bounds and the
+// probe read towards that point (box projection, parallax-corrected: right
+// where the scene is a box around the probe), at a mip level growing with
+// roughness, times the split-sum environment BRDF in Karis's analytic fit
+// (Physically Based Shading on Mobile, 2014).
+vec3 probeSpecular(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughness) {
+  vec3 r = reflect(-v, n);
+  r = mix(r, vec3(1e-6), equal(r, vec3(0.0)));  // no 0/0 below
+  vec3 t1 = (uProbeBoxMax - p) / r, t2 = (uProbeBoxMin - p) / r;
+  vec3 tf = max(t1, t2);
+  float t = max(min(min(tf.x, tf.y), tf.z), 0.0);
+  vec3 dir = p + r * t;  // from the probe at the render-space origin
+  vec3 radiance = textureLod(uProbe, dir, roughness * uProbeMaxLod).rgb;
+  float nv = clamp(dot(n, v), 0.0, 1.0);
+  const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
+  const vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
+  vec4 q = roughness * c0 + c1;
+  float a004 = min(q.x * q.x, exp2(-9.28 * nv)) * q.x + q.y;
+  vec2 ab = vec2(-1.04, 1.04) * a004 + q.zw;
+  vec3 f0 = mix(vec3(0.04), baseColor, metallic);
+  return radiance * (f0 * ab.x + ab.y);
 }
 
 // The octree lookup, shared with C++ (octree/octree_irradiance.cpp).
@@ -104,8 +147,11 @@ vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float rough
 #define LO_VDLS_HALF uHalfVdls
 #include "octree_lookup.h"
 
+// The VDLs light the diffuse lobe and the share of the specular one that the
+// probe does not (gVdlSpecular, set by main).
+float gVdlSpecular = 1.0;
 vec3 loVdlResponse(LoSurface s, vec3 d) {
-  return brdfCos(s.n, s.v, d, s.baseColor, s.metallic, s.roughness);
+  return brdfCosWeighted(s.n, s.v, d, s.baseColor, s.metallic, s.roughness, gVdlSpecular);
 }
 
 vec3 hashColor(ivec3 c) {
@@ -478,8 +524,14 @@ void main() {
       float occlusion = uHasOcclusionTexture
                             ? 1.0 + uOcclusionStrength * (texture(uOcclusionTexture, vOcclusionUv).r - 1.0)
                             : 1.0;
-      radiance += occlusion * loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth,
-                                               uNormalOffset, uInterpolation, uMaxVdls, s);
+      float probe = probeWeight(roughness);
+      gVdlSpecular = 1.0 - probe;
+      vec3 indirect = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth,
+                                       uNormalOffset, uInterpolation, uMaxVdls, s);
+      if (probe > 0.0) {
+        indirect += probe * probeSpecular(vPosition, n, v, baseColor, metallic, roughness);
+      }
+      radiance += occlusion * indirect;
     }
   }
   if (uTransmission > 0.0) {

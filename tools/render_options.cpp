@@ -9,6 +9,7 @@ RenderParams ShadingOptions::renderParams(RenderMode mode) const {
   p.mode = mode;
   p.interpolation = interpolation == "on";
   p.specular = specular == "on";
+  p.reflections = reflections == "on";
   p.maxVdls = vdls;
   return p;
 }
@@ -42,6 +43,11 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
       ->capture_default_str();
   cmd->add_option("--specular", opt.specular,
                   "GGX lobe of the glTF BRDF (off: diffuse only)" + key("key G"))
+      ->check(onOff())
+      ->capture_default_str();
+  cmd->add_option("--reflections", opt.reflections,
+                  "Glossy and metal surfaces reflect a box-projected cube map of the lit scene "
+                  "captured at its centre (off: the VDLs light the specular lobe too)")
       ->check(onOff())
       ->capture_default_str();
   cmd->add_option("--exposure", opt.exposure,

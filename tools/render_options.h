@@ -1,7 +1,7 @@
 #pragma once
 /// @file tools/render_options.h
 /// @brief The shading flags `render` and `view` share (--interpolation,
-/// --specular, --exposure, --vdls, --emitter-lights, --shadow-map-size,
+/// --specular, --reflections, --exposure, --vdls, --emitter-lights, --shadow-map-size,
 /// --half-float, --cosine-correction): one registration and one translation
 /// into the renderer's parameters, so both commands draw the same picture
 /// from the same flags.
@@ -23,6 +23,7 @@ namespace lo::tool {
 struct ShadingOptions {
   std::string interpolation = "on";
   std::string specular = "on";
+  std::string reflections = "on";
   float exposure = 0;  ///< EV
   int vdls = kMaxVdls;
   std::string areaLights = "on";

@@ -229,6 +229,15 @@ struct Renderer::Impl {
   float cascadeFar[4] = {0, 0, 0, 0};      ///< view depth where each cascade ends
   float cascadeTexel[4] = {0, 0, 0, 0};    ///< world size of one texel of each cascade
   float cascadeDepth[4] = {1, 1, 1, 1};    ///< world depth range of each cascade's map
+  /// The reflection probe: a mipmapped RGBA16F cube map of the lit scene seen
+  /// from the scene's centre (render space origin), parallax-corrected to
+  /// the scene's bounds in the shader. Captured on the first frame that
+  /// wants it, again after setOctree.
+  bool probeWanted = false;
+  bool probeValid = false;
+  bool capturingProbe = false;
+  GLuint probeTexture = 0, probeFbo = 0, probeDepth = 0;
+  int probeLevels = 1;
   std::array<float, 12> fittedCamera{};    ///< the camera the cascades were fitted to
 
   GLuint depthSampler = 0;  ///< reads the shadow maps' depths (no comparison): PCSS blocker search
@@ -256,6 +265,9 @@ struct Renderer::Impl {
     glDeleteBuffers(1, &vbo);
     glDeleteBuffers(1, &lightUbo);
     if (blendEbo) glDeleteBuffers(1, &blendEbo);
+    if (probeTexture) glDeleteTextures(1, &probeTexture);
+    if (probeFbo) glDeleteFramebuffers(1, &probeFbo);
+    if (probeDepth) glDeleteRenderbuffers(1, &probeDepth);
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &emptyVao);
     glDeleteFramebuffers(1, &shadowFbo);
@@ -844,6 +856,69 @@ struct Renderer::Impl {
     checkGl("rendering the cascaded shadow maps");
   }
 
+  /// Renders the probe's six faces (90-degree views from the scene's centre,
+  /// GL's cube-face orientations) with the full scene program, reflections
+  /// off, then builds the mip chain that rough surfaces read (box-filtered
+  /// mips: a blur that grows with roughness, not a GGX prefilter).
+  void captureProbe(const RenderParams& rp) {
+    const int size = params.probeSize;
+    if (!probeTexture) {
+      glGenTextures(1, &probeTexture);
+      glBindTexture(GL_TEXTURE_CUBE_MAP, probeTexture);
+      probeLevels = 1;
+      while ((size >> probeLevels) > 0) ++probeLevels;
+      for (int f = 0; f < 6; ++f) {
+        glTexImage2D(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), 0, GL_RGBA16F, size, size, 0,
+                     GL_RGBA, GL_FLOAT, nullptr);
+      }
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+      glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+      glGenFramebuffers(1, &probeFbo);
+      glGenRenderbuffers(1, &probeDepth);
+      glBindRenderbuffer(GL_RENDERBUFFER, probeDepth);
+      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, size, size);
+      checkGl("allocating the reflection probe");
+    }
+    GLint previous = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous);
+    glBindFramebuffer(GL_FRAMEBUFFER, probeFbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, probeDepth);
+    const Vec3 forward[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const Vec3 up[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    RenderParams face = rp;
+    face.mode = RenderMode::Full;
+    face.reflections = false;
+    capturingProbe = true;
+    for (int f = 0; f < 6; ++f) {
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
+                             GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), probeTexture, 0);
+      GLenum drawBuffer = GL_COLOR_ATTACHMENT0;
+      glDrawBuffers(1, &drawBuffer);
+      if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        capturingProbe = false;
+        throw GlError("reflection probe framebuffer incomplete");
+      }
+      PinholeCamera camera;
+      camera.eye = renderOrigin;  // render space (0, 0, 0): the scene's centre
+      camera.forward = forward[f];
+      camera.up = up[f];
+      camera.yfov = 0.5f * kPi;
+      camera.znear = 1e-3f * sceneSize;
+      camera.zfar = 2.0f * sceneSize;
+      draw(camera, face, size, size, 1.0f, false);
+    }
+    capturingProbe = false;
+    glBindTexture(GL_TEXTURE_CUBE_MAP, probeTexture);
+    glGenerateMipmap(GL_TEXTURE_CUBE_MAP);
+    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
+    probeValid = true;
+    checkGl("capturing the reflection probe");
+  }
+
   /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
   /// `program` in use: the solid ranges in one call, then the masked ranges
   /// alpha-tested one by one, and with `blended` the blended ranges too (a
@@ -953,6 +1028,11 @@ struct Renderer::Impl {
       throw InputError("render: VDLs per voxel must be 1.." + std::to_string(kMaxVdls) + ", got " +
                        std::to_string(rp.maxVdls));
     }
+    // The probe shows the lit scene: captured before the first frame that
+    // reflects it (it draws six frames of its own through this function).
+    const bool reflect = rp.reflections && probeWanted && !capturingProbe &&
+                         (rp.mode == RenderMode::Full || rp.mode == RenderMode::Indirect);
+    if (reflect && !probeValid) captureProbe(rp);
     const Vec3 eyeRender = toRender(camera.eye);
     glm::vec3 eye = toGlm(eyeRender);
     float zfar = camera.zfar > 0 ? camera.zfar
@@ -1004,6 +1084,14 @@ struct Renderer::Impl {
     glUniform4fv(loc("uCascadeFar"), 1, cascadeFar);
     glUniform4fv(loc("uCascadeTexel"), 1, cascadeTexel);
     glUniform4fv(loc("uCascadeDepth"), 1, cascadeDepth);
+    glUniform1i(loc("uHasProbe"), reflect ? 1 : 0);
+    glUniform1i(loc("uProbe"), 11);
+    glUniform3f(loc("uProbeBoxMin"), bounds.lower.x, bounds.lower.y, bounds.lower.z);
+    glUniform3f(loc("uProbeBoxMax"), bounds.upper.x, bounds.upper.y, bounds.upper.z);
+    glUniform1f(loc("uProbeMaxLod"), float(probeLevels - 1));
+    glActiveTexture(GL_TEXTURE11);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, reflect ? probeTexture : 0);
+    glActiveTexture(GL_TEXTURE0);
     glUniform1i(loc("uInterpolation"), rp.interpolation ? 1 : 0);
     glUniform1i(loc("uSpecular"), rp.specular ? 1 : 0);
     glUniform1i(loc("uMaxVdls"), rp.maxVdls);
@@ -1131,6 +1219,10 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
                      std::to_string(params.shadowMapSize));
   }
   if (params.emitterLights < 0) throw InputError("emitter lights must be >= 0");
+  if (params.probeSize < 4 || params.probeSize > 4096) {
+    throw InputError("reflection probe size must be 4..4096, got " +
+                     std::to_string(params.probeSize));
+  }
   r.checkLimits(octree);
   Bounds3 world = scene.bounds();
   if (world.empty()) world.extend(Vec3(0, 0, 0));
@@ -1146,7 +1238,13 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.uploadOctree(octree);
   r.uploadScene(scene);
   r.setupLights(scene);
+  for (const Material& m : scene.materials) {
+    r.probeWanted = r.probeWanted || m.roughness < shader::LO_PROBE_NONE ||
+                    m.metallicRoughnessTexture >= 0;
+  }
 }
+
+bool Renderer::hasReflectionProbe() const { return impl_->probeWanted; }
 
 Renderer::~Renderer() = default;
 
@@ -1157,6 +1255,7 @@ int Renderer::areaLightCount() const { return impl_->areaLightCount; }
 void Renderer::setOctree(const GpuOctree& octree) {
   impl_->checkLimits(octree);
   impl_->uploadOctree(octree);
+  impl_->probeValid = false;  // it shows the old octree's light
 }
 
 RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& params) {

@@ -38,6 +38,11 @@ struct RenderParams {
   /// Lookup point offset along the surface normal, in voxel sizes (see
   /// docs/render.md: picks the voxel in front of a surface lying on a voxel face).
   float normalOffset = 0.01f;
+  /// Environment reflections (paper §5.1, Fig. 12): glossy and metal surfaces
+  /// take their specular indirect light from a box-projected cube map of the
+  /// lit scene captured at the scene's centre; the VDLs keep the diffuse and
+  /// rough-specular terms. Off: the VDLs light every term.
+  bool reflections = true;
 };
 
 /// Set once: resources built for the scene.
@@ -54,6 +59,9 @@ struct RendererParams {
   int emitterLights = 8;
   /// Texture limits to respect; 0 = query the current context.
   int max3DTextureSize = 0, max2DTextureSize = 0;
+  /// Texels per side of each face of the reflection probe's cube map
+  /// (RenderParams::reflections); captured on the first frame that needs it.
+  int probeSize = 128;
 };
 
 
@@ -86,6 +94,9 @@ class Renderer {
   /// each), without the read-back: the real-time cost.
   double timeFrames(const PinholeCamera& camera, const RenderParams& params, int frames);
 
+  /// Whether the scene has a surface the reflection probe serves (roughness,
+  /// by factor or map, below the probe's cut-off, shaders/render_constants.h).
+  bool hasReflectionProbe() const;
   int emitterLightCount() const;  ///< virtual point lights on emissive triangles
   int areaLightCount() const;     ///< emissive triangles drawn as area lights
 

@@ -996,5 +996,59 @@ TEST(RenderImage, SunCascadesResolveASmallShadowOnALargeGround) {
   EXPECT_LT(between, 3 * 281) << "a penumbra wider than 3 pixels on average";
 }
 
+
+// Environment reflections: a mirror floor in a box of walls that glow in six
+// colours, lit by nothing else (no VDLs, emitters not drawn as lights), shows
+// the colour of the wall its reflected ray really hits: the probe at the box's
+// centre, read box-projected. Read from the centre without the projection,
+// the same ray would show the ceiling's colour.
+TEST(RenderImage, MirrorReflectsTheWallItsRayHits) {
+  REQUIRE_OSMESA();
+  Scene scene;
+  auto glow = [&scene](const Vec3& radiance) {
+    Material m;
+    m.baseColor = {0, 0, 0};
+    m.emission = radiance;
+    scene.materials.push_back(m);
+    return int(scene.materials.size()) - 1;
+  };
+  test::addQuad(scene, {1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {-1, 0, 0}, glow({1, 0, 0}));   // +x
+  test::addQuad(scene, {-1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {1, 0, 0}, glow({0, 1, 0}));   // -x
+  test::addQuad(scene, {-1, 1, -1}, {2, 0, 0}, {0, 0, 2}, {0, -1, 0}, glow({0, 0, 1}));   // ceiling
+  test::addQuad(scene, {-1, -1, 1}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, glow({1, 1, 0}));   // +z
+  test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, glow({0, 1, 1}));   // -z
+  Material mirror;
+  mirror.baseColor = {1, 1, 1};
+  mirror.metallic = 1.0f;
+  mirror.roughness = 0.0f;
+  scene.materials.push_back(mirror);
+  test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, int(scene.materials.size()) - 1);
+  RendererParams rp;
+  rp.areaLights = false;
+  rp.emitterLights = 0;
+  const GpuOctree empty =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  Renderer renderer(scene, empty, rp);
+  ASSERT_TRUE(renderer.hasReflectionProbe());
+  RenderParams p;
+  p.width = p.height = 64;
+  p.mode = RenderMode::Full;
+  // The centre pixel sees the floor at (0.3, -1, 0.2); its reflection rises
+  // along (0, 1.2, 0.8) and meets the +z wall at (0.3, 0.2, 1): yellow. From
+  // the box's centre that direction meets the ceiling: blue.
+  const PinholeCamera camera =
+      PinholeCamera::lookAt({0.3f, 0.2f, -0.6f}, {0.3f, -1.0f, 0.2f}, 50.0f * kPi / 180.0f);
+  const RgbImage image = renderer.render(camera, p);
+  writePng(test::outputDir("render_mirror") + "/rendered.png", image, 0.0f);
+  const float* c = image.pixel(p.width / 2, p.height / 2);
+  EXPECT_NEAR(c[0], 1.0f, 0.05f);
+  EXPECT_NEAR(c[1], 1.0f, 0.05f);
+  EXPECT_LT(c[2], 0.05f) << "the ceiling's blue: the reflection was not box-projected";
+  // Without the probe, nothing lights the mirror.
+  p.reflections = false;
+  const float* off = renderer.render(camera, p).pixel(p.width / 2, p.height / 2);
+  EXPECT_LT(off[0] + off[1] + off[2], 1e-4f);
+}
+
 }  // namespace
 }  // namespace lo
