@@ -62,6 +62,9 @@ uniform vec3 uProbeBoxMin;     // the scene's bounds (render space): the paralla
 uniform vec3 uProbeBoxMax;
 uniform float uProbeMaxLod;
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
+uniform float uThickness;     // KHR_materials_volume thickness; 0 = thin-walled
+uniform float uIor;           // KHR_materials_ior
+uniform mat4 uViewProj;       // render space -> clip (the vertex shader's)
 
 // std140 twin: GpuLight / LightBlock in src/render/renderer.cpp.
 struct Light {
@@ -94,7 +97,7 @@ vec3 brdfCosWeighted(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, flo
   float nv = max(dot(n, v), 1e-4);
   vec3 h = normalize(l + v);
   float nh = max(dot(n, h), 0.0);
-  float vh = max(dot(v, h), 0.0);
+  float vh = clamp(dot(v, h), 0.0, 1.0);  // pow(1 - vh, 5) is NaN for vh a rounding above 1
   float a = max(roughness * roughness, 2e-3);
   float a2 = a * a;
   float dd = nh * nh * (a2 - 1.0) + 1.0;
@@ -539,7 +542,20 @@ void main() {
     // surface replaces that share of its diffuse lobe by the scene behind
     // it, seen straight through, tinted by the base colour and weighted by
     // the Fresnel transmittance at the viewing angle (Schlick, F0 = 0.04).
-    vec3 behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0).rgb;
+    // Thin-walled: seen straight through. With a volume: screen-space
+    // refraction, the image read where the refracted ray leaves a slab of the
+    // material's thickness (an approximation: the real exit depends on the
+    // shape behind the surface).
+    vec3 behind;
+    if (uThickness > 0.0) {
+      vec3 t = refract(-v, n, 1.0 / max(uIor, 1.0));
+      if (dot(t, t) == 0.0) t = -v;
+      vec4 clip = uViewProj * vec4(vPosition + t * uThickness, 1.0);
+      vec2 uv = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
+      behind = textureLod(uBehind, uv, 0.0).rgb;
+    } else {
+      behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0).rgb;
+    }
     if (uEncodeSrgb) behind = srgbDecode(behind);
     behind /= uExposureScale;
     float fresnel = 0.04 + 0.96 * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);

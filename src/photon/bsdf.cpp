@@ -63,6 +63,7 @@ BsdfLobes bsdfLobes(const Material& m, float metallicIn, float roughnessIn) {
   info.diffuseWeight = (1.0f - metallic) * (1.0f - transmission);
   info.alpha = roughness * roughness;
   info.ior = m.ior > 0 ? m.ior : 1.5f;
+  info.thinWalled = !(m.thickness > 0);
   info.storesPhotons = info.diffuseWeight > 0 || (metallic > 0 && roughness > kGlossyRoughness);
   return info;
 }
@@ -89,13 +90,19 @@ bool sampleBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, cons
     // Flux needs no eta^2 factor; radiance would, but the path tracer follows
     // importance from the camera, where the two factors cancel over a
     // round trip, so none is applied in either direction.
-    float n1 = frontFace ? 1.0f : lobes.ior, n2 = frontFace ? lobes.ior : 1.0f;
+    // A thin wall is entered and left at once: the interface seen from the
+    // air on either side.
+    const bool entering = frontFace || lobes.thinWalled;
+    float n1 = entering ? 1.0f : lobes.ior, n2 = entering ? lobes.ior : 1.0f;
     float cosI = std::min(1.0f, dot(wo, n)), cosT = 0;
     float f = fresnelDielectric(cosI, n1, n2, cosT);
     out.delta = true;
     if (rng.uniform() < f) {
       out.wi = reflect(wo, n);
       out.weight = Vec3{1, 1, 1};
+    } else if (lobes.thinWalled) {
+      out.wi = -wo;
+      out.weight = albedo;
     } else {
       float eta = n1 / n2;
       out.wi = -wo * eta + n * (eta * cosI - cosT);

@@ -11,7 +11,10 @@
 ///     Smith G2, Schlick Fresnel with F0 = baseColor; alpha < kMirrorAlpha is a
 ///     perfect mirror (a delta lobe);
 ///   - glass (weight (1-metallic) transmission): smooth dielectric, Fresnel
-///     reflection or refraction tinted by baseColor (a delta lobe).
+///     reflection or transmission tinted by baseColor (a delta lobe); the
+///     transmitted ray refracts where the material has a volume
+///     (KHR_materials_volume thickness > 0) and goes straight through a
+///     thin-walled one (glTF's default).
 /// There is no dielectric specular layer on the diffuse lobe (unlike the GL
 /// renderer's BRDF, docs/render.md). Shading uses the geometric normal only.
 ///
@@ -37,6 +40,7 @@ struct BsdfLobes {
   float diffuseWeight = 1;
   float alpha = 1;  ///< GGX alpha = roughness^2
   float ior = 1.5f;
+  bool thinWalled = true;     ///< transmission passes straight (no KHR_materials_volume)
   bool storesPhotons = true;  ///< diffuse lobe, or metal rougher than kGlossyRoughness
   /// Whether any lobe is not a delta distribution (light sampling can help).
   bool hasSmoothLobe() const {

@@ -109,6 +109,8 @@ struct DrawRange {
   GLint first = 0;
   GLsizei count = 0;
   float transmission = 0;  ///< > 0: drawn after the opaque scene, see-through
+  float thickness = 0;     ///< KHR_materials_volume: > 0 refracts the image behind
+  float ior = 1.5f;
 };
 
 /// Draw order of the scene pass: plain opaque ranges first (one call in the
@@ -420,6 +422,8 @@ struct Renderer::Impl {
       DrawRange range;
       const DrawCategory category = categoryOf(mat);
       range.transmission = mat.transmission;
+      range.thickness = mat.thickness;
+      range.ior = mat.ior;
       range.alphaMode = alphaModeOf(mat);
       range.baseAlpha = mat.baseAlpha;
       range.alphaCutoff = mat.alphaCutoff;
@@ -1136,6 +1140,8 @@ struct Renderer::Impl {
     const GLint alphaMode = loc("uAlphaMode");
     const GLint baseAlpha = loc("uBaseAlpha");
     const GLint alphaCutoff = loc("uAlphaCutoff");
+    const GLint thickness = loc("uThickness");
+    const GLint ior = loc("uIor");
     glUniform1f(transmission, 0.0f);
     // glTF: single-sided materials are culled from behind (counter-clockwise
     // winding in front, as the loader keeps it).
@@ -1182,6 +1188,8 @@ struct Renderer::Impl {
       glUniform1i(hasNormal, range.normalTexture >= 0 ? 1 : 0);
       glUniform1f(normalScale, range.normalScale);
       glUniform1f(transmission, range.transmission);
+      glUniform1f(thickness, range.thickness);
+      glUniform1f(ior, range.ior);
       bind(GL_TEXTURE10, range.emissiveTexture);
       glActiveTexture(GL_TEXTURE0);
       glUniform1i(hasEmissive, range.emissiveTexture >= 0 ? 1 : 0);

@@ -535,6 +535,12 @@ class SceneBuilder {
       m.transmission =
           float(numberExt(g.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0));
       m.ior = float(numberExt(g.extensions, "KHR_materials_ior", "ior", 1.5));
+      m.thickness =
+          float(numberExt(g.extensions, "KHR_materials_volume", "thicknessFactor", 0.0));
+      if (!(m.thickness >= 0)) {
+        fail(path_, "material " + std::to_string(i) +
+                        ": KHR_materials_volume thicknessFactor must be finite and >= 0");
+      }
       m.doubleSided = g.doubleSided;
       if (!isFinite(m.baseColor) || !isFinite(m.emission) || !std::isfinite(m.metallic) ||
           !std::isfinite(m.roughness) || !std::isfinite(m.transmission) || !std::isfinite(m.ior)) {

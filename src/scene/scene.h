@@ -86,6 +86,10 @@ struct Material {
   TextureTransform emissiveTransform;
   float transmission = 0.0f;         ///< KHR_materials_transmission, [0,1]
   float ior = 1.5f;                  ///< KHR_materials_ior
+  /// KHR_materials_volume thicknessFactor (scene units). 0 (no volume): a
+  /// transmissive surface is thin-walled, as glTF defines it: light passes
+  /// straight through it. > 0: the surface bounds a solid that refracts.
+  float thickness = 0.0f;
   /// glTF doubleSided. false: the back of the surface is culled from the
   /// camera's view (render, view), as glTF viewers do. Light transport (bake,
   /// path tracer, shadows) treats every surface as two-sided except emission,

@@ -451,7 +451,7 @@ TEST(SceneGltf, MaterialExtensionsAndTexture) {
       "roughnessFactor": 0.75, "baseColorTexture": {"index": 0}},
     "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4},
       "KHR_materials_transmission": {"transmissionFactor": 0.9},
-      "KHR_materials_ior": {"ior": 1.33}}}])";
+      "KHR_materials_ior": {"ior": 1.33}, "KHR_materials_volume": {"thicknessFactor": 0.2}}}])";
   g.extraTop = R"("textures": [{"source": 0}], "images": [{"uri": "tex.ppm"}], )";
   Scene s = loadScene(writeGltf(dir, "material.gltf", g));
   ASSERT_EQ(s.materials.size(), 1u);
@@ -461,6 +461,7 @@ TEST(SceneGltf, MaterialExtensionsAndTexture) {
   EXPECT_FLOAT_EQ(m.roughness, 0.75f);
   EXPECT_FLOAT_EQ(m.transmission, 0.9f);
   EXPECT_FLOAT_EQ(m.ior, 1.33f);
+  EXPECT_FLOAT_EQ(m.thickness, 0.2f);
   EXPECT_TRUE(m.doubleSided);
   ASSERT_EQ(m.baseColorTexture, 0);
   ASSERT_EQ(s.textures.size(), 1u);
