@@ -183,7 +183,11 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
     Vec3 p = org + dir * hit.t;
     const Vec3& normal = hit.geometricNormal;
     bool frontFace = dot(dir, normal) < 0;
-    Vec3 n = frontFace ? normal : -normal;
+    // The shading normal: the geometric one, tilted by a normal map as the
+    // renderer tilts it (Scene::shadingNormal); offsets and sides keep the
+    // geometric one.
+    const Vec3 n = ctx.scene->shadingNormal(hit.triangle, hit.b1, hit.b2,
+                                            frontFace ? normal : -normal);
     Vec3 wo = -dir;
     Vec3 le = emittedRadiance(ctx, hit.triangle, hit.b1, hit.b2, normal, wo);
     if (maxComponent(le) > 0) {

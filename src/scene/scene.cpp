@@ -142,6 +142,32 @@ float Scene::coverage(size_t t, float b1, float b2) const {
   return std::clamp(alpha, 0.0f, 1.0f);
 }
 
+Vec3 Scene::shadingNormal(size_t t, float b1, float b2, const Vec3& n) const {
+  const Material& m = materials[size_t(triangleMaterial[t])];
+  if (m.normalTexture < 0) return n;
+  float u, v, u0, v0, u1, v1, u2, v2;
+  if (!texcoord(t, b1, b2, m.normalTexCoord, m.normalTransform, u, v)) return n;
+  texcoord(t, 0, 0, m.normalTexCoord, m.normalTransform, u0, v0);
+  texcoord(t, 1, 0, m.normalTexCoord, m.normalTransform, u1, v1);
+  texcoord(t, 0, 1, m.normalTexCoord, m.normalTransform, u2, v2);
+  // dp/du from the triangle's edges: e1 = du1 T + dv1 B', e2 = du2 T + dv2 B'.
+  const Vec3 p0 = positions[indices[3 * t]];
+  const Vec3 e1 = positions[indices[3 * t + 1]] - p0, e2 = positions[indices[3 * t + 2]] - p0;
+  const float du1 = u1 - u0, dv1 = v1 - v0, du2 = u2 - u0, dv2 = v2 - v0;
+  const float det = du1 * dv2 - du2 * dv1;
+  if (!(std::fabs(det) > 1e-20f)) return n;
+  Vec3 tangent = (e1 * dv2 - e2 * dv1) / det;
+  tangent = tangent - n * dot(n, tangent);
+  if (!(lengthSquared(tangent) > 1e-20f)) return n;
+  tangent = normalize(tangent);
+  const Vec3 bitangent = cross(n, tangent);
+  Vec3 mapped = textures[size_t(m.normalTexture)].lookup(u, v) * 2.0f - Vec3{1, 1, 1};
+  mapped.x *= m.normalScale;
+  mapped.y *= m.normalScale;
+  const Vec3 out = tangent * mapped.x + bitangent * mapped.y + n * mapped.z;
+  return lengthSquared(out) > 0 ? normalize(out) : n;
+}
+
 void Scene::metallicRoughness(size_t t, float b1, float b2, float& metallic,
                               float& roughness) const {
   const Material& m = materials[size_t(triangleMaterial[t])];
