@@ -127,9 +127,10 @@ double uvSignedArea(const float* uv) {
 
 std::string LightmapUvs::ToString() const {
   std::ostringstream os;
-  os << "LightmapUvs{" << width << "x" << height << ", " << pageCount << " page(s), " << chartCount
-     << " charts, " << degenerateTriangles << " degenerate triangles, texelSize " << texelSize
-     << ", utilisation " << utilisation << ", worstStretch " << worstStretch << "}";
+  os << "LightmapUvs{" << width << "x" << height << ", " << pageCount << " page(s), gutter "
+     << gutter << ", " << chartCount << " charts, " << degenerateTriangles
+     << " degenerate triangles, texelSize " << texelSize << ", utilisation " << utilisation
+     << ", worstStretch " << worstStretch << "}";
   return os.str();
 }
 
@@ -148,6 +149,7 @@ LightmapUvs buildLightmapUvs(const Scene& scene, const LightmapUvParams& params)
 
   LightmapUvs out;
   out.width = out.height = size;
+  out.gutter = gutter;
   out.uv.assign(6 * nt, 0.0f);
   out.trianglePage.assign(nt, 0);
   out.triangleChart.assign(nt, -1);

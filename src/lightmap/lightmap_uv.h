@@ -43,6 +43,10 @@ struct LightmapUvParams {
 struct LightmapUvs {
   int width = 0, height = 0;  ///< page size in texels
   int pageCount = 0;
+  /// Empty texels the packing keeps between charts and at the page borders
+  /// (LightmapUvParams::gutter); 0 where unknown (TEXCOORD_1). The atlas bake
+  /// dilates this many rings by default (lightmap/lightmap_atlas.h).
+  int gutter = 0;
   /// 6 floats per triangle: corner UVs (u0 v0 u1 v1 u2 v2) in [0, 1] of its
   /// page, corners in the order of Scene::indices.
   std::vector<float> uv;

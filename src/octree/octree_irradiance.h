@@ -26,4 +26,25 @@ struct OctreeShadeParams {
 Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3& normal,
                       const OctreeShadeParams& params = {});
 
+/// E(p, n) and the direction it comes from, for a directional lightmap
+/// (paper §4.2.3: one VDL per texel rebuilt for the specular term).
+struct OctreeIrradianceSample {
+  Vec3 irradiance{0, 0, 0};  ///< E(p, n), W/m^2: octreeIrradiance's value
+  /// sum_i Y(c_i) max(0, n . d_i) d_i (Y = Rec. 709 luminance) over the same
+  /// VDLs with the same interpolation weights as E: the luminance-weighted
+  /// VDL direction sum, world space, towards the light. Its length is at
+  /// most Y(E), equal when every contributing VDL has one direction; zero
+  /// where nothing lights the point.
+  Vec3 directionSum{0, 0, 0};
+};
+
+/// E(p, n) as octreeIrradiance, and the luminance-weighted direction sum.
+/// A C++ twin of shaders/octree_lookup.h's loOctreeIndirect built from the
+/// same pieces (position offset, descent, nearest leaf, VDL fetch and
+/// decoding) with the sum of loShadeLeaf taken beside E; a test holds its E
+/// to octreeIrradiance's.
+OctreeIrradianceSample octreeIrradianceSample(const GpuOctree& octree, const Vec3& position,
+                                              const Vec3& normal,
+                                              const OctreeShadeParams& params = {});
+
 }  // namespace lo

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/math.h"
+#include "core/rng.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
 #include "reference/first_hit.h"
@@ -198,6 +199,66 @@ TEST(OctreeIrradiance, FirstHitImageOfALitPlaneIsTheAnalyticValueAtEveryPixel) {
     return octreeIrradiance(o, h.position, h.normal);
   });
   EXPECT_NEAR(image2.at(5).x, expected.x, 1e-5f);
+}
+
+// octreeIrradianceSample is a C++ twin of the shader's loOctreeIndirect that
+// also sums the VDL directions: its E must be octreeIrradiance's, and its
+// direction sum the luminance-weighted one of the VDLs the lookup reads.
+Vec3 randomUnit(Rng& rng) {
+  const float z = 2 * rng.uniform() - 1, phi = 2 * kPi * rng.uniform();
+  const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+TEST(OctreeIrradiance, SampleGivesTheLookupsIrradianceAndItsDirection) {
+  // A slab of random VDLs, a few voxels empty (so interpolation renormalizes
+  // and the nearest-leaf fallback runs).
+  VdlGrid g = constantGrid(3, 0, 2, {});
+  Rng rng(7, 0);
+  for (size_t v = 0; v < g.size(); ++v) {
+    const int count = rng.uniform() < 0.1f ? 0 : 1 + int(rng.uniformInt(4));
+    g.vdlCount[v] = uint8_t(count);
+    for (int i = 0; i < count; ++i)
+      g.vdls[v * kMaxVdls + size_t(i)] =
+          vdl(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 3.0f, randomUnit(rng));
+  }
+  GpuOctreeParams half = test::paperCosine();
+  half.halfFloat = true;
+  for (const GpuOctree& o : {buildGpuOctree(g, test::paperCosine()), buildGpuOctree(g, half)}) {
+    for (int trial = 0; trial < 400; ++trial) {
+      OctreeShadeParams p;
+      p.interpolation = trial % 2 == 0;
+      p.maxVdls = 1 + trial % 4;
+      const Vec3 q{0.2f + 7.6f * rng.uniform(), 0.2f + 7.6f * rng.uniform(),
+                   0.05f + 2.9f * rng.uniform()};
+      const Vec3 pos = q * kVoxel, n = randomUnit(rng);
+      const OctreeIrradianceSample s = octreeIrradianceSample(o, pos, n, p);
+      const Vec3 e = octreeIrradiance(o, pos, n, p);
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(s.irradiance[c], e[c], 1e-6f * (1 + e[c])) << trial;
+      ASSERT_LE(length(s.directionSum), luminance(e) * (1 + 1e-5f) + 1e-7f) << trial;
+      if (p.interpolation) continue;
+      // One leaf: the voxel in front of the point, else the one behind.
+      OctreeSample leaf = lookupOctree(o, (q + n * p.normalOffset) * kVoxel);
+      if (!leaf.found) leaf = lookupOctree(o, (q - n * p.normalOffset) * kVoxel);
+      Vec3 expected{0, 0, 0};
+      for (int i = 0; i < std::min(leaf.vdlCount, p.maxVdls); ++i) {
+        const Vdl& v = leaf.vdls[i];
+        expected += v.direction * (luminance(v.irradiance) * std::max(0.0f, dot(n, v.direction)));
+      }
+      ASSERT_NEAR(length(s.directionSum - expected), 0.0f, 1e-5f * (1 + length(expected))) << trial;
+    }
+  }
+  // VDLs of one direction: the sum points along it, |sum| = Y(E).
+  const Vec3 d = normalize(Vec3{0.3f, -0.5f, 0.8f});
+  VdlGrid one = constantGrid(3, 0, 1, {vdl({1, 2, 3}, d)});
+  for (size_t v = 0; v < one.size(); ++v)
+    one.vdls[v * kMaxVdls].irradiance *= 1.0f + 0.1f * float(v % 7);
+  const GpuOctree o = buildGpuOctree(one, test::paperCosine());
+  const Vec3 dq = decodedDirection(o, 0);
+  const OctreeIrradianceSample s =
+      octreeIrradianceSample(o, Vec3{3.3f, 4.6f, 1.2f} * kVoxel, {0, 0, 1});
+  EXPECT_GT(luminance(s.irradiance), 0.5f);
+  EXPECT_NEAR(length(s.directionSum - dq * luminance(s.irradiance)), 0.0f, 1e-5f);
 }
 
 TEST(FirstHit, MissesCountZeroAndBadParamsAreRefused) {

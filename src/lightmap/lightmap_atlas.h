@@ -1,0 +1,112 @@
+#pragma once
+/// @file lightmap/lightmap_atlas.h
+/// @brief Render to atlas (paper §4.2.3), the CPU path: the light octree
+/// evaluated at every texel the lightmap UVs' triangles touch, the empty
+/// texels around the charts filled, and the charts' seams stitched. What the
+/// renderer's octree lookup gives at a surface point, stored per texel, so a
+/// renderer may read a texture instead of walking the octree.
+///
+/// Texels and spaces: texel (x, y) of page p covers u in [x, x + 1) / width
+/// and v in [y, y + 1) / height of the page (LightmapUvs' convention) and is
+/// pixel (x, y) of the page's images (index y * width + x). Row 0 is v = 0:
+/// the order of a GL upload and of glTF, whose v = 0 is an image's top row;
+/// a picture of a page shows the UV layout upside down (v grows downwards).
+/// Positions and directions are world space; irradiance is W/m^2.
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "lightmap/lightmap_uv.h"
+#include "octree/gpu_octree.h"
+#include "octree/octree_irradiance.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+/// LightmapAtlas::coverage values.
+constexpr uint8_t kAtlasEmpty = 0;    ///< no triangle, not dilated: black
+constexpr uint8_t kAtlasCovered = 1;  ///< a triangle's UV footprint overlaps the texel
+constexpr uint8_t kAtlasDilated = 2;  ///< filled from its neighbours by dilation
+
+struct AtlasBakeParams {
+  /// The lookup's settings (interpolation, VDLs used, normal offset): pass
+  /// the renderer's, so that the atlas holds what it would compute.
+  OctreeShadeParams shade;
+  /// Rings of empty texels around the covered ones to fill (8-neighbours),
+  /// >= -1. -1 = LightmapUvs::gutter, at least 1: one ring is what a bilinear
+  /// lookup anywhere on a triangle reads beyond the covered texels; the
+  /// gutter is the most that packing left free between charts. 0 = none.
+  int dilation = -1;
+  /// Make the bilinear lookups on the two sides of every chart seam agree
+  /// (a sparse least-squares solve over the texels those lookups read).
+  /// Stitching runs after dilation: the lookups at a chart's border read
+  /// the first dilated ring.
+  bool stitchSeams = true;
+};
+
+/// The baked pages. Each vector holds pageCount entries, each page width x
+/// height texels.
+struct LightmapAtlas {
+  int width = 0, height = 0, pageCount = 0;
+  /// E (W/m^2, RGB) per texel: octreeIrradiance at the texel's surface point
+  /// and shading normal. Dilated texels: the mean of their filled
+  /// neighbours. Empty texels: 0. Stitching then moves the texels that the
+  /// lookups along seams read by the least change that joins the two sides,
+  /// mostly the dilated ones (which may go below zero there: a renderer sees
+  /// them only blended with the covered texels beside them).
+  std::vector<RgbImage> irradiance;
+  /// A directional lightmap: the unit luminance-weighted mean VDL direction
+  /// (OctreeIrradianceSample::directionSum normalized; world space, towards
+  /// the light; components may be negative, stored as is), zero where no
+  /// light arrives. With E and the shading normal n a renderer rebuilds one
+  /// VDL per texel for its specular term.
+  std::vector<RgbImage> direction;
+  /// Per page, width * height values kAtlasEmpty / kAtlasCovered / kAtlasDilated.
+  std::vector<std::vector<uint8_t>> coverage;
+
+  int dilation = 0;             ///< rings dilated (the resolved parameter)
+  size_t coveredTexels = 0;     ///< texels with kAtlasCovered, all pages
+  size_t dilatedTexels = 0;     ///< texels with kAtlasDilated, all pages
+  size_t skippedTriangles = 0;  ///< charted triangles with zero UV area (no texel)
+  size_t seamEdges = 0;         ///< mesh edges whose two sides differ in UV or page
+  size_t seamSamples = 0;       ///< points stitched along them (about 2 per texel)
+  size_t stitchedTexels = 0;    ///< texels the stitching solve could move
+  /// Largest |E_a - E_b| (W/m^2, any channel) between the bilinear lookups
+  /// of the two sides of a seam sample, before and after stitching (equal
+  /// when stitchSeams is off).
+  float seamMismatchBefore = 0, seamMismatchAfter = 0;
+  /// Wall time of each phase, seconds.
+  double rasterSeconds = 0, evaluateSeconds = 0, dilateSeconds = 0, stitchSeconds = 0;
+
+  double seconds() const { return rasterSeconds + evaluateSeconds + dilateSeconds + stitchSeconds; }
+  std::string ToString() const;  ///< sizes, counts and times
+};
+
+/// @brief Bakes `octree` into the atlas of `uvs` (paper §4.2.3, render to
+/// atlas; docs/lightmap.md, "Octree into atlas"):
+///  1. conservative rasterisation in UV space: every texel whose square
+///     overlaps a triangle's UV footprint (separating axes; touching is not
+///     overlapping) belongs to the triangle whose footprint contains the
+///     texel centre, else to the nearest (in UV), ties to the lower triangle
+///     index;
+///  2. each covered texel evaluated at the point of its triangle nearest to
+///     its centre (in UV), mapped to world space by barycentrics, with the
+///     interpolated vertex normal (Scene::normals, else the face normal);
+///  3. `dilation` rings of empty texels filled with the mean of their
+///     filled 8-neighbours;
+///  4. seams stitched (params.stitchSeams): along every edge that two
+///     triangles share in 3D (welded by exact position, consistently
+///     oriented) but not in UV, about two points per texel; the texels that
+///     the bilinear lookups at those points read on both sides are moved by
+///     the least (weighted) change that makes the two sides' lookups agree.
+/// Triangles without a chart (LightmapUvs::triangleChart -1) get no texel.
+/// Deterministic: the same inputs give the same bytes.
+/// @throws InputError for a bad parameter (naming the field), UVs that do
+/// not match the scene (naming the array), or bad indices (checkSceneIndices).
+LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, const GpuOctree& octree,
+                                const AtlasBakeParams& params = {});
+
+}  // namespace lo
