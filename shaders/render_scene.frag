@@ -17,6 +17,7 @@ in vec2 vNormalUv;
 in vec2 vMetallicRoughnessUv;
 in vec2 vOcclusionUv;
 in vec2 vEmissiveUv;
+in vec3 vLightmap;  // lightmap u, v, page
 out vec4 fragColor;
 
 uniform usampler3D uOctree;  // RGBA8UI pool of 2x2x2 tiles
@@ -56,6 +57,9 @@ uniform vec3 uViewForward;     // the camera's unit view direction (render space
 uniform vec4 uCascadeFar;      // view depth where each sun cascade ends
 uniform vec4 uCascadeTexel;    // world size of a texel of each cascade
 uniform vec4 uCascadeDepth;    // world depth range of each cascade's map
+uniform bool uAtlas;           // indirect light from the lightmap atlas, not the octree
+uniform sampler2DArray uAtlasIrradiance;  // E (W/m^2) per texel, a layer per page (RGB9E5)
+uniform sampler2DArray uAtlasDirection;   // unit mean VDL direction per texel (RGBA8 snorm)
 uniform bool uHasProbe;        // environment reflections from the probe (RenderParams::reflections)
 uniform samplerCube uProbe;    // the lit scene seen from the render-space origin, mipmapped
 uniform vec3 uProbeBoxMin;     // the scene's bounds (render space): the parallax box
@@ -529,8 +533,25 @@ void main() {
                             : 1.0;
       float probe = probeWeight(roughness);
       gVdlSpecular = 1.0 - probe;
-      vec3 indirect = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth,
-                                       uNormalOffset, uInterpolation, uMaxVdls, s);
+      vec3 indirect;
+      if (uAtlas) {
+        // Render to atlas (paper §4.2.3): one VDL rebuilt from the texel's
+        // irradiance E (baked for the interpolated vertex normal) and mean
+        // direction d: E / (n_bake . d) along d, through the same BRDF.
+        vec3 E = texture(uAtlasIrradiance, vLightmap).rgb;
+        vec3 d = texture(uAtlasDirection, vLightmap).rgb;
+        float dl = length(d);
+        indirect = vec3(0.0);
+        if (dl > 1e-3) {
+          d /= dl;
+          vec3 nb = normalize(vNormal);
+          if (dot(nb, ng) < 0.0) nb = -nb;
+          indirect = loVdlResponse(s, d) * E / max(dot(nb, d), 0.05);
+        }
+      } else {
+        indirect = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
+                                    uInterpolation, uMaxVdls, s);
+      }
       if (probe > 0.0) {
         indirect += probe * probeSpecular(vPosition, n, v, baseColor, metallic, roughness);
       }

@@ -12,6 +12,7 @@ layout(location = 6) in vec2 aNormalUv;  // the UV set the normal map names
 layout(location = 7) in vec2 aMetallicRoughnessUv;
 layout(location = 8) in vec2 aOcclusionUv;
 layout(location = 9) in vec2 aEmissiveUv;
+layout(location = 10) in vec3 aLightmap;  // lightmap u, v and page (Renderer::setAtlas)
 
 uniform mat4 uViewProj;
 invariant gl_Position;  // as render_depth.vert: the depth pre-pass must match exactly
@@ -26,6 +27,7 @@ out vec2 vNormalUv;
 out vec2 vMetallicRoughnessUv;
 out vec2 vOcclusionUv;
 out vec2 vEmissiveUv;
+out vec3 vLightmap;
 
 void main() {
   vPosition = aPosition;
@@ -38,5 +40,6 @@ void main() {
   vMetallicRoughnessUv = aMetallicRoughnessUv;
   vOcclusionUv = aOcclusionUv;
   vEmissiveUv = aEmissiveUv;
+  vLightmap = aLightmap;
   gl_Position = uViewProj * vec4(aPosition, 1.0);
 }

@@ -93,6 +93,7 @@ int runRender(const RenderOptions& opt) {
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
 
   Renderer renderer(scene, octree, opt.shading.rendererParams());
+  opt.shading.prepareLighting(renderer, scene, octree, opt.quiet);
   RgbImage image = renderer.render(camera, params);
   writeImage(opt.output, image, opt.shading.exposure);
 

@@ -2,6 +2,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+
+#include "lightmap/lightmap_bake.h"
+
 namespace lo::tool {
 
 RenderParams ShadingOptions::renderParams(RenderMode mode) const {
@@ -10,6 +14,7 @@ RenderParams ShadingOptions::renderParams(RenderMode mode) const {
   p.interpolation = interpolation == "on";
   p.specular = specular == "on";
   p.reflections = reflections == "on";
+  p.lighting = parseLighting(lighting);
   p.maxVdls = vdls;
   return p;
 }
@@ -33,6 +38,23 @@ GpuOctreeParams ShadingOptions::octreeParams(const GlInfo* info) const {
   return p;
 }
 
+void ShadingOptions::prepareLighting(Renderer& renderer, const Scene& scene,
+                                     const GpuOctree& octree, bool quiet) const {
+  if (parseLighting(lighting) != Lighting::Atlas) return;
+  LightmapParams params;
+  params.uvSource = parseUvSource(uv);
+  const RenderParams frame = renderParams(RenderMode::Full);
+  params.atlas.shade.interpolation = frame.interpolation;
+  params.atlas.shade.maxVdls = frame.maxVdls;
+  params.atlas.shade.normalOffset = frame.normalOffset;
+  const LightmapBake baked = bakeLightmap(scene, octree, params);
+  renderer.setAtlas(baked.uvs, baked.atlas);
+  if (!quiet) {
+    std::printf("atlas: %s; %.1f MiB on the GPU\n", baked.ToString().c_str(),
+                double(renderer.atlasBytes()) / (1024.0 * 1024.0));
+  }
+}
+
 CLI::Validator onOff() { return CLI::IsMember({"on", "off"}); }
 
 void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
@@ -49,6 +71,16 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
                   "Glossy and metal surfaces reflect a box-projected cube map of the lit scene "
                   "captured at its centre (off: the VDLs light the specular lobe too)")
       ->check(onOff())
+      ->capture_default_str();
+  cmd->add_option("--lighting", opt.lighting,
+                  "Indirect light from the octree per fragment, or from a lightmap atlas the octree "
+                  "is rendered into first (paper 4.2.3: one fetch instead of a tree walk)")
+      ->check(CLI::IsMember({"octree", "atlas"}))
+      ->capture_default_str();
+  cmd->add_option("--uv", opt.uv,
+                  "Lightmap UVs for --lighting atlas: default (the scene's TEXCOORD_1 if it has "
+                  "one, else automatic charts), auto (charts always), texcoord1 (required)")
+      ->check(CLI::IsMember({"default", "auto", "texcoord1"}))
       ->capture_default_str();
   cmd->add_option("--exposure", opt.exposure,
                   std::string(window ? "Exposure" : "PNG exposure") +

@@ -24,6 +24,8 @@ struct ShadingOptions {
   std::string interpolation = "on";
   std::string specular = "on";
   std::string reflections = "on";
+  std::string lighting = "octree";  ///< octree | atlas
+  std::string uv = "default";       ///< lightmap UVs for --lighting atlas: default | auto | texcoord1
   float exposure = 0;  ///< EV
   int vdls = kMaxVdls;
   std::string areaLights = "on";
@@ -37,6 +39,11 @@ struct ShadingOptions {
   RendererParams rendererParams() const;
   /// The octree's texel format, within the limits of `info` when given.
   GpuOctreeParams octreeParams(const GlInfo* info = nullptr) const;
+  /// With --lighting atlas: bakes lightmap UVs and the octree into their
+  /// atlas (src/lightmap, the renderer's lookup settings) and hands them to
+  /// `renderer`; prints what was baked unless `quiet`. No-op for octree.
+  void prepareLighting(Renderer& renderer, const Scene& scene, const GpuOctree& octree,
+                       bool quiet) const;
 };
 
 /// Registers the flags on `cmd`; `window` adds the keys that change each one

@@ -98,6 +98,9 @@ int runView(const ViewOptions& opt) {
     throw InputError("--progressive bakes the lights from the scene: give no LIGHTS.vdb ('" +
                      opt.lights + "')");
   }
+  if (opt.progressive && opt.shading.lighting == "atlas") {
+    throw InputError("--lighting atlas needs a finished bake: it cannot follow --progressive");
+  }
   if (!opt.progressive && opt.lights.empty()) {
     throw InputError("LIGHTS.vdb is required (a bake of the scene), or use --progressive");
   }
@@ -181,6 +184,7 @@ int runView(const ViewOptions& opt) {
   }
 
   Renderer renderer(scene, octree, opt.shading.rendererParams());
+  opt.shading.prepareLighting(renderer, scene, octree, opt.quiet);
   octree = GpuOctree();  // uploaded; the CPU copy is not needed any more
   if (!opt.quiet && !view.path) std::printf("%s", viewerKeyHelp());
 

@@ -163,6 +163,16 @@ std::string texelCount(int w, int h, int d) {
 
 using namespace render_internal;
 
+Lighting parseLighting(const std::string& name) {
+  if (name == "octree") return Lighting::Octree;
+  if (name == "atlas") return Lighting::Atlas;
+  throw InputError("unknown lighting '" + name + "' (expected octree or atlas)");
+}
+
+std::string toString(Lighting lighting) {
+  return lighting == Lighting::Atlas ? "atlas" : "octree";
+}
+
 RenderMode parseRenderMode(const std::string& name) {
   if (name == "full") return RenderMode::Full;
   if (name == "direct") return RenderMode::Direct;
@@ -218,6 +228,12 @@ struct Renderer::Impl {
   int behindWidth = 0, behindHeight = 0;
   bool behindFloat = false;
   std::vector<GLuint> textures;         ///< per Scene::textures entry; 0 = not used
+  /// Per vertex of the vertex buffer: 3 x its Scene triangle + its corner
+  /// (the buffer is grouped by material, not in triangle order).
+  std::vector<uint32_t> vertexCorner;
+  size_t sceneTriangles = 0;
+  GLuint atlasVbo = 0, atlasIrradiance = 0, atlasDirection = 0;
+  size_t atlasTextureBytes = 0;
   float maxAnisotropy = 1;              ///< of the context (1: no anisotropic filtering)
   GLuint octreeTexture = 0, vdlTexture = 0, vdlHalfTexture = 0, shadowTexture = 0, lightUbo = 0;
   GLuint shadowFbo = 0;
@@ -270,6 +286,9 @@ struct Renderer::Impl {
     if (probeTexture) glDeleteTextures(1, &probeTexture);
     if (probeFbo) glDeleteFramebuffers(1, &probeFbo);
     if (probeDepth) glDeleteRenderbuffers(1, &probeDepth);
+    if (atlasVbo) glDeleteBuffers(1, &atlasVbo);
+    GLuint atlasTextures[] = {atlasIrradiance, atlasDirection};
+    glDeleteTextures(2, atlasTextures);
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &emptyVao);
     glDeleteFramebuffers(1, &shadowFbo);
@@ -477,6 +496,7 @@ struct Renderer::Impl {
             setUv(v.emissiveUv, mat.emissiveTexCoord, mat.emissiveTransform);
           }
           vertices.push_back(v);
+          vertexCorner.push_back(uint32_t(3 * t + size_t(k)));
         }
         if (category == kBlended) {
           const Vertex* tri = &vertices[vertices.size() - 3];
@@ -1088,6 +1108,19 @@ struct Renderer::Impl {
     glUniform4fv(loc("uCascadeFar"), 1, cascadeFar);
     glUniform4fv(loc("uCascadeTexel"), 1, cascadeTexel);
     glUniform4fv(loc("uCascadeDepth"), 1, cascadeDepth);
+    if (rp.lighting == Lighting::Atlas && !atlasVbo) {
+      throw InputError("render: lighting 'atlas' needs an atlas (Renderer::setAtlas, or "
+                       "`render --lighting atlas`, which bakes one)");
+    }
+    const bool atlas = rp.lighting == Lighting::Atlas && !capturingProbe;
+    glUniform1i(loc("uAtlas"), atlas ? 1 : 0);
+    glUniform1i(loc("uAtlasIrradiance"), 12);
+    glUniform1i(loc("uAtlasDirection"), 13);
+    glActiveTexture(GL_TEXTURE12);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, atlas ? atlasIrradiance : 0);
+    glActiveTexture(GL_TEXTURE13);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, atlas ? atlasDirection : 0);
+    glActiveTexture(GL_TEXTURE0);
     glUniform1i(loc("uHasProbe"), reflect ? 1 : 0);
     glUniform1i(loc("uProbe"), 11);
     glUniform3f(loc("uProbeBoxMin"), bounds.lower.x, bounds.lower.y, bounds.lower.z);
@@ -1245,6 +1278,7 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.depthProgram = buildProgram({"render_depth.vert", "render_depth.frag"});
   r.uploadOctree(octree);
   r.uploadScene(scene);
+  r.sceneTriangles = scene.triangleCount();
   r.setupLights(scene);
   for (const Material& m : scene.materials) {
     r.probeWanted = r.probeWanted || m.roughness < shader::LO_PROBE_NONE ||
@@ -1253,6 +1287,74 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
 }
 
 bool Renderer::hasReflectionProbe() const { return impl_->probeWanted; }
+
+bool Renderer::hasAtlas() const { return impl_->atlasVbo != 0; }
+
+size_t Renderer::atlasBytes() const { return impl_->atlasTextureBytes; }
+
+void Renderer::setAtlas(const LightmapUvs& uvs, const LightmapAtlas& atlas) {
+  Impl& r = *impl_;
+  const size_t triangles = r.sceneTriangles;
+  if (uvs.uv.size() != 6 * triangles || uvs.trianglePage.size() != triangles) {
+    throw InputError("atlas: lightmap UVs for " + std::to_string(uvs.trianglePage.size()) +
+                     " triangles, the scene has " + std::to_string(triangles));
+  }
+  if (atlas.pageCount < 1 || atlas.width < 1 || atlas.height < 1 ||
+      atlas.irradiance.size() != size_t(atlas.pageCount) ||
+      atlas.direction.size() != size_t(atlas.pageCount)) {
+    throw InputError("atlas: no pages to upload");
+  }
+  GLint maxSize = 0, maxLayers = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
+  if (atlas.width > maxSize || atlas.height > maxSize || atlas.pageCount > maxLayers) {
+    throw InputError("atlas of " + std::to_string(atlas.pageCount) + " pages of " +
+                     texelCount(atlas.width, atlas.height, 0) +
+                     " texels exceeds GL_MAX_TEXTURE_SIZE = " + std::to_string(maxSize) +
+                     " or GL_MAX_ARRAY_TEXTURE_LAYERS = " + std::to_string(maxLayers));
+  }
+  // Per vertex: the lightmap UV of its triangle corner and the page.
+  std::vector<float> attribute(3 * r.vertexCorner.size());
+  for (size_t i = 0; i < r.vertexCorner.size(); ++i) {
+    const size_t t = r.vertexCorner[i] / 3, k = r.vertexCorner[i] % 3;
+    attribute[3 * i] = uvs.uv[6 * t + 2 * k];
+    attribute[3 * i + 1] = uvs.uv[6 * t + 2 * k + 1];
+    attribute[3 * i + 2] = float(uvs.trianglePage[t]);
+  }
+  if (!r.atlasVbo) glGenBuffers(1, &r.atlasVbo);
+  glBindVertexArray(r.vao);
+  glBindBuffer(GL_ARRAY_BUFFER, r.atlasVbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(attribute.size() * sizeof(float)),
+               attribute.empty() ? nullptr : attribute.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(10);
+  glVertexAttribPointer(10, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+  glBindVertexArray(0);
+  // Pages as layers: bilinear, no mipmaps (they would bleed across charts).
+  auto upload = [&](GLuint& texture, GLenum format, const std::vector<RgbImage>& pages,
+                    bool clampNegative) {
+    if (!texture) glGenTextures(1, &texture);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, texture);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GLint(format), atlas.width, atlas.height,
+                 atlas.pageCount, 0, GL_RGB, GL_FLOAT, nullptr);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    for (int p = 0; p < atlas.pageCount; ++p) {
+      std::vector<float> texels = pages[size_t(p)].rgb;
+      if (clampNegative) {
+        for (float& v : texels) v = std::max(v, 0.0f);  // stitching may dip the gutter below 0
+      }
+      glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, p, atlas.width, atlas.height, 1, GL_RGB,
+                      GL_FLOAT, texels.data());
+    }
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  };
+  upload(r.atlasIrradiance, GL_RGB9_E5, atlas.irradiance, true);
+  upload(r.atlasDirection, GL_RGBA8_SNORM, atlas.direction, false);
+  r.atlasTextureBytes = size_t(atlas.width) * size_t(atlas.height) * size_t(atlas.pageCount) * 8;
+  checkGl("uploading the lightmap atlas");
+}
 
 Renderer::~Renderer() = default;
 

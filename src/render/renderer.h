@@ -12,6 +12,8 @@
 
 #include "core/math.h"
 #include "image/image.h"
+#include "lightmap/lightmap_atlas.h"
+#include "lightmap/lightmap_uv.h"
 #include "octree/gpu_octree.h"
 #include "scene/pinhole_camera.h"
 #include "scene/scene.h"
@@ -24,6 +26,16 @@ enum class RenderMode {
   Indirect,  ///< the light octree only
   Voxels,    ///< leaves coloured by a hash of their voxel coordinate; empty = black
 };
+/// Where the indirect light comes from (paper §4.2): the light octree walked
+/// per fragment, or the atlas it was rendered into (§4.2.3: one fetch).
+enum class Lighting {
+  Octree,  ///< the octree lookup per fragment (n_VDL + depth + 1 fetches, x8 interpolated)
+  Atlas,   ///< the lightmap atlas (Renderer::setAtlas): irradiance and direction, one fetch each
+};
+/// "octree" | "atlas". @throws InputError naming the value.
+Lighting parseLighting(const std::string& name);
+std::string toString(Lighting lighting);
+
 /// "full" | "direct" | "indirect" | "voxels". @throws InputError naming the value.
 RenderMode parseRenderMode(const std::string& name);
 std::string toString(RenderMode mode);
@@ -43,6 +55,8 @@ struct RenderParams {
   /// lit scene captured at the scene's centre; the VDLs keep the diffuse and
   /// rough-specular terms. Off: the VDLs light every term.
   bool reflections = true;
+  /// Indirect light from the octree or from the atlas (setAtlas first).
+  Lighting lighting = Lighting::Octree;
 };
 
 /// Set once: resources built for the scene.
@@ -83,6 +97,18 @@ class Renderer {
   /// @throws InputError like the constructor when the textures exceed the
   /// context's limits (the old octree is kept then).
   void setOctree(const GpuOctree& octree);
+
+  /// Uploads lightmap UVs (per triangle corner, of the scene given to the
+  /// constructor) and the pages baked for them, for RenderParams::lighting =
+  /// Atlas: the indirect light of a fragment is then one VDL rebuilt from the
+  /// atlas, E / max(n_bake . d, 0.05) along d, shaded by the same BRDF
+  /// (exact for the diffuse term). Irradiance is stored as GL_RGB9_E5 (shared
+  /// exponent, 4 B, no negatives), direction as GL_RGBA8_SNORM (4 B).
+  /// @throws InputError when the UVs do not match the scene or the pages
+  /// exceed the context's texture limits.
+  void setAtlas(const LightmapUvs& uvs, const LightmapAtlas& atlas);
+  bool hasAtlas() const;
+  size_t atlasBytes() const;  ///< GPU bytes of the atlas textures (0 without one)
 
   /// Renders into an offscreen RGBA32F target and reads its RGB back.
   RgbImage render(const PinholeCamera& camera, const RenderParams& params);

@@ -1,0 +1,82 @@
+/// @file lightmap/lightmap_bake.cpp
+/// @brief UV source choice and the CPU atlas bake behind lightmap_bake.h.
+
+#include "lightmap/lightmap_bake.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace lo {
+
+UvSource parseUvSource(const std::string& name) {
+  if (name == "default") return UvSource::Default;
+  if (name == "auto") return UvSource::Charts;
+  if (name == "texcoord1") return UvSource::Texcoord1;
+  throw InputError("unknown UV source '" + name + "' (expected auto or texcoord1)");
+}
+
+std::string LightmapBake::ToString() const {
+  std::ostringstream os;
+  os << (fromTexcoord1 ? "TEXCOORD_1" : "automatic charts") << ": " << uvs.chartCount
+     << " charts, " << atlas.pageCount << " page(s) of " << atlas.width << " x " << atlas.height
+     << ", texel " << uvs.texelSize << ", utilisation " << uvs.utilisation << ", worst stretch "
+     << uvs.worstStretch << "; " << atlas.coveredTexels << " texels covered, "
+     << atlas.dilatedTexels << " dilated; UVs " << uvSeconds << " s, atlas " << atlasSeconds
+     << " s";
+  return os.str();
+}
+
+float defaultLightmapTexel(const GpuOctree& octree) {
+  return 0.25f * octree.cubeSize / float(1 << std::max(octree.depth, 0));
+}
+
+LightmapBake bakeLightmap(const Scene& scene, const GpuOctree& octree,
+                          const LightmapParams& params) {
+  using Clock = std::chrono::steady_clock;
+  LightmapBake out;
+  const auto start = Clock::now();
+  const bool hasTexcoord1 = scene.texcoords1.size() == 2 * scene.positions.size() &&
+                            !scene.texcoords1.empty();
+  const bool useTexcoord1 = params.uvSource == UvSource::Texcoord1 ||
+                            (params.uvSource == UvSource::Default && hasTexcoord1);
+  if (useTexcoord1) {
+    try {
+      out.uvs = lightmapUvsFromTexcoord1(scene, params.uv.atlasSize);
+    } catch (const InputError& e) {
+      throw InputError(std::string("TEXCOORD_1 cannot serve as lightmap UVs: ") + e.what() +
+                       " (use --uv auto for automatic charts)");
+    }
+    out.fromTexcoord1 = true;
+  } else if (params.uv.texelSize > 0) {
+    out.uvs = buildLightmapUvs(scene, params.uv);
+  } else {
+    // A quarter voxel per texel, on the smallest page that holds it: from
+    // the charts' area in texels over a fill of about 70%, grown by a
+    // quarter (rounded to 16 texels) while the charts take more than one
+    // page.
+    LightmapUvParams uv = params.uv;
+    uv.texelSize = defaultLightmapTexel(octree);
+    double area = 0;
+    for (size_t t = 0; t < scene.triangleCount(); ++t) area += scene.triangleArea(t);
+    const double texels = area / (double(uv.texelSize) * uv.texelSize) / 0.7;
+    auto grow = [](int s) { return (s + s / 4 + 15) / 16 * 16; };
+    int size = 64;
+    while (size < params.uv.atlasSize && double(size) * size < texels) size = grow(size);
+    for (;; size = grow(size)) {
+      uv.atlasSize = std::min(size, params.uv.atlasSize);
+      out.uvs = buildLightmapUvs(scene, uv);
+      if (out.uvs.pageCount <= 1 || uv.atlasSize >= params.uv.atlasSize) break;
+    }
+  }
+  const auto uvDone = Clock::now();
+  out.atlas = bakeLightmapAtlas(scene, out.uvs, octree, params.atlas);
+  out.uvSeconds = std::chrono::duration<double>(uvDone - start).count();
+  out.atlasSeconds = std::chrono::duration<double>(Clock::now() - uvDone).count();
+  return out;
+}
+
+}  // namespace lo
