@@ -100,9 +100,11 @@ inline Vec3 offsetOrigin(const Context& ctx, const Vec3& p, const Vec3& normal, 
 /// Next-event estimation at a surface point: every punctual light, plus one
 /// emissive triangle picked by power, MIS-weighted against BSDF sampling.
 /// Returns the reflected radiance towards wo (without path throughput).
+/// With `misWeights` false the emitter sample counts fully (light sampling
+/// alone estimates the integral: DirectIrradiance).
 inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, const Vec3& n,
                          const Vec3& wo, const BsdfLobes& lobes, const Vec3& albedo, Rng& rng,
-                         uint32_t& rays) {
+                         uint32_t& rays, bool misWeights = true) {
   Vec3 sum{0, 0, 0};
   for (const Light* light : ctx.lights) {
     Vec3 wi;
@@ -157,7 +159,7 @@ inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, 
       Vec3 f = maxComponent(le) > 0 && cosLight > 0 ? evalBsdf(lobes, albedo, wo, wi, n) : Vec3{};
       if (maxComponent(f) > 0) {
         float pdfLight = ctx.emitterPickPdf[tri] * dist2 / cosLight;  // solid angle
-        float w = powerHeuristic(pdfLight, pdfBsdf(lobes, wo, wi, n));
+        float w = misWeights ? powerHeuristic(pdfLight, pdfBsdf(lobes, wo, wi, n)) : 1.0f;
         Vec3 org = offsetOrigin(ctx, p, normal, wi);
         ++rays;
         // Stop short of the emitter by twice the offset so it does not occlude itself.
@@ -468,6 +470,39 @@ ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
   result.raysTraced = rays.load();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+struct DirectIrradiance::Impl {
+  reference_internal::Context ctx;
+  std::unique_ptr<RayTracer> tracer;
+};
+
+DirectIrradiance::DirectIrradiance(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+  checkSceneIndices(scene);
+  reference_internal::buildContext(scene, ReferenceParams{}, impl_->ctx);
+  impl_->tracer = std::make_unique<RayTracer>(scene);
+  impl_->ctx.tracer = impl_->tracer.get();
+}
+
+DirectIrradiance::~DirectIrradiance() = default;
+
+Vec3 DirectIrradiance::at(const Vec3& p, uint32_t triangle, const Vec3& n, int samples,
+                          uint64_t seed, uint64_t index) const {
+  const reference_internal::Context& ctx = impl_->ctx;
+  // A Lambertian lobe of albedo pi: f cos = cos, so the light sum is E.
+  BsdfLobes lambert;
+  const Vec3 albedo{kPi, kPi, kPi};
+  Vec3 normal = ctx.scene->faceNormal(triangle);
+  if (dot(normal, n) < 0) normal = -normal;
+  Rng rng(seed, index);
+  uint32_t rays = 0;
+  const int count = std::max(samples, 1);
+  Vec3 sum{0, 0, 0};
+  for (int i = 0; i < count; ++i) {
+    sum += reference_internal::sampleLights(ctx, p, normal, n, n, lambert, albedo, rng, rays,
+                                            /*misWeights=*/false);
+  }
+  return sum / float(count);
 }
 
 }  // namespace lo

@@ -8,6 +8,7 @@
 /// (scene/scene.h), or, for Part::Irradiance, irradiance W/m^2.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "core/math.h"
@@ -69,5 +70,30 @@ struct ReferenceImage {
 /// @throws InputError for bad params (sizes, spp) or bad triangle indices.
 ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
                                const ReferenceParams& params, ProgressSink* progress = nullptr);
+
+/// @brief Direct irradiance E(p, n) (W/m^2) from every light, with shadow
+/// rays, by the path tracer's own light sampling: punctual lights exactly,
+/// emissive triangles by `samples` samples, each an emitter picked by power
+/// (mean emission x area) and a uniform point on it (emissive textures and
+/// one-sided emission as the path tracer reads them). For lightmaps that
+/// hold the direct light too (`lightmap --content full`). Thread-safe.
+class DirectIrradiance {
+ public:
+  /// @throws InputError for bad scene indices; builds an Embree scene.
+  explicit DirectIrradiance(const Scene& scene);
+  ~DirectIrradiance();
+  DirectIrradiance(const DirectIrradiance&) = delete;
+  DirectIrradiance& operator=(const DirectIrradiance&) = delete;
+
+  /// E at surface point `p` of triangle `triangle` (its geometric normal
+  /// offsets the shadow rays' origins) for the unit normal `n`, on n's side.
+  /// Deterministic: the same (seed, index) give the same value.
+  Vec3 at(const Vec3& p, uint32_t triangle, const Vec3& n, int samples, uint64_t seed,
+          uint64_t index) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace lo

@@ -276,3 +276,41 @@ TEST(Reference, RejectsBadParams) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// DirectIrradiance: the analytic irradiance of a square emitter above a
+// floor point (form factor), and of a point light; a blocker in between
+// removes it.
+TEST(DirectIrradiance, SquareEmitterAndPointLightAnalytic) {
+  Scene scene = floorScene();
+  int emitter = addMaterial(scene, Vec3(0.0f), Vec3(3.0f));
+  addQuad(scene, {-0.5f, 1, -0.5f}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, emitter);
+  DirectIrradiance direct(scene);
+  // Floor triangle under the centre: the first triangle of floorScene.
+  const Vec3 p{0, 0, 0}, n{0, 1, 0};
+  const Vec3 e = direct.at(p, 0, n, 4096, 1, 0);
+  const double expected = squareEmitterIrradiance(3.0, 0.5, 1.0);
+  EXPECT_NEAR(e.x, expected, 0.03 * expected);
+  EXPECT_EQ(e.x, direct.at(p, 0, n, 4096, 1, 0).x) << "deterministic";
+  // Facing away from the emitter: nothing.
+  EXPECT_EQ(direct.at(p, 0, Vec3{0, -1, 0}, 64, 1, 0).x, 0.0f);
+
+  Scene lit = floorScene();
+  Light point;
+  point.type = Light::Type::Point;
+  point.position = {0.3f, 2.0f, 0.0f};
+  point.intensity = 8.0f;
+  lit.lights.push_back(point);
+  DirectIrradiance pointDirect(lit);
+  const Vec3 q{0.3f, 0, 0};
+  EXPECT_NEAR(pointDirect.at(q, 0, n, 1, 1, 0).x, 8.0f / 4.0f, 1e-4f);
+  // A blocker between the light and the point.
+  addQuad(lit, {0.2f, 1.0f, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, {0, -1, 0}, 0);
+  DirectIrradiance blocked(lit);
+  EXPECT_EQ(blocked.at(q, 0, n, 1, 1, 0).x, 0.0f);
+}
+
+}  // namespace
+}  // namespace lo
