@@ -49,6 +49,7 @@ uniform bool uHasOcclusionTexture;
 uniform float uOcclusionStrength;
 uniform sampler2D uEmissiveTexture;  // linear RGB emission map (sRGB decoded at load)
 uniform bool uHasEmissiveTexture;
+uniform float uEmissionScale;  // 1; 0 while the probe is captured if emitters are lights
 uniform int uAlphaMode;      // LO_ALPHA_OPAQUE, LO_ALPHA_MASK or LO_ALPHA_BLEND (glTF alphaMode)
 uniform float uBaseAlpha;    // baseColorFactor's alpha
 uniform float uAlphaCutoff;  // glTF alphaCutoff (mask)
@@ -92,24 +93,34 @@ layout(std140) uniform LightBlock {
 // off it is exactly baseColor/pi * (n.l): the analytic tests rely on that.
 // `specularWeight` scales the GGX lobe alone (the VDLs' share of a surface's
 // specular light when the reflection probe takes the rest).
-vec3 brdfCosWeighted(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness,
-                     float specularWeight) {
-  float nl = dot(n, l);
-  if (nl <= 0.0) return vec3(0.0);
-  vec3 diffuse = baseColor * (1.0 - metallic) * (1.0 - uTransmission) / LO_PI;
-  if (!uSpecular) return diffuse * nl;
+// The two lobes of the BRDF (no cosine) towards l (unit, nl = n.l > 0):
+// (1 - F) diffuse and F D V, GGX of alpha a.
+void brdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float a,
+               out vec3 diffuse, out vec3 specular) {
+  float nl = max(dot(n, l), 1e-4);
+  diffuse = baseColor * (1.0 - metallic) * (1.0 - uTransmission) / LO_PI;
   float nv = max(dot(n, v), 1e-4);
   vec3 h = normalize(l + v);
   float nh = max(dot(n, h), 0.0);
   float vh = clamp(dot(v, h), 0.0, 1.0);  // pow(1 - vh, 5) is NaN for vh a rounding above 1
-  float a = max(roughness * roughness, 2e-3);
   float a2 = a * a;
   float dd = nh * nh * (a2 - 1.0) + 1.0;
   float D = a2 / (LO_PI * dd * dd);
   float vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));
   vec3 f0 = mix(vec3(0.04), baseColor, metallic);
   vec3 F = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
-  return ((1.0 - F) * diffuse + specularWeight * F * (D * vis)) * nl;
+  diffuse *= 1.0 - F;
+  specular = F * (D * vis);
+}
+
+vec3 brdfCosWeighted(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness,
+                     float specularWeight) {
+  float nl = dot(n, l);
+  if (nl <= 0.0) return vec3(0.0);
+  if (!uSpecular) return baseColor * (1.0 - metallic) * (1.0 - uTransmission) / LO_PI * nl;
+  vec3 diffuse, specular;
+  brdfLobes(n, v, l, baseColor, metallic, max(roughness * roughness, 2e-3), diffuse, specular);
+  return (diffuse + specularWeight * specular) * nl;
 }
 
 vec3 brdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
@@ -223,6 +234,29 @@ float polygonIrradiance(vec3 p, vec3 n, vec3 a, vec3 b, vec3 c, out vec3 lightCe
   return 0.5 * abs(sum);
 }
 
+// The point of triangle (a, b, c) nearest p (Ericson, Real-Time Collision
+// Detection, 5.1.5).
+vec3 closestOnTriangle(vec3 p, vec3 a, vec3 b, vec3 c) {
+  vec3 ab = b - a, ac = c - a, ap = p - a;
+  float d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  vec3 bp = p - b;
+  float d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + ab * (d1 / (d1 - d3));
+  vec3 cp = p - c;
+  float d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + ac * (d2 / (d2 - d6));
+  float va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0)
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  float denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
 // Soft shadow of area light i (PCSS, Fernando 2005) from its shadow cube at
 // the triangle's centre: the blockers found in the region of the map that
 // can hide part of the light from p give their mean distance d_b; the
@@ -320,7 +354,9 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
 // ground outside the wall through a texel that straddles the wall's base;
 // the price is a shadow one texel larger, on the lit side.
 // The fragment's unit geometric normal, turned to the viewer (set by main):
-// shadow biases follow the surface's real slope, not the normal map's.
+// shadow lookups (receiver plane, offsets, biases) follow the surface's real
+// plane, not the normal map's or the interpolated normal's (a tilted
+// receiver plane shadows the surface by itself).
 vec3 gGeometricNormal;
 
 float sunShadow(int i, vec3 p, vec3 n, vec3 toLight) {
@@ -403,10 +439,40 @@ vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughn
     float solid = polygonIrradiance(p, n, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz, lightCentre);
     if (solid <= 0.0) continue;
     vec3 la = normalize(lightCentre - p);
-    // The BRDF times the cosine in the direction of the light's visible
-    // part, over that cosine: exact for the diffuse lobe.
-    vec3 f = brdfCos(n, v, la, baseColor, metallic, roughness) / max(dot(n, la), 1e-4);
-    sum += f * L.colorFar.rgb * solid * areaShadow(i, p, n, la);
+    float visible = areaShadow(i, p, gGeometricNormal, la);
+    if (visible <= 0.0) continue;
+    // Diffuse: the lobe in the direction of the light's visible part times
+    // the exact projected solid angle.
+    vec3 diffuse, specular;
+    float a = max(roughness * roughness, 2e-3);
+    brdfLobes(n, v, la, baseColor, metallic, a, diffuse, specular);
+    if (!uSpecular) diffuse = baseColor * (1.0 - metallic) * (1.0 - uTransmission) / LO_PI;
+    vec3 f = diffuse * solid;
+    if (uSpecular) {
+      // Specular: a representative point (Karis 2013): the point of the
+      // triangle nearest the reflected ray, the GGX lobe evaluated towards
+      // it with its own alpha and scaled by (alpha / alpha')^2, alpha'
+      // widened by the light's angular radius: a glossy surface shows the
+      // light's shape, not a highlight of the lobe's size at its centre.
+      vec3 r = reflect(-v, n);
+      vec3 nE = L.directionRange.xyz;
+      float towards = dot(r, nE);
+      vec3 q = lightCentre;
+      if (towards < -1e-4) q = p + r * max(dot(L.corner0.xyz - p, nE) / towards, 0.0);
+      q = closestOnTriangle(q, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz);
+      vec3 ls = normalize(q - p);
+      float nls = dot(n, ls);
+      if (nls > 0.0) {
+        float distance = length(lightCentre - p);
+        float radius = L.corner0.w * 0.5641896;  // sqrt(area / pi)
+        float wide = clamp(a + radius / (2.0 * distance), a, 1.0);
+        vec3 dRep, sRep;
+        brdfLobes(n, v, ls, baseColor, metallic, a, dRep, sRep);
+        float omega = solid / max(dot(n, la), 1e-4);  // the light's solid angle
+        f += sRep * (a * a / (wide * wide)) * nls * omega;
+      }
+    }
+    sum += f * L.colorFar.rgb * visible;
 #undef L
   }
   for (int i = 0; i < uLightCount.x - uLightCount.y; ++i) {
@@ -437,7 +503,8 @@ vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughn
       }
     }
     if (dot(n, l) <= 0.0 || max(E.r, max(E.g, E.b)) <= 0.0) continue;
-    float visible = type == LO_LIGHT_DIRECTIONAL ? sunShadow(i, p, n, l) : shadow(i, p, n, l);
+    float visible = type == LO_LIGHT_DIRECTIONAL ? sunShadow(i, p, gGeometricNormal, l)
+                                                   : shadow(i, p, gGeometricNormal, l);
     sum += brdfCos(n, v, l, baseColor, metallic, roughness) * E * visible;
   }
   return sum;
@@ -522,7 +589,7 @@ void main() {
   } else {
 #ifdef LO_DIRECT_LIGHT
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_DIRECT) {
-      radiance += emission + direct(vPosition, n, v, baseColor, metallic, roughness);
+      radiance += emission * uEmissionScale + direct(vPosition, n, v, baseColor, metallic, roughness);
     }
 #endif
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_INDIRECT) {

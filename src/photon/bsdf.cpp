@@ -85,6 +85,7 @@ bool sampleBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, cons
                 bool frontFace, Rng& rng, BsdfSample& out) {
   float lobe = rng.uniform();
   out.delta = false;
+  out.passThrough = false;
   if (lobe < lobes.transmissionWeight) {
     // Smooth dielectric: reflect with the Fresnel probability, else refract.
     // Flux needs no eta^2 factor; radiance would, but the path tracer follows
@@ -103,6 +104,7 @@ bool sampleBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, cons
     } else if (lobes.thinWalled) {
       out.wi = -wo;
       out.weight = albedo;
+      out.passThrough = true;
     } else {
       float eta = n1 / n2;
       out.wi = -wo * eta + n * (eta * cosI - cosT);

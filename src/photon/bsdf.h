@@ -67,6 +67,10 @@ struct BsdfSample {
   Vec3 wi;             ///< new direction, not normalised (callers normalise)
   Vec3 weight;         ///< the chosen lobe's f * |cos| / pdf: what the throughput is multiplied by
   bool delta = false;  ///< mirror or glass: evalBsdf/pdfBsdf do not cover it
+  /// Straight through a thin-walled transmissive surface: the light keeps
+  /// its direction (the photon tracer does not count it as a bounce: the
+  /// renderer draws such light as direct light, no shadow cast).
+  bool passThrough = false;
 };
 
 /// Chooses a lobe by its weight and samples it: diffuse cosine-weighted,

@@ -35,6 +35,9 @@ constexpr float kRayEpsilonScale = 1e-5f;
 /// Paths per work item: the unit TBB schedules and the unit whose photons stay
 /// in path order inside one buffer.
 constexpr size_t kChunkPaths = 256;
+/// A path ends after this many rays whatever its bounce count (passes
+/// through thin walls do not count as bounces).
+constexpr uint32_t kMaxPathRays = 1024;
 constexpr size_t kMinBatchPaths = 4096;
 constexpr size_t kMaxBatchPaths = size_t(1) << 19;
 
@@ -249,7 +252,7 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
       out.push_back(ph);
       ++photonCount;
     }
-    if (int(bounce) >= ctx.maxBounces) return;
+    if (int(bounce) >= ctx.maxBounces || rayCount > kMaxPathRays) return;
 
     Vec3 albedo = ctx.scene->albedo(hit.triangle, hit.b1, hit.b2);
     BsdfSample sample;
@@ -262,6 +265,10 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     if (lengthSquared(dir) == 0) return;
     // Offset to the side the new ray leaves on (refraction crosses over).
     org = p + (dot(dir, normal) > 0 ? normal : -normal) * ctx.epsilon;
+    // Through a thin wall the light is still direct light: the renderer
+    // draws it so (thin-walled glass casts no shadow), so the photon keeps
+    // its bounce count (--include-direct decides whether it is stored).
+    if (sample.passThrough) --bounce;
   }
 }
 

@@ -945,10 +945,15 @@ struct Renderer::Impl {
 
   /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
   /// `program` in use: the solid ranges in one call, then the masked ranges
-  /// alpha-tested one by one, and with `blended` the blended ranges too (a
-  /// shadow map has no partial coverage: they cast a shadow where their
-  /// alpha is at least 1/2). Transmissive ranges are not drawn.
-  void drawDepthOnly(GLuint program, bool blended) {
+  /// alpha-tested one by one, and with `shadows` (a shadow map) the blended
+  /// ranges too (a shadow map has no partial coverage: they cast a shadow
+  /// where their alpha is at least 1/2) and the transmissive ones with a
+  /// volume (a solid glass body focuses what it lets through into a caustic,
+  /// which the photon map carries as indirect light: its direct shadow is
+  /// dark). Thin-walled transmissive ranges cast no shadow: light passes
+  /// them straight, as direct light (the photon tracer agrees).
+  void drawDepthOnly(GLuint program, bool shadows) {
+    const bool blended = shadows;
     const GLint alphaTest = glGetUniformLocation(program, "uAlphaTest");
     glUniform1i(alphaTest, 0);
     glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
@@ -966,6 +971,14 @@ struct Renderer::Impl {
       glActiveTexture(GL_TEXTURE4);
       glBindTexture(GL_TEXTURE_2D, range.texture >= 0 ? textures[size_t(range.texture)] : 0);
       glDrawArrays(GL_TRIANGLES, range.first, range.count);
+    }
+    if (shadows) {
+      glUniform1i(alphaTest, 0);
+      for (size_t i = 0; i < ranges.size(); ++i) {
+        if (rangeCategory[i] == kTransmissive && ranges[i].thickness > 0) {
+          glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].count);
+        }
+      }
     }
     glActiveTexture(GL_TEXTURE0);
   }
@@ -1113,6 +1126,10 @@ struct Renderer::Impl {
                        "`render --lighting atlas`, which bakes one)");
     }
     const bool atlas = rp.lighting == Lighting::Atlas && !capturingProbe;
+    // The probe leaves out emitters that the direct pass draws as lights:
+    // their reflection comes from the lights' specular term already.
+    glUniform1f(loc("uEmissionScale"),
+                capturingProbe && (areaLightCount > 0 || emitterLights > 0) ? 0.0f : 1.0f);
     glUniform1i(loc("uAtlas"), atlas ? 1 : 0);
     glUniform1i(loc("uAtlasIrradiance"), 12);
     glUniform1i(loc("uAtlasDirection"), 13);

@@ -142,7 +142,17 @@ float Scene::coverage(size_t t, float b1, float b2) const {
   return std::clamp(alpha, 0.0f, 1.0f);
 }
 
-Vec3 Scene::shadingNormal(size_t t, float b1, float b2, const Vec3& n) const {
+Vec3 Scene::shadingNormal(size_t t, float b1, float b2, const Vec3& geometric) const {
+  Vec3 n = geometric;
+  if (normals.size() == positions.size()) {
+    const float b0 = 1.0f - b1 - b2;
+    const Vec3 smooth = normals[indices[3 * t]] * b0 + normals[indices[3 * t + 1]] * b1 +
+                        normals[indices[3 * t + 2]] * b2;
+    if (lengthSquared(smooth) > 1e-12f) {
+      n = normalize(smooth);
+      if (dot(n, geometric) < 0) n = -n;
+    }
+  }
   const Material& m = materials[size_t(triangleMaterial[t])];
   if (m.normalTexture < 0) return n;
   float u, v, u0, v0, u1, v1, u2, v2;

@@ -157,12 +157,13 @@ struct Scene {
   /// Coverage of triangle t at (b1, b2) as its material's alpha mode reads
   /// it: 1 for Opaque; 1 or 0 against the cutoff for Mask; alpha for Blend.
   float coverage(size_t t, float b1, float b2) const;
-  /// The shading normal of triangle t at (b1, b2): `n` (unit, the geometric
-  /// normal turned to the side being shaded) tilted by the material's normal
-  /// map, in the tangent frame the renderer uses (tangent = the surface
-  /// direction of +u of the map's UVs, bitangent = cross(n, tangent): glTF's
-  /// convention for tangent.w = 1; render_scene.frag perturbNormal); `n`
-  /// itself without a map or with degenerate UVs.
+  /// The shading normal of triangle t at (b1, b2), as the renderer shades:
+  /// the interpolated vertex normal (when the scene has normals; else `n`,
+  /// the unit geometric normal turned to the side being shaded), turned to
+  /// n's side, then tilted by the material's normal map in the tangent frame
+  /// the renderer uses (tangent = the surface direction of +u of the map's
+  /// UVs, bitangent = cross(normal, tangent): glTF's convention for
+  /// tangent.w = 1; render_scene.frag perturbNormal).
   Vec3 shadingNormal(size_t t, float b1, float b2, const Vec3& n) const;
   /// Metallic and roughness of triangle t at (b1, b2): the factors times the
   /// metallicRoughnessTexture's B and G channels where there is one.

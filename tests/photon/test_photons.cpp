@@ -344,6 +344,7 @@ TEST(Photons, GlassStoresNothingAndConservesEnergy) {
   int glass = addMaterial(scene, {1, 1, 1});
   scene.materials[size_t(glass)].transmission = 1.0f;
   scene.materials[size_t(glass)].ior = 1.5f;
+  scene.materials[size_t(glass)].thickness = 0.2f;  // a solid slab (KHR_materials_volume)
   const Vec3 slabLo{-0.8f, -0.4f, -0.8f}, slabHi{0.8f, -0.2f, 0.8f};
   addSolidBox(scene, slabLo, slabHi, glass);
 
@@ -646,3 +647,33 @@ TEST(Photons, MetallicRoughnessMapMakesAMirrorDiffuse) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// A thin-walled pane (no volume): light passes straight through it, as
+// direct light: photons that crossed it keep bounce 0 (the renderer draws
+// that light, the pane casts no shadow), and without --include-direct none
+// of them is stored on the floor under it.
+TEST(Photons, ThinWalledGlassPassesLightAsDirect) {
+  const float a = 0.5f;
+  Scene scene = litBox({a, a, a}, {1, 1, 1}, 1.0f);
+  int glass = addMaterial(scene, {1, 1, 1});
+  scene.materials[size_t(glass)].transmission = 1.0f;
+  addQuad(scene, {-0.8f, -0.3f, -0.8f}, {1.6f, 0, 0}, {0, 0, 1.6f}, {0, 1, 0}, glass);
+  PhotonParams params;
+  params.storedPhotons = 50000;
+  params.includeDirect = true;
+  PhotonMap map = tracePhotons(scene, params);
+  double direct = 0;
+  for (const Photon& p : map.photons) {
+    if (p.position.y < -0.99f && std::fabs(p.position.x) < 0.5f && std::fabs(p.position.z) < 0.5f &&
+        p.bounce == 0)
+      direct += p.power.x;
+  }
+  EXPECT_GT(direct, 0.0) << "light through the pane arrives as bounce 0";
+}
+
+}  // namespace
+}  // namespace lo
+
