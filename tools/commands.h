@@ -17,6 +17,9 @@ std::function<int()> addBakeCommand(CLI::App& app);
 /// `lightoctree render SCENE LIGHTS.vdb -o IMAGE.{png,exr} ...`
 std::function<int()> addRenderCommand(CLI::App& app);
 
+/// `lightoctree lightmap SCENE LIGHTS.vdb -o OUT.{glb,gltf} [--image exr|png] [--preview-unlit] ...`
+std::function<int()> addLightmapCommand(CLI::App& app);
+
 /// `lightoctree convert IN.vdb -o OUT.vdb [--depth D] [--vdls K|auto] ...`
 std::function<int()> addConvertCommand(CLI::App& app);
 

@@ -19,6 +19,7 @@ int run(int argc, char** argv) {
   std::vector<std::function<int()>> commands;
   commands.push_back(lo::tool::addBakeCommand(app));
   commands.push_back(lo::tool::addRenderCommand(app));
+  commands.push_back(lo::tool::addLightmapCommand(app));
   commands.push_back(lo::tool::addConvertCommand(app));
   commands.push_back(lo::tool::addInspectCommand(app));
   commands.push_back(lo::tool::addReferenceCommand(app));

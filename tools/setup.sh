@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages Light Octree builds and tests with.
-# Idempotent: packages already present are skipped, so a second run is a no-op.
+# Installs the Debian 12 packages Light Octree builds and tests with, and the
+# Khronos glTF validator (npm) into .cache/npm.
+# Idempotent: what is already present is skipped, so a second run is a no-op.
 # Needs root (or sudo) only when something is missing.
 set -euo pipefail
 
@@ -23,7 +24,28 @@ PACKAGES=(
   gnuplot-nox
   # a virtual display for the `lightoctree view` window tests (xvfb-run)
   xvfb xauth
+  # Node.js runs the Khronos glTF validator on the `lightoctree lightmap`
+  # exports (tests gltf.validate_*); npm, which installs the validator, is
+  # handled below
+  nodejs
 )
+
+# The Khronos glTF validator (npm package gltf-validator, pinned), installed
+# into the project-local folder the tests read (git ignores .cache/).
+GLTF_VALIDATOR_VERSION="2.0.0-dev.3.10"
+NPM_PREFIX="$(cd "$(dirname "$0")/.." && pwd)/.cache/npm"
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+updated=0
+apt_install() {
+  if [ $updated -eq 0 ]; then
+    $SUDO apt-get update -qq
+    updated=1
+  fi
+  $SUDO apt-get install -y -qq --no-install-recommends "$@" >/dev/null
+}
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -31,16 +53,29 @@ for p in "${PACKAGES[@]}"; do
     missing+=("$p")
   fi
 done
-
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#PACKAGES[@]} packages present"
-  exit 0
+else
+  echo "setup: installing ${#missing[@]} package(s): ${missing[*]}"
+  apt_install "${missing[@]}"
 fi
 
-echo "setup: installing ${#missing[@]} package(s): ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+# Debian's nodejs comes without npm (Debian's npm package); a NodeSource
+# nodejs ships its own npm and conflicts with Debian's, so npm is installed
+# only where the command is missing.
+if ! command -v npm >/dev/null 2>&1; then
+  echo "setup: installing npm"
+  apt_install npm
+fi
+
+installed="$(sed -n 's/.*"version": *"\([^"]*\)".*/\1/p' \
+  "$NPM_PREFIX/node_modules/gltf-validator/package.json" 2>/dev/null || true)"
+if [ "$installed" = "$GLTF_VALIDATOR_VERSION" ]; then
+  echo "setup: gltf-validator $installed present in .cache/npm"
+else
+  echo "setup: installing gltf-validator $GLTF_VALIDATOR_VERSION into .cache/npm"
+  mkdir -p "$NPM_PREFIX"
+  npm install --prefix "$NPM_PREFIX" --no-audit --no-fund --no-save --loglevel=error \
+    "gltf-validator@$GLTF_VALIDATOR_VERSION" >/dev/null
+fi
 echo "setup: done"

@@ -100,13 +100,76 @@ void writeExr(const std::string& path, const RgbImage& image) {
 
 void writePng(const std::string& path, const RgbImage& image, float exposureEv) {
   checkImage(path, image);
-  float scale = std::exp2(exposureEv);
+  const std::vector<unsigned char> png = encodePng(image, exposureEv);
+  writeTextAtomically(path, std::string(png.begin(), png.end()));
+}
+
+std::vector<unsigned char> encodePng8(int width, int height, int channels,
+                                      const unsigned char* pixels) {
+  if (width < 1 || height < 1 || channels < 1 || channels > 4 || !pixels) {
+    throw InputError("encodePng8: " + std::to_string(width) + " x " + std::to_string(height) +
+                     " pixels of " + std::to_string(channels) + " channel(s)");
+  }
+  std::vector<unsigned char> out;
+  auto append = [](void* context, void* data, int size) {
+    auto* bytes = static_cast<std::vector<unsigned char>*>(context);
+    const auto* p = static_cast<const unsigned char*>(data);
+    bytes->insert(bytes->end(), p, p + size);
+  };
+  if (!stbi_write_png_to_func(append, &out, width, height, channels, pixels, width * channels)) {
+    throw IoError("encodePng8: stbi_write_png_to_func failed");
+  }
+  return out;
+}
+
+std::vector<unsigned char> encodePng(const RgbImage& image, float exposureEv) {
+  checkImage("encodePng", image);
+  const float scale = std::exp2(exposureEv);
   std::vector<unsigned char> rgb(image.pixelCount() * 3);
   for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = encodeSrgb8(image.rgb[i] * scale);
-  writeAtomically(path, [&](const std::string& tmp) {
-    if (!stbi_write_png(tmp.c_str(), image.width, image.height, 3, rgb.data(), image.width * 3))
-      throw std::runtime_error("stbi_write_png failed");
-  });
+  return encodePng8(image.width, image.height, 3, rgb.data());
+}
+
+std::vector<unsigned char> encodeRgbmPng(const RgbImage& image, float range) {
+  checkImage("encodeRgbmPng", image);
+  if (!(std::isfinite(range) && range > 0)) {
+    throw InputError("encodeRgbmPng: range " + std::to_string(range) + " must be finite and > 0");
+  }
+  std::vector<unsigned char> rgba(image.pixelCount() * 4);
+  for (size_t i = 0; i < image.pixelCount(); ++i) {
+    float c[3];
+    for (int k = 0; k < 3; ++k) {
+      const float v = image.rgb[3 * i + size_t(k)];
+      c[k] = std::isfinite(v) ? std::clamp(v, 0.0f, range) : 0.0f;
+    }
+    const float m = std::max({c[0], c[1], c[2]}) / range;
+    // Rounded up (at least 1, so that the division below is defined): the
+    // largest channel then needs at most 255.
+    const int a = std::clamp(int(std::ceil(double(m) * 255.0)), 1, 255);
+    const double scale = 255.0 / (double(a) / 255.0 * double(range));
+    for (int k = 0; k < 3; ++k) {
+      rgba[4 * i + size_t(k)] = (unsigned char)std::min(255L, std::lround(double(c[k]) * scale));
+    }
+    rgba[4 * i + 3] = (unsigned char)a;
+  }
+  return encodePng8(image.width, image.height, 4, rgba.data());
+}
+
+RgbImage decodeRgbm(const DecodedImage& image, float range) {
+  if (image.channels != 4 || image.width < 1 || image.height < 1 ||
+      image.values.size() != size_t(image.width) * size_t(image.height) * 4) {
+    throw InputError("decodeRgbm: RGBM needs an RGBA image, got " +
+                     std::to_string(image.channels) + " channel(s)");
+  }
+  if (!(std::isfinite(range) && range > 0)) {
+    throw InputError("decodeRgbm: range " + std::to_string(range) + " must be finite and > 0");
+  }
+  RgbImage out(image.width, image.height);
+  for (size_t i = 0; i < out.pixelCount(); ++i) {
+    const float m = image.values[4 * i + 3] * range;
+    for (int k = 0; k < 3; ++k) out.rgb[3 * i + size_t(k)] = image.values[4 * i + size_t(k)] * m;
+  }
+  return out;
 }
 
 void writeImage(const std::string& path, const RgbImage& image, float exposureEv) {

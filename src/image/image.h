@@ -65,4 +65,29 @@ void writeImage(const std::string& path, const RgbImage& image, float exposureEv
 /// NaN and Inf encode as 0).
 unsigned char encodeSrgb8(float linear);
 
+/// @brief A PNG file in memory (stb_image_write, zlib, no colour chunk):
+/// `pixels` holds width * height * channels bytes (1..4 channels), row 0 at
+/// the top. @throws InputError for a bad size or channel count.
+std::vector<unsigned char> encodePng8(int width, int height, int channels,
+                                      const unsigned char* pixels);
+/// @brief The bytes writePng writes: radiance * 2^exposureEv, clamped,
+/// sRGB-encoded (encodeSrgb8), 8-bit RGB.
+std::vector<unsigned char> encodePng(const RgbImage& image, float exposureEv = 0.0f);
+
+/// @brief RGBM: linear RGB in [0, range] in an 8-bit RGBA PNG, for HDR data
+/// that must travel as PNG (lightmaps for viewers without EXR). Per pixel,
+/// with c = RGB clamped to [0, range] (NaN as 0):
+///   A = max(1, ceil(255 * max(c) / range)),  M = A / 255,
+///   RGB = round(255 * c / (M * range)),
+/// decoded as c' = (RGB / 255) * (A / 255) * range (decodeRgbm). No sRGB curve
+/// on any channel: the PNG holds data, not a picture. A is rounded up, so the
+/// channel never exceeds 255, and |c' - c| <= 0.5 / 255 * M * range
+/// <= (0.5 / 255) * (max(c) + range / 255) per channel.
+/// @throws InputError for an empty image or a range that is not finite and > 0.
+std::vector<unsigned char> encodeRgbmPng(const RgbImage& image, float range);
+/// @brief The inverse of encodeRgbmPng for a decoded RGBA image
+/// (decodeImageBytes: channels scaled to [0, 1]). @throws InputError unless
+/// the image has 4 channels and range is finite and > 0.
+RgbImage decodeRgbm(const DecodedImage& image, float range);
+
 }  // namespace lo

@@ -191,11 +191,11 @@ void rasterTriangle(const LightmapUvs& uvs, size_t t, PageRaster& raster) {
   }
 }
 
-/// The surface point and shading normal of texel `i` owned by triangle t.
+/// The surface point and shading normal of texel `i` owned by triangle t,
+/// and the point's barycentrics b.
 void texelSurface(const Scene& scene, const LightmapUvs& uvs, size_t t, size_t i, Vec3& position,
-                  Vec3& normal) {
+                  Vec3& normal, double b[3]) {
   const Uv centre{double(i % size_t(uvs.width)) + 0.5, double(i / size_t(uvs.width)) + 0.5};
-  double b[3];
   closestPointBarycentrics(centre, corner(uvs, t, 0), corner(uvs, t, 1), corner(uvs, t, 2), b);
   const uint32_t* v = &scene.indices[3 * t];
   double p[3] = {0, 0, 0};
@@ -222,14 +222,15 @@ Vec3 unitOrZero(const Vec3& v) {
 
 /// Fills `rings` rings of empty texels: each ring, every empty texel with a
 /// filled 8-neighbour gets the mean of its filled neighbours (all of a ring
-/// computed before any is written, so the order does not matter).
+/// computed before any is written, so the order does not matter). `extra`
+/// images (albedo, emission), when given, are averaged the same way.
 void dilatePage(int width, int height, int rings, std::vector<uint8_t>& coverage, RgbImage& e,
-                RgbImage& d, size_t& dilated) {
+                RgbImage& d, size_t& dilated, const std::vector<RgbImage*>& extra = {}) {
   constexpr uint8_t kPending = 255;
   std::vector<size_t> frontier, next;
   for (size_t i = 0; i < coverage.size(); ++i)
     if (coverage[i] == kAtlasCovered) frontier.push_back(i);
-  std::vector<Vec3> eNext, dNext;
+  std::vector<Vec3> eNext, dNext, xNext;
   for (int ring = 0; ring < rings && !frontier.empty(); ++ring) {
     next.clear();
     for (size_t i : frontier) {
@@ -248,9 +249,11 @@ void dilatePage(int width, int height, int rings, std::vector<uint8_t>& coverage
     std::sort(next.begin(), next.end());
     eNext.assign(next.size(), Vec3{0, 0, 0});
     dNext.assign(next.size(), Vec3{0, 0, 0});
+    xNext.assign(next.size() * extra.size(), Vec3{0, 0, 0});
     for (size_t k = 0; k < next.size(); ++k) {
       const int x = int(next[k] % size_t(width)), y = int(next[k] / size_t(width));
       Vec3 es{0, 0, 0}, ds{0, 0, 0};
+      Vec3* xs = xNext.data() + k * extra.size();
       int count = 0;
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
@@ -260,16 +263,19 @@ void dilatePage(int width, int height, int rings, std::vector<uint8_t>& coverage
           if (coverage[j] != kAtlasCovered && coverage[j] != kAtlasDilated) continue;
           es += e.at(j);
           ds += d.at(j);
+          for (size_t m = 0; m < extra.size(); ++m) xs[m] += extra[m]->at(j);
           ++count;
         }
       }
       eNext[k] = es / float(count);
       dNext[k] = unitOrZero(ds);
+      for (size_t m = 0; m < extra.size(); ++m) xs[m] = xs[m] / float(count);
     }
     for (size_t k = 0; k < next.size(); ++k) {
       coverage[next[k]] = kAtlasDilated;
       e.set(next[k], eNext[k]);
       d.set(next[k], dNext[k]);
+      for (size_t m = 0; m < extra.size(); ++m) extra[m]->set(next[k], xNext[k * extra.size() + m]);
     }
     dilated += next.size();
     frontier.swap(next);
@@ -492,7 +498,11 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
       if (uvs.triangleChart[t] >= 0) byPage[fill[size_t(uvs.trianglePage[t])]++] = int32_t(t);
   }
 
+  const bool direct = bool(params.directLight);
   PageRaster raster;
+  // Per page, with params.radiance: the albedo and emission at each texel's
+  // surface point (dilated like E), combined with the stitched E at the end.
+  std::vector<RgbImage> albedo, emission;
   for (int page = 0; page < uvs.pageCount; ++page) {
     auto start = Clock::now();
     raster.triangle.assign(texels, -1);
@@ -513,21 +523,48 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
 
     start = Clock::now();
     RgbImage e(uvs.width, uvs.height), d(uvs.width, uvs.height);
+    std::vector<AtlasSurfacePoint> directPoints;
+    if (params.radiance) {
+      albedo.push_back(RgbImage(uvs.width, uvs.height));
+      emission.push_back(RgbImage(uvs.width, uvs.height));
+    }
     for (size_t i = 0; i < texels; ++i) {
       if (raster.triangle[i] < 0) continue;
+      const size_t t = size_t(raster.triangle[i]);
       Vec3 position, normal;
-      texelSurface(scene, uvs, size_t(raster.triangle[i]), i, position, normal);
+      double b[3];
+      texelSurface(scene, uvs, t, i, position, normal, b);
       const OctreeIrradianceSample s =
           octreeIrradianceSample(octree, position, normal, params.shade);
       e.set(i, s.irradiance);
       d.set(i, unitOrZero(s.directionSum));
+      if (params.radiance) {
+        albedo.back().set(i, scene.albedo(t, float(b[1]), float(b[2])));
+        emission.back().set(i, scene.emission(t, float(b[1]), float(b[2])));
+      }
       coverage[i] = kAtlasCovered;
       ++atlas.coveredTexels;
+      if (direct) directPoints.push_back({position, uint32_t(t), normal});
+    }
+    if (direct) {
+      // The direct light of the covered texels in parallel, in texel order.
+      const std::vector<Vec3> light = params.directLight(directPoints, page);
+      if (light.size() != directPoints.size()) {
+        throw InternalError("atlas: the direct light gave " + std::to_string(light.size()) +
+                            " values for " + std::to_string(directPoints.size()) + " texels");
+      }
+      size_t k = 0;
+      for (size_t i = 0; i < texels; ++i) {
+        if (coverage[i] == kAtlasCovered) e.set(i, e.at(i) + light[k++]);
+      }
+      directPoints.clear();
     }
     atlas.evaluateSeconds += secondsSince(start);
 
     start = Clock::now();
-    dilatePage(uvs.width, uvs.height, atlas.dilation, coverage, e, d, atlas.dilatedTexels);
+    std::vector<RgbImage*> extra;
+    if (params.radiance) extra = {&albedo.back(), &emission.back()};
+    dilatePage(uvs.width, uvs.height, atlas.dilation, coverage, e, d, atlas.dilatedTexels, extra);
     atlas.dilateSeconds += secondsSince(start);
     atlas.irradiance.push_back(std::move(e));
     atlas.direction.push_back(std::move(d));
@@ -547,6 +584,22 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
     atlas.seamMismatchAfter = seamMismatch(system, atlas);
   }
   atlas.stitchSeconds = secondsSince(start);
+
+  if (params.radiance) {
+    // L = albedo / pi * E + emission from the final E: a seam joined in E is
+    // joined in L wherever the albedo agrees (LightmapAtlas::radiance).
+    const auto radianceStart = Clock::now();
+    for (int page = 0; page < atlas.pageCount; ++page) {
+      const size_t p = size_t(page);
+      RgbImage l(atlas.width, atlas.height);
+      for (size_t i = 0; i < texels; ++i) {
+        if (atlas.coverage[p][i] == kAtlasEmpty) continue;
+        l.set(i, albedo[p].at(i) * atlas.irradiance[p].at(i) * (1.0f / kPi) + emission[p].at(i));
+      }
+      atlas.radiance.push_back(std::move(l));
+    }
+    atlas.evaluateSeconds += secondsSince(radianceStart);
+  }
   return atlas;
 }
 

@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,13 @@ constexpr uint8_t kAtlasEmpty = 0;    ///< no triangle, not dilated: black
 constexpr uint8_t kAtlasCovered = 1;  ///< a triangle's UV footprint overlaps the texel
 constexpr uint8_t kAtlasDilated = 2;  ///< filled from its neighbours by dilation
 
+/// A covered texel's surface point, as AtlasBakeParams::directLight gets it.
+struct AtlasSurfacePoint {
+  Vec3 position;          ///< world space
+  uint32_t triangle = 0;  ///< the scene triangle the texel samples
+  Vec3 normal;            ///< unit, the interpolated vertex normal (the side baked)
+};
+
 struct AtlasBakeParams {
   /// The lookup's settings (interpolation, VDLs used, normal offset): pass
   /// the renderer's, so that the atlas holds what it would compute.
@@ -45,6 +53,16 @@ struct AtlasBakeParams {
   /// Stitching runs after dilation: the lookups at a chart's border read
   /// the first dilated ring.
   bool stitchSeams = true;
+  /// Also bake LightmapAtlas::radiance: what a viewer should show of a
+  /// diffuse surface, albedo / pi * E + emission, for previews in tools
+  /// that know no lightmaps (the glTF export's unlit form).
+  bool radiance = false;
+  /// Set: E also holds the direct light (`lightmap --content full`), this
+  /// function's value at the covered texels' surface points (the lightmap
+  /// command passes the path tracer's DirectIrradiance::atMany: ray-traced
+  /// soft shadows; this stage itself links no ray tracer). The direction
+  /// keeps the indirect light's. Called once per page, points in texel order.
+  std::function<std::vector<Vec3>(const std::vector<AtlasSurfacePoint>&, int page)> directLight;
 };
 
 /// The baked pages. Each vector holds pageCount entries, each page width x
@@ -64,6 +82,18 @@ struct LightmapAtlas {
   /// light arrives. With E and the shading normal n a renderer rebuilds one
   /// VDL per texel for its specular term.
   std::vector<RgbImage> direction;
+  /// Only with AtlasBakeParams::radiance (else empty): per texel the
+  /// outgoing radiance of a Lambertian surface, W/(m^2 sr) (RGB):
+  ///   L = albedo / pi * E + emission,
+  /// albedo = Scene::albedo and emission = Scene::emission of the texel's
+  /// triangle at its surface point (the one E is evaluated at), E the
+  /// texel's final (stitched) irradiance. Dilated texels take the mean albedo
+  /// and emission of their filled neighbours, ring by ring as E does, so the
+  /// gutter continues the chart beside it. Not stitched itself: where E
+  /// agrees across a seam, L agrees wherever the albedo does, and a change of
+  /// material at a seam stays sharp. L follows E's sign: a dilated texel that
+  /// stitching pushed below zero gives L below the emission there.
+  std::vector<RgbImage> radiance;
   /// Per page, width * height values kAtlasEmpty / kAtlasCovered / kAtlasDilated.
   std::vector<std::vector<uint8_t>> coverage;
 

@@ -505,4 +505,18 @@ Vec3 DirectIrradiance::at(const Vec3& p, uint32_t triangle, const Vec3& n, int s
   return sum / float(count);
 }
 
+std::vector<Vec3> DirectIrradiance::atMany(const std::vector<Point>& points, int samples,
+                                           uint64_t seed, uint64_t firstIndex) const {
+  std::vector<Vec3> out(points.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        const Point& q = points[i];
+                        out[i] = at(q.position, q.triangle, q.normal, samples, seed, firstIndex + i);
+                      }
+                    });
+  return out;
+}
+
 }  // namespace lo
+

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/math.h"
 #include "core/progress.h"
@@ -90,6 +91,17 @@ class DirectIrradiance {
   /// Deterministic: the same (seed, index) give the same value.
   Vec3 at(const Vec3& p, uint32_t triangle, const Vec3& n, int samples, uint64_t seed,
           uint64_t index) const;
+
+  /// A surface point: position, triangle (for the ray offset), unit normal.
+  struct Point {
+    Vec3 position;
+    uint32_t triangle = 0;
+    Vec3 normal;
+  };
+  /// `at` for many points in parallel (TBB); point i uses index
+  /// firstIndex + i: the result does not depend on the thread count.
+  std::vector<Vec3> atMany(const std::vector<Point>& points, int samples, uint64_t seed,
+                           uint64_t firstIndex = 0) const;
 
  private:
   struct Impl;

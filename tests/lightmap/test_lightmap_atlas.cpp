@@ -404,6 +404,143 @@ TEST(LightmapAtlas, PlaneUnderAConstantVdlIsTheCosineLawAtEveryTexel) {
   }
 }
 
+// --content full: the direct light function's value is added to every
+// covered texel's E, at the texel's own surface point and normal (here a
+// function of the position, so a mix-up of texels shows).
+TEST(LightmapAtlas, DirectLightIsAddedAtEachCoveredTexel) {
+  PlaneCase plane = tiltedPlane();
+  const Vec3 c{2.0f, 1.0f, 0.5f};
+  const GpuOctree octree = denseOctree([&](const Coord&) {
+    return std::vector<Vdl>{vdl(c, {0.3f, -0.2f, 1.0f})};
+  });
+  LightmapUvParams up;
+  up.atlasSize = 64;
+  const LightmapUvs uvs = buildLightmapUvs(plane.scene, up);
+  AtlasBakeParams indirectOnly;
+  indirectOnly.dilation = 0;
+  indirectOnly.stitchSeams = false;
+  const LightmapAtlas without = bakeLightmapAtlas(plane.scene, uvs, octree, indirectOnly);
+  AtlasBakeParams full = indirectOnly;
+  size_t calls = 0;
+  full.directLight = [&](const std::vector<AtlasSurfacePoint>& points, int page) {
+    EXPECT_EQ(page, 0);
+    ++calls;
+    std::vector<Vec3> out;
+    for (const AtlasSurfacePoint& p : points) {
+      EXPECT_NEAR(length(p.normal), 1.0f, 1e-5f);
+      out.push_back(Vec3{1.0f + p.position.x, 2.0f, 3.0f});
+    }
+    return out;
+  };
+  const LightmapAtlas with = bakeLightmapAtlas(plane.scene, uvs, octree, full);
+  EXPECT_EQ(calls, 1u);
+  size_t covered = 0;
+  for (size_t i = 0; i < with.coverage[0].size(); ++i) {
+    if (with.coverage[0][i] != kAtlasCovered) continue;
+    const Vec3 added = with.irradiance[0].at(i) - without.irradiance[0].at(i);
+    EXPECT_NEAR(added.y, 2.0f, 1e-5f);
+    EXPECT_NEAR(added.z, 3.0f, 1e-5f);
+    EXPECT_GT(added.x, 0.0f);
+    ++covered;
+  }
+  EXPECT_EQ(covered, with.coveredTexels);
+  EXPECT_GT(covered, 0u);
+}
+
+// The radiance pages (AtlasBakeParams::radiance): on a textured, emissive
+// plane under one constant VDL, every covered texel holds albedo / pi * E +
+// emission with the albedo of the texture texel under its surface point,
+// found here from the point's position (not from the bake's barycentrics).
+TEST(LightmapAtlas, RadianceIsAlbedoOverPiTimesIrradiancePlusEmission) {
+  PlaneCase plane = tiltedPlane();
+  const Vec3 origin(0.35f, 0.3f, 0.55f), eu(1.2f, 0.25f, 0.1f), ev(-0.2f, 0.9f, 0.35f);
+  constexpr int kGrid = 4, kTex = 4;
+  for (int j = 0; j <= kGrid; ++j)
+    for (int i = 0; i <= kGrid; ++i) {
+      plane.scene.texcoords0.push_back(float(i) / kGrid);
+      plane.scene.texcoords0.push_back(float(j) / kGrid);
+    }
+  Texture tex;
+  tex.width = tex.height = kTex;
+  for (int y = 0; y < kTex; ++y)
+    for (int x = 0; x < kTex; ++x)
+      tex.texels.push_back({0.1f + 0.2f * float(x), 0.9f - 0.2f * float(y), 0.5f});
+  plane.scene.textures.push_back(tex);
+  Material& m = plane.scene.materials[0];
+  m.baseColor = {0.9f, 0.8f, 0.7f};
+  m.baseColorTexture = 0;
+  m.emission = {0.05f, 0.1f, 0.0f};
+
+  const Vec3 c{2.0f, 1.0f, 0.5f};
+  const GpuOctree octree = denseOctree([&](const Coord&) {
+    return std::vector<Vdl>{vdl(c, {0.3f, -0.2f, 1.0f})};
+  });
+  const Vec3 analytic = c * std::max(0.0f, dot(plane.normal, decodedDirection(octree, 0)));
+  LightmapUvParams up;
+  up.atlasSize = 64;
+  const LightmapUvs uvs = buildLightmapUvs(plane.scene, up);
+  AtlasBakeParams params;
+  EXPECT_TRUE(bakeLightmapAtlas(plane.scene, uvs, octree, params).radiance.empty());
+  params.radiance = true;
+  const LightmapAtlas atlas = bakeLightmapAtlas(plane.scene, uvs, octree, params);
+  ASSERT_EQ(atlas.radiance.size(), 1u);
+
+  // (u, v) of a point of the plane: solve p - origin = u eu + v ev.
+  const double a11 = dot(eu, eu), a12 = dot(eu, ev), a22 = dot(ev, ev);
+  auto planeUv = [&](const Vec3& p, double& u, double& v) {
+    const Vec3 q = p - origin;
+    const double b1 = dot(eu, q), b2 = dot(ev, q), det = a11 * a22 - a12 * a12;
+    u = (b1 * a22 - b2 * a12) / det;
+    v = (a11 * b2 - a12 * b1) / det;
+  };
+  size_t checked = 0;
+  std::vector<Vec3> seen;
+  Vec3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
+  for (int y = 0; y < atlas.height; ++y) {
+    for (int x = 0; x < atlas.width; ++x) {
+      const size_t i = size_t(y) * size_t(atlas.width) + size_t(x);
+      if (atlas.coverage[0][i] != kAtlasCovered) continue;
+      const Vec3 l = atlas.radiance[0].at(i);
+      lo = min(lo, l);
+      hi = max(hi, l);
+      const ReferenceTexel r = referenceTexel(plane.scene, uvs, 0, x, y);
+      if (r.ambiguous || !r.covered) continue;
+      double u, v;
+      planeUv(r.position, u, v);
+      // Points within 1e-3 texture texels of a texel border: either texel.
+      const double tu = u * kTex, tv = v * kTex;
+      if (std::fabs(tu - std::round(tu)) < 1e-3 || std::fabs(tv - std::round(tv)) < 1e-3) continue;
+      const int tx = std::clamp(int(std::floor(tu)), 0, kTex - 1);
+      const int ty = std::clamp(int(std::floor(tv)), 0, kTex - 1);
+      const Vec3 albedo = m.baseColor * tex.texels[size_t(ty * kTex + tx)];
+      const Vec3 e = atlas.irradiance[0].at(i);
+      const Vec3 expected = albedo * e / kPi + m.emission;
+      const Vec3 fromAnalytic = albedo * analytic / kPi + m.emission;
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_NEAR(l[k], expected[k], 1e-6f * (1 + expected[k])) << x << ", " << y;
+        ASSERT_NEAR(l[k], fromAnalytic[k], 1e-5f * (1 + expected[k])) << x << ", " << y;
+      }
+      if (std::find(seen.begin(), seen.end(), albedo) == seen.end()) seen.push_back(albedo);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, size_t(0.8 * double(atlas.coveredTexels))) << atlas.ToString();
+  EXPECT_EQ(seen.size(), size_t(kTex * kTex));  // the texture shows, not one colour
+  // Dilated texels: the mean of their neighbours' albedo under the same E,
+  // so inside the covered texels' range; empty texels stay black.
+  for (size_t i = 0; i < atlas.coverage[0].size(); ++i) {
+    const Vec3 l = atlas.radiance[0].at(i);
+    if (atlas.coverage[0][i] == kAtlasEmpty) {
+      ASSERT_EQ(l, Vec3(0, 0, 0)) << i;
+    } else if (atlas.coverage[0][i] == kAtlasDilated) {
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_GE(l[k], lo[k] - 1e-6f) << i;
+        ASSERT_LE(l[k], hi[k] + 1e-6f) << i;
+      }
+    }
+  }
+}
+
 TEST(LightmapAtlas, DilationFillsTheRingsAskedForAndNothingElse) {
   const PlaneCase plane = tiltedPlane();
   // Irradiance varying across voxels, so that a dilated texel's mean of its
