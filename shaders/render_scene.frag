@@ -18,6 +18,7 @@ in vec2 vMetallicRoughnessUv;
 in vec2 vOcclusionUv;
 in vec2 vEmissiveUv;
 in vec3 vLightmap;  // lightmap u, v, page
+in vec4 vTangent;   // glTF TANGENT, w = +-1; w = 0: derive the tangent from the UVs
 out vec4 fragColor;
 
 uniform usampler3D uOctree;  // RGBA8UI pool of 2x2x2 tiles
@@ -512,12 +513,25 @@ vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughn
 
 #endif  // LO_DIRECT_LIGHT
 
-// The normal map's normal in world space. Tangents are not read from the
-// file: the tangent is the direction of +u on the surface, from screen-space
-// derivatives of the position and the UVs (as the glTF sample viewer does
-// without TANGENT), and the bitangent cross(n, t), glTF's convention for
-// tangent.w = 1 (mirrored UVs are not detected).
-vec3 perturbNormal(vec3 n, vec3 p, vec2 uv) {
+// The normal map's normal in world space. With the file's TANGENT (vTangent.w
+// = +-1) the frame is its tangent and w cross(n, t), turned with the normal
+// to the side seen (side = -1 when n was flipped to face the viewer), as the
+// glTF sample viewer does. Without it the tangent is the direction of +u on
+// the surface, from screen-space derivatives of the position and the UVs,
+// and the bitangent cross(n, t), glTF's convention for tangent.w = 1
+// (mirrored UVs are not detected). Scene::shadingNormal is the C++ twin.
+vec3 perturbNormal(vec3 n, vec3 p, vec2 uv, float side) {
+  if (abs(vTangent.w) > 0.5) {
+    vec3 n0 = n * side;
+    vec3 t0 = vTangent.xyz - n0 * dot(n0, vTangent.xyz);
+    if (dot(t0, t0) > 1e-20) {
+      t0 = normalize(t0);
+      vec3 b0 = cross(n0, t0) * sign(vTangent.w);
+      vec3 m = texture(uNormalTexture, uv).rgb * 2.0 - 1.0;
+      m.xy *= uNormalScale;
+      return normalize((t0 * m.x + b0 * m.y) * side + n * m.z);
+    }
+  }
   vec3 dpdx = dFdx(p), dpdy = dFdy(p);
   vec2 duvdx = dFdx(uv), duvdy = dFdy(uv);
   float det = duvdx.x * duvdy.y - duvdy.x * duvdx.y;
@@ -549,11 +563,15 @@ void main() {
   // derivatives), not from gl_FrontFacing: scene files do not agree on winding.
   vec3 ng = cross(dFdx(vPosition), dFdy(vPosition));
   if (dot(ng, v) < 0.0) ng = -ng;
-  if (dot(n, ng) < 0.0) n = -n;
+  float side = 1.0;
+  if (dot(n, ng) < 0.0) {
+    n = -n;
+    side = -1.0;
+  }
 #ifdef LO_DIRECT_LIGHT
   gGeometricNormal = normalize(ng);
 #endif
-  if (uHasNormalTexture) n = perturbNormal(n, vPosition, vNormalUv);
+  if (uHasNormalTexture) n = perturbNormal(n, vPosition, vNormalUv, side);
   // glTF: base colour = factor x texture, sampled per pixel (trilinear,
   // anisotropic where the context has it).
   vec3 baseColor = vBaseColor;

@@ -13,6 +13,7 @@ layout(location = 7) in vec2 aMetallicRoughnessUv;
 layout(location = 8) in vec2 aOcclusionUv;
 layout(location = 9) in vec2 aEmissiveUv;
 layout(location = 10) in vec3 aLightmap;  // lightmap u, v and page (Renderer::setAtlas)
+layout(location = 11) in vec4 aTangent;   // glTF TANGENT (w = +-1), or w = 0: none
 
 uniform mat4 uViewProj;
 invariant gl_Position;  // as render_depth.vert: the depth pre-pass must match exactly
@@ -28,6 +29,7 @@ out vec2 vMetallicRoughnessUv;
 out vec2 vOcclusionUv;
 out vec2 vEmissiveUv;
 out vec3 vLightmap;
+out vec4 vTangent;
 
 void main() {
   vPosition = aPosition;
@@ -41,5 +43,6 @@ void main() {
   vOcclusionUv = aOcclusionUv;
   vEmissiveUv = aEmissiveUv;
   vLightmap = aLightmap;
+  vTangent = aTangent;
   gl_Position = uViewProj * vec4(aPosition, 1.0);
 }

@@ -91,6 +91,7 @@ struct Vertex {
   float metallicRoughnessUv[2];
   float occlusionUv[2];
   float emissiveUv[2];
+  float tangent[4];  ///< glTF TANGENT (xyz, w = +-1), w = 0 without: derived in the shader
 };
 
 /// A run of the vertex buffer drawn with one material's textures.
@@ -495,6 +496,9 @@ struct Renderer::Impl {
           if (range.emissiveTexture >= 0) {
             setUv(v.emissiveUv, mat.emissiveTexCoord, mat.emissiveTransform);
           }
+          if (scene.tangents.size() == 4 * scene.positions.size()) {
+            std::memcpy(v.tangent, &scene.tangents[4 * size_t(index)], sizeof v.tangent);
+          }
           vertices.push_back(v);
           vertexCorner.push_back(uint32_t(3 * t + size_t(k)));
         }
@@ -532,6 +536,7 @@ struct Renderer::Impl {
     attrib(7, 2, offsetof(Vertex, metallicRoughnessUv));
     attrib(8, 2, offsetof(Vertex, occlusionUv));
     attrib(9, 2, offsetof(Vertex, emissiveUv));
+    attrib(11, 4, offsetof(Vertex, tangent));
     if (!blendCentroids.empty()) glGenBuffers(1, &blendEbo);
     glBindVertexArray(0);
     glGenVertexArrays(1, &emptyVao);

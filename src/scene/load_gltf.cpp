@@ -814,8 +814,9 @@ class SceneBuilder {
         }
         return v;
       };
-      std::vector<double> nrm, uv0, uv1;
+      std::vector<double> nrm, uv0, uv1, tan;
       if (attr("NORMAL") >= 0) nrm = readSameCount(attr("NORMAL"), TINYGLTF_TYPE_VEC3, "NORMAL");
+      if (attr("TANGENT") >= 0) tan = readSameCount(attr("TANGENT"), TINYGLTF_TYPE_VEC4, "TANGENT");
       if (attr("TEXCOORD_0") >= 0)
         uv0 = readSameCount(attr("TEXCOORD_0"), TINYGLTF_TYPE_VEC2, "TEXCOORD_0");
       if (attr("TEXCOORD_1") >= 0)
@@ -856,6 +857,7 @@ class SceneBuilder {
       appendNormals(nrm, normalMatrix, nverts, base, tris, flip);
       appendUv(scene_.texcoords0, hasUv0_, uv0, nverts, base);
       appendUv(scene_.texcoords1, hasUv1_, uv1, nverts, base);
+      appendTangents(tan, world, nverts, base, flip);
 
       for (auto& t : tris) {
         if (flip) std::swap(t[1], t[2]);
@@ -944,6 +946,31 @@ class SceneBuilder {
     }
   }
 
+  /// TANGENT of a primitive into Scene::tangents (xyz by the node's linear
+  /// part, normalised; w flipped with the winding under a mirroring
+  /// transform); vertices of primitives without one get w = 0.
+  void appendTangents(const std::vector<double>& tan, const Mat4& world, size_t nverts,
+                      uint32_t base, bool flip) {
+    if (tan.empty() && !hasTangents_) return;
+    if (!hasTangents_) {
+      hasTangents_ = true;
+      scene_.tangents.assign(4 * size_t(base), 0.0f);
+    }
+    if (tan.empty()) {
+      scene_.tangents.resize(scene_.tangents.size() + 4 * nverts, 0.0f);
+      return;
+    }
+    for (size_t v = 0; v < nverts; ++v) {
+      Vec3 t = world.vector({float(tan[4 * v]), float(tan[4 * v + 1]), float(tan[4 * v + 2])});
+      const float w = float(tan[4 * v + 3]);
+      if (!isFinite(t) || !std::isfinite(w)) fail(path_, "non-finite vertex tangent");
+      const bool usable = lengthSquared(t) > 0 && w != 0;
+      t = usable ? normalize(t) : Vec3{0, 0, 0};
+      scene_.tangents.insert(scene_.tangents.end(),
+                             {t.x, t.y, t.z, usable ? ((w < 0) != flip ? -1.0f : 1.0f) : 0.0f});
+    }
+  }
+
   void finishVertexAttributes() {
     LO_CHECK(!hasNormals_ || scene_.normals.size() == scene_.positions.size());
   }
@@ -954,7 +981,7 @@ class SceneBuilder {
   Scene scene_;
   std::map<int, int> imageToTexture_;
   int defaultMaterial_ = -1;
-  bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false;
+  bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false;
 };
 
 }  // namespace

@@ -157,6 +157,36 @@ Vec3 Scene::shadingNormal(size_t t, float b1, float b2, const Vec3& geometric) c
   if (m.normalTexture < 0) return n;
   float u, v, u0, v0, u1, v1, u2, v2;
   if (!texcoord(t, b1, b2, m.normalTexCoord, m.normalTransform, u, v)) return n;
+  // The file's tangents (glTF TANGENT) where all three corners have one.
+  if (tangents.size() == 4 * positions.size()) {
+    const uint32_t i0 = indices[3 * t], i1 = indices[3 * t + 1], i2 = indices[3 * t + 2];
+    const float w0 = tangents[4 * i0 + 3];
+    if (w0 != 0 && tangents[4 * i1 + 3] != 0 && tangents[4 * i2 + 3] != 0) {
+      const float b0 = 1.0f - b1 - b2;
+      auto corner = [&](uint32_t i) {
+        return Vec3{tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]};
+      };
+      // The vertex normal's own side: the frame follows the surface, then
+      // turns with the normal to the side being shaded (as glTF viewers
+      // negate t and b on back faces).
+      const float side = normals.size() == positions.size() &&
+                                 dot(normals[i0] * b0 + normals[i1] * b1 + normals[i2] * b2, n) < 0
+                             ? -1.0f
+                             : 1.0f;
+      const Vec3 n0 = n * side;
+      Vec3 tangent = corner(i0) * b0 + corner(i1) * b1 + corner(i2) * b2;
+      tangent = tangent - n0 * dot(n0, tangent);
+      if (lengthSquared(tangent) > 1e-20f) {
+        tangent = normalize(tangent);
+        const Vec3 bitangent = cross(n0, tangent) * w0;
+        Vec3 mapped = textures[size_t(m.normalTexture)].lookup(u, v) * 2.0f - Vec3{1, 1, 1};
+        mapped.x *= m.normalScale;
+        mapped.y *= m.normalScale;
+        const Vec3 out = (tangent * mapped.x + bitangent * mapped.y) * side + n * mapped.z;
+        return lengthSquared(out) > 0 ? normalize(out) : n;
+      }
+    }
+  }
   texcoord(t, 0, 0, m.normalTexCoord, m.normalTransform, u0, v0);
   texcoord(t, 1, 0, m.normalTexCoord, m.normalTransform, u1, v1);
   texcoord(t, 0, 1, m.normalTexCoord, m.normalTransform, u2, v2);

@@ -140,6 +140,11 @@ struct Scene {
   std::vector<Vec3> normals;      ///< per vertex, unit, world space; empty = use face normals
   std::vector<float> texcoords0;  ///< 2 floats per vertex, or empty
   std::vector<float> texcoords1;  ///< 2 floats per vertex, or empty
+  /// glTF TANGENT, 4 floats per vertex: the unit world-space tangent and w =
+  /// +-1 (bitangent = w cross(normal, tangent)); w = 0 on vertices of
+  /// primitives that had none (their tangent is derived from the UVs). Empty
+  /// when no primitive had one.
+  std::vector<float> tangents;
   std::vector<uint32_t> indices;  ///< 3 per triangle, into positions
   std::vector<int32_t> triangleMaterial;  ///< one per triangle, into materials
   std::vector<Material> materials;

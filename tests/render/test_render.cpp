@@ -616,6 +616,42 @@ TEST(RenderImage, NormalMapTiltsTheShadingNormal) {
   EXPECT_NEAR(brightness[1], facing * std::cos(2.0f * theta), 0.01f * facing);
 }
 
+// glTF TANGENT: a file tangent along -u turns the map's tilt around: the
+// sun the derived frame faced is now the mirrored one (cos 2 theta), and
+// Scene::shadingNormal (the path tracer's) tilts the same way.
+TEST(RenderImage, FileTangentsOrientTheNormalMap) {
+  REQUIRE_OSMESA();
+  const float theta = 0.4f;
+  QuadSetup s;
+  Texture map;
+  map.width = map.height = 1;
+  map.texels = {Vec3{0.5f * (std::sin(theta) + 1.0f), 0.5f, 0.5f * (std::cos(theta) + 1.0f)}};
+  s.scene.textures.push_back(map);
+  s.scene.materials[0].normalTexture = 0;
+  s.scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};  // u along +x
+  s.scene.tangents.clear();
+  for (size_t v = 0; v < s.scene.positions.size(); ++v) {
+    s.scene.tangents.insert(s.scene.tangents.end(), {-1.0f, 0.0f, 0.0f, 1.0f});
+  }
+  Light sun;
+  sun.type = Light::Type::Directional;
+  sun.direction = -Vec3{std::sin(theta), 0.0f, std::cos(theta)};
+  sun.intensity = 2.0f;
+  s.scene.lights.push_back(sun);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  Renderer renderer(s.scene, octree);
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const float brightness = renderer.render(s.camera, p).pixel(p.width / 2, p.height / 2)[0];
+  const float facing = 0.5f * kInvPi * 2.0f;
+  EXPECT_NEAR(brightness, facing * std::cos(2.0f * theta), 0.01f * facing);
+  // The path tracer's shading normal: tilted towards -x.
+  const Vec3 n = s.scene.shadingNormal(0, 0.3f, 0.3f, Vec3{0, 0, 1});
+  EXPECT_NEAR(n.x, -std::sin(theta), 1e-3f);
+  EXPECT_NEAR(n.z, std::cos(theta), 1e-3f);
+}
+
 // metallicRoughnessTexture: B scales metallic, G roughness. A metal material
 // (factor 1) whose map says metallic 0 renders as the dielectric of the same
 // roughness; and occlusionTexture darkens the octree's light only: R = 0.25

@@ -77,12 +77,14 @@ struct MiniGltf {
   std::string materials;  // JSON array, or empty
   std::string extraTop;   // more top-level members, each followed by ","
   std::string bufferUri;  // empty: embedded data: URI
+  std::vector<float> tangents;  // TANGENT (VEC4), or empty
 
   std::string blob() const {
     std::string b;
     append(b, positions);
     append(b, normals);
     if (indexed) append(b, indices);
+    append(b, tangents);
     return b;
   }
 
@@ -96,6 +98,7 @@ struct MiniGltf {
     if (!materials.empty()) os << "\"materials\": " << materials << ", ";
     os << "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0";
     if (!normals.empty()) os << ", \"NORMAL\": 1";
+    if (!tangents.empty()) os << ", \"TANGENT\": 3";
     os << "}";
     if (indexed) os << ", \"indices\": 2";
     if (material >= 0) os << ", \"material\": " << material;
@@ -109,12 +112,22 @@ struct MiniGltf {
       os << "{\"bufferView\": 0, \"componentType\": 5126, \"count\": 1, \"type\": \"VEC3\"}, ";
     }
     os << "{\"bufferView\": 2, \"componentType\": 5125, \"count\": " << indices.size()
-       << ", \"type\": \"SCALAR\"}], ";
+       << ", \"type\": \"SCALAR\"}";
+    if (!tangents.empty()) {
+      os << ", {\"bufferView\": 3, \"componentType\": 5126, \"count\": " << tangents.size() / 4
+         << ", \"type\": \"VEC4\"}";
+    }
+    os << "], ";
     size_t nrmOffset = posBytes, idxOffset = posBytes + nrmBytes;
     os << "\"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": " << posBytes
        << "}, {\"buffer\": 0, \"byteOffset\": " << nrmOffset << ", \"byteLength\": " << nrmBytes
        << "}, {\"buffer\": 0, \"byteOffset\": " << idxOffset
-       << ", \"byteLength\": " << (indexed ? indices.size() * 4 : 0) << "}], ";
+       << ", \"byteLength\": " << (indexed ? indices.size() * 4 : 0) << "}";
+    if (!tangents.empty()) {
+      os << ", {\"buffer\": 0, \"byteOffset\": " << idxOffset + (indexed ? indices.size() * 4 : 0)
+         << ", \"byteLength\": " << tangents.size() * 4 << "}";
+    }
+    os << "], ";
     std::string uri =
         bufferUri.empty() ? "data:application/octet-stream;base64," + base64(bin) : bufferUri;
     os << "\"buffers\": [{\"byteLength\": " << bin.size() << ", \"uri\": \"" << uri << "\"}]}";
@@ -865,3 +878,28 @@ TEST(SceneGltf, UnknownAlphaModeIsRefused) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// glTF TANGENT is read per vertex, turned by the node's transform, and its
+// w flips under a mirroring node (the winding flips with it).
+TEST(SceneGltf, TangentsAreReadAndTransformed) {
+  std::string dir = test::outputDir("SceneGltf_Tangent");
+  MiniGltf g = oneTriangle();
+  g.tangents = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1};
+  g.nodes = R"([{"mesh": 0, "rotation": [0, 0, 0.7071068, 0.7071068]}])";  // 90 deg about z
+  Scene s = loadScene(writeGltf(dir, "tangent.gltf", g));
+  ASSERT_EQ(s.tangents.size(), 12u);
+  EXPECT_NEAR(s.tangents[0], 0.0f, 1e-5f);
+  EXPECT_NEAR(s.tangents[1], 1.0f, 1e-5f);  // +x turned to +y
+  EXPECT_EQ(s.tangents[3], 1.0f);
+  g.nodes = R"([{"mesh": 0, "scale": [-1, 1, 1]}])";
+  Scene m = loadScene(writeGltf(dir, "mirror.gltf", g));
+  ASSERT_EQ(m.tangents.size(), 12u);
+  EXPECT_EQ(m.tangents[3], -1.0f) << "a mirroring node flips the bitangent sign";
+}
+
+}  // namespace
+}  // namespace lo
+
