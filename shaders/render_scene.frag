@@ -599,12 +599,15 @@ void main() {
   }
 
   vec3 radiance = vec3(0.0);
+#ifndef LO_ATLAS_LIGHTING
   if (uMode == LO_MODE_VOXELS) {
     uvec4 leaf;
     ivec3 voxel;
     vec3 q = loOctreePosition(vPosition, n, uOctreeOrigin, uVoxelSize, uNormalOffset);
     radiance = loNearestLeaf(q, n, uDepth, uNormalOffset, leaf, voxel) ? hashColor(voxel) : vec3(0.0);
-  } else {
+  } else
+#endif
+  {
 #ifdef LO_DIRECT_LIGHT
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_DIRECT) {
       radiance += emission * uEmissionScale + direct(vPosition, n, v, baseColor, metallic, roughness);
@@ -619,7 +622,13 @@ void main() {
       float probe = probeWeight(roughness);
       gVdlSpecular = 1.0 - probe;
       vec3 indirect;
+      // The atlas programs (LO_ATLAS_LIGHTING) leave the octree walk out: on
+      // a software rasterizer the code's mere presence costs (renderer.cpp).
+#ifdef LO_ATLAS_LIGHTING
+      if (true) {
+#else
       if (uAtlas) {
+#endif
         // Render to atlas (paper §4.2.3): one VDL rebuilt from the texel's
         // irradiance E (baked for the interpolated vertex normal) and mean
         // direction d: E / (n_bake . d) along d, through the same BRDF.
@@ -634,8 +643,10 @@ void main() {
           indirect = loVdlResponse(s, d) * E / max(dot(nb, d), 0.05);
         }
       } else {
+#ifndef LO_ATLAS_LIGHTING
         indirect = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
                                     uInterpolation, uMaxVdls, s);
+#endif
       }
       if (probe > 0.0) {
         indirect += probe * probeSpecular(vPosition, n, v, baseColor, metallic, roughness);

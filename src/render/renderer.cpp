@@ -215,6 +215,9 @@ struct Renderer::Impl {
   /// direct) and without it (indirect, voxels), so the octree-only modes do
   /// not pay for the lights' code on a software rasterizer.
   GLuint sceneProgram = 0, sceneIndirectProgram = 0;
+  /// The same two with the atlas lookup compiled in place of the octree's
+  /// (LO_ATLAS_LIGHTING), built on the first atlas frame.
+  GLuint sceneAtlasProgram = 0, sceneIndirectAtlasProgram = 0;
   GLuint shadowProgram = 0, depthProgram = 0, probeProgram = 0;
   GLuint vao = 0, vbo = 0, emptyVao = 0;
   std::vector<DrawRange> ranges;        ///< the vertex buffer by material, in DrawCategory order
@@ -272,7 +275,8 @@ struct Renderer::Impl {
   }
 
   ~Impl() {
-    GLuint programs[] = {sceneProgram, sceneIndirectProgram, shadowProgram, depthProgram,
+    GLuint programs[] = {sceneProgram, sceneIndirectProgram, sceneAtlasProgram,
+                         sceneIndirectAtlasProgram, shadowProgram, depthProgram,
                          probeProgram};
     for (GLuint p : programs) {
       if (p) glDeleteProgram(p);
@@ -1111,8 +1115,19 @@ struct Renderer::Impl {
       glDepthFunc(GL_LEQUAL);
       glDepthMask(GL_FALSE);
     }
-    GLuint p = rp.mode == RenderMode::Full || rp.mode == RenderMode::Direct ? sceneProgram
-                                                                            : sceneIndirectProgram;
+    const bool withDirect = rp.mode == RenderMode::Full || rp.mode == RenderMode::Direct;
+    const bool atlasProgram = rp.lighting == Lighting::Atlas && !capturingProbe &&
+                              rp.mode != RenderMode::Voxels && atlasVbo;
+    if (atlasProgram && !sceneAtlasProgram) {
+      sceneAtlasProgram = buildProgram({"render_scene.vert", "render_scene.frag"},
+                                       {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"});
+      glUniformBlockBinding(sceneAtlasProgram,
+                            glGetUniformBlockIndex(sceneAtlasProgram, "LightBlock"), 0);
+      sceneIndirectAtlasProgram =
+          buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_ATLAS_LIGHTING"});
+    }
+    GLuint p = atlasProgram ? (withDirect ? sceneAtlasProgram : sceneIndirectAtlasProgram)
+                            : (withDirect ? sceneProgram : sceneIndirectProgram);
     glUseProgram(p);
     auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
     glUniformMatrix4fv(loc("uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
@@ -1440,6 +1455,9 @@ void compileAllShaders() {
     glDeleteProgram(buildProgram(files));
   }
   glDeleteProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT"}));
+  glDeleteProgram(buildProgram({"render_scene.vert", "render_scene.frag"},
+                               {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"}));
+  glDeleteProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_ATLAS_LIGHTING"}));
 }
 
 std::vector<std::array<float, 4>> runLayoutProbe(LayoutProbe function,
