@@ -1,8 +1,25 @@
 #include "test_util.h"
 
 #include <filesystem>
+#include <memory>
+
+#include "render/context.h"
 
 namespace lo::test {
+
+GlContext* osmesaContext() {
+  static std::unique_ptr<GlContext> context;
+  static bool tried = false;
+  if (!tried) {
+    tried = true;
+    try {
+      context = createGlContext({GlBackend::OSMesa});
+    } catch (const std::exception&) {
+    }
+  }
+  if (context) context->makeCurrent();
+  return context.get();
+}
 
 std::string sharedScenesDir() { return std::string(LO_SHARED_DIR) + "/scenes"; }
 std::string dataDir() { return LO_DATA_DIR; }

@@ -7,7 +7,15 @@
 #include "octree/gpu_octree.h"
 #include "scene/scene.h"
 
+namespace lo {
+class GlContext;
+}
+
 namespace lo::test {
+
+/// One OSMesa context for the whole test binary, made current; null when the
+/// machine has none (tests then skip).
+GlContext* osmesaContext();
 
 /// Folder with the shared test scenes (../shared/scenes beside the repository).
 std::string sharedScenesDir();

@@ -23,19 +23,7 @@
 namespace lo {
 namespace {
 
-GlContext* context() {
-  static std::unique_ptr<GlContext> c;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    try {
-      c = createGlContext({GlBackend::OSMesa});
-    } catch (const std::exception&) {
-    }
-  }
-  if (c) c->makeCurrent();
-  return c.get();
-}
+GlContext* context() { return test::osmesaContext(); }
 
 TEST(AtlasRender, CornellBoxAtlasEqualsOctree) {
   if (!context()) GTEST_SKIP() << "no OSMesa context available";

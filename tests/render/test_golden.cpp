@@ -47,19 +47,7 @@ bool updating() {
   return v && std::string(v) == "1";
 }
 
-GlContext* context() {
-  static std::unique_ptr<GlContext> c;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    try {
-      c = createGlContext({GlBackend::OSMesa});
-    } catch (const std::exception&) {
-    }
-  }
-  if (c) c->makeCurrent();
-  return c.get();
-}
+GlContext* context() { return test::osmesaContext(); }
 
 struct GoldenScene {
   Scene scene;

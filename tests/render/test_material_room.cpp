@@ -48,19 +48,7 @@ constexpr double kFloorTolerance = 0.12;
 /// Measured 0.966.
 constexpr double kCheckerCorrelation = 0.9;
 
-GlContext* context() {
-  static std::unique_ptr<GlContext> c;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    try {
-      c = createGlContext({GlBackend::OSMesa});
-    } catch (const std::exception&) {
-    }
-  }
-  if (c) c->makeCurrent();
-  return c.get();
-}
+GlContext* context() { return test::osmesaContext(); }
 
 float luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 

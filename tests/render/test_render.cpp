@@ -21,22 +21,8 @@
 namespace lo {
 namespace {
 
-/// One OSMesa context for the whole binary; tests skip if there is none.
-GlContext* osmesa() {
-  static std::unique_ptr<GlContext> context;
-  static bool tried = false;
-  static std::string why;
-  if (!tried) {
-    tried = true;
-    try {
-      context = createGlContext({GlBackend::OSMesa});
-    } catch (const std::exception& e) {
-      why = e.what();
-    }
-  }
-  if (context) context->makeCurrent();
-  return context.get();
-}
+/// The binary's OSMesa context (test_util); tests skip if there is none.
+GlContext* osmesa() { return test::osmesaContext(); }
 
 #define REQUIRE_OSMESA()                                          \
   do {                                                            \
