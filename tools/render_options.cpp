@@ -15,6 +15,7 @@ RenderParams ShadingOptions::renderParams(RenderMode mode) const {
   p.specular = specular == "on";
   p.reflections = reflections == "on";
   p.lighting = parseLighting(lighting);
+  p.supersample = supersample;
   p.maxVdls = vdls;
   return p;
 }
@@ -82,6 +83,13 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
                   "one, else automatic charts), auto (charts always), texcoord1 (required)")
       ->check(CLI::IsMember({"default", "auto", "texcoord1"}))
       ->capture_default_str();
+  if (!window) {
+    cmd->add_option("--supersample", opt.supersample,
+                    "Anti-aliasing: each pixel the mean of N x N samples (the image drawn N times "
+                    "larger, then box-filtered), as the path tracer integrates a pixel")
+        ->check(CLI::Range(1, 16))
+        ->capture_default_str();
+  }
   cmd->add_option("--exposure", opt.exposure,
                   std::string(window ? "Exposure" : "PNG exposure") +
                       " in EV (radiance * 2^EV)" + key("keys , . 0"))

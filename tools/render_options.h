@@ -26,6 +26,7 @@ struct ShadingOptions {
   std::string reflections = "on";
   std::string lighting = "octree";  ///< octree | atlas
   std::string uv = "default";       ///< lightmap UVs for --lighting atlas: default | auto | texcoord1
+  int supersample = 1;              ///< render: samples per pixel side (anti-aliasing)
   float exposure = 0;  ///< EV
   int vdls = kMaxVdls;
   std::string areaLights = "on";

@@ -1407,22 +1407,33 @@ void Renderer::setOctree(const GpuOctree& octree) {
 
 RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& params) {
   Impl& r = *impl_;
-  r.ensureTarget(params.width, params.height);
+  const int s = params.supersample;
+  if (s < 1 || s > 16) {
+    throw InputError("render: supersampling must be 1..16, got " + std::to_string(s));
+  }
+  const int w = params.width * s, h = params.height * s;
+  r.ensureTarget(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo);
-  r.draw(camera, params, params.width, params.height, 1.0f, false);
-  RgbImage image(params.width, params.height);
-  std::vector<float> raw(size_t(params.width) * params.height * 4);
+  r.draw(camera, params, w, h, 1.0f, false);
+  std::vector<float> raw(size_t(w) * size_t(h) * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glReadPixels(0, 0, params.width, params.height, GL_RGBA, GL_FLOAT, raw.data());
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, raw.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   checkGl("reading back the image");
-  // GL rows go bottom-up; image rows top-down. Alpha is dropped.
+  // GL rows go bottom-up; image rows top-down. Alpha is dropped; each output
+  // pixel is the mean of its s x s block.
+  RgbImage image(params.width, params.height);
+  const float norm = 1.0f / float(s * s);
   for (int y = 0; y < params.height; ++y) {
-    const float* src = raw.data() + size_t(params.height - 1 - y) * size_t(params.width) * 4;
     float* dst = image.rgb.data() + size_t(y) * size_t(params.width) * 3;
-    for (int x = 0; x < params.width; ++x) {
-      for (int c = 0; c < 3; ++c) dst[3 * x + c] = src[4 * x + c];
+    for (int sy = 0; sy < s; ++sy) {
+      const float* src = raw.data() + size_t(h - 1 - (y * s + sy)) * size_t(w) * 4;
+      for (int x = 0; x < params.width; ++x) {
+        for (int sx = 0; sx < s; ++sx) {
+          for (int c = 0; c < 3; ++c) dst[3 * x + c] += src[4 * (x * s + sx) + c] * norm;
+        }
+      }
     }
   }
   return image;

@@ -57,6 +57,10 @@ struct RenderParams {
   bool reflections = true;
   /// Indirect light from the octree or from the atlas (setAtlas first).
   Lighting lighting = Lighting::Octree;
+  /// Renderer::render only: each pixel the mean of supersample x supersample
+  /// samples on a regular grid (the image drawn that much larger, then
+  /// box-filtered): anti-aliased edges, as a path tracer integrates a pixel.
+  int supersample = 1;
 };
 
 /// Set once: resources built for the scene.

@@ -14,6 +14,7 @@
 #include "test_util.h"
 #include "core/error.h"
 #include "render/context.h"
+#include "image/compare.h"
 #include "image/image.h"
 #include "render/layout_probe.h"
 #include "render/renderer.h"
@@ -803,6 +804,50 @@ GpuOctree constantOctree() {
 int columnAt(const QuadSetup& s, const RenderParams& p, float x, float z) {
   const float worldPerPixel = 2.0f * (2.0f - z) * std::tan(0.5f * s.camera.yfov) / float(p.height);
   return p.width / 2 + int(std::floor((x - 0.1f) / worldPerPixel));
+}
+
+// Supersampling: an image drawn with supersample s is the s x s box filter of
+// the same image drawn s times larger (a brute-force cross-check), and it
+// anti-aliases: a quad's edge crossing a pixel gives it a fractional value.
+TEST(RenderImage, SupersamplingIsTheBoxFilterOfTheLargerImage) {
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Light light;
+  light.type = Light::Type::Point;
+  light.position = {0.1f, -0.05f, 1.0f};
+  light.intensity = 2.0f;
+  s.scene.lights.push_back(light);
+  Renderer renderer(s.scene, constantOctree());
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  p.width = 40;
+  p.height = 30;
+  // Wide enough to see the quad's right edge (x = 1).
+  const PinholeCamera camera =
+      PinholeCamera::lookAt({0.9f, -0.05f, 1.5f}, {0.9f, -0.05f, 0.0f}, 40.0f * kPi / 180.0f);
+  p.supersample = 3;
+  const RgbImage small = renderer.render(camera, p);
+  RenderParams big = p;
+  big.supersample = 1;
+  big.width = 120;
+  big.height = 90;
+  const RgbImage filtered = binImage(renderer.render(camera, big), 3);
+  ASSERT_EQ(small.rgb.size(), filtered.rgb.size());
+  for (size_t i = 0; i < small.rgb.size(); ++i) ASSERT_NEAR(small.rgb[i], filtered.rgb[i], 1e-5f) << i;
+  int fractional = 0;
+  const float lit = small.pixel(5, 15)[0];
+  for (int x = 0; x < p.width; ++x) {
+    const float v = small.pixel(x, 15)[0];
+    if (v > 0.05f * lit && v < 0.95f * lit) ++fractional;
+  }
+  EXPECT_GE(fractional, 1) << "the edge pixel is partly covered";
+  EXPECT_THROW(
+      {
+        RenderParams bad = p;
+        bad.supersample = 0;
+        renderer.render(camera, bad);
+      },
+      InputError);
 }
 
 // glTF MASK: the cut-out half of a card neither hides the quad behind it nor
