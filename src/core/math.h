@@ -81,6 +81,36 @@ inline void orthonormalBasis(const Vec3& n, Vec3& t, Vec3& b) {
   b = {c, sign + n.y * n.y * a, -n.y};
 }
 
+/// A double-precision 3-vector, for geometry that must not depend on the
+/// order of float operations (voxelization's overlap tests, chart flattening).
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+  Vec3d() = default;
+  Vec3d(double x_, double y_, double z_) : x(x_), y(y_), z(z_) {}
+  explicit Vec3d(const Vec3& v) : x(v.x), y(v.y), z(v.z) {}
+  double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+  double& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+  Vec3d operator+(const Vec3d& b) const { return {x + b.x, y + b.y, z + b.z}; }
+  Vec3d operator-(const Vec3d& b) const { return {x - b.x, y - b.y, z - b.z}; }
+  Vec3d operator*(double s) const { return {x * s, y * s, z * s}; }
+  Vec3d& operator+=(const Vec3d& b) {
+    x += b.x;
+    y += b.y;
+    z += b.z;
+    return *this;
+  }
+  Vec3 toVec3() const { return {float(x), float(y), float(z)}; }
+};
+inline double dot(const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3d cross(const Vec3d& a, const Vec3d& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double length(const Vec3d& v) { return std::sqrt(dot(v, v)); }
+inline Vec3d normalize(const Vec3d& v) {
+  const double l = length(v);
+  return l > 0 ? v * (1.0 / l) : Vec3d{};
+}
+
 /// Integer voxel coordinate (index space of a grid).
 struct Coord {
   int32_t x = 0, y = 0, z = 0;

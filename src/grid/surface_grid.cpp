@@ -29,30 +29,7 @@ namespace lo {
 
 namespace surface_grid_internal {
 
-struct D3 {
-  double x = 0, y = 0, z = 0;
-  D3() = default;
-  D3(double x_, double y_, double z_) : x(x_), y(y_), z(z_) {}
-  explicit D3(const Vec3& v) : x(v.x), y(v.y), z(v.z) {}
-  double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
-  double& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
-  D3 operator+(const D3& b) const { return {x + b.x, y + b.y, z + b.z}; }
-  D3 operator-(const D3& b) const { return {x - b.x, y - b.y, z - b.z}; }
-  D3 operator*(double s) const { return {x * s, y * s, z * s}; }
-  D3& operator+=(const D3& b) {
-    x += b.x;
-    y += b.y;
-    z += b.z;
-    return *this;
-  }
-  Vec3 toVec3() const { return {float(x), float(y), float(z)}; }
-};
-
-inline double dot(const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline D3 cross(const D3& a, const D3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-inline double length(const D3& a) { return std::sqrt(dot(a, a)); }
+using D3 = Vec3d;  // core/math.h
 
 /// Separating axis test (Akenine-Möller 2001) of the triangle v[0..2], given
 /// relative to the box centre, against the closed box [-h, h]. An axis

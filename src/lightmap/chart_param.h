@@ -16,31 +16,8 @@
 
 namespace lo::lightmap_internal {
 
-/// A double-precision 3-vector for the flattening's arithmetic.
-struct D3 {
-  double x = 0, y = 0, z = 0;
-  D3() = default;
-  D3(double x_, double y_, double z_) : x(x_), y(y_), z(z_) {}
-  explicit D3(const Vec3& v) : x(v.x), y(v.y), z(v.z) {}
-  D3 operator+(const D3& b) const { return {x + b.x, y + b.y, z + b.z}; }
-  D3 operator-(const D3& b) const { return {x - b.x, y - b.y, z - b.z}; }
-  D3 operator*(double s) const { return {x * s, y * s, z * s}; }
-  D3& operator+=(const D3& b) {
-    x += b.x;
-    y += b.y;
-    z += b.z;
-    return *this;
-  }
-};
-inline double dot(const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline D3 cross(const D3& a, const D3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-inline double length(const D3& v) { return std::sqrt(dot(v, v)); }
-inline D3 normalize(const D3& v) {
-  const double l = length(v);
-  return l > 0 ? v * (1.0 / l) : D3{};
-}
+/// The flattening's arithmetic is in double (core/math.h).
+using D3 = Vec3d;
 
 /// Per-triangle geometry: unit normal (from the winding), area, and whether
 /// the triangle is degenerate. Degenerate = zero area, or a height (twice the
