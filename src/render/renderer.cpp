@@ -962,7 +962,6 @@ struct Renderer::Impl {
   /// dark). Thin-walled transmissive ranges cast no shadow: light passes
   /// them straight, as direct light (the photon tracer agrees).
   void drawDepthOnly(GLuint program, bool shadows) {
-    const bool blended = shadows;
     const GLint alphaTest = glGetUniformLocation(program, "uAlphaTest");
     glUniform1i(alphaTest, 0);
     glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
@@ -972,7 +971,7 @@ struct Renderer::Impl {
     const GLint cutoff = glGetUniformLocation(program, "uAlphaCutoff");
     for (size_t i = 0; i < ranges.size(); ++i) {
       const DrawRange& range = ranges[i];
-      if (rangeCategory[i] != kMasked && !(blended && rangeCategory[i] == kBlended)) continue;
+      if (rangeCategory[i] != kMasked && !(shadows && rangeCategory[i] == kBlended)) continue;
       glUniform1i(alphaTest, 1);
       glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
       glUniform1f(baseAlpha, range.baseAlpha);

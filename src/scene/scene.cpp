@@ -157,6 +157,13 @@ Vec3 Scene::shadingNormal(size_t t, float b1, float b2, const Vec3& geometric) c
   if (m.normalTexture < 0) return n;
   float u, v, u0, v0, u1, v1, u2, v2;
   if (!texcoord(t, b1, b2, m.normalTexCoord, m.normalTransform, u, v)) return n;
+  // The map's tangent-space normal, x and y scaled by normalTexture.scale.
+  auto mappedNormal = [&] {
+    Vec3 mapped = textures[size_t(m.normalTexture)].lookup(u, v) * 2.0f - Vec3{1, 1, 1};
+    mapped.x *= m.normalScale;
+    mapped.y *= m.normalScale;
+    return mapped;
+  };
   // The file's tangents (glTF TANGENT) where all three corners have one.
   if (tangents.size() == 4 * positions.size()) {
     const uint32_t i0 = indices[3 * t], i1 = indices[3 * t + 1], i2 = indices[3 * t + 2];
@@ -179,9 +186,7 @@ Vec3 Scene::shadingNormal(size_t t, float b1, float b2, const Vec3& geometric) c
       if (lengthSquared(tangent) > 1e-20f) {
         tangent = normalize(tangent);
         const Vec3 bitangent = cross(n0, tangent) * w0;
-        Vec3 mapped = textures[size_t(m.normalTexture)].lookup(u, v) * 2.0f - Vec3{1, 1, 1};
-        mapped.x *= m.normalScale;
-        mapped.y *= m.normalScale;
+        const Vec3 mapped = mappedNormal();
         const Vec3 out = (tangent * mapped.x + bitangent * mapped.y) * side + n * mapped.z;
         return lengthSquared(out) > 0 ? normalize(out) : n;
       }
@@ -201,9 +206,7 @@ Vec3 Scene::shadingNormal(size_t t, float b1, float b2, const Vec3& geometric) c
   if (!(lengthSquared(tangent) > 1e-20f)) return n;
   tangent = normalize(tangent);
   const Vec3 bitangent = cross(n, tangent);
-  Vec3 mapped = textures[size_t(m.normalTexture)].lookup(u, v) * 2.0f - Vec3{1, 1, 1};
-  mapped.x *= m.normalScale;
-  mapped.y *= m.normalScale;
+  const Vec3 mapped = mappedNormal();
   const Vec3 out = tangent * mapped.x + bitangent * mapped.y + n * mapped.z;
   return lengthSquared(out) > 0 ? normalize(out) : n;
 }
