@@ -14,6 +14,8 @@
  *   loOctreeIndirect the indirect light at a surface point: trilinear over the 8
  *                    voxels around it with empty ones left out and the weights
  *                    renormalized (§4.2.1), else loNearestLeaf
+ *   loOctreeIrradiance the same lookup's irradiance and the direction it comes
+ *                    from, for lightmaps (§4.2.3)
  *
  * The includer defines, before including:
  *   LO_FETCH_POOL(p)      RGBA8UI texel of the pool at ivec3 p, as uvec4
@@ -143,6 +145,13 @@ LO_LOOKUP_FN vec3 loOctreePosition(vec3 p, vec3 n, vec3 origin, float voxelSize,
   return (p - origin) / voxelSize + normalOffset * n;
 }
 
+/* Weight of corner o (0 or 1 per axis) of the cell in a trilinear
+ * interpolation at fraction f. */
+LO_LOOKUP_FN float loTrilinearWeight(vec3 f, ivec3 o) {
+  return (o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y) *
+         (o.z == 1 ? f.z : 1.0f - f.z);
+}
+
 /* Indirect light at world position p of surface s (paper §3.2, §4.2). */
 LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize, int depth,
                                    float normalOffset, bool interpolation, int maxVdls,
@@ -159,8 +168,7 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
     float weightSum = 0.0f;
     for (int k = 0; k < 8; ++k) {
       ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
-      float w = (o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y) *
-                (o.z == 1 ? f.z : 1.0f - f.z);
+      float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
       uvec4 leaf;
       if (loLookupLeaf(LO_TEX base + o, depth, leaf)) {
@@ -174,6 +182,70 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
   ivec3 voxel;
   if (loNearestLeaf(LO_TEX q, s.n, depth, normalOffset, leaf, voxel)) {
     return loShadeLeaf(LO_TEX leaf, maxVdls, s);
+  }
+  return vec3(0.0f);
+}
+
+/* Irradiance and where it comes from, for lightmaps (paper §4.2.3: one VDL
+ * per texel rebuilt for the specular term): loShadeLeaf with the cosine as
+ * the response, E = sum_i max(0, n . d_i) c_i, and beside it the
+ * luminance-weighted direction sum sum_i Y(c_i) max(0, n . d_i) d_i (Rec. 709
+ * luminance, world space, towards the light). */
+LO_LOOKUP_FN vec3 loShadeLeafIrradiance(LO_TEX_PARAM uvec4 leaf, int maxVdls, vec3 n,
+                                        LO_OUT(vec3) direction) {
+  uint first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
+  int count = min(int(leaf.a), maxVdls);
+  vec3 irradiance = vec3(0.0f);
+  direction = vec3(0.0f);
+  for (int i = 0; i < count; ++i) {
+    vec4 t = loFetchVdl(LO_TEX first + uint(i));
+    vec3 d = loVdlDirection(t.a);
+    float cosine = max(0.0f, dot(n, d));
+    irradiance += vec3(cosine) * vec3(t);
+    direction += (cosine * dot(vec3(t), vec3(0.2126f, 0.7152f, 0.0722f))) * d;
+  }
+  return irradiance;
+}
+
+/* loOctreeIndirect of a Lambertian surface of unit albedo times pi, i.e. the
+ * irradiance E(p, n), with the direction sum of loShadeLeafIrradiance taken
+ * with the same weights. The lightmap bakes (lightmap/lightmap_atlas.cpp on
+ * the CPU, shaders/atlas_bake.frag on the GPU) call this one function. */
+LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, float voxelSize,
+                                     int depth, float normalOffset, bool interpolation,
+                                     int maxVdls, LO_OUT(vec3) direction) {
+  vec3 q = loOctreePosition(p, n, origin, voxelSize, normalOffset);
+  vec3 e;
+  vec3 d;
+  direction = vec3(0.0f);
+  if (interpolation) {
+    vec3 u = q - vec3(0.5f);
+    ivec3 base = ivec3(floor(u));
+    vec3 f = u - floor(u);
+    vec3 sum = vec3(0.0f);
+    vec3 directionSum = vec3(0.0f);
+    float weightSum = 0.0f;
+    for (int k = 0; k < 8; ++k) {
+      ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+      float w = loTrilinearWeight(f, o);
+      if (w <= 0.0f) continue;
+      uvec4 leaf;
+      if (loLookupLeaf(LO_TEX base + o, depth, leaf)) {
+        e = loShadeLeafIrradiance(LO_TEX leaf, maxVdls, n, d);
+        sum += w * e;
+        directionSum += w * d;
+        weightSum += w;
+      }
+    }
+    if (weightSum > 0.0f) {
+      direction = directionSum / weightSum;
+      return sum / weightSum;
+    }
+  }
+  uvec4 leaf;
+  ivec3 voxel;
+  if (loNearestLeaf(LO_TEX q, n, depth, normalOffset, leaf, voxel)) {
+    return loShadeLeafIrradiance(LO_TEX leaf, maxVdls, n, direction);
   }
   return vec3(0.0f);
 }

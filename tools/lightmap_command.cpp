@@ -1,5 +1,5 @@
 // `lightoctree lightmap`: scene + baked .vdb -> light octree -> lightmap UVs
-// and atlas (CPU, src/lightmap) -> page images and a glTF 2.0 file that other
+// and atlas (src/lightmap on the CPU, or render/atlas_gpu.h in GL) -> page images and a glTF 2.0 file that other
 // tools open (src/scene gltf_export.h), optionally with an unlit preview.
 
 #include <CLI/CLI.hpp>
@@ -15,6 +15,8 @@
 #include "lightmap/lightmap_bake.h"
 #include "octree/gpu_octree.h"
 #include "reference/path_tracer.h"
+#include "render/atlas_gpu.h"
+#include "render/context.h"
 #include "report.h"
 #include "scene/gltf_export.h"
 #include "scene/scene.h"
@@ -50,6 +52,8 @@ struct LightmapOptions {
   std::string image = "exr";
   bool previewUnlit = false;
   float exposure = 0;
+  std::string atlasOn = "cpu";  // cpu | osmesa | egl
+  bool chartImage = false;
   bool quiet = false;
 };
 
@@ -167,6 +171,20 @@ int runLightmap(const LightmapOptions& opt) {
       return direct->atMany(points, samples, /*seed=*/1, uint64_t(page) << 32);
     };
   }
+  // --atlas-on osmesa|egl: the octree rendered into the atlas by GL
+  // (render/atlas_gpu.h) in a headless context of that kind.
+  std::unique_ptr<GlContext> context;
+  std::unique_ptr<GpuAtlasEvaluator> gpu;
+  if (opt.atlasOn != "cpu") {
+    GlContextParams contextParams;
+    contextParams.backend = parseGlBackend(opt.atlasOn);
+    context = createGlContext(contextParams);
+    if (!opt.quiet) {
+      std::printf("%s: %s\n", opt.atlasOn.c_str(), context->info().ToString().c_str());
+    }
+    gpu = std::make_unique<GpuAtlasEvaluator>();
+    run.bake.atlas.evaluator = gpu.get();
+  }
   const LightmapBake lm = bakeLightmap(scene, octree, run.bake);
   const LightmapUvs& uvs = lm.uvs;
   const LightmapAtlas& atlas = lm.atlas;
@@ -242,8 +260,22 @@ int runLightmap(const LightmapOptions& opt) {
   };
   writeGltf(run.output, lit);
   if (run.preview) writeGltf(run.previewPath, unlit);
+  std::vector<std::string> chartPaths;
+  if (opt.chartImage) {
+    const fs::path out(run.output);
+    for (int p = 0; p < uvs.pageCount; ++p) {
+      chartPaths.push_back(
+          (out.parent_path() / (out.stem().string() + "-charts" + std::to_string(p) + ".png"))
+              .string());
+      const std::vector<uint8_t> png = encodePng(chartLayoutImage(uvs, p));
+      writeTextAtomically(chartPaths.back(), std::string(png.begin(), png.end()));
+      written.add(chartPaths.back());
+    }
+  }
   written.keep();
-  writeTimer.finish(formatCount(size_t(atlas.pageCount) + 1 + (run.preview ? 1 : 0)) + " files");
+  writeTimer.finish(formatCount(size_t(atlas.pageCount) + 1 + (run.preview ? 1 : 0) +
+                                chartPaths.size()) +
+                    " files");
 
   if (opt.quiet) return 0;
   printSummary(stdout, rows);
@@ -272,6 +304,7 @@ int runLightmap(const LightmapOptions& opt) {
     std::printf("wrote %s (%s, unlit preview)\n", run.previewPath.c_str(),
                 formatBytes(unlit.gltf.size()).c_str());
   }
+  for (const std::string& path : chartPaths) std::printf("wrote %s (chart layout)\n", path.c_str());
   return 0;
 }
 
@@ -281,7 +314,7 @@ std::function<int()> addLightmapCommand(CLI::App& app) {
   auto opt = std::make_shared<LightmapOptions>();
   CLI::App* cmd = app.add_subcommand(
       "lightmap",
-      "Bake the light octree into lightmap atlases (CPU) and export the scene as glTF 2.0 with "
+      "Bake the light octree into lightmap atlases and export the scene as glTF 2.0 with "
       "lightmap UVs (TEXCOORD_1) and the atlas pages beside it, referenced from each material's "
       "extras.lightmap (docs/lightmap.md).");
   cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
@@ -330,6 +363,15 @@ std::function<int()> addLightmapCommand(CLI::App& app) {
                   "Exposure of the unlit preview in EV (radiance * 2^EV before the sRGB curve)")
       ->check(CLI::Range(-30.0f, 30.0f))
       ->capture_default_str();
+  cmd->add_option("--atlas-on", opt->atlasOn,
+                  "Where the octree is rendered into the atlas: cpu (the C++ lookup; the same "
+                  "bytes on every machine), osmesa (OpenGL in software) or egl (a GPU, "
+                  "headless): the scene shader's lookup run per texel (paper 4.2.3)")
+      ->check(CLI::IsMember({"cpu", "osmesa", "egl"}))
+      ->capture_default_str();
+  cmd->add_flag("--chart-image", opt->chartImage,
+                "Also write OUT-chartsN.png: each page's UV layout, one colour per chart, chart "
+                "borders darker (v = 0 is the top row)");
   cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runLightmap(*opt) : -1; };
 }

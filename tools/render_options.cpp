@@ -3,8 +3,10 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <memory>
 
 #include "lightmap/lightmap_bake.h"
+#include "render/atlas_gpu.h"
 
 namespace lo::tool {
 
@@ -48,6 +50,12 @@ void ShadingOptions::prepareLighting(Renderer& renderer, const Scene& scene,
   params.atlas.shade.interpolation = frame.interpolation;
   params.atlas.shade.maxVdls = frame.maxVdls;
   params.atlas.shade.normalOffset = frame.normalOffset;
+  params.atlas.stitchSeams = stitchSeams == "on";
+  std::unique_ptr<GpuAtlasEvaluator> gpu;
+  if (atlasOn == "gpu") {
+    gpu = std::make_unique<GpuAtlasEvaluator>();
+    params.atlas.evaluator = gpu.get();
+  }
   const LightmapBake baked = bakeLightmap(scene, octree, params);
   renderer.setAtlas(baked.uvs, baked.atlas);
   if (!quiet) {
@@ -82,6 +90,16 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
                   "Lightmap UVs for --lighting atlas: default (the scene's TEXCOORD_1 if it has "
                   "one, else automatic charts), auto (charts always), texcoord1 (required)")
       ->check(CLI::IsMember({"default", "auto", "texcoord1"}))
+      ->capture_default_str();
+  cmd->add_option("--atlas-on", opt.atlasOn,
+                  "Where --lighting atlas renders the octree into the atlas: cpu (the C++ "
+                  "lookup) or gpu (the scene shader's lookup in this GL context, paper 4.2.3)")
+      ->check(CLI::IsMember({"cpu", "gpu"}))
+      ->capture_default_str();
+  cmd->add_option("--stitch-seams", opt.stitchSeams,
+                  "With --lighting atlas: make the lookups on the two sides of every chart seam "
+                  "agree (off: see the seams as the charts were baked)")
+      ->check(onOff())
       ->capture_default_str();
   if (!window) {
     cmd->add_option("--supersample", opt.supersample,

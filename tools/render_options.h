@@ -26,6 +26,8 @@ struct ShadingOptions {
   std::string reflections = "on";
   std::string lighting = "octree";  ///< octree | atlas
   std::string uv = "default";       ///< lightmap UVs for --lighting atlas: default | auto | texcoord1
+  std::string atlasOn = "cpu";      ///< where --lighting atlas bakes: cpu | gpu (the renderer's context)
+  std::string stitchSeams = "on";   ///< --lighting atlas: join the charts' seams (docs/lightmap.md)
   int supersample = 1;              ///< render: samples per pixel side (anti-aliasing)
   float exposure = 0;  ///< EV
   int vdls = kMaxVdls;
@@ -41,7 +43,8 @@ struct ShadingOptions {
   /// The octree's texel format, within the limits of `info` when given.
   GpuOctreeParams octreeParams(const GlInfo* info = nullptr) const;
   /// With --lighting atlas: bakes lightmap UVs and the octree into their
-  /// atlas (src/lightmap, the renderer's lookup settings) and hands them to
+  /// atlas (src/lightmap, the renderer's lookup settings; with --atlas-on
+  /// gpu in the renderer's GL context, render/atlas_gpu.h) and hands them to
   /// `renderer`; prints what was baked unless `quiet`. No-op for octree.
   void prepareLighting(Renderer& renderer, const Scene& scene, const GpuOctree& octree,
                        bool quiet) const;

@@ -503,10 +503,12 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
   // Per page, with params.radiance: the albedo and emission at each texel's
   // surface point (dilated like E), combined with the stitched E at the end.
   std::vector<RgbImage> albedo, emission;
+  AtlasPageEvaluator* const evaluator = params.evaluator;
+  if (evaluator) evaluator->begin(scene, uvs, octree, params.shade);
+  std::vector<int32_t> pageTriangles;
   for (int page = 0; page < uvs.pageCount; ++page) {
     auto start = Clock::now();
-    raster.triangle.assign(texels, -1);
-    raster.distance2.assign(texels, std::numeric_limits<float>::infinity());
+    pageTriangles.clear();
     for (size_t k = pageStart[size_t(page)]; k < pageStart[size_t(page) + 1]; ++k) {
       const size_t t = size_t(byPage[k]);
       const float* p = &uvs.uv[6 * t];
@@ -516,28 +518,52 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
         ++atlas.skippedTriangles;
         continue;
       }
-      rasterTriangle(uvs, t, raster);
+      pageTriangles.push_back(int32_t(t));
+    }
+    RgbImage e(uvs.width, uvs.height), d(uvs.width, uvs.height);
+    if (evaluator) {
+      AtlasPageTexels done = evaluator->evaluatePage(page, pageTriangles);
+      if (done.triangle.size() != texels || done.irradiance.width != uvs.width ||
+          done.irradiance.height != uvs.height || done.direction.width != uvs.width ||
+          done.direction.height != uvs.height) {
+        throw InternalError("atlas: the page evaluator returned a page of another size");
+      }
+      raster.triangle = std::move(done.triangle);
+      e = std::move(done.irradiance);
+      d = std::move(done.direction);
+      atlas.evaluateSeconds += secondsSince(start);
+    } else {
+      raster.triangle.assign(texels, -1);
+      raster.distance2.assign(texels, std::numeric_limits<float>::infinity());
+      for (int32_t t : pageTriangles) rasterTriangle(uvs, size_t(t), raster);
+      atlas.rasterSeconds += secondsSince(start);
     }
     std::vector<uint8_t> coverage(texels, kAtlasEmpty);
-    atlas.rasterSeconds += secondsSince(start);
 
     start = Clock::now();
-    RgbImage e(uvs.width, uvs.height), d(uvs.width, uvs.height);
     std::vector<AtlasSurfacePoint> directPoints;
     if (params.radiance) {
       albedo.push_back(RgbImage(uvs.width, uvs.height));
       emission.push_back(RgbImage(uvs.width, uvs.height));
     }
+    // The surface points themselves are needed only to evaluate the octree
+    // here, for the direct light and for the radiance.
+    const bool needSurface = !evaluator || direct || params.radiance;
     for (size_t i = 0; i < texels; ++i) {
       if (raster.triangle[i] < 0) continue;
       const size_t t = size_t(raster.triangle[i]);
-      Vec3 position, normal;
-      double b[3];
-      texelSurface(scene, uvs, t, i, position, normal, b);
-      const OctreeIrradianceSample s =
-          octreeIrradianceSample(octree, position, normal, params.shade);
-      e.set(i, s.irradiance);
-      d.set(i, unitOrZero(s.directionSum));
+      if (t >= nt) {
+        throw InternalError("atlas: the page evaluator named triangle " + std::to_string(t));
+      }
+      Vec3 position{0, 0, 0}, normal{0, 0, 1};
+      double b[3] = {1, 0, 0};
+      if (needSurface) texelSurface(scene, uvs, t, i, position, normal, b);
+      if (!evaluator) {
+        const OctreeIrradianceSample s =
+            octreeIrradianceSample(octree, position, normal, params.shade);
+        e.set(i, s.irradiance);
+        d.set(i, unitOrZero(s.directionSum));
+      }
       if (params.radiance) {
         albedo.back().set(i, scene.albedo(t, float(b[1]), float(b[2])));
         emission.back().set(i, scene.emission(t, float(b[1]), float(b[2])));

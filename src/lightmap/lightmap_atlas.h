@@ -39,6 +39,31 @@ struct AtlasSurfacePoint {
   Vec3 normal;            ///< unit, the interpolated vertex normal (the side baked)
 };
 
+/// One page rasterised and evaluated (steps 1 and 2 of bakeLightmapAtlas),
+/// each vector or image width x height texels of the page.
+struct AtlasPageTexels {
+  std::vector<int32_t> triangle;  ///< the scene triangle owning each texel, -1 = none
+  RgbImage irradiance;            ///< E at the owner's surface point (0 where none)
+  RgbImage direction;             ///< unit direction sum, or zero (LightmapAtlas::direction)
+};
+
+/// Steps 1 and 2 of bakeLightmapAtlas done by another implementation: the
+/// GPU's, lo_render's GpuAtlasEvaluator (render/atlas_gpu.h), which draws the
+/// triangles at their lightmap UVs and runs the same octree lookup in a
+/// fragment shader. It must follow the rules of those steps (which texels a
+/// triangle covers, which triangle owns a texel, the surface point and normal
+/// it is evaluated at); the rest of the bake (direct light, dilation, seams,
+/// radiance) stays bakeLightmapAtlas's.
+class AtlasPageEvaluator {
+ public:
+  virtual ~AtlasPageEvaluator() = default;
+  /// Called once per bake, before the pages: the inputs, already checked.
+  virtual void begin(const Scene& scene, const LightmapUvs& uvs, const GpuOctree& octree,
+                     const OctreeShadeParams& shade) = 0;
+  /// The triangles of `page` (those with a chart and UV area, in index order).
+  virtual AtlasPageTexels evaluatePage(int page, const std::vector<int32_t>& triangles) = 0;
+};
+
 struct AtlasBakeParams {
   /// The lookup's settings (interpolation, VDLs used, normal offset): pass
   /// the renderer's, so that the atlas holds what it would compute.
@@ -63,6 +88,10 @@ struct AtlasBakeParams {
   /// soft shadows; this stage itself links no ray tracer). The direction
   /// keeps the indirect light's. Called once per page, points in texel order.
   std::function<std::vector<Vec3>(const std::vector<AtlasSurfacePoint>&, int page)> directLight;
+  /// Set: steps 1 and 2 are done by it (not owned; it must outlive the
+  /// call), its time counted as LightmapAtlas::evaluateSeconds. Null: on
+  /// the CPU, with octreeIrradianceSample.
+  AtlasPageEvaluator* evaluator = nullptr;
 };
 
 /// The baked pages. Each vector holds pageCount entries, each page width x

@@ -461,4 +461,63 @@ LightmapUvs lightmapUvsFromTexcoord1(const Scene& scene, int atlasSize) {
   return out;
 }
 
+RgbImage chartLayoutImage(const LightmapUvs& uvs, int page) {
+  if (page < 0 || page >= uvs.pageCount) {
+    throw InputError("chartLayoutImage: page " + std::to_string(page) + " of " +
+                     std::to_string(uvs.pageCount));
+  }
+  const int w = uvs.width, h = uvs.height;
+  std::vector<int32_t> chartOf(size_t(w) * size_t(h), -1);
+  for (size_t t = 0; t < uvs.triangleChart.size(); ++t) {
+    if (uvs.triangleChart[t] < 0 || uvs.trianglePage[t] != page) continue;
+    double x[3], y[3];
+    for (int k = 0; k < 3; ++k) {
+      x[k] = double(uvs.uv[6 * t + size_t(2 * k)]) * w;
+      y[k] = double(uvs.uv[6 * t + size_t(2 * k) + 1]) * h;
+    }
+    const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    if (area == 0) continue;
+    const int x0 = std::max(0, int(std::floor(std::min({x[0], x[1], x[2]}))));
+    const int x1 = std::min(w - 1, int(std::ceil(std::max({x[0], x[1], x[2]}))));
+    const int y0 = std::max(0, int(std::floor(std::min({y[0], y[1], y[2]}))));
+    const int y1 = std::min(h - 1, int(std::ceil(std::max({y[0], y[1], y[2]}))));
+    for (int py = y0; py <= y1; ++py) {
+      for (int px = x0; px <= x1; ++px) {
+        const double cx = px + 0.5, cy = py + 0.5;
+        bool inside = true;
+        for (int k = 0; k < 3 && inside; ++k) {
+          const int j = (k + 1) % 3;
+          const double e = (x[j] - x[k]) * (cy - y[k]) - (y[j] - y[k]) * (cx - x[k]);
+          inside = area > 0 ? e >= 0 : e <= 0;
+        }
+        if (inside) chartOf[size_t(py) * size_t(w) + size_t(px)] = uvs.triangleChart[t];
+      }
+    }
+  }
+  RgbImage image(w, h);
+  for (int py = 0; py < h; ++py) {
+    for (int px = 0; px < w; ++px) {
+      const size_t i = size_t(py) * size_t(w) + size_t(px);
+      const int32_t c = chartOf[i];
+      if (c < 0) continue;
+      uint32_t k = uint32_t(c) * 2654435761u;
+      k ^= k >> 15;
+      k *= 2246822519u;
+      k ^= k >> 13;
+      Vec3 colour{0.25f + 0.7f * float(k & 255u) / 255.0f,
+                  0.25f + 0.7f * float((k >> 8) & 255u) / 255.0f,
+                  0.25f + 0.7f * float((k >> 16) & 255u) / 255.0f};
+      // A texel beside another chart or an empty one: the border, darker.
+      bool border = false;
+      for (int d = 0; d < 4 && !border; ++d) {
+        const int nx = px + (d == 0) - (d == 1), ny = py + (d == 2) - (d == 3);
+        border = nx < 0 || ny < 0 || nx >= w || ny >= h ||
+                 chartOf[size_t(ny) * size_t(w) + size_t(nx)] != c;
+      }
+      image.set(i, border ? colour * 0.45f : colour);
+    }
+  }
+  return image;
+}
+
 }  // namespace lo

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "image/image.h"
 #include "scene/scene.h"
 
 namespace lo {
@@ -89,5 +90,13 @@ void checkLightmapTexcoords(const Scene& scene);
 /// worstStretch is measured as for buildLightmapUvs.
 /// @throws InputError as checkLightmapTexcoords, or for atlasSize < 1.
 LightmapUvs lightmapUvsFromTexcoord1(const Scene& scene, int atlasSize);
+
+/// @brief A picture of page `page`'s layout: each texel whose centre lies in a
+/// triangle takes its chart's colour (a hash of the chart index), chart
+/// borders a darker shade of it, empty texels black. Row 0 is v = 0 (the
+/// atlas convention: written as an image, the layout shows upside down).
+/// For looking at charts (`lightmap --chart-image`, docs/lightmap.md).
+/// @throws InputError when `page` is not a page of `uvs`.
+RgbImage chartLayoutImage(const LightmapUvs& uvs, int page);
 
 }  // namespace lo

@@ -112,69 +112,16 @@ Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3&
                                           params.maxVdls, s));
 }
 
-namespace {
-
-/// loShadeLeaf (octree_lookup.h) with the direction sum beside it; the
-/// irradiance sum is the same float operations in the same order.
-void shadeLeafWithDirection(const GpuOctree& octree, const glm::uvec4& leaf, int maxVdls,
-                            const glm::vec3& n, glm::vec3& irradiance, glm::vec3& direction) {
-  const uint32_t first = layout::loUnpackAddress(leaf.r, leaf.g, leaf.b);
-  const int count = std::min(int(leaf.a), maxVdls);
-  irradiance = glm::vec3(0.0f);
-  direction = glm::vec3(0.0f);
-  for (int i = 0; i < count; ++i) {
-    const glm::vec4 t = lookup::loFetchVdl(octree, first + uint32_t(i));
-    const glm::vec3 d = lookup::loVdlDirection(t.a);
-    const float cosine = glm::max(0.0f, glm::dot(n, d));
-    irradiance += glm::vec3(cosine) * glm::vec3(t);
-    direction += (cosine * luminance(Vec3{t.r, t.g, t.b})) * d;
-  }
-}
-
-}  // namespace
-
 OctreeIrradianceSample octreeIrradianceSample(const GpuOctree& octree, const Vec3& position,
                                               const Vec3& normal, const OctreeShadeParams& params) {
   OctreeIrradianceSample out;
   if (octree.depth < 1 || octree.pool.empty()) return out;
   const float voxelSize = octree.cubeSize / float(1 << octree.depth);
-  const glm::vec3 n = toGlm(normal);
-  // loOctreeIndirect, step for step.
-  const glm::vec3 q = lookup::loOctreePosition(toGlm(position), n, toGlm(octree.origin), voxelSize,
-                                               params.normalOffset);
-  glm::vec3 e, d;
-  if (params.interpolation) {
-    const glm::vec3 u = q - glm::vec3(0.5f);
-    const glm::ivec3 base = glm::ivec3(glm::floor(u));
-    const glm::vec3 f = u - glm::floor(u);
-    glm::vec3 sum(0.0f), directionSum(0.0f);
-    float weightSum = 0.0f;
-    for (int k = 0; k < 8; ++k) {
-      const glm::ivec3 o(k & 1, (k >> 1) & 1, (k >> 2) & 1);
-      const float w = (o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y) *
-                      (o.z == 1 ? f.z : 1.0f - f.z);
-      if (w <= 0.0f) continue;
-      glm::uvec4 leaf;
-      if (lookup::loLookupLeaf(octree, base + o, octree.depth, leaf)) {
-        shadeLeafWithDirection(octree, leaf, params.maxVdls, n, e, d);
-        sum += w * e;
-        directionSum += w * d;
-        weightSum += w;
-      }
-    }
-    if (weightSum > 0.0f) {
-      out.irradiance = fromGlm(sum / weightSum);
-      out.directionSum = fromGlm(directionSum / weightSum);
-      return out;
-    }
-  }
-  glm::uvec4 leaf;
-  glm::ivec3 voxel;
-  if (lookup::loNearestLeaf(octree, q, n, octree.depth, params.normalOffset, leaf, voxel)) {
-    shadeLeafWithDirection(octree, leaf, params.maxVdls, n, e, d);
-    out.irradiance = fromGlm(e);
-    out.directionSum = fromGlm(d);
-  }
+  glm::vec3 direction;
+  out.irradiance = fromGlm(lookup::loOctreeIrradiance(
+      octree, toGlm(position), toGlm(normal), toGlm(octree.origin), voxelSize, octree.depth,
+      params.normalOffset, params.interpolation, params.maxVdls, direction));
+  out.directionSum = fromGlm(direction);
   return out;
 }
 

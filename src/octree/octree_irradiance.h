@@ -38,11 +38,10 @@ struct OctreeIrradianceSample {
   Vec3 directionSum{0, 0, 0};
 };
 
-/// E(p, n) as octreeIrradiance, and the luminance-weighted direction sum.
-/// A C++ twin of shaders/octree_lookup.h's loOctreeIndirect built from the
-/// same pieces (position offset, descent, nearest leaf, VDL fetch and
-/// decoding) with the sum of loShadeLeaf taken beside E; a test holds its E
-/// to octreeIrradiance's.
+/// E(p, n) as octreeIrradiance, and the luminance-weighted direction sum:
+/// shaders/octree_lookup.h's loOctreeIrradiance, the function the GPU's
+/// lightmap bake (shaders/atlas_bake.frag) runs too; a test holds its E to
+/// octreeIrradiance's.
 OctreeIrradianceSample octreeIrradianceSample(const GpuOctree& octree, const Vec3& position,
                                               const Vec3& normal,
                                               const OctreeShadeParams& params = {});

@@ -130,7 +130,8 @@ std::vector<std::vector<std::string>> allPrograms() {
   return {{"render_scene.vert", "render_scene.frag"},
           {"render_shadow.vert", "render_shadow.frag"},
           {"render_depth.vert", "render_depth.frag"},
-          {"render_fullscreen.vert", "render_layout_probe.frag"}};
+          {"render_fullscreen.vert", "render_layout_probe.frag"},
+          {"atlas_bake.vert", "atlas_bake.geom", "atlas_bake.frag"}};
 }
 
 void checkGl(const char* what) {

@@ -20,6 +20,7 @@
 #include "render/context.h"
 #include "render/gl_util.h"
 #include "render/layout_probe.h"
+#include "render/octree_textures.h"
 
 namespace lo {
 namespace render_internal {
@@ -153,13 +154,6 @@ glm::vec3 perpendicular(const glm::vec3& d) {
   return glm::normalize(glm::cross(d, glm::cross(a, d)));
 }
 
-std::string texelCount(int w, int h, int d) {
-  std::ostringstream os;
-  os << w << " x " << h;
-  if (d > 0) os << " x " << d;
-  return os.str();
-}
-
 }  // namespace render_internal
 
 using namespace render_internal;
@@ -239,7 +233,8 @@ struct Renderer::Impl {
   GLuint atlasVbo = 0, atlasIrradiance = 0, atlasDirection = 0;
   size_t atlasTextureBytes = 0;
   float maxAnisotropy = 1;              ///< of the context (1: no anisotropic filtering)
-  GLuint octreeTexture = 0, vdlTexture = 0, vdlHalfTexture = 0, shadowTexture = 0, lightUbo = 0;
+  OctreeTextures octreeTextures;
+  GLuint shadowTexture = 0, lightUbo = 0;
   GLuint shadowFbo = 0;
   GLuint targetFbo = 0, targetColor = 0, targetDepth = 0;
   int targetWidth = 0, targetHeight = 0;
@@ -263,7 +258,6 @@ struct Renderer::Impl {
   std::array<float, 12> fittedCamera{};    ///< the camera the cascades were fitted to
 
   GLuint depthSampler = 0;  ///< reads the shadow maps' depths (no comparison): PCSS blocker search
-  bool halfVdls = false;
 
   LightBlock lightBlock{};
 
@@ -281,8 +275,8 @@ struct Renderer::Impl {
     for (GLuint p : programs) {
       if (p) glDeleteProgram(p);
     }
-    GLuint own[] = {octreeTexture, vdlTexture, vdlHalfTexture, shadowTexture, targetColor};
-    glDeleteTextures(5, own);
+    GLuint own[] = {shadowTexture, targetColor};
+    glDeleteTextures(2, own);
     if (!textures.empty()) glDeleteTextures(GLsizei(textures.size()), textures.data());
     if (behindTexture) glDeleteTextures(1, &behindTexture);
     glDeleteBuffers(1, &vbo);
@@ -302,78 +296,12 @@ struct Renderer::Impl {
     glDeleteRenderbuffers(1, &targetDepth);
   }
 
-  void checkLimits(const GpuOctree& octree) {
-    GLint max3D = params.max3DTextureSize, max2D = params.max2DTextureSize;
-    if (max3D <= 0) glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3D);
-    if (max2D <= 0) glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max2D);
-    int largest3D = std::max({octree.poolWidth(), octree.poolHeight(), octree.poolDepth()});
-    if (largest3D > max3D) {
-      throw InputError("octree pool of " +
-                       texelCount(octree.poolWidth(), octree.poolHeight(), octree.poolDepth()) +
-                       " texels exceeds GL_MAX_3D_TEXTURE_SIZE = " + std::to_string(max3D) +
-                       " by " + std::to_string(largest3D - max3D) +
-                       " texels: rebake with a smaller --depth");
-    }
-    int largest2D = std::max(octree.vdlWidth, octree.vdlHeight);
-    if (largest2D > max2D) {
-      throw InputError("VDL texture of " + texelCount(octree.vdlWidth, octree.vdlHeight, 0) +
-                       " texels exceeds GL_MAX_TEXTURE_SIZE = " + std::to_string(max2D) + " by " +
-                       std::to_string(largest2D - max2D) +
-                       " texels: rebake with a smaller --depth or fewer --vdls");
-    }
-  }
-
   void uploadOctree(const GpuOctree& octree) {
-    GLuint old[] = {octreeTexture, vdlTexture, vdlHalfTexture};  // 0 the first time: no-op
-    glDeleteTextures(3, old);
-    octreeTexture = vdlTexture = vdlHalfTexture = 0;
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glGenTextures(1, &octreeTexture);
-    glBindTexture(GL_TEXTURE_3D, octreeTexture);
-    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    const uint8_t emptyTexel[4] = {0, 0, 0, 0};  // LO_FLAG_EMPTY: keeps the sampler complete
-    size_t expected = size_t(octree.poolWidth()) * octree.poolHeight() * octree.poolDepth() * 4;
-    bool hasPool = expected > 0;
-    if (hasPool) LO_CHECK_EQ(octree.pool.size(), expected);
-    glTexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8UI, hasPool ? octree.poolWidth() : 1,
-                 hasPool ? octree.poolHeight() : 1, hasPool ? octree.poolDepth() : 1, 0,
-                 GL_RGBA_INTEGER, GL_UNSIGNED_BYTE, hasPool ? octree.pool.data() : emptyTexel);
-    checkGl("uploading the octree pool (GL_TEXTURE_3D, GL_RGBA8UI)");
-
-    // Both VDL samplers get a texture of their type (the unused one a 1x1
-    // dummy), so that the program is valid whichever precision is in use.
-    auto makeTexture = [](GLuint& texture) {
-      glGenTextures(1, &texture);
-      glBindTexture(GL_TEXTURE_2D, texture);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    };
-    size_t vdlTexels = size_t(octree.vdlWidth) * octree.vdlHeight * 4;
-    halfVdls = octree.halfFloat && vdlTexels > 0;
-    const float zero[4] = {0, 0, 0, 0};
-    const uint16_t zeroHalf[4] = {0, 0, 0, 0};
-    makeTexture(vdlTexture);
-    if (vdlTexels > 0 && !halfVdls) {
-      LO_CHECK_EQ(octree.vdlTexels.size(), vdlTexels);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, octree.vdlWidth, octree.vdlHeight, 0, GL_RGBA,
-                   GL_FLOAT, octree.vdlTexels.data());
-    } else {
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, 1, 1, 0, GL_RGBA, GL_FLOAT, zero);
-    }
-    makeTexture(vdlHalfTexture);
-    if (halfVdls) {
-      LO_CHECK_EQ(octree.vdlTexelsHalf.size(), vdlTexels);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16UI, octree.vdlWidth, octree.vdlHeight, 0,
-                   GL_RGBA_INTEGER, GL_UNSIGNED_SHORT, octree.vdlTexelsHalf.data());
-    } else {
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16UI, 1, 1, 0, GL_RGBA_INTEGER, GL_UNSIGNED_SHORT,
-                   zeroHalf);
-    }
-    checkGl("uploading the VDL texture (GL_TEXTURE_2D)");
-    depth = octree.depth;
+    OctreeTextures::checkLimits(octree, params.max3DTextureSize, params.max2DTextureSize);
+    octreeTextures.upload(octree);
     octreeOrigin = toRender(octree.origin);
-    voxelSize = octree.depth > 0 ? octree.cubeSize / float(1 << octree.depth) : octree.cubeSize;
+    depth = octree.depth;
+    voxelSize = octreeTextures.voxelSize;
   }
 
   /// Uploads a texture (linear RGB, and its alpha where it has one) with
@@ -808,8 +736,6 @@ struct Renderer::Impl {
       const float t = float(i) / float(kCascades);
       splits[i] = 0.5f * n * std::pow(f / n, t) + 0.5f * (n + (f - n) * t);
     }
-    const glm::vec3 right = glm::normalize(glm::cross(forward, up));
-    const glm::vec3 upOrtho = glm::cross(right, forward);
     const float th = std::tan(0.5f * yfov), tw = th * aspect;
     glBindBuffer(GL_UNIFORM_BUFFER, lightUbo);
     for (int c = 0; c < kCascades; ++c) {
@@ -1171,19 +1097,10 @@ struct Renderer::Impl {
     glUniform1f(loc("uNormalOffset"), rp.normalOffset);
     glUniform1f(loc("uExposureScale"), exposureScale);
     glUniform1i(loc("uEncodeSrgb"), encodeSrgb ? 1 : 0);
-    glUniform1i(loc("uOctree"), 0);
-    glUniform1i(loc("uVdls"), 1);
+    octreeTextures.bind(p, 0, 1, 3);
     glUniform1i(loc("uShadowMaps"), 2);
-    glUniform1i(loc("uVdlsHalf"), 3);
-    glUniform1i(loc("uHalfVdls"), halfVdls ? 1 : 0);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_3D, octreeTexture);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, vdlTexture);
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_2D_ARRAY, shadowTexture);
-    glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D, vdlHalfTexture);
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(loc("uBaseColorTexture"), 4);
     glUniform1i(loc("uShadowDepths"), 5);
@@ -1300,7 +1217,7 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
     throw InputError("reflection probe size must be 4..4096, got " +
                      std::to_string(params.probeSize));
   }
-  r.checkLimits(octree);
+  OctreeTextures::checkLimits(octree, params.max3DTextureSize, params.max2DTextureSize);
   Bounds3 world = scene.bounds();
   if (world.empty()) world.extend(Vec3(0, 0, 0));
   r.renderOrigin = world.center();
@@ -1399,7 +1316,6 @@ int Renderer::emitterLightCount() const { return impl_->emitterLights; }
 int Renderer::areaLightCount() const { return impl_->areaLightCount; }
 
 void Renderer::setOctree(const GpuOctree& octree) {
-  impl_->checkLimits(octree);
   impl_->uploadOctree(octree);
   impl_->probeValid = false;  // it shows the old octree's light
 }

@@ -14,41 +14,21 @@
 #include <vector>
 
 #include "core/error.h"
+#include "lightmap/atlas_test_scenes.h"
 #include "lightmap/lightmap_uv.h"
 #include "test_util.h"
 
 namespace lo {
 namespace {
 
-Scene emptyScene() {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  return scene;
-}
+using namespace atlas_test;
+
 
 void addTriangle(Scene& scene, const Vec3& a, const Vec3& b, const Vec3& c) {
   const uint32_t base = uint32_t(scene.positions.size());
   scene.positions.insert(scene.positions.end(), {a, b, c});
   scene.indices.insert(scene.indices.end(), {base, base + 1, base + 2});
   scene.triangleMaterial.push_back(0);
-}
-
-// An n x n grid of quads spanning origin + [0, 1] eu + [0, 1] ev, vertices
-// shared, two triangles per quad, facing cross(eu, ev).
-void addGrid(Scene& scene, int n, const Vec3& origin, const Vec3& eu, const Vec3& ev) {
-  const uint32_t base = uint32_t(scene.positions.size());
-  for (int j = 0; j <= n; ++j) {
-    for (int i = 0; i <= n; ++i)
-      scene.positions.push_back(origin + eu * (float(i) / n) + ev * (float(j) / n));
-  }
-  auto id = [&](int i, int j) { return base + uint32_t(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      scene.indices.insert(scene.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      scene.indices.insert(scene.indices.end(), {id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      scene.triangleMaterial.insert(scene.triangleMaterial.end(), {0, 0});
-    }
-  }
 }
 
 // Open cylinder about the y axis (no caps), outward facing; the seam column
@@ -89,17 +69,6 @@ void addSphere(Scene& scene, const Vec3& centre, float radius, int rings, int se
       if (j + 1 < rings) addTriangle(scene, b, d, c);
     }
   }
-}
-
-// Cube lo + [0, size]^3 of six outward-facing quads (separate vertices per face).
-void addCube(Scene& scene, const Vec3& lo, float size) {
-  const Vec3 ex{size, 0, 0}, ey{0, size, 0}, ez{0, 0, size};
-  test::addQuad(scene, lo, ex, ez, {0, -1, 0}, 0);
-  test::addQuad(scene, lo + ey, ex, ez, {0, 1, 0}, 0);
-  test::addQuad(scene, lo, ey, ez, {-1, 0, 0}, 0);
-  test::addQuad(scene, lo + ex, ey, ez, {1, 0, 0}, 0);
-  test::addQuad(scene, lo, ex, ey, {0, 0, -1}, 0);
-  test::addQuad(scene, lo + ez, ex, ey, {0, 0, 1}, 0);
 }
 
 double uvArea(const LightmapUvs& uvs, size_t t) {
@@ -270,6 +239,45 @@ TEST(LightmapUv, CubeGivesSixFlatCharts) {
   expectValid(scene, uvs, params);
   // Six equal squares, two rows of three: about 6 / 9 of the page.
   EXPECT_GT(uvs.utilisation, 0.6f) << uvs.ToString();
+}
+
+// The chart picture (lightmap --chart-image): each chart's interior one
+// colour of its own, its border a darker shade, the rest black, and its
+// area the charts' share of the page.
+TEST(LightmapUv, ChartLayoutImageColoursEachChart) {
+  Scene scene = emptyScene();
+  addCube(scene, Vec3(0.0f), 1.0f);
+  LightmapUvParams params;
+  params.atlasSize = 96;
+  const LightmapUvs uvs = buildLightmapUvs(scene, params);
+  ASSERT_EQ(uvs.chartCount, 6);
+  const RgbImage image = chartLayoutImage(uvs, 0);
+  ASSERT_EQ(image.width, uvs.width);
+  ASSERT_EQ(image.height, uvs.height);
+  std::vector<Vec3> colours;  // interior colours (not beside another colour)
+  size_t lit = 0;
+  for (int y = 1; y + 1 < image.height; ++y) {
+    for (int x = 1; x + 1 < image.width; ++x) {
+      const Vec3 c = image.at(size_t(y) * size_t(image.width) + size_t(x));
+      if (c.x + c.y + c.z == 0) continue;
+      ++lit;
+      bool interior = true;
+      for (int d = 0; d < 4; ++d) {
+        const int nx = x + (d == 0) - (d == 1), ny = y + (d == 2) - (d == 3);
+        const Vec3 n = image.at(size_t(ny) * size_t(image.width) + size_t(nx));
+        interior = interior && n.x == c.x && n.y == c.y && n.z == c.z;
+      }
+      if (!interior) continue;
+      if (std::none_of(colours.begin(), colours.end(), [&](const Vec3& k) {
+            return k.x == c.x && k.y == c.y && k.z == c.z;
+          })) {
+        colours.push_back(c);
+      }
+    }
+  }
+  EXPECT_EQ(colours.size(), 6u);
+  EXPECT_NEAR(double(lit) / double(image.pixelCount()), uvs.utilisation, 0.05);
+  EXPECT_THROW(chartLayoutImage(uvs, 1), InputError);
 }
 
 TEST(LightmapUv, OpenCylinderUnrolls) {
