@@ -11,7 +11,18 @@
  *   A == LO_FLAG_INNER    : RGB = tile coordinates (tx, ty, tz) of the child tile
  *   A in [1, LO_MAX_VDLS] : leaf holding A VDLs; RGB = 24-bit index
  *                           (R | G<<8 | B<<16) of its first VDL texel
+ *   A == LO_FLAG_LAYERED  : leaf of a voxel with surface layers (below); RGB =
+ *                           24-bit index of its layer block
  * A leaf stores only the VDLs its voxel has (the count lives in the flag).
+ *
+ * Layer block (a voxel whose surfaces face clearly different ways keeps one
+ * set of VDLs per orientation, at most LO_MAX_LAYERS): texels of the VDL
+ * texture, read like VDL texels (loFetchVdl):
+ *   block header : RGB = the VDL counts of layers 0, 1, 2 (0 past the last),
+ *                  A = the number of layers
+ *   per layer, in order: its header, RGB = a point of its surface in voxel
+ *                  units relative to the voxel's lower corner, A = its unit
+ *                  normal packed like a VDL direction; then its VDL texels.
  *
  * VDL texture (paper §4.2.2, Fig. 8): a 2D texture, LO_VDL_TEXTURE_WIDTH
  * texels wide. One texel per VDL: RGB = irradiance (W/m^2), A = direction
@@ -49,7 +60,15 @@ using std::sin;
 
 const uint LO_FLAG_EMPTY = 0u;
 const uint LO_FLAG_INNER = 255u;
+const uint LO_FLAG_LAYERED = 254u;
 const uint LO_MAX_VDLS = 8u;
+const uint LO_MAX_LAYERS = 3u;
+/* A layer serves a surface point whose normal lies within this cosine of
+ * its own (60 degrees: layers are that far apart, lightgrid/vdl_grid.h)... */
+const float LO_LAYER_MIN_COSINE = 0.5;
+/* ...and that lies on the same side as the layer's surface of every other
+ * layer's plane, within this many voxels. */
+const float LO_LAYER_SIDE_TOLERANCE = 0.1;
 const uint LO_VDL_TEXTURE_WIDTH = 4096u;
 const uint LO_ADDRESS_BITS = 24u;
 const uint LO_MAX_ADDRESS = 16777215u; /* 2^24 - 1 */
@@ -70,7 +89,9 @@ float loAtan2(float y, float x) {
 }
 #endif
 
-LO_LAYOUT_FN bool loIsLeaf(uint flag) { return flag >= 1u && flag <= LO_MAX_VDLS; }
+LO_LAYOUT_FN bool loIsLeaf(uint flag) {
+  return (flag >= 1u && flag <= LO_MAX_VDLS) || flag == LO_FLAG_LAYERED;
+}
 
 /* 24-bit address <-> three 8-bit channels. */
 LO_LAYOUT_FN uint loPackAddressR(uint address) { return address & 255u; }

@@ -9,11 +9,13 @@
  *                    (at most `depth` texel fetches; a leaf may sit at any level)
  *   loHalfToFloat    IEEE binary16 bits -> float (half-precision VDL texels)
  *   loFetchVdl       one VDL texel, decoded: rgb irradiance (W/m^2), a packed direction
- *   loShadeLeaf      sum_i response(d_i) c_i over a leaf's VDLs (paper §4.2.2)
+ *   loLeafVdls       a leaf's VDLs for a surface point (the layer of a layered
+ *                    leaf that serves it)
+ *   loShadeVdls      sum_i response(d_i) c_i over those VDLs (paper §4.2.2)
  *   loNearestLeaf    the voxel in front of a surface point, else the one behind it
  *   loOctreeIndirect the indirect light at a surface point: trilinear over the 8
  *                    voxels around it with empty ones left out and the weights
- *                    renormalized (§4.2.1), else loNearestLeaf
+ *                    renormalized (§4.2.1), else the voxel in front, else behind
  *   loOctreeIrradiance the same lookup's irradiance and the direction it comes
  *                    from, for lightmaps (§4.2.3)
  *
@@ -67,6 +69,8 @@ struct LoSurface {
   vec3 baseColor; /* linear RGB */
   float metallic;
   float roughness;
+  vec3 ng;        /* unit normal that picks surface layers: the interpolated
+                     vertex (or geometric) normal, turned to the viewer */
 };
 
 vec3 loVdlResponse(LoSurface s, vec3 d); /* defined by the includer */
@@ -114,13 +118,68 @@ LO_LOOKUP_FN vec3 loVdlDirection(float code) {
   return vec3(loUnpackDirectionX(code), loUnpackDirectionY(code), loUnpackDirectionZ(code));
 }
 
-/* Paper §4.2.2: c = sum_i brdf(d_i, v, n) c_i over the leaf's first maxVdls
- * VDLs (the strongest come first), each a directional light of irradiance c_i. */
-LO_LOOKUP_FN vec3 loShadeLeaf(LO_TEX_PARAM uvec4 leaf, int maxVdls, LoSurface s) {
-  uint first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
-  int count = min(int(leaf.a), maxVdls);
+/* The VDLs of leaf texel `leaf` (voxel c) that light a surface point at q
+ * (octree voxel units) whose surface faces ng: all of a plain leaf's; of a
+ * layered leaf (octree_layout.h), the layer whose normal lies closest to ng,
+ * within LO_LAYER_MIN_COSINE, and whose surface lies on q's side of every
+ * other layer's plane (LO_LAYER_SIDE_TOLERANCE): a floor layer lit from one
+ * side of a thin wall does not light the floor on its other side. False when
+ * no layer serves the point: the voxel then lends it no light. */
+LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
+                             LO_OUT(uint) first, LO_OUT(int) count) {
+  first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
+  count = int(leaf.a);
+  if (leaf.a != LO_FLAG_LAYERED) return true;
+  vec4 h = loFetchVdl(LO_TEX first);
+  int layers = min(int(h.a), int(LO_MAX_LAYERS));
+  int counts[3];
+  counts[0] = int(h.r);
+  counts[1] = int(h.g);
+  counts[2] = int(h.b);
+  vec3 points[3];
+  vec3 normals[3];
+  uint address[3];
+  uint a = first + 1u;
+  for (int l = 0; l < layers; ++l) {
+    vec4 t = loFetchVdl(LO_TEX a);
+    points[l] = vec3(c) + vec3(t);
+    normals[l] = loVdlDirection(t.a);
+    address[l] = a + 1u;
+    a += 1u + uint(counts[l]);
+  }
+  int best = -1;
+  float bestCosine = LO_LAYER_MIN_COSINE;
+  for (int l = 0; l < layers; ++l) {
+    float cosine = dot(ng, normals[l]);
+    if (!(cosine > bestCosine)) continue;
+    bool sameSide = true;
+    for (int m = 0; m < layers; ++m) {
+      if (m == l) continue;
+      float sq = dot(normals[m], q - points[m]);
+      float sl = dot(normals[m], points[l] - points[m]);
+      if ((sq > LO_LAYER_SIDE_TOLERANCE && sl < -LO_LAYER_SIDE_TOLERANCE) ||
+          (sq < -LO_LAYER_SIDE_TOLERANCE && sl > LO_LAYER_SIDE_TOLERANCE)) {
+        sameSide = false;
+      }
+    }
+    if (sameSide) {
+      best = l;
+      bestCosine = cosine;
+    }
+  }
+  if (best < 0) return false;
+  first = address[best];
+  count = counts[best];
+  return true;
+}
+
+/* Paper §4.2.2: c = sum_i brdf(d_i, v, n) c_i over the first maxVdls of the
+ * `count` VDLs at `first` (the strongest come first), each a directional light
+ * of irradiance c_i. */
+LO_LOOKUP_FN vec3 loShadeVdls(LO_TEX_PARAM uint first, int count, int maxVdls, LoSurface s) {
+  int n = min(count, maxVdls);
   vec3 sum = vec3(0.0f);
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < n; ++i) {
     vec4 t = loFetchVdl(LO_TEX first + uint(i));
     sum += loVdlResponse(s, loVdlDirection(t.a)) * vec3(t);
   }
@@ -157,10 +216,15 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
                                    float normalOffset, bool interpolation, int maxVdls,
                                    LoSurface s) {
   vec3 q = loOctreePosition(p, s.n, origin, voxelSize, normalOffset);
+  uvec4 leaf;
+  uint first;
+  int count;
   if (interpolation) {
-    /* Trilinear over the 8 voxels around q (paper §4.2.1); empty neighbours
-     * are left out and the remaining weights renormalized, so light never
-     * leaks in from empty space or fades at the edge of the geometry. */
+    /* Trilinear over the 8 voxels around q (paper §4.2.1); empty neighbours,
+     * and layered ones without a layer for this surface (loLeafVdls), are
+     * left out and the remaining weights renormalized, so light never leaks
+     * in from empty space, through a thin wall or fades at the edge of the
+     * geometry. */
     vec3 u = q - vec3(0.5f);
     ivec3 base = ivec3(floor(u));
     vec3 f = u - floor(u);
@@ -170,34 +234,36 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
       ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      uvec4 leaf;
-      if (loLookupLeaf(LO_TEX base + o, depth, leaf)) {
-        sum += w * loShadeLeaf(LO_TEX leaf, maxVdls, s);
+      if (loLookupLeaf(LO_TEX base + o, depth, leaf) &&
+          loLeafVdls(LO_TEX leaf, base + o, q, s.ng, first, count)) {
+        sum += w * loShadeVdls(LO_TEX first, count, maxVdls, s);
         weightSum += w;
       }
     }
     if (weightSum > 0.0f) return sum / weightSum;
   }
-  uvec4 leaf;
-  ivec3 voxel;
-  if (loNearestLeaf(LO_TEX q, s.n, depth, normalOffset, leaf, voxel)) {
-    return loShadeLeaf(LO_TEX leaf, maxVdls, s);
+  /* The voxel in front of the surface, else the one behind it (loNearestLeaf). */
+  for (int k = 0; k < 2; ++k) {
+    ivec3 voxel = ivec3(floor(k == 0 ? q : q - (normalOffset + normalOffset) * s.n));
+    if (loLookupLeaf(LO_TEX voxel, depth, leaf) &&
+        loLeafVdls(LO_TEX leaf, voxel, q, s.ng, first, count)) {
+      return loShadeVdls(LO_TEX first, count, maxVdls, s);
+    }
   }
   return vec3(0.0f);
 }
 
 /* Irradiance and where it comes from, for lightmaps (paper §4.2.3: one VDL
- * per texel rebuilt for the specular term): loShadeLeaf with the cosine as
+ * per texel rebuilt for the specular term): loShadeVdls with the cosine as
  * the response, E = sum_i max(0, n . d_i) c_i, and beside it the
  * luminance-weighted direction sum sum_i Y(c_i) max(0, n . d_i) d_i (Rec. 709
  * luminance, world space, towards the light). */
-LO_LOOKUP_FN vec3 loShadeLeafIrradiance(LO_TEX_PARAM uvec4 leaf, int maxVdls, vec3 n,
+LO_LOOKUP_FN vec3 loShadeVdlsIrradiance(LO_TEX_PARAM uint first, int count, int maxVdls, vec3 n,
                                         LO_OUT(vec3) direction) {
-  uint first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
-  int count = min(int(leaf.a), maxVdls);
+  int used = min(count, maxVdls);
   vec3 irradiance = vec3(0.0f);
   direction = vec3(0.0f);
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < used; ++i) {
     vec4 t = loFetchVdl(LO_TEX first + uint(i));
     vec3 d = loVdlDirection(t.a);
     float cosine = max(0.0f, dot(n, d));
@@ -208,13 +274,17 @@ LO_LOOKUP_FN vec3 loShadeLeafIrradiance(LO_TEX_PARAM uvec4 leaf, int maxVdls, ve
 }
 
 /* loOctreeIndirect of a Lambertian surface of unit albedo times pi, i.e. the
- * irradiance E(p, n), with the direction sum of loShadeLeafIrradiance taken
- * with the same weights. The lightmap bakes (lightmap/lightmap_atlas.cpp on
- * the CPU, shaders/atlas_bake.frag on the GPU) call this one function. */
+ * irradiance E(p, n) (n also picks the layers), with the direction sum of
+ * loShadeVdlsIrradiance taken with the same weights. The lightmap bakes
+ * (lightmap/lightmap_atlas.cpp on the CPU, shaders/atlas_bake.frag on the
+ * GPU) call this one function. */
 LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, float voxelSize,
                                      int depth, float normalOffset, bool interpolation,
                                      int maxVdls, LO_OUT(vec3) direction) {
   vec3 q = loOctreePosition(p, n, origin, voxelSize, normalOffset);
+  uvec4 leaf;
+  uint first;
+  int count;
   vec3 e;
   vec3 d;
   direction = vec3(0.0f);
@@ -229,9 +299,9 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
       ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      uvec4 leaf;
-      if (loLookupLeaf(LO_TEX base + o, depth, leaf)) {
-        e = loShadeLeafIrradiance(LO_TEX leaf, maxVdls, n, d);
+      if (loLookupLeaf(LO_TEX base + o, depth, leaf) &&
+          loLeafVdls(LO_TEX leaf, base + o, q, n, first, count)) {
+        e = loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, d);
         sum += w * e;
         directionSum += w * d;
         weightSum += w;
@@ -242,10 +312,12 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
       return sum / weightSum;
     }
   }
-  uvec4 leaf;
-  ivec3 voxel;
-  if (loNearestLeaf(LO_TEX q, n, depth, normalOffset, leaf, voxel)) {
-    return loShadeLeafIrradiance(LO_TEX leaf, maxVdls, n, direction);
+  for (int k = 0; k < 2; ++k) {
+    ivec3 voxel = ivec3(floor(k == 0 ? q : q - (normalOffset + normalOffset) * n));
+    if (loLookupLeaf(LO_TEX voxel, depth, leaf) &&
+        loLeafVdls(LO_TEX leaf, voxel, q, n, first, count)) {
+      return loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, direction);
+    }
   }
   return vec3(0.0f);
 }

@@ -571,6 +571,10 @@ void main() {
 #ifdef LO_DIRECT_LIGHT
   gGeometricNormal = normalize(ng);
 #endif
+  // The interpolated normal, before the normal map: it picks the octree's
+  // surface layers (octree_lookup.h), as the bake's photons were sorted by
+  // the geometry's own normals.
+  vec3 nLayer = n;
   if (uHasNormalTexture) n = perturbNormal(n, vPosition, vNormalUv, side);
   // glTF: base colour = factor x texture, sampled per pixel (trilinear,
   // anisotropic where the context has it).
@@ -614,7 +618,7 @@ void main() {
     }
 #endif
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_INDIRECT) {
-      LoSurface s = LoSurface(n, v, baseColor, metallic, roughness);
+      LoSurface s = LoSurface(n, v, baseColor, metallic, roughness, nLayer);
       // glTF: occlusion darkens the indirect light only.
       float occlusion = uHasOcclusionTexture
                             ? 1.0 + uOcclusionStrength * (texture(uOcclusionTexture, vOcclusionUv).r - 1.0)

@@ -31,6 +31,9 @@ struct BakeOptions {
   uint64_t seed = 1;
   int threads = 0;  // 0 = all cores
   bool includeDirect = false;
+  std::string layers = "on";
+  std::string occlusion = "on";
+  std::string edgeCorrection = "on";
   std::string photonMap;
   std::string statsJson;
   bool quiet = false;
@@ -58,6 +61,9 @@ int runBake(const BakeOptions& opt) {
   params.vdls = parseVdlCount(opt.vdls);
   params.seed = opt.seed;
   params.includeDirect = opt.includeDirect;
+  params.layers = opt.layers == "on";
+  params.occlusion = opt.occlusion == "on";
+  params.edgeCorrection = opt.edgeCorrection == "on";
   params.keepPhotons = !opt.photonMap.empty();
   BakeResult baked = bake(scene, params, &progress);
   rows.insert(rows.end(), baked.stats.stages.begin(), baked.stats.stages.end());
@@ -84,7 +90,9 @@ int runBake(const BakeOptions& opt) {
     j["parameters"] = {{"depth", opt.depth},         {"photons", opt.photons},
                        {"knn", opt.knn},             {"radius", baked.metadata.radius},
                        {"vdls", opt.vdls},           {"seed", opt.seed},
-                       {"threads", opt.threads},     {"include_direct", opt.includeDirect}};
+                       {"threads", opt.threads},     {"include_direct", opt.includeDirect},
+                       {"layers", opt.layers},       {"gather_occlusion", opt.occlusion},
+                       {"edge_correction", opt.edgeCorrection}};
     j["counts"] = {{"triangles", st.triangles},
                    {"stored_photons", st.storedPhotons},
                    {"emitted_paths", st.emittedPaths},
@@ -148,6 +156,22 @@ std::function<int()> addBakeCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--include-direct", opt->includeDirect,
                 "Also store direct-light photons (by default the GL renderer draws direct light)");
+  cmd->add_option("--layers", opt->layers,
+                  "Surface layers: a voxel whose photons land on surfaces facing clearly "
+                  "different ways (an edge, the two sides of a thin wall) keeps one gather and "
+                  "one set of VDLs per orientation (docs/accuracy.md)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--gather-occlusion", opt->occlusion,
+                  "Leave out photons that lie behind geometry seen from the voxel: no light "
+                  "gathered through thin walls (one shadow ray per neighbouring photon group)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--edge-correction", opt->edgeCorrection,
+                  "Divide the gathered power by the part of the gather disc that lies on the "
+                  "surface, not the whole disc: next to an edge the plain estimate is too dark")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   cmd->add_option("--photon-map", opt->photonMap,
                   "Also write the photons as an OpenVDB point grid for inspection");
   cmd->add_option("--stats-json", opt->statsJson, "Write the per-stage figures as JSON");

@@ -34,6 +34,7 @@ struct RenderOptions {
   ShadingOptions shading;
   std::string backend = "osmesa";
   int frames = 0;
+  int irradianceSpp = 64;
   bool quiet = false;
 };
 
@@ -41,8 +42,11 @@ struct RenderOptions {
 /// evaluated on the CPU (octree/octree_irradiance.h: the shader's lookup and
 /// interpolation with the cosine alone) at the reference renderer's first-hit
 /// points, so that it compares with `reference --part irradiance`. Needs no
-/// OpenGL. 4 jittered rays per pixel average over the pixel's footprint as
-/// the reference's samples do.
+/// OpenGL. `--spp` jittered rays per pixel (64 by default) average over the
+/// pixel's footprint as the reference's thousands of samples do: with 4, a
+/// pixel across an edge mixes its two surfaces in steps of a quarter, an
+/// error of up to a quarter of their difference that is the sampling's,
+/// not the octree's.
 int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedVdl& baked) {
   if (opt.frames > 0) throw InputError("--frames: not with --mode irradiance (no GL frame)");
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
@@ -56,7 +60,7 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
   FirstHitParams params;
   params.width = opt.width;
   params.height = opt.height;
-  params.samplesPerPixel = 4;
+  params.samplesPerPixel = opt.irradianceSpp;
   RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {
     return octreeIrradiance(octree, hit.position, hit.normal, shade);
   });
@@ -143,6 +147,11 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   cmd->add_option("--frames", opt->frames,
                   "Also time this many frames (no read-back) and print the mean frame time")
       ->check(CLI::Range(0, 100000));
+  cmd->add_option("--spp", opt->irradianceSpp,
+                  "--mode irradiance: camera rays per pixel, averaged as the reference averages "
+                  "its samples (pixels across an edge need many)")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runRender(*opt) : -1; };
 }

@@ -5,8 +5,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "core/error.h"
+#include "photon/ray_tracer.h"
 
 namespace lo {
 
@@ -55,6 +57,7 @@ GatherParams BakeParams::gatherParams() const {
   GatherParams p;
   p.k = knn;
   p.radius = radius;
+  p.edgeCorrection = edgeCorrection;
   return p;
 }
 
@@ -70,7 +73,26 @@ std::string BakeParams::ToString() const {
   return "BakeParams{depth " + std::to_string(depth) + ", photons " + std::to_string(photons) +
          ", knn " + std::to_string(knn) + ", radius " + std::to_string(radius) + ", vdls " +
          vdls.ToString() + ", seed " + std::to_string(seed) +
-         (includeDirect ? ", include direct" : "") + "}";
+         (includeDirect ? ", include direct" : "") + (layers ? "" : ", no layers") +
+         (occlusion ? "" : ", no occlusion") + (edgeCorrection ? "" : ", no edge correction") +
+         "}";
+}
+
+// Segments are tested in a frame centred on the scene: its floats are finest
+// there, as the photon tracer's are.
+GatherOcclusion::GatherOcclusion(const Scene& scene) : origin_(scene.tracingOrigin()) {
+  tracer_ = std::make_unique<RayTracer>(origin_ == Vec3{0, 0, 0} ? scene
+                                                                 : scene.translated(-origin_));
+}
+
+GatherOcclusion::~GatherOcclusion() = default;
+
+SegmentBlocked GatherOcclusion::test() const {
+  const RayTracer* tracer = tracer_.get();
+  const Vec3 origin = origin_;
+  return [tracer, origin](const Vec3& from, const Vec3& to) {
+    return tracer->occluded(from - origin, to - from, 1.0f - 1e-4f);
+  };
 }
 
 SurfaceGrid voxelizeAndSplat(const Scene& scene, const std::vector<Photon>& photons,
@@ -104,11 +126,24 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
   SurfaceGrid grid = voxelizeAndSplat(scene, photons, params.grid, progress, &s, &rows);
 
   StageTimer cluster(rows, "gather + cluster");
-  VdlGrid vdls =
-      buildVdlGrid(grid, photons, params.gather, params.cluster, progress, &s.threadSeconds);
-  char split[128];
-  std::snprintf(split, sizeof split, "thread-seconds: gather %.3f, K-means %.3f",
-                s.threadSeconds.gatherSeconds, s.threadSeconds.clusterSeconds);
+  GatherParams gather = params.gather;
+  std::unique_ptr<GatherOcclusion> occlusion;
+  if (params.occlusion && !gather.blocked && scene.triangleCount() > 0) {
+    occlusion = std::make_unique<GatherOcclusion>(scene);
+    gather.blocked = occlusion->test();
+  }
+  const LayerParams layerParams;
+  VdlGrid vdls = buildVdlGrid(grid, photons, gather, params.cluster, progress, &s.threadSeconds,
+                              params.layers ? &layerParams : nullptr);
+  size_t layered = 0;
+  for (size_t e = 0; e < vdls.layers.size(); ++e) {
+    if (e == 0 || vdls.layers.voxel[e] != vdls.layers.voxel[e - 1]) ++layered;
+  }
+  s.layeredVoxels = layered;
+  s.extraLayers = vdls.layers.size();
+  char split[160];
+  std::snprintf(split, sizeof split, "%s voxels with 2+ layers; thread-seconds: gather %.3f, K-means %.3f",
+                formatCount(layered).c_str(), s.threadSeconds.gatherSeconds, s.threadSeconds.clusterSeconds);
   s.gatherClusterSeconds = cluster.finish(split);
   s.radius = resolveRadius(params.gather, grid.frame);
   if (stats) *stats = s;
@@ -157,6 +192,8 @@ BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* prog
   level.grid = params.gridParams();
   level.gather = params.gatherParams();
   level.cluster = params.clusterParams();
+  level.layers = params.layers;
+  level.occlusion = params.occlusion;
   r.grid = bakeLevel(scene, photons.photons, level, progress, &s.level, &s.stages);
 
   BakeMetadata& meta = r.metadata;
@@ -168,6 +205,9 @@ BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* prog
   meta.vdls = params.vdls.ToString();
   meta.seed = int64_t(params.seed);
   meta.sceneBounds = scene.bounds();
+  meta.surfaceLayers = params.layers ? 1 : 0;
+  meta.gatherOcclusion = params.occlusion ? 1 : 0;
+  meta.edgeCorrection = params.edgeCorrection ? 1 : 0;
   if (params.keepPhotons) r.photons = std::move(photons);
   return r;
 }

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,14 @@ struct BakeParams {
   uint64_t seed = 1;           ///< same inputs and seed, same bytes, whatever the thread count
   bool includeDirect = false;  ///< also store bounce-0 photons (the renderer draws direct light)
   bool keepPhotons = false;    ///< return the photon map in BakeResult::photons
+  /// Surface layers (`--layers`): a voxel whose photons face clearly
+  /// different ways keeps one gather and VDL set per orientation.
+  bool layers = true;
+  /// Gather occlusion (`--gather-occlusion`): photons behind geometry, seen
+  /// from the voxel, are not gathered (no light through thin walls).
+  bool occlusion = true;
+  /// Edge correction (`--edge-correction`): GatherParams::edgeCorrection.
+  bool edgeCorrection = true;
 
   PhotonParams photonParams() const;
   GridParams gridParams() const;
@@ -58,12 +67,32 @@ struct BakeParams {
   std::string ToString() const;
 };
 
+class RayTracer;
+
+/// The bake's gather occlusion (GatherParams::blocked): segments tested
+/// against the scene's triangles with a ray tracer built here, in a frame
+/// centred on the scene. Keep it alive while the gather runs.
+class GatherOcclusion {
+ public:
+  explicit GatherOcclusion(const Scene& scene);
+  ~GatherOcclusion();
+  GatherOcclusion(const GatherOcclusion&) = delete;
+  GatherOcclusion& operator=(const GatherOcclusion&) = delete;
+  SegmentBlocked test() const;
+
+ private:
+  std::unique_ptr<RayTracer> tracer_;
+  Vec3 origin_{0, 0, 0};
+};
+
 /// One octree level from a traced photon map (what the progressive preview
 /// bakes once per depth): voxelize, splat, gather + cluster.
 struct LevelParams {
   GridParams grid;        ///< depth (paper's delta) and padding of the bounding cube
   GatherParams gather;    ///< KNN k, radius (0 = kDefaultRadiusVoxels voxels at this depth)
   ClusterParams cluster;  ///< VDLs per voxel, seed
+  bool layers = true;     ///< BakeParams::layers
+  bool occlusion = true;  ///< BakeParams::occlusion: gather.blocked by the scene's ray tracer
 };
 
 /// What bakeLevel did, for reports and benchmarks. Seconds are wall time.
@@ -71,6 +100,8 @@ struct LevelStats {
   size_t activeVoxels = 0;    ///< voxels that touch geometry
   size_t droppedPhotons = 0;  ///< photons outside every active voxel's neighbourhood
   float radius = 0;           ///< gathering radius used, world units
+  size_t layeredVoxels = 0;   ///< voxels with more than one surface layer
+  size_t extraLayers = 0;     ///< their layers beyond the first (VdlGrid::layers)
   double voxelizeSeconds = 0, splatSeconds = 0, gatherClusterSeconds = 0;
   BakeTimings threadSeconds;  ///< gather / K-means split, summed over threads
   double seconds() const { return voxelizeSeconds + splatSeconds + gatherClusterSeconds; }

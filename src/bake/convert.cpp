@@ -65,7 +65,11 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
       GatherParams gather;
       gather.k = inMeta.knn > 0 ? inMeta.knn : GatherParams{}.k;
       gather.radius = 0;  // the default for the new depth: kDefaultRadiusVoxels voxels
-      r.grid = buildVdlGrid(grid, photons, gather, cluster, progress);
+      // The bake's defaults: surface layers and gather occlusion.
+      const GatherOcclusion occlusion(*params.scene);
+      gather.blocked = occlusion.test();
+      const LayerParams layers;
+      r.grid = buildVdlGrid(grid, photons, gather, cluster, progress, nullptr, &layers);
       r.metadata.knn = gather.k;
       r.metadata.radius = resolveRadius(gather, grid.frame);
       r.metadata.photons = int64_t(photons.size());
@@ -100,6 +104,10 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
   } else {
     r.grid = in;
     r.method = "same grid";
+  }
+  if (in.layers.size() > 0 && r.grid.layers.size() == 0) {
+    r.method += " (the input's surface layers are not carried to another depth: bake again, "
+                "or convert with --photon-map, for layers at depth " + std::to_string(depth) + ")";
   }
   return r;
 }

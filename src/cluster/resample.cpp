@@ -332,6 +332,31 @@ VdlGrid reclusterVdlGrid(const VdlGrid& grid, const ClusterParams& params) {
   Mixers mixers;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrainVoxels),
                     ReclusterBody{grid, params, mixers, out});
+  // Surface layers: the same, layer by layer (a few per cent of the voxels).
+  const VdlLayers& in = grid.layers;
+  VdlLayers& L = out.layers;
+  out.points = grid.points;
+  L.voxel = in.voxel;
+  L.normals = in.normals;
+  L.points = in.points;
+  L.irradiance = in.irradiance;
+  L.photonCount = in.photonCount;
+  L.radius = in.radius;
+  L.angularError.resize(in.size());
+  L.vdlCount.resize(in.size());
+  L.vdls.assign(in.size() * size_t(out.maxVdls), Vdl{});
+  std::vector<DirectionSample> samples;
+  for (size_t e = 0; e < in.size(); ++e) {
+    samples.clear();
+    const Vdl* vdls = grid.layerVdlsOf(e);
+    for (int i = 0; i < in.vdlCount[e]; ++i) samples.push_back({vdls[i].direction, vdls[i].irradiance});
+    const ClusterResult c =
+        clusterDirections(samples.data(), samples.size(), params.vdls, params, uint64_t(n + e));
+    L.vdlCount[e] = uint8_t(c.count);
+    L.angularError[e] = std::sqrt(in.angularError[e] * in.angularError[e] +
+                                  c.angularError * c.angularError);
+    for (int i = 0; i < c.count; ++i) L.vdls[e * size_t(out.maxVdls) + size_t(i)] = c.vdls[size_t(i)];
+  }
   return out;
 }
 

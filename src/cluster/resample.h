@@ -52,7 +52,10 @@ VdlGrid refineVdlGrid(const VdlGrid& grid, const SurfaceGrid& finerGeometry,
 /// @brief Same voxels, VDLs re-clustered to params.vdls (or auto under that
 /// cap): each voxel's VDLs are the samples. Irradiance, normal, area, counts
 /// and radius are kept; angular_error combines the old error with the new
-/// clustering's (see coarsenVdlGrid). maxVdls becomes params.vdls.
+/// clustering's (see coarsenVdlGrid). maxVdls becomes params.vdls. Surface
+/// layers are kept, their VDLs re-clustered the same way. (coarsenVdlGrid
+/// and refineVdlGrid return grids without layers: a new depth needs a new
+/// bake for them.)
 VdlGrid reclusterVdlGrid(const VdlGrid& grid, const ClusterParams& params);
 
 /// @brief Checks that `b` is the frame of `a` refined (or coarsened) to b.depth:

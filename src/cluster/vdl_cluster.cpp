@@ -7,6 +7,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -29,6 +30,16 @@ struct Worker {
   std::vector<DirectionSample> samples;
   double gatherSeconds = 0;
   double clusterSeconds = 0;
+  /// Layers 1 and 2 of this thread's voxels, in no particular order
+  /// (sorted by voxel and layer when merged).
+  struct Layer {
+    uint32_t voxel;
+    int layer;
+    Vec3 normal, point, irradiance;
+    float photonCount, radius;
+    ClusterResult vdls;
+  };
+  std::vector<Layer> layers;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -43,39 +54,59 @@ inline double secondsBetween(Clock::time_point a, Clock::time_point b) {
 constexpr size_t kGrainVoxels = 64;
 
 struct BakeBody {
+  const SurfaceGrid& grid;
   const std::vector<Photon>& photons;
   const ClusterParams& cluster;
+  const LayerParams* layerParams;
   tbb::enumerable_thread_specific<Worker>& workers;
   Progress& progress;
   VdlGrid& out;
+
+  /// K-means of the gathered photons' directions. Each photon's share of the
+  /// irradiance estimate E = sum(power) / (pi r_k^2 coverage) (W/m^2), so the
+  /// VDLs sum to the estimate. Layer l > 0 of voxel v seeds its stream with v + l n.
+  ClusterResult clusterGathered(Worker& w, uint64_t stream) const {
+    const GatherResult& g = w.gathered;
+    w.samples.clear();
+    const float r = g.radius;
+    if (r > 0) {
+      const float invArea = 1.0f / (kPi * r * r * g.coverage);
+      for (uint32_t p : g.photons) {
+        const Photon& ph = photons[p];
+        w.samples.push_back({ph.direction, ph.power * invArea});
+      }
+    }
+    return clusterDirections(w.samples.data(), w.samples.size(), cluster.vdls, cluster, stream);
+  }
 
   void operator()(const tbb::blocked_range<size_t>& range) const {
     Worker& w = workers.local();
     double gatherSeconds = 0, clusterSeconds = 0;
     const size_t maxVdls = size_t(out.maxVdls);
+    SurfaceLayer found[kMaxLayers];
     for (size_t v = range.begin(); v != range.end(); ++v) {
       Clock::time_point t0 = Clock::now();
-      w.gatherer.gather(v, w.gathered);
-      const GatherResult& g = w.gathered;
-      // Each photon's share of the irradiance estimate E = sum(power) / (pi r_k^2)
-      // (W/m^2), so the VDLs of the voxel sum to its estimate.
-      w.samples.clear();
-      const float r = g.radius;
-      if (r > 0) {
-        const float invArea = 1.0f / (kPi * r * r);
-        for (uint32_t p : g.photons) {
-          const Photon& ph = photons[p];
-          w.samples.push_back({ph.direction, ph.power * invArea});
-        }
+      const int layers = layerParams ? w.gatherer.findSurfaceLayers(v, *layerParams, found) : 0;
+      // A voxel whose geometry faces several ways gathers along its layers'
+      // normals even when one layer is lit: the area-weighted mean of
+      // opposing faces (a ball resting on the floor) is a meaningless normal.
+      const bool several = !grid.orientationStart.empty() &&
+                           grid.orientationStart[v + 1] != grid.orientationStart[v];
+      const bool layered = layers >= 2 || (layers == 1 && several);
+      if (layered) {
+        w.gatherer.gatherLayer(v, found[0].point, found[0].normal, w.gathered);
+      } else {
+        w.gatherer.gather(v, w.gathered);
       }
+      const GatherResult& g = w.gathered;
       Clock::time_point t1 = Clock::now();
-      ClusterResult c =
-          clusterDirections(w.samples.data(), w.samples.size(), cluster.vdls, cluster, v);
+      ClusterResult c = clusterGathered(w, v);
       Clock::time_point t2 = Clock::now();
       gatherSeconds += secondsBetween(t0, t1);
       clusterSeconds += secondsBetween(t1, t2);
 
       out.normals[v] = g.normal;
+      out.points[v] = layered ? found[0].point : grid.centroids[v];
       out.irradiance[v] = g.irradiance;
       out.photonCount[v] = float(g.photons.size());
       out.radius[v] = g.radius;
@@ -83,6 +114,19 @@ struct BakeBody {
       out.vdlCount[v] = uint8_t(c.count);
       Vdl* dst = out.vdls.data() + v * maxVdls;
       for (int i = 0; i < c.count; ++i) dst[i] = c.vdls[i];
+
+      for (int l = 1; l < layers; ++l) {
+        Clock::time_point t3 = Clock::now();
+        w.gatherer.gatherLayer(v, found[l].point, found[l].normal, w.gathered);
+        Clock::time_point t4 = Clock::now();
+        Worker::Layer layer{uint32_t(v), l, w.gathered.normal, found[l].point,
+                            w.gathered.irradiance, float(w.gathered.photons.size()),
+                            w.gathered.radius,
+                            clusterGathered(w, uint64_t(v) + uint64_t(l) * grid.size())};
+        w.layers.push_back(layer);
+        gatherSeconds += secondsBetween(t3, t4);
+        clusterSeconds += secondsBetween(t4, Clock::now());
+      }
     }
     w.gatherSeconds += gatherSeconds;
     w.clusterSeconds += clusterSeconds;
@@ -94,7 +138,7 @@ struct BakeBody {
 
 VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons,
                      const GatherParams& gather, const ClusterParams& cluster,
-                     ProgressSink* progress, BakeTimings* timings) {
+                     ProgressSink* progress, BakeTimings* timings, const LayerParams* layers) {
   using namespace vdl_grid_internal;
   if (cluster.vdls < 1 || cluster.vdls > kMaxVdls) {
     throw InputError("VDL count " + std::to_string(cluster.vdls) + " is outside [1, " +
@@ -116,6 +160,11 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
   out.angularError.assign(n, 0.0f);
   out.vdlCount.assign(n, 0);
   out.vdls.assign(n * size_t(out.maxVdls), Vdl{});  // unused slots stay zero
+  out.points.assign(n, Vec3{});
+  if (layers && (layers->maxLayers < 1 || layers->maxLayers > kMaxLayers)) {
+    throw InputError("surface layers: at most " + std::to_string(layers->maxLayers) +
+                     " per voxel is outside [1, " + std::to_string(kMaxLayers) + "]");
+  }
 
   // One copy of the binned photons, read by every thread's gatherer.
   std::shared_ptr<const BinnedPhotons> binned = binPhotonsForGather(grid, photons);
@@ -126,7 +175,29 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
     // Every voxel writes only its own slots and seeds its K-means with its
     // index, so the result does not depend on the partition or thread count.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrainVoxels),
-                      BakeBody{photons, cluster, workers, bar, out});
+                      BakeBody{grid, photons, cluster, layers, workers, bar, out});
+  }
+
+  // Layers 1 and 2, gathered by whichever thread, in voxel and layer order.
+  std::vector<Worker::Layer> extra;
+  for (Worker& w : workers) {
+    extra.insert(extra.end(), w.layers.begin(), w.layers.end());
+    w.layers.clear();
+  }
+  std::sort(extra.begin(), extra.end(), [](const Worker::Layer& a, const Worker::Layer& b) {
+    return a.voxel < b.voxel || (a.voxel == b.voxel && a.layer < b.layer);
+  });
+  VdlLayers& L = out.layers;
+  for (const Worker::Layer& e : extra) {
+    L.voxel.push_back(e.voxel);
+    L.normals.push_back(e.normal);
+    L.points.push_back(e.point);
+    L.irradiance.push_back(e.irradiance);
+    L.photonCount.push_back(e.photonCount);
+    L.radius.push_back(e.radius);
+    L.angularError.push_back(e.vdls.angularError);
+    L.vdlCount.push_back(uint8_t(e.vdls.count));
+    for (int i = 0; i < out.maxVdls; ++i) L.vdls.push_back(i < e.vdls.count ? e.vdls.vdls[size_t(i)] : Vdl{});
   }
 
   if (timings) {

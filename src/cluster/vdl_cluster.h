@@ -52,9 +52,14 @@ struct BakeTimings {
 };
 
 /// Gathers and clusters every active voxel (TBB over blocks of voxels,
-/// deterministic: each voxel's K-means stream is its index).
+/// deterministic: each voxel's K-means stream is its index). With `layers`,
+/// a voxel whose own photons face clearly different ways
+/// (Gatherer::findSurfaceLayers) gets one gather and one set of VDLs per
+/// orientation: layer 0 in the grid's arrays, the others in
+/// VdlGrid::layers (docs/accuracy.md, "Surface layers").
 VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons,
                      const GatherParams& gather, const ClusterParams& cluster,
-                     ProgressSink* progress = nullptr, BakeTimings* timings = nullptr);
+                     ProgressSink* progress = nullptr, BakeTimings* timings = nullptr,
+                     const LayerParams* layers = nullptr);
 
 }  // namespace lo

@@ -148,7 +148,18 @@ class KnnSelection {
 struct Side {
   bool sphere;
   bool positive;
-  bool accepts(float c) const { return sphere || (positive ? c > 0 : c < 0); }
+  float cosine = 0;  ///< kept beyond this cosine (0: the whole hemisphere)
+  bool accepts(float c) const { return sphere || (positive ? c > cosine : c < -cosine); }
+};
+
+/// Where and how one gather looks: the query point and normal, whether the
+/// normal is already oriented (a surface layer: no vote), and how far from it
+/// a photon's normal may turn.
+struct QuerySpec {
+  Vec3 point;
+  Vec3 normal;
+  bool fixedNormal = false;
+  float sideCosine = 0;
 };
 
 /// Pass 2: one photon as a candidate (if within r and on the kept side).
@@ -173,18 +184,98 @@ inline void selectPhoton(const Vec3& position, const Vec3& normal, uint32_t inde
 /// Photons with dot(photon normal, n) <= 0 arrived from behind (the photon
 /// normal faces its arrival side, so this also removes photons on the back of a
 /// thin wall) and are rejected; the k nearest by (d^2, index) are kept.
-template <typename Vote, typename Select>
-void gatherWith(const SurfaceGrid& grid, const std::vector<Photon>& photons, size_t voxel,
-                const GatherParams& params, float radius, std::vector<uint64_t>& keys,
-                GatherResult& out, Vote&& vote, Select&& select) {
+/// The share of the disc of radius r around q, perpendicular to n, that lies
+/// on surfaces facing like n: 32 points spread evenly over the disc's area
+/// (4 rings of 8), each counted when the voxel holding it, or one of the
+/// voxels half a voxel above and below it along n (the surface may curve
+/// away from the disc), has geometry within 60 degrees of n (either way:
+/// the winding need not face the light). A density estimate divides the
+/// photons' power by this share of pi r^2: near an edge, where the disc
+/// reaches past the surface, the photons cover only part of it.
+/// GatherParams::edgeCorrection; 1 for the sphere metric or r = 0.
+double surfaceCoverage(const SurfaceGrid& grid, const Vec3& q, const Vec3& n, float r) {
+  if (n == Vec3{} || !(r > 0) || grid.size() == 0) return 1.0;
+  const Vec3 a = std::fabs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  const Vec3 t1 = normalize(cross(n, a)), t2 = cross(n, t1);
+  const float lift = 0.5f * grid.frame.voxelSize;
+  const bool orientations = grid.orientationStart.size() == grid.size() + 1;
+  // Whether point p of the disc lies on a surface facing like n in voxel v:
+  // one of v's orientations faces like n, and p lies on q's side of the
+  // planes of those that cross it (a wall standing on the floor: points of
+  // the floor's disc past the wall are not on the floor), within a tenth of
+  // a voxel. Either side: the test does not depend on the winding.
+  const float tolerance = 0.1f * grid.frame.voxelSize;
+  auto facesLikeN = [&](int64_t v, const Vec3& p) {
+    if (v < 0) return false;
+    if (!orientations || grid.orientationStart[size_t(v)] == grid.orientationStart[size_t(v) + 1]) {
+      return std::fabs(dot(grid.normals[size_t(v)], n)) > 0.5f || grid.normals[size_t(v)] == Vec3{};
+    }
+    // The facing surface's area against a full cut through the voxel: a
+    // surface that fills its voxel goes on behind whatever crosses it (a ball
+    // resting on the floor: the floor continues under it, in shadow); one
+    // that fills part of it ends at a crossing surface (a wall standing on
+    // the floor: no floor behind the wall).
+    const float h2 = grid.frame.voxelSize * grid.frame.voxelSize;
+    bool facing = false, partial = true;
+    for (uint32_t o = grid.orientationStart[size_t(v)]; o < grid.orientationStart[size_t(v) + 1];
+         ++o) {
+      const SurfaceGrid::Orientation& k = grid.orientations[o];
+      if (std::fabs(dot(k.normal, n)) > 0.5f) {
+        facing = true;
+        const float full =
+            h2 / std::max({std::fabs(k.normal.x), std::fabs(k.normal.y), std::fabs(k.normal.z)});
+        partial = partial && k.area < 0.9f * full;
+      }
+    }
+    if (!facing) return false;
+    if (!partial) return true;
+    for (uint32_t o = grid.orientationStart[size_t(v)]; o < grid.orientationStart[size_t(v) + 1];
+         ++o) {
+      const SurfaceGrid::Orientation& k = grid.orientations[o];
+      if (std::fabs(dot(k.normal, n)) > 0.5f) continue;
+      const float sp = dot(k.normal, p - k.centroid), sq = dot(k.normal, q - k.centroid);
+      if ((sp > tolerance && sq < -tolerance) || (sp < -tolerance && sq > tolerance)) return false;
+    }
+    return true;
+  };
+  constexpr int kRings = 4, kAngles = 8;
+  int covered = 0;
+  for (int ring = 0; ring < kRings; ++ring) {
+    const float rr = r * std::sqrt((float(ring) + 0.5f) / float(kRings));
+    for (int k = 0; k < kAngles; ++k) {
+      // Rings turned by half a step against each other.
+      const float phi = (float(k) + 0.5f * float(ring & 1)) * (2.0f * kPi / float(kAngles));
+      const Vec3 p = q + (t1 * std::cos(phi) + t2 * std::sin(phi)) * rr;
+      const Coord c = grid.frame.coordOf(p);
+      bool hit = facesLikeN(grid.find(c), p);
+      if (!hit) {
+        const Coord up = grid.frame.coordOf(p + n * lift), down = grid.frame.coordOf(p - n * lift);
+        hit = (up != c && facesLikeN(grid.find(up), p)) ||
+              (down != c && facesLikeN(grid.find(down), p));
+      }
+      covered += hit;
+    }
+  }
+  return double(covered) / double(kRings * kAngles);
+}
+
+template <typename Vote, typename Prepare, typename Select>
+void gatherWith(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+                const QuerySpec& spec, const GatherParams& params, float radius,
+                std::vector<uint64_t>& keys, GatherResult& out, Vote&& vote, Prepare&& prepare,
+                Select&& select) {
   Query query;
-  query.point = grid.centroids[voxel];
-  query.normal = grid.normals[voxel];
+  query.point = spec.point;
+  query.normal = spec.normal;
   query.squash2m1 = params.normalSquash * params.normalSquash - 1.0f;
   query.radius2 = radius * radius;
 
   Scan scan;
-  vote(query, scan);
+  if (spec.fixedNormal) {
+    scan.orientation = 1;  // the layer's normal is oriented already
+  } else {
+    vote(query, scan);
+  }
   if (query.normal == Vec3{}) {
     const Vec3 mean =
         normalize(Vec3{float(scan.mean[0]), float(scan.mean[1]), float(scan.mean[2])});
@@ -195,11 +286,12 @@ void gatherWith(const SurfaceGrid& grid, const std::vector<Photon>& photons, siz
     }
   }
   Vec3 n = query.normal;
-  Side side{query.normal == Vec3{}, true};
+  Side side{query.normal == Vec3{}, true, spec.sideCosine};
   if (scan.orientation < 0) {
     n = -n;
     side.positive = false;
   }
+  prepare(query.point, n, side);
 
   const size_t k = size_t(params.k);
   KnnSelection selection(keys, k);
@@ -219,8 +311,13 @@ void gatherWith(const SurfaceGrid& grid, const std::vector<Photon>& photons, siz
     power[1] += photons[p].power.y;
     power[2] += photons[p].power.z;
   }
-  const double invArea = 1.0 / (double(kPi) * double(rk) * double(rk));
+  // Edge correction: the disc's share on the surface (at least a quarter,
+  // so that a stray estimate cannot blow up).
+  const double coverage =
+      params.edgeCorrection ? std::max(0.25, surfaceCoverage(grid, query.point, n, rk)) : 1.0;
+  const double invArea = 1.0 / (double(kPi) * double(rk) * double(rk) * coverage);
   out.radius = rk;
+  out.coverage = float(coverage);
   out.normal = n;
   out.irradiance = {float(power[0] * invArea), float(power[1] * invArea),
                     float(power[2] * invArea)};
@@ -231,6 +328,14 @@ void checkParams(const GatherParams& params) {
   if (!(params.normalSquash > 0) || !std::isfinite(params.normalSquash)) {
     throw InputError("gather normalSquash " + std::to_string(params.normalSquash) +
                      " must be finite and > 0");
+  }
+  if (!(params.layerCosine >= -1 && params.layerCosine < 1)) {
+    throw InputError("gather layerCosine " + std::to_string(params.layerCosine) +
+                     " must lie in [-1, 1)");
+  }
+  if (!(params.occlusionLift >= 0) || !std::isfinite(params.occlusionLift)) {
+    throw InputError("gather occlusionLift " + std::to_string(params.occlusionLift) +
+                     " must be finite and >= 0");
   }
 }
 
@@ -252,7 +357,7 @@ std::shared_ptr<const BinnedPhotons> binPhotonsForGather(const SurfaceGrid& grid
     const uint32_t i = grid.binPhotons[j];
     LO_CHECK_LT(size_t(i), photons.size());
     const Photon& p = photons[i];
-    binned->entries[j] = {p.position, p.normal, average(p.power), i};
+    binned->entries[j] = {p.position, p.normal, average(p.power), i, BinnedPhotons::kNoGroup};
   }
   binned->bins.resize(grid.size());
   for (size_t v = 0; v < grid.size(); ++v) {
@@ -282,6 +387,26 @@ std::shared_ptr<const BinnedPhotons> binPhotonsForGather(const SurfaceGrid& grid
       bin.weight[g] += entry.weight;
     }
     if (bin.groups < 0 || !finite) bin.groups = 0;
+    // Where each group (or the whole bin) lies, for the occlusion test.
+    double sum[BinnedPhotons::kMaxGroups][3] = {};
+    uint32_t count[BinnedPhotons::kMaxGroups] = {};
+    for (uint32_t j = b; j != e; ++j) {
+      BinnedPhotons::Entry& entry = binned->entries[j];
+      int g = 0;
+      if (bin.groups > 0) {
+        while (!(bin.normal[g] == entry.normal)) ++g;
+        entry.group = uint32_t(g);
+      } else {
+        bin.normalSum += entry.normal;
+      }
+      for (int a = 0; a < 3; ++a) sum[g][a] += double(entry.position[a]);
+      ++count[g];
+    }
+    for (int g = 0; g < std::max(1, bin.groups); ++g) {
+      if (count[g] == 0) continue;
+      bin.point[g] = Vec3{float(sum[g][0] / count[g]), float(sum[g][1] / count[g]),
+                          float(sum[g][2] / count[g])};
+    }
   }
   return binned;
 }
@@ -339,10 +464,8 @@ void Gatherer::updateBlock(const Coord& c) {
   }
 }
 
-void Gatherer::gather(size_t voxel, GatherResult& out) {
+void Gatherer::findNear(const Vec3& q) {
   using namespace gather_internal;
-  LO_CHECK_LT(voxel, grid_.size());
-  updateBlock(grid_.coords[voxel]);
   const GridFrame& f = grid_.frame;
   const double vs = f.voxelSize;
   // Prune neighbour bins in index space by the distance from the query point to
@@ -355,7 +478,6 @@ void Gatherer::gather(size_t voxel, GatherResult& out) {
   // bounds the ellipsoid distance of its photons from below (with slack for
   // the float rounding of d^2).
   const double squash = std::min(1.0, double(params_.normalSquash));
-  const Vec3& q = grid_.centroids[voxel];
   const double qi[3] = {(double(q.x) - f.origin.x) / vs, (double(q.y) - f.origin.y) / vs,
                         (double(q.z) - f.origin.z) / vs};
   near_.clear();
@@ -369,6 +491,48 @@ void Gatherer::gather(size_t voxel, GatherResult& out) {
     const double euclid = std::max(0.0, std::sqrt(box2) * vs - double(grid_.binMargin));
     near_.push_back({euclid * euclid * squash * squash * (1.0 - 1e-4), i});
   }
+}
+
+void Gatherer::markBlocked(size_t ownVoxel, const Vec3& point, const Vec3& normal,
+                           float sideCosine) {
+  if (!params_.blocked) return;
+  const float lift = params_.occlusionLift * grid_.frame.voxelSize;
+  const Vec3 from = point + normal * lift;
+  const bool sphere = normal == Vec3{};
+  for (Near& nr : near_) {
+    const Neighbour& nb = blockNeighbours_[nr.neighbour];
+    if (nb.voxel == ownVoxel) continue;
+    const BinnedPhotons::Bin& bin = binned_->bins[nb.voxel];
+    if (bin.groups > 0) {
+      for (int g = 0; g < bin.groups; ++g) {
+        // A group the kept side rejects contributes nothing: no ray.
+        if (!sphere && !(dot(bin.normal[g], normal) > sideCosine)) continue;
+        if (params_.blocked(from, bin.point[g] + bin.normal[g] * lift)) nr.blocked |= 1u << g;
+      }
+    } else {
+      const Vec3 n = normalize(bin.normalSum);
+      const Vec3 to = bin.point[0] + (isFinite(n) ? n : Vec3{0, 0, 0}) * lift;
+      if (params_.blocked(from, to)) nr.blocked = 1u;
+    }
+  }
+}
+
+void Gatherer::gather(size_t voxel, GatherResult& out) {
+  LO_CHECK_LT(voxel, grid_.size());
+  gatherAt(voxel, grid_.centroids[voxel], grid_.normals[voxel], false, 0.0f, out);
+}
+
+void Gatherer::gatherLayer(size_t voxel, const Vec3& point, const Vec3& normal,
+                           GatherResult& out) {
+  LO_CHECK_LT(voxel, grid_.size());
+  gatherAt(voxel, point, normal, true, params_.layerCosine, out);
+}
+
+void Gatherer::gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, bool fixedNormal,
+                        float sideCosine, GatherResult& out) {
+  using namespace gather_internal;
+  updateBlock(grid_.coords[voxel]);
+  findNear(point);
   const BinnedPhotons::Entry* entries = binned_->entries.data();
   // Pass 1, the orientation vote: every photon within r, in bin order.
   // A bin whose photons all lie within r (d^2 is convex, so its largest value
@@ -409,28 +573,109 @@ void Gatherer::gather(size_t voxel, GatherResult& out) {
       }
     }
   };
+  auto prepare = [&](const Vec3& p, const Vec3& n, const Side& side) {
+    markBlocked(voxel, p, n, side.sphere ? -2.0f : side.cosine);
+  };
   // Pass 2, the selection: nearest bins first; once k candidates are held, a
   // bin whose bound exceeds the k-th distance cannot improve the set, nor can
-  // any later bin.
+  // any later bin. Groups behind geometry (markBlocked) are skipped.
   auto select = [&](const Query& query, Side side, KnnSelection& selection) {
     std::sort(near_.begin(), near_.end());
     for (const Near& nr : near_) {
       if (selection.full() && nr.bound2 > double(selection.bound())) break;
       const Neighbour& nb = blockNeighbours_[nr.neighbour];
-      for (uint32_t j = nb.begin; j != nb.end; ++j) {
-        selectPhoton(entries[j].position, entries[j].normal, entries[j].index, query, side,
-                     selection);
+      if (nr.blocked == 0) {
+        for (uint32_t j = nb.begin; j != nb.end; ++j) {
+          selectPhoton(entries[j].position, entries[j].normal, entries[j].index, query, side,
+                       selection);
+        }
+      } else if (binned_->bins[nb.voxel].groups > 0) {
+        for (uint32_t j = nb.begin; j != nb.end; ++j) {
+          if (nr.blocked & (1u << entries[j].group)) continue;
+          selectPhoton(entries[j].position, entries[j].normal, entries[j].index, query, side,
+                       selection);
+        }
       }
     }
   };
-  gatherWith(grid_, photons_, voxel, params_, radius_, keys_, out, vote, select);
+  QuerySpec spec;
+  spec.point = point;
+  spec.normal = normal;
+  spec.fixedNormal = fixedNormal;
+  spec.sideCosine = sideCosine;
+  gatherWith(grid_, photons_, spec, params_, radius_, keys_, out, vote, prepare, select);
 }
 
-GatherResult gatherBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,
-                              size_t voxel, const GatherParams& params) {
-  using namespace gather_internal;
+int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
+                                SurfaceLayer* out) const {
+  LO_CHECK_LT(voxel, grid_.size());
+  // Candidate surfaces: the voxel's geometric orientations (SurfaceGrid::
+  // orientations), else its one normal and centroid.
+  struct Candidate {
+    Vec3 normal, point;
+    float area;
+  };
+  Candidate candidates[SurfaceGrid::kMaxOrientations];
+  int count = 0;
+  if (grid_.orientationStart.size() == grid_.size() + 1) {
+    for (uint32_t o = grid_.orientationStart[voxel]; o < grid_.orientationStart[voxel + 1]; ++o) {
+      const SurfaceGrid::Orientation& g = grid_.orientations[o];
+      // The two faces of a thin wall are one surface here: its photons say
+      // which side (or both) is lit.
+      bool opposite = false;
+      for (int c = 0; c < count; ++c) {
+        opposite = opposite || -dot(candidates[c].normal, g.normal) > params.splitCosine;
+      }
+      if (!opposite) candidates[count++] = {g.normal, g.centroid, g.area};
+    }
+  }
+  if (count == 0) {
+    if (!(lengthSquared(grid_.normals[voxel]) > 0.5f)) return 0;
+    candidates[count++] = {grid_.normals[voxel], grid_.centroids[voxel], grid_.areas[voxel]};
+  }
+  // Which side of each surface its photons arrived on: the photons of the
+  // voxel's own bin within params.splitCosine of the front or the back.
+  const BinnedPhotons::Entry* entries = binned_->entries.data();
+  double front[SurfaceGrid::kMaxOrientations] = {}, back[SurfaceGrid::kMaxOrientations] = {};
+  uint32_t frontCount[SurfaceGrid::kMaxOrientations] = {},
+           backCount[SurfaceGrid::kMaxOrientations] = {};
+  double total = 0;
+  for (uint32_t j = grid_.binStart[voxel]; j != grid_.binStart[voxel + 1]; ++j) {
+    const BinnedPhotons::Entry& e = entries[j];
+    if (!isFinite(e.normal) || !(e.weight >= 0)) continue;
+    total += double(e.weight);
+    for (int c = 0; c < count; ++c) {
+      const float d = dot(e.normal, candidates[c].normal);
+      if (d > params.splitCosine) {
+        front[c] += double(e.weight);
+        ++frontCount[c];
+      } else if (-d > params.splitCosine) {
+        back[c] += double(e.weight);
+        ++backCount[c];
+      }
+    }
+  }
+  // A surface lit on one side is a layer facing that side (its winding's when
+  // no photon landed on it: a dark layer still claims its fragments); lit on
+  // both, two layers facing away from each other.
+  auto significant = [&](double w, uint32_t n) {
+    return n >= params.minPhotons && w >= double(params.minShare) * total && w > 0;
+  };
+  int layers = 0;
+  for (int c = 0; c < count && layers < params.maxLayers; ++c) {
+    const Candidate& k = candidates[c];
+    const bool f = significant(front[c], frontCount[c]), b = significant(back[c], backCount[c]);
+    if (f || !b) out[layers++] = {k.normal, k.point, front[c], frontCount[c]};
+    if (b && layers < params.maxLayers) out[layers++] = {-k.normal, k.point, back[c], backCount[c]};
+  }
+  return layers;
+}
+
+namespace gather_internal {
+
+GatherResult bruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+                        const QuerySpec& spec, const GatherParams& params) {
   checkParams(params);
-  LO_CHECK_LT(voxel, grid.size());
   const float radius = resolveRadius(params, grid.frame);
   std::vector<uint64_t> keys;
   GatherResult out;
@@ -442,8 +687,31 @@ GatherResult gatherBruteForce(const SurfaceGrid& grid, const std::vector<Photon>
       selectPhoton(photons[i].position, photons[i].normal, uint32_t(i), query, side, selection);
     }
   };
-  gatherWith(grid, photons, voxel, params, radius, keys, out, vote, select);
+  gatherWith(grid, photons, spec, params, radius, keys, out, vote,
+             [](const Vec3&, const Vec3&, const Side&) {}, select);
   return out;
+}
+
+}  // namespace gather_internal
+
+GatherResult gatherBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+                              size_t voxel, const GatherParams& params) {
+  LO_CHECK_LT(voxel, grid.size());
+  gather_internal::QuerySpec spec;
+  spec.point = grid.centroids[voxel];
+  spec.normal = grid.normals[voxel];
+  return gather_internal::bruteForce(grid, photons, spec, params);
+}
+
+GatherResult gatherLayerBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+                                   const Vec3& point, const Vec3& normal,
+                                   const GatherParams& params) {
+  gather_internal::QuerySpec spec;
+  spec.point = point;
+  spec.normal = normal;
+  spec.fixedNormal = true;
+  spec.sideCosine = params.layerCosine;
+  return gather_internal::bruteForce(grid, photons, spec, params);
 }
 
 }  // namespace lo

@@ -4,6 +4,7 @@
 /// radius r, distances measured in an ellipsoid aligned with the voxel normal.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -13,6 +14,11 @@
 
 namespace lo {
 
+/// Whether geometry blocks the straight segment between two points (world
+/// space). The bake answers it with the scene's ray tracer (src/photon); the
+/// gather uses it to leave out photons behind a wall.
+using SegmentBlocked = std::function<bool(const Vec3& from, const Vec3& to)>;
+
 struct GatherParams {
   int k = 300;  ///< nearest neighbours (paper: 300)
   /// Gathering radius in world units; 0 = kDefaultRadiusVoxels * voxel size.
@@ -21,6 +27,38 @@ struct GatherParams {
   /// `normalSquash` times its length, so photons on a perpendicular wall or
   /// behind a thin wall fall outside the search region.
   float normalSquash = 4.0f;
+  /// Photons of a surface layer (Gatherer::gatherLayer) face within this
+  /// cosine of the layer's normal: 0.5 = 60 degrees, so the faces of a box
+  /// edge (90 degrees) and the two sides of a thin wall stay apart.
+  float layerCosine = 0.5f;
+  /// Set: photon bins (per group of photons sharing a normal) that a
+  /// segment from the query point to them crosses geometry are left out: no
+  /// light is gathered through a thin wall. Both ends are lifted off their
+  /// surfaces by occlusionLift voxels along their normals, so that a
+  /// segment along a plane does not graze it.
+  SegmentBlocked blocked;
+  float occlusionLift = 0.6f;
+  /// Edge correction: divide the photons' power by the part of the disc
+  /// pi r_k^2 that lies on the surface (surfaceCoverage in gather.cpp), not
+  /// the whole disc: next to an edge, where the disc reaches past the
+  /// surface, the plain estimate is too dark by up to half.
+  bool edgeCorrection = true;
+};
+
+/// One surface of a voxel facing one way (Gatherer::findSurfaceLayers).
+struct SurfaceLayer {
+  Vec3 normal{0, 0, 0};  ///< unit, facing the side its light arrives from
+  Vec3 point{0, 0, 0};   ///< a point of the surface (its centroid in the voxel), world space
+  double weight = 0;     ///< summed average(power) of the voxel's photons on that side
+  uint32_t photons = 0;
+};
+
+/// Criteria of findSurfaceLayers.
+struct LayerParams {
+  int maxLayers = 3;          ///< at most this many (kMaxLayers)
+  float splitCosine = 0.5f;   ///< a photon is on a surface's side within this cosine (60 deg)
+  float minShare = 0.1f;      ///< a lit side holds at least this share of the voxel's photon weight
+  uint32_t minPhotons = 4;    ///< and at least this many photons
 };
 
 /// Fills grid.binStart / grid.binPhotons / grid.binMargin: the photons whose
@@ -45,7 +83,9 @@ struct GatherResult {
   float radius =
       0.0f;  ///< r_k: distance (ellipsoid metric) of the k-th photon, or r if fewer found
   Vec3 normal{0, 0, 0};      ///< voxel normal oriented towards the side the light arrives from
-  Vec3 irradiance{0, 0, 0};  ///< sum(power) / (pi r_k^2), W/m^2
+  Vec3 irradiance{0, 0, 0};  ///< sum(power) / (pi r_k^2 coverage), W/m^2
+  /// Share of the disc pi r_k^2 on the surface (GatherParams::edgeCorrection), else 1.
+  float coverage = 1.0f;
 };
 
 /// The photons of a surface grid's bins, copied contiguously in bin order
@@ -58,7 +98,9 @@ struct BinnedPhotons {
     Vec3 normal;     ///< the photon's normal (facing its arrival side)
     float weight;    ///< average(power), W: the orientation vote's weight
     uint32_t index;  ///< into the photon array
+    uint32_t group;  ///< its bin's group of equal normals, kNoGroup when the bin has none
   };
+  static constexpr uint32_t kNoGroup = 0xffffffffu;
   std::vector<Entry> entries;
   /// Per bin (grid voxel): the bounds of its photons' positions and, when its
   /// photons carry at most kMaxGroups distinct normals, their summed weight
@@ -70,6 +112,11 @@ struct BinnedPhotons {
     int groups = 0;  ///< 0: vote per photon
     Vec3 normal[kMaxGroups];
     double weight[kMaxGroups] = {0, 0, 0, 0};
+    /// Mean photon position per group (groups > 0), else of the whole bin
+    /// (point[0]), and for a bin without groups its mean photon normal
+    /// (unnormalised): where GatherParams::blocked aims.
+    Vec3 point[kMaxGroups];
+    Vec3 normalSum{0, 0, 0};
   };
   std::vector<Bin> bins;
 };
@@ -90,6 +137,19 @@ class Gatherer {
   Gatherer(const SurfaceGrid& grid, const std::vector<Photon>& photons,
            std::shared_ptr<const BinnedPhotons> binned, const GatherParams& params);
   void gather(size_t voxel, GatherResult& out);
+  /// One surface layer of `voxel` (findSurfaceLayers): the k nearest photons
+  /// to `point` whose normals lie within GatherParams::layerCosine of
+  /// `normal` (unit, already oriented: no vote), in the ellipsoid along it.
+  void gatherLayer(size_t voxel, const Vec3& point, const Vec3& normal, GatherResult& out);
+  /// The surface layers of `voxel`: its geometric orientations
+  /// (SurfaceGrid::orientations, the largest first), else its one normal,
+  /// each facing the side its photons arrived on (the photons of the voxel's
+  /// own bin within params.splitCosine of its front or back; the winding's
+  /// side when none did), or two layers facing away from each other when
+  /// both sides hold params.minShare of the bin's weight and
+  /// params.minPhotons. At most params.maxLayers; a point of each is the
+  /// orientation's centroid. Fewer than 2: the voxel needs no layers.
+  int findSurfaceLayers(size_t voxel, const LayerParams& params, SurfaceLayer* out) const;
 
  private:
   const SurfaceGrid& grid_;
@@ -113,19 +173,34 @@ class Gatherer {
   struct Near {
     double bound2;  ///< lower bound of d^2 (world units^2) of any photon in the bin
     uint32_t neighbour;
+    uint32_t blocked = 0;  ///< bit g: group g is behind geometry (bit 0 alone for a bin without groups)
     bool operator<(const Near& o) const {
       return bound2 < o.bound2 || (bound2 == o.bound2 && neighbour < o.neighbour);
     }
   };
   void updateBlock(const Coord& voxelCoord);
+  /// near_ for a query point: the neighbour bins within reach.
+  void findNear(const Vec3& point);
+  /// Sets Near::blocked by GatherParams::blocked from `point` lifted along
+  /// `normal` (skipping `ownVoxel`'s bin and groups the kept side rejects).
+  void markBlocked(size_t ownVoxel, const Vec3& point, const Vec3& normal, float sideCosine);
+  /// gather and gatherLayer: `fixedNormal` skips the orientation vote;
+  /// photons are kept when dot(photon normal, n) > sideCosine.
+  void gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, bool fixedNormal,
+                float sideCosine, GatherResult& out);
   Coord blockCoord_{};
   bool blockValid_ = false;
   std::vector<Neighbour> blockNeighbours_;
   std::vector<Near> near_;  ///< this voxel's neighbours within reach, nearest first
 };
 
-/// Reference: the same selection by scanning every photon. For tests.
+/// Reference: the same selection by scanning every photon, for tests
+/// (without GatherParams::blocked, which works on bins).
 GatherResult gatherBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,
                               size_t voxel, const GatherParams& params);
+/// Reference of Gatherer::gatherLayer, likewise.
+GatherResult gatherLayerBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+                                   const Vec3& point, const Vec3& normal,
+                                   const GatherParams& params);
 
 }  // namespace lo

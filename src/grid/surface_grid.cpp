@@ -302,22 +302,64 @@ SurfaceGrid buildSurfaceGrid(const Scene& scene, const GridParams& params, Progr
                       }
                     });
 
+  grid.orientationStart.push_back(0);
+  constexpr int kMaxClusters = 16;
+  struct Cluster {
+    D3 normal{0, 0, 0}, centroid{0, 0, 0};
+    double area = 0;
+  };
+  Cluster clusters[kMaxClusters];
   for (size_t i = 0; i < all.size();) {
     size_t j = i;
     double area = 0;
     D3 normal(0, 0, 0), areaCentroid(0, 0, 0), zeroCentroid(0, 0, 0);
+    int clusterCount = 0;
     for (; j < all.size() && all[j].key == all[i].key; ++j) {
       const Contribution& k = all[j];
       area += k.area;
       normal += faceNormals[k.triangle] * k.area;
       if (k.area > 0) {
         areaCentroid += k.centroid;
+        // Orientation clusters (in (voxel, triangle) order: deterministic).
+        const D3& fn = faceNormals[k.triangle];
+        int m = 0;
+        for (; m < clusterCount; ++m) {
+          const double l = length(clusters[m].normal);
+          if (l > 0 && dot(clusters[m].normal, fn) > 0.5 * l) break;
+        }
+        if (m == clusterCount && clusterCount < kMaxClusters) clusters[clusterCount++] = Cluster{};
+        if (m < clusterCount) {
+          clusters[m].normal += fn * k.area;
+          clusters[m].centroid += k.centroid;
+          clusters[m].area += k.area;
+        }
       } else {
         zeroCentroid += k.centroid;
       }
     }
     const Coord c = coordFromKey(all[i].key);
     const D3 center = frame.center(c);
+    {
+      int order[kMaxClusters];
+      int kept = 0;
+      for (int m = 0; m < clusterCount; ++m) {
+        if (clusters[m].area >= 0.02 * area && length(clusters[m].normal) > 1e-6 * clusters[m].area) {
+          order[kept++] = m;
+        }
+      }
+      std::stable_sort(order, order + kept,
+                       [&](int a, int b) { return clusters[a].area > clusters[b].area; });
+      kept = std::min(kept, SurfaceGrid::kMaxOrientations);
+      if (kept >= 2) {
+        for (int o = 0; o < kept; ++o) {
+          const Cluster& k = clusters[order[o]];
+          grid.orientations.push_back({(k.normal * (1.0 / length(k.normal))).toVec3(),
+                                       (center + k.centroid * (1.0 / k.area)).toVec3(),
+                                       float(k.area)});
+        }
+      }
+      grid.orientationStart.push_back(uint32_t(grid.orientations.size()));
+    }
     grid.coords.push_back(c);
     grid.areas.push_back(float(area));
     // Opposite faces in one voxel (both sides of a thin wall, or coincident

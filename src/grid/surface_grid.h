@@ -34,6 +34,23 @@ class SurfaceGrid {
   std::vector<Vec3> centroids;   ///< area-weighted centroid of the geometry inside the voxel, world space
   std::vector<float> areas;      ///< area of the geometry clipped to the voxel, world units^2
 
+  /// The ways the geometry inside a voxel faces, where there is more than one
+  /// (an edge, a corner, a curved or folded surface): the triangles clipped
+  /// to the voxel clustered by their winding normals (a triangle joins the
+  /// first cluster whose running area-weighted mean lies within 60 degrees,
+  /// else starts one; clusters under 2% of the voxel's area dropped; at most
+  /// kMaxOrientations, the largest first). Voxel v's are
+  /// orientations[orientationStart[v] .. orientationStart[v + 1]); none for a
+  /// voxel of one orientation. Empty orientationStart: not computed.
+  struct Orientation {
+    Vec3 normal;    ///< unit, area-weighted mean of the cluster's winding normals
+    Vec3 centroid;  ///< area-weighted centroid of its geometry in the voxel, world space
+    float area;     ///< its clipped area, world units^2
+  };
+  static constexpr int kMaxOrientations = 4;
+  std::vector<uint32_t> orientationStart;
+  std::vector<Orientation> orientations;
+
   /// Photon bins (CSR), filled by the gather's splatPhotons (gather/gather.h): the photons whose position lies
   /// in voxel v are binPhotons[binStart[v] .. binStart[v+1]), in photon order.
   std::vector<uint32_t> binStart;

@@ -46,6 +46,31 @@ struct LightGridVoxels {
   size_t size() const { return coords.size(); }
 };
 
+/// Most surface layers a voxel keeps (docs/accuracy.md, "Surface layers").
+constexpr int kMaxLayers = 3;
+
+/// The second and third surface layers of the voxels that have them. A voxel
+/// whose photons land on surfaces facing clearly different ways (the faces
+/// meeting at an edge, the two sides of a thin wall) keeps one layer per
+/// orientation, each with its own normal, gather and VDLs; layer 0 is the
+/// voxel's entry in VdlGrid's own arrays, as for every voxel, and layers 1
+/// and 2 are the entries here, with the same meaning per field.
+struct VdlLayers {
+  /// The voxel (index into VdlGrid::coords) each entry belongs to:
+  /// ascending, a voxel's layer 1 before its layer 2.
+  std::vector<uint32_t> voxel;
+  std::vector<Vec3> normals;      ///< unit, facing the side the layer's light arrives from
+  std::vector<Vec3> points;       ///< a point of the layer's surface, world space
+  std::vector<Vec3> irradiance;   ///< W/m^2, the sum of the layer's VDLs
+  std::vector<float> photonCount;
+  std::vector<float> radius;
+  std::vector<float> angularError;
+  std::vector<uint8_t> vdlCount;
+  std::vector<Vdl> vdls;          ///< size() * VdlGrid::maxVdls, strongest first
+
+  size_t size() const { return voxel.size(); }
+};
+
 /// LightGridVoxels with up to `maxVdls` VDLs per voxel (paper §3.1.2); the
 /// total irradiance is the sum of the voxel's VDLs. Unused slots are zero.
 struct VdlGrid : LightGridVoxels {
@@ -53,15 +78,22 @@ struct VdlGrid : LightGridVoxels {
   std::vector<float> angularError;  ///< weighted std. deviation of chord length (paper §5.3.2)
   std::vector<uint8_t> vdlCount;
   std::vector<Vdl> vdls;            ///< size() * maxVdls, strongest first per voxel
+  /// Per voxel, a point of layer 0's surface (world space): what the
+  /// renderer's side test (shaders/octree_lookup.h) measures the other
+  /// layers' planes against. Used only where the voxel has more layers;
+  /// empty = none recorded (files without layers).
+  std::vector<Vec3> points;
+  VdlLayers layers;  ///< layers 1 and 2 of the voxels that have them
 
   const Vdl* vdlsOf(size_t v) const { return vdls.data() + v * size_t(maxVdls); }
+  const Vdl* layerVdlsOf(size_t e) const { return layers.vdls.data() + e * size_t(maxVdls); }
 };
 
 /// Version of the light-grid file contract (docs/vdb-contract.md), written as
 /// the int32 file metadata `format_version`. Readers refuse files with a
 /// higher number and read files without the key (written before it existed)
-/// as version 1.
-constexpr int kVdlFormatVersion = 1;
+/// as version 1. Version 2 added the surface layers (`layer*` grids).
+constexpr int kVdlFormatVersion = 2;
 
 /// What a light grid means: the settings that made it, stored beside the grids
 /// as file metadata.
@@ -82,6 +114,9 @@ struct BakeMetadata {
   int formatVersion = kVdlFormatVersion;
   /// Set by `convert`: what the file was converted from, e.g. "cornell.vdb (depth 6)".
   std::string convertedFrom;
+  /// The gather's accuracy options (docs/accuracy.md); -1 = not recorded
+  /// (files written before format version 2).
+  int surfaceLayers = -1, gatherOcclusion = -1, edgeCorrection = -1;
 };
 
 }  // namespace lo

@@ -76,6 +76,43 @@ void validate(const VdlGrid& grid, const GpuOctreeParams& params) {
     throw InputError("GPU octree: max 2D texture size " + std::to_string(params.max2DTextureSize) +
                      " must be positive");
   }
+  const VdlLayers& L = grid.layers;
+  const size_t ne = L.size();
+  if (L.normals.size() != ne || L.points.size() != ne || L.vdlCount.size() != ne ||
+      L.vdls.size() != ne * size_t(grid.maxVdls)) {
+    throw InputError("GPU octree: surface layer arrays disagree: " + std::to_string(ne) +
+                     " layers, " + std::to_string(L.normals.size()) + " normals, " +
+                     std::to_string(L.points.size()) + " points, " +
+                     std::to_string(L.vdls.size()) + " VDL slots");
+  }
+  if (!grid.points.empty() && grid.points.size() != grid.size()) {
+    throw InputError("GPU octree: " + std::to_string(grid.points.size()) + " layer points for " +
+                     std::to_string(grid.size()) + " voxels");
+  }
+  for (size_t e = 0; e < ne; ++e) {
+    const uint32_t v = L.voxel[e];
+    int layer = 1;
+    for (size_t b = e; b > 0 && L.voxel[b - 1] == v; --b) ++layer;
+    if (v >= grid.size() || (e > 0 && L.voxel[e - 1] > v) || layer >= kMaxLayers) {
+      throw InputError("GPU octree: surface layer " + std::to_string(e) + " names voxel " +
+                       std::to_string(v) + " out of order, out of range or as its layer " +
+                       std::to_string(layer) + " (at most " + std::to_string(kMaxLayers - 1) +
+                       " extra layers per voxel)");
+    }
+    if (L.vdlCount[e] > grid.maxVdls || !isFinite(L.normals[e]) || !isFinite(L.points[e])) {
+      throw InputError("GPU octree: surface layer " + std::to_string(e) + " of voxel " +
+                       std::to_string(v) + " has " + std::to_string(L.vdlCount[e]) +
+                       " VDLs, normal " + L.normals[e].ToString() + ", point " +
+                       L.points[e].ToString());
+    }
+    for (int i = 0; i < L.vdlCount[e]; ++i) {
+      const Vdl& vdl = L.vdls[e * size_t(grid.maxVdls) + size_t(i)];
+      if (!isFinite(vdl.irradiance) || !isFinite(vdl.direction)) {
+        throw InputError("GPU octree: surface layer " + std::to_string(e) + " of voxel " +
+                         std::to_string(v) + " VDL " + std::to_string(i) + " is not finite");
+      }
+    }
+  }
   const int res = f.resolution();
   for (size_t v = 0; v < grid.size(); ++v) {
     const Coord& c = grid.coords[v];
@@ -168,10 +205,29 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
     uint64_t code;
     uint32_t voxel;
   };
+  // Each voxel's extra surface layers: entries extraFirst[v] .. + extraCount[v]
+  // of grid.layers (validated: ascending by voxel).
+  std::vector<uint32_t> extraFirst(grid.size(), 0);
+  std::vector<uint8_t> extraCount(grid.size(), 0);
+  for (size_t e = 0; e < grid.layers.size(); ++e) {
+    const uint32_t v = grid.layers.voxel[e];
+    if (extraCount[v]++ == 0) extraFirst[v] = uint32_t(e);
+  }
+  // Texels of a leaf: its VDLs, or a layer block (octree_layout.h).
+  auto leafTexels = [&](size_t v) -> size_t {
+    if (extraCount[v] == 0) return grid.vdlCount[v];
+    size_t n = 2 + grid.vdlCount[v];
+    for (uint32_t e = extraFirst[v]; e < extraFirst[v] + extraCount[v]; ++e) {
+      n += 1 + grid.layers.vdlCount[e];
+    }
+    return n;
+  };
   std::vector<Leaf> leaves;
   leaves.reserve(grid.size());
   for (size_t v = 0; v < grid.size(); ++v) {
-    if (grid.vdlCount[v] > 0) leaves.push_back({mortonCode(grid.coords[v], depth), uint32_t(v)});
+    if (grid.vdlCount[v] > 0 || extraCount[v] > 0) {
+      leaves.push_back({mortonCode(grid.coords[v], depth), uint32_t(v)});
+    }
   }
   std::sort(leaves.begin(), leaves.end(),
             [](const Leaf& a, const Leaf& b) { return a.code < b.code; });
@@ -240,7 +296,7 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
 
   // VDL texture size and the 24-bit address space.
   size_t vdlTotal = 0;
-  for (const Leaf& leaf : leaves) vdlTotal += grid.vdlCount[leaf.voxel];
+  for (const Leaf& leaf : leaves) vdlTotal += leafTexels(leaf.voxel);
   const size_t addressSpace = size_t(LO_MAX_ADDRESS) + 1;
   if (vdlTotal > addressSpace) {
     throw InputError("GPU octree: " + std::to_string(vdlTotal) +
@@ -280,6 +336,19 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
     const size_t x = 2 * tx + (child & 1u), y = 2 * ty + ((child >> 1) & 1u),
                  z = 2 * tz + ((child >> 2) & 1u);
     return &out.pool[((z * poolH + y) * poolW + x) * 4];
+  };
+  // One texel: rgb as floats (halves in the half texture), a as the float
+  // of an integer (the packed direction, a count).
+  auto writeTexel = [&](size_t index, const Vec3& rgb, float a) {
+    const size_t offset =
+        (size_t(loVdlTexelY(uint(index))) * width + size_t(loVdlTexelX(uint(index)))) * 4;
+    if (out.halfFloat) {
+      for (int c = 0; c < 3; ++c) out.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(rgb[c]);
+      out.vdlTexelsHalf[offset + 3] = uint16_t(a);
+    } else {
+      for (int c = 0; c < 3; ++c) out.vdlTexels[offset + size_t(c)] = rgb[c];
+      out.vdlTexels[offset + 3] = a;
+    }
   };
   // `normal`: the voxel's normal for params.cosineCorrection, else zero.
   auto writeVdl = [&](size_t index, const Vdl& vdl, const Vec3& normal) {
@@ -325,17 +394,48 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
       } else {
         const Leaf& leaf = leaves[j];  // level `depth` is the leaf list itself
         LO_CHECK_EQ(leaf.code, code);
-        const int count = grid.vdlCount[leaf.voxel];
+        const size_t v = leaf.voxel;
+        const int count = grid.vdlCount[v];
         const uint address = uint(nextVdl);
         t[0] = uint8_t(loPackAddressR(address));
         t[1] = uint8_t(loPackAddressG(address));
         t[2] = uint8_t(loPackAddressB(address));
-        t[3] = uint8_t(count);
-        const Vdl* vdls = grid.vdlsOf(leaf.voxel);
+        t[3] = uint8_t(extraCount[v] > 0 ? LO_FLAG_LAYERED : uint(count));
+        const Vdl* vdls = grid.vdlsOf(v);
         const Vec3 normal = params.cosineCorrection && grid.normals.size() == grid.size()
-                                ? normalize(grid.normals[leaf.voxel])
+                                ? normalize(grid.normals[v])
                                 : Vec3{0, 0, 0};
-        for (int i = 0; i < count; ++i) writeVdl(nextVdl++, vdls[i], normal);
+        if (extraCount[v] == 0) {
+          for (int i = 0; i < count; ++i) writeVdl(nextVdl++, vdls[i], normal);
+          continue;
+        }
+        // A layer block: header, then per layer its header and VDLs.
+        const uint32_t e0 = extraFirst[v];
+        const int layers = 1 + extraCount[v];
+        Vec3 counts{float(count), 0, 0};
+        for (int l = 1; l < layers; ++l) counts[l] = float(grid.layers.vdlCount[e0 + uint32_t(l) - 1]);
+        writeTexel(nextVdl++, counts, float(layers));
+        const Vec3 corner{float(grid.coords[v].x), float(grid.coords[v].y),
+                          float(grid.coords[v].z)};
+        auto local = [&](const Vec3& world) {
+          return (world - grid.frame.origin) / grid.frame.voxelSize - corner;
+        };
+        auto writeLayer = [&](const Vec3& layerNormal, const Vec3& point, const Vdl* layerVdls,
+                              int layerCount) {
+          const Vec3 n = normalize(layerNormal);
+          writeTexel(nextVdl++, local(point), loPackDirection(n.x, n.y, n.z));
+          const Vec3 correction = params.cosineCorrection ? n : Vec3{0, 0, 0};
+          for (int i = 0; i < layerCount; ++i) writeVdl(nextVdl++, layerVdls[i], correction);
+        };
+        const Vec3 point0 = grid.points.empty() ? grid.frame.origin + (corner + Vec3(0.5f)) *
+                                                                          grid.frame.voxelSize
+                                                : grid.points[v];
+        writeLayer(grid.normals[v], point0, vdls, count);
+        for (int l = 1; l < layers; ++l) {
+          const uint32_t e = e0 + uint32_t(l) - 1;
+          writeLayer(grid.layers.normals[e], grid.layers.points[e], grid.layerVdlsOf(e),
+                     grid.layers.vdlCount[e]);
+        }
       }
     }
   }

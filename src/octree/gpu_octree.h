@@ -86,6 +86,7 @@ float halfToFloat(uint16_t bits);
 struct OctreeSample {
   bool found = false;  ///< false in empty space or outside the cube
   Coord voxel;         ///< the leaf's voxel coordinate at the octree depth
+  int layerCount = 1;  ///< surface layers of the voxel; the VDLs below are layer 0's
   int vdlCount = 0;
   Vdl vdls[kMaxVdls];  ///< decoded (directions through the 8+8-bit packing)
 };

@@ -87,9 +87,17 @@ OctreeSample lookupOctree(const GpuOctree& octree, const Vec3& worldPosition) {
   }
   sample.found = true;
   sample.voxel = voxel;
-  sample.vdlCount = int(leaf.a);
-  const uint32_t first = layout::loUnpackAddress(leaf.r, leaf.g, leaf.b);
-  for (uint32_t i = 0; i < leaf.a; ++i) {
+  uint32_t first = layout::loUnpackAddress(leaf.r, leaf.g, leaf.b);
+  uint32_t count = leaf.a;
+  if (leaf.a == layout::LO_FLAG_LAYERED) {
+    // Layer 0: its VDLs follow the block header and its own header.
+    const glm::vec4 h = lookup::loFetchVdl(octree, first);
+    sample.layerCount = int(h.a);
+    count = uint32_t(h.r);
+    first += 2;
+  }
+  sample.vdlCount = int(count);
+  for (uint32_t i = 0; i < count; ++i) {
     const glm::vec4 t = lookup::loFetchVdl(octree, first + i);
     sample.vdls[i].irradiance = {t.r, t.g, t.b};
     sample.vdls[i].direction = fromGlm(lookup::loVdlDirection(t.a));
@@ -107,6 +115,7 @@ Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3&
   s.baseColor = glm::vec3(1.0f);
   s.metallic = 0.0f;
   s.roughness = 1.0f;
+  s.ng = s.n;
   return fromGlm(lookup::loOctreeIndirect(octree, toGlm(position), toGlm(octree.origin), voxelSize,
                                           octree.depth, params.normalOffset, params.interpolation,
                                           params.maxVdls, s));

@@ -170,7 +170,10 @@ nlohmann::json pointJson(const SweepPoint& p) {
           {"vdls", p.vdls},
           {"interpolation", p.interpolation},
           {"half_float", p.halfFloat},
-          {"cosine_correction", p.cosineCorrection}};
+          {"cosine_correction", p.cosineCorrection},
+          {"layers", p.layers},
+          {"occlusion", p.occlusion},
+          {"edge_correction", p.edgeCorrection}};
 }
 
 nlohmann::json resultJson(const SweepResult& r) {
@@ -255,13 +258,17 @@ std::string SweepPoint::label() const {
   if (!interpolation) s += " no-interp";
   if (halfFloat) s += " half";
   if (!cosineCorrection) s += " paper-cosine";
+  if (!layers) s += " no-layers";
+  if (!occlusion) s += " no-occlusion";
+  if (!edgeCorrection) s += " no-edge";
   return s;
 }
 
 std::string SweepPoint::bakeKey() const {
   using namespace sweep_internal;
   return "d" + std::to_string(depth) + "-p" + std::to_string(photons) + "-k" + std::to_string(knn) +
-         "-r" + formatNumber(radiusVoxels) + "-v" + vdls;
+         "-r" + formatNumber(radiusVoxels) + "-v" + vdls + (layers ? "" : "-l0") +
+         (occlusion ? "" : "-o0") + (edgeCorrection ? "" : "-e0");
 }
 
 std::string SweepPoint::key() const {
@@ -317,6 +324,16 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale) {
   vary("interpolation", [](SweepPoint& p) { p.interpolation = false; });
   vary("texels", [](SweepPoint& p) { p.halfFloat = true; });
   vary("cosine", [](SweepPoint& p) { p.cosineCorrection = false; });
+  // The accuracy options (docs/accuracy.md), one off at a time, and all off:
+  // the gather as it was before them.
+  vary("accuracy", [](SweepPoint& p) { p.layers = false; });
+  vary("accuracy", [](SweepPoint& p) { p.occlusion = false; });
+  vary("accuracy", [](SweepPoint& p) { p.edgeCorrection = false; });
+  vary("accuracy", [](SweepPoint& p) {
+    p.layers = false;
+    p.occlusion = false;
+    p.edgeCorrection = false;
+  });
   // Combined points: cheaper photon maps with a matching k (the photon
   // density per voxel falls with the count), coarser and finer grids.
   vary("combined", [](SweepPoint& p) {
@@ -431,6 +448,9 @@ BakeParams bakeParamsOf(const SweepPoint& point, const Scene& scene, uint64_t se
   b.knn = point.knn;
   b.vdls = parseVdlCount(point.vdls, "sweep point --vdls");
   b.seed = seed;
+  b.layers = point.layers;
+  b.occlusion = point.occlusion;
+  b.edgeCorrection = point.edgeCorrection;
   // 0 lets the gather apply its own default (kDefaultRadiusVoxels voxels).
   if (point.radiusVoxels != kDefaultRadiusVoxels) {
     b.radius = point.radiusVoxels * makeGridFrame(scene.bounds(), point.depth).voxelSize;
@@ -582,7 +602,9 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     FirstHitParams hitParams;
     hitParams.width = params.width;
     hitParams.height = params.height;
-    hitParams.samplesPerPixel = 4;
+    // Many rays per pixel: a pixel across an edge mixes its surfaces as
+    // the reference's samples do (4 rays made up to a quarter of the jump).
+    hitParams.samplesPerPixel = 64;
     hitParams.seed = params.seed;
     const RgbImage irradiance = renderFirstHits(scene, camera, hitParams, [&](const FirstHit& h) {
       return octreeIrradiance(octree, h.position, h.normal, shade);

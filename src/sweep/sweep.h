@@ -33,9 +33,12 @@ struct SweepPoint {
   bool interpolation = true;     ///< trilinear lookup over 8 voxels
   bool halfFloat = false;        ///< RGBA16UI half-float VDL texels instead of RGBA32F
   bool cosineCorrection = true;  ///< GpuOctreeParams::cosineCorrection (off: the paper's form)
+  bool layers = true;            ///< BakeParams::layers (surface layers)
+  bool occlusion = true;         ///< BakeParams::occlusion (gather occlusion)
+  bool edgeCorrection = true;    ///< BakeParams::edgeCorrection
 
   /// Short human label, e.g. "d6 600k k300 r1.5 v4" (+ " no-interp", " half",
-  /// " paper-cosine").
+  /// " paper-cosine", " no-layers", " no-occlusion", " no-edge").
   std::string label() const;
   /// File-name-safe key of the bake parameters only (points that differ only
   /// in interpolation or texel format share one bake).

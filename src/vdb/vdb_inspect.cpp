@@ -241,23 +241,114 @@ class VdlChecker {
     add("same_transform", true, "every grid on one transform");
   }
 
+  /// Which active set a grid shares: the voxels' (0), or surface layer l's
+  /// (layer_point goes with layer 1: the voxels that have layers).
+  static int layerGroup(const std::string& name) {
+    if (name == "layer_point") return 1;
+    if (name.rfind("layer", 0) == 0 && name.size() > 6 && name[6] == '_' && name[5] >= '1' &&
+        name[5] <= '9') {
+      return name[5] - '0';
+    }
+    return 0;
+  }
+
   void checkSameActive() {
-    const openvdb::GridBase* ref = nullptr;
+    const openvdb::GridBase* ref[kMaxLayers + 7] = {};
+    std::string counts;
     for (const auto& g : *f_.grids) {
       if (!g) continue;
-      if (!ref) {
-        ref = g.get();
-      } else if (g->activeVoxelCount() != ref->activeVoxelCount() ||
-                 g->evalActiveVoxelBoundingBox() != ref->evalActiveVoxelBoundingBox()) {
+      const int group = layerGroup(g->getName());
+      const openvdb::GridBase*& r = ref[group];
+      if (!r) {
+        r = g.get();
+        counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
+                  (group == 0 ? " in every voxel grid" : " in every layer" + std::to_string(group) +
+                                                              " grid");
+      } else if (g->activeVoxelCount() != r->activeVoxelCount() ||
+                 g->evalActiveVoxelBoundingBox() != r->evalActiveVoxelBoundingBox()) {
         add("same_active_voxels", false,
             "grid '" + g->getName() + "' has " + std::to_string(g->activeVoxelCount()) +
-                " active voxels, '" + ref->getName() + "' " +
-                std::to_string(ref->activeVoxelCount()));
+                " active voxels, '" + r->getName() + "' " + std::to_string(r->activeVoxelCount()));
         return;
       }
     }
-    add("same_active_voxels", true,
-        std::to_string(ref ? ref->activeVoxelCount() : 0) + " in every grid");
+    add("same_active_voxels", true, counts.empty() ? "no grids" : counts);
+  }
+
+  /// Surface layers (format version 2): each layer's voxels are voxels of the
+  /// file (layer 2's among layer 1's), counts integers within max_vdls, the
+  /// VDLs of each layer sum to its irradiance.
+  void checkLayers(int maxVdls, double sumTol) {
+    auto count1 = openvdb::gridPtrCast<FloatGrid>(find("layer1_vdl_count"));
+    bool anyLayerGrid = false;
+    for (const auto& g : *f_.grids) anyLayerGrid = anyLayerGrid || (g && layerGroup(g->getName()) > 0);
+    if (!anyLayerGrid) return;
+    auto voxels = openvdb::gridPtrCast<FloatGrid>(find("vdl_count"));
+    std::string problem;
+    uint64_t layers = 0;
+    double worstSum = 0;
+    for (int layer = 1; layer < kMaxLayers && problem.empty(); ++layer) {
+      const std::string prefix = "layer" + std::to_string(layer) + "_";
+      auto count = openvdb::gridPtrCast<FloatGrid>(find(prefix + "vdl_count"));
+      auto irr = openvdb::gridPtrCast<Vec3SGrid>(find(prefix + "irradiance"));
+      auto normal = openvdb::gridPtrCast<Vec3SGrid>(find(prefix + "normal"));
+      auto point = openvdb::gridPtrCast<Vec3SGrid>(find(prefix + "point"));
+      if (!count) {
+        if (layer == 1) problem = "layer grids without 'layer1_vdl_count'";
+        break;
+      }
+      std::vector<Vec3SGrid::Ptr> vi;
+      for (int i = 0; i < maxVdls; ++i) {
+        vi.push_back(openvdb::gridPtrCast<Vec3SGrid>(
+            find(prefix + "vdl" + std::to_string(i) + "_irradiance")));
+        if (!vi.back() || !openvdb::gridPtrCast<Vec3SGrid>(
+                              find(prefix + "vdl" + std::to_string(i) + "_direction"))) {
+          problem = "missing or mistyped '" + prefix + "vdl" + std::to_string(i) + "_*'";
+        }
+      }
+      if (!irr || !normal || !point || !find("layer_point")) {
+        problem = "missing or mistyped grids of layer " + std::to_string(layer);
+      }
+      if (!problem.empty()) break;
+      auto irrAcc = irr->getConstAccessor();
+      for (auto it = count->cbeginValueOn(); it && problem.empty(); ++it) {
+        ++layers;
+        const openvdb::Coord c = it.getCoord();
+        if (!voxels || !voxels->tree().isValueOn(c)) {
+          problem = prefix + "vdl_count is active at " + coordText(c) + ", not a voxel of the file";
+        } else if (layer > 1 && !(count1 && count1->tree().isValueOn(c))) {
+          problem = "layer " + std::to_string(layer) + " at " + coordText(c) + " without layer 1";
+        }
+        const float n = *it;
+        if (problem.empty() && (!(n >= 0 && n <= float(maxVdls)) || n != std::floor(n))) {
+          problem = prefix + "vdl_count at " + coordText(c) + " holds " + num(n);
+        }
+        if (!problem.empty()) break;
+        const openvdb::Vec3s e = irrAcc.getValue(c);
+        double sum[3] = {0, 0, 0}, scale = std::max({double(e[0]), double(e[1]), double(e[2])});
+        for (int i = 0; i < maxVdls; ++i) {
+          const openvdb::Vec3s v = vi[size_t(i)]->getConstAccessor().getValue(c);
+          for (int k = 0; k < 3; ++k) {
+            sum[k] += v[k];
+            scale = std::max(scale, double(std::abs(v[k])));
+          }
+        }
+        double diff = 0;
+        for (int k = 0; k < 3; ++k) diff = std::max(diff, std::abs(sum[k] - double(e[k])));
+        const double rel = scale > 0 ? diff / scale : (diff > 0 ? 1e30 : 0.0);
+        worstSum = std::max(worstSum, std::isfinite(rel) ? rel : 1e30);
+        if (!(rel <= sumTol)) {
+          problem = prefix + "vdl sum at " + coordText(c) + " differs by " + num(rel) +
+                    " of the irradiance (allowed " + num(sumTol) + ")";
+        }
+      }
+    }
+    add("layers", problem.empty(),
+        problem.empty() ? std::to_string(layers) + " extra surface layers on voxels of the file; "
+                                                    "their VDLs sum to their irradiance (largest "
+                                                    "relative difference " +
+                              num(worstSum) + ")"
+                        : problem);
   }
 
   void checkValues(int maxVdls) {
@@ -340,6 +431,7 @@ class VdlChecker {
                 : std::string("VDLs sum to the irradiance")) +
             " (largest relative difference " + num(worstSum) + ", allowed " + num(sumTol) +
             (half ? ", half floats)" : ")"));
+    checkLayers(maxVdls, sumTol);
   }
 
   const OpenedFile& f_;

@@ -76,6 +76,14 @@ constexpr const char* kIrradianceUnits = "W/m^2";
 std::string vdlIrradianceName(int i) { return "vdl" + std::to_string(i) + "_irradiance"; }
 std::string vdlDirectionName(int i) { return "vdl" + std::to_string(i) + "_direction"; }
 
+// Surface layers (docs/vdb-contract.md): "layer_point" holds layer 0's point
+// on the voxels that have more layers; layer l's grids are "layer<l>_" + the
+// name of the voxel grid they mirror, active on the voxels that have layer l.
+constexpr const char* kLayerPoint = "layer_point";
+std::string layerName(int layer, const std::string& name) {
+  return "layer" + std::to_string(layer) + "_" + name;
+}
+
 // ---------------------------------------------------------------------------
 // Deterministic bytes. io::Archive writes a random UUID (36 ASCII characters
 // after the 21-byte header prefix: magic, file version, library version, the
@@ -201,6 +209,23 @@ void checkArrays(const VdlGrid& g) {
   LO_CHECK_EQ(g.angularError.size(), n);
   LO_CHECK_EQ(g.vdlCount.size(), n);
   LO_CHECK_EQ(g.vdls.size(), n * size_t(g.maxVdls));
+  const VdlLayers& L = g.layers;
+  const size_t ne = L.size();
+  if (ne == 0) return;
+  LO_CHECK_EQ(g.points.size(), n);
+  LO_CHECK_EQ(L.normals.size(), ne);
+  LO_CHECK_EQ(L.points.size(), ne);
+  LO_CHECK_EQ(L.irradiance.size(), ne);
+  LO_CHECK_EQ(L.photonCount.size(), ne);
+  LO_CHECK_EQ(L.radius.size(), ne);
+  LO_CHECK_EQ(L.angularError.size(), ne);
+  LO_CHECK_EQ(L.vdlCount.size(), ne);
+  LO_CHECK_EQ(L.vdls.size(), ne * size_t(g.maxVdls));
+  for (size_t e = 0; e < ne; ++e) {
+    LO_CHECK_LT(size_t(L.voxel[e]), n);
+    if (e > 0) LO_CHECK_LE(L.voxel[e - 1], L.voxel[e]);
+    if (e > 1) LO_CHECK(L.voxel[e - 2] != L.voxel[e]);  // at most kMaxLayers - 1 extra
+  }
 }
 
 openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
@@ -224,6 +249,11 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   if (!meta.convertedFrom.empty()) {
     m.insertMeta("converted_from", openvdb::StringMetadata(meta.convertedFrom));
   }
+  if (meta.surfaceLayers >= 0) m.insertMeta("surface_layers", openvdb::Int32Metadata(meta.surfaceLayers));
+  if (meta.gatherOcclusion >= 0) {
+    m.insertMeta("gather_occlusion", openvdb::Int32Metadata(meta.gatherOcclusion));
+  }
+  if (meta.edgeCorrection >= 0) m.insertMeta("edge_correction", openvdb::Int32Metadata(meta.edgeCorrection));
   return m;
 }
 
@@ -251,6 +281,54 @@ openvdb::GridPtrVec buildVdlGrids(const VdlGrid& g, const Transform::Ptr& xform)
                                openvdb::VEC_INVARIANT, xform, c,
                                [&](size_t v) { return g.vdlsOf(v)[i].direction; }));
   }
+  if (g.layers.size() == 0) return grids;
+
+  // Surface layers: per layer index, its entries and their voxels.
+  const VdlLayers& L = g.layers;
+  std::vector<size_t> entries[kMaxLayers];
+  std::vector<Coord> coords[kMaxLayers];
+  for (size_t e = 0; e < L.size(); ++e) {
+    const int layer = e > 0 && L.voxel[e - 1] == L.voxel[e] ? 2 : 1;
+    entries[layer].push_back(e);
+    coords[layer].push_back(c[L.voxel[e]]);
+    if (layer == 1) {
+      entries[0].push_back(L.voxel[e]);
+      coords[0].push_back(c[L.voxel[e]]);
+    }
+  }
+  grids.push_back(vectorGrid(kLayerPoint, "world space", openvdb::VEC_CONTRAVARIANT_ABSOLUTE,
+                             xform, coords[0],
+                             [&](size_t k) { return g.points[entries[0][k]]; }));
+  for (int layer = 1; layer < kMaxLayers; ++layer) {
+    const std::vector<size_t>& es = entries[layer];
+    const std::vector<Coord>& lc = coords[layer];
+    if (es.empty()) continue;
+    auto name = [layer](const std::string& n) { return layerName(layer, n); };
+    grids.push_back(vectorGrid(name(kIrradiance), kIrradianceUnits, openvdb::VEC_INVARIANT, xform,
+                               lc, [&](size_t k) { return L.irradiance[es[k]]; }));
+    grids.push_back(vectorGrid(name(kNormal), "unit vector, world space",
+                               openvdb::VEC_COVARIANT_NORMALIZE, xform, lc,
+                               [&](size_t k) { return L.normals[es[k]]; }));
+    grids.push_back(vectorGrid(name("point"), "world space", openvdb::VEC_CONTRAVARIANT_ABSOLUTE,
+                               xform, lc, [&](size_t k) { return L.points[es[k]]; }));
+    grids.push_back(floatGrid(name(kPhotonCount), "photons", xform, lc,
+                              [&](size_t k) { return L.photonCount[es[k]]; }));
+    grids.push_back(floatGrid(name(kAngularError), "chord length (0..2), weighted std. deviation",
+                              xform, lc, [&](size_t k) { return L.angularError[es[k]]; }));
+    grids.push_back(floatGrid(name(kVdlCount), "count", xform, lc,
+                              [&](size_t k) { return float(L.vdlCount[es[k]]); }));
+    grids.push_back(floatGrid(name(kRadius), "world units", xform, lc,
+                              [&](size_t k) { return L.radius[es[k]]; }));
+    for (int i = 0; i < g.maxVdls; ++i) {
+      grids.push_back(vectorGrid(name(vdlIrradianceName(i)), kIrradianceUnits,
+                                 openvdb::VEC_INVARIANT, xform, lc,
+                                 [&](size_t k) { return g.layerVdlsOf(es[k])[i].irradiance; }));
+      grids.push_back(vectorGrid(name(vdlDirectionName(i)),
+                                 "unit vector towards the light, world space",
+                                 openvdb::VEC_INVARIANT, xform, lc,
+                                 [&](size_t k) { return g.layerVdlsOf(es[k])[i].direction; }));
+    }
+  }
   return grids;
 }
 
@@ -261,7 +339,11 @@ bool isOptionalGrid(const std::string& name) {
 
 // Counts and areas stay 32-bit in half-float files (see VdlWriteOptions).
 bool keepsFullPrecision(const std::string& name) {
-  return name == kVdlCount || name == kPhotonCount || name == kArea;
+  auto endsWith = [&](const std::string& tail) {
+    return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  return endsWith(kVdlCount) || endsWith(kPhotonCount) || name == kArea ||
+         endsWith("point");
 }
 
 void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
@@ -383,6 +465,9 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.units = metaValue<std::string>(path, m, "units", false, "");
   meta.formatVersion = metaValue<int32_t>(path, m, "format_version", false, 0);
   meta.convertedFrom = metaValue<std::string>(path, m, "converted_from", false, "");
+  meta.surfaceLayers = metaValue<int32_t>(path, m, "surface_layers", false, -1);
+  meta.gatherOcclusion = metaValue<int32_t>(path, m, "gather_occlusion", false, -1);
+  meta.edgeCorrection = metaValue<int32_t>(path, m, "edge_correction", false, -1);
   return meta;
 }
 
@@ -412,6 +497,145 @@ void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const Bak
 }
 
 namespace {
+
+/// The surface layers of a version-2 file (none when it has no
+/// "layer1_normal" grid): every grid of a layer present, on the file's
+/// transform, each layer's voxels among the file's voxels, layer 2's among
+/// layer 1's.
+void readLayers(const std::string& path, const OpenedFile& f, const Transform& xform, int maxVdls,
+                LoadedVdl& out) {
+  VdlGrid& g = out.grid;
+  const size_t n = g.size();
+  if (!findGrid(f, layerName(1, kNormal))) {
+    for (const auto& grid : *f.grids) {
+      if (grid && grid->getName().rfind("layer", 0) == 0) {
+        throw InputError(path + ": grid '" + grid->getName() +
+                         "' without 'layer1_normal': incomplete surface layers");
+      }
+    }
+    return;
+  }
+  auto voxelOf = [&](const openvdb::Coord& c, const std::string& grid) -> uint32_t {
+    const Coord k{c.x(), c.y(), c.z()};
+    auto it = std::lower_bound(g.coords.begin(), g.coords.end(), k, canonicalLess);
+    if (it == g.coords.end() || *it != k) {
+      throw InputError(path + ": grid '" + grid + "' is active at " + k.ToString() +
+                       ", which is not a voxel of the file");
+    }
+    return uint32_t(it - g.coords.begin());
+  };
+  auto checked = [&](const openvdb::GridBase::Ptr& grid) {
+    if (!(grid->transform() == xform)) {
+      throw InputError(path + ": mismatched transforms: grid '" + grid->getName() +
+                       "' differs from 'vdl_count'");
+    }
+  };
+  // Layer 0's points, on the voxels with layers.
+  g.points.assign(n, Vec3{});
+  for (size_t v = 0; v < n; ++v) {
+    g.points[v] = g.frame.origin + (Vec3{float(g.coords[v].x), float(g.coords[v].y),
+                                         float(g.coords[v].z)} + Vec3(0.5f)) * g.frame.voxelSize;
+  }
+  auto points = requireGrid<Vec3SGrid>(path, f, kLayerPoint);
+  checked(points);
+  for (auto it = points->cbeginValueOn(); it; ++it) {
+    g.points[voxelOf(it.getCoord(), kLayerPoint)] = fromVdb(*it);
+  }
+  struct Entry {
+    uint32_t voxel;
+    int layer;
+    openvdb::Coord coord;
+  };
+  std::vector<Entry> entries;
+  std::vector<char> hasLayer1(n, 0);
+  for (int layer = 1; layer < kMaxLayers; ++layer) {
+    const std::string countName = layerName(layer, kVdlCount);
+    if (!findGrid(f, countName)) {
+      if (layer == 1) requireGrid<FloatGrid>(path, f, countName);  // names it as missing
+      break;
+    }
+    auto count = requireGrid<FloatGrid>(path, f, countName);
+    checked(count);
+    for (auto it = count->cbeginValueOn(); it; ++it) {
+      const uint32_t v = voxelOf(it.getCoord(), countName);
+      if (layer == 1) hasLayer1[v] = 1;
+      if (layer == 2 && !hasLayer1[v]) {
+        throw InputError(path + ": voxel " + g.coords[v].ToString() +
+                         " has surface layer 2 but not layer 1");
+      }
+      entries.push_back({v, layer, it.getCoord()});
+    }
+  }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return a.voxel < b.voxel || (a.voxel == b.voxel && a.layer < b.layer);
+  });
+  for (size_t v = 0; v < n; ++v) {
+    if (!hasLayer1[v]) continue;
+    if (!points->tree().isValueOn(toVdb(g.coords[v]))) {
+      throw InputError(path + ": grid 'layer_point' has no value at " + g.coords[v].ToString() +
+                       ", a voxel with surface layers");
+    }
+  }
+  VdlLayers& L = g.layers;
+  const size_t ne = entries.size();
+  L.voxel.resize(ne);
+  L.normals.resize(ne);
+  L.points.resize(ne);
+  L.irradiance.resize(ne);
+  L.photonCount.resize(ne);
+  L.radius.resize(ne);
+  L.angularError.resize(ne);
+  L.vdlCount.resize(ne);
+  L.vdls.resize(ne * size_t(maxVdls));
+  for (int layer = 1; layer < kMaxLayers; ++layer) {
+    if (!findGrid(f, layerName(layer, kVdlCount))) break;
+    auto vec = [&](const std::string& name) {
+      auto grid = requireGrid<Vec3SGrid>(path, f, layerName(layer, name));
+      checked(grid);
+      return grid;
+    };
+    auto flt = [&](const std::string& name) {
+      auto grid = requireGrid<FloatGrid>(path, f, layerName(layer, name));
+      checked(grid);
+      return grid;
+    };
+    auto irr = vec(kIrradiance)->getConstAccessor();
+    auto nrm = vec(kNormal)->getConstAccessor();
+    auto pts = vec("point")->getConstAccessor();
+    auto pc = flt(kPhotonCount)->getConstAccessor();
+    auto ae = flt(kAngularError)->getConstAccessor();
+    auto vc = flt(kVdlCount)->getConstAccessor();
+    auto rad = flt(kRadius)->getConstAccessor();
+    std::vector<openvdb::Vec3SGrid::ConstAccessor> vi, vd;
+    for (int i = 0; i < maxVdls; ++i) {
+      vi.push_back(vec(vdlIrradianceName(i))->getConstAccessor());
+      vd.push_back(vec(vdlDirectionName(i))->getConstAccessor());
+    }
+    for (size_t e = 0; e < ne; ++e) {
+      if (entries[e].layer != layer) continue;
+      const openvdb::Coord c = entries[e].coord;
+      L.voxel[e] = entries[e].voxel;
+      L.irradiance[e] = fromVdb(irr.getValue(c));
+      L.normals[e] = fromVdb(nrm.getValue(c));
+      L.points[e] = fromVdb(pts.getValue(c));
+      L.photonCount[e] = pc.getValue(c);
+      L.angularError[e] = ae.getValue(c);
+      L.radius[e] = rad.getValue(c);
+      const float count = vc.getValue(c);
+      if (!(count >= 0 && count <= float(maxVdls)) || count != std::floor(count)) {
+        throw InputError(path + ": " + layerName(layer, kVdlCount) + " at " +
+                         g.coords[entries[e].voxel].ToString() + " is " + std::to_string(count) +
+                         ", expected an integer in [0, " + std::to_string(maxVdls) + "]");
+      }
+      L.vdlCount[e] = uint8_t(count);
+      for (int i = 0; i < maxVdls; ++i) {
+        Vdl& vdl = L.vdls[e * size_t(maxVdls) + size_t(i)];
+        vdl.irradiance = fromVdb(vi[size_t(i)].getValue(c));
+        vdl.direction = fromVdb(vd[size_t(i)].getValue(c));
+      }
+    }
+  }
+}
 
 LoadedVdl readVdl(const std::string& path) {
   OpenedFile f = openFile(path);
@@ -533,6 +757,7 @@ LoadedVdl readVdl(const std::string& path) {
       vdl.direction = fromVdb(da.getValue(c));
     }
   }
+  readLayers(path, f, xform, maxVdls, out);
   return out;
 }
 

@@ -45,12 +45,17 @@ TEST(BakeLevel, IsTheStagesInSequence) {
   params.gather.k = 60;
   params.cluster.vdls = 3;
   params.cluster.seed = 9;
+  params.occlusion = false;  // the ray tracer's segment test is the bake module's own wiring
   LevelStats stats;
   VdlGrid level = bakeLevel(scene, map.photons, params, nullptr, &stats);
 
   SurfaceGrid grid = buildSurfaceGrid(scene, params.grid);
   size_t dropped = splatPhotons(grid, map.photons);
-  VdlGrid direct = buildVdlGrid(grid, map.photons, params.gather, params.cluster);
+  const LayerParams layers;
+  VdlGrid direct =
+      buildVdlGrid(grid, map.photons, params.gather, params.cluster, nullptr, nullptr, &layers);
+  EXPECT_EQ(level.layers.voxel, direct.layers.voxel);
+  EXPECT_GT(level.layers.size(), 0u) << "the room's edges have layers";
   expectSameGrid(level, direct);
   EXPECT_GT(level.size(), 0u);
   EXPECT_EQ(stats.activeVoxels, grid.size());

@@ -339,7 +339,59 @@ TEST(Gather, FewerThanKUsesTheSearchRadius) {
     ASSERT_LT(within, size_t(params.k));
     EXPECT_EQ(res.photons.size(), within);
     EXPECT_EQ(res.radius, r);
-    EXPECT_NEAR(res.irradiance.x, power / (kPi * r * r), 1e-4 * power / (r * r) + 1e-9);
+    // The disc's share on the plane (edge correction): all of it inside,
+    // less where it reaches past the plane's border.
+    const bool inside = q.x > r && q.x < 1 - r && q.z > r && q.z < 1 - r;
+    if (inside) EXPECT_EQ(res.coverage, 1.0f) << q.ToString();
+    if (q.x < 0.5f * r || q.z < 0.5f * r) EXPECT_LT(res.coverage, 0.9f) << q.ToString();
+    EXPECT_NEAR(res.irradiance.x, power / (kPi * r * r * res.coverage),
+                1e-4 * power / (r * r) + 1e-9);
+  }
+}
+
+// Edge correction: on a uniformly lit plane the estimate next to its border
+// (where half the disc reaches past it) is the interior's, not half of it.
+TEST(Gather, EdgeCorrectionKeepsTheBorderOfAPlaneLit) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  std::vector<Photon> photons = uniformPhotons(scene, 200000, 11);
+  SurfaceGrid grid = gridFor(scene, 4, photons);
+  for (bool correct : {true, false}) {
+    GatherParams params;
+    params.k = 2000;  // the radius, not k, bounds the disc: r_k = r everywhere
+    params.edgeCorrection = correct;
+    Gatherer g(grid, photons, params);
+    GatherResult res;
+    double border = 0, interior = 0;
+    int nb = 0, ni = 0;
+    for (size_t v = 0; v < grid.size(); ++v) {
+      g.gather(v, res);
+      const Vec3 q = grid.centroids[v];
+      const bool atBorder = q.x < 0.05f && q.z > 0.3f && q.z < 0.7f;
+      const bool inside = q.x > 0.3f && q.x < 0.7f && q.z > 0.3f && q.z < 0.7f;
+      if (atBorder) {
+        border += res.irradiance.x;
+        ++nb;
+      }
+      if (inside) {
+        interior += res.irradiance.x;
+        ++ni;
+      }
+    }
+    ASSERT_GT(nb, 0);
+    ASSERT_GT(ni, 0);
+    const double ratio = (border / nb) / (interior / ni);
+    std::printf("edge correction %s: border / interior irradiance %.3f (exact: 1)\n",
+                correct ? "on" : "off", ratio);
+    // The coverage test sees geometry per voxel: a free border's place
+    // inside its voxel is not known, so the correction is partial there.
+    // (Where a wall crosses the surface, its plane gives the exact border.)
+    if (correct) {
+      EXPECT_GT(ratio, 0.85);
+    } else {
+      EXPECT_LT(ratio, 0.8);
+    }
   }
 }
 
@@ -366,6 +418,149 @@ TEST(Gather, SameResultForAnyThreadCount) {
   };
   std::vector<Vec3> one = run(1), two = run(2);
   for (size_t v = 0; v < grid.size(); ++v) ASSERT_EQ(one[v], two[v]) << v;
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+// Surface layers: the gather of one layer (fixed normal, photons within the
+// layer cosine) equals the brute force over every photon, at the layers the
+// voxels' own photons give.
+TEST(GatherLayers, LayerGatherMatchesBruteForce) {
+  Scene scene = cornellLikeBox();
+  std::vector<Photon> photons = uniformPhotons(scene, 60000, 5);
+  SurfaceGrid grid = gridFor(scene, 5, photons);
+  GatherParams p;
+  p.k = 60;
+  Gatherer gatherer(grid, photons, p);
+  LayerParams lp;
+  lp.minPhotons = 3;  // about 8 photons per voxel face here
+  SurfaceLayer layers[3];
+  size_t checked = 0, layered = 0;
+  GatherResult g;
+  for (size_t v = 0; v < grid.size(); v += 3) {
+    const int n = gatherer.findSurfaceLayers(v, lp, layers);
+    layered += n >= 2;
+    for (int l = 0; l < n; ++l) {
+      gatherer.gatherLayer(v, layers[l].point, layers[l].normal, g);
+      const GatherResult b =
+          gatherLayerBruteForce(grid, photons, layers[l].point, layers[l].normal, p);
+      ASSERT_EQ(sorted(g.photons), sorted(b.photons)) << "voxel " << v << " layer " << l;
+      EXPECT_EQ(g.radius, b.radius);
+      EXPECT_EQ(g.normal, layers[l].normal);
+      for (uint32_t i : g.photons) {
+        ASSERT_GT(dot(photons[i].normal, layers[l].normal), p.layerCosine);
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100u);
+  EXPECT_GT(layered, 10u) << "the box's edges give voxels with two layers";
+}
+
+// Layer detection in one voxel holding a floor and a thin wall (two quads
+// facing away from each other): the floor is one layer; the wall one per lit
+// side (both here); a surface whose photons are too few keeps the side its
+// winding faces.
+TEST(GatherLayers, FindsTheSurfacesOfAVoxelAndTheirLitSides) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);           // floor
+  test::addQuad(scene, {0.53f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);       // wall, +x face
+  test::addQuad(scene, {0.53f, 0, 0}, {0, 0, 1}, {0, 1, 0}, {-1, 0, 0}, 0);      // wall, -x face
+  std::vector<Photon> photons;
+  auto add = [&](Vec3 p, Vec3 n, int count) {
+    for (int i = 0; i < count; ++i) {
+      Photon ph;
+      ph.position = p + Vec3{0, 0.001f * float(i % 7), 0.001f * float(i % 5)};
+      ph.normal = n;
+      ph.direction = n;
+      ph.power = Vec3(1.0f);
+      photons.push_back(ph);
+    }
+  };
+  // Voxel size 1.02 / 16: all in the voxel holding (0.52, 0.01, 0.51).
+  add({0.52f, 0.0f, 0.51f}, {0, 1, 0}, 40);   // floor
+  add({0.53f, 0.02f, 0.51f}, {1, 0, 0}, 30);  // wall, lit from +x
+  add({0.53f, 0.02f, 0.51f}, {-1, 0, 0}, 20); // and from -x
+  SurfaceGrid grid = gridFor(scene, 4, photons);
+  const int64_t voxel = grid.find(grid.frame.coordOf({0.52f, 0.01f, 0.51f}));
+  ASSERT_GE(voxel, 0);
+  ASSERT_EQ(grid.orientationStart[size_t(voxel) + 1] - grid.orientationStart[size_t(voxel)], 3u)
+      << "floor, and the wall's two faces";
+  Gatherer gatherer(grid, photons, GatherParams{});
+  SurfaceLayer layers[3];
+  LayerParams lp;
+  auto normals = [&](int n) {
+    std::vector<Vec3> out;
+    for (int l = 0; l < n; ++l) out.push_back(layers[l].normal);
+    return out;
+  };
+  auto has = [](const std::vector<Vec3>& v, Vec3 n) {
+    return std::any_of(v.begin(), v.end(), [&](const Vec3& m) { return length(m - n) < 1e-5f; });
+  };
+  int n = gatherer.findSurfaceLayers(size_t(voxel), lp, layers);
+  ASSERT_EQ(n, 3);
+  EXPECT_TRUE(has(normals(n), {0, 1, 0}));
+  EXPECT_TRUE(has(normals(n), {1, 0, 0}));
+  EXPECT_TRUE(has(normals(n), {-1, 0, 0}));
+  for (int l = 0; l < n; ++l) {
+    // Each layer's point lies on its surface.
+    if (layers[l].normal.y > 0.5f) EXPECT_NEAR(layers[l].point.y, 0.0f, 1e-5f);
+    if (std::fabs(layers[l].normal.x) > 0.5f) EXPECT_NEAR(layers[l].point.x, 0.53f, 1e-5f);
+  }
+  lp.maxLayers = 2;
+  EXPECT_EQ(gatherer.findSurfaceLayers(size_t(voxel), lp, layers), 2);
+  lp.maxLayers = 3;
+  lp.minShare = 0.4f;  // neither side of the wall holds 40%: it keeps one layer
+  n = gatherer.findSurfaceLayers(size_t(voxel), lp, layers);
+  EXPECT_EQ(n, 2);
+  EXPECT_TRUE(has(normals(n), {0, 1, 0}));
+}
+
+// Gather occlusion: a floor split by a thin wall, photons on one side only.
+// Without the occlusion test the dark side's voxels next to the wall gather
+// the lit side's photons; with it (a segment test that knows the wall plane
+// x = 0.5) they gather none.
+TEST(GatherLayers, OcclusionKeepsPhotonsBehindAWallOut) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  test::addQuad(scene, {0.5f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);
+  std::vector<Photon> photons;
+  for (const Photon& p : uniformPhotons(scene, 40000, 9)) {
+    if (p.position.x > 0.5f && p.normal.y > 0.5f) photons.push_back(p);  // the lit floor
+  }
+  SurfaceGrid grid = gridFor(scene, 5, photons);
+  GatherParams p;
+  p.k = 100;
+  p.radius = 0.08f;  // 2.5 voxels: reaches across the wall
+  auto crossesWall = [](const Vec3& a, const Vec3& b) {
+    return (a.x - 0.5f) * (b.x - 0.5f) < 0 && std::min(a.y, b.y) < 1.0f;
+  };
+  size_t leaking = 0, blocked = 0, dark = 0;
+  GatherResult g;
+  for (int occlusion = 0; occlusion < 2; ++occlusion) {
+    GatherParams q = p;
+    if (occlusion) q.blocked = crossesWall;
+    Gatherer gatherer(grid, photons, q);
+    for (size_t v = 0; v < grid.size(); ++v) {
+      const Vec3& c = grid.centroids[v];
+      if (!(c.x < 0.49f && c.y < 0.01f && grid.normals[v].y > 0.9f)) continue;  // dark floor
+      gatherer.gather(v, g);
+      if (occlusion) {
+        blocked += g.photons.empty();
+        ++dark;
+      } else {
+        leaking += !g.photons.empty();
+      }
+    }
+  }
+  EXPECT_GT(leaking, 10u) << "without occlusion the radius reaches across the wall";
+  EXPECT_EQ(blocked, dark) << "with it, no dark voxel gathers a lit photon";
 }
 
 }  // namespace

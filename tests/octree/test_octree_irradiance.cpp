@@ -285,3 +285,68 @@ TEST(FirstHit, MissesCountZeroAndBadParamsAreRefused) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// Surface layers in the octree (octree_layout.h's layer blocks): one voxel
+// holding a floor (normal +y, lit by VDL A from above) and a wall standing on
+// it (normal +x, at x = 0.5 voxel, lit by VDL B from +x). A point of the floor
+// takes layer A, a point of the wall layer B; a floor point behind the wall
+// (x < 0.5 voxel) is served by neither (the floor layer's surface lies on the
+// other side of the wall's plane), and a point facing -z by neither. Float and
+// half-float texels; without cosine correction, so the values are the VDLs'.
+TEST(OctreeLayers, EachSurfaceOfAVoxelGetsItsOwnLayer) {
+  VdlGrid g;
+  g.frame.origin = {0, 0, 0};
+  g.frame.voxelSize = kVoxel;
+  g.frame.depth = 2;
+  g.maxVdls = 2;
+  g.coords.push_back({1, 1, 1});
+  g.normals.push_back({0, 1, 0});
+  g.vdlCount.push_back(1);
+  const Vdl a = vdl({2.0f, 1.5f, 1.0f}, {0, 1, 0}), b = vdl({0.5f, 0.25f, 1.0f}, {1, 0, 0});
+  g.vdls = {a, Vdl{}};
+  const Vec3 corner = Vec3{1, 1, 1} * kVoxel;
+  g.points = {corner + Vec3{0.75f, 0.1f, 0.5f} * kVoxel};  // on the floor, +x of the wall
+  g.layers.voxel = {0};
+  g.layers.normals = {{1, 0, 0}};
+  g.layers.points = {corner + Vec3{0.5f, 0.5f, 0.5f} * kVoxel};
+  g.layers.irradiance = {b.irradiance};
+  g.layers.photonCount = {10};
+  g.layers.radius = {0.1f};
+  g.layers.angularError = {0};
+  g.layers.vdlCount = {1};
+  g.layers.vdls = {b, Vdl{}};
+  for (bool half : {false, true}) {
+    SCOPED_TRACE(half ? "half" : "float");
+    GpuOctreeParams params;
+    params.halfFloat = half;
+    params.cosineCorrection = false;
+    const GpuOctree o = buildGpuOctree(g, params);
+    EXPECT_EQ(o.leafCount, 1u);
+    EXPECT_EQ(o.vdlCount, 1u + 2u * 2u) << "block header + per layer header and one VDL";
+    const OctreeSample s = lookupOctree(o, corner + Vec3(0.6f) * kVoxel);
+    EXPECT_EQ(s.layerCount, 2);
+    EXPECT_EQ(s.vdlCount, 1);
+    const float tol = half ? 2e-3f : 1e-4f;  // the 8+8-bit direction: cos within 2e-5
+    OctreeShadeParams shade;
+    for (bool interpolation : {true, false}) {
+      shade.interpolation = interpolation;
+      const Vec3 floorPoint = corner + Vec3{0.8f, 0.1f, 0.5f} * kVoxel;
+      const Vec3 floorE = octreeIrradiance(o, floorPoint, {0, 1, 0}, shade);
+      EXPECT_NEAR(length(floorE - a.irradiance), 0.0f, tol * length(a.irradiance));
+      const Vec3 wallPoint = corner + Vec3{0.5f, 0.6f, 0.5f} * kVoxel;
+      const Vec3 wallE = octreeIrradiance(o, wallPoint, {1, 0, 0}, shade);
+      EXPECT_NEAR(length(wallE - b.irradiance), 0.0f, tol * length(b.irradiance));
+      // Behind the wall: the floor layer's surface lies on the wall's other side.
+      const Vec3 behind = corner + Vec3{0.2f, 0.1f, 0.5f} * kVoxel;
+      EXPECT_EQ(octreeIrradiance(o, behind, {0, 1, 0}, shade), Vec3(0.0f));
+      // A surface facing neither layer's way.
+      EXPECT_EQ(octreeIrradiance(o, floorPoint, {0, 0, -1}, shade), Vec3(0.0f));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lo

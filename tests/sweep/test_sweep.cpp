@@ -24,6 +24,9 @@ std::set<std::string> differences(const SweepPoint& a, const SweepPoint& b) {
   if (a.interpolation != b.interpolation) d.insert("interpolation");
   if (a.halfFloat != b.halfFloat) d.insert("texels");
   if (a.cosineCorrection != b.cosineCorrection) d.insert("cosine");
+  if (a.layers != b.layers || a.occlusion != b.occlusion || a.edgeCorrection != b.edgeCorrection) {
+    d.insert("accuracy");
+  }
   return d;
 }
 
@@ -50,7 +53,8 @@ TEST(SweepPoints, OneParameterAtATimeAroundThePaper) {
         EXPECT_EQ(d, std::set<std::string>{p.group}) << p.label();
       }
     }
-    for (const char* g : {"depth", "photons", "knn", "vdls", "interpolation", "texels", "cosine"})
+    for (const char* g :
+         {"depth", "photons", "knn", "vdls", "interpolation", "texels", "cosine", "accuracy"})
       EXPECT_TRUE(groups.count(g)) << g;
   }
   // The full sweep covers the ranges.

@@ -98,22 +98,25 @@ TEST(FormatVersion, WrittenReadAndNewerRefused) {
   VdlGrid g = floorGrid();
   writeVdlGrid(dir + "/v1.vdb", g, meta());
   LoadedVdl v1 = readVdlGrid(dir + "/v1.vdb");
-  EXPECT_EQ(v1.meta.formatVersion, 1);
+  EXPECT_EQ(v1.meta.formatVersion, kVdlFormatVersion);
   EXPECT_TRUE(v1.notes.empty());
   VdbReport r = inspectVdb(dir + "/v1.vdb");
   auto it = std::find_if(r.metadata.begin(), r.metadata.end(),
                          [](const auto& kv) { return kv.first == "format_version"; });
   ASSERT_NE(it, r.metadata.end());
-  EXPECT_EQ(it->second, "1");
+  EXPECT_EQ(it->second, std::to_string(kVdlFormatVersion));
 
   // A file written by a future lightoctree.
   vdb_internal::Damage newer;
-  newer.formatVersion = 2;
-  vdb_internal::writeVdlGridDamaged(dir + "/v2.vdb", g, meta(), newer);
-  std::string msg = readError(dir + "/v2.vdb");
-  EXPECT_NE(msg.find("format_version 2 is not supported"), std::string::npos) << msg;
+  newer.formatVersion = kVdlFormatVersion + 1;
+  vdb_internal::writeVdlGridDamaged(dir + "/vnext.vdb", g, meta(), newer);
+  std::string msg = readError(dir + "/vnext.vdb");
+  EXPECT_NE(msg.find("format_version " + std::to_string(kVdlFormatVersion + 1) +
+                     " is not supported"),
+            std::string::npos)
+      << msg;
   EXPECT_NE(msg.find("newer lightoctree"), std::string::npos) << msg;
-  expectCheck(inspectVdb(dir + "/v2.vdb"), "format_version", false);
+  expectCheck(inspectVdb(dir + "/vnext.vdb"), "format_version", false);
 
   // A file written before the key existed: read as version 1, with a note.
   vdb_internal::Damage older;
@@ -343,7 +346,8 @@ TEST(Convert, VdbPrintListsTheGridsOfAConvertedFile) {
   }
   EXPECT_EQ(out.find("angular_error"), std::string::npos) << out;
   EXPECT_NE(out.find("is_saved_as_half_float: true"), std::string::npos) << out;
-  EXPECT_NE(out.find("format_version: 1"), std::string::npos) << out;
+  EXPECT_NE(out.find("format_version: " + std::to_string(kVdlFormatVersion)), std::string::npos)
+      << out;
   EXPECT_TRUE(readVdlGrid(dir + "/c.vdb").grid.size() == coarse.size());
 }
 

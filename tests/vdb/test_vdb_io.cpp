@@ -11,9 +11,12 @@
 #include <vector>
 
 #include "test_util.h"
+#include "bake/bake.h"
+#include "bake/convert.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "vdb/vdb_internal.h"
+#include "vdb/vdb_inspect.h"
 #include "vdb/vdb_io.h"
 
 namespace lo {
@@ -349,6 +352,66 @@ TEST(VdbIo, PhotonPointsAreDeterministicAndMayBeEmpty) {
   EXPECT_EQ(info.pointCount, 0u);
   EXPECT_EQ(info.gridNames, std::vector<std::string>{"photons"});
   EXPECT_THROW(writePhotonPoints(dir + "/bad.vdb", photons, 0.0f), InputError);
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+// Surface layers round-trip through the .vdb: a bake of a room (its edges
+// have layers) written and read back gives the same layers, points and VDLs,
+// and the same octree bytes.
+TEST(VdbLayers, RoundTrip) {
+  BakeParams p;
+  p.depth = 4;
+  p.photons = 60000;
+  p.knn = 60;
+  const BakeResult baked = bake(test::pointLitRoom(), p);
+  const VdlGrid& g = baked.grid;
+  ASSERT_GT(g.layers.size(), 0u);
+  const std::string path = test::outputDir("VdbLayers") + "/room.vdb";
+  writeVdlGrid(path, g, baked.metadata);
+  const LoadedVdl r = readVdlGrid(path);
+  EXPECT_EQ(r.meta.formatVersion, kVdlFormatVersion);
+  const VdlLayers &a = g.layers, &b = r.grid.layers;
+  ASSERT_EQ(b.size(), a.size());
+  EXPECT_EQ(b.voxel, a.voxel);
+  EXPECT_EQ(b.normals, a.normals);
+  EXPECT_EQ(b.points, a.points);
+  EXPECT_EQ(b.irradiance, a.irradiance);
+  EXPECT_EQ(b.vdlCount, a.vdlCount);
+  EXPECT_EQ(b.photonCount, a.photonCount);
+  ASSERT_EQ(b.vdls.size(), a.vdls.size());
+  for (size_t i = 0; i < a.vdls.size(); ++i) {
+    EXPECT_EQ(b.vdls[i].irradiance, a.vdls[i].irradiance);
+    EXPECT_EQ(b.vdls[i].direction, a.vdls[i].direction);
+  }
+  for (size_t e = 0; e < a.size(); ++e) EXPECT_EQ(r.grid.points[a.voxel[e]], g.points[a.voxel[e]]);
+  const GpuOctree x = buildGpuOctree(g), y = buildGpuOctree(r.grid);
+  EXPECT_EQ(x.pool, y.pool);
+  EXPECT_EQ(x.vdlTexels, y.vdlTexels);
+  // inspect checks the layers too.
+  const VdbReport report = inspectVdb(path);
+  bool layersChecked = false;
+  for (const VdbCheck& c : report.checks) {
+    EXPECT_TRUE(c.passed) << c.name << ": " << c.detail;
+    layersChecked = layersChecked || c.name == "layers";
+  }
+  EXPECT_TRUE(layersChecked);
+  // Same-depth re-clustering keeps them; a new depth drops them and says so.
+  ConvertParams cp;
+  cp.vdls = "2";
+  const ConvertResult two = convertLightGrid(r.grid, r.meta, cp);
+  EXPECT_EQ(two.grid.layers.voxel, a.voxel);
+  EXPECT_LE(*std::max_element(two.grid.layers.vdlCount.begin(), two.grid.layers.vdlCount.end()), 2);
+  cp.vdls = "";
+  cp.depth = 3;
+  const ConvertResult coarse = convertLightGrid(r.grid, r.meta, cp);
+  EXPECT_EQ(coarse.grid.layers.size(), 0u);
+  EXPECT_NE(coarse.method.find("surface layers are not carried"), std::string::npos)
+      << coarse.method;
 }
 
 }  // namespace

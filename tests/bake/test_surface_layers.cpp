@@ -1,0 +1,135 @@
+// Surface layers and gather occlusion through the whole bake (bake() ->
+// VdlGrid -> GpuOctree -> octreeIrradiance), against answers known without
+// the bake: two perpendicular black planes, each lit by its own distant light
+// that grazes the other, hold exactly their own light's irradiance up to the
+// edge where they meet; a floor split by a thin wall with the light on one
+// side holds none on the other.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "bake/bake.h"
+#include "octree/gpu_octree.h"
+#include "octree/octree_irradiance.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+Light sun(const Vec3& travel, float intensity) {
+  Light l;
+  l.type = Light::Type::Directional;
+  l.direction = normalize(travel);
+  l.intensity = intensity;
+  return l;
+}
+
+Scene blackScene() {
+  Scene scene;
+  Material black;
+  black.baseColor = {0, 0, 0};  // no bounce: every photon is a direct one
+  scene.materials.push_back(black);
+  return scene;
+}
+
+struct EdgeError {
+  double floor = 0, wall = 0;  ///< mean relative error within one voxel of the edge
+};
+
+/// A floor (y = 0, facing up) and a wall (x = 0, facing +x) meeting along the
+/// z axis; light A straight down lights only the floor (E_A = 2), light B
+/// along -x only the wall (E_B = 1).
+EdgeError edgeError(bool layers) {
+  Scene scene = blackScene();
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  test::addQuad(scene, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);
+  scene.lights.push_back(sun({0, -1, 0}, 2.0f));
+  scene.lights.push_back(sun({-1, 0, 0}, 1.0f));
+  BakeParams p;
+  p.depth = 4;
+  p.photons = 400000;
+  p.includeDirect = true;
+  p.layers = layers;
+  const BakeResult baked = bake(scene, p);
+  const GpuOctree octree = buildGpuOctree(baked.grid);
+  const float voxel = baked.grid.frame.voxelSize;
+  EdgeError e;
+  int n = 0;
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 8; ++j) {
+      const float d = voxel * (0.05f + 0.9f * float(i) / 7.0f);  // within a voxel of the edge
+      const float z = 0.25f + 0.5f * float(j) / 7.0f;
+      const Vec3 floorE = octreeIrradiance(octree, {d, 0, z}, {0, 1, 0});
+      const Vec3 wallE = octreeIrradiance(octree, {0, d, z}, {1, 0, 0});
+      e.floor += std::fabs(floorE.x - 2.0) / 2.0;
+      e.wall += std::fabs(wallE.x - 1.0) / 1.0;
+      ++n;
+    }
+  }
+  e.floor /= n;
+  e.wall /= n;
+  std::printf("edge, layers %s: %zu voxels with 2+ layers; mean relative error within one voxel "
+              "of the edge: floor %.3f, wall %.3f\n",
+              layers ? "on" : "off", baked.stats.level.layeredVoxels, e.floor, e.wall);
+  return e;
+}
+
+TEST(SurfaceLayers, EachFaceOfAnEdgeKeepsItsOwnLight) {
+  const EdgeError on = edgeError(true);
+  const EdgeError off = edgeError(false);
+  // Photon noise of a k = 300 estimate is ~6%; the edge voxels without
+  // layers mix the two faces' photons.
+  EXPECT_LT(on.floor, 0.08);
+  EXPECT_LT(on.wall, 0.08);
+  EXPECT_GT(off.floor + off.wall, 2.0 * (on.floor + on.wall));
+}
+
+/// A 1 x 1 floor split at x = 0.5 by a thin wall (both sides facing out,
+/// up to y = 1), lit from above on the +x side only (a sun whose light
+/// reaches x < 0.5 is blocked by a roof there).
+TEST(SurfaceLayers, NoLightThroughAThinWall) {
+  Scene scene = blackScene();
+  Material white;
+  white.baseColor = {0.8f, 0.8f, 0.8f};
+  scene.materials.push_back(white);
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 1);        // floor
+  test::addQuad(scene, {0.5f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 1);     // wall, +x side
+  test::addQuad(scene, {0.5f, 0, 0}, {0, 0, 1}, {0, 1, 0}, {-1, 0, 0}, 1);    // wall, -x side
+  test::addQuad(scene, {0, 1, 0}, {0, 0, 1}, {0.5f, 0, 0}, {0, 1, 0}, 0);     // black roof over x < 0.5
+  test::addQuad(scene, {0, 1, 0}, {0.5f, 0, 0}, {0, 0, 1}, {0, -1, 0}, 0);
+  scene.lights.push_back(sun({0, -1, 0}, 1.0f));
+  for (int on = 0; on < 2; ++on) {
+    BakeParams p;
+    p.depth = 5;
+    p.photons = 300000;
+    p.layers = on;
+    p.occlusion = on;
+    const BakeResult baked = bake(scene, p);
+    const GpuOctree octree = buildGpuOctree(baked.grid);
+    double dark = 0, lit = 0;
+    int n = 0;
+    for (int i = 0; i < 16; ++i) {
+      const float x = 0.5f - 0.004f - 0.06f * float(i % 4) / 3.0f;  // the dark side, near the wall
+      const float z = 0.2f + 0.6f * float(i / 4) / 3.0f;
+      dark += luminance(octreeIrradiance(octree, {x, 0, z}, {0, 1, 0}));
+      lit += luminance(octreeIrradiance(octree, {1.0f - x, 0, z}, {0, 1, 0}));
+      ++n;
+    }
+    std::printf("thin wall, layers and occlusion %s: floor near the wall, dark side %.4g, lit "
+                "side (indirect) %.4g W/m^2\n",
+                on ? "on" : "off", dark / n, lit / n);
+    ASSERT_GT(lit, 0.0);
+    if (on) {
+      EXPECT_EQ(dark, 0.0) << "light through the wall";
+    } else {
+      EXPECT_GT(dark, 0.05 * lit) << "the test would not show a leak";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lo
