@@ -34,6 +34,7 @@ struct BakeOptions {
   std::string layers = "on";
   std::string occlusion = "on";
   std::string edgeCorrection = "on";
+  std::string smoothing = "on";
   std::string photonMap;
   std::string statsJson;
   bool quiet = false;
@@ -64,6 +65,7 @@ int runBake(const BakeOptions& opt) {
   params.layers = opt.layers == "on";
   params.occlusion = opt.occlusion == "on";
   params.edgeCorrection = opt.edgeCorrection == "on";
+  params.smoothing = opt.smoothing == "on";
   params.keepPhotons = !opt.photonMap.empty();
   BakeResult baked = bake(scene, params, &progress);
   rows.insert(rows.end(), baked.stats.stages.begin(), baked.stats.stages.end());
@@ -92,7 +94,7 @@ int runBake(const BakeOptions& opt) {
                        {"vdls", opt.vdls},           {"seed", opt.seed},
                        {"threads", opt.threads},     {"include_direct", opt.includeDirect},
                        {"layers", opt.layers},       {"gather_occlusion", opt.occlusion},
-                       {"edge_correction", opt.edgeCorrection}};
+                       {"edge_correction", opt.edgeCorrection}, {"smoothing", opt.smoothing}};
     j["counts"] = {{"triangles", st.triangles},
                    {"stored_photons", st.storedPhotons},
                    {"emitted_paths", st.emittedPaths},
@@ -170,6 +172,11 @@ std::function<int()> addBakeCommand(CLI::App& app) {
   cmd->add_option("--edge-correction", opt->edgeCorrection,
                   "Divide the gathered power by the part of the gather disc that lies on the "
                   "surface, not the whole disc: next to an edge the plain estimate is too dark")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--smoothing", opt->smoothing,
+                  "Smooth each voxel's estimate with its neighbours on the same surface, where "
+                  "they differ by no more than the photon noise explains (shadow edges kept)")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   cmd->add_option("--photon-map", opt->photonMap,

@@ -75,6 +75,7 @@ std::string BakeParams::ToString() const {
          vdls.ToString() + ", seed " + std::to_string(seed) +
          (includeDirect ? ", include direct" : "") + (layers ? "" : ", no layers") +
          (occlusion ? "" : ", no occlusion") + (edgeCorrection ? "" : ", no edge correction") +
+         (smoothing ? ", smoothing" : "") +
          "}";
 }
 
@@ -135,6 +136,7 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
   const LayerParams layerParams;
   VdlGrid vdls = buildVdlGrid(grid, photons, gather, params.cluster, progress, &s.threadSeconds,
                               params.layers ? &layerParams : nullptr);
+  if (params.smoothing) smoothVdlGrid(grid, vdls);
   size_t layered = 0;
   for (size_t e = 0; e < vdls.layers.size(); ++e) {
     if (e == 0 || vdls.layers.voxel[e] != vdls.layers.voxel[e - 1]) ++layered;
@@ -194,6 +196,7 @@ BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* prog
   level.cluster = params.clusterParams();
   level.layers = params.layers;
   level.occlusion = params.occlusion;
+  level.smoothing = params.smoothing;
   r.grid = bakeLevel(scene, photons.photons, level, progress, &s.level, &s.stages);
 
   BakeMetadata& meta = r.metadata;

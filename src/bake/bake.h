@@ -59,6 +59,8 @@ struct BakeParams {
   bool occlusion = true;
   /// Edge correction (`--edge-correction`): GatherParams::edgeCorrection.
   bool edgeCorrection = true;
+  /// Layer-aware smoothing of the estimates (`--smoothing`): smoothVdlGrid.
+  bool smoothing = true;
 
   PhotonParams photonParams() const;
   GridParams gridParams() const;
@@ -93,6 +95,7 @@ struct LevelParams {
   ClusterParams cluster;  ///< VDLs per voxel, seed
   bool layers = true;     ///< BakeParams::layers
   bool occlusion = true;  ///< BakeParams::occlusion: gather.blocked by the scene's ray tracer
+  bool smoothing = true;  ///< BakeParams::smoothing
 };
 
 /// What bakeLevel did, for reports and benchmarks. Seconds are wall time.

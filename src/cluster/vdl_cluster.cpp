@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <utility>
@@ -208,6 +209,67 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
     }
   }
   return out;
+}
+
+size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& params) {
+  const size_t n = out.size();
+  LO_CHECK_EQ(grid.size(), n);
+  std::vector<char> layered(n, 0);
+  for (uint32_t v : out.layers.voxel) layered[v] = 1;
+  const float h = out.frame.voxelSize;
+  const float inv2s2 = 1.0f / (2.0f * params.sigmaVoxels * params.sigmaVoxels * h * h);
+  std::vector<Vec3> smoothed(out.irradiance);
+  std::vector<char> changed(n, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      if (layered[v] || out.vdlCount[v] == 0) continue;
+      const Vec3 nv = out.normals[v];
+      if (!(lengthSquared(nv) > 0.5f)) continue;
+      const Vec3 pv = out.points.empty() ? grid.centroids[v] : out.points[v];
+      const float yv = luminance(out.irradiance[v]);
+      if (!(yv > 0) || !(out.photonCount[v] > 0)) continue;
+      const float noise = params.rangeSigmas * yv / std::sqrt(out.photonCount[v]);
+      const float invNoise2 = 1.0f / (2.0f * noise * noise);
+      double sum[3] = {0, 0, 0}, weight = 0;
+      const Coord c = out.coords[v];
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int64_t w = grid.find({c.x + dx, c.y + dy, c.z + dz});
+            if (w < 0 || layered[size_t(w)] || out.vdlCount[size_t(w)] == 0) continue;
+            const size_t k = size_t(w);
+            if (!(dot(out.normals[k], nv) > params.minCosine)) continue;
+            const Vec3 pw = out.points.empty() ? grid.centroids[k] : out.points[k];
+            if (std::fabs(dot(pw - pv, nv)) > params.planeVoxels * h) continue;
+            const float dy2 = luminance(out.irradiance[k]) - yv;
+            const float wk = std::exp(-lengthSquared(pw - pv) * inv2s2 - dy2 * dy2 * invNoise2);
+            for (int a = 0; a < 3; ++a) sum[a] += double(wk) * double(out.irradiance[k][a]);
+            weight += double(wk);
+          }
+        }
+      }
+      if (!(weight > 0)) continue;
+      smoothed[v] = Vec3{float(sum[0] / weight), float(sum[1] / weight), float(sum[2] / weight)};
+      changed[v] = 1;
+    }
+  });
+  size_t count = 0;
+  for (size_t v = 0; v < n; ++v) {
+    if (!changed[v]) continue;
+    ++count;
+    Vdl* vdls = out.vdls.data() + v * size_t(out.maxVdls);
+    for (int a = 0; a < 3; ++a) {
+      const float e = out.irradiance[v][a];
+      if (!(e > 0)) continue;
+      const float scale = smoothed[v][a] / e;
+      for (int i = 0; i < out.vdlCount[v]; ++i) vdls[i].irradiance[a] *= scale;
+    }
+    // The VDLs' sum, rounded as stored.
+    Vec3 total{0, 0, 0};
+    for (int i = 0; i < out.vdlCount[v]; ++i) total += vdls[i].irradiance;
+    out.irradiance[v] = total;
+  }
+  return count;
 }
 
 }  // namespace lo

@@ -62,4 +62,23 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
                      ProgressSink* progress = nullptr, BakeTimings* timings = nullptr,
                      const LayerParams* layers = nullptr);
 
+/// Layer-aware smoothing of the estimates (docs/accuracy.md, "Less noise"):
+/// each voxel of one layer takes the weighted mean of its own irradiance and
+/// that of its 26 neighbours that face the same way (normals within
+/// acos(minCosine)) and lie in its plane (within planeVoxels of it along its
+/// normal). Weights: a Gaussian of the distance (sigmaVoxels) times a range
+/// term exp(-(dY / (rangeSigmas * noise))^2 / 2), noise = Y / sqrt(photons
+/// gathered): differences the photon noise explains are smoothed, larger
+/// ones (a shadow's edge) kept. The voxel's VDLs are scaled per channel to
+/// the new irradiance (directions unchanged). Voxels with layers are left as
+/// they are and lend nothing. Deterministic (reads the unsmoothed values).
+struct SmoothParams {
+  float sigmaVoxels = 1.0f;
+  float rangeSigmas = 2.0f;
+  float minCosine = 0.8f;
+  float planeVoxels = 0.3f;
+};
+/// @returns the number of voxels changed.
+size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& params = {});
+
 }  // namespace lo

@@ -173,7 +173,8 @@ nlohmann::json pointJson(const SweepPoint& p) {
           {"cosine_correction", p.cosineCorrection},
           {"layers", p.layers},
           {"occlusion", p.occlusion},
-          {"edge_correction", p.edgeCorrection}};
+          {"edge_correction", p.edgeCorrection},
+          {"smoothing", p.smoothing}};
 }
 
 nlohmann::json resultJson(const SweepResult& r) {
@@ -261,6 +262,7 @@ std::string SweepPoint::label() const {
   if (!layers) s += " no-layers";
   if (!occlusion) s += " no-occlusion";
   if (!edgeCorrection) s += " no-edge";
+  if (smoothing != BakeParams{}.smoothing) s += smoothing ? " smooth" : " no-smooth";
   return s;
 }
 
@@ -268,7 +270,8 @@ std::string SweepPoint::bakeKey() const {
   using namespace sweep_internal;
   return "d" + std::to_string(depth) + "-p" + std::to_string(photons) + "-k" + std::to_string(knn) +
          "-r" + formatNumber(radiusVoxels) + "-v" + vdls + (layers ? "" : "-l0") +
-         (occlusion ? "" : "-o0") + (edgeCorrection ? "" : "-e0");
+         (occlusion ? "" : "-o0") + (edgeCorrection ? "" : "-e0") +
+         (smoothing == BakeParams{}.smoothing ? "" : (smoothing ? "-s1" : "-s0"));
 }
 
 std::string SweepPoint::key() const {
@@ -329,10 +332,12 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale) {
   vary("accuracy", [](SweepPoint& p) { p.layers = false; });
   vary("accuracy", [](SweepPoint& p) { p.occlusion = false; });
   vary("accuracy", [](SweepPoint& p) { p.edgeCorrection = false; });
+  vary("accuracy", [](SweepPoint& p) { p.smoothing = !p.smoothing; });
   vary("accuracy", [](SweepPoint& p) {
     p.layers = false;
     p.occlusion = false;
     p.edgeCorrection = false;
+    p.smoothing = false;
   });
   // Combined points: cheaper photon maps with a matching k (the photon
   // density per voxel falls with the count), coarser and finer grids.
@@ -451,6 +456,7 @@ BakeParams bakeParamsOf(const SweepPoint& point, const Scene& scene, uint64_t se
   b.layers = point.layers;
   b.occlusion = point.occlusion;
   b.edgeCorrection = point.edgeCorrection;
+  b.smoothing = point.smoothing;
   // 0 lets the gather apply its own default (kDefaultRadiusVoxels voxels).
   if (point.radiusVoxels != kDefaultRadiusVoxels) {
     b.radius = point.radiusVoxels * makeGridFrame(scene.bounds(), point.depth).voxelSize;

@@ -36,9 +36,10 @@ struct SweepPoint {
   bool layers = true;            ///< BakeParams::layers (surface layers)
   bool occlusion = true;         ///< BakeParams::occlusion (gather occlusion)
   bool edgeCorrection = true;    ///< BakeParams::edgeCorrection
+  bool smoothing = BakeParams{}.smoothing;  ///< BakeParams::smoothing
 
   /// Short human label, e.g. "d6 600k k300 r1.5 v4" (+ " no-interp", " half",
-  /// " paper-cosine", " no-layers", " no-occlusion", " no-edge").
+  /// " paper-cosine", " no-layers", " no-occlusion", " no-edge", " smooth").
   std::string label() const;
   /// File-name-safe key of the bake parameters only (points that differ only
   /// in interpolation or texel format share one bake).

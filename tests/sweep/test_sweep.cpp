@@ -24,7 +24,8 @@ std::set<std::string> differences(const SweepPoint& a, const SweepPoint& b) {
   if (a.interpolation != b.interpolation) d.insert("interpolation");
   if (a.halfFloat != b.halfFloat) d.insert("texels");
   if (a.cosineCorrection != b.cosineCorrection) d.insert("cosine");
-  if (a.layers != b.layers || a.occlusion != b.occlusion || a.edgeCorrection != b.edgeCorrection) {
+  if (a.layers != b.layers || a.occlusion != b.occlusion || a.edgeCorrection != b.edgeCorrection ||
+      a.smoothing != b.smoothing) {
     d.insert("accuracy");
   }
   return d;
