@@ -44,6 +44,9 @@ int runBake(const BakeOptions& opt) {
   checkOutputFolder(opt.output, "--output");
   if (!opt.photonMap.empty()) checkOutputFolder(opt.photonMap, "--photon-map");
   if (!opt.statsJson.empty()) checkOutputFolder(opt.statsJson, "--stats-json");
+  checkDistinctFiles(
+      {{"--output", opt.output}, {"--photon-map", opt.photonMap}, {"--stats-json", opt.statsJson}},
+      {{"SCENE", opt.scene}});
 
   ThreadLimit threadLimit(opt.threads);
   ConsoleProgress progress(opt.quiet);
@@ -51,6 +54,7 @@ int runBake(const BakeOptions& opt) {
 
   StageTimer loadTimer(rows, "load scene");
   Scene scene = loadScene(opt.scene);
+  printSceneWarnings(scene);
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.lights.size()) + " punctual lights");
 

@@ -39,6 +39,8 @@ int runCompare(const CompareOptions& opt) {
     }
   }
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
+  checkDistinctFiles({{"--diff", opt.diff}, {"--json", opt.json}},
+                     {{"TEST", opt.test}, {"REFERENCE", opt.reference}, {"--mask", opt.mask}});
   RgbImage test = readImage(opt.test);
   RgbImage reference = readImage(opt.reference);
   RgbImage mask;

@@ -39,6 +39,8 @@ struct ConvertOptions {
 
 int runConvert(const ConvertOptions& opt) {
   checkOutputFolder(opt.output, "--output");
+  checkDistinctFiles({{"--output", opt.output}},
+                     {{"IN", opt.input}, {"--scene", opt.scene}, {"--photon-map", opt.photonMap}});
   const auto& optional = optionalVdlGridNames();
   for (const std::string& name : opt.drop) {
     if (std::find(optional.begin(), optional.end(), name) == optional.end()) {
@@ -66,6 +68,7 @@ int runConvert(const ConvertOptions& opt) {
   if (!opt.scene.empty() && needsScene) {
     StageTimer loadTimer(rows, "load scene");
     scene = loadScene(opt.scene);
+    printSceneWarnings(scene);
     params.scene = &scene;
     loadTimer.finish(formatCount(scene.triangleCount()) + " triangles");
   }

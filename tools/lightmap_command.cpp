@@ -72,6 +72,7 @@ struct LightmapRun {
 
 LightmapRun resolve(const LightmapOptions& opt) {
   checkOutputFolder(opt.output, "--output");
+  checkDistinctFiles({{"--output", opt.output}}, {{"SCENE", opt.scene}, {"LIGHTS", opt.lights}});
   if (!hasExtension(opt.output, ".glb") && !hasExtension(opt.output, ".gltf")) {
     throw InputError("--output: '" + opt.output + "' must end in .glb or .gltf");
   }
@@ -144,6 +145,7 @@ int runLightmap(const LightmapOptions& opt) {
 
   StageTimer loadTimer(rows, "load scene");
   const Scene scene = loadScene(opt.scene);
+  printSceneWarnings(scene);
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.materials.size()) + " materials");
 

@@ -44,10 +44,13 @@ void checkImageOutput(const std::string& path, const char* flag) {
 int runReference(const ReferenceOptions& opt) {
   checkImageOutput(opt.output, "--output");
   if (!opt.stdErrorOutput.empty()) checkImageOutput(opt.stdErrorOutput, "--std-error");
+  checkDistinctFiles({{"--output", opt.output}, {"--std-error", opt.stdErrorOutput}},
+                     {{"SCENE", opt.scene}});
   checkCameraOptions(opt.camera);
   ThreadLimit threadLimit(opt.threads);
 
   Scene scene = loadScene(opt.scene);
+  printSceneWarnings(scene);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   ReferenceParams params;
   params.width = opt.width;

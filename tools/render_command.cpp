@@ -16,6 +16,7 @@
 #include "octree/octree_irradiance.h"
 #include "reference/first_hit.h"
 #include "render/context.h"
+#include "report.h"
 #include "image/image.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -72,12 +73,14 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
 int runRender(const RenderOptions& opt) {
   // Everything that can be checked before the work is checked first.
   checkOutputFolder(opt.output, "--output");
+  checkDistinctFiles({{"--output", opt.output}}, {{"SCENE", opt.scene}, {"LIGHTS", opt.lights}});
   if (!hasExtension(opt.output, ".png") && !hasExtension(opt.output, ".exr")) {
     throw InputError("--output: '" + opt.output + "' must end in .png or .exr");
   }
   checkCameraOptions(opt.camera);
   if (opt.mode == "irradiance") {
     Scene scene = loadScene(opt.scene);
+    printSceneWarnings(scene);
     return renderIrradiance(opt, scene, readVdlGrid(opt.lights));
   }
   RenderParams params = opt.shading.renderParams(parseRenderMode(opt.mode));
@@ -85,8 +88,16 @@ int runRender(const RenderOptions& opt) {
   params.height = opt.height;
 
   Scene scene = loadScene(opt.scene);
+  printSceneWarnings(scene);
   LoadedVdl baked = readVdlGrid(opt.lights);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
+  if (baked.meta.includeDirect == 1 &&
+      (params.mode == RenderMode::Full || params.mode == RenderMode::Direct)) {
+    std::fprintf(stderr,
+                 "warning: %s was baked with --include-direct: its VDLs hold the direct light, "
+                 "which mode %s draws again (counted twice); use --mode indirect\n",
+                 opt.lights.c_str(), opt.mode.c_str());
+  }
 
   GlContextParams contextParams;
   contextParams.backend = parseGlBackend(opt.backend);

@@ -63,4 +63,8 @@ void printSummary(std::FILE* out, const std::vector<StageReport>& rows) {
   std::fprintf(out, "%-18s %9.3fs\n", "total", total);
 }
 
+void printSceneWarnings(const Scene& scene) {
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+}
+
 }  // namespace lo::tool

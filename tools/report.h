@@ -9,6 +9,7 @@
 
 #include "core/progress.h"
 #include "core/resources.h"
+#include "scene/scene.h"
 
 namespace lo::tool {
 
@@ -30,5 +31,8 @@ class ConsoleProgress : public ProgressSink {
 };
 
 void printSummary(std::FILE* out, const std::vector<StageReport>& rows);
+
+/// The scene's Scene::warnings on stderr, one "warning: ..." line each.
+void printSceneWarnings(const Scene& scene);
 
 }  // namespace lo::tool

@@ -41,7 +41,8 @@ int runSweepCommand(const SweepOptions& opt) {
   params.seed = opt.seed;
   ConsoleProgress progress(opt.quiet);
   params.progress = &progress;
-  checkOutputFolder(opt.out, "--out");
+  // A results folder: an existing one is reused; a new one needs its parent.
+  if (!std::filesystem::is_directory(opt.out)) checkOutputFolder(opt.out, "--out");
   std::filesystem::create_directories(opt.out);
   std::FILE* log = opt.quiet ? nullptr : stdout;
   std::vector<SweepResult> results = runSweep(params, log);

@@ -25,6 +25,7 @@
 #include "bake/progressive_bake.h"
 #include "render/camera_path.h"
 #include "render/context.h"
+#include "report.h"
 #include "render/fly_camera.h"
 #include "render/renderer.h"
 #include "render/viewer.h"
@@ -126,6 +127,7 @@ int runView(const ViewOptions& opt) {
   view.quiet = opt.quiet;
 
   Scene scene = loadScene(opt.scene);
+  printSceneWarnings(scene);
   std::optional<LoadedVdl> baked;
   if (!opt.progressive) baked = readVdlGrid(opt.lights);
 

@@ -164,6 +164,16 @@ namespace {
 void checkParams(const BakeParams& p) {
   checkDepth(p.depth);
   if (p.photons < 1) throw InputError("--photons must be at least 1");
+  // The photon map and its bins cost about kBakeBytesPerPhoton each (measured
+  // at depths 6 to 8, docs/scale.md): refuse before tracing what cannot fit.
+  const size_t available = availableMemoryBytes();
+  const double needed = double(p.photons) * double(kBakeBytesPerPhoton);
+  if (available > 0 && needed > double(available)) {
+    throw InputError("--photons " + std::to_string(p.photons) + " needs about " +
+                     formatBytes(size_t(needed)) + " (" + std::to_string(kBakeBytesPerPhoton) +
+                     " bytes per stored photon), more than the " + formatBytes(available) +
+                     " of memory available: store fewer photons");
+  }
   if (p.knn < 1) throw InputError("--knn " + std::to_string(p.knn) + " must be at least 1");
   if (!(p.radius >= 0.0f) || !std::isfinite(p.radius)) {
     throw InputError("--radius " + std::to_string(p.radius) + " must be a finite positive length");
@@ -178,6 +188,18 @@ void checkParams(const BakeParams& p) {
 
 BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* progress) {
   checkParams(params);
+  // What the .vdb can store, checked before any work: OpenVDB refuses a
+  // transform whose scale cubed is below 3e-15 (math::ScaleMap).
+  if (scene.triangleCount() > 0) {
+    const GridFrame frame = makeGridFrame(scene.bounds(), params.depth);
+    const double h = frame.voxelSize;
+    if (!(h * h * h >= kMinStorableVoxel * kMinStorableVoxel * kMinStorableVoxel)) {
+      throw InputError("--depth " + std::to_string(params.depth) + ": voxels of " +
+                       formatNumber(float(h)) + " scene units are smaller than a .vdb stores (" +
+                       formatNumber(float(kMinStorableVoxel)) +
+                       "): bake at a smaller --depth, or the scene in larger units");
+    }
+  }
   BakeResult r;
   BakeStats& s = r.stats;
   s.triangles = scene.triangleCount();
@@ -211,6 +233,7 @@ BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* prog
   meta.surfaceLayers = params.layers ? 1 : 0;
   meta.gatherOcclusion = params.occlusion ? 1 : 0;
   meta.edgeCorrection = params.edgeCorrection ? 1 : 0;
+  meta.includeDirect = params.includeDirect ? 1 : 0;
   if (params.keepPhotons) r.photons = std::move(photons);
   return r;
 }

@@ -40,6 +40,14 @@ std::string vdlCountError(const std::string& text);
 /// 1 <= depth <= kMaxGridDepth: the one depth check of the bake module.
 void checkDepth(int depth, const std::string& what = "--depth");
 
+/// Memory a bake needs per stored photon (the map, its bins and the gather's
+/// copy), bytes: checked against the memory available before tracing.
+constexpr size_t kBakeBytesPerPhoton = 120;
+
+/// Smallest voxel a .vdb transform stores, scene units: OpenVDB refuses
+/// scales whose cube is below 3e-15 (with a margin).
+constexpr double kMinStorableVoxel = 1.5e-5;
+
 /// Every setting of a bake, with the defaults of `lightoctree bake`.
 struct BakeParams {
   int depth = 6;            ///< 2^depth voxels across the padded bounding cube (paper's delta)

@@ -1,24 +1,169 @@
 #include "core/file.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <random>
 #include <system_error>
 
 #include "core/error.h"
 
 namespace lo {
 
-std::string temporaryPathFor(const std::string& path) { return path + ".tmp"; }
+namespace fs = std::filesystem;
+
+namespace file_internal {
+
+// Temporary files alive now, removed by a signal handler if the process is
+// interrupted: fixed slots of fixed size, so that the handler only reads
+// memory and calls unlink (async-signal-safe).
+constexpr int kSlots = 64;
+constexpr size_t kPathBytes = 4096;
+struct Slot {
+  std::atomic<int> state{0};  // 0 free, 1 being written, 2 live
+  char path[kPathBytes];
+};
+Slot slots[kSlots];
+struct sigaction previous[3];
+constexpr int kSignals[3] = {SIGINT, SIGTERM, SIGHUP};
+
+void onSignal(int sig) {
+  for (Slot& s : slots) {
+    if (s.state.load() == 2) ::unlink(s.path);
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (kSignals[i] != sig) continue;
+    sigaction(sig, &previous[i], nullptr);  // the handler before ours (default: terminate)
+  }
+  ::raise(sig);
+}
+
+void installHandlers() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    for (int i = 0; i < 3; ++i) {
+      struct sigaction current {};
+      sigaction(kSignals[i], nullptr, &current);
+      // An ignored signal stays ignored; a program's own handler is kept.
+      if (current.sa_handler == SIG_IGN || current.sa_handler != SIG_DFL) continue;
+      struct sigaction action {};
+      action.sa_handler = onSignal;
+      sigemptyset(&action.sa_mask);
+      action.sa_flags = 0;
+      sigaction(kSignals[i], &action, &previous[i]);
+    }
+  });
+}
+
+/// Registers `path` for removal on a signal; -1 when every slot is taken
+/// (the file is still removed on errors, just not on signals).
+int track(const std::string& path) {
+  installHandlers();
+  if (path.size() >= kPathBytes) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = 0;
+    if (slots[i].state.compare_exchange_strong(expected, 1)) {
+      std::memcpy(slots[i].path, path.c_str(), path.size() + 1);
+      slots[i].state.store(2);
+      return i;
+    }
+  }
+  return -1;
+}
+
+void untrack(int slot) {
+  if (slot >= 0) slots[slot].state.store(0);
+}
+
+std::string describe(const fs::file_status& s) {
+  switch (s.type()) {
+    case fs::file_type::directory: return "a folder";
+    case fs::file_type::symlink: return "a symbolic link";
+    case fs::file_type::block:
+    case fs::file_type::character: return "a device";
+    case fs::file_type::fifo: return "a pipe";
+    case fs::file_type::socket: return "a socket";
+    default: return "not a regular file";
+  }
+}
+
+/// "" when `path` may be replaced (absent or a regular file), else why not.
+std::string notReplaceable(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status s = fs::symlink_status(path, ec);
+  if (ec || s.type() == fs::file_type::not_found || s.type() == fs::file_type::regular) return "";
+  return describe(s);
+}
+
+}  // namespace file_internal
+
+std::string temporaryPathFor(const std::string& path) {
+  static std::atomic<uint64_t> counter{0};
+  static const uint64_t seed = [] {
+    std::random_device rd;
+    return (uint64_t(rd()) << 32) ^ uint64_t(rd());
+  }();
+  const uint64_t n = counter.fetch_add(1);
+  std::mt19937_64 mix(seed ^ (n * 0x9e3779b97f4a7c15ull));
+  char tag[64];
+  std::snprintf(tag, sizeof tag, "%ld-%016llx", long(::getpid()),
+                static_cast<unsigned long long>(mix()));
+  const fs::path p(path);
+  return (p.parent_path() / ("." + p.filename().string() + "." + tag + ".tmp")).string();
+}
+
+bool isTemporaryPathFor(const std::string& candidate, const std::string& path) {
+  const std::string name = fs::path(candidate).filename().string();
+  const std::string prefix = "." + fs::path(path).filename().string() + ".";
+  return fs::path(candidate).parent_path() == fs::path(path).parent_path() &&
+         name.size() > prefix.size() + 4 && name.compare(0, prefix.size(), prefix) == 0 &&
+         name.compare(name.size() - 4, 4, ".tmp") == 0;
+}
+
+std::vector<std::string> leftoverTemporaries(const std::string& path) {
+  std::vector<std::string> out;
+  fs::path folder = fs::path(path).parent_path();
+  if (folder.empty()) folder = ".";
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string candidate =
+        (fs::path(path).parent_path() / entry.path().filename()).string();
+    if (isTemporaryPathFor(candidate, path)) out.push_back(entry.path().string());
+  }
+  return out;
+}
 
 void writeAtomically(const std::string& path,
                      const std::function<void(const std::string& tmp)>& write) {
+  using namespace file_internal;
+  const std::string refused = notReplaceable(path);
+  if (!refused.empty()) {
+    throw IoError(path + ": will not write: it is " + refused + " (write to a new name)");
+  }
   const std::string tmp = temporaryPathFor(path);
-  auto removeTmp = [&tmp] {
+  // Created exclusively and without following links: a name that exists
+  // (whoever put it there) is an error, never something to write through.
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    throw IoError(path + ": cannot create the temporary file '" + tmp + "' (" +
+                  std::strerror(errno) + ")");
+  }
+  ::close(fd);
+  const int slot = track(tmp);
+  auto removeTmp = [&] {
     std::error_code ignored;
-    std::filesystem::remove(tmp, ignored);
+    fs::remove(tmp, ignored);
+    untrack(slot);
   };
   try {
     write(tmp);
@@ -29,12 +174,23 @@ void writeAtomically(const std::string& path,
     removeTmp();
     throw IoError(path + ": cannot write (" + e.what() + ")");
   }
+  // The writer opened the name itself: it must still be our regular file.
+  if (fs::symlink_status(tmp).type() != fs::file_type::regular) {
+    removeTmp();
+    throw IoError(path + ": the temporary file '" + tmp + "' was replaced while writing");
+  }
+  const std::string refusedNow = notReplaceable(path);
+  if (!refusedNow.empty()) {
+    removeTmp();
+    throw IoError(path + ": will not write: it is " + refusedNow + " (write to a new name)");
+  }
   std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
+  fs::rename(tmp, path, ec);
   if (ec) {
     removeTmp();
     throw IoError(path + ": cannot rename '" + tmp + "' (" + ec.message() + ")");
   }
+  untrack(slot);
 }
 
 void writeTextAtomically(const std::string& path, const std::string& text) {
@@ -47,14 +203,53 @@ void writeTextAtomically(const std::string& path, const std::string& text) {
 }
 
 void checkOutputFolder(const std::string& path, const char* flag) {
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+  const fs::path parent = fs::path(path).parent_path();
+  const fs::path folder = parent.empty() ? fs::path(".") : parent;
+  if (!fs::is_directory(folder)) {
     throw InputError(std::string(flag) + ": folder '" + parent.string() + "' does not exist");
+  }
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+    throw InputError(std::string(flag) + ": folder '" + folder.string() +
+                     "' is not writable: " + std::strerror(errno));
+  }
+  const std::string refused = file_internal::notReplaceable(path);
+  if (!refused.empty()) {
+    throw InputError(std::string(flag) + ": '" + path + "' is " + refused +
+                     "; outputs replace only regular files (write to a new name)");
+  }
+}
+
+void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs) {
+  auto same = [](const std::string& a, const std::string& b) {
+    std::error_code ec1, ec2;
+    if (fs::exists(a, ec1) && fs::exists(b, ec2)) {
+      std::error_code ec;
+      if (fs::equivalent(a, b, ec)) return true;
+    }
+    std::error_code ea, eb;
+    const fs::path ca = fs::weakly_canonical(a, ea), cb = fs::weakly_canonical(b, eb);
+    return !ea && !eb && ca == cb;
+  };
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const auto& [flag, path] = outputs[i];
+    if (path.empty()) continue;
+    for (const auto& [inFlag, in] : inputs) {
+      if (!in.empty() && same(path, in)) {
+        throw InputError(flag + ": '" + path + "' is the input " + inFlag +
+                         ": it would be replaced; write to another name");
+      }
+    }
+    for (size_t j = i + 1; j < outputs.size(); ++j) {
+      if (!outputs[j].second.empty() && same(path, outputs[j].second)) {
+        throw InputError(flag + " and " + outputs[j].first + " name the same file '" + path +
+                         "'");
+      }
+    }
   }
 }
 
 std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
+  std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return char(std::tolower(c)); });
   return ext;

@@ -2,28 +2,53 @@
 /// @file core/file.h
 /// @brief Output files: every writer of the project goes through these, so
 /// that an interrupted or failed write never leaves a half file under the
-/// final name, and a bad output path is reported before any long work.
+/// final name, nothing is written through a link or over what is not a
+/// regular file, and a bad output path is reported before any long work.
+/// See docs/architecture.md, "Outputs".
 
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace lo {
 
-/// @brief Writes `path` through a temporary file beside it: `write(tmp)` fills
-/// the temporary file, which is then renamed over `path` (atomic on POSIX
-/// within one file system). On any failure the temporary file is removed and
-/// an IoError naming `path` and the cause is thrown; `path` is untouched.
+/// @brief Writes `path` through a temporary file beside it: a new name per
+/// call (temporaryPathFor), created exclusively (an existing file or link of
+/// that name is an error, never followed), which `write(tmp)` fills and which
+/// is then renamed over `path` (atomic on POSIX within one file system).
+/// `path` itself is replaced only when it does not exist or is a regular file:
+/// a symbolic link, a device, a folder is refused. On any failure, and on
+/// SIGINT, SIGTERM or SIGHUP while the temporary file exists, it is removed;
+/// an IoError names `path` and the cause; `path` is untouched.
 void writeAtomically(const std::string& path, const std::function<void(const std::string& tmp)>& write);
 
 /// @brief writeAtomically for a text (or any byte) string.
 void writeTextAtomically(const std::string& path, const std::string& text);
 
-/// @brief The temporary name writeAtomically uses for `path`.
+/// @brief A new temporary name for `path`: ".NAME.PID-RANDOM.tmp" in the same
+/// folder (hidden, unpredictable, distinct for every call and process).
 std::string temporaryPathFor(const std::string& path);
 
-/// @throws InputError naming `flag` when the folder that would hold `path`
-/// does not exist. Called by commands before any long work.
+/// @brief Whether `candidate` is a name temporaryPathFor(path) can return
+/// (for tests that check nothing was left behind).
+bool isTemporaryPathFor(const std::string& candidate, const std::string& path);
+
+/// @brief The temporary files of `path` present in its folder.
+std::vector<std::string> leftoverTemporaries(const std::string& path);
+
+/// @throws InputError naming `flag` when `path` cannot be written: its folder
+/// does not exist or is not writable, or `path` names a folder, a link or
+/// anything but a regular file. Called by commands before any long work.
 void checkOutputFolder(const std::string& path, const char* flag);
+
+/// @brief A command's files, each with the flag that named it.
+using NamedPaths = std::vector<std::pair<std::string, std::string>>;  // (flag, path)
+
+/// @throws InputError naming both flags when an output is one of the inputs
+/// (the same file, by any name) or two outputs are the same file. Empty paths
+/// are skipped. Called by commands before any work.
+void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs);
 
 /// @brief True when `path` ends in `extension` (".png"), ignoring ASCII case.
 bool hasExtension(const std::string& path, const char* extension);

@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -81,6 +82,45 @@ std::string formatCount(size_t n) {
   std::string s = std::to_string(n);
   for (int i = int(s.size()) - 3; i > 0; i -= 3) s.insert(size_t(i), ",");
   return s;
+}
+
+size_t availableMemoryBytes() {
+  size_t available = 0;
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    while (std::fgets(line, sizeof line, f)) {
+      unsigned long long kib = 0;
+      if (std::sscanf(line, "MemAvailable: %llu kB", &kib) == 1) {
+        available = size_t(kib) * 1024;
+        break;
+      }
+    }
+    std::fclose(f);
+  }
+  // A container's limit (cgroup v2, then v1) is what the process can have.
+  for (const char* path : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    if (std::FILE* f = std::fopen(path, "r")) {
+      unsigned long long limit = 0;
+      const bool number = std::fscanf(f, "%llu", &limit) == 1;
+      std::fclose(f);
+      if (number && limit > 0 && limit < (1ull << 60)) {
+        const size_t rss = currentRssBytes();
+        const size_t room = size_t(limit) > rss ? size_t(limit) - rss : 0;
+        available = available ? std::min(available, room) : room;
+      }
+      break;
+    }
+  }
+  // LIGHTOCTREE_MEMORY_LIMIT (bytes): a budget of one's own, or a smaller
+  // machine's in tests.
+  if (const char* limit = std::getenv("LIGHTOCTREE_MEMORY_LIMIT")) {
+    char* end = nullptr;
+    const unsigned long long bytes = std::strtoull(limit, &end, 10);
+    if (end != limit && *end == '\0' && bytes > 0) {
+      available = available ? std::min(available, size_t(bytes)) : size_t(bytes);
+    }
+  }
+  return available;
 }
 
 }  // namespace lo

@@ -35,6 +35,12 @@ bool resetPeakRss();
 /// /proc/self/status), bytes; 0 if unavailable.
 size_t peakRssSinceResetBytes();
 
+/// Memory the kernel says a new allocation can get without swapping
+/// (MemAvailable of /proc/meminfo, capped by the cgroup's limit when one is
+/// set, and by the environment variable LIGHTOCTREE_MEMORY_LIMIT in bytes when
+/// set), bytes; 0 if unknown.
+size_t availableMemoryBytes();
+
 /// One stage's row in a report.
 struct StageReport {
   std::string name;

@@ -117,6 +117,10 @@ struct BakeMetadata {
   /// The gather's accuracy options (docs/accuracy.md); -1 = not recorded
   /// (files written before format version 2).
   int surfaceLayers = -1, gatherOcclusion = -1, edgeCorrection = -1;
+  /// 1: the photon map held direct light too (bake --include-direct), so the
+  /// VDLs carry it and a renderer must not add it again; 0: indirect only;
+  /// -1: not recorded (older files).
+  int includeDirect = -1;
 };
 
 }  // namespace lo

@@ -187,8 +187,57 @@ uint64_t jsonUInt(const nlohmann::json& o, const char* key, uint64_t fallback) {
   return it->get<uint64_t>();
 }
 
+void checkJsonNesting(const std::string& path, const std::string& text) {
+  size_t depth = 0;
+  bool inString = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (inString) {
+      if (c == '\\') {
+        ++i;  // the escaped character
+      } else if (c == '"') {
+        inString = false;
+      }
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '{' || c == '[') {
+      if (++depth > kMaxJsonDepth) {
+        fail(path, "invalid glTF: JSON nested more than " + std::to_string(kMaxJsonDepth) +
+                       " levels deep (at byte " + std::to_string(i) + ")");
+      }
+    } else if ((c == '}' || c == ']') && depth > 0) {
+      --depth;
+    }
+  }
+}
+
+/// Integers the glTF gives where tinygltf keeps an int (indices, enums):
+/// beyond int32 they would wrap (2^32 + 3 read as 3, a silently wrong
+/// scene). Sizes (byteLength, byteOffset, count) are 64-bit in tinygltf.
+void checkIntegerRanges(const std::string& path, const nlohmann::json& j,
+                        const std::string& where, int depth) {
+  if (depth > int(kMaxJsonDepth)) return;
+  auto check = [&](const std::string& key, const nlohmann::json& v, const std::string& at) {
+    if (!v.is_number_integer() || key == "byteLength" || key == "byteOffset" || key == "count") {
+      checkIntegerRanges(path, v, at, depth + 1);
+      return;
+    }
+    const bool fits = v.is_number_unsigned()
+                          ? v.get<uint64_t>() <= uint64_t(std::numeric_limits<int32_t>::max())
+                          : v.get<int64_t>() >= std::numeric_limits<int32_t>::min() &&
+                                v.get<int64_t>() <= std::numeric_limits<int32_t>::max();
+    if (!fits) fail(path, "invalid glTF: " + at + " = " + v.dump() + " is out of range");
+  };
+  if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) check(it.key(), it.value(), where + "/" + it.key());
+  } else if (j.is_array()) {
+    for (size_t i = 0; i < j.size(); ++i) check("", j[i], where + "/" + std::to_string(i));
+  }
+}
+
 void prevalidateJson(const std::string& path, const std::string& baseDir, const nlohmann::json& j) {
   if (!j.is_object()) fail(path, "invalid glTF: the top level is not a JSON object");
+  checkIntegerRanges(path, j, "", 0);
   std::vector<uint64_t> bufferLengths;
   auto buffers = j.find("buffers");
   if (buffers != j.end() && buffers->is_array()) {
@@ -1025,6 +1074,10 @@ Scene loadGltf(const std::string& path) {
     fail(path, "file larger than 4 GiB");
   }
   std::string jsonText = binary ? glbJson(path, bytes) : std::string(bytes.begin(), bytes.end());
+  // Both JSON parsers (nlohmann here, tinygltf's copy below) recurse once per
+  // level: a document nested deeper than any glTF needs would overflow the
+  // stack. Counted first, outside strings.
+  checkJsonNesting(path, jsonText);
   nlohmann::json j = nlohmann::json::parse(jsonText, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) fail(path, "invalid glTF: the JSON does not parse");
   prevalidateJson(path, baseDir, j);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -360,9 +361,39 @@ std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std
   return bytes;
 }
 
-void validateScene(const Scene& scene) {
+std::string formatLimit(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+void validateScene(Scene& scene) {
   if (scene.triangleCount() == 0) fail(scene.sourcePath, "no triangles in the scene");
   checkSceneIndices(scene);
+  // Coordinates the tracers can hold: Embree and the bake work in single
+  // precision, in a frame centred on the scene; beyond kMaxCoordinate a
+  // float has not a millimetre left (docs/scene.md, "Limits").
+  for (size_t i = 0; i < scene.positions.size(); ++i) {
+    const Vec3& p = scene.positions[i];
+    if (std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > kMaxCoordinate) {
+      fail(scene.sourcePath, "vertex " + std::to_string(i) + " lies at " + p.ToString() +
+                                 ", beyond " + formatLimit(kMaxCoordinate) +
+                                 " scene units from the origin (a node transform or unit "
+                                 "scale out of range?)");
+    }
+  }
+  // Energy conservation: a diffuse albedo above 1 creates light. glTF says
+  // base colour factors lie in [0, 1]; larger ones are clamped, with a warning.
+  for (Material& m : scene.materials) {
+    const Vec3 clamped = min(max(m.baseColor, Vec3{0, 0, 0}), Vec3{1, 1, 1});
+    if (!(clamped == m.baseColor)) {
+      scene.warnings.push_back(scene.sourcePath + ": material '" + m.name + "' has base colour " +
+                               m.baseColor.ToString() +
+                               ", outside [0, 1] (an albedo above 1 creates energy): clamped to " +
+                               clamped.ToString());
+      m.baseColor = clamped;
+    }
+  }
   LO_CHECK(scene.normals.empty() || scene.normals.size() == scene.positions.size());
   LO_CHECK(scene.texcoords0.empty() || scene.texcoords0.size() == 2 * scene.positions.size());
   LO_CHECK(scene.texcoords1.empty() || scene.texcoords1.size() == 2 * scene.positions.size());

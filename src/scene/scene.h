@@ -136,6 +136,9 @@ struct Camera {
 /// Triangle soup in world space, one material index per triangle.
 struct Scene {
   std::string sourcePath;
+  /// What loading corrected and a user should hear of (e.g. a base colour
+  /// above 1 clamped): one sentence each, naming the file and the thing.
+  std::vector<std::string> warnings;
   std::vector<Vec3> positions;    ///< world space
   std::vector<Vec3> normals;      ///< per vertex, unit, world space; empty = use face normals
   std::vector<float> texcoords0;  ///< 2 floats per vertex, or empty
@@ -195,6 +198,15 @@ struct Scene {
   /// (directions, areas and powers are unchanged by a translation).
   Scene translated(const Vec3& offset) const;
 };
+
+/// Largest |coordinate| a scene may have, scene units (glTF metres): 1e12
+/// (a million km). The tracers work in single precision in a frame centred
+/// on the scene; loadScene refuses vertices beyond this, naming the vertex.
+constexpr float kMaxCoordinate = 1e12f;
+
+/// Deepest nesting of objects and arrays a glTF's JSON may have: both JSON
+/// parsers recurse once per level, and nothing in glTF needs more.
+constexpr size_t kMaxJsonDepth = 256;
 
 /// @brief The index checks every stage that walks the triangles relies on:
 /// index count a multiple of 3, fewer than 2^32 - 1 triangles, every vertex

@@ -39,8 +39,9 @@ Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, si
 Scene loadGltf(const std::string& path);
 Scene loadObj(const std::string& path);
 
-/// Final checks shared by both loaders: at least one triangle, finite vertices,
-/// every index in range, one material per triangle in range.
-void validateScene(const Scene& scene);
+/// Final checks shared by both loaders: at least one triangle, finite vertices
+/// within kMaxCoordinate, every index in range, one material per triangle in
+/// range; base colours clamped to [0, 1] (Scene::warnings says so).
+void validateScene(Scene& scene);
 
 }  // namespace lo::scene_internal

@@ -254,6 +254,7 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
     m.insertMeta("gather_occlusion", openvdb::Int32Metadata(meta.gatherOcclusion));
   }
   if (meta.edgeCorrection >= 0) m.insertMeta("edge_correction", openvdb::Int32Metadata(meta.edgeCorrection));
+  if (meta.includeDirect >= 0) m.insertMeta("include_direct", openvdb::Int32Metadata(meta.includeDirect));
   return m;
 }
 
@@ -468,6 +469,7 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.surfaceLayers = metaValue<int32_t>(path, m, "surface_layers", false, -1);
   meta.gatherOcclusion = metaValue<int32_t>(path, m, "gather_occlusion", false, -1);
   meta.edgeCorrection = metaValue<int32_t>(path, m, "edge_correction", false, -1);
+  meta.includeDirect = metaValue<int32_t>(path, m, "include_direct", false, -1);
   return meta;
 }
 
@@ -497,6 +499,41 @@ void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const Bak
 }
 
 namespace {
+
+/// What no reader of the file may draw or convert, refused at reading:
+/// non-finite values (NaN, Inf) and a depth outside the octree's range.
+/// inspect reports these (and the softer checks: signs, sums, units) as
+/// failed checks.
+void checkValues(const std::string& path, const VdlGrid& g) {
+  if (g.frame.depth < 1 || g.frame.depth > kMaxGridDepth) {
+    throw InputError(path + ": file metadata depth = " + std::to_string(g.frame.depth) +
+                     " is outside [1, " + std::to_string(kMaxGridDepth) + "]");
+  }
+  auto fail = [&](const Coord& c, const std::string& what) {
+    throw InputError(path + ": " + what + " at voxel " + c.ToString() +
+                     " is not finite (NaN or Inf): the file is damaged");
+  };
+  for (size_t v = 0; v < g.size(); ++v) {
+    const Coord& c = g.coords[v];
+    if (!isFinite(g.irradiance[v])) fail(c, "irradiance");
+    if (!isFinite(g.normals[v])) fail(c, "normal");
+    for (int i = 0; i < g.vdlCount[v]; ++i) {
+      const Vdl& vdl = g.vdlsOf(v)[i];
+      if (!isFinite(vdl.irradiance) || !isFinite(vdl.direction)) fail(c, "VDL " + std::to_string(i));
+    }
+  }
+  for (size_t e = 0; e < g.layers.size(); ++e) {
+    const Coord& c = g.coords[g.layers.voxel[e]];
+    if (!isFinite(g.layers.irradiance[e]) || !isFinite(g.layers.normals[e]) ||
+        !isFinite(g.layers.points[e])) {
+      fail(c, "a surface layer");
+    }
+    for (int i = 0; i < g.layers.vdlCount[e]; ++i) {
+      const Vdl& vdl = g.layerVdlsOf(e)[i];
+      if (!isFinite(vdl.irradiance) || !isFinite(vdl.direction)) fail(c, "a surface layer's VDL");
+    }
+  }
+}
 
 /// The surface layers of a version-2 file (none when it has no
 /// "layer1_normal" grid): every grid of a layer present, on the file's
@@ -758,6 +795,7 @@ LoadedVdl readVdl(const std::string& path) {
     }
   }
   readLayers(path, f, xform, maxVdls, out);
+  checkValues(path, out.grid);
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
 #include "test_util.h"
@@ -129,6 +130,34 @@ TEST(SurfaceLayers, NoLightThroughAThinWall) {
       EXPECT_GT(dark, 0.05 * lit) << "the test would not show a leak";
     }
   }
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+// A scene so small that its voxels are below what a .vdb transform stores is
+// refused before any work, naming --depth (it used to fail at the write,
+// after the whole bake).
+TEST(BakeLimits, VoxelsTooSmallForAVdbAreRefusedFirst) {
+  Scene scene = test::pointLitRoom();
+  for (Vec3& p : scene.positions) p = p * 1e-3f;
+  for (Light& l : scene.lights) l.position = l.position * 1e-3f;
+  BakeParams p;
+  p.depth = 8;
+  try {
+    bake(scene, p);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("--depth 8"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("smaller than a .vdb stores"), std::string::npos) << msg;
+  }
+  p.depth = 4;  // 16 voxels across a millimetre: storable
+  p.photons = 2000;
+  EXPECT_NO_THROW(bake(scene, p));
 }
 
 }  // namespace

@@ -342,8 +342,12 @@ TEST(Gather, FewerThanKUsesTheSearchRadius) {
     // The disc's share on the plane (edge correction): all of it inside,
     // less where it reaches past the plane's border.
     const bool inside = q.x > r && q.x < 1 - r && q.z > r && q.z < 1 - r;
-    if (inside) EXPECT_EQ(res.coverage, 1.0f) << q.ToString();
-    if (q.x < 0.5f * r || q.z < 0.5f * r) EXPECT_LT(res.coverage, 0.9f) << q.ToString();
+    if (inside) {
+      EXPECT_EQ(res.coverage, 1.0f) << q.ToString();
+    }
+    if (q.x < 0.5f * r || q.z < 0.5f * r) {
+      EXPECT_LT(res.coverage, 0.9f) << q.ToString();
+    }
     EXPECT_NEAR(res.irradiance.x, power / (kPi * r * r * res.coverage),
                 1e-4 * power / (r * r) + 1e-9);
   }
@@ -509,8 +513,12 @@ TEST(GatherLayers, FindsTheSurfacesOfAVoxelAndTheirLitSides) {
   EXPECT_TRUE(has(normals(n), {-1, 0, 0}));
   for (int l = 0; l < n; ++l) {
     // Each layer's point lies on its surface.
-    if (layers[l].normal.y > 0.5f) EXPECT_NEAR(layers[l].point.y, 0.0f, 1e-5f);
-    if (std::fabs(layers[l].normal.x) > 0.5f) EXPECT_NEAR(layers[l].point.x, 0.53f, 1e-5f);
+    if (layers[l].normal.y > 0.5f) {
+      EXPECT_NEAR(layers[l].point.y, 0.0f, 1e-5f);
+    }
+    if (std::fabs(layers[l].normal.x) > 0.5f) {
+      EXPECT_NEAR(layers[l].point.x, 0.53f, 1e-5f);
+    }
   }
   lp.maxLayers = 2;
   EXPECT_EQ(gatherer.findSurfaceLayers(size_t(voxel), lp, layers), 2);

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "image/compare.h"
 #include "image/image.h"
+#include "core/file.h"
 #include "test_util.h"
 
 namespace lo {
@@ -92,7 +93,7 @@ TEST(Compare, ExrRoundTripIsExact) {
   img.rgb[4] = 1e-30f;
   img.rgb[7] = 12345.678f;
   writeExr(dir + "/a.exr", img);
-  EXPECT_FALSE(std::filesystem::exists(dir + "/a.exr.tmp"));
+  EXPECT_TRUE(leftoverTemporaries(dir + "/a.exr").empty());
   RgbImage back = readImage(dir + "/a.exr");
   EXPECT_EQ(back.width, 5);
   EXPECT_EQ(back.height, 3);

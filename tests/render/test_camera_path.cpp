@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "render/camera_path.h"
 #include "render/fly_camera.h"
+#include "core/file.h"
 #include "test_util.h"
 
 namespace lo {
@@ -176,7 +177,7 @@ TEST(CameraPath, AppendCreatesThenExtendsTheFile) {
   b.eye = Vec3(-1, 0.25f, 9);
   appendCameraKey(file, a);
   appendCameraKey(file, b);
-  EXPECT_FALSE(std::filesystem::exists(file + ".tmp"));
+  EXPECT_TRUE(leftoverTemporaries(file).empty());
   CameraPath path = readCameraPath(file);
   ASSERT_EQ(path.keys.size(), 2u);
   EXPECT_EQ(path.keys[0].eye, a.eye);

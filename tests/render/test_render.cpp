@@ -11,6 +11,7 @@
 #include <memory>
 #include <sstream>
 
+#include "core/file.h"
 #include "test_util.h"
 #include "core/error.h"
 #include "render/context.h"
@@ -782,7 +783,7 @@ TEST(RenderImageIo, WritesPngAndExrAtomicallyAndRejectsOtherExtensions) {
   writeImage(dir + "/a.exr", image);
   EXPECT_TRUE(std::filesystem::exists(dir + "/a.png"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/a.exr"));
-  EXPECT_FALSE(std::filesystem::exists(dir + "/a.png.tmp"));
+  EXPECT_TRUE(leftoverTemporaries(dir + "/a.png").empty());
   EXPECT_THROW(writeImage(dir + "/a.jpg", image), InputError);
   EXPECT_EQ(encodeSrgb8(0.0f), 0);
   EXPECT_EQ(encodeSrgb8(1.0f), 255);

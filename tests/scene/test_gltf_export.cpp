@@ -18,6 +18,7 @@
 #include "image/image.h"
 #include "scene/gltf_export.h"
 #include "scene/scene.h"
+#include "core/file.h"
 #include "test_util.h"
 
 namespace lo {
@@ -134,7 +135,7 @@ TEST(GltfExport, LoaderReadsBackGeometryLightmapUvsMaterialsLightsAndCameras) {
     SCOPED_TRACE(name);
     const std::string path = dir + "/" + name;
     writeLightmapGltf(c.scene, c.lm, path);
-    EXPECT_FALSE(fs::exists(path + ".tmp"));
+    EXPECT_TRUE(leftoverTemporaries(path).empty());
     if (std::string(name) == "case.gltf") {
       EXPECT_TRUE(fs::exists(dir + "/case.bin"));
       // The page uri is percent-encoded in the extras.
@@ -288,7 +289,7 @@ TEST(GltfExport, BadExportsNameTheFieldAndWriteNothing) {
       EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
     }
     EXPECT_FALSE(fs::exists(p));
-    EXPECT_FALSE(fs::exists(p + ".tmp"));
+    EXPECT_TRUE(leftoverTemporaries(p).empty());
   };
   const LightmapExport good = exportCase().lm;
   LightmapExport lm = good;

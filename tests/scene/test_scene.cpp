@@ -903,3 +903,82 @@ TEST(SceneGltf, TangentsAreReadAndTransformed) {
 }  // namespace
 }  // namespace lo
 
+
+namespace lo {
+namespace {
+
+// Hardening (docs/scene.md, "Limits"): inputs that used to crash or load as
+// a silently wrong scene are refused with a message naming the file and the
+// problem; a base colour above 1 is clamped with a warning.
+TEST(SceneLimits, DeepJsonIsRefusedBeforeParsing) {
+  std::string dir = test::outputDir("SceneLimits.Deep");
+  MiniGltf g = oneTriangle();
+  std::string deep(100000, '[');
+  deep += std::string(100000, ']');
+  g.extraTop = "\"extras\": " + deep + ", ";
+  try {
+    loadScene(writeGltf(dir, "deep.gltf", g));
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("deep.gltf"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("nested more than"), std::string::npos) << msg;
+  }
+  // Brackets inside strings do not count.
+  g.extraTop = "\"extras\": {\"note\": \"" + std::string(1000, '[') + "\"}, ";
+  EXPECT_EQ(loadScene(writeGltf(dir, "brackets.gltf", g)).triangleCount(), 1u);
+}
+
+TEST(SceneLimits, IndexBeyondInt32IsRefused) {
+  std::string dir = test::outputDir("SceneLimits.Index");
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{}])";
+  std::string json = g.json();
+  const std::string from = "\"material\": 0", to = "\"material\": 4294967299";  // 2^32 + 3
+  ASSERT_NE(json.find(from), std::string::npos);
+  json.replace(json.find(from), from.size(), to);
+  writeFile(dir + "/index.gltf", json);
+  try {
+    loadScene(dir + "/index.gltf");
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("/meshes/0/primitives/0/material = 4294967299 is out of range"),
+              std::string::npos)
+        << msg;
+  }
+}
+
+TEST(SceneLimits, CoordinatesBeyondTheTracersRangeAreRefused) {
+  std::string dir = test::outputDir("SceneLimits.Far");
+  MiniGltf g = oneTriangle();
+  g.nodes = R"([{"mesh": 0, "translation": [1e20, 0, 0]}])";
+  try {
+    loadScene(writeGltf(dir, "far.gltf", g));
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("far.gltf"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("beyond 1e+12 scene units"), std::string::npos) << msg;
+  }
+  g.nodes = R"([{"mesh": 0, "translation": [1e9, 0, 0]}])";  // far, but representable
+  EXPECT_EQ(loadScene(writeGltf(dir, "farish.gltf", g)).triangleCount(), 1u);
+}
+
+TEST(SceneLimits, BaseColourAboveOneIsClampedWithAWarning) {
+  std::string dir = test::outputDir("SceneLimits.Bright");
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"name": "hot", "pbrMetallicRoughness": {"baseColorFactor": [1000, 0.5, 1.5, 1]}}])";
+  const Scene s = loadScene(writeGltf(dir, "bright.gltf", g));
+  EXPECT_EQ(s.materials[0].baseColor, Vec3(1.0f, 0.5f, 1.0f));
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("material 'hot'"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("clamped"), std::string::npos) << s.warnings[0];
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}])";
+  EXPECT_TRUE(loadScene(writeGltf(dir, "fine.gltf", g)).warnings.empty());
+}
+
+}  // namespace
+}  // namespace lo

@@ -1,0 +1,126 @@
+// Output files (core/file.h): a fresh, exclusively created temporary name for
+// every write, nothing written through links or over what is not a regular
+// file, no temporary left after a failure or a SIGINT, and commands that
+// refuse an output that is one of their inputs.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "core/error.h"
+#include "core/file.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string readAll(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+TEST(OutputFiles, TemporaryNamesAreFreshHiddenAndBesideTheTarget) {
+  const std::string dir = test::outputDir("OutputFiles.Names");
+  std::set<std::string> names;
+  for (int i = 0; i < 100; ++i) {
+    const std::string t = temporaryPathFor(dir + "/out.vdb");
+    EXPECT_TRUE(names.insert(t).second) << t;
+    EXPECT_EQ(fs::path(t).parent_path(), fs::path(dir));
+    EXPECT_EQ(fs::path(t).filename().string().rfind(".out.vdb.", 0), 0u) << t;
+    EXPECT_TRUE(isTemporaryPathFor(t, dir + "/out.vdb"));
+  }
+  EXPECT_FALSE(isTemporaryPathFor(dir + "/out.vdb.tmp", dir + "/out.vdb"));
+}
+
+TEST(OutputFiles, ReplacesARegularFileAndLeavesNothingBehind) {
+  const std::string dir = test::outputDir("OutputFiles.Replace");
+  const std::string path = dir + "/a.txt";
+  writeTextAtomically(path, "old");
+  writeTextAtomically(path, "new");
+  EXPECT_EQ(readAll(path), "new");
+  EXPECT_TRUE(leftoverTemporaries(path).empty());
+  // A failing writer: the target keeps its old bytes, no temporary remains.
+  EXPECT_THROW(writeAtomically(path, [](const std::string&) { throw std::runtime_error("boom"); }),
+               IoError);
+  EXPECT_EQ(readAll(path), "new");
+  EXPECT_TRUE(leftoverTemporaries(path).empty());
+}
+
+TEST(OutputFiles, NeverWritesThroughALinkOrOverWhatIsNotARegularFile) {
+  const std::string dir = test::outputDir("OutputFiles.Links");
+  const std::string victim = dir + "/victim.txt", link = dir + "/link.txt";
+  writeTextAtomically(victim, "precious");
+  fs::remove(link);
+  fs::create_symlink(victim, link);
+  try {
+    writeTextAtomically(link, "overwritten");
+    FAIL() << "expected an IoError";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("symbolic link"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(readAll(victim), "precious");
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_THROW(checkOutputFolder(link, "--output"), InputError);
+  const std::string folder = dir + "/a-folder";
+  fs::create_directories(folder);
+  EXPECT_THROW(writeTextAtomically(folder, "x"), IoError);
+  EXPECT_TRUE(fs::is_directory(folder));
+  EXPECT_THROW(checkOutputFolder("/dev/null", "--output"), InputError);
+  EXPECT_THROW(checkOutputFolder(dir + "/no-such-folder/x.vdb", "--output"), InputError);
+  EXPECT_TRUE(leftoverTemporaries(link).empty());
+}
+
+TEST(OutputFiles, AnOutputThatIsAnInputIsRefused) {
+  const std::string dir = test::outputDir("OutputFiles.Inputs");
+  writeTextAtomically(dir + "/scene.gltf", "{}");
+  try {
+    checkDistinctFiles({{"--output", dir + "/./scene.gltf"}}, {{"SCENE", dir + "/scene.gltf"}});
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("--output"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("the input SCENE"), std::string::npos) << msg;
+  }
+  try {
+    checkDistinctFiles({{"--output", dir + "/o.vdb"}, {"--stats-json", dir + "/o.vdb"}}, {});
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--output and --stats-json"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(checkDistinctFiles({{"--output", dir + "/o.vdb"}, {"--stats-json", ""}},
+                                     {{"SCENE", dir + "/scene.gltf"}}));
+}
+
+// SIGINT while a temporary file is being written: the process ends by the
+// signal, the temporary file is gone and the target is untouched.
+TEST(OutputFiles, SigintRemovesTheTemporaryFile) {
+  const std::string dir = test::outputDir("OutputFiles.Sigint");
+  const std::string path = dir + "/interrupted.txt";
+  writeTextAtomically(path, "before");
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    writeAtomically(path, [](const std::string& tmp) {
+      std::ofstream(tmp) << "half";
+      ::raise(SIGINT);
+    });
+    ::_exit(0);  // not reached: SIGINT ends the child
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
+  EXPECT_EQ(readAll(path), "before");
+  EXPECT_TRUE(leftoverTemporaries(path).empty());
+}
+
+}  // namespace
+}  // namespace lo
