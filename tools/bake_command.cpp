@@ -122,7 +122,7 @@ int runBake(const BakeOptions& opt) {
     j["peak_rss_bytes"] = peakRssBytes();
     writeTextAtomically(opt.statsJson, j.dump(2) + "\n");
   }
-  std::printf("\nwrote %s\n", opt.output.c_str());
+  if (!opt.quiet) std::printf("\nwrote %s\n", opt.output.c_str());
   return 0;
 }
 
@@ -150,13 +150,14 @@ std::function<int()> addBakeCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--radius", opt->radius,
                   "Gathering radius in scene units (default: " + formatNumber(kDefaultRadiusVoxels) + " voxel sizes)")
-      ->check(CLI::PositiveNumber);
+      ->check(finitePositive());
   cmd->add_option("--vdls", opt->vdls,
                   "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest that keep the angular error "
                   "under 0.35 (about 20 degrees)")
       ->check(vdlCountValidator())
       ->capture_default_str();
-  cmd->add_option("--seed", opt->seed, "Random seed (same seed, same bytes)")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Random seed (same seed, same bytes)")
+      ->check(seedValidator())->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();

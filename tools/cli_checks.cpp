@@ -1,5 +1,9 @@
 #include "cli_checks.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
 #include "bake/bake.h"
 
 namespace lo::tool {
@@ -10,5 +14,34 @@ CLI::Validator vdlCountValidator() {
 }
 
 CLI::Validator depthValidator() { return CLI::Range(1, kMaxGridDepth); }
+
+CLI::Validator seedValidator() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        const std::string max = "18446744073709551615";
+        const bool digits = !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
+        std::string trimmed = s.substr(std::min(s.find_first_not_of('0'), s.size()));
+        if (trimmed.empty()) trimmed = "0";
+        if (!digits || trimmed.size() > max.size() ||
+            (trimmed.size() == max.size() && trimmed > max)) {
+          return "must be a whole number from 0 to " + max + ", got '" + s + "'";
+        }
+        return {};
+      },
+      "0..2^64-1", "Seed");
+}
+
+CLI::Validator finitePositive() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(s.c_str(), &end);
+        if (end == s.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0)) {
+          return "must be a finite number > 0, got '" + s + "'";
+        }
+        return {};
+      },
+      "NUMBER > 0", "FinitePositive");
+}
 
 }  // namespace lo::tool

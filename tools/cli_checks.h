@@ -14,4 +14,11 @@ CLI::Validator vdlCountValidator();
 /// `--depth`: 1..kMaxGridDepth.
 CLI::Validator depthValidator();
 
+/// `--seed`: decimal digits only, at most 2^64 - 1: "-1", "1e23" or a number
+/// beyond 64 bits would otherwise wrap to some other seed without a word.
+CLI::Validator seedValidator();
+
+/// A finite number > 0 ("nan" and "inf" refused, unlike CLI::PositiveNumber).
+CLI::Validator finitePositive();
+
 }  // namespace lo::tool

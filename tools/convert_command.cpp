@@ -132,7 +132,8 @@ std::function<int()> addConvertCommand(CLI::App& app) {
   cmd->add_option("--photon-map", opt->photonMap,
                   "Photon file written by 'bake --photon-map': re-gather at the new depth")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--seed", opt->seed, "K-means seed")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "K-means seed")
+      ->check(seedValidator())->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress or summary, only errors");

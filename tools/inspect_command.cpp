@@ -100,7 +100,9 @@ void printText(const VdbReport& r) {
 int runInspect(const InspectOptions& opt) {
   VdbReport r = inspectVdb(opt.input);
   if (opt.json) {
-    std::printf("%s\n", toJson(r).dump(2).c_str());
+    // Metadata of other tools need not be UTF-8: invalid bytes become U+FFFD.
+    std::printf("%s\n",
+                toJson(r).dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   } else {
     printText(r);
   }

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "camera_options.h"
+#include "cli_checks.h"
 #include "commands.h"
 #include "core/error.h"
 #include "core/file.h"
@@ -122,6 +123,7 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
       ->check(CLI::IsMember({"full", "direct", "indirect", "irradiance"}))
       ->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Random seed (same seed and --spp, same bytes)")
+      ->check(seedValidator())
       ->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, 1024))

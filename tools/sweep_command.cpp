@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "core/error.h"
 #include "core/file.h"
@@ -82,6 +83,7 @@ std::function<int()> addSweepCommand(CLI::App& app) {
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Random seed of bakes and references")
+      ->check(seedValidator())
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runSweepCommand(*opt) : -1; };

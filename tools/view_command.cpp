@@ -263,7 +263,8 @@ std::function<int()> addViewCommand(CLI::App& app) {
   cmd->add_option("--knn", opt->knn, "Progressive: nearest photons gathered per voxel")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  cmd->add_option("--seed", opt->seed, "Progressive: random seed")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Progressive: random seed")
+      ->check(seedValidator())->capture_default_str();
   cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runView(*opt) : -1; };
 }

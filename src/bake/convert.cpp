@@ -105,6 +105,25 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
     r.grid = in;
     r.method = "same grid";
   }
+  // The contract: a voxel's irradiance is the sum of its VDLs. Values that
+  // went through half floats before (convert --half, then another convert)
+  // sum to their rounded totals only within half precision: the totals
+  // follow the VDLs, so the sums hold to float rounding in any chain.
+  if (r.method != "same grid") {
+    VdlGrid& g = r.grid;
+    for (size_t v = 0; v < g.size(); ++v) {
+      if (g.vdlCount[v] == 0) continue;
+      Vec3 sum{0, 0, 0};
+      for (int i = 0; i < g.vdlCount[v]; ++i) sum += g.vdlsOf(v)[i].irradiance;
+      g.irradiance[v] = sum;
+    }
+    for (size_t e = 0; e < g.layers.size(); ++e) {
+      if (g.layers.vdlCount[e] == 0) continue;
+      Vec3 sum{0, 0, 0};
+      for (int i = 0; i < g.layers.vdlCount[e]; ++i) sum += g.layerVdlsOf(e)[i].irradiance;
+      g.layers.irradiance[e] = sum;
+    }
+  }
   if (in.layers.size() > 0 && r.grid.layers.size() == 0) {
     r.method += " (the input's surface layers are not carried to another depth: bake again, "
                 "or convert with --photon-map, for layers at depth " + std::to_string(depth) + ")";

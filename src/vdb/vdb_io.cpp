@@ -16,8 +16,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "core/error.h"
@@ -441,6 +443,21 @@ T metaValue(const std::string& path, const openvdb::MetaMap& meta, const std::st
   }
   auto typed = openvdb::DynamicPtrCast<const openvdb::TypedMetadata<T>>(m);
   if (!typed) {
+    // Integers of the other width (pyopenvdb writes every Python int as
+    // int32 when it fits, and int64 otherwise): the same value.
+    if constexpr (std::is_same_v<T, int64_t>) {
+      if (auto narrow = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m)) {
+        return int64_t(narrow->value());
+      }
+    }
+    if constexpr (std::is_same_v<T, int32_t>) {
+      if (auto wide = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(m)) {
+        if (wide->value() >= std::numeric_limits<int32_t>::min() &&
+            wide->value() <= std::numeric_limits<int32_t>::max()) {
+          return int32_t(wide->value());
+        }
+      }
+    }
     throw InputError(path + ": file metadata '" + key + "' has type " + m->typeName() +
                      ", expected " + openvdb::typeNameAsString<T>());
   }
@@ -856,6 +873,10 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
 std::vector<Photon> readPoints(const std::string& path) {
   namespace pts = openvdb::points;
   OpenedFile f = openFile(path);
+  if (!findGrid(f, "photons") && findGrid(f, kIrradiance)) {
+    throw InputError(path + ": is a VDL file (written by `lightoctree bake -o`), not a photon "
+                     "file (`bake --photon-map`)");
+  }
   auto grid = requireGrid<pts::PointDataGrid>(path, f, "photons");
   std::vector<Photon> out;
   out.reserve(size_t(pts::pointCount(grid->tree())));

@@ -445,3 +445,37 @@ TEST(VdbIo, NonFiniteValuesAreRefusedAtReading) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// convert chains keep the contract: half floats, then fewer VDLs, then a
+// coarser depth, each written and read back, pass inspect's checks (the
+// VDL sums used to drift past the tolerance after a half-float step).
+TEST(VdbIo, ConvertChainsKeepTheVdlSums) {
+  BakeParams p;
+  p.depth = 4;
+  p.photons = 40000;
+  p.knn = 60;
+  const BakeResult baked = bake(test::pointLitRoom(), p);
+  const std::string dir = test::outputDir("VdbIo.ConvertChain");
+  VdlWriteOptions half;
+  half.halfFloat = true;
+  writeVdlGrid(dir + "/half.vdb", baked.grid, baked.metadata, half);
+  LoadedVdl in = readVdlGrid(dir + "/half.vdb");
+  for (const std::string& step : {"vdls 2", "depth 3"}) {
+    ConvertParams cp;
+    if (step == "vdls 2") cp.vdls = "2";
+    if (step == "depth 3") cp.depth = 3;
+    const ConvertResult out = convertLightGrid(in.grid, in.meta, cp);
+    const std::string path = dir + "/" + (step == "vdls 2" ? "v2" : "d3") + ".vdb";
+    writeVdlGrid(path, out.grid, out.metadata);
+    for (const VdbCheck& c : inspectVdb(path).checks) {
+      EXPECT_TRUE(c.passed) << step << ": " << c.name << ": " << c.detail;
+    }
+    in = readVdlGrid(path);
+  }
+}
+
+}  // namespace
+}  // namespace lo
