@@ -25,6 +25,8 @@ uniform usampler3D uOctree;
 uniform sampler2D uVdls;
 uniform usampler2D uVdlsHalf;
 uniform bool uHalfVdls;
+uniform bool uCompactVdls;
+uniform float uVdlScale;
 uniform float uVoxelSize;
 uniform int uDepth;
 uniform float uNormalOffset;
@@ -39,6 +41,8 @@ layout(location = 2) out int oTriangle;
 #define LO_FETCH_VDL_FLOAT(p) texelFetch(uVdls, p, 0)
 #define LO_FETCH_VDL_HALF(p) texelFetch(uVdlsHalf, p, 0)
 #define LO_VDLS_HALF uHalfVdls
+#define LO_VDLS_COMPACT uCompactVdls
+#define LO_VDL_SCALE uVdlScale
 #include "octree_lookup.h"
 
 // Irradiance: the response to a VDL is its cosine (octree_irradiance.cpp).

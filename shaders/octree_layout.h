@@ -34,6 +34,12 @@
  *     overflows at 65504, and no 16-bit float encoding has 65536 finite,
  *     non-denormal values, so the 16-bit packed direction cannot ride in a
  *     half alpha; as an integer channel it costs the same 8 bytes per VDL.
+ *   compact: RGBA16UI too: R | G << 16 = RGB as shared-exponent RGB9E5 bits
+ *     (9-bit mantissas, a 5-bit exponent shared by the three channels), times
+ *     a power-of-two scale per octree chosen so that its brightest texel fits:
+ *     no irradiance is clamped, whatever the light's power; B = 0; A = the
+ *     packed direction as for half. Header texels of layer blocks are stored
+ *     without the scale.
  * VDL index i lives at texel (i % LO_VDL_TEXTURE_WIDTH, i / LO_VDL_TEXTURE_WIDTH).
  *
  * Direction frame: theta from +Z (0..pi), phi from +X towards +Y (0..2pi),
@@ -50,6 +56,7 @@ namespace layout {
 using uint = uint32_t;
 using std::acos;
 using std::cos;
+using std::exp2;
 using std::floor;
 using std::min;
 using std::sin;
@@ -91,6 +98,13 @@ float loAtan2(float y, float x) {
 
 LO_LAYOUT_FN bool loIsLeaf(uint flag) {
   return (flag >= 1u && flag <= LO_MAX_VDLS) || flag == LO_FLAG_LAYERED;
+}
+
+/* Shared-exponent RGB9E5 bits -> RGB (GL_RGB9_E5's decoding, OpenGL 4.5
+ * spec 8.5.2): channel = mantissa * 2^(exponent - 15 - 9). */
+LO_LAYOUT_FN float loRgb9e5Channel(uint bits, uint shift) {
+  uint e = (bits >> 27u) & 31u;
+  return float((bits >> shift) & 511u) * exp2(float(e) - 24.0);
 }
 
 /* 24-bit address <-> three 8-bit channels. */

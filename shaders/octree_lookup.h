@@ -23,7 +23,9 @@
  *   LO_FETCH_POOL(p)      RGBA8UI texel of the pool at ivec3 p, as uvec4
  *   LO_FETCH_VDL_FLOAT(p) RGBA32F VDL texel at ivec2 p, as vec4
  *   LO_FETCH_VDL_HALF(p)  RGBA16UI VDL texel at ivec2 p, as uvec4
- *   LO_VDLS_HALF          true when the VDL texels are the half ones
+ *   LO_VDLS_HALF          true when the VDL texels are the 16-bit ones
+ *   LO_VDLS_COMPACT       true when those hold compact texels (RGB9E5)
+ *   LO_VDL_SCALE          the compact texels' irradiance scale
  * and, anywhere in the same unit, the response of a surface to one VDL:
  *   vec3 loVdlResponse(LoSurface s, vec3 d)   (the BRDF times the cosine in the
  *   shader; the cosine alone, i.e. irradiance, in C++).
@@ -104,14 +106,28 @@ LO_LOOKUP_FN float loHalfToFloat(uint h) {
   return (h & 32768u) != 0u ? -v : v;
 }
 
-/* One VDL texel: rgb irradiance (W/m^2), a packed direction (octree_layout.h). */
-LO_LOOKUP_FN vec4 loFetchVdl(LO_TEX_PARAM uint index) {
+/* One texel of the VDL texture as stored: rgb (irradiance in W/m^2 for a
+ * VDL; for compact texels before the octree's scale), a = packed direction
+ * or count. Layer block headers are read with this (octree_layout.h). */
+LO_LOOKUP_FN vec4 loFetchTexel(LO_TEX_PARAM uint index) {
   ivec2 p = ivec2(int(loVdlTexelX(index)), int(loVdlTexelY(index)));
   if (LO_VDLS_HALF) {
     uvec4 t = LO_FETCH_VDL_HALF(p);
+    if (LO_VDLS_COMPACT) {
+      uint bits = t.r | (t.g << 16u);
+      return vec4(loRgb9e5Channel(bits, 0u), loRgb9e5Channel(bits, 9u),
+                  loRgb9e5Channel(bits, 18u), float(t.a));
+    }
     return vec4(loHalfToFloat(t.r), loHalfToFloat(t.g), loHalfToFloat(t.b), float(t.a));
   }
   return LO_FETCH_VDL_FLOAT(p);
+}
+
+/* One VDL texel: rgb irradiance (W/m^2), a packed direction (octree_layout.h). */
+LO_LOOKUP_FN vec4 loFetchVdl(LO_TEX_PARAM uint index) {
+  vec4 t = loFetchTexel(LO_TEX index);
+  if (LO_VDLS_COMPACT) return vec4(vec3(t) * LO_VDL_SCALE, t.a);
+  return t;
 }
 
 LO_LOOKUP_FN vec3 loVdlDirection(float code) {
@@ -130,7 +146,7 @@ LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
   first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
   count = int(leaf.a);
   if (leaf.a != LO_FLAG_LAYERED) return true;
-  vec4 h = loFetchVdl(LO_TEX first);
+  vec4 h = loFetchTexel(LO_TEX first);
   int layers = min(int(h.a), int(LO_MAX_LAYERS));
   int counts[3];
   counts[0] = int(h.r);
@@ -141,7 +157,7 @@ LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
   uint address[3];
   uint a = first + 1u;
   for (int l = 0; l < layers; ++l) {
-    vec4 t = loFetchVdl(LO_TEX a);
+    vec4 t = loFetchTexel(LO_TEX a);
     points[l] = vec3(c) + vec3(t);
     normals[l] = loVdlDirection(t.a);
     address[l] = a + 1u;

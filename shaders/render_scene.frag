@@ -25,6 +25,8 @@ uniform usampler3D uOctree;  // RGBA8UI pool of 2x2x2 tiles
 uniform sampler2D uVdls;       // RGBA32F: irradiance, packed direction
 uniform usampler2D uVdlsHalf;  // RGBA16UI: half-float bits of irradiance, packed direction
 uniform bool uHalfVdls;        // which of the two holds the VDLs
+uniform bool uCompactVdls;     // the 16-bit texels hold compact (RGB9E5) irradiance
+uniform float uVdlScale;       // ... times this scale
 uniform sampler2DArrayShadow uShadowMaps;
 uniform sampler2DArray uShadowDepths;  // the same maps read as depths (PCSS blocker search)
 uniform vec3 uOctreeOrigin;  // world
@@ -164,6 +166,8 @@ vec3 probeSpecular(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float
 #define LO_FETCH_VDL_FLOAT(p) texelFetch(uVdls, p, 0)
 #define LO_FETCH_VDL_HALF(p) texelFetch(uVdlsHalf, p, 0)
 #define LO_VDLS_HALF uHalfVdls
+#define LO_VDLS_COMPACT uCompactVdls
+#define LO_VDL_SCALE uVdlScale
 #include "octree_lookup.h"
 
 // The VDLs light the diffuse lobe and the share of the specular one that the

@@ -32,7 +32,8 @@ RendererParams ShadingOptions::rendererParams() const {
 
 GpuOctreeParams ShadingOptions::octreeParams(const GlInfo* info) const {
   GpuOctreeParams p;
-  p.halfFloat = halfFloat;
+  p.halfFloat = halfFloat || texels == "half";
+  p.compact = texels == "compact";
   p.cosineCorrection = cosineCorrection == "on";
   if (info) {
     p.max3DTextureSize = info->max3DTextureSize;
@@ -135,8 +136,13 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
                   "form, darker; see docs/accuracy.md)")
       ->check(onOff())
       ->capture_default_str();
-  cmd->add_flag("--half-float", opt.halfFloat,
-                "VDL texture with half-float irradiance (RGBA16UI) instead of RGBA32F");
+  cmd->add_option("--texels", opt.texels,
+                  "VDL texels on the GPU: float (RGBA32F, 16 B), half (RGBA16UI half floats, 8 B; "
+                  "clamps above 65504) or compact (8 B: shared-exponent RGB9E5 with a scale per "
+                  "octree, nothing clamped)")
+      ->check(CLI::IsMember({"float", "half", "compact"}))
+      ->capture_default_str();
+  cmd->add_flag("--half-float", opt.halfFloat, "The same as --texels half");
 }
 
 }  // namespace lo::tool

@@ -35,6 +35,7 @@ struct ShadingOptions {
   int emitterLights = RendererParams{}.emitterLights;
   int shadowMapSize = RendererParams{}.shadowMapSize;
   bool halfFloat = false;
+  std::string texels = "compact";  ///< VDL texels: float | half | compact
   std::string cosineCorrection = "on";
 
   /// Mode, interpolation, GGX lobe and VDLs of a frame (size left at default).

@@ -174,6 +174,30 @@ uint16_t floatToHalf(float value) {
   return uint16_t(sign | q);
 }
 
+uint32_t encodeRgb9e5(const Vec3& rgb) {
+  // OpenGL 4.5 spec 8.5.2, the shared-exponent encoding of GL_RGB9_E5.
+  constexpr int kMantissa = 9, kBias = 15, kMaxExponent = 31;
+  const double maxValue = (511.0 / 512.0) * std::exp2(kMaxExponent - kBias);
+  double c[3];
+  for (int i = 0; i < 3; ++i) {
+    const double v = double(rgb[i]);
+    c[i] = std::isnan(v) ? 0.0 : std::clamp(v, 0.0, maxValue);
+  }
+  const double largest = std::max({c[0], c[1], c[2]});
+  int exponent = largest > 0 ? std::max(-kBias - 1, int(std::floor(std::log2(largest)))) + 1 + kBias
+                             : 0;
+  if (largest > 0) {
+    const double maxMantissa = std::floor(largest / std::exp2(exponent - kBias - kMantissa) + 0.5);
+    if (maxMantissa == 512.0) ++exponent;
+  }
+  uint32_t bits = uint32_t(exponent) << 27;
+  for (int i = 0; i < 3; ++i) {
+    const double m = std::floor(c[i] / std::exp2(exponent - kBias - kMantissa) + 0.5);
+    bits |= uint32_t(std::min(m, 511.0)) << (9 * i);
+  }
+  return bits;
+}
+
 float halfToFloat(uint16_t bits) {
   const uint32_t sign = uint32_t(bits & 0x8000u) << 16;
   const uint32_t exponent = (bits >> 10) & 0x1fu;
@@ -316,7 +340,20 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   }
   out.vdlWidth = int(width);
   out.vdlHeight = int(height);
-  out.halfFloat = params.halfFloat;
+  out.halfFloat = params.halfFloat || params.compact;
+  out.compact = params.compact;
+  if (out.compact) {
+    // The brightest texel after the cosine correction (at most 1 / the
+    // smallest cosine it divides by) fits under 2^15 of RGB9E5's 65408.
+    float brightest = 0;
+    for (const Vdl& v : grid.vdls) brightest = std::max({brightest, v.irradiance.x, v.irradiance.y, v.irradiance.z});
+    for (const Vdl& v : grid.layers.vdls) {
+      brightest = std::max({brightest, v.irradiance.x, v.irradiance.y, v.irradiance.z});
+    }
+    brightest /= kMinCorrectionCosine;
+    out.irradianceScale =
+        brightest > 0 ? std::exp2(std::ceil(std::log2(double(brightest) / 32768.0))) : 1.0f;
+  }
   if (out.halfFloat) {
     out.vdlTexelsHalf.assign(width * height * 4, 0);
   } else {
@@ -342,7 +379,12 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   auto writeTexel = [&](size_t index, const Vec3& rgb, float a) {
     const size_t offset =
         (size_t(loVdlTexelY(uint(index))) * width + size_t(loVdlTexelX(uint(index)))) * 4;
-    if (out.halfFloat) {
+    if (out.compact) {  // headers: without the scale
+      const uint32_t bits = encodeRgb9e5(rgb);
+      out.vdlTexelsHalf[offset] = uint16_t(bits & 0xffffu);
+      out.vdlTexelsHalf[offset + 1] = uint16_t(bits >> 16);
+      out.vdlTexelsHalf[offset + 3] = uint16_t(a);
+    } else if (out.halfFloat) {
       for (int c = 0; c < 3; ++c) out.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(rgb[c]);
       out.vdlTexelsHalf[offset + 3] = uint16_t(a);
     } else {
@@ -363,7 +405,12 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
                     loUnpackDirectionZ(packed)};
       irradiance = irradiance / std::max(std::fabs(dot(normal, dq)), kMinCorrectionCosine);
     }
-    if (out.halfFloat) {
+    if (out.compact) {
+      const uint32_t bits = encodeRgb9e5(irradiance / out.irradianceScale);
+      out.vdlTexelsHalf[offset] = uint16_t(bits & 0xffffu);
+      out.vdlTexelsHalf[offset + 1] = uint16_t(bits >> 16);
+      out.vdlTexelsHalf[offset + 3] = uint16_t(packed);
+    } else if (out.halfFloat) {
       for (int c = 0; c < 3; ++c)
         out.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(irradiance[c]);
       out.vdlTexelsHalf[offset + 3] = uint16_t(packed);
@@ -454,7 +501,7 @@ std::string GpuOctree::ToString() const {
      << ", leaves " << leafCount << ", tiles " << nodeCount << " in " << tilesX << "x" << tilesY
      << "x" << tilesZ << " (pool " << poolWidth() << "x" << poolHeight() << "x" << poolDepth()
      << " RGBA8, " << kib(poolBytes()) << "), VDLs " << vdlCount << " in " << vdlWidth << "x"
-     << vdlHeight << (halfFloat ? " RGBA16UI(half)" : " RGBA32F") << " (" << kib(vdlBytes())
+     << vdlHeight << (compact ? " RGBA16UI(RGB9E5)" : halfFloat ? " RGBA16UI(half)" : " RGBA32F") << " (" << kib(vdlBytes())
      << "), bytes/leaf: pool " << std::fixed << std::setprecision(2) << double(poolBytes()) / leaves
      << " + VDLs " << double(vdlBytes()) / leaves << "]";
   return os.str();

@@ -16,6 +16,11 @@ namespace lo {
 
 struct GpuOctreeParams {
   bool halfFloat = false;        ///< VDL texels as RGBA16UI (half RGB bits) instead of RGBA32F
+  /// Compact VDL texels (8 bytes, in the RGBA16UI texture): irradiance as
+  /// shared-exponent RGB9E5 times a power-of-two scale per octree chosen from
+  /// its brightest VDL, so nothing is clamped whatever the light's power
+  /// (half floats clamp at 65504); shaders/octree_layout.h. Overrides halfFloat.
+  bool compact = false;
   int max3DTextureSize = 2048;   ///< GL_MAX_3D_TEXTURE_SIZE of the target context
   int max2DTextureSize = 16384;  ///< GL_MAX_TEXTURE_SIZE of the target context
   /// The bake stores each VDL's share c_i of the irradiance *on the voxel's
@@ -48,7 +53,9 @@ struct GpuOctree {
   /// vdlTexels (RGBA32F) / vdlTexelsHalf (RGBA16UI: RGB = IEEE half bits,
   /// A = packed direction as an integer; see shaders/octree_layout.h) is filled.
   int vdlWidth = 0, vdlHeight = 0;
-  bool halfFloat = false;
+  bool halfFloat = false;      ///< the texels are vdlTexelsHalf's 16-bit ones
+  bool compact = false;        ///< those hold compact texels (RGB9E5 x irradianceScale)
+  float irradianceScale = 1;   ///< compact: a power of two
   std::vector<float> vdlTexels;
   std::vector<uint16_t> vdlTexelsHalf;
 
@@ -80,6 +87,9 @@ std::string octreeMemoryReport(const GpuOctree& octree);
 /// becoming infinity (an infinite irradiance would poison the shader's sum);
 /// NaN stays NaN.
 uint16_t floatToHalf(float value);
+/// GL_RGB9_E5's shared-exponent encoding (OpenGL 4.5 spec 8.5.2): negative
+/// and NaN channels become 0, values above 65408 clamp to it.
+uint32_t encodeRgb9e5(const Vec3& rgb);
 float halfToFloat(uint16_t bits);
 
 /// Result of the C++ reference of the shader's lookup.

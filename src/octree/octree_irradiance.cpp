@@ -54,6 +54,8 @@ glm::uvec4 fetchVdlHalf(const GpuOctree& o, const glm::ivec2& p) {
 #define LO_FETCH_VDL_FLOAT(p) ::lo::octree_lookup_internal::fetchVdlFloat(tex, p)
 #define LO_FETCH_VDL_HALF(p) ::lo::octree_lookup_internal::fetchVdlHalf(tex, p)
 #define LO_VDLS_HALF tex.halfFloat
+#define LO_VDLS_COMPACT tex.compact
+#define LO_VDL_SCALE tex.irradianceScale
 #include <octree_lookup.h>
 
 namespace lo {
@@ -91,7 +93,7 @@ OctreeSample lookupOctree(const GpuOctree& octree, const Vec3& worldPosition) {
   uint32_t count = leaf.a;
   if (leaf.a == layout::LO_FLAG_LAYERED) {
     // Layer 0: its VDLs follow the block header and its own header.
-    const glm::vec4 h = lookup::loFetchVdl(octree, first);
+    const glm::vec4 h = lookup::loFetchTexel(octree, first);
     sample.layerCount = int(h.a);
     count = uint32_t(h.r);
     first += 2;

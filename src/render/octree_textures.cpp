@@ -68,6 +68,8 @@ void OctreeTextures::upload(const GpuOctree& octree) {
   };
   const size_t vdlTexels = size_t(octree.vdlWidth) * octree.vdlHeight * 4;
   half = octree.halfFloat && vdlTexels > 0;
+  compact = half && octree.compact;
+  scale = octree.irradianceScale;
   const float zero[4] = {0, 0, 0, 0};
   const uint16_t zeroHalf[4] = {0, 0, 0, 0};
   makeTexture(vdl);
@@ -98,6 +100,8 @@ void OctreeTextures::bind(GLuint program, int poolUnit, int vdlUnit, int halfUni
   glUniform1i(glGetUniformLocation(program, "uVdls"), vdlUnit);
   glUniform1i(glGetUniformLocation(program, "uVdlsHalf"), halfUnit);
   glUniform1i(glGetUniformLocation(program, "uHalfVdls"), half ? 1 : 0);
+  glUniform1i(glGetUniformLocation(program, "uCompactVdls"), compact ? 1 : 0);
+  glUniform1f(glGetUniformLocation(program, "uVdlScale"), scale);
   glActiveTexture(GLenum(GL_TEXTURE0 + poolUnit));
   glBindTexture(GL_TEXTURE_3D, pool);
   glActiveTexture(GLenum(GL_TEXTURE0 + vdlUnit));

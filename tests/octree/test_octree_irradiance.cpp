@@ -11,6 +11,8 @@
 #include "core/error.h"
 #include "core/math.h"
 #include "core/rng.h"
+#include <octree_layout.h>
+
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
 #include "reference/first_hit.h"
@@ -318,10 +320,12 @@ TEST(OctreeLayers, EachSurfaceOfAVoxelGetsItsOwnLayer) {
   g.layers.angularError = {0};
   g.layers.vdlCount = {1};
   g.layers.vdls = {b, Vdl{}};
-  for (bool half : {false, true}) {
-    SCOPED_TRACE(half ? "half" : "float");
+  for (int format = 0; format < 3; ++format) {
+    const bool half = format > 0;
+    SCOPED_TRACE(format == 0 ? "float" : format == 1 ? "half" : "compact");
     GpuOctreeParams params;
     params.halfFloat = half;
+    params.compact = format == 2;
     params.cosineCorrection = false;
     const GpuOctree o = buildGpuOctree(g, params);
     EXPECT_EQ(o.leafCount, 1u);
@@ -345,6 +349,67 @@ TEST(OctreeLayers, EachSurfaceOfAVoxelGetsItsOwnLayer) {
       // A surface facing neither layer's way.
       EXPECT_EQ(octreeIrradiance(o, floorPoint, {0, 0, -1}, shade), Vec3(0.0f));
     }
+  }
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+// Compact texels (RGB9E5 times a scale per octree): the cosine law within
+// RGB9E5's rounding (9-bit mantissas: 2^-9 of the largest channel), and a
+// light a million times brighter gives a million times the irradiance,
+// where half floats clamp at 65504.
+TEST(CompactTexels, RoundTripAndNoClampingAtAnyPower) {
+  for (float power : {1.0f, 1e6f, 1e-6f}) {
+    SCOPED_TRACE(power);
+    const Vec3 c = Vec3{2.0f, 1.0f, 0.5f} * power;
+    const VdlGrid g = constantGrid(3, 2, 3, {vdl(c, {0.3f, 0.5f, 0.8f}), vdl(c * 0.25f, {-0.6f, 0.2f, 0.7f})});
+    GpuOctreeParams fp;
+    fp.cosineCorrection = false;
+    GpuOctreeParams cp = fp;
+    cp.compact = true;
+    const GpuOctree f = buildGpuOctree(g, fp), k = buildGpuOctree(g, cp);
+    EXPECT_TRUE(k.compact);
+    EXPECT_EQ(k.vdlBytes() * 2, f.vdlBytes());
+    // A power of two.
+    EXPECT_EQ(std::exp2(std::round(std::log2(k.irradianceScale))), k.irradianceScale);
+    for (const Vec3& n : {Vec3{0, 0, 1}, normalize(Vec3{0.2f, 0.3f, 1.0f})}) {
+      const Vec3 p = Vec3{1.3f, 2.2f, 2.5f} * kVoxel;
+      const Vec3 ef = octreeIrradiance(f, p, n), ek = octreeIrradiance(k, p, n);
+      for (int a = 0; a < 3; ++a) EXPECT_NEAR(ek[a], ef[a], 4e-3f * ef[a]) << a;
+    }
+  }
+  // Half floats clamp a million-fold light; compact texels do not.
+  const Vec3 c = Vec3{2.0f, 1.0f, 0.5f} * 1e6f;
+  const VdlGrid g = constantGrid(3, 2, 3, {vdl(c, {0, 0, 1})});
+  GpuOctreeParams hp, cp;
+  hp.halfFloat = true;
+  hp.cosineCorrection = cp.cosineCorrection = false;
+  cp.compact = true;
+  const Vec3 p = Vec3{1.3f, 2.2f, 2.5f} * kVoxel;
+  EXPECT_LT(octreeIrradiance(buildGpuOctree(g, hp), p, {0, 0, 1}).x, 1e5f);
+  EXPECT_NEAR(octreeIrradiance(buildGpuOctree(g, cp), p, {0, 0, 1}).x, c.x, 4e-3f * c.x);
+}
+
+TEST(CompactTexels, EncodingMatchesTheGlSpec) {
+  // Exact values: 1 = 256 * 2^-8 (exponent 16), 0.5 and 0.25 share it.
+  const uint32_t one = encodeRgb9e5({1.0f, 0.5f, 0.25f});
+  EXPECT_EQ(one >> 27, 16u);
+  EXPECT_EQ(one & 511u, 256u);
+  EXPECT_EQ((one >> 9) & 511u, 128u);
+  EXPECT_EQ((one >> 18) & 511u, 64u);
+  EXPECT_EQ(encodeRgb9e5({0, 0, 0}), 0u);
+  EXPECT_EQ(encodeRgb9e5({-1.0f, std::nanf(""), 0}), 0u);  // negative and NaN: 0
+  const uint32_t big = encodeRgb9e5({1e9f, 0, 0});         // clamps to 65408
+  EXPECT_EQ(big >> 27, 31u);
+  EXPECT_EQ(big & 511u, 511u);
+  // Decoding (octree_layout.h) inverts it for representable values.
+  for (float v : {1.0f, 3.0f, 0.125f, 1000.0f, 6.5e-5f}) {
+    const uint32_t bits = encodeRgb9e5({v, 0, 0});
+    EXPECT_NEAR(layout::loRgb9e5Channel(bits, 0u), v, v / 256.0f) << v;
   }
 }
 

@@ -333,6 +333,20 @@ TEST(RenderImage, ConstantVdlAlongNormalGivesAlbedoOverPiTimesE) {
   }
   half.vdlTexels.clear();
   checkQuad(half, {v}, true, "render_constant_vdl_half");
+  // Compact texels (RGB9E5 x a power-of-two scale); 2, 1, 0.5 are exact.
+  GpuOctree compact = half;
+  compact.compact = true;
+  compact.irradianceScale = 4.0f;
+  for (size_t i = 0; i < compact.vdlTexelsHalf.size(); i += 4) {
+    const uint32_t bits = encodeRgb9e5(Vec3{halfToFloat(half.vdlTexelsHalf[i]),
+                                            halfToFloat(half.vdlTexelsHalf[i + 1]),
+                                            halfToFloat(half.vdlTexelsHalf[i + 2])} /
+                                       4.0f);
+    compact.vdlTexelsHalf[i] = uint16_t(bits & 0xffffu);
+    compact.vdlTexelsHalf[i + 1] = uint16_t(bits >> 16);
+    compact.vdlTexelsHalf[i + 2] = 0;
+  }
+  checkQuad(compact, {v}, true, "render_constant_vdl_compact");
 }
 
 TEST(RenderImage, SeveralVdlsAddWithTheirCosines) {

@@ -463,7 +463,7 @@ TEST(VdbIo, ConvertChainsKeepTheVdlSums) {
   half.halfFloat = true;
   writeVdlGrid(dir + "/half.vdb", baked.grid, baked.metadata, half);
   LoadedVdl in = readVdlGrid(dir + "/half.vdb");
-  for (const std::string& step : {"vdls 2", "depth 3"}) {
+  for (const std::string step : {"vdls 2", "depth 3"}) {
     ConvertParams cp;
     if (step == "vdls 2") cp.vdls = "2";
     if (step == "depth 3") cp.depth = 3;
