@@ -35,6 +35,7 @@ struct BakeOptions {
   std::string occlusion = "on";
   std::string edgeCorrection = "on";
   std::string smoothing = "on";
+  std::vector<double> bounds;  // x0 y0 z0 x1 y1 z1, empty = the whole scene
   std::string photonMap;
   std::string statsJson;
   bool quiet = false;
@@ -70,9 +71,21 @@ int runBake(const BakeOptions& opt) {
   params.occlusion = opt.occlusion == "on";
   params.edgeCorrection = opt.edgeCorrection == "on";
   params.smoothing = opt.smoothing == "on";
+  if (!opt.bounds.empty()) {
+    params.region.extend(Vec3{float(opt.bounds[0]), float(opt.bounds[1]), float(opt.bounds[2])});
+    params.region.extend(Vec3{float(opt.bounds[3]), float(opt.bounds[4]), float(opt.bounds[5])});
+  }
   params.keepPhotons = !opt.photonMap.empty();
   BakeResult baked = bake(scene, params, &progress);
   rows.insert(rows.end(), baked.stats.stages.begin(), baked.stats.stages.end());
+  if (baked.stats.emittedPaths > 0 && 2 * baked.stats.emptyPaths > baked.stats.emittedPaths) {
+    std::fprintf(stderr,
+                 "warning: %s of %s photon paths stored nothing (the light mostly misses the "
+                 "surfaces%s): bake the part that matters with --bounds\n",
+                 formatCount(baked.stats.emptyPaths).c_str(),
+                 formatCount(baked.stats.emittedPaths).c_str(),
+                 params.region.empty() ? ", e.g. a sun over a large open scene" : " in --bounds");
+  }
   baked.metadata.sourceScene = std::filesystem::path(opt.scene).filename().string();
 
   StageTimer writeTimer(rows, "write .vdb");
@@ -184,6 +197,12 @@ std::function<int()> addBakeCommand(CLI::App& app) {
                   "they differ by no more than the photon noise explains (shadow edges kept)")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
+  cmd->add_option("--bounds", opt->bounds,
+                  "A region of interest, x0,y0,z0,x1,y1,z1 in scene units: the grid covers it "
+                  "alone, photons are stored only inside it and suns shine on its footprint "
+                  "(a room on a large ground plane)")
+      ->expected(6)
+      ->delimiter(',');
   cmd->add_option("--photon-map", opt->photonMap,
                   "Also write the photons as an OpenVDB point grid for inspection");
   cmd->add_option("--stats-json", opt->statsJson, "Write the per-stage figures as JSON");

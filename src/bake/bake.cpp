@@ -44,12 +44,14 @@ PhotonParams BakeParams::photonParams() const {
   p.storedPhotons = photons;
   p.includeDirect = includeDirect;
   p.seed = seed;
+  p.region = region;
   return p;
 }
 
 GridParams BakeParams::gridParams() const {
   GridParams p;
   p.depth = depth;
+  p.region = region;
   return p;
 }
 
@@ -164,6 +166,11 @@ namespace {
 void checkParams(const BakeParams& p) {
   checkDepth(p.depth);
   if (p.photons < 1) throw InputError("--photons must be at least 1");
+  if (!p.region.empty() &&
+      (!isFinite(p.region.lower) || !isFinite(p.region.upper) ||
+       !(maxComponent(p.region.extent()) > 0))) {
+    throw InputError("--bounds " + p.region.ToString() + " is not a finite box");
+  }
   // The photon map and its bins cost about kBakeBytesPerPhoton each (measured
   // at depths 6 to 8, docs/scale.md): refuse before tracing what cannot fit.
   const size_t available = availableMemoryBytes();
@@ -191,7 +198,8 @@ BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* prog
   // What the .vdb can store, checked before any work: OpenVDB refuses a
   // transform whose scale cubed is below 3e-15 (math::ScaleMap).
   if (scene.triangleCount() > 0) {
-    const GridFrame frame = makeGridFrame(scene.bounds(), params.depth);
+    const GridFrame frame =
+        makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth);
     const double h = frame.voxelSize;
     if (!(h * h * h >= kMinStorableVoxel * kMinStorableVoxel * kMinStorableVoxel)) {
       throw InputError("--depth " + std::to_string(params.depth) + ": voxels of " +
@@ -209,6 +217,7 @@ BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* prog
   PhotonMap photons = tracePhotons(scene, params.photonParams(), progress);
   s.storedPhotons = photons.photons.size();
   s.emittedPaths = photons.emittedPaths;
+  s.emptyPaths = photons.emptyPaths;
   s.traceSeconds = trace.finish(formatCount(photons.photons.size()) + " photons from " +
                                 formatCount(photons.emittedPaths) + " paths");
 
@@ -234,6 +243,7 @@ BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* prog
   meta.gatherOcclusion = params.occlusion ? 1 : 0;
   meta.edgeCorrection = params.edgeCorrection ? 1 : 0;
   meta.includeDirect = params.includeDirect ? 1 : 0;
+  meta.region = params.region;
   if (params.keepPhotons) r.photons = std::move(photons);
   return r;
 }

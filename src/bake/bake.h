@@ -69,6 +69,10 @@ struct BakeParams {
   bool edgeCorrection = true;
   /// Layer-aware smoothing of the estimates (`--smoothing`): smoothVdlGrid.
   bool smoothing = true;
+  /// A region of interest (`--bounds`; empty = the whole scene): the grid
+  /// covers it alone, photons are stored only inside it, and directional
+  /// lights emit over its footprint (PhotonParams::region).
+  Bounds3 region;
 
   PhotonParams photonParams() const;
   GridParams gridParams() const;
@@ -140,6 +144,7 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
 struct BakeStats {
   size_t triangles = 0;
   size_t storedPhotons = 0, emittedPaths = 0;
+  size_t emptyPaths = 0;  ///< traced paths that stored no photon (light that missed the grid)
   size_t denseVoxels = 0;  ///< 8^depth
   double traceSeconds = 0;
   LevelStats level;        ///< voxelize / splat / gather + cluster

@@ -53,6 +53,7 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
     StageTimer voxelize(rows, "voxelize scene");
     GridParams gridParams;
     gridParams.depth = depth;
+    gridParams.region = inMeta.region;  // the bake's region of interest, if it had one
     SurfaceGrid grid = buildSurfaceGrid(*params.scene, gridParams, progress);
     // The bake voxelized the same scene with makeGridFrame, whose origin does
     // not depend on the depth: a different scene shows up here.

@@ -267,7 +267,8 @@ SurfaceGrid buildSurfaceGrid(const Scene& scene, const GridParams& params, Progr
   checkSceneIndices(scene);
 
   SurfaceGrid grid;
-  grid.frame = makeGridFrame(scene.bounds(), params.depth, params.padding);
+  grid.frame = makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth,
+                             params.padding);
   const FrameD frame(grid.frame);
 
   tbb::enumerable_thread_specific<std::vector<Contribution>> perThread;

@@ -22,6 +22,9 @@ namespace lo {
 struct GridParams {
   int depth = 6;          ///< 2^depth voxels per axis (paper's delta)
   float padding = 0.01f;  ///< fraction of the largest extent added on each side
+  /// The grid covers this box (a region of interest) instead of the scene's
+  /// bounds; geometry outside it has no voxels. Empty = the scene's bounds.
+  Bounds3 region;
 };
 
 /// Active voxels in canonical order: sorted by 8^3 block (OpenVDB leaf), then

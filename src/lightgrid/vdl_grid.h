@@ -121,6 +121,8 @@ struct BakeMetadata {
   /// VDLs carry it and a renderer must not add it again; 0: indirect only;
   /// -1: not recorded (older files).
   int includeDirect = -1;
+  /// The bake's region of interest (`bake --bounds`); empty = the whole scene.
+  Bounds3 region;
 };
 
 }  // namespace lo

@@ -66,6 +66,8 @@ struct Context {
   std::vector<Emitter> emitters;
   std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
   Bounds3 bounds;
+  Bounds3 region;       ///< photons stored only inside (empty: everywhere)
+  Bounds3 emitBounds;   ///< what directional lights cover: the region, else the bounds
   float epsilon = 0;
   int maxBounces = 0;
   bool includeDirect = false;
@@ -157,14 +159,17 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
     }
     case Emitter::Kind::Directional: {
       const Light& light = scene.lights[e.index];
-      // A disc of the bounding sphere's radius (the same disc Light::power
-      // uses), perpendicular to the light, placed outside the bounds.
-      float radius = 0.5f * length(ctx.bounds.extent());
+      // A disc of the covered bounding sphere's radius (the same disc
+      // Light::power uses), perpendicular to the light, placed outside the
+      // whole scene (occluders beyond a region of interest still cast).
+      float radius = 0.5f * length(ctx.emitBounds.extent());
+      const float away = length(ctx.emitBounds.center() - ctx.bounds.center()) +
+                         0.5f * length(ctx.bounds.extent());
       Vec3 n = normalize(light.direction), t, b;
       orthonormalBasis(n, t, b);
       float r = radius * std::sqrt(rng.uniform());
       float phi = 2.0f * kPi * rng.uniform();
-      out.origin = ctx.bounds.center() - n * (radius + 4.0f * ctx.epsilon) +
+      out.origin = ctx.emitBounds.center() - n * (std::max(radius, away) + 4.0f * ctx.epsilon) +
                    t * (r * std::cos(phi)) + b * (r * std::sin(phi));
       out.direction = n;
       return true;
@@ -242,7 +247,10 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     Vec3 n = frontFace ? normal : -normal;  // faces the incoming side
     Vec3 wo = -dir;
 
-    if (mat.storesPhotons && (bounce > 0 || ctx.includeDirect)) {
+    if (mat.storesPhotons && (bounce > 0 || ctx.includeDirect) &&
+        (ctx.region.empty() || (p.x >= ctx.region.lower.x && p.y >= ctx.region.lower.y &&
+                                p.z >= ctx.region.lower.z && p.x <= ctx.region.upper.x &&
+                                p.y <= ctx.region.upper.y && p.z <= ctx.region.upper.z))) {
       Photon ph;
       ph.position = p;
       ph.direction = wo;
@@ -291,7 +299,7 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
         break;
       case Light::Type::Directional:
         e.kind = Emitter::Kind::Directional;
-        e.power = light.power(ctx.bounds);
+        e.power = light.power(ctx.emitBounds);
         break;
     }
     if (light.type != Light::Type::Spot) e.samplePower = e.power;
@@ -369,7 +377,12 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   // positions round to world floats.
   const Vec3 origin = scene.tracingOrigin();
   if (origin == Vec3{0, 0, 0}) return photon_internal::traceInSceneFrame(scene, params, progress);
-  PhotonMap map = photon_internal::traceInSceneFrame(scene.translated(-origin), params, progress);
+  PhotonParams shifted = params;
+  if (!shifted.region.empty()) {
+    shifted.region.lower -= origin;
+    shifted.region.upper -= origin;
+  }
+  PhotonMap map = photon_internal::traceInSceneFrame(scene.translated(-origin), shifted, progress);
   for (Photon& photon : map.photons) photon.position += origin;
   return map;
 }
@@ -386,6 +399,8 @@ PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params,
   Context ctx;
   ctx.scene = &scene;
   ctx.bounds = scene.bounds();
+  ctx.region = params.region;
+  ctx.emitBounds = params.region.empty() ? ctx.bounds : params.region;
   ctx.maxBounces = params.maxBounces;
   ctx.includeDirect = params.includeDirect;
   ctx.seed = params.seed;
@@ -419,6 +434,7 @@ PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params,
 
   std::vector<ChunkResult> chunks;
   size_t emitted = 0;  // paths whose photons are in map.photons
+  size_t empty = 0;    // of those, paths that stored nothing
   size_t rays = 0;
   bool done = false;
   size_t batch = std::min(maxEmitted, std::clamp(target, kMinBatchPaths, size_t(65536)));
@@ -440,6 +456,7 @@ PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params,
         offset += chunk.pathPhotons[i];
         rays += chunk.pathRays[i];
         ++emitted;
+        empty += chunk.pathPhotons[i] == 0;
         if (map.photons.size() == target) {
           done = true;
           break;
@@ -458,6 +475,7 @@ PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params,
   }
 
   map.emittedPaths = emitted;
+  map.emptyPaths = empty;
   map.raysTraced = rays;
   float invPaths = emitted > 0 ? float(1.0 / double(emitted)) : 0.0f;
   for (Photon& ph : map.photons) ph.power *= invPaths;

@@ -21,11 +21,17 @@ struct PhotonParams {
   /// Stop after this many emitted paths even if fewer photons were stored
   /// (a scene whose light never reaches a diffuse surface). 0 = 64 * storedPhotons.
   size_t maxEmitted = 0;
+  /// A region of interest (world space; empty = the whole scene): only
+  /// photons inside it are stored, and directional lights emit over its
+  /// footprint (a disc of its bounding sphere) instead of the whole scene's,
+  /// starting outside the scene so that occluders beyond the region still cast.
+  Bounds3 region;
 };
 
 struct PhotonMap {
   std::vector<Photon> photons;
   size_t emittedPaths = 0;      ///< paths traced to obtain `photons`
+  size_t emptyPaths = 0;        ///< of those, paths that stored no photon
   Vec3 emittedPower{0, 0, 0};   ///< total RGB power of all lights, W
   size_t raysTraced = 0;        ///< for statistics
 };

@@ -257,6 +257,10 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   }
   if (meta.edgeCorrection >= 0) m.insertMeta("edge_correction", openvdb::Int32Metadata(meta.edgeCorrection));
   if (meta.includeDirect >= 0) m.insertMeta("include_direct", openvdb::Int32Metadata(meta.includeDirect));
+  if (!meta.region.empty()) {
+    m.insertMeta("region_min", openvdb::Vec3SMetadata(toVdb(meta.region.lower)));
+    m.insertMeta("region_max", openvdb::Vec3SMetadata(toVdb(meta.region.upper)));
+  }
   return m;
 }
 
@@ -487,6 +491,10 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.gatherOcclusion = metaValue<int32_t>(path, m, "gather_occlusion", false, -1);
   meta.edgeCorrection = metaValue<int32_t>(path, m, "edge_correction", false, -1);
   meta.includeDirect = metaValue<int32_t>(path, m, "include_direct", false, -1);
+  meta.region.lower = fromVdb(
+      metaValue<openvdb::Vec3s>(path, m, "region_min", false, openvdb::Vec3s(INFINITY)));
+  meta.region.upper = fromVdb(
+      metaValue<openvdb::Vec3s>(path, m, "region_max", false, openvdb::Vec3s(-INFINITY)));
   return meta;
 }
 

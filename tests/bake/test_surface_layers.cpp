@@ -162,3 +162,56 @@ TEST(BakeLimits, VoxelsTooSmallForAVdbAreRefusedFirst) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// A small room on a 50 m ground plane under a sun: without a region of
+// interest most photon paths store nothing (the grid spans the ground, the
+// sun shines on all of it); with --bounds on the room, the grid covers the
+// room alone, every stored photon lies in it, and far fewer paths are wasted.
+TEST(BakeRegion, ARoomOnAGroundPlane) {
+  Scene scene = blackScene();
+  Material white;
+  white.baseColor = {0.7f, 0.7f, 0.7f};
+  scene.materials.push_back(white);
+  test::addQuad(scene, {-25, 0, -25}, {50, 0, 0}, {0, 0, 50}, {0, 1, 0}, 1);  // ground
+  // A room of 2 x 1 x 2 m open to the sky.
+  test::addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 1, 0}, {0, 0, 1}, 1);
+  test::addQuad(scene, {-1, 0, 1}, {2, 0, 0}, {0, 1, 0}, {0, 0, -1}, 1);
+  test::addQuad(scene, {-1, 0, -1}, {0, 0, 2}, {0, 1, 0}, {1, 0, 0}, 1);
+  test::addQuad(scene, {1, 0, -1}, {0, 0, 2}, {0, 1, 0}, {-1, 0, 0}, 1);
+  scene.lights.push_back(sun({0.3f, -1.0f, 0.2f}, 1.0f));
+  BakeParams p;
+  p.depth = 5;
+  p.photons = 20000;
+  p.knn = 50;
+  const BakeResult whole = bake(scene, p, nullptr);
+  Bounds3 room;
+  room.extend(Vec3{-1.2f, -0.1f, -1.2f});
+  room.extend(Vec3{1.2f, 1.2f, 1.2f});
+  p.region = room;
+  const BakeResult roi = bake(scene, p, nullptr);
+  const double wasted = double(whole.stats.emptyPaths) / double(whole.stats.emittedPaths);
+  const double wastedRoi = double(roi.stats.emptyPaths) / double(roi.stats.emittedPaths);
+  std::printf("ground plane: %zu paths for %zu photons (%.0f%% stored nothing); with --bounds "
+              "%zu paths (%.0f%%)\n",
+              whole.stats.emittedPaths, whole.stats.storedPhotons, 100 * wasted,
+              roi.stats.emittedPaths, 100 * wastedRoi);
+  EXPECT_GT(wasted, 0.5) << "the case bake warns about";
+  EXPECT_EQ(roi.stats.storedPhotons, p.photons);
+  EXPECT_LT(wastedRoi, wasted);
+  EXPECT_LT(roi.stats.emittedPaths, whole.stats.emittedPaths / 4);
+  // The grid spans the region, not the ground.
+  EXPECT_LT(roi.grid.frame.voxelSize * float(roi.grid.frame.resolution()), 2.6f);
+  EXPECT_GT(whole.grid.frame.voxelSize * float(whole.grid.frame.resolution()), 49.0f);
+  for (const Coord& c : roi.grid.coords) {
+    const Vec3 centre = roi.grid.frame.voxelCenter(c);
+    ASSERT_TRUE(centre.x > -1.4f && centre.x < 1.4f && centre.z > -1.4f && centre.z < 1.4f)
+        << centre.ToString();
+  }
+  EXPECT_EQ(roi.metadata.region.lower, room.lower);
+}
+
+}  // namespace
+}  // namespace lo
