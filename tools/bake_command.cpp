@@ -35,6 +35,8 @@ struct BakeOptions {
   std::string occlusion = "on";
   std::string edgeCorrection = "on";
   std::string smoothing = "on";
+  int autoCap = BakeParams{}.autoCap;
+  float autoThreshold = BakeParams{}.autoThreshold;
   std::vector<double> bounds;  // x0 y0 z0 x1 y1 z1, empty = the whole scene
   std::string photonMap;
   std::string statsJson;
@@ -71,6 +73,8 @@ int runBake(const BakeOptions& opt) {
   params.occlusion = opt.occlusion == "on";
   params.edgeCorrection = opt.edgeCorrection == "on";
   params.smoothing = opt.smoothing == "on";
+  params.autoCap = opt.autoCap;
+  params.autoThreshold = opt.autoThreshold;
   if (!opt.bounds.empty()) {
     params.region.extend(Vec3{float(opt.bounds[0]), float(opt.bounds[1]), float(opt.bounds[2])});
     params.region.extend(Vec3{float(opt.bounds[3]), float(opt.bounds[4]), float(opt.bounds[5])});
@@ -78,12 +82,18 @@ int runBake(const BakeOptions& opt) {
   params.keepPhotons = !opt.photonMap.empty();
   BakeResult baked = bake(scene, params, &progress);
   rows.insert(rows.end(), baked.stats.stages.begin(), baked.stats.stages.end());
-  if (baked.stats.emittedPaths > 0 && 2 * baked.stats.emptyPaths > baked.stats.emittedPaths) {
+  // Half the paths of a closed room store nothing (the light is absorbed at
+  // its first bounce, which is not stored); a sun over open ground wastes
+  // nearly all of them, and may stop short of the photons asked.
+  const BakeStats& st = baked.stats;
+  if (st.emittedPaths > 0 && (st.storedPhotons < params.photons ||
+                              10 * st.emptyPaths > 9 * st.emittedPaths)) {
     std::fprintf(stderr,
-                 "warning: %s of %s photon paths stored nothing (the light mostly misses the "
-                 "surfaces%s): bake the part that matters with --bounds\n",
-                 formatCount(baked.stats.emptyPaths).c_str(),
-                 formatCount(baked.stats.emittedPaths).c_str(),
+                 "warning: %s of %s photon paths stored nothing and %s of %s photons were "
+                 "stored (the light mostly misses the surfaces%s): bake the part that matters "
+                 "with --bounds\n",
+                 formatCount(st.emptyPaths).c_str(), formatCount(st.emittedPaths).c_str(),
+                 formatCount(st.storedPhotons).c_str(), formatCount(params.photons).c_str(),
                  params.region.empty() ? ", e.g. a sun over a large open scene" : " in --bounds");
   }
   baked.metadata.sourceScene = std::filesystem::path(opt.scene).filename().string();
@@ -165,9 +175,17 @@ std::function<int()> addBakeCommand(CLI::App& app) {
                   "Gathering radius in scene units (default: " + formatNumber(kDefaultRadiusVoxels) + " voxel sizes)")
       ->check(finitePositive());
   cmd->add_option("--vdls", opt->vdls,
-                  "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest that keep the angular error "
-                  "under 0.35 (about 20 degrees)")
+                  "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest (up to --auto-cap) whose "
+                  "angular error is under --auto-threshold")
       ->check(vdlCountValidator())
+      ->capture_default_str();
+  cmd->add_option("--auto-cap", opt->autoCap, "With --vdls auto: at most this many VDLs per voxel")
+      ->check(CLI::Range(1, kMaxVdls))
+      ->capture_default_str();
+  cmd->add_option("--auto-threshold", opt->autoThreshold,
+                  "With --vdls auto: the fewest VDLs whose angular error (chord-length deviation, "
+                  "0..2; 0.35 is about 20 degrees) is under this")
+      ->check(finitePositive())
       ->capture_default_str();
   cmd->add_option("--seed", opt->seed, "Random seed (same seed, same bytes)")
       ->check(seedValidator())->capture_default_str();

@@ -66,8 +66,9 @@ GatherParams BakeParams::gatherParams() const {
 ClusterParams BakeParams::clusterParams() const {
   ClusterParams p;
   p.seed = seed;
-  p.vdls = vdls.count;
+  p.vdls = vdls.automatic ? autoCap : vdls.count;
   p.autoCount = vdls.automatic;
+  p.autoThreshold = autoThreshold;
   return p;
 }
 
@@ -184,6 +185,14 @@ void checkParams(const BakeParams& p) {
   if (p.knn < 1) throw InputError("--knn " + std::to_string(p.knn) + " must be at least 1");
   if (!(p.radius >= 0.0f) || !std::isfinite(p.radius)) {
     throw InputError("--radius " + std::to_string(p.radius) + " must be a finite positive length");
+  }
+  if (p.vdls.automatic && (p.autoCap < 1 || p.autoCap > kMaxVdls)) {
+    throw InputError("--auto-cap " + std::to_string(p.autoCap) + " is outside [1, " +
+                     std::to_string(kMaxVdls) + "]");
+  }
+  if (p.vdls.automatic && !(p.autoThreshold > 0 && p.autoThreshold <= 2)) {
+    throw InputError("--auto-threshold " + std::to_string(p.autoThreshold) +
+                     " is outside (0, 2] (a chord length)");
   }
   if (!p.vdls.automatic && (p.vdls.count < 1 || p.vdls.count > kMaxVdls)) {
     throw InputError("--vdls " + std::to_string(p.vdls.count) + " is outside [1, " +

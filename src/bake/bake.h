@@ -56,6 +56,13 @@ struct BakeParams {
   /// Gathering radius, world units; 0 = kDefaultRadiusVoxels voxel sizes.
   float radius = 0.0f;
   VdlCount vdls;
+  /// `--vdls auto`: at most this many VDLs per voxel (`--auto-cap`), the
+  /// fewest whose angular error (chord-length deviation) is under
+  /// autoThreshold (`--auto-threshold`; the paper's 0.35 ~ 20 degrees keeps
+  /// almost every voxel at the cap; 0.5 gives 3.1 VDLs per voxel on the test
+  /// scenes at the irradiance error of 4, docs/octree.md).
+  int autoCap = 4;
+  float autoThreshold = 0.5f;
   uint64_t seed = 1;           ///< same inputs and seed, same bytes, whatever the thread count
   bool includeDirect = false;  ///< also store bounce-0 photons (the renderer draws direct light)
   bool keepPhotons = false;    ///< return the photon map in BakeResult::photons

@@ -252,18 +252,34 @@ class VdlChecker {
     return 0;
   }
 
+  /// The VDL grids of one slot ("vdl2", "layer1_vdl0"): active where the
+  /// voxel (or layer) has that VDL (sparse since format version 2).
+  static std::string vdlSlot(const std::string& name) {
+    const size_t at = name.find("vdl");
+    if (at == std::string::npos || (at != 0 && at != 7)) return "";
+    const size_t under = name.find('_', at);
+    if (under == std::string::npos || under == at + 3) return "";
+    const std::string tail = name.substr(under);
+    if (tail != "_irradiance" && tail != "_direction") return "";
+    return name.substr(0, under);
+  }
+
   void checkSameActive() {
-    const openvdb::GridBase* ref[kMaxLayers + 7] = {};
+    std::map<std::string, const openvdb::GridBase*> ref;
     std::string counts;
     for (const auto& g : *f_.grids) {
       if (!g) continue;
+      const std::string slot = vdlSlot(g->getName());
       const int group = layerGroup(g->getName());
-      const openvdb::GridBase*& r = ref[group];
+      const std::string key = !slot.empty() ? slot : "layer" + std::to_string(group);
+      const openvdb::GridBase*& r = ref[key];
       if (!r) {
         r = g.get();
-        counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
-                  (group == 0 ? " in every voxel grid" : " in every layer" + std::to_string(group) +
-                                                              " grid");
+        if (slot.empty()) {
+          counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
+                    (group == 0 ? " in every voxel grid"
+                                : " in every layer" + std::to_string(group) + " grid");
+        }
       } else if (g->activeVoxelCount() != r->activeVoxelCount() ||
                  g->evalActiveVoxelBoundingBox() != r->evalActiveVoxelBoundingBox()) {
         add("same_active_voxels", false,

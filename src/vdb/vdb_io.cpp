@@ -281,12 +281,25 @@ openvdb::GridPtrVec buildVdlGrids(const VdlGrid& g, const Transform::Ptr& xform)
       floatGrid(kRadius, "world units", xform, c, [&](size_t v) { return g.radius[v]; }));
   grids.push_back(
       floatGrid(kArea, "world units^2", xform, c, [&](size_t v) { return g.areas[v]; }));
+  // VDL i only where the voxel has more than i VDLs (sparse: a voxel with
+  // fewer stores no zeros in the higher grids).
+  std::vector<size_t> withVdl;
+  std::vector<Coord> withVdlCoords;
   for (int i = 0; i < g.maxVdls; ++i) {
+    withVdl.clear();
+    withVdlCoords.clear();
+    for (size_t v = 0; v < g.size(); ++v) {
+      if (g.vdlCount[v] > i) {
+        withVdl.push_back(v);
+        withVdlCoords.push_back(c[v]);
+      }
+    }
     grids.push_back(vectorGrid(vdlIrradianceName(i), kIrradianceUnits, openvdb::VEC_INVARIANT,
-                               xform, c, [&](size_t v) { return g.vdlsOf(v)[i].irradiance; }));
+                               xform, withVdlCoords,
+                               [&](size_t k) { return g.vdlsOf(withVdl[k])[i].irradiance; }));
     grids.push_back(vectorGrid(vdlDirectionName(i), "unit vector towards the light, world space",
-                               openvdb::VEC_INVARIANT, xform, c,
-                               [&](size_t v) { return g.vdlsOf(v)[i].direction; }));
+                               openvdb::VEC_INVARIANT, xform, withVdlCoords,
+                               [&](size_t k) { return g.vdlsOf(withVdl[k])[i].direction; }));
   }
   if (g.layers.size() == 0) return grids;
 
@@ -327,13 +340,21 @@ openvdb::GridPtrVec buildVdlGrids(const VdlGrid& g, const Transform::Ptr& xform)
     grids.push_back(floatGrid(name(kRadius), "world units", xform, lc,
                               [&](size_t k) { return L.radius[es[k]]; }));
     for (int i = 0; i < g.maxVdls; ++i) {
+      std::vector<size_t> ek;
+      std::vector<Coord> kc;
+      for (size_t k = 0; k < es.size(); ++k) {
+        if (L.vdlCount[es[k]] > i) {
+          ek.push_back(es[k]);
+          kc.push_back(lc[k]);
+        }
+      }
       grids.push_back(vectorGrid(name(vdlIrradianceName(i)), kIrradianceUnits,
-                                 openvdb::VEC_INVARIANT, xform, lc,
-                                 [&](size_t k) { return g.layerVdlsOf(es[k])[i].irradiance; }));
+                                 openvdb::VEC_INVARIANT, xform, kc,
+                                 [&](size_t k) { return g.layerVdlsOf(ek[k])[i].irradiance; }));
       grids.push_back(vectorGrid(name(vdlDirectionName(i)),
                                  "unit vector towards the light, world space",
-                                 openvdb::VEC_INVARIANT, xform, lc,
-                                 [&](size_t k) { return g.layerVdlsOf(es[k])[i].direction; }));
+                                 openvdb::VEC_INVARIANT, xform, kc,
+                                 [&](size_t k) { return g.layerVdlsOf(ek[k])[i].direction; }));
     }
   }
   return grids;
@@ -748,8 +769,6 @@ LoadedVdl readVdl(const std::string& path) {
   for (const FloatGrid::Ptr& g : {photonCount, angularError, radius, area}) {
     if (g) all.push_back(g);
   }
-  all.insert(all.end(), vdlIrr.begin(), vdlIrr.end());
-  all.insert(all.end(), vdlDir.begin(), vdlDir.end());
 
   const Transform& xform = vdlCount->transform();
   const openvdb::Index64 active = vdlCount->activeVoxelCount();
@@ -762,6 +781,23 @@ LoadedVdl readVdl(const std::string& path) {
       throw InputError(path + ": grid '" + g->getName() + "' has " +
                        std::to_string(g->activeVoxelCount()) + " active voxels, 'vdl_count' has " +
                        std::to_string(active));
+    }
+  }
+  // VDL grids: active where the voxel has that VDL (sparse), or on every voxel
+  // (files before version 2 store zeros); never beyond the voxels.
+  for (const auto& vg : {vdlIrr, vdlDir}) {
+    for (const auto& g : vg) {
+      if (!(g->transform() == xform)) {
+        throw InputError(path + ": mismatched transforms: grid '" + g->getName() +
+                         "' differs from 'vdl_count'");
+      }
+      for (auto it = g->cbeginValueOn(); it; ++it) {
+        if (!vdlCount->tree().isValueOn(it.getCoord())) {
+          throw InputError(path + ": grid '" + g->getName() + "' is active at " +
+                           Coord{it.getCoord().x(), it.getCoord().y(), it.getCoord().z()}.ToString() +
+                           ", which is not a voxel of the file");
+        }
+      }
     }
   }
 
