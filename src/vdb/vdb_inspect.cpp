@@ -136,6 +136,7 @@ class VdlChecker {
     checkFinite();
     checkSameTransform();
     checkSameActive();
+    checkDepthAndBounds();
     if (!contract) return;  // the value checks need every required grid
     checkValues(maxVdls);
   }
@@ -250,6 +251,59 @@ class VdlChecker {
       return name[5] - '0';
     }
     return 0;
+  }
+
+  /// What the reader (readVdlGrid) and the GPU octree refuse, checked the
+  /// same way here so that inspect never passes a file render refuses: the
+  /// depth metadata within [1, kMaxGridDepth], a transform of uniform scale
+  /// and translation only, and every voxel within [0, 2^depth) on each axis.
+  void checkDepthAndBounds() {
+    auto m = (*f_.meta)["depth"];
+    int depth = -1;
+    if (auto i32 = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m)) depth = i32->value();
+    if (auto i64 = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(m)) {
+      depth = i64->value() >= 0 && i64->value() <= 64 ? int(i64->value()) : -1;
+    }
+    const bool depthOk = depth >= 1 && depth <= kMaxGridDepth;
+    add("depth", depthOk,
+        depthOk ? std::to_string(depth) + " (2^" + std::to_string(depth) + " voxels per axis)"
+                : "file metadata depth is " + (m ? m->str() : std::string("missing")) +
+                      ", expected an int32 in [1, " + std::to_string(kMaxGridDepth) + "]");
+    std::string transform;
+    for (const auto& g : *f_.grids) {
+      if (!g || !transform.empty()) continue;
+      const auto map = g->transform().baseMap();
+      const bool axisAligned = map->isType<openvdb::math::UniformScaleTranslateMap>() ||
+                               map->isType<openvdb::math::UniformScaleMap>();
+      if (!g->transform().isLinear() || !axisAligned) {
+        transform = "grid '" + g->getName() + "' has a " + g->transform().mapType() +
+                    " transform, expected a uniform scale and translation";
+      }
+    }
+    add("transform", transform.empty(),
+        transform.empty() ? "uniform scale and translation" : transform);
+    if (!depthOk) return;
+    const int res = 1 << depth;
+    std::string outside;
+    uint64_t count = 0;
+    for (const auto& g : *f_.grids) {
+      if (!g || g->isType<openvdb::points::PointDataGrid>()) continue;
+      const openvdb::CoordBBox box = g->evalActiveVoxelBoundingBox();
+      if (g->activeVoxelCount() == 0) continue;
+      const openvdb::Coord lo = box.min(), hi = box.max();
+      if (lo.x() < 0 || lo.y() < 0 || lo.z() < 0 || hi.x() >= res || hi.y() >= res ||
+          hi.z() >= res) {
+        ++count;
+        if (outside.empty()) {
+          outside = "grid '" + g->getName() + "' has voxels from " + coordText(lo) + " to " +
+                    coordText(hi) + ", outside [0, " + std::to_string(res) + ")";
+        }
+      }
+    }
+    add("voxel_bounds", count == 0,
+        count == 0 ? "every voxel within [0, " + std::to_string(res) + ") of depth " +
+                         std::to_string(depth)
+                   : std::to_string(count) + " grid(s) beyond it; first " + outside);
   }
 
   /// The VDL grids of one slot ("vdl2", "layer1_vdl0"): active where the

@@ -18,6 +18,7 @@
 #include "core/rng.h"
 #include "core/file.h"
 #include "test_util.h"
+#include "octree/gpu_octree.h"
 #include "vdb/vdb_inspect.h"
 #include "vdb/vdb_internal.h"
 #include "vdb/vdb_io.h"
@@ -357,6 +358,35 @@ TEST(Convert, VdbPrintListsTheGridsOfAConvertedFile) {
   EXPECT_NE(out.find("format_version: " + std::to_string(kVdlFormatVersion)), std::string::npos)
       << out;
   EXPECT_TRUE(readVdlGrid(dir + "/c.vdb").grid.size() == coarse.size());
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+// inspect and the readers agree (issue: a checker and a reader that
+// disagree): a file the reader or the GPU octree refuses fails a check.
+TEST(Inspect, FailsWhatTheReadersRefuse) {
+  const std::string dir = test::outputDir("Inspect.Agree");
+  // A rotated transform: readVdlGrid refuses, inspect's "transform" fails.
+  vdb_internal::Damage rotated;
+  rotated.rotateTransform = true;
+  vdb_internal::writeVdlGridDamaged(dir + "/rotated.vdb", floorGrid(), meta(), rotated);
+  EXPECT_THROW(readVdlGrid(dir + "/rotated.vdb"), InputError);
+  expectCheck(inspectVdb(dir + "/rotated.vdb"), "transform", false);
+  // Voxels outside [0, 2^depth): the GPU octree refuses, "voxel_bounds" fails.
+  VdlGrid g = floorGrid();
+  for (Coord& c : g.coords) c.x -= 100;
+  writeVdlGrid(dir + "/outside.vdb", g, meta());
+  EXPECT_THROW(buildGpuOctree(readVdlGrid(dir + "/outside.vdb").grid), InputError);
+  expectCheck(inspectVdb(dir + "/outside.vdb"), "voxel_bounds", false);
+  // A good file passes both.
+  writeVdlGrid(dir + "/good.vdb", floorGrid(), meta());
+  expectCheck(inspectVdb(dir + "/good.vdb"), "voxel_bounds", true);
+  expectCheck(inspectVdb(dir + "/good.vdb"), "transform", true);
+  expectCheck(inspectVdb(dir + "/good.vdb"), "depth", true);
 }
 
 }  // namespace
