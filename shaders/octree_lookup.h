@@ -11,6 +11,8 @@
  *   loFetchVdl       one VDL texel, decoded: rgb irradiance (W/m^2), a packed direction
  *   loLeafVdls       a leaf's VDLs for a surface point (the layer of a layered
  *                    leaf that serves it)
+ *   loServingLeaf    a voxel's leaf and its VDLs for a surface point, in one call
+ *   loNearestServingLeaf  the voxel in front of the point, else behind, that serves it
  *   loShadeVdls      sum_i response(d_i) c_i over those VDLs (paper §4.2.2)
  *   loNearestLeaf    the voxel in front of a surface point, else the one behind it
  *   loOctreeIndirect the indirect light at a surface point: trilinear over the 8
@@ -214,6 +216,24 @@ LO_LOOKUP_FN bool loNearestLeaf(LO_TEX_PARAM vec3 q, vec3 n, int depth, float no
   return loLookupLeaf(LO_TEX voxel, depth, leaf);
 }
 
+/* The VDLs of voxel c that serve a surface point at q facing ng: its leaf
+ * (loLookupLeaf), then the leaf's layer for the point (loLeafVdls). */
+LO_LOOKUP_FN bool loServingLeaf(LO_TEX_PARAM ivec3 c, vec3 q, vec3 ng, int depth,
+                                LO_OUT(uint) first, LO_OUT(int) count) {
+  uvec4 leaf;
+  return loLookupLeaf(LO_TEX c, depth, leaf) && loLeafVdls(LO_TEX leaf, c, q, ng, first, count);
+}
+
+/* loNearestLeaf's choice, the voxel in front of the surface else the one
+ * behind it, among the voxels that serve the point (loServingLeaf). */
+LO_LOOKUP_FN bool loNearestServingLeaf(LO_TEX_PARAM vec3 q, vec3 n, vec3 ng, int depth,
+                                       float normalOffset, LO_OUT(uint) first,
+                                       LO_OUT(int) count) {
+  if (loServingLeaf(LO_TEX ivec3(floor(q)), q, ng, depth, first, count)) return true;
+  return loServingLeaf(LO_TEX ivec3(floor(q - (normalOffset + normalOffset) * n)), q, ng, depth,
+                       first, count);
+}
+
 /* Position in voxel units of the octree, moved normalOffset voxels along n. */
 LO_LOOKUP_FN vec3 loOctreePosition(vec3 p, vec3 n, vec3 origin, float voxelSize,
                                    float normalOffset) {
@@ -232,7 +252,6 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
                                    float normalOffset, bool interpolation, int maxVdls,
                                    LoSurface s) {
   vec3 q = loOctreePosition(p, s.n, origin, voxelSize, normalOffset);
-  uvec4 leaf;
   uint first;
   int count;
   if (interpolation) {
@@ -250,21 +269,15 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
       ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      if (loLookupLeaf(LO_TEX base + o, depth, leaf) &&
-          loLeafVdls(LO_TEX leaf, base + o, q, s.ng, first, count)) {
+      if (loServingLeaf(LO_TEX base + o, q, s.ng, depth, first, count)) {
         sum += w * loShadeVdls(LO_TEX first, count, maxVdls, s);
         weightSum += w;
       }
     }
     if (weightSum > 0.0f) return sum / weightSum;
   }
-  /* The voxel in front of the surface, else the one behind it (loNearestLeaf). */
-  for (int k = 0; k < 2; ++k) {
-    ivec3 voxel = ivec3(floor(k == 0 ? q : q - (normalOffset + normalOffset) * s.n));
-    if (loLookupLeaf(LO_TEX voxel, depth, leaf) &&
-        loLeafVdls(LO_TEX leaf, voxel, q, s.ng, first, count)) {
-      return loShadeVdls(LO_TEX first, count, maxVdls, s);
-    }
+  if (loNearestServingLeaf(LO_TEX q, s.n, s.ng, depth, normalOffset, first, count)) {
+    return loShadeVdls(LO_TEX first, count, maxVdls, s);
   }
   return vec3(0.0f);
 }
@@ -298,7 +311,6 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
                                      int depth, float normalOffset, bool interpolation,
                                      int maxVdls, LO_OUT(vec3) direction) {
   vec3 q = loOctreePosition(p, n, origin, voxelSize, normalOffset);
-  uvec4 leaf;
   uint first;
   int count;
   vec3 e;
@@ -315,8 +327,7 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
       ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      if (loLookupLeaf(LO_TEX base + o, depth, leaf) &&
-          loLeafVdls(LO_TEX leaf, base + o, q, n, first, count)) {
+      if (loServingLeaf(LO_TEX base + o, q, n, depth, first, count)) {
         e = loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, d);
         sum += w * e;
         directionSum += w * d;
@@ -328,12 +339,8 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
       return sum / weightSum;
     }
   }
-  for (int k = 0; k < 2; ++k) {
-    ivec3 voxel = ivec3(floor(k == 0 ? q : q - (normalOffset + normalOffset) * n));
-    if (loLookupLeaf(LO_TEX voxel, depth, leaf) &&
-        loLeafVdls(LO_TEX leaf, voxel, q, n, first, count)) {
-      return loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, direction);
-    }
+  if (loNearestServingLeaf(LO_TEX q, n, n, depth, normalOffset, first, count)) {
+    return loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, direction);
   }
   return vec3(0.0f);
 }
