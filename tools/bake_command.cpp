@@ -82,20 +82,8 @@ int runBake(const BakeOptions& opt) {
   params.keepPhotons = !opt.photonMap.empty();
   BakeResult baked = bake(scene, params, &progress);
   rows.insert(rows.end(), baked.stats.stages.begin(), baked.stats.stages.end());
-  // Half the paths of a closed room store nothing (the light is absorbed at
-  // its first bounce, which is not stored); a sun over open ground wastes
-  // nearly all of them, and may stop short of the photons asked.
-  const BakeStats& st = baked.stats;
-  if (st.emittedPaths > 0 && (st.storedPhotons < params.photons ||
-                              10 * st.emptyPaths > 9 * st.emittedPaths)) {
-    std::fprintf(stderr,
-                 "warning: %s of %s photon paths stored nothing and %s of %s photons were "
-                 "stored (the light mostly misses the surfaces%s): bake the part that matters "
-                 "with --bounds\n",
-                 formatCount(st.emptyPaths).c_str(), formatCount(st.emittedPaths).c_str(),
-                 formatCount(st.storedPhotons).c_str(), formatCount(params.photons).c_str(),
-                 params.region.empty() ? ", e.g. a sun over a large open scene" : " in --bounds");
-  }
+  const std::string missed = photonBudgetWarning(params, baked.stats);
+  if (!missed.empty()) std::fprintf(stderr, "warning: %s\n", missed.c_str());
   baked.metadata.sourceScene = std::filesystem::path(opt.scene).filename().string();
 
   StageTimer writeTimer(rows, "write .vdb");

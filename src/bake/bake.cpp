@@ -202,6 +202,19 @@ void checkParams(const BakeParams& p) {
 
 }  // namespace
 
+std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
+  if (st.emittedPaths == 0 ||
+      !(st.storedPhotons < params.photons || 10 * st.emptyPaths > 9 * st.emittedPaths)) {
+    return "";
+  }
+  return formatCount(st.emptyPaths) + " of " + formatCount(st.emittedPaths) +
+         " photon paths stored nothing and " + formatCount(st.storedPhotons) + " of " +
+         formatCount(params.photons) + " photons were stored (the light mostly misses the " +
+         "surfaces" +
+         (params.region.empty() ? ", e.g. a sun over a large open scene" : " in --bounds") +
+         "): bake the part that matters with --bounds";
+}
+
 BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* progress) {
   checkParams(params);
   // What the .vdb can store, checked before any work: OpenVDB refuses a

@@ -170,6 +170,14 @@ struct BakeResult {
   PhotonMap photons;  ///< filled when BakeParams::keepPhotons
 };
 
+/// "" when the photon tracing was worth its paths; else a sentence saying
+/// that the light mostly missed the surfaces and suggesting --bounds: when
+/// fewer photons than asked were stored, or nine paths in ten stored nothing
+/// (half the paths of a closed room store nothing: the light is absorbed at
+/// its first bounce, which is not stored; a sun over open ground wastes
+/// nearly all of them).
+std::string photonBudgetWarning(const BakeParams& params, const BakeStats& stats);
+
 /// @brief Bakes `scene` with `params` (paper §3.1). Deterministic.
 /// @throws InputError for out-of-range parameters (naming them) and the
 /// stages' errors (a scene without light, a grid too deep).

@@ -198,7 +198,10 @@ TEST(BakeRegion, ARoomOnAGroundPlane) {
               "%zu paths (%.0f%%)\n",
               whole.stats.emittedPaths, whole.stats.storedPhotons, 100 * wasted,
               roi.stats.emittedPaths, 100 * wastedRoi);
-  EXPECT_GT(wasted, 0.5) << "the case bake warns about";
+  EXPECT_GT(wasted, 0.5);
+  p.region = Bounds3{};
+  EXPECT_NE(photonBudgetWarning(p, whole.stats).find("--bounds"), std::string::npos)
+      << "the case bake warns about";
   EXPECT_EQ(roi.stats.storedPhotons, p.photons);
   EXPECT_LT(wastedRoi, wasted);
   EXPECT_LT(roi.stats.emittedPaths, whole.stats.emittedPaths / 4);
@@ -211,6 +214,8 @@ TEST(BakeRegion, ARoomOnAGroundPlane) {
         << centre.ToString();
   }
   EXPECT_EQ(roi.metadata.region.lower, room.lower);
+  p.region = room;
+  EXPECT_EQ(photonBudgetWarning(p, roi.stats), "");
 }
 
 }  // namespace
