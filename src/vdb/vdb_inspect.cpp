@@ -381,6 +381,8 @@ class VdlChecker {
       }
       if (!problem.empty()) break;
       auto irrAcc = irr->getConstAccessor();
+      std::vector<Vec3SGrid::ConstAccessor> via;
+      for (const Vec3SGrid::Ptr& g : vi) via.push_back(g->getConstAccessor());
       for (auto it = count->cbeginValueOn(); it && problem.empty(); ++it) {
         ++layers;
         const openvdb::Coord c = it.getCoord();
@@ -397,7 +399,7 @@ class VdlChecker {
         const openvdb::Vec3s e = irrAcc.getValue(c);
         double sum[3] = {0, 0, 0}, scale = std::max({double(e[0]), double(e[1]), double(e[2])});
         for (int i = 0; i < maxVdls; ++i) {
-          const openvdb::Vec3s v = vi[size_t(i)]->getConstAccessor().getValue(c);
+          const openvdb::Vec3s v = via[size_t(i)].getValue(c);
           for (int k = 0; k < 3; ++k) {
             sum[k] += v[k];
             scale = std::max(scale, double(std::abs(v[k])));

@@ -361,15 +361,20 @@ TEST(VdbIo, PhotonPointsAreDeterministicAndMayBeEmpty) {
 namespace lo {
 namespace {
 
-// Surface layers round-trip through the .vdb: a bake of a room (its edges
-// have layers) written and read back gives the same layers, points and VDLs,
-// and the same octree bytes.
-TEST(VdbLayers, RoundTrip) {
+/// A small bake of a room (its edges have surface layers) for the tests below.
+BakeResult smallRoomBake() {
   BakeParams p;
   p.depth = 4;
   p.photons = 60000;
   p.knn = 60;
-  const BakeResult baked = bake(test::pointLitRoom(), p);
+  return bake(test::pointLitRoom(), p);
+}
+
+// Surface layers round-trip through the .vdb: a bake of a room (its edges
+// have layers) written and read back gives the same layers, points and VDLs,
+// and the same octree bytes.
+TEST(VdbLayers, RoundTrip) {
+  const BakeResult baked = smallRoomBake();
   const VdlGrid& g = baked.grid;
   ASSERT_GT(g.layers.size(), 0u);
   const std::string path = test::outputDir("VdbLayers") + "/room.vdb";
@@ -453,11 +458,7 @@ namespace {
 // coarser depth, each written and read back, pass inspect's checks (the
 // VDL sums used to drift past the tolerance after a half-float step).
 TEST(VdbIo, ConvertChainsKeepTheVdlSums) {
-  BakeParams p;
-  p.depth = 4;
-  p.photons = 40000;
-  p.knn = 60;
-  const BakeResult baked = bake(test::pointLitRoom(), p);
+  const BakeResult baked = smallRoomBake();
   const std::string dir = test::outputDir("VdbIo.ConvertChain");
   VdlWriteOptions half;
   half.halfFloat = true;
