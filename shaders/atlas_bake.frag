@@ -27,6 +27,7 @@ uniform usampler2D uVdlsHalf;
 uniform bool uHalfVdls;
 uniform bool uCompactVdls;
 uniform float uVdlScale;
+uniform int uShTerms;
 uniform float uVoxelSize;
 uniform int uDepth;
 uniform float uNormalOffset;
@@ -43,6 +44,7 @@ layout(location = 2) out int oTriangle;
 #define LO_VDLS_HALF uHalfVdls
 #define LO_VDLS_COMPACT uCompactVdls
 #define LO_VDL_SCALE uVdlScale
+#define LO_SH_TERMS uShTerms
 #include "octree_lookup.h"
 
 // Irradiance: the response to a VDL is its cosine (octree_irradiance.cpp).

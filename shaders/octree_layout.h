@@ -42,6 +42,14 @@
  *     without the scale.
  * VDL index i lives at texel (i % LO_VDL_TEXTURE_WIDTH, i / LO_VDL_TEXTURE_WIDTH).
  *
+ * SH octrees (the sh1 / sh2 representations, LO_SH_TERMS = 4 or 9 for the
+ * whole octree): a plain leaf's flag is 1 and its first texel index points
+ * at LO_SH_TERMS texels, RGB = the SH terms E_i below, A = 0; a layer
+ * block's counts are LO_SH_TERMS per layer. Compact SH texels are RGBA16UI
+ * with RGB = IEEE half bits times the octree's power-of-two scale (the terms
+ * are signed, which RGB9E5 cannot hold); block headers are halves without
+ * the scale.
+ *
  * Direction frame: theta from +Z (0..pi), phi from +X towards +Y (0..2pi),
  * world space: d = (sin(theta) cos(phi), sin(theta) sin(phi), cos(theta)).
  */
@@ -146,6 +154,33 @@ LO_LAYOUT_FN float loUnpackDirectionY(float code) {
   return sin(loPackedTheta(code)) * sin(loPackedPhi(code));
 }
 LO_LAYOUT_FN float loUnpackDirectionZ(float code) { return cos(loPackedTheta(code)); }
+
+/* Spherical harmonics (the `sh1` / `sh2` representations, docs/accuracy.md):
+ * real SH in the usual order i = l(l+1) + m, i < 4 for L1, < 9 for L2 (Sloan,
+ * "Stupid Spherical Harmonics Tricks", 2008), at a unit direction (x, y, z).
+ * A leaf then holds LO_SH_TERMS texels instead of VDLs, texel i with the
+ * RGB coefficient E_i of the voxel's irradiance E(n) = sum_i E_i Y_i(n)
+ * (W/m^2): the radiance coefficients already convolved with the clamped
+ * cosine (Ramamoorthi and Hanrahan 2001). */
+const uint LO_SH_MAX_TERMS = 9u;
+LO_LAYOUT_FN float loShBasis(uint i, float x, float y, float z) {
+  if (i == 0u) return 0.282094792;
+  if (i == 1u) return 0.488602512 * y;
+  if (i == 2u) return 0.488602512 * z;
+  if (i == 3u) return 0.488602512 * x;
+  if (i == 4u) return 1.092548431 * x * y;
+  if (i == 5u) return 1.092548431 * y * z;
+  if (i == 6u) return 0.315391565 * (3.0 * z * z - 1.0);
+  if (i == 7u) return 1.092548431 * x * z;
+  return 0.546274215 * (x * x - y * y);
+}
+/* The clamped cosine's SH coefficients per band: pi, 2 pi / 3, pi / 4 for
+ * the terms of bands 0, 1 and 2 (irradiance = this times radiance). */
+LO_LAYOUT_FN float loShCosineBand(uint i) {
+  if (i == 0u) return LO_PI;
+  if (i < 4u) return 2.0 * LO_PI / 3.0;
+  return LO_PI / 4.0;
+}
 
 #ifdef __cplusplus
 #undef LO_LAYOUT_FN

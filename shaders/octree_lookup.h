@@ -13,7 +13,8 @@
  *                    leaf that serves it)
  *   loServingLeaf    a voxel's leaf and its VDLs for a surface point, in one call
  *   loNearestServingLeaf  the voxel in front of the point, else behind, that serves it
- *   loShadeVdls      sum_i response(d_i) c_i over those VDLs (paper §4.2.2)
+ *   loShadeVdls      sum_i response(d_i) c_i over those VDLs (paper §4.2.2), or
+ *                    the SH irradiance as one light from its dominant direction
  *   loNearestLeaf    the voxel in front of a surface point, else the one behind it
  *   loOctreeIndirect the indirect light at a surface point: trilinear over the 8
  *                    voxels around it with empty ones left out and the weights
@@ -28,6 +29,7 @@
  *   LO_VDLS_HALF          true when the VDL texels are the 16-bit ones
  *   LO_VDLS_COMPACT       true when those hold compact texels (RGB9E5)
  *   LO_VDL_SCALE          the compact texels' irradiance scale
+ *   LO_SH_TERMS           0 when the leaves hold VDLs, else the SH terms per leaf
  * and, anywhere in the same unit, the response of a surface to one VDL:
  *   vec3 loVdlResponse(LoSurface s, vec3 d)   (the BRDF times the cosine in the
  *   shader; the cosine alone, i.e. irradiance, in C++).
@@ -51,6 +53,7 @@ using glm::dot;
 using glm::exp2;
 using glm::floor;
 using glm::greaterThanEqual;
+using glm::length;
 using glm::lessThan;
 using glm::max;
 using glm::min;
@@ -115,7 +118,7 @@ LO_LOOKUP_FN vec4 loFetchTexel(LO_TEX_PARAM uint index) {
   ivec2 p = ivec2(int(loVdlTexelX(index)), int(loVdlTexelY(index)));
   if (LO_VDLS_HALF) {
     uvec4 t = LO_FETCH_VDL_HALF(p);
-    if (LO_VDLS_COMPACT) {
+    if (LO_VDLS_COMPACT && LO_SH_TERMS == 0) {
       uint bits = t.r | (t.g << 16u);
       return vec4(loRgb9e5Channel(bits, 0u), loRgb9e5Channel(bits, 9u),
                   loRgb9e5Channel(bits, 18u), float(t.a));
@@ -191,10 +194,42 @@ LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
   return true;
 }
 
+/* SH irradiance E(n) = sum_i E_i Y_i(n) of the LO_SH_TERMS texels at
+ * `first` (octree_layout.h), clamped at zero, and the direction its light
+ * mostly comes from: the gradient of the band-1 terms' luminance (unit, or
+ * zero when they vanish). */
+LO_LOOKUP_FN vec3 loShIrradiance(LO_TEX_PARAM uint first, vec3 n, LO_OUT(vec3) dominant) {
+  vec3 e = vec3(0.0f);
+  vec3 g = vec3(0.0f);
+  for (int i = 0; i < LO_SH_TERMS; ++i) {
+    vec3 t = vec3(loFetchVdl(LO_TEX first + uint(i)));
+    e += t * loShBasis(uint(i), n.x, n.y, n.z);
+    float y = dot(t, vec3(0.2126f, 0.7152f, 0.0722f));
+    if (i == 1) g.y = y;
+    if (i == 2) g.z = y;
+    if (i == 3) g.x = y;
+  }
+  float len = length(g);
+  dominant = len > 0.0f ? g / len : vec3(0.0f);
+  return max(e, vec3(0.0f));
+}
+
+/* The SH light of a leaf as one directional light of irradiance E(n) from
+ * the dominant direction d (the surface's normal where d lies below or
+ * along its horizon): response(d) E(n) / (n . d), which is E(n) times the
+ * BRDF for a diffuse surface and keeps a specular highlight along d. */
+LO_LOOKUP_FN vec3 loShadeSh(LO_TEX_PARAM uint first, LoSurface s) {
+  vec3 d;
+  vec3 e = loShIrradiance(LO_TEX first, s.n, d);
+  if (!(dot(s.n, d) > 0.05f)) d = s.n;
+  return loVdlResponse(s, d) * e / max(dot(s.n, d), 0.05f);
+}
+
 /* Paper §4.2.2: c = sum_i brdf(d_i, v, n) c_i over the first maxVdls of the
  * `count` VDLs at `first` (the strongest come first), each a directional light
- * of irradiance c_i. */
+ * of irradiance c_i. In an SH octree, loShadeSh. */
 LO_LOOKUP_FN vec3 loShadeVdls(LO_TEX_PARAM uint first, int count, int maxVdls, LoSurface s) {
+  if (LO_SH_TERMS > 0) return loShadeSh(LO_TEX first, s);
   int n = min(count, maxVdls);
   vec3 sum = vec3(0.0f);
   for (int i = 0; i < n; ++i) {
@@ -289,6 +324,12 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
  * luminance, world space, towards the light). */
 LO_LOOKUP_FN vec3 loShadeVdlsIrradiance(LO_TEX_PARAM uint first, int count, int maxVdls, vec3 n,
                                         LO_OUT(vec3) direction) {
+  if (LO_SH_TERMS > 0) {
+    vec3 d;
+    vec3 e = loShIrradiance(LO_TEX first, n, d);
+    direction = dot(e, vec3(0.2126f, 0.7152f, 0.0722f)) * d;
+    return e;
+  }
   int used = min(count, maxVdls);
   vec3 irradiance = vec3(0.0f);
   direction = vec3(0.0f);

@@ -27,6 +27,7 @@ uniform usampler2D uVdlsHalf;  // RGBA16UI: half-float bits of irradiance, packe
 uniform bool uHalfVdls;        // which of the two holds the VDLs
 uniform bool uCompactVdls;     // the 16-bit texels hold compact (RGB9E5) irradiance
 uniform float uVdlScale;       // ... times this scale
+uniform int uShTerms;          // 0: the leaves hold VDLs; else SH terms per leaf
 uniform sampler2DArrayShadow uShadowMaps;
 uniform sampler2DArray uShadowDepths;  // the same maps read as depths (PCSS blocker search)
 uniform vec3 uOctreeOrigin;  // world
@@ -168,6 +169,7 @@ vec3 probeSpecular(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float
 #define LO_VDLS_HALF uHalfVdls
 #define LO_VDLS_COMPACT uCompactVdls
 #define LO_VDL_SCALE uVdlScale
+#define LO_SH_TERMS uShTerms
 #include "octree_lookup.h"
 
 // The VDLs light the diffuse lobe and the share of the specular one that the

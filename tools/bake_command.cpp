@@ -28,6 +28,7 @@ struct BakeOptions {
   int knn = 300;
   float radius = 0;  // 0 = auto
   std::string vdls = "4";
+  std::string representation = "vdl";
   uint64_t seed = 1;
   int threads = 0;  // 0 = all cores
   bool includeDirect = false;
@@ -75,6 +76,9 @@ int runBake(const BakeOptions& opt) {
   params.smoothing = opt.smoothing == "on";
   params.autoCap = opt.autoCap;
   params.autoThreshold = opt.autoThreshold;
+  params.representation = opt.representation == "sh1"   ? LightRepresentation::Sh1
+                          : opt.representation == "sh2" ? LightRepresentation::Sh2
+                                                        : LightRepresentation::Vdl;
   if (!opt.bounds.empty()) {
     params.region.extend(Vec3{float(opt.bounds[0]), float(opt.bounds[1]), float(opt.bounds[2])});
     params.region.extend(Vec3{float(opt.bounds[3]), float(opt.bounds[4]), float(opt.bounds[5])});
@@ -106,7 +110,8 @@ int runBake(const BakeOptions& opt) {
     j["output"] = opt.output;
     j["parameters"] = {{"depth", opt.depth},         {"photons", opt.photons},
                        {"knn", opt.knn},             {"radius", baked.metadata.radius},
-                       {"vdls", opt.vdls},           {"seed", opt.seed},
+                       {"vdls", opt.vdls},           {"representation", opt.representation},
+                       {"seed", opt.seed},
                        {"threads", opt.threads},     {"include_direct", opt.includeDirect},
                        {"layers", opt.layers},       {"gather_occlusion", opt.occlusion},
                        {"edge_correction", opt.edgeCorrection}, {"smoothing", opt.smoothing}};
@@ -166,6 +171,12 @@ std::function<int()> addBakeCommand(CLI::App& app) {
                   "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest (up to --auto-cap) whose "
                   "angular error is under --auto-threshold")
       ->check(vdlCountValidator())
+      ->capture_default_str();
+  cmd->add_option("--representation", opt->representation,
+                  "How each voxel stores its light: 'vdl' (virtual directional lights, the "
+                  "paper's), or the irradiance as spherical harmonics of order 1 ('sh1', 4 terms) "
+                  "or 2 ('sh2', 9 terms); docs/accuracy.md compares them")
+      ->check(CLI::IsMember({"vdl", "sh1", "sh2"}))
       ->capture_default_str();
   cmd->add_option("--auto-cap", opt->autoCap, "With --vdls auto: at most this many VDLs per voxel")
       ->check(CLI::Range(1, kMaxVdls))

@@ -69,13 +69,15 @@ ClusterParams BakeParams::clusterParams() const {
   p.vdls = vdls.automatic ? autoCap : vdls.count;
   p.autoCount = vdls.automatic;
   p.autoThreshold = autoThreshold;
+  p.representation = representation;
   return p;
 }
 
 std::string BakeParams::ToString() const {
   return "BakeParams{depth " + std::to_string(depth) + ", photons " + std::to_string(photons) +
          ", knn " + std::to_string(knn) + ", radius " + std::to_string(radius) + ", vdls " +
-         vdls.ToString() + ", seed " + std::to_string(seed) +
+         vdls.ToString() + ", representation " + representationName(representation) +
+         ", seed " + std::to_string(seed) +
          (includeDirect ? ", include direct" : "") + (layers ? "" : ", no layers") +
          (occlusion ? "" : ", no occlusion") + (edgeCorrection ? "" : ", no edge correction") +
          (smoothing ? ", smoothing" : "") +
@@ -259,6 +261,7 @@ BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* prog
   meta.knn = params.knn;
   meta.radius = s.level.radius;
   meta.vdls = params.vdls.ToString();
+  meta.representation = representationName(params.representation);
   meta.seed = int64_t(params.seed);
   meta.sceneBounds = scene.bounds();
   meta.surfaceLayers = params.layers ? 1 : 0;

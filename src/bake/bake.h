@@ -63,6 +63,9 @@ struct BakeParams {
   /// scenes at the irradiance error of 4, docs/octree.md).
   int autoCap = 4;
   float autoThreshold = 0.5f;
+  /// VDLs (the paper's), or SH of order 1 or 2 (`--representation`,
+  /// docs/accuracy.md "Spherical harmonics"): ClusterParams::representation.
+  LightRepresentation representation = LightRepresentation::Vdl;
   uint64_t seed = 1;           ///< same inputs and seed, same bytes, whatever the thread count
   bool includeDirect = false;  ///< also store bounce-0 photons (the renderer draws direct light)
   bool keepPhotons = false;    ///< return the photon map in BakeResult::photons

@@ -19,6 +19,12 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
   const int inDepth = in.frame.depth;
   const int depth = params.depth > 0 ? params.depth : inDepth;
   checkDepth(depth);
+  if (in.shTerms > 0) {
+    throw InputError(std::string("convert works on VDL files; this one holds ") +
+                     (in.shTerms == 4 ? "sh1" : "sh2") +
+                     " spherical harmonics (bake --representation): bake it again with the "
+                     "settings wanted");
+  }
   if (depth > inDepth && !params.scene) {
     throw InputError("--depth " + std::to_string(depth) + " is finer than the input's depth " +
                      std::to_string(inDepth) +

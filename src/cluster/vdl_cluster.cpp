@@ -15,9 +15,43 @@
 #include <utility>
 #include <vector>
 
+#include <octree_layout.h>
+
 #include "core/error.h"
 
 namespace lo {
+
+void projectSh(const DirectionSample* samples, size_t n, const Vec3& normal, int terms, Vec3* out) {
+  LO_CHECK(terms >= 1 && terms <= int(layout::LO_SH_MAX_TERMS));
+  const bool oriented = lengthSquared(normal) > 0.5f;
+  double sum[layout::LO_SH_MAX_TERMS][3] = {};
+  double total[3] = {0, 0, 0};
+  for (size_t k = 0; k < n; ++k) {
+    const Vec3 d = samples[k].direction;
+    const Vec3 c = samples[k].value;
+    const float cosine = oriented ? std::fabs(dot(normal, d)) : 1.0f;
+    const Vec3 intensity = c / std::max(cosine, kShMinCosine);
+    for (int i = 0; i < terms; ++i) {
+      const double y = double(layout::loShBasis(uint32_t(i), d.x, d.y, d.z));
+      for (int a = 0; a < 3; ++a) sum[i][a] += y * double(intensity[a]);
+    }
+    for (int a = 0; a < 3; ++a) total[a] += double(c[a]);
+  }
+  double atNormal[3] = {0, 0, 0};
+  for (int i = 0; i < terms; ++i) {
+    const double band = double(layout::loShCosineBand(uint32_t(i)));
+    const double y = oriented ? double(layout::loShBasis(uint32_t(i), normal.x, normal.y, normal.z)) : 0.0;
+    for (int a = 0; a < 3; ++a) {
+      sum[i][a] *= band;
+      atNormal[a] += sum[i][a] * y;
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    const double scale = oriented && atNormal[a] > 0 && total[a] > 0 ? total[a] / atNormal[a] : 1.0;
+    for (int i = 0; i < terms; ++i) out[i][a] = float(sum[i][a] * scale);
+  }
+}
+
 namespace vdl_grid_internal {
 
 // Per-thread state: the gatherer holds candidate scratch; the sample buffer
@@ -39,6 +73,7 @@ struct Worker {
     Vec3 normal, point, irradiance;
     float photonCount, radius;
     ClusterResult vdls;
+    std::array<Vec3, layout::LO_SH_MAX_TERMS> sh;
   };
   std::vector<Layer> layers;
 };
@@ -66,7 +101,7 @@ struct BakeBody {
   /// K-means of the gathered photons' directions. Each photon's share of the
   /// irradiance estimate E = sum(power) / (pi r_k^2 coverage) (W/m^2), so the
   /// VDLs sum to the estimate. Layer l > 0 of voxel v seeds its stream with v + l n.
-  ClusterResult clusterGathered(Worker& w, uint64_t stream) const {
+  ClusterResult clusterGathered(Worker& w, uint64_t stream, Vec3* sh) const {
     const GatherResult& g = w.gathered;
     w.samples.clear();
     const float r = g.radius;
@@ -76,6 +111,11 @@ struct BakeBody {
         const Photon& ph = photons[p];
         w.samples.push_back({ph.direction, ph.power * invArea});
       }
+    }
+    const int terms = shTermsOf(cluster.representation);
+    if (terms > 0) {
+      projectSh(w.samples.data(), w.samples.size(), g.normal, terms, sh);
+      return ClusterResult{};
     }
     return clusterDirections(w.samples.data(), w.samples.size(), cluster.vdls, cluster, stream);
   }
@@ -101,7 +141,8 @@ struct BakeBody {
       }
       const GatherResult& g = w.gathered;
       Clock::time_point t1 = Clock::now();
-      ClusterResult c = clusterGathered(w, v);
+      const size_t terms = size_t(out.shTerms);
+      ClusterResult c = clusterGathered(w, v, out.sh.data() + v * terms);
       Clock::time_point t2 = Clock::now();
       gatherSeconds += secondsBetween(t0, t1);
       clusterSeconds += secondsBetween(t1, t2);
@@ -122,8 +163,8 @@ struct BakeBody {
         Clock::time_point t4 = Clock::now();
         Worker::Layer layer{uint32_t(v), l, w.gathered.normal, found[l].point,
                             w.gathered.irradiance, float(w.gathered.photons.size()),
-                            w.gathered.radius,
-                            clusterGathered(w, uint64_t(v) + uint64_t(l) * grid.size())};
+                            w.gathered.radius, ClusterResult{}, {}};
+        layer.vdls = clusterGathered(w, uint64_t(v) + uint64_t(l) * grid.size(), layer.sh.data());
         w.layers.push_back(layer);
         gatherSeconds += secondsBetween(t3, t4);
         clusterSeconds += secondsBetween(t4, Clock::now());
@@ -162,6 +203,8 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
   out.vdlCount.assign(n, 0);
   out.vdls.assign(n * size_t(out.maxVdls), Vdl{});  // unused slots stay zero
   out.points.assign(n, Vec3{});
+  out.shTerms = shTermsOf(cluster.representation);
+  out.sh.assign(n * size_t(out.shTerms), Vec3{});
   if (layers && (layers->maxLayers < 1 || layers->maxLayers > kMaxLayers)) {
     throw InputError("surface layers: at most " + std::to_string(layers->maxLayers) +
                      " per voxel is outside [1, " + std::to_string(kMaxLayers) + "]");
@@ -199,6 +242,7 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
     L.angularError.push_back(e.vdls.angularError);
     L.vdlCount.push_back(uint8_t(e.vdls.count));
     for (int i = 0; i < out.maxVdls; ++i) L.vdls.push_back(i < e.vdls.count ? e.vdls.vdls[size_t(i)] : Vdl{});
+    L.sh.insert(L.sh.end(), e.sh.begin(), e.sh.begin() + out.shTerms);
   }
 
   if (timings) {
@@ -222,7 +266,7 @@ size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& 
   std::vector<char> changed(n, 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
-      if (layered[v] || out.vdlCount[v] == 0) continue;
+      if (layered[v] || !out.lit(v)) continue;
       const Vec3 nv = out.normals[v];
       if (!(lengthSquared(nv) > 0.5f)) continue;
       const Vec3 pv = out.points.empty() ? grid.centroids[v] : out.points[v];
@@ -236,7 +280,7 @@ size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& 
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dx = -1; dx <= 1; ++dx) {
             const int64_t w = grid.find({c.x + dx, c.y + dy, c.z + dz});
-            if (w < 0 || layered[size_t(w)] || out.vdlCount[size_t(w)] == 0) continue;
+            if (w < 0 || layered[size_t(w)] || !out.lit(size_t(w))) continue;
             const size_t k = size_t(w);
             if (!(dot(out.normals[k], nv) > params.minCosine)) continue;
             const Vec3 pw = out.points.empty() ? grid.centroids[k] : out.points[k];
@@ -257,6 +301,18 @@ size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& 
   for (size_t v = 0; v < n; ++v) {
     if (!changed[v]) continue;
     ++count;
+    if (out.shTerms > 0) {
+      // SH is linear: scale every term's channel; E(n) follows exactly.
+      Vec3* sh = out.sh.data() + v * size_t(out.shTerms);
+      for (int a = 0; a < 3; ++a) {
+        const float e = out.irradiance[v][a];
+        if (!(e > 0)) continue;
+        const float scale = smoothed[v][a] / e;
+        for (int i = 0; i < out.shTerms; ++i) sh[i][a] *= scale;
+        out.irradiance[v][a] = smoothed[v][a];
+      }
+      continue;
+    }
     Vdl* vdls = out.vdls.data() + v * size_t(out.maxVdls);
     for (int a = 0; a < 3; ++a) {
       const float e = out.irradiance[v][a];

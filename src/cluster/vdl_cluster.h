@@ -24,6 +24,8 @@ struct ClusterParams {
   float autoThreshold = 0.35f;  ///< chord-length standard deviation (0.35 ~ 20 degrees, paper §5.3.2)
   int maxIterations = 20;
   uint64_t seed = 1;
+  /// VDLs (K-means, the fields above), or SH of order 1 or 2 (projectSh).
+  LightRepresentation representation = LightRepresentation::Vdl;
 };
 
 /// One weighted direction to cluster: a photon (value = its share of the
@@ -45,6 +47,23 @@ struct ClusterResult {
 /// Handles n < k, identical directions, empty clusters and zero weights.
 ClusterResult clusterDirections(const DirectionSample* samples, size_t n, int k,
                                 const ClusterParams& params, uint64_t stream);
+
+/// Smallest cosine to the voxel's normal projectSh divides by: the
+/// GpuOctreeParams::cosineCorrection of the VDLs (kMinCorrectionCosine),
+/// applied at the bake.
+constexpr float kShMinCosine = 0.25f;
+
+/// The SH representation of one voxel (or layer) from its gathered samples:
+/// each sample (value c_k on the voxel's surface, direction d_k) is a
+/// directional light of intensity c_k / max(|n . d_k|, kShMinCosine), n =
+/// `normal`; their radiance is projected on the `terms` (4 or 9) real SH of
+/// shaders/octree_layout.h and convolved with the clamped cosine, giving
+/// irradiance coefficients E_i (out[0 .. terms)). Each channel is then
+/// scaled so that E(n) = sum_i E_i Y_i(n) equals the samples' sum, the
+/// gathered estimate, where both are positive: the truncated series keeps
+/// the voxel's own irradiance and adds the change with the normal (a normal
+/// map's). `normal` zero: no division, no scaling.
+void projectSh(const DirectionSample* samples, size_t n, const Vec3& normal, int terms, Vec3* out);
 
 struct BakeTimings {
   double gatherSeconds = 0;   ///< summed over threads

@@ -67,14 +67,37 @@ struct VdlLayers {
   std::vector<float> angularError;
   std::vector<uint8_t> vdlCount;
   std::vector<Vdl> vdls;          ///< size() * VdlGrid::maxVdls, strongest first
+  std::vector<Vec3> sh;           ///< size() * VdlGrid::shTerms (SH grids only)
 
   size_t size() const { return voxel.size(); }
 };
 
+/// How a voxel's directional light is stored: VDLs (the paper's), or the
+/// irradiance as spherical harmonics of order 1 (4 terms) or 2 (9 terms),
+/// the paper's future work (docs/accuracy.md, "Spherical harmonics").
+enum class LightRepresentation { Vdl, Sh1, Sh2 };
+
+/// 0 for VDLs, else the SH terms per voxel (4 or 9).
+inline int shTermsOf(LightRepresentation r) {
+  return r == LightRepresentation::Sh1 ? 4 : r == LightRepresentation::Sh2 ? 9 : 0;
+}
+/// "vdl", "sh1", "sh2": the flag's and the file metadata's spelling.
+inline const char* representationName(LightRepresentation r) {
+  return r == LightRepresentation::Sh1 ? "sh1" : r == LightRepresentation::Sh2 ? "sh2" : "vdl";
+}
+
 /// LightGridVoxels with up to `maxVdls` VDLs per voxel (paper §3.1.2); the
 /// total irradiance is the sum of the voxel's VDLs. Unused slots are zero.
+///
+/// Or, when shTerms > 0, the SH representation: per voxel (and layer)
+/// shTerms RGB coefficients E_i of the irradiance E(n) = sum_i E_i Y_i(n)
+/// (Y_i: shaders/octree_layout.h's loShBasis), scaled so that E at the
+/// voxel's normal is its gathered irradiance; the VDL slots are then all
+/// empty (counts 0).
 struct VdlGrid : LightGridVoxels {
   int maxVdls = 4;
+  int shTerms = 0;                  ///< 0: VDLs; 4 or 9: SH of order 1 or 2
+  std::vector<Vec3> sh;             ///< size() * shTerms
   std::vector<float> angularError;  ///< weighted std. deviation of chord length (paper §5.3.2)
   std::vector<uint8_t> vdlCount;
   std::vector<Vdl> vdls;            ///< size() * maxVdls, strongest first per voxel
@@ -87,13 +110,24 @@ struct VdlGrid : LightGridVoxels {
 
   const Vdl* vdlsOf(size_t v) const { return vdls.data() + v * size_t(maxVdls); }
   const Vdl* layerVdlsOf(size_t e) const { return layers.vdls.data() + e * size_t(maxVdls); }
+  const Vec3* shOf(size_t v) const { return sh.data() + v * size_t(shTerms); }
+  const Vec3* layerShOf(size_t e) const { return layers.sh.data() + e * size_t(shTerms); }
+  /// Whether voxel v carries light to draw (VDLs, or SH terms).
+  bool lit(size_t v) const {
+    return shTerms > 0 ? (irradiance[v].x != 0 || irradiance[v].y != 0 || irradiance[v].z != 0)
+                       : vdlCount[v] > 0;
+  }
 };
 
 /// Version of the light-grid file contract (docs/vdb-contract.md), written as
 /// the int32 file metadata `format_version`. Readers refuse files with a
 /// higher number and read files without the key (written before it existed)
-/// as version 1. Version 2 added the surface layers (`layer*` grids).
-constexpr int kVdlFormatVersion = 2;
+/// as version 1. Version 2 added the surface layers (`layer*` grids);
+/// version 3 the SH representation (`sh<i>` grids). A file is written with
+/// the lowest version that holds it: VDL files stay version 2, readable by
+/// the readers of version 2.
+constexpr int kVdlFormatVersion = 3;
+constexpr int kVdlFormatVersionVdl = 2;
 
 /// What a light grid means: the settings that made it, stored beside the grids
 /// as file metadata.
@@ -107,10 +141,14 @@ struct BakeMetadata {
   int knn = 0;
   float radius = 0;          ///< world units
   std::string vdls;          ///< "4" or "auto"
+  /// "vdl", "sh1" or "sh2" (representationName); files before format
+  /// version 3 hold VDLs.
+  std::string representation = "vdl";
   int64_t seed = 0;
   Bounds3 sceneBounds;
   std::string units = "length: scene units (glTF metres); irradiance: W/m^2 (scene light units)";
-  /// Always written as kVdlFormatVersion; on reading, the file's value (1 when absent).
+  /// Written as kVdlFormatVersion for SH files, kVdlFormatVersionVdl for
+  /// VDL files; on reading, the file's value (1 when absent).
   int formatVersion = kVdlFormatVersion;
   /// Set by `convert`: what the file was converted from, e.g. "cornell.vdb (depth 6)".
   std::string convertedFrom;

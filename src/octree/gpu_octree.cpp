@@ -68,6 +68,30 @@ void validate(const VdlGrid& grid, const GpuOctreeParams& params) {
                      std::to_string(grid.vdls.size()) + " VDL slots (expected voxels * " +
                      std::to_string(grid.maxVdls) + ")");
   }
+  if (grid.shTerms != 0 && grid.shTerms != 4 && grid.shTerms != 9) {
+    throw InputError("GPU octree: " + std::to_string(grid.shTerms) +
+                     " SH terms per voxel; expected 0 (VDLs), 4 or 9");
+  }
+  if (grid.sh.size() != grid.size() * size_t(grid.shTerms) ||
+      grid.layers.sh.size() != grid.layers.size() * size_t(grid.shTerms)) {
+    throw InputError("GPU octree: " + std::to_string(grid.sh.size()) + " SH terms for " +
+                     std::to_string(grid.size()) + " voxels and " +
+                     std::to_string(grid.layers.sh.size()) + " for " +
+                     std::to_string(grid.layers.size()) + " layers, at " +
+                     std::to_string(grid.shTerms) + " per voxel");
+  }
+  for (size_t i = 0; i < grid.sh.size(); ++i) {
+    if (!isFinite(grid.sh[i])) {
+      throw InputError("GPU octree: voxel " + std::to_string(i / size_t(grid.shTerms)) +
+                       " SH term " + std::to_string(i % size_t(grid.shTerms)) + " is not finite");
+    }
+  }
+  for (size_t i = 0; i < grid.layers.sh.size(); ++i) {
+    if (!isFinite(grid.layers.sh[i])) {
+      throw InputError("GPU octree: surface layer " + std::to_string(i / size_t(grid.shTerms)) +
+                       " SH term " + std::to_string(i % size_t(grid.shTerms)) + " is not finite");
+    }
+  }
   if (params.max3DTextureSize < 2) {
     throw InputError("GPU octree: max 3D texture size " + std::to_string(params.max3DTextureSize) +
                      " cannot hold one 2x2x2 tile");
@@ -237,19 +261,22 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
     const uint32_t v = grid.layers.voxel[e];
     if (extraCount[v]++ == 0) extraFirst[v] = uint32_t(e);
   }
-  // Texels of a leaf: its VDLs, or a layer block (octree_layout.h).
+  // Texels of one layer's light: its VDLs, or its SH terms.
+  const bool sh = grid.shTerms > 0;
+  auto texelsOf = [&](int vdlCount) { return sh ? size_t(grid.shTerms) : size_t(vdlCount); };
+  // Texels of a leaf: its light, or a layer block (octree_layout.h).
   auto leafTexels = [&](size_t v) -> size_t {
-    if (extraCount[v] == 0) return grid.vdlCount[v];
-    size_t n = 2 + grid.vdlCount[v];
+    if (extraCount[v] == 0) return texelsOf(grid.vdlCount[v]);
+    size_t n = 2 + texelsOf(grid.vdlCount[v]);
     for (uint32_t e = extraFirst[v]; e < extraFirst[v] + extraCount[v]; ++e) {
-      n += 1 + grid.layers.vdlCount[e];
+      n += 1 + texelsOf(grid.layers.vdlCount[e]);
     }
     return n;
   };
   std::vector<Leaf> leaves;
   leaves.reserve(grid.size());
   for (size_t v = 0; v < grid.size(); ++v) {
-    if (grid.vdlCount[v] > 0 || extraCount[v] > 0) {
+    if (grid.lit(v) || extraCount[v] > 0) {
       leaves.push_back({mortonCode(grid.coords[v], depth), uint32_t(v)});
     }
   }
@@ -342,7 +369,18 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   out.vdlHeight = int(height);
   out.halfFloat = params.halfFloat || params.compact;
   out.compact = params.compact;
-  if (out.compact) {
+  out.shTerms = grid.shTerms;
+  if (out.compact && sh) {
+    // Signed SH terms ride as halves times the scale (octree_layout.h): the
+    // largest magnitude fits under 2^14 of the half's 65504.
+    float largest = 0;
+    for (const Vec3& t : grid.sh) largest = std::max({largest, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z)});
+    for (const Vec3& t : grid.layers.sh) {
+      largest = std::max({largest, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z)});
+    }
+    out.irradianceScale =
+        largest > 0 ? std::exp2(std::ceil(std::log2(double(largest) / 16384.0))) : 1.0f;
+  } else if (out.compact) {
     // The brightest texel after the cosine correction (at most 1 / the
     // smallest cosine it divides by) fits under 2^15 of RGB9E5's 65408.
     float brightest = 0;
@@ -379,7 +417,7 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   auto writeTexel = [&](size_t index, const Vec3& rgb, float a) {
     const size_t offset =
         (size_t(loVdlTexelY(uint(index))) * width + size_t(loVdlTexelX(uint(index)))) * 4;
-    if (out.compact) {  // headers: without the scale
+    if (out.compact && !sh) {  // headers: without the scale
       const uint32_t bits = encodeRgb9e5(rgb);
       out.vdlTexelsHalf[offset] = uint16_t(bits & 0xffffu);
       out.vdlTexelsHalf[offset + 1] = uint16_t(bits >> 16);
@@ -420,6 +458,11 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
     }
   };
 
+  // One SH term: compact ones as halves divided by the scale.
+  auto writeSh = [&](size_t index, const Vec3& term) {
+    writeTexel(index, out.compact ? term / out.irradianceScale : term, 0.0f);
+  };
+
   // Each node at level l >= 1 is one texel in its parent's tile. Parents are
   // found by walking the sorted parent level alongside the sorted children.
   size_t nextVdl = 0;
@@ -447,20 +490,27 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
         t[0] = uint8_t(loPackAddressR(address));
         t[1] = uint8_t(loPackAddressG(address));
         t[2] = uint8_t(loPackAddressB(address));
-        t[3] = uint8_t(extraCount[v] > 0 ? LO_FLAG_LAYERED : uint(count));
+        // An SH leaf's flag is 1 (a leaf); its texel count is the octree's shTerms.
+        t[3] = uint8_t(extraCount[v] > 0 ? LO_FLAG_LAYERED : sh ? 1u : uint(count));
         const Vdl* vdls = grid.vdlsOf(v);
         const Vec3 normal = params.cosineCorrection && grid.normals.size() == grid.size()
                                 ? normalize(grid.normals[v])
                                 : Vec3{0, 0, 0};
         if (extraCount[v] == 0) {
+          if (sh) {
+            for (int i = 0; i < grid.shTerms; ++i) writeSh(nextVdl++, grid.shOf(v)[i]);
+            continue;
+          }
           for (int i = 0; i < count; ++i) writeVdl(nextVdl++, vdls[i], normal);
           continue;
         }
         // A layer block: header, then per layer its header and VDLs.
         const uint32_t e0 = extraFirst[v];
         const int layers = 1 + extraCount[v];
-        Vec3 counts{float(count), 0, 0};
-        for (int l = 1; l < layers; ++l) counts[l] = float(grid.layers.vdlCount[e0 + uint32_t(l) - 1]);
+        Vec3 counts{float(texelsOf(count)), 0, 0};
+        for (int l = 1; l < layers; ++l) {
+          counts[l] = float(texelsOf(grid.layers.vdlCount[e0 + uint32_t(l) - 1]));
+        }
         writeTexel(nextVdl++, counts, float(layers));
         const Vec3 corner{float(grid.coords[v].x), float(grid.coords[v].y),
                           float(grid.coords[v].z)};
@@ -468,20 +518,24 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
           return (world - grid.frame.origin) / grid.frame.voxelSize - corner;
         };
         auto writeLayer = [&](const Vec3& layerNormal, const Vec3& point, const Vdl* layerVdls,
-                              int layerCount) {
+                              int layerCount, const Vec3* layerSh) {
           const Vec3 n = normalize(layerNormal);
           writeTexel(nextVdl++, local(point), loPackDirection(n.x, n.y, n.z));
+          if (sh) {
+            for (int i = 0; i < grid.shTerms; ++i) writeSh(nextVdl++, layerSh[i]);
+            return;
+          }
           const Vec3 correction = params.cosineCorrection ? n : Vec3{0, 0, 0};
           for (int i = 0; i < layerCount; ++i) writeVdl(nextVdl++, layerVdls[i], correction);
         };
         const Vec3 point0 = grid.points.empty() ? grid.frame.origin + (corner + Vec3(0.5f)) *
                                                                           grid.frame.voxelSize
                                                 : grid.points[v];
-        writeLayer(grid.normals[v], point0, vdls, count);
+        writeLayer(grid.normals[v], point0, vdls, count, sh ? grid.shOf(v) : nullptr);
         for (int l = 1; l < layers; ++l) {
           const uint32_t e = e0 + uint32_t(l) - 1;
           writeLayer(grid.layers.normals[e], grid.layers.points[e], grid.layerVdlsOf(e),
-                     grid.layers.vdlCount[e]);
+                     grid.layers.vdlCount[e], sh ? grid.layerShOf(e) : nullptr);
         }
       }
     }
@@ -501,7 +555,11 @@ std::string GpuOctree::ToString() const {
      << ", leaves " << leafCount << ", tiles " << nodeCount << " in " << tilesX << "x" << tilesY
      << "x" << tilesZ << " (pool " << poolWidth() << "x" << poolHeight() << "x" << poolDepth()
      << " RGBA8, " << kib(poolBytes()) << "), VDLs " << vdlCount << " in " << vdlWidth << "x"
-     << vdlHeight << (compact ? " RGBA16UI(RGB9E5)" : halfFloat ? " RGBA16UI(half)" : " RGBA32F") << " (" << kib(vdlBytes())
+     << vdlHeight
+     << (compact ? (shTerms > 0 ? " RGBA16UI(scaled half)" : " RGBA16UI(RGB9E5)")
+                 : halfFloat ? " RGBA16UI(half)" : " RGBA32F")
+     << (shTerms > 0 ? ", SH " + std::to_string(shTerms) + " terms" : std::string()) << " ("
+     << kib(vdlBytes())
      << "), bytes/leaf: pool " << std::fixed << std::setprecision(2) << double(poolBytes()) / leaves
      << " + VDLs " << double(vdlBytes()) / leaves << "]";
   return os.str();

@@ -56,6 +56,9 @@ struct GpuOctree {
   bool halfFloat = false;      ///< the texels are vdlTexelsHalf's 16-bit ones
   bool compact = false;        ///< those hold compact texels (RGB9E5 x irradianceScale)
   float irradianceScale = 1;   ///< compact: a power of two
+  /// 0: the leaves hold VDLs; 4 or 9: each leaf (and layer) holds that many
+  /// SH terms (VdlGrid::shTerms), compact ones as halves times the scale.
+  int shTerms = 0;
   std::vector<float> vdlTexels;
   std::vector<uint16_t> vdlTexelsHalf;
 

@@ -56,6 +56,7 @@ glm::uvec4 fetchVdlHalf(const GpuOctree& o, const glm::ivec2& p) {
 #define LO_VDLS_HALF tex.halfFloat
 #define LO_VDLS_COMPACT tex.compact
 #define LO_VDL_SCALE tex.irradianceScale
+#define LO_SH_TERMS tex.shTerms
 #include <octree_lookup.h>
 
 namespace lo {

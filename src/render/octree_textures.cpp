@@ -70,6 +70,7 @@ void OctreeTextures::upload(const GpuOctree& octree) {
   half = octree.halfFloat && vdlTexels > 0;
   compact = half && octree.compact;
   scale = octree.irradianceScale;
+  shTerms = octree.shTerms;
   const float zero[4] = {0, 0, 0, 0};
   const uint16_t zeroHalf[4] = {0, 0, 0, 0};
   makeTexture(vdl);
@@ -102,6 +103,7 @@ void OctreeTextures::bind(GLuint program, int poolUnit, int vdlUnit, int halfUni
   glUniform1i(glGetUniformLocation(program, "uHalfVdls"), half ? 1 : 0);
   glUniform1i(glGetUniformLocation(program, "uCompactVdls"), compact ? 1 : 0);
   glUniform1f(glGetUniformLocation(program, "uVdlScale"), scale);
+  glUniform1i(glGetUniformLocation(program, "uShTerms"), shTerms);
   glActiveTexture(GLenum(GL_TEXTURE0 + poolUnit));
   glBindTexture(GL_TEXTURE_3D, pool);
   glActiveTexture(GLenum(GL_TEXTURE0 + vdlUnit));

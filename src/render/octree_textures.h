@@ -33,14 +33,16 @@ class OctreeTextures {
   void upload(const GpuOctree& octree);
   /// Binds the pool, the float VDLs and the half VDLs to texture units
   /// `poolUnit`, `vdlUnit` and `halfUnit`, and points `program`'s samplers
-  /// uOctree, uVdls, uVdlsHalf at them, uHalfVdls, uCompactVdls and uVdlScale
-  /// at `half`, `compact` and `scale`; the program must be in use.
+  /// uOctree, uVdls, uVdlsHalf at them, and uHalfVdls, uCompactVdls,
+  /// uVdlScale and uShTerms at `half`, `compact`, `scale` and `shTerms`; the
+  /// program must be in use.
   void bind(GLuint program, int poolUnit, int vdlUnit, int halfUnit) const;
 
   GLuint pool = 0, vdl = 0, vdlHalf = 0;
   bool half = false;       ///< the VDL texels are the 16-bit ones
   bool compact = false;    ///< ... holding compact (RGB9E5) irradiance
   float scale = 1;         ///< the compact texels' irradiance scale
+  int shTerms = 0;         ///< GpuOctree::shTerms
   int depth = 0;           ///< the octree's depth
   float voxelSize = 1;     ///< world units
   Vec3 origin{0, 0, 0};    ///< world position of the cube's corner

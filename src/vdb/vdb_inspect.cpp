@@ -7,6 +7,7 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointDataGrid.h>
+#include <octree_layout.h>
 
 #include <algorithm>
 #include <cmath>
@@ -153,6 +154,28 @@ class VdlChecker {
     return nullptr;
   }
 
+  /// SH terms per voxel from the metadata `representation`: 0 for VDLs (and
+  /// files without the key), 4 for sh1, 9 for sh2, -1 for anything else.
+  int readShTerms() const {
+    auto typed = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f_.meta)["representation"]);
+    if (!typed) return (*f_.meta)["representation"] ? -1 : 0;
+    const std::string& r = typed->value();
+    return r == "vdl" ? 0 : r == "sh1" ? 4 : r == "sh2" ? 9 : -1;
+  }
+
+  /// Sum of the SH terms at voxel c (grids `prefix` + "sh<i>") evaluated at
+  /// the normal n: E(n), and in `scale` the largest |term| seen.
+  double shAt(const std::vector<Vec3SGrid::ConstAccessor>& sh, const openvdb::Coord& c,
+              const openvdb::Vec3s& n, int k, double& scale) const {
+    double e = 0;
+    for (size_t i = 0; i < sh.size(); ++i) {
+      const double t = double(sh[i].getValue(c)[k]);
+      e += t * double(layout::loShBasis(uint32_t(i), n[0], n[1], n[2]));
+      scale = std::max(scale, std::abs(t));
+    }
+    return e;
+  }
+
   int readMaxVdls() const {
     auto m = (*f_.meta)["max_vdls"];
     auto typed = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m);
@@ -185,6 +208,12 @@ class VdlChecker {
     need("irradiance", "vec3s", true);
     need("normal", "vec3s", true);
     need("vdl_count", "float", true);
+    const int shTerms = readShTerms();
+    if (shTerms < 0) {
+      problems += std::string(problems.empty() ? "" : "; ") +
+                  "file metadata representation is not 'vdl', 'sh1' or 'sh2'";
+    }
+    for (int i = 0; i < shTerms; ++i) need("sh" + std::to_string(i), "vec3s", true);
     std::string absent;
     for (const std::string& name : optionalVdlGridNames()) {
       need(name, "float", false);
@@ -367,6 +396,16 @@ class VdlChecker {
         if (layer == 1) problem = "layer grids without 'layer1_vdl_count'";
         break;
       }
+      const int shTerms = std::max(0, readShTerms());
+      std::vector<Vec3SGrid::ConstAccessor> sha;
+      for (int i = 0; i < shTerms; ++i) {
+        auto g = openvdb::gridPtrCast<Vec3SGrid>(find(prefix + "sh" + std::to_string(i)));
+        if (!g) {
+          problem = "missing or mistyped '" + prefix + "sh" + std::to_string(i) + "'";
+          break;
+        }
+        sha.push_back(g->getConstAccessor());
+      }
       std::vector<Vec3SGrid::Ptr> vi;
       for (int i = 0; i < maxVdls; ++i) {
         vi.push_back(openvdb::gridPtrCast<Vec3SGrid>(
@@ -381,6 +420,7 @@ class VdlChecker {
       }
       if (!problem.empty()) break;
       auto irrAcc = irr->getConstAccessor();
+      auto normalAcc = normal->getConstAccessor();
       std::vector<Vec3SGrid::ConstAccessor> via;
       for (const Vec3SGrid::Ptr& g : vi) via.push_back(g->getConstAccessor());
       for (auto it = count->cbeginValueOn(); it && problem.empty(); ++it) {
@@ -405,19 +445,23 @@ class VdlChecker {
             scale = std::max(scale, double(std::abs(v[k])));
           }
         }
+        if (shTerms > 0) {
+          const openvdb::Vec3s nl = normalAcc.getValue(c);
+          for (int k = 0; k < 3; ++k) sum[k] = shAt(sha, c, nl, k, scale);
+        }
         double diff = 0;
         for (int k = 0; k < 3; ++k) diff = std::max(diff, std::abs(sum[k] - double(e[k])));
         const double rel = scale > 0 ? diff / scale : (diff > 0 ? 1e30 : 0.0);
         worstSum = std::max(worstSum, std::isfinite(rel) ? rel : 1e30);
         if (!(rel <= sumTol)) {
-          problem = prefix + "vdl sum at " + coordText(c) + " differs by " + num(rel) +
+          problem = prefix + (shTerms > 0 ? "SH at the normal" : "vdl sum") + " at " + coordText(c) + " differs by " + num(rel) +
                     " of the irradiance (allowed " + num(sumTol) + ")";
         }
       }
     }
     add("layers", problem.empty(),
         problem.empty() ? std::to_string(layers) + " extra surface layers on voxels of the file; "
-                                                    "their VDLs sum to their irradiance (largest "
+                                                    "their light sums to their irradiance (largest "
                                                     "relative difference " +
                               num(worstSum) + ")"
                         : problem);
@@ -434,6 +478,13 @@ class VdlChecker {
     }
     const bool half = irr->saveFloatAsHalf() || vi[0]->saveFloatAsHalf();
     const double sumTol = half ? kVdlSumToleranceHalf : kVdlSumTolerance;
+    // SH files: E(n) at the voxel's normal is its irradiance, in place of the VDL sum.
+    const int shTerms = readShTerms();
+    std::vector<Vec3SGrid::ConstAccessor> sha;
+    for (int i = 0; i < shTerms; ++i) {
+      sha.push_back(openvdb::gridPtrCast<Vec3SGrid>(find("sh" + std::to_string(i)))->getConstAccessor());
+    }
+    auto normalAcc = openvdb::gridPtrCast<Vec3SGrid>(find("normal"))->getConstAccessor();
 
     uint64_t badCount = 0, negative = 0, notUnit = 0, badSum = 0, voxels = 0;
     std::string firstCount, firstNegative, firstNotUnit, firstSum;
@@ -476,12 +527,17 @@ class VdlChecker {
         }
       }
       if (neg && negative++ == 0) firstNegative = coordText(c);
+      if (shTerms > 0) {
+        const openvdb::Vec3s nv = normalAcc.getValue(c);
+        for (int k = 0; k < 3; ++k) sum[k] = shAt(sha, c, nv, k, scale);
+      }
       double diff = 0;
       for (int k = 0; k < 3; ++k) diff = std::max(diff, std::abs(sum[k] - double(e[k])));
       const double rel = scale > 0 ? diff / scale : (diff > 0 ? 1e30 : 0.0);
       if (std::isfinite(rel)) worstSum = std::max(worstSum, rel);
       if (!(rel <= sumTol) && badSum++ == 0) {
-        firstSum = coordText(c) + ": sum of VDLs differs by " + num(rel) + " of the irradiance";
+        firstSum = coordText(c) + (shTerms > 0 ? ": SH at the normal" : ": sum of VDLs") +
+                   " differs by " + num(rel) + " of the irradiance";
       }
     }
     const std::string of = " of " + std::to_string(voxels) + " voxels";
@@ -498,9 +554,10 @@ class VdlChecker {
                  : std::string("used VDL slots unit")) +
             " (largest |length - 1| " + num(worstUnit) + ", allowed " +
             num(kUnitDirectionTolerance) + ")");
-    add("vdl_sum", badSum == 0,
+    add(shTerms > 0 ? "sh_sum" : "vdl_sum", badSum == 0,
         (badSum ? std::to_string(badSum) + of + " off; first " + firstSum
-                : std::string("VDLs sum to the irradiance")) +
+                : std::string(shTerms > 0 ? "SH irradiance at each voxel's normal is its irradiance"
+                                          : "VDLs sum to the irradiance")) +
             " (largest relative difference " + num(worstSum) + ", allowed " + num(sumTol) +
             (half ? ", half floats)" : ")"));
     checkLayers(maxVdls, sumTol);

@@ -77,6 +77,9 @@ constexpr const char* kIrradianceUnits = "W/m^2";
 
 std::string vdlIrradianceName(int i) { return "vdl" + std::to_string(i) + "_irradiance"; }
 std::string vdlDirectionName(int i) { return "vdl" + std::to_string(i) + "_direction"; }
+// SH files (format version 3): "sh<i>" = term i of the irradiance's SH.
+std::string shName(int i) { return "sh" + std::to_string(i); }
+constexpr const char* kShUnits = "W/m^2 (SH term; E(n) = sum_i sh<i> Y_i(n))";
 
 // Surface layers (docs/vdb-contract.md): "layer_point" holds layer 0's point
 // on the voxels that have more layers; layer l's grids are "layer<l>_" + the
@@ -211,8 +214,11 @@ void checkArrays(const VdlGrid& g) {
   LO_CHECK_EQ(g.angularError.size(), n);
   LO_CHECK_EQ(g.vdlCount.size(), n);
   LO_CHECK_EQ(g.vdls.size(), n * size_t(g.maxVdls));
+  LO_CHECK(g.shTerms == 0 || g.shTerms == 4 || g.shTerms == 9);
+  LO_CHECK_EQ(g.sh.size(), n * size_t(g.shTerms));
   const VdlLayers& L = g.layers;
   const size_t ne = L.size();
+  LO_CHECK_EQ(L.sh.size(), ne * size_t(g.shTerms));
   if (ne == 0) return;
   LO_CHECK_EQ(g.points.size(), n);
   LO_CHECK_EQ(L.normals.size(), ne);
@@ -247,7 +253,13 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   m.insertMeta("scene_bounds_max", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.upper)));
   m.insertMeta("units", openvdb::StringMetadata(meta.units));
   m.insertMeta("max_vdls", openvdb::Int32Metadata(grid.maxVdls));
-  m.insertMeta("format_version", openvdb::Int32Metadata(kVdlFormatVersion));
+  // The lowest version that holds the file (lightgrid/vdl_grid.h).
+  m.insertMeta("format_version", openvdb::Int32Metadata(grid.shTerms > 0 ? kVdlFormatVersion
+                                                                          : kVdlFormatVersionVdl));
+  if (grid.shTerms > 0) {
+    m.insertMeta("representation",
+                 openvdb::StringMetadata(grid.shTerms == 4 ? "sh1" : "sh2"));
+  }
   if (!meta.convertedFrom.empty()) {
     m.insertMeta("converted_from", openvdb::StringMetadata(meta.convertedFrom));
   }
@@ -300,6 +312,10 @@ openvdb::GridPtrVec buildVdlGrids(const VdlGrid& g, const Transform::Ptr& xform)
     grids.push_back(vectorGrid(vdlDirectionName(i), "unit vector towards the light, world space",
                                openvdb::VEC_INVARIANT, xform, withVdlCoords,
                                [&](size_t k) { return g.vdlsOf(withVdl[k])[i].direction; }));
+  }
+  for (int i = 0; i < g.shTerms; ++i) {
+    grids.push_back(vectorGrid(shName(i), kShUnits, openvdb::VEC_INVARIANT, xform, c,
+                               [&](size_t v) { return g.shOf(v)[i]; }));
   }
   if (g.layers.size() == 0) return grids;
 
@@ -355,6 +371,10 @@ openvdb::GridPtrVec buildVdlGrids(const VdlGrid& g, const Transform::Ptr& xform)
                                  "unit vector towards the light, world space",
                                  openvdb::VEC_INVARIANT, xform, kc,
                                  [&](size_t k) { return g.layerVdlsOf(ek[k])[i].direction; }));
+    }
+    for (int i = 0; i < g.shTerms; ++i) {
+      grids.push_back(vectorGrid(name(shName(i)), kShUnits, openvdb::VEC_INVARIANT, xform, lc,
+                                 [&](size_t k) { return g.layerShOf(es[k])[i]; }));
     }
   }
   return grids;
@@ -500,6 +520,7 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.knn = metaValue<int32_t>(path, m, "knn", false, 0);
   meta.radius = metaValue<float>(path, m, "radius", false, 0.0f);
   meta.vdls = metaValue<std::string>(path, m, "vdls", false, "");
+  meta.representation = metaValue<std::string>(path, m, "representation", false, "vdl");
   meta.seed = metaValue<int64_t>(path, m, "seed", false, 0);
   meta.sceneBounds.lower = fromVdb(
       metaValue<openvdb::Vec3s>(path, m, "scene_bounds_min", false, openvdb::Vec3s(INFINITY)));
@@ -567,6 +588,9 @@ void checkValues(const std::string& path, const VdlGrid& g) {
       const Vdl& vdl = g.vdlsOf(v)[i];
       if (!isFinite(vdl.irradiance) || !isFinite(vdl.direction)) fail(c, "VDL " + std::to_string(i));
     }
+    for (int i = 0; i < g.shTerms; ++i) {
+      if (!isFinite(g.shOf(v)[i])) fail(c, "SH term " + std::to_string(i));
+    }
   }
   for (size_t e = 0; e < g.layers.size(); ++e) {
     const Coord& c = g.coords[g.layers.voxel[e]];
@@ -577,6 +601,9 @@ void checkValues(const std::string& path, const VdlGrid& g) {
     for (int i = 0; i < g.layers.vdlCount[e]; ++i) {
       const Vdl& vdl = g.layerVdlsOf(e)[i];
       if (!isFinite(vdl.irradiance) || !isFinite(vdl.direction)) fail(c, "a surface layer's VDL");
+    }
+    for (int i = 0; i < g.shTerms; ++i) {
+      if (!isFinite(g.layerShOf(e)[i])) fail(c, "a surface layer's SH term");
     }
   }
 }
@@ -670,6 +697,7 @@ void readLayers(const std::string& path, const OpenedFile& f, const Transform& x
   L.angularError.resize(ne);
   L.vdlCount.resize(ne);
   L.vdls.resize(ne * size_t(maxVdls));
+  L.sh.resize(ne * size_t(g.shTerms));
   for (int layer = 1; layer < kMaxLayers; ++layer) {
     if (!findGrid(f, layerName(layer, kVdlCount))) break;
     auto vec = [&](const std::string& name) {
@@ -694,6 +722,8 @@ void readLayers(const std::string& path, const OpenedFile& f, const Transform& x
       vi.push_back(vec(vdlIrradianceName(i))->getConstAccessor());
       vd.push_back(vec(vdlDirectionName(i))->getConstAccessor());
     }
+    std::vector<openvdb::Vec3SGrid::ConstAccessor> sh;
+    for (int i = 0; i < g.shTerms; ++i) sh.push_back(vec(shName(i))->getConstAccessor());
     for (size_t e = 0; e < ne; ++e) {
       if (entries[e].layer != layer) continue;
       const openvdb::Coord c = entries[e].coord;
@@ -715,6 +745,9 @@ void readLayers(const std::string& path, const OpenedFile& f, const Transform& x
         Vdl& vdl = L.vdls[e * size_t(maxVdls) + size_t(i)];
         vdl.irradiance = fromVdb(vi[size_t(i)].getValue(c));
         vdl.direction = fromVdb(vd[size_t(i)].getValue(c));
+      }
+      for (int i = 0; i < g.shTerms; ++i) {
+        L.sh[e * size_t(g.shTerms) + size_t(i)] = fromVdb(sh[size_t(i)].getValue(c));
       }
     }
   }
@@ -765,7 +798,22 @@ LoadedVdl readVdl(const std::string& path) {
     vdlIrr.push_back(requireGrid<Vec3SGrid>(path, f, vdlIrradianceName(i)));
     vdlDir.push_back(requireGrid<Vec3SGrid>(path, f, vdlDirectionName(i)));
   }
+  // The representation: VDLs, or SH terms (format version 3).
+  const std::string& representation = out.meta.representation;
+  const int shTerms = representation == "sh1" ? 4 : representation == "sh2" ? 9 : 0;
+  if (shTerms == 0 && representation != "vdl") {
+    throw InputError(path + ": file metadata representation = '" + representation +
+                     "'; expected vdl, sh1 or sh2");
+  }
+  if (shTerms > 0 && out.meta.formatVersion < 3) {
+    throw InputError(path + ": representation " + representation + " in a format version " +
+                     std::to_string(out.meta.formatVersion) +
+                     " file (SH grids came with version 3): the file is inconsistent");
+  }
+  std::vector<Vec3SGrid::Ptr> shGrids;
+  for (int i = 0; i < shTerms; ++i) shGrids.push_back(requireGrid<Vec3SGrid>(path, f, shName(i)));
   std::vector<openvdb::GridBase::Ptr> all = {irradiance, normal, vdlCount};
+  for (const Vec3SGrid::Ptr& sg : shGrids) all.push_back(sg);
   for (const FloatGrid::Ptr& g : {photonCount, angularError, radius, area}) {
     if (g) all.push_back(g);
   }
@@ -804,6 +852,7 @@ LoadedVdl readVdl(const std::string& path) {
   VdlGrid& g = out.grid;
   g.frame = readFrame(path, xform, out.meta.depth);
   g.maxVdls = maxVdls;
+  g.shTerms = shTerms;
   g.coords.reserve(size_t(active));
   for (auto it = vdlCount->cbeginValueOn(); it; ++it) {
     const openvdb::Coord c = it.getCoord();
@@ -853,6 +902,20 @@ LoadedVdl readVdl(const std::string& path) {
       Vdl& vdl = g.vdls[v * size_t(maxVdls) + size_t(i)];
       vdl.irradiance = fromVdb(ia.getValue(c));
       vdl.direction = fromVdb(da.getValue(c));
+    }
+  }
+  g.sh.resize(n * size_t(shTerms));
+  for (int i = 0; i < shTerms; ++i) {
+    auto sa = shGrids[size_t(i)]->getConstAccessor();
+    for (size_t v = 0; v < n; ++v) g.sh[v * size_t(shTerms) + size_t(i)] = fromVdb(sa.getValue(toVdb(g.coords[v])));
+  }
+  if (shTerms > 0) {
+    for (size_t v = 0; v < n; ++v) {
+      if (g.vdlCount[v] != 0) {
+        throw InputError(path + ": voxel " + g.coords[v].ToString() + " of an " + representation +
+                         " file has " + std::to_string(g.vdlCount[v]) +
+                         " VDLs; SH files hold none");
+      }
     }
   }
   readLayers(path, f, xform, maxVdls, out);

@@ -44,7 +44,7 @@ struct EdgeError {
 /// A floor (y = 0, facing up) and a wall (x = 0, facing +x) meeting along the
 /// z axis; light A straight down lights only the floor (E_A = 2), light B
 /// along -x only the wall (E_B = 1).
-EdgeError edgeError(bool layers) {
+EdgeError edgeError(bool layers, LightRepresentation representation = LightRepresentation::Vdl) {
   Scene scene = blackScene();
   test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
   test::addQuad(scene, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);
@@ -55,6 +55,7 @@ EdgeError edgeError(bool layers) {
   p.photons = 400000;
   p.includeDirect = true;
   p.layers = layers;
+  p.representation = representation;
   const BakeResult baked = bake(scene, p);
   const GpuOctree octree = buildGpuOctree(baked.grid);
   const float voxel = baked.grid.frame.voxelSize;
@@ -73,9 +74,10 @@ EdgeError edgeError(bool layers) {
   }
   e.floor /= n;
   e.wall /= n;
-  std::printf("edge, layers %s: %zu voxels with 2+ layers; mean relative error within one voxel "
+  std::printf("edge, %s, layers %s: %zu voxels with 2+ layers; mean relative error within one voxel "
               "of the edge: floor %.3f, wall %.3f\n",
-              layers ? "on" : "off", baked.stats.level.layeredVoxels, e.floor, e.wall);
+              representationName(representation), layers ? "on" : "off",
+              baked.stats.level.layeredVoxels, e.floor, e.wall);
   return e;
 }
 
@@ -87,6 +89,16 @@ TEST(SurfaceLayers, EachFaceOfAnEdgeKeepsItsOwnLight) {
   EXPECT_LT(on.floor, 0.08);
   EXPECT_LT(on.wall, 0.08);
   EXPECT_GT(off.floor + off.wall, 2.0 * (on.floor + on.wall));
+}
+
+// The same edge with the SH representation: each layer's SH, scaled to its
+// gathered estimate at its normal, gives each face its own light.
+TEST(SurfaceLayers, EachFaceOfAnEdgeKeepsItsOwnLightAsSphericalHarmonics) {
+  for (LightRepresentation r : {LightRepresentation::Sh1, LightRepresentation::Sh2}) {
+    const EdgeError on = edgeError(true, r);
+    EXPECT_LT(on.floor, 0.08) << representationName(r);
+    EXPECT_LT(on.wall, 0.08) << representationName(r);
+  }
 }
 
 /// A 1 x 1 floor split at x = 0.5 by a thin wall (both sides facing out,

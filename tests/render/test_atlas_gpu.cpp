@@ -180,16 +180,18 @@ TEST(AtlasGpu, CornellBoxMatchesTheCpuBake) {
 // The same with an octree that has surface layers (a fresh bake of the
 // Cornell box: its edges have them): the GLSL layer choice
 // (octree_lookup.h's loLeafVdls) is the C++ one.
-TEST(AtlasGpu, LayeredOctreeMatchesTheCpuBake) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+void expectLayeredBakeMatches(LightRepresentation representation) {
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
   BakeParams bp;
   bp.depth = 5;
   bp.photons = 100000;
   bp.knn = 100;
+  bp.representation = representation;
   const BakeResult baked = bake(scene, bp);
   ASSERT_GT(baked.grid.layers.size(), 0u);
-  const GpuOctree octree = buildGpuOctree(baked.grid);
+  GpuOctreeParams op;
+  op.compact = true;
+  const GpuOctree octree = buildGpuOctree(baked.grid, op);
   LightmapParams lp;
   lp.atlas.stitchSeams = false;
   const LightmapBake cpu = bakeLightmap(scene, octree, lp);
@@ -197,9 +199,10 @@ TEST(AtlasGpu, LayeredOctreeMatchesTheCpuBake) {
   lp.atlas.evaluator = &evaluator;
   const LightmapBake gpu = bakeLightmap(scene, octree, lp);
   const AtlasDifference covered = difference(gpu.atlas, cpu.atlas, kAtlasCovered);
-  std::printf("layered Cornell box: %zu covered texels compared, %zu differ in coverage, E within "
-              "%.2g\n",
-              covered.compared, covered.coverageDiffers, covered.irradiance);
+  std::printf("layered Cornell box, %s: %zu covered texels compared, %zu differ in coverage, E "
+              "within %.2g\n",
+              representationName(representation), covered.compared, covered.coverageDiffers,
+              covered.irradiance);
   EXPECT_EQ(covered.coverageDiffers, 0u);
   // Float rounding of a position next to a layer's plane may flip the side
   // test: count the texels that differ, they must be rare.
@@ -210,6 +213,19 @@ TEST(AtlasGpu, LayeredOctreeMatchesTheCpuBake) {
     differ += length(a - b) > 1e-4f * (1e-3f + length(b));
   }
   EXPECT_LT(differ, cpu.atlas.coveredTexels / 1000) << differ << " texels differ";
+}
+
+TEST(AtlasGpu, LayeredOctreeMatchesTheCpuBake) {
+  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  expectLayeredBakeMatches(LightRepresentation::Vdl);
+}
+
+// The SH representation's GLSL (loShIrradiance, signed half texels times the
+// scale) is the C++ one.
+TEST(AtlasGpu, ShOctreeMatchesTheCpuBake) {
+  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  expectLayeredBakeMatches(LightRepresentation::Sh1);
+  expectLayeredBakeMatches(LightRepresentation::Sh2);
 }
 
 }  // namespace

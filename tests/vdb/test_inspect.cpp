@@ -100,13 +100,13 @@ TEST(FormatVersion, WrittenReadAndNewerRefused) {
   VdlGrid g = floorGrid();
   writeVdlGrid(dir + "/v1.vdb", g, meta());
   LoadedVdl v1 = readVdlGrid(dir + "/v1.vdb");
-  EXPECT_EQ(v1.meta.formatVersion, kVdlFormatVersion);
+  EXPECT_EQ(v1.meta.formatVersion, kVdlFormatVersionVdl);
   EXPECT_TRUE(v1.notes.empty());
   VdbReport r = inspectVdb(dir + "/v1.vdb");
   auto it = std::find_if(r.metadata.begin(), r.metadata.end(),
                          [](const auto& kv) { return kv.first == "format_version"; });
   ASSERT_NE(it, r.metadata.end());
-  EXPECT_EQ(it->second, std::to_string(kVdlFormatVersion));
+  EXPECT_EQ(it->second, std::to_string(kVdlFormatVersionVdl));
 
   // A file written by a future lightoctree.
   vdb_internal::Damage newer;
@@ -355,7 +355,7 @@ TEST(Convert, VdbPrintListsTheGridsOfAConvertedFile) {
   }
   EXPECT_EQ(out.find("angular_error"), std::string::npos) << out;
   EXPECT_NE(out.find("is_saved_as_half_float: true"), std::string::npos) << out;
-  EXPECT_NE(out.find("format_version: " + std::to_string(kVdlFormatVersion)), std::string::npos)
+  EXPECT_NE(out.find("format_version: " + std::to_string(kVdlFormatVersionVdl)), std::string::npos)
       << out;
   EXPECT_TRUE(readVdlGrid(dir + "/c.vdb").grid.size() == coarse.size());
 }

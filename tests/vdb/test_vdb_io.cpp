@@ -380,7 +380,7 @@ TEST(VdbLayers, RoundTrip) {
   const std::string path = test::outputDir("VdbLayers") + "/room.vdb";
   writeVdlGrid(path, g, baked.metadata);
   const LoadedVdl r = readVdlGrid(path);
-  EXPECT_EQ(r.meta.formatVersion, kVdlFormatVersion);
+  EXPECT_EQ(r.meta.formatVersion, kVdlFormatVersionVdl);
   const VdlLayers &a = g.layers, &b = r.grid.layers;
   ASSERT_EQ(b.size(), a.size());
   EXPECT_EQ(b.voxel, a.voxel);
