@@ -174,7 +174,8 @@ nlohmann::json pointJson(const SweepPoint& p) {
           {"layers", p.layers},
           {"occlusion", p.occlusion},
           {"edge_correction", p.edgeCorrection},
-          {"smoothing", p.smoothing}};
+          {"smoothing", p.smoothing},
+          {"representation", p.representation}};
 }
 
 nlohmann::json resultJson(const SweepResult& r) {
@@ -263,6 +264,7 @@ std::string SweepPoint::label() const {
   if (!occlusion) s += " no-occlusion";
   if (!edgeCorrection) s += " no-edge";
   if (smoothing != BakeParams{}.smoothing) s += smoothing ? " smooth" : " no-smooth";
+  if (representation != "vdl") s += " " + representation;
   return s;
 }
 
@@ -271,7 +273,8 @@ std::string SweepPoint::bakeKey() const {
   return "d" + std::to_string(depth) + "-p" + std::to_string(photons) + "-k" + std::to_string(knn) +
          "-r" + formatNumber(radiusVoxels) + "-v" + vdls + (layers ? "" : "-l0") +
          (occlusion ? "" : "-o0") + (edgeCorrection ? "" : "-e0") +
-         (smoothing == BakeParams{}.smoothing ? "" : (smoothing ? "-s1" : "-s0"));
+         (smoothing == BakeParams{}.smoothing ? "" : (smoothing ? "-s1" : "-s0")) +
+         (representation == "vdl" ? "" : "-" + representation);
 }
 
 std::string SweepPoint::key() const {
@@ -339,6 +342,9 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale) {
     p.edgeCorrection = false;
     p.smoothing = false;
   });
+  // Spherical harmonics beside the VDLs (the paper's future work).
+  vary("representation", [](SweepPoint& p) { p.representation = "sh1"; });
+  vary("representation", [](SweepPoint& p) { p.representation = "sh2"; });
   // Combined points: cheaper photon maps with a matching k (the photon
   // density per voxel falls with the count), coarser and finer grids.
   vary("combined", [](SweepPoint& p) {
@@ -457,6 +463,9 @@ BakeParams bakeParamsOf(const SweepPoint& point, const Scene& scene, uint64_t se
   b.occlusion = point.occlusion;
   b.edgeCorrection = point.edgeCorrection;
   b.smoothing = point.smoothing;
+  b.representation = point.representation == "sh1"   ? LightRepresentation::Sh1
+                     : point.representation == "sh2" ? LightRepresentation::Sh2
+                                                     : LightRepresentation::Vdl;
   // 0 lets the gather apply its own default (kDefaultRadiusVoxels voxels).
   if (point.radiusVoxels != kDefaultRadiusVoxels) {
     b.radius = point.radiusVoxels * makeGridFrame(scene.bounds(), point.depth).voxelSize;

@@ -37,9 +37,11 @@ struct SweepPoint {
   bool occlusion = true;         ///< BakeParams::occlusion (gather occlusion)
   bool edgeCorrection = true;    ///< BakeParams::edgeCorrection
   bool smoothing = BakeParams{}.smoothing;  ///< BakeParams::smoothing
+  std::string representation = "vdl";     ///< BakeParams::representation: "vdl", "sh1", "sh2"
 
   /// Short human label, e.g. "d6 600k k300 r1.5 v4" (+ " no-interp", " half",
-  /// " paper-cosine", " no-layers", " no-occlusion", " no-edge", " smooth").
+  /// " paper-cosine", " no-layers", " no-occlusion", " no-edge", " smooth",
+  /// " sh1", " sh2").
   std::string label() const;
   /// File-name-safe key of the bake parameters only (points that differ only
   /// in interpolation or texel format share one bake).
