@@ -13,6 +13,8 @@
 #include "core/file.h"
 #include "core/threads.h"
 #include "image/image.h"
+#include "lightgrid/grid_frame.h"
+#include "reference/first_hit.h"
 #include "reference/path_tracer.h"
 #include "report.h"
 #include "scene/scene.h"
@@ -32,6 +34,7 @@ struct ReferenceOptions {
   uint64_t seed = 1;
   int threads = 0;
   int maxBounces = 256;
+  double edgeDistance = 0;  // 0 = one voxel of a depth-6 bake
   bool quiet = false;
 };
 
@@ -53,6 +56,26 @@ int runReference(const ReferenceOptions& opt) {
   Scene scene = loadScene(opt.scene);
   printSceneWarnings(scene);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
+  if (opt.part == "edge-mask") {
+    FirstHitParams fp;
+    fp.width = opt.width;
+    fp.height = opt.height;
+    fp.samplesPerPixel = std::min(opt.spp, 64);
+    fp.seed = opt.seed;
+    const float distance = opt.edgeDistance > 0 ? float(opt.edgeDistance)
+                                                : makeGridFrame(scene.bounds(), 6).voxelSize;
+    ConsoleProgress progress(opt.quiet);
+    const RgbImage mask = renderEdgeMask(scene, camera, fp, distance, &progress);
+    writeImage(opt.output, mask);
+    if (!opt.quiet) {
+      double covered = 0;
+      for (size_t i = 0; i < mask.pixelCount(); ++i) covered += mask.at(i).x > 0 ? 1 : 0;
+      std::printf("edge mask %s: %d x %d, within %g of an edge: %.1f%% of the pixels\nwrote %s\n",
+                  opt.scene.c_str(), opt.width, opt.height, double(distance),
+                  100.0 * covered / double(mask.pixelCount()), opt.output.c_str());
+    }
+    return 0;
+  }
   ReferenceParams params;
   params.width = opt.width;
   params.height = opt.height;
@@ -119,9 +142,15 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
       ->excludes(spp);
   cmd->add_option("--part", opt->part,
                   "full | direct | indirect (what `render --mode indirect` approximates) | "
-                  "irradiance (indirect irradiance at the first hit, W/m^2)")
-      ->check(CLI::IsMember({"full", "direct", "indirect", "irradiance"}))
+                  "irradiance (indirect irradiance at the first hit, W/m^2) | edge-mask (1 where "
+                  "the first hit lies within --edge-distance of an edge, for `compare --mask`; "
+                  "--spp up to 64 rays per pixel)")
+      ->check(CLI::IsMember({"full", "direct", "indirect", "irradiance", "edge-mask"}))
       ->capture_default_str();
+  cmd->add_option("--edge-distance", opt->edgeDistance,
+                  "With --part edge-mask: how near an edge, in scene units (default: one voxel "
+                  "of a depth-6 bake of the scene)")
+      ->check(finitePositive());
   cmd->add_option("--seed", opt->seed, "Random seed (same seed and --spp, same bytes)")
       ->check(seedValidator())
       ->capture_default_str();

@@ -62,4 +62,31 @@ RgbImage renderFirstHits(const Scene& scene, const PinholeCamera& camera,
   return image;
 }
 
+RgbImage renderEdgeMask(const Scene& scene, const PinholeCamera& camera,
+                        const FirstHitParams& params, float distance, ProgressSink* progress) {
+  if (!(distance > 0) || !std::isfinite(distance)) {
+    throw InputError("edge mask: distance " + std::to_string(distance) +
+                     " must be finite and positive");
+  }
+  RayTracer tracer(scene);
+  constexpr int kDirections = 16;
+  const float lift = distance / 50.0f, dropLift = distance / 20.0f;
+  auto nearEdge = [&](const FirstHit& h) -> Vec3 {
+    const Vec3 n = h.normal;
+    const Vec3 a = std::fabs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    const Vec3 t1 = normalize(cross(n, a)), t2 = cross(n, t1);
+    const Vec3 p = h.position + n * lift;
+    for (int k = 0; k < kDirections; ++k) {
+      const float phi = 2.0f * kPi * float(k) / float(kDirections);
+      const Vec3 t = t1 * std::cos(phi) + t2 * std::sin(phi);
+      if (tracer.occluded(p, t, distance)) return Vec3(1.0f);  // another surface across
+      if (!tracer.occluded(h.position + t * distance + n * dropLift, -n, 2.0f * dropLift)) {
+        return Vec3(1.0f);  // the surface ends or bends away
+      }
+    }
+    return Vec3(0.0f);
+  };
+  return renderFirstHits(scene, camera, params, nearEdge, progress);
+}
+
 }  // namespace lo

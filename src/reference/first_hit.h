@@ -41,4 +41,21 @@ RgbImage renderFirstHits(const Scene& scene, const PinholeCamera& camera,
                          const std::function<Vec3(const FirstHit&)>& shade,
                          ProgressSink* progress = nullptr);
 
+/// The pixels whose first hit lies within `distance` (scene units) of an
+/// edge: where the surface meets another one (a wall joint, an object
+/// resting on the floor) or ends or bends (a box's outer edge, a tight
+/// curve). Per jittered ray of renderFirstHits, 1 at such a hit, else 0; a
+/// pixel holds the share of its rays that hit near an edge. The test at a
+/// hit p with normal n, over 16 directions t in its tangent plane: a ray
+/// from p (lifted off the surface by distance / 50) along t that hits
+/// geometry within `distance`, or a ray down along -n from p + distance t
+/// (lifted by distance / 20) that finds no surface within twice the lift.
+/// It is the mask of the accuracy issue's "pixels within one voxel of an
+/// edge" (docs/accuracy.md), used with `compare --mask`.
+/// @throws InputError for a distance that is not finite and positive, and
+/// as renderFirstHits.
+RgbImage renderEdgeMask(const Scene& scene, const PinholeCamera& camera,
+                        const FirstHitParams& params, float distance,
+                        ProgressSink* progress = nullptr);
+
 }  // namespace lo

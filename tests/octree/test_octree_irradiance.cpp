@@ -285,6 +285,45 @@ TEST(FirstHit, MissesCountZeroAndBadParamsAreRefused) {
                InputError);
 }
 
+// The edge mask (reference/first_hit.h): a floor seen from above with a wall
+// standing on it at x = 0.5. A floor hit is in the mask exactly when it lies
+// within the distance of the wall's foot; the same jittered rays (same seed)
+// give each pixel's hit point, so every pixel is checked against geometry.
+TEST(FirstHit, EdgeMaskMarksTheHitsNearAnEdge) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {-3, -3, 0}, {6, 0, 0}, {0, 6, 0}, {0, 0, 1}, 0);              // floor
+  test::addQuad(scene, {0.5f, -3, 0}, {0, 6, 0}, {0, 0, 1}, {-1, 0, 0}, 0);           // wall
+  const PinholeCamera camera =
+      PinholeCamera::lookAt({0, 0, 10}, {0, 0, 0}, 2.0f * std::atan(0.15f));
+  FirstHitParams params;
+  params.width = 60;
+  params.height = 40;
+  params.samplesPerPixel = 1;
+  const float distance = 0.2f;
+  const RgbImage mask = renderEdgeMask(scene, camera, params, distance);
+  const RgbImage where = renderFirstHits(scene, camera, params, [](const FirstHit& h) {
+    return Vec3{h.position.x, h.position.z, 1.0f};
+  });
+  int near = 0, far = 0;
+  for (size_t i = 0; i < mask.pixelCount(); ++i) {
+    const Vec3 w = where.at(i);
+    ASSERT_EQ(w.z, 1.0f) << "pixel " << i << " missed the scene";
+    if (w.y > 1e-4f || w.x >= 0.5f) continue;  // the wall, or beyond it
+    const float gap = 0.5f - w.x;
+    if (gap < distance - 1e-3f) {
+      EXPECT_EQ(mask.at(i).x, 1.0f) << "floor hit " << gap << " from the wall";
+      ++near;
+    } else if (gap > distance + 1e-3f) {
+      EXPECT_EQ(mask.at(i).x, 0.0f) << "floor hit " << gap << " from the wall";
+      ++far;
+    }
+  }
+  EXPECT_GT(near, 40);
+  EXPECT_GT(far, 800);
+  EXPECT_THROW(renderEdgeMask(scene, camera, params, 0.0f), InputError);
+}
+
 }  // namespace
 }  // namespace lo
 
