@@ -28,6 +28,7 @@ std::set<std::string> differences(const SweepPoint& a, const SweepPoint& b) {
       a.smoothing != b.smoothing) {
     d.insert("accuracy");
   }
+  if (a.representation != b.representation) d.insert("representation");
   return d;
 }
 
@@ -55,7 +56,8 @@ TEST(SweepPoints, OneParameterAtATimeAroundThePaper) {
       }
     }
     for (const char* g :
-         {"depth", "photons", "knn", "vdls", "interpolation", "texels", "cosine", "accuracy"})
+         {"depth", "photons", "knn", "vdls", "interpolation", "texels", "cosine", "accuracy",
+          "representation"})
       EXPECT_TRUE(groups.count(g)) << g;
   }
   // The full sweep covers the ranges.
