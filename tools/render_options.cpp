@@ -35,6 +35,7 @@ GpuOctreeParams ShadingOptions::octreeParams(const GlInfo* info) const {
   p.halfFloat = halfFloat || texels == "half";
   p.compact = texels == "compact";
   p.cosineCorrection = cosineCorrection == "on";
+  p.tolerance = tolerance;
   if (info) {
     p.max3DTextureSize = info->max3DTextureSize;
     p.max2DTextureSize = info->max2DTextureSize;
@@ -143,6 +144,12 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
       ->check(CLI::IsMember({"float", "half", "compact"}))
       ->capture_default_str();
   cmd->add_flag("--half-float", opt.halfFloat, "The same as --texels half");
+  cmd->add_option("--tolerance", opt.tolerance,
+                  "Adaptive leaves: siblings whose light agrees within this share of each "
+                  "voxel's irradiance, at its own surface, become one coarser leaf (0 = every "
+                  "leaf at the bake's depth; docs/octree.md)")
+      ->check(CLI::Range(0.0f, 1.0f))
+      ->capture_default_str();
 }
 
 }  // namespace lo::tool

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "octree/adaptive_leaves.h"
 
 namespace lo {
 
@@ -249,10 +250,14 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   // Lit voxels in Morton order. A voxel without VDLs is left out entirely: the
   // flag cannot say "leaf with 0 VDLs" (0 = empty), and an empty branch reads
   // as no indirect light, which is what a voxel without VDLs contributes.
+  // With adaptive leaves, voxels a collapsed leaf holds are replaced by it.
   struct Leaf {
-    uint64_t code;
-    uint32_t voxel;
+    uint64_t code;   ///< Morton code at `depth` of the leaf's first voxel
+    uint32_t voxel;  ///< grid voxel, or index into adaptive.leaves when collapsed
+    int level;       ///< depth, or the collapsed leaf's level
   };
+  const AdaptiveLeaves adaptive =
+      collapseLeaves(grid, params.tolerance, params.cosineCorrection);
   // Each voxel's extra surface layers: entries extraFirst[v] .. + extraCount[v]
   // of grid.layers (validated: ascending by voxel).
   std::vector<uint32_t> extraFirst(grid.size(), 0);
@@ -276,10 +281,21 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   std::vector<Leaf> leaves;
   leaves.reserve(grid.size());
   for (size_t v = 0; v < grid.size(); ++v) {
-    if (grid.lit(v) || extraCount[v] > 0) {
-      leaves.push_back({mortonCode(grid.coords[v], depth), uint32_t(v)});
+    if ((grid.lit(v) || extraCount[v] > 0) && !adaptive.collapsed[v]) {
+      leaves.push_back({mortonCode(grid.coords[v], depth), uint32_t(v), depth});
     }
   }
+  for (size_t k = 0; k < adaptive.leaves.size(); ++k) {
+    const CollapsedLeaf& c = adaptive.leaves[k];
+    const uint64_t code = mortonCode(c.coord, c.level) << (3 * (depth - c.level));
+    leaves.push_back({code, uint32_t(k), c.level});
+  }
+  // Texels of a leaf: a collapsed one holds its light's texels.
+  auto texelsOfLeaf = [&](const Leaf& leaf) -> size_t {
+    if (leaf.level == depth) return leafTexels(leaf.voxel);
+    const CollapsedLeaf& c = adaptive.leaves[leaf.voxel];
+    return sh ? c.sh.size() : c.vdls.size();
+  };
   std::sort(leaves.begin(), leaves.end(),
             [](const Leaf& a, const Leaf& b) { return a.code < b.code; });
   for (size_t i = 1; i < leaves.size(); ++i) {
@@ -290,25 +306,37 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
     }
   }
 
-  // Nodes per level, sorted: level l holds the distinct ancestors code >> 3(depth - l).
-  // Tiles are allocated breadth first: one tile per node at levels 0..depth-1,
-  // in level order, Morton order inside a level (= BFS with children visited
-  // in child-index order), so the layout does not depend on the input order.
+  // Nodes per level, sorted: level l holds the distinct ancestors code >> 3(depth - l)
+  // of the leaves at level l or below; a node is a leaf (levelLeaf = its index
+  // in `leaves`) or inner (-1). Tiles are allocated breadth first: one tile
+  // per inner node, in level order, Morton order inside a level (= BFS with
+  // children visited in child-index order), so the layout does not depend on
+  // the input order.
   std::vector<std::vector<uint64_t>> levels(size_t(depth) + 1);
+  std::vector<std::vector<int64_t>> levelLeaf(size_t(depth) + 1);
   levels[0].push_back(0);
+  levelLeaf[0].push_back(-1);
   for (int l = 1; l <= depth; ++l) {
     std::vector<uint64_t>& nodes = levels[size_t(l)];
     const int shift = 3 * (depth - l);
-    for (const Leaf& leaf : leaves) {
+    for (size_t i = 0; i < leaves.size(); ++i) {
+      const Leaf& leaf = leaves[i];
+      if (leaf.level < l) continue;
       uint64_t code = leaf.code >> shift;
-      if (nodes.empty() || nodes.back() != code) nodes.push_back(code);
+      if (nodes.empty() || nodes.back() != code) {
+        nodes.push_back(code);
+        levelLeaf[size_t(l)].push_back(leaf.level == l ? int64_t(i) : -1);
+      }
     }
   }
-  std::vector<size_t> levelOffset(size_t(depth) + 1, 0);
+  // Tile of each inner node: levelTile[l][j] (unused for leaves).
+  std::vector<std::vector<size_t>> levelTile(size_t(depth) + 1);
   size_t tileCount = 0;
   for (int l = 0; l < depth; ++l) {
-    levelOffset[size_t(l)] = tileCount;
-    tileCount += levels[size_t(l)].size();
+    levelTile[size_t(l)].assign(levels[size_t(l)].size(), 0);
+    for (size_t j = 0; j < levels[size_t(l)].size(); ++j) {
+      if (levelLeaf[size_t(l)][j] < 0) levelTile[size_t(l)][j] = tileCount++;
+    }
   }
 
   // Near-cubic tile arrangement within the 8-bit tile coordinates and the
@@ -347,7 +375,7 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
 
   // VDL texture size and the 24-bit address space.
   size_t vdlTotal = 0;
-  for (const Leaf& leaf : leaves) vdlTotal += leafTexels(leaf.voxel);
+  for (const Leaf& leaf : leaves) vdlTotal += texelsOfLeaf(leaf);
   const size_t addressSpace = size_t(LO_MAX_ADDRESS) + 1;
   if (vdlTotal > addressSpace) {
     throw InputError("GPU octree: " + std::to_string(vdlTotal) +
@@ -473,16 +501,30 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
     for (size_t j = 0; j < nodes.size(); ++j) {
       const uint64_t code = nodes[j];
       while (parents[p] != code >> 3) ++p;
-      uint8_t* t = texel(levelOffset[size_t(l) - 1] + p, uint32_t(code & 7u));
-      if (l < depth) {
+      uint8_t* t = texel(levelTile[size_t(l) - 1][p], uint32_t(code & 7u));
+      const int64_t leafIndex = levelLeaf[size_t(l)][j];
+      if (leafIndex < 0) {
         uint32_t tx, ty, tz;
-        tileCoord(levelOffset[size_t(l)] + j, tx, ty, tz);
+        tileCoord(levelTile[size_t(l)][j], tx, ty, tz);
         t[0] = uint8_t(tx);
         t[1] = uint8_t(ty);
         t[2] = uint8_t(tz);
         t[3] = uint8_t(LO_FLAG_INNER);
+      } else if (l < depth) {
+        // A collapsed leaf: its texels, stored as they are (intensities, SH terms).
+        const CollapsedLeaf& c = adaptive.leaves[leaves[size_t(leafIndex)].voxel];
+        const uint address = uint(nextVdl);
+        t[0] = uint8_t(loPackAddressR(address));
+        t[1] = uint8_t(loPackAddressG(address));
+        t[2] = uint8_t(loPackAddressB(address));
+        t[3] = uint8_t(sh ? 1u : uint(c.vdls.size()));
+        if (sh) {
+          for (const Vec3& term : c.sh) writeSh(nextVdl++, term);
+        } else {
+          for (const Vdl& vdl : c.vdls) writeVdl(nextVdl++, vdl, Vec3{0, 0, 0});
+        }
       } else {
-        const Leaf& leaf = leaves[j];  // level `depth` is the leaf list itself
+        const Leaf& leaf = leaves[size_t(leafIndex)];
         LO_CHECK_EQ(leaf.code, code);
         const size_t v = leaf.voxel;
         const int count = grid.vdlCount[v];
@@ -542,6 +584,8 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   }
   LO_CHECK_EQ(nextVdl, vdlTotal);
   out.leafCount = leaves.size();
+  out.collapsedLeaves = adaptive.leaves.size();
+  out.collapsedVoxels = adaptive.voxelsCollapsed;
   out.nodeCount = tileCount;
   out.vdlCount = vdlTotal;
   return out;
@@ -552,7 +596,11 @@ std::string GpuOctree::ToString() const {
   std::ostringstream os;
   const double leaves = leafCount > 0 ? double(leafCount) : 1.0;
   os << "GpuOctree[depth " << depth << ", origin " << origin.ToString() << ", cube " << cubeSize
-     << ", leaves " << leafCount << ", tiles " << nodeCount << " in " << tilesX << "x" << tilesY
+     << ", leaves " << leafCount
+     << (collapsedLeaves > 0 ? " (" + std::to_string(collapsedLeaves) + " adaptive, for " +
+                                   std::to_string(collapsedVoxels) + " voxels)"
+                             : std::string())
+     << ", tiles " << nodeCount << " in " << tilesX << "x" << tilesY
      << "x" << tilesZ << " (pool " << poolWidth() << "x" << poolHeight() << "x" << poolDepth()
      << " RGBA8, " << kib(poolBytes()) << "), VDLs " << vdlCount << " in " << vdlWidth << "x"
      << vdlHeight

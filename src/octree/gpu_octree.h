@@ -33,6 +33,10 @@ struct GpuOctreeParams {
   /// On by default, as in every command; off gives the paper's form (the
   /// sweep's "paper-cosine" point).
   bool cosineCorrection = true;
+  /// Adaptive leaves (octree/adaptive_leaves.h): siblings whose light agrees
+  /// within this share of a voxel's irradiance, at every voxel's own surface,
+  /// collapse into one coarser leaf. 0 = every leaf at the grid's depth.
+  float tolerance = 0.0f;
 };
 
 /// Smallest cosine cosineCorrection divides by: bounds the gain of grazing
@@ -62,7 +66,9 @@ struct GpuOctree {
   std::vector<float> vdlTexels;
   std::vector<uint16_t> vdlTexelsHalf;
 
-  size_t leafCount = 0;  ///< non-empty voxels
+  size_t leafCount = 0;  ///< leaves (non-empty voxels, or collapsed nodes standing for several)
+  size_t collapsedLeaves = 0;  ///< leaves above the grid's depth (adaptive leaves)
+  size_t collapsedVoxels = 0;  ///< voxels those stand for
   size_t nodeCount = 0;  ///< tiles in the pool (inner nodes incl. root)
   size_t vdlCount = 0;   ///< VDL texels used
 

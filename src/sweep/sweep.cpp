@@ -175,7 +175,8 @@ nlohmann::json pointJson(const SweepPoint& p) {
           {"occlusion", p.occlusion},
           {"edge_correction", p.edgeCorrection},
           {"smoothing", p.smoothing},
-          {"representation", p.representation}};
+          {"representation", p.representation},
+          {"tolerance", p.tolerance}};
 }
 
 nlohmann::json resultJson(const SweepResult& r) {
@@ -191,6 +192,7 @@ nlohmann::json resultJson(const SweepResult& r) {
           {"active_voxels", r.activeVoxels},
           {"dense_voxels", r.denseVoxels},
           {"vdl_texels", r.vdlTexels},
+          {"gpu_leaves", r.gpuLeaves},
           {"frame_ms", r.frameMs},
           {"irradiance_rel_rmse", r.irradianceRelRmse},
           {"irradiance_rel_mae", r.irradianceRelMae},
@@ -211,6 +213,7 @@ SweepResult resultFromJson(const nlohmann::json& j, const SweepPoint& point) {
   r.activeVoxels = j.at("active_voxels");
   r.denseVoxels = j.at("dense_voxels");
   r.vdlTexels = j.at("vdl_texels");
+  r.gpuLeaves = j.value("gpu_leaves", -1.0);
   r.frameMs = j.at("frame_ms");
   r.irradianceRelRmse = j.at("irradiance_rel_rmse");
   r.irradianceRelMae = j.at("irradiance_rel_mae");
@@ -265,6 +268,7 @@ std::string SweepPoint::label() const {
   if (!edgeCorrection) s += " no-edge";
   if (smoothing != BakeParams{}.smoothing) s += smoothing ? " smooth" : " no-smooth";
   if (representation != "vdl") s += " " + representation;
+  if (tolerance > 0) s += " tol" + formatNumber(tolerance);
   return s;
 }
 
@@ -279,7 +283,8 @@ std::string SweepPoint::bakeKey() const {
 
 std::string SweepPoint::key() const {
   return bakeKey() + (interpolation ? "-i1" : "-i0") + (halfFloat ? "-h1" : "-h0") +
-         (cosineCorrection ? "" : "-c0");
+         (cosineCorrection ? "" : "-c0") +
+         (tolerance > 0 ? "-t" + formatNumber(tolerance) : "");
 }
 
 SweepPoint paperPoint() { return SweepPoint{}; }
@@ -345,6 +350,12 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale) {
   // Spherical harmonics beside the VDLs (the paper's future work).
   vary("representation", [](SweepPoint& p) { p.representation = "sh1"; });
   vary("representation", [](SweepPoint& p) { p.representation = "sh2"; });
+  // Adaptive leaves (docs/octree.md): the same bake, coarser leaves where the light agrees.
+  for (float t : {0.05f, 0.1f, 0.2f, 0.4f}) vary("tolerance", [t](SweepPoint& p) { p.tolerance = t; });
+  vary("tolerance", [](SweepPoint& p) {
+    p.representation = "sh1";
+    p.tolerance = 0.1f;
+  });
   // Combined points: cheaper photon maps with a matching k (the photon
   // density per voxel falls with the count), coarser and finer grids.
   vary("combined", [](SweepPoint& p) {
@@ -604,6 +615,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     GpuOctreeParams octreeParams;
     octreeParams.halfFloat = point.halfFloat;
     octreeParams.cosineCorrection = point.cosineCorrection;
+    octreeParams.tolerance = point.tolerance;
     if (const GlContext* gl = indirectRenderer.context.get()) {
       octreeParams.max3DTextureSize = gl->info().max3DTextureSize;
       octreeParams.max2DTextureSize = gl->info().max2DTextureSize;
@@ -611,6 +623,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     const GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
     r.gpuBytes = double(octree.poolBytes() + octree.vdlBytes());
     r.vdlTexels = double(octree.vdlCount);
+    r.gpuLeaves = double(octree.leafCount);
     OctreeShadeParams shade;
     shade.interpolation = point.interpolation;
     shade.normalOffset = RenderParams().normalOffset;
@@ -706,20 +719,21 @@ namespace sweep_internal {
 std::string markdownTable(const std::vector<SweepResult>& results) {
   std::ostringstream os;
   os << "| setting | varies | trace s | voxelize s | splat s | gather+cluster s | bake s | "
-        "peak RSS MiB | .vdb KiB | GPU KiB | active voxels | frame ms | irradiance rel. RMSE | "
-        "rel. MAE | indirect image rel. RMSE | front |\n"
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+        "peak RSS MiB | .vdb KiB | GPU KiB | active voxels | GPU leaves | frame ms | "
+        "irradiance rel. RMSE | rel. MAE | indirect image rel. RMSE | front |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
   for (const SweepResult& r : results) {
     const bool paper = r.point.sameSettings(paperPoint());
     char line[1024];
     std::string front = std::string(r.paretoTime ? "T" : "") + (r.paretoMemory ? "M" : "");
     std::snprintf(line, sizeof line,
                   "| %s%s%s | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %.0f | %.0f | %.0f "
-                  "| %s | %.1f%% | %.1f%% | %s | %s |\n",
+                  "| %s | %s | %.1f%% | %.1f%% | %s | %s |\n",
                   paper ? "**" : "", r.point.label().c_str(), paper ? "** (paper)" : "",
                   r.point.group.c_str(), r.traceSeconds, r.voxelizeSeconds, r.splatSeconds,
                   r.clusterSeconds, r.bakeSeconds, r.peakRssBytes / 1048576.0, r.vdbBytes / 1024.0,
                   r.gpuBytes / 1024.0, r.activeVoxels,
+                  r.gpuLeaves >= 0 ? formatNumber(r.gpuLeaves).c_str() : "-",
                   r.frameMs >= 0 ? formatNumber(std::round(r.frameMs * 10) / 10).c_str() : "-",
                   100 * r.irradianceRelRmse, 100 * r.irradianceRelMae,
                   r.indirectRelRmse >= 0
@@ -750,7 +764,7 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
 
   // Plot data: x = bake seconds or GPU KiB, y = irradiance relative RMSE in %.
   using Rows = std::vector<std::pair<double, std::pair<double, std::string>>>;
-  Rows allTime, allMem, frontTime, frontMem, paperTime, paperMem;
+  Rows allTime, allMem, frontTime, frontMem, paperTime, paperMem, toleranceMem;
   for (const SweepResult& r : results) {
     const double e = 100 * r.irradianceRelRmse, t = r.bakeSeconds, m = r.gpuBytes / 1024.0;
     const std::string l = r.point.label();
@@ -761,6 +775,14 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
     if (r.point.sameSettings(paperPoint())) {
       paperTime.push_back({t, {e, l}});
       paperMem.push_back({m, {e, l}});
+      toleranceMem.push_back({m, {e, "uniform"}});
+    }
+    // The adaptive leaves' trade: the paper's bake at each tolerance.
+    SweepPoint uniform = r.point;
+    uniform.tolerance = 0;
+    uniform.group = "paper";
+    if (r.point.tolerance > 0 && uniform.sameSettings(paperPoint())) {
+      toleranceMem.push_back({m, {e, "tol " + formatNumber(r.point.tolerance)}});
     }
   }
   const std::string dataDir = dir + "/plot-data";
@@ -771,6 +793,7 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
   writeTextAtomically(dataDir + "/front-memory.dat", plotData(frontMem));
   writeTextAtomically(dataDir + "/paper-time.dat", plotData(paperTime));
   writeTextAtomically(dataDir + "/paper-memory.dat", plotData(paperMem));
+  writeTextAtomically(dataDir + "/tolerance-memory.dat", plotData(toleranceMem));
   const std::string sceneName = fs::path(params.scene).stem().string();
   std::ostringstream gp;
   gp << "# Redraw with: cd " << dir << " && gnuplot sweep.gp\n"
@@ -778,6 +801,7 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
      << "set logscale x\nset grid\nset key top right\n"
      << "set ylabel 'indirect irradiance: relative RMSE vs reference (%)'\n";
   auto plot = [&](const char* png, const char* xlabel, const char* which) {
+    const bool memory = std::string(which) == "memory";
     gp << "set output '" << png << "'\n"
        << "set title '" << sceneName << ": error against " << xlabel << "'\n"
        << "set xlabel '" << xlabel << " (log scale)'\n"
@@ -787,8 +811,14 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
        << ".dat' using 1:2 with linespoints pt 7 ps 1.2 lw 2 lc rgb '#d62728' title 'Pareto "
           "front', \\\n"
        << "     'plot-data/front-" << which
-       << ".dat' using 1:2:3 with labels offset 1,0.6 left font 'sans,8' notitle, \\\n"
-       << "     'plot-data/paper-" << which
+       << ".dat' using 1:2:3 with labels offset 1,0.6 left font 'sans,8' notitle, \\\n";
+    if (memory) {
+      gp << "     'plot-data/tolerance-memory.dat' using 1:2 with linespoints pt 9 ps 1.2 lw 2 "
+            "lc rgb '#2ca02c' title 'adaptive leaves (tolerance)', \\\n"
+         << "     'plot-data/tolerance-memory.dat' using 1:2:3 with labels offset -1,-0.9 right "
+            "font 'sans,8' tc rgb '#2ca02c' notitle, \\\n";
+    }
+    gp << "     'plot-data/paper-" << which
        << ".dat' using 1:2 with points pt 5 ps 2.2 lc rgb '#1f77b4' title 'paper (d6 600k k300 "
           "v4)'\n";
   };

@@ -38,10 +38,11 @@ struct SweepPoint {
   bool edgeCorrection = true;    ///< BakeParams::edgeCorrection
   bool smoothing = BakeParams{}.smoothing;  ///< BakeParams::smoothing
   std::string representation = "vdl";     ///< BakeParams::representation: "vdl", "sh1", "sh2"
+  float tolerance = 0.0f;  ///< GpuOctreeParams::tolerance (adaptive leaves; 0 = uniform tree)
 
   /// Short human label, e.g. "d6 600k k300 r1.5 v4" (+ " no-interp", " half",
   /// " paper-cosine", " no-layers", " no-occlusion", " no-edge", " smooth",
-  /// " sh1", " sh2").
+  /// " sh1", " sh2", " tol0.1").
   std::string label() const;
   /// File-name-safe key of the bake parameters only (points that differ only
   /// in interpolation or texel format share one bake).
@@ -76,6 +77,7 @@ struct SweepResult {
   double gpuBytes = 0;      ///< octree pool + VDL texture as uploaded
   double activeVoxels = 0, denseVoxels = 0;
   double vdlTexels = 0;  ///< VDLs stored in the GPU texture
+  double gpuLeaves = -1;  ///< leaves of the GPU octree (< 0: not recorded)
   double frameMs = -1;   ///< OSMesa frame time, indirect mode; < 0: not measured
   // Errors against the references (luminance; relative RMSE and MAE).
   double irradianceRelRmse = 0, irradianceRelMae = 0;

@@ -180,7 +180,7 @@ TEST(AtlasGpu, CornellBoxMatchesTheCpuBake) {
 // The same with an octree that has surface layers (a fresh bake of the
 // Cornell box: its edges have them): the GLSL layer choice
 // (octree_lookup.h's loLeafVdls) is the C++ one.
-void expectLayeredBakeMatches(LightRepresentation representation) {
+void expectLayeredBakeMatches(LightRepresentation representation, float tolerance = 0) {
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
   BakeParams bp;
   bp.depth = 5;
@@ -191,7 +191,9 @@ void expectLayeredBakeMatches(LightRepresentation representation) {
   ASSERT_GT(baked.grid.layers.size(), 0u);
   GpuOctreeParams op;
   op.compact = true;
+  op.tolerance = tolerance;
   const GpuOctree octree = buildGpuOctree(baked.grid, op);
+  if (tolerance > 0) ASSERT_GT(octree.collapsedLeaves, 0u);
   LightmapParams lp;
   lp.atlas.stitchSeams = false;
   const LightmapBake cpu = bakeLightmap(scene, octree, lp);
@@ -226,6 +228,14 @@ TEST(AtlasGpu, ShOctreeMatchesTheCpuBake) {
   if (!context()) GTEST_SKIP() << "no OSMesa context available";
   expectLayeredBakeMatches(LightRepresentation::Sh1);
   expectLayeredBakeMatches(LightRepresentation::Sh2);
+}
+
+// Adaptive leaves: the GLSL descent stops at leaves above the grid's depth
+// as the C++ one does.
+TEST(AtlasGpu, AdaptiveOctreeMatchesTheCpuBake) {
+  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  expectLayeredBakeMatches(LightRepresentation::Vdl, 0.1f);
+  expectLayeredBakeMatches(LightRepresentation::Sh1, 0.1f);
 }
 
 }  // namespace
