@@ -59,6 +59,10 @@ int runBake(const BakeOptions& opt) {
   StageTimer loadTimer(rows, "load scene");
   Scene scene = loadScene(opt.scene);
   printSceneWarnings(scene);
+  if (opt.bounds.empty() && !scene.region.empty() && !opt.quiet) {
+    std::printf("region of interest marked in the scene: %s (--bounds overrides it)\n",
+                scene.region.ToString().c_str());
+  }
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.lights.size()) + " punctual lights");
 

@@ -217,7 +217,10 @@ std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
          "): bake the part that matters with --bounds";
 }
 
-BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* progress) {
+BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* progress) {
+  // The scene's own region of interest (a glTF marker node) when none is given.
+  BakeParams params = requested;
+  if (params.region.empty()) params.region = scene.region;
   checkParams(params);
   // What the .vdb can store, checked before any work: OpenVDB refuses a
   // transform whose scale cubed is below 3e-15 (math::ScaleMap).

@@ -181,7 +181,8 @@ struct BakeResult {
 /// nearly all of them).
 std::string photonBudgetWarning(const BakeParams& params, const BakeStats& stats);
 
-/// @brief Bakes `scene` with `params` (paper §3.1). Deterministic.
+/// @brief Bakes `scene` with `params` (paper §3.1). Deterministic. Without
+/// params.region, the scene's marked region (Scene::region) is the region.
 /// @throws InputError for out-of-range parameters (naming them) and the
 /// stages' errors (a scene without light, a grid too deep).
 BakeResult bake(const Scene& scene, const BakeParams& params, ProgressSink* progress = nullptr);

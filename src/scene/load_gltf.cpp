@@ -761,7 +761,11 @@ class SceneBuilder {
       for (double v : world.m)
         if (!std::isfinite(v))
           fail(path_, "node " + std::to_string(item.node) + " has a non-finite transform");
-      if (node.mesh >= 0) addMesh(node.mesh, world);
+      if (isRegionMarker(node, item.node)) {
+        addRegion(node, item.node, world);
+      } else if (node.mesh >= 0) {
+        addMesh(node.mesh, world);
+      }
       if (node.camera >= 0) addCamera(node, item.node, world);
       auto ext = node.extensions.find("KHR_lights_punctual");
       if (ext != node.extensions.end() && ext->second.IsObject() && ext->second.Has("light")) {
@@ -773,6 +777,41 @@ class SceneBuilder {
       for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
         stack.push_back({*c, world, item.depth + 1});
     }
+  }
+
+  /// A region-of-interest marker: `"extras": {"lightoctree_region": true}`.
+  bool isRegionMarker(const tinygltf::Node& node, int nodeIndex) const {
+    if (!node.extras.IsObject() || !node.extras.Has("lightoctree_region")) return false;
+    const tinygltf::Value& v = node.extras.Get("lightoctree_region");
+    if (!v.IsBool()) {
+      fail(path_, "node " + std::to_string(nodeIndex) +
+                      ": extras.lightoctree_region must be true or false");
+    }
+    return v.Get<bool>();
+  }
+
+  /// The marker's mesh, loaded like any other for its world-space bounds, then
+  /// taken out of the scene again: it marks the region, it is not geometry.
+  void addRegion(const tinygltf::Node& node, int nodeIndex, const Mat4& world) {
+    if (node.mesh < 0) {
+      fail(path_, "node " + std::to_string(nodeIndex) +
+                      " marks the region of interest (extras.lightoctree_region) but has no "
+                      "mesh: give it a box mesh spanning the region");
+    }
+    Scene& sc = scene_;
+    const size_t positions = sc.positions.size(), normals = sc.normals.size(),
+                 uv0 = sc.texcoords0.size(), uv1 = sc.texcoords1.size(),
+                 tangents = sc.tangents.size(), indices = sc.indices.size(),
+                 materials = sc.triangleMaterial.size();
+    addMesh(node.mesh, world);
+    for (size_t i = positions; i < sc.positions.size(); ++i) sc.region.extend(sc.positions[i]);
+    sc.positions.resize(positions);
+    sc.normals.resize(normals);
+    sc.texcoords0.resize(uv0);
+    sc.texcoords1.resize(uv1);
+    sc.tangents.resize(tangents);
+    sc.indices.resize(indices);
+    sc.triangleMaterial.resize(materials);
   }
 
   void addCamera(const tinygltf::Node& node, int nodeIndex, const Mat4& world) {

@@ -154,6 +154,11 @@ struct Scene {
   std::vector<Texture> textures;
   std::vector<Light> lights;
   std::vector<Camera> cameras;
+  /// A region of interest marked in the file (glTF: a node whose `extras`
+  /// hold `"lightoctree_region": true`; docs/scene.md): the world-space bounds
+  /// of the marker nodes' meshes, which are not part of the scene. Empty =
+  /// none. The bake uses it when `--bounds` gives none.
+  Bounds3 region;
 
   size_t triangleCount() const { return indices.size() / 3; }
   Bounds3 bounds() const;

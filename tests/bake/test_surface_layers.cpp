@@ -226,6 +226,15 @@ TEST(BakeRegion, ARoomOnAGroundPlane) {
         << centre.ToString();
   }
   EXPECT_EQ(roi.metadata.region.lower, room.lower);
+  // The same region marked in the scene (a glTF marker node) when no
+  // --bounds is given: the same bake.
+  Scene marked = scene;
+  marked.region = room;
+  p.region = Bounds3{};
+  const BakeResult fromScene = bake(marked, p, nullptr);
+  EXPECT_EQ(fromScene.metadata.region.lower, room.lower);
+  EXPECT_EQ(fromScene.grid.coords, roi.grid.coords);
+  EXPECT_EQ(fromScene.stats.emittedPaths, roi.stats.emittedPaths);
   p.region = room;
   EXPECT_EQ(photonBudgetWarning(p, roi.stats), "");
 }

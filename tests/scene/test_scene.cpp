@@ -378,6 +378,36 @@ TEST(SceneGltf, NodeTransformsTrsAndMatrix) {
       expectNear(s.normals[s.indices[3 * t + size_t(k)]], s.faceNormal(t), 1e-5f, "normal");
 }
 
+// A region of interest marked in the file: the marker node's mesh is not
+// geometry; its world-space bounds are Scene::region.
+TEST(SceneGltf, RegionMarkerNodeGivesTheRegionAndIsNoGeometry) {
+  std::string dir = test::outputDir("SceneGltf_RegionMarker");
+  MiniGltf g = oneTriangle();
+  g.nodes = R"([{"mesh": 0},
+                {"mesh": 0, "translation": [5, 6, 7], "scale": [2, 3, 4],
+                 "extras": {"lightoctree_region": true}},
+                {"mesh": 0, "translation": [-1, 0, 0], "extras": {"lightoctree_region": false}}])";
+  g.sceneNodes = "[0, 1, 2]";
+  Scene s = loadScene(writeGltf(dir, "region.gltf", g));
+  EXPECT_EQ(s.triangleCount(), 2u);  // nodes 0 and 2; the marker is not geometry
+  EXPECT_EQ(s.positions.size(), 6u);
+  EXPECT_EQ(s.normals.size(), 6u);
+  ASSERT_FALSE(s.region.empty());
+  expectNear(s.region.lower, {5, 6, 7}, 1e-6f, "region lower");
+  expectNear(s.region.upper, {7, 9, 7}, 1e-6f, "region upper");
+  // Without one, no region.
+  MiniGltf plain = oneTriangle();
+  EXPECT_TRUE(loadScene(writeGltf(dir, "plain.gltf", plain)).region.empty());
+  // A marker needs a mesh, and true or false.
+  MiniGltf noMesh = oneTriangle();
+  noMesh.nodes = R"([{"mesh": 0}, {"extras": {"lightoctree_region": true}}])";
+  noMesh.sceneNodes = "[0, 1]";
+  expectInputError(writeGltf(dir, "nomesh.gltf", noMesh), "has no mesh");
+  MiniGltf notBool = oneTriangle();
+  notBool.nodes = R"([{"mesh": 0, "extras": {"lightoctree_region": 1}}])";
+  expectInputError(writeGltf(dir, "notbool.gltf", notBool), "must be true or false");
+}
+
 TEST(SceneGltf, NonUniformScaleNormalsUseInverseTranspose) {
   std::string dir = test::outputDir("SceneGltf_NonUniform");
   MiniGltf g;
