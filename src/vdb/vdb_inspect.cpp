@@ -7,7 +7,6 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointDataGrid.h>
-#include <octree_layout.h>
 
 #include <algorithm>
 #include <cmath>
@@ -118,12 +117,6 @@ std::string coordText(const openvdb::Coord& c) {
          ")";
 }
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(4);
-  os << v;
-  return os.str();
-}
 
 /// The VDL contract checks; `add` records one result.
 class VdlChecker {
@@ -139,7 +132,7 @@ class VdlChecker {
     checkSameActive();
     checkDepthAndBounds();
     if (!contract) return;  // the value checks need every required grid
-    checkValues(maxVdls);
+    checkValues();
   }
 
  private:
@@ -161,19 +154,6 @@ class VdlChecker {
     if (!typed) return (*f_.meta)["representation"] ? -1 : 0;
     const std::string& r = typed->value();
     return r == "vdl" ? 0 : r == "sh1" ? 4 : r == "sh2" ? 9 : -1;
-  }
-
-  /// Sum of the SH terms at voxel c (grids `prefix` + "sh<i>") evaluated at
-  /// the normal n: E(n), and in `scale` the largest |term| seen.
-  double shAt(const std::vector<Vec3SGrid::ConstAccessor>& sh, const openvdb::Coord& c,
-              const openvdb::Vec3s& n, int k, double& scale) const {
-    double e = 0;
-    for (size_t i = 0; i < sh.size(); ++i) {
-      const double t = double(sh[i].getValue(c)[k]);
-      e += t * double(layout::loShBasis(uint32_t(i), n[0], n[1], n[2]));
-      scale = std::max(scale, std::abs(t));
-    }
-    return e;
   }
 
   int readMaxVdls() const {
@@ -374,193 +354,19 @@ class VdlChecker {
     add("same_active_voxels", true, counts.empty() ? "no grids" : counts);
   }
 
-  /// Surface layers (format version 2): each layer's voxels are voxels of the
-  /// file (layer 2's among layer 1's), counts integers within max_vdls, the
-  /// VDLs of each layer sum to its irradiance.
-  void checkLayers(int maxVdls, double sumTol) {
-    auto count1 = openvdb::gridPtrCast<FloatGrid>(find("layer1_vdl_count"));
-    bool anyLayerGrid = false;
-    for (const auto& g : *f_.grids) anyLayerGrid = anyLayerGrid || (g && layerGroup(g->getName()) > 0);
-    if (!anyLayerGrid) return;
-    auto voxels = openvdb::gridPtrCast<FloatGrid>(find("vdl_count"));
-    std::string problem;
-    uint64_t layers = 0;
-    double worstSum = 0;
-    for (int layer = 1; layer < kMaxLayers && problem.empty(); ++layer) {
-      const std::string prefix = "layer" + std::to_string(layer) + "_";
-      auto count = openvdb::gridPtrCast<FloatGrid>(find(prefix + "vdl_count"));
-      auto irr = openvdb::gridPtrCast<Vec3SGrid>(find(prefix + "irradiance"));
-      auto normal = openvdb::gridPtrCast<Vec3SGrid>(find(prefix + "normal"));
-      auto point = openvdb::gridPtrCast<Vec3SGrid>(find(prefix + "point"));
-      if (!count) {
-        if (layer == 1) problem = "layer grids without 'layer1_vdl_count'";
-        break;
-      }
-      const int shTerms = std::max(0, readShTerms());
-      std::vector<Vec3SGrid::ConstAccessor> sha;
-      for (int i = 0; i < shTerms; ++i) {
-        auto g = openvdb::gridPtrCast<Vec3SGrid>(find(prefix + "sh" + std::to_string(i)));
-        if (!g) {
-          problem = "missing or mistyped '" + prefix + "sh" + std::to_string(i) + "'";
-          break;
-        }
-        sha.push_back(g->getConstAccessor());
-      }
-      std::vector<Vec3SGrid::Ptr> vi;
-      for (int i = 0; i < maxVdls; ++i) {
-        vi.push_back(openvdb::gridPtrCast<Vec3SGrid>(
-            find(prefix + "vdl" + std::to_string(i) + "_irradiance")));
-        if (!vi.back() || !openvdb::gridPtrCast<Vec3SGrid>(
-                              find(prefix + "vdl" + std::to_string(i) + "_direction"))) {
-          problem = "missing or mistyped '" + prefix + "vdl" + std::to_string(i) + "_*'";
-        }
-      }
-      if (!irr || !normal || !point || !find("layer_point")) {
-        problem = "missing or mistyped grids of layer " + std::to_string(layer);
-      }
-      if (!problem.empty()) break;
-      auto irrAcc = irr->getConstAccessor();
-      auto normalAcc = normal->getConstAccessor();
-      std::vector<Vec3SGrid::ConstAccessor> via;
-      for (const Vec3SGrid::Ptr& g : vi) via.push_back(g->getConstAccessor());
-      for (auto it = count->cbeginValueOn(); it && problem.empty(); ++it) {
-        ++layers;
-        const openvdb::Coord c = it.getCoord();
-        if (!voxels || !voxels->tree().isValueOn(c)) {
-          problem = prefix + "vdl_count is active at " + coordText(c) + ", not a voxel of the file";
-        } else if (layer > 1 && !(count1 && count1->tree().isValueOn(c))) {
-          problem = "layer " + std::to_string(layer) + " at " + coordText(c) + " without layer 1";
-        }
-        const float n = *it;
-        if (problem.empty() && (!(n >= 0 && n <= float(maxVdls)) || n != std::floor(n))) {
-          problem = prefix + "vdl_count at " + coordText(c) + " holds " + num(n);
-        }
-        if (!problem.empty()) break;
-        const openvdb::Vec3s e = irrAcc.getValue(c);
-        double sum[3] = {0, 0, 0}, scale = std::max({double(e[0]), double(e[1]), double(e[2])});
-        for (int i = 0; i < maxVdls; ++i) {
-          const openvdb::Vec3s v = via[size_t(i)].getValue(c);
-          for (int k = 0; k < 3; ++k) {
-            sum[k] += v[k];
-            scale = std::max(scale, double(std::abs(v[k])));
-          }
-        }
-        if (shTerms > 0) {
-          const openvdb::Vec3s nl = normalAcc.getValue(c);
-          for (int k = 0; k < 3; ++k) sum[k] = shAt(sha, c, nl, k, scale);
-        }
-        double diff = 0;
-        for (int k = 0; k < 3; ++k) diff = std::max(diff, std::abs(sum[k] - double(e[k])));
-        const double rel = scale > 0 ? diff / scale : (diff > 0 ? 1e30 : 0.0);
-        worstSum = std::max(worstSum, std::isfinite(rel) ? rel : 1e30);
-        if (!(rel <= sumTol)) {
-          problem = prefix + (shTerms > 0 ? "SH at the normal" : "vdl sum") + " at " + coordText(c) + " differs by " + num(rel) +
-                    " of the irradiance (allowed " + num(sumTol) + ")";
-        }
-      }
+  /// The values' meaning: the one validation every reader runs
+  /// (checkLightGridValues), on the grid as the reader reads it. A file the
+  /// reader refuses fails "readable" with the reader's message.
+  void checkValues() {
+    LoadedVdl loaded;
+    try {
+      loaded = vdb_internal::readVdlStructure(r_.path);
+    } catch (const InputError& e) {
+      add("readable", false, e.what());
+      return;
     }
-    add("layers", problem.empty(),
-        problem.empty() ? std::to_string(layers) + " extra surface layers on voxels of the file; "
-                                                    "their light sums to their irradiance (largest "
-                                                    "relative difference " +
-                              num(worstSum) + ")"
-                        : problem);
-  }
-
-  void checkValues(int maxVdls) {
-    auto irr = openvdb::gridPtrCast<Vec3SGrid>(find("irradiance"));
-    auto count = openvdb::gridPtrCast<FloatGrid>(find("vdl_count"));
-    std::vector<Vec3SGrid::Ptr> vi, vd;
-    for (int i = 0; i < maxVdls; ++i) {
-      vi.push_back(
-          openvdb::gridPtrCast<Vec3SGrid>(find("vdl" + std::to_string(i) + "_irradiance")));
-      vd.push_back(openvdb::gridPtrCast<Vec3SGrid>(find("vdl" + std::to_string(i) + "_direction")));
-    }
-    const bool half = irr->saveFloatAsHalf() || vi[0]->saveFloatAsHalf();
-    const double sumTol = half ? kVdlSumToleranceHalf : kVdlSumTolerance;
-    // SH files: E(n) at the voxel's normal is its irradiance, in place of the VDL sum.
-    const int shTerms = readShTerms();
-    std::vector<Vec3SGrid::ConstAccessor> sha;
-    for (int i = 0; i < shTerms; ++i) {
-      sha.push_back(openvdb::gridPtrCast<Vec3SGrid>(find("sh" + std::to_string(i)))->getConstAccessor());
-    }
-    auto normalAcc = openvdb::gridPtrCast<Vec3SGrid>(find("normal"))->getConstAccessor();
-
-    uint64_t badCount = 0, negative = 0, notUnit = 0, badSum = 0, voxels = 0;
-    std::string firstCount, firstNegative, firstNotUnit, firstSum;
-    double worstUnit = 0, worstSum = 0;
-    auto irrAcc = irr->getConstAccessor();
-    std::vector<Vec3SGrid::ConstAccessor> ia, da;
-    for (int i = 0; i < maxVdls; ++i) {
-      ia.push_back(vi[size_t(i)]->getConstAccessor());
-      da.push_back(vd[size_t(i)]->getConstAccessor());
-    }
-    auto negativeIn = [](const openvdb::Vec3s& v) { return v[0] < 0 || v[1] < 0 || v[2] < 0; };
-    // Voxels in vdl_count's active order: deterministic "first offending voxel".
-    for (auto it = count->cbeginValueOn(); it; ++it) {
-      ++voxels;
-      const openvdb::Coord c = it.getCoord();
-      const float n = *it;
-      if (!(n >= 0 && n <= float(maxVdls)) || n != std::floor(n)) {
-        if (badCount++ == 0) firstCount = coordText(c) + " holds " + num(n);
-        continue;
-      }
-      const openvdb::Vec3s e = irrAcc.getValue(c);
-      bool neg = negativeIn(e);
-      double sum[3] = {0, 0, 0};
-      double scale = std::max({double(e[0]), double(e[1]), double(e[2])});
-      for (int i = 0; i < maxVdls; ++i) {
-        const openvdb::Vec3s vIrr = ia[size_t(i)].getValue(c);
-        neg = neg || negativeIn(vIrr);
-        for (int k = 0; k < 3; ++k) {
-          sum[k] += vIrr[k];
-          scale = std::max(scale, double(std::abs(vIrr[k])));
-        }
-        if (i < int(n)) {
-          const double len = da[size_t(i)].getValue(c).length();
-          const double dev = std::abs(len - 1.0);
-          worstUnit = std::max(worstUnit, std::isfinite(dev) ? dev : 1e30);
-          if (!(dev < kUnitDirectionTolerance) && notUnit++ == 0) {
-            firstNotUnit = "vdl" + std::to_string(i) + "_direction at " + coordText(c) +
-                           " has length " + num(len);
-          }
-        }
-      }
-      if (neg && negative++ == 0) firstNegative = coordText(c);
-      if (shTerms > 0) {
-        const openvdb::Vec3s nv = normalAcc.getValue(c);
-        for (int k = 0; k < 3; ++k) sum[k] = shAt(sha, c, nv, k, scale);
-      }
-      double diff = 0;
-      for (int k = 0; k < 3; ++k) diff = std::max(diff, std::abs(sum[k] - double(e[k])));
-      const double rel = scale > 0 ? diff / scale : (diff > 0 ? 1e30 : 0.0);
-      if (std::isfinite(rel)) worstSum = std::max(worstSum, rel);
-      if (!(rel <= sumTol) && badSum++ == 0) {
-        firstSum = coordText(c) + (shTerms > 0 ? ": SH at the normal" : ": sum of VDLs") +
-                   " differs by " + num(rel) + " of the irradiance";
-      }
-    }
-    const std::string of = " of " + std::to_string(voxels) + " voxels";
-    add("vdl_count", badCount == 0,
-        badCount ? std::to_string(badCount) + of + " not an integer in [0, " +
-                       std::to_string(maxVdls) + "]; first " + firstCount
-                 : "integers in [0, " + std::to_string(maxVdls) + "]");
-    add("irradiance_non_negative", negative == 0,
-        negative
-            ? std::to_string(negative) + of + " with a negative channel; first " + firstNegative
-            : "irradiance and VDL irradiance >= 0");
-    add("unit_directions", notUnit == 0,
-        (notUnit ? std::to_string(notUnit) + " used VDL slots not unit; first " + firstNotUnit
-                 : std::string("used VDL slots unit")) +
-            " (largest |length - 1| " + num(worstUnit) + ", allowed " +
-            num(kUnitDirectionTolerance) + ")");
-    add(shTerms > 0 ? "sh_sum" : "vdl_sum", badSum == 0,
-        (badSum ? std::to_string(badSum) + of + " off; first " + firstSum
-                : std::string(shTerms > 0 ? "SH irradiance at each voxel's normal is its irradiance"
-                                          : "VDLs sum to the irradiance")) +
-            " (largest relative difference " + num(worstSum) + ", allowed " + num(sumTol) +
-            (half ? ", half floats)" : ")"));
-    checkLayers(maxVdls, sumTol);
+    add("readable", true, "render, convert and the sweep read it");
+    for (const VdbCheck& c : checkLightGridValues(loaded.grid, loaded.halfFloat)) r_.checks.push_back(c);
   }
 
   const OpenedFile& f_;

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "vdb/vdb_io.h"
+
 namespace lo {
 
 struct GridSummary {
@@ -28,11 +30,6 @@ struct GridSummary {
   std::vector<std::pair<std::string, std::string>> metadata;  ///< as text
 };
 
-struct VdbCheck {
-  std::string name;  ///< e.g. "unit_directions"
-  bool passed = true;
-  std::string detail;  ///< what was measured / the first offending voxel
-};
 
 struct VdbReport {
   std::string path;
@@ -50,20 +47,15 @@ struct VdbReport {
   }
 };
 
-/// Tolerance of the "vdl_sum" check (Σ VDL irradiance = irradiance), relative
-/// to the voxel's largest irradiance channel: full floats, and half floats
-/// (up to 9 values each rounded to 11 bits, ~2.4e-4 each).
-constexpr double kVdlSumTolerance = 1e-4;
-constexpr double kVdlSumToleranceHalf = 3e-3;
-/// |length − 1| allowed for the directions of used VDL slots.
-constexpr double kUnitDirectionTolerance = 1e-3;
-
-/// Reads every grid of `path` and runs the checks. Checks of a VDL file:
-/// contract (required grids with their types, max_vdls), format_version,
-/// finite (no NaN/Inf), same_transform, same_active_voxels, vdl_count
-/// (integers in [0, max_vdls]), irradiance_non_negative, unit_directions (for
-/// slots i < vdl_count), vdl_sum. A file that is not a VDL file fails
-/// "contract" (a photon file gets only the "photons" check).
+/// Reads every grid of `path` and runs the checks. Checks of a VDL file: the
+/// file's structure (contract: required grids with their types, max_vdls;
+/// format_version; finite: no NaN/Inf in any grid; same_transform;
+/// same_active_voxels; depth, transform, voxel_bounds), then "readable" (the
+/// reader every command uses accepts it) and the values' meaning, the very
+/// checks that reader runs (checkLightGridValues in vdb_io.h): so a file
+/// passes inspect exactly when render and convert take it. A file that is
+/// not a VDL file fails "contract" (a photon file gets only the "photons"
+/// check).
 /// @throws InputError naming the file when it is missing, truncated or not an
 /// OpenVDB file.
 VdbReport inspectVdb(const std::string& path);

@@ -9,6 +9,7 @@
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/points/PointCount.h>
 #include <openvdb/tools/PointIndexGrid.h>
+#include <octree_layout.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -24,6 +25,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/isolate.h"
 #include "vdb/vdb_file.h"
 #include "vdb/vdb_internal.h"
 
@@ -35,11 +37,48 @@ void initOpenVdb() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
+std::string clipped(const std::string& text) {
+  constexpr size_t kMax = 400;
+  if (text.size() <= kMax) return text;
+  return text.substr(0, kMax) + "... (" + std::to_string(text.size() - kMax) + " more characters)";
+}
+
+IsolationLimits readLimits(uintmax_t fileBytes) {
+  IsolationLimits limits;
+  limits.memoryBytes = kReadMemoryBaseBytes + size_t(kReadMemoryPerFileByte * double(fileBytes));
+  limits.seconds = kReadSecondsBase + double(fileBytes) * kReadSecondsPerByte;
+  return limits;
+}
+
 OpenedFile openFile(const std::string& path) {
   initOpenVdb();
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(path + ": file does not exist");
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
+  // OpenVDB trusts the sizes a file states: a damaged file can make it
+  // allocate gigabytes, loop for minutes or corrupt the heap. A child
+  // process reads it first under limits; only a file it read whole is read
+  // here (docs/robustness.md, "Reading untrusted files").
+  const uintmax_t bytes = std::filesystem::file_size(path, ec);
+  const IsolationLimits limits = readLimits(ec ? 0 : bytes);
+  const IsolatedRun trial = runIsolated(
+      [&](std::string&) {
+        openvdb::io::File file(path);
+        file.open(false);
+        file.getMetadata();
+        file.getGrids();
+        file.close();
+        return 0;
+      },
+      limits);
+  if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode != 0) {
+    throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(trial.message));
+  }
+  if (trial.outcome != IsolatedRun::Outcome::Finished &&
+      trial.outcome != IsolatedRun::Outcome::NotIsolated) {
+    throw InputError(path + ": damaged or not an OpenVDB file: reading it " +
+                     trial.ToString(limits));
+  }
   OpenedFile f;
   try {
     openvdb::io::File file(path);
@@ -50,7 +89,7 @@ OpenedFile openFile(const std::string& path) {
     f.grids = file.getGrids();
     file.close();
   } catch (const std::exception& e) {
-    throw InputError(path + ": cannot read as an OpenVDB file: " + e.what());
+    throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(e.what()));
   }
   if (!f.grids || !f.meta) throw InputError(path + ": cannot read as an OpenVDB file");
   return f;
@@ -584,6 +623,10 @@ void checkValues(const std::string& path, const VdlGrid& g) {
     const Coord& c = g.coords[v];
     if (!isFinite(g.irradiance[v])) fail(c, "irradiance");
     if (!isFinite(g.normals[v])) fail(c, "normal");
+    if (!std::isfinite(g.photonCount[v]) || !std::isfinite(g.radius[v]) ||
+        !std::isfinite(g.areas[v]) || !std::isfinite(g.angularError[v])) {
+      fail(c, "photon_count, radius, area or angular_error");
+    }
     for (int i = 0; i < g.vdlCount[v]; ++i) {
       const Vdl& vdl = g.vdlsOf(v)[i];
       if (!isFinite(vdl.irradiance) || !isFinite(vdl.direction)) fail(c, "VDL " + std::to_string(i));
@@ -1060,6 +1103,8 @@ PointFileInfo inspectPointFile(const std::string& path) {
   return info;
 }
 
+LoadedVdl readVdlStructure(const std::string& path) { return readVdl(path); }
+
 }  // namespace vdb_internal
 
 const std::vector<std::string>& optionalVdlGridNames() {
@@ -1078,7 +1123,134 @@ std::vector<Photon> readPhotonPoints(const std::string& path) {
   return vdb_internal::readPoints(path);
 }
 
-LoadedVdl readVdlGrid(const std::string& path) { return vdb_internal::readVdl(path); }
+LoadedVdl readVdlGrid(const std::string& path) {
+  LoadedVdl loaded = vdb_internal::readVdl(path);
+  for (const VdbCheck& c : checkLightGridValues(loaded.grid, loaded.halfFloat)) {
+    if (!c.passed) {
+      throw InputError(path + ": check " + c.name + " fails: " + c.detail +
+                       " (`lightoctree inspect` lists every check)");
+    }
+  }
+  return loaded;
+}
+
+std::vector<VdbCheck> checkLightGridValues(const VdlGrid& g, bool halfFloat) {
+  const double sumTol = halfFloat ? kVdlSumToleranceHalf : kVdlSumTolerance;
+  const bool sh = g.shTerms > 0;
+  auto num = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", v);
+    return std::string(text);
+  };
+  uint64_t badCount = 0, negative = 0, outOfRange = 0, notUnit = 0, badSum = 0;
+  std::string firstCount, firstNegative, firstRange, firstNotUnit, firstSum;
+  double worstUnit = 0, worstSum = 0;
+  auto negativeIn = [](const Vec3& v) { return v.x < 0 || v.y < 0 || v.z < 0; };
+  auto beyond = [](const Vec3& v) {
+    return std::fabs(v.x) > kMaxStoredIrradiance || std::fabs(v.y) > kMaxStoredIrradiance ||
+           std::fabs(v.z) > kMaxStoredIrradiance;
+  };
+  // One voxel's (or layer's) light: its checks, given where it is named.
+  auto check = [&](const std::string& where, const Vec3& e, const Vec3& normal, int count,
+                   const Vdl* vdls, const Vec3* terms, uint64_t& sums, std::string& firstSumText) {
+    if (count < 0 || count > g.maxVdls) {
+      if (badCount++ == 0) firstCount = where + " holds " + std::to_string(count);
+      return;
+    }
+    bool neg = negativeIn(e), big = beyond(e);
+    double sum[3] = {0, 0, 0};
+    double scale = std::max({double(e.x), double(e.y), double(e.z)});
+    for (int i = 0; i < count; ++i) {
+      const Vdl& v = vdls[i];
+      neg = neg || negativeIn(v.irradiance);
+      big = big || beyond(v.irradiance);
+      for (int k = 0; k < 3; ++k) {
+        sum[k] += double(v.irradiance[k]);
+        scale = std::max(scale, double(std::fabs(v.irradiance[k])));
+      }
+      const double dev = std::fabs(double(length(v.direction)) - 1.0);
+      worstUnit = std::max(worstUnit, std::isfinite(dev) ? dev : 1e30);
+      if (!(dev < kUnitDirectionTolerance) && notUnit++ == 0) {
+        firstNotUnit = where + " VDL " + std::to_string(i) + " has a direction of length " +
+                       num(double(length(v.direction)));
+      }
+    }
+    if (sh) {
+      const Vec3 n = normal;
+      for (int k = 0; k < 3; ++k) sum[k] = 0;
+      for (int i = 0; i < g.shTerms; ++i) {
+        big = big || beyond(terms[i]);
+        const double y = double(layout::loShBasis(uint32_t(i), n.x, n.y, n.z));
+        for (int k = 0; k < 3; ++k) {
+          sum[k] += double(terms[i][k]) * y;
+          scale = std::max(scale, double(std::fabs(terms[i][k])));
+        }
+      }
+    }
+    if (neg && negative++ == 0) firstNegative = where;
+    if (big && outOfRange++ == 0) firstRange = where;
+    double diff = 0;
+    for (int k = 0; k < 3; ++k) diff = std::max(diff, std::fabs(sum[k] - double(e[k])));
+    const double rel = scale > 0 ? diff / scale : (diff > 0 ? 1e30 : 0.0);
+    worstSum = std::max(worstSum, std::isfinite(rel) ? rel : 1e30);
+    if (!(rel <= sumTol) && sums++ == 0) {
+      firstSumText = where + (sh ? ": SH at the normal" : ": sum of VDLs") + " differs by " +
+                     num(rel) + " of the irradiance";
+    }
+  };
+  for (size_t v = 0; v < g.size(); ++v) {
+    check("voxel " + g.coords[v].ToString(), g.irradiance[v], g.normals[v], g.vdlCount[v],
+          g.vdlsOf(v), sh ? g.shOf(v) : nullptr, badSum, firstSum);
+  }
+  const std::string of = " of " + std::to_string(g.size()) + " voxels";
+  std::vector<VdbCheck> checks;
+  checks.push_back({"vdl_count", badCount == 0,
+                    badCount ? std::to_string(badCount) + of + " hold more than " +
+                                   std::to_string(g.maxVdls) + " VDLs; first " + firstCount
+                             : "integers in [0, " + std::to_string(g.maxVdls) + "]"});
+  checks.push_back({"irradiance_non_negative", negative == 0,
+                    negative ? std::to_string(negative) + " voxels or layers with a negative "
+                                   "channel; first " + firstNegative
+                             : std::string(sh ? "irradiance >= 0" : "irradiance and VDL irradiance >= 0")});
+  checks.push_back({"irradiance_range", outOfRange == 0,
+                    outOfRange ? std::to_string(outOfRange) + " voxels or layers beyond " +
+                                     num(kMaxStoredIrradiance) + " W/m^2; first " + firstRange
+                               : "every value within " + num(kMaxStoredIrradiance) + " W/m^2"});
+  checks.push_back({"unit_directions", notUnit == 0,
+                    (notUnit ? std::to_string(notUnit) + " used VDL slots not unit; first " +
+                                   firstNotUnit
+                             : std::string("used VDL slots unit")) +
+                        " (largest |length - 1| " + num(worstUnit) + ", allowed " +
+                        num(kUnitDirectionTolerance) + ")"});
+  checks.push_back({sh ? "sh_sum" : "vdl_sum", badSum == 0,
+                    (badSum ? std::to_string(badSum) + of + " off; first " + firstSum
+                            : std::string(sh ? "SH irradiance at each voxel's normal is its "
+                                               "irradiance"
+                                             : "VDLs sum to the irradiance")) +
+                        " (largest relative difference " + num(worstSum) + ", allowed " +
+                        num(sumTol) + (halfFloat ? ", half floats)" : ")")});
+  if (g.layers.size() > 0) {
+    uint64_t layerSums = 0;
+    std::string firstLayerSum;
+    const double voxelWorst = worstSum;
+    worstSum = 0;
+    for (size_t e = 0; e < g.layers.size(); ++e) {
+      check("layer of voxel " + g.coords[g.layers.voxel[e]].ToString(), g.layers.irradiance[e],
+            g.layers.normals[e], g.layers.vdlCount[e], g.layerVdlsOf(e),
+            sh ? g.layerShOf(e) : nullptr, layerSums, firstLayerSum);
+    }
+    checks.push_back({"layers", layerSums == 0,
+                      layerSums ? std::to_string(layerSums) + " of " +
+                                      std::to_string(g.layers.size()) + " layers off; first " +
+                                      firstLayerSum
+                                : std::to_string(g.layers.size()) +
+                                      " extra surface layers; their light sums to their "
+                                      "irradiance (largest relative difference " +
+                                      num(worstSum) + ")"});
+    worstSum = voxelWorst;
+  }
+  return checks;
+}
 
 void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons,
                        float voxelSize) {

@@ -49,8 +49,40 @@ struct LoadedVdl {
   bool halfFloat = false;  ///< the irradiance grid was stored as half floats
 };
 
+/// One check of a light grid's meaning, as `inspect` reports it.
+struct VdbCheck {
+  std::string name;  ///< e.g. "unit_directions"
+  bool passed = true;
+  std::string detail;  ///< what was measured / the first offending voxel
+};
+
+/// Tolerance of the sum checks ("vdl_sum": Σ VDL irradiance = irradiance;
+/// "sh_sum": E(normal) = irradiance), relative to the voxel's largest
+/// irradiance channel: full floats, and half floats (up to 9 values each
+/// rounded to 11 bits, ~2.4e-4 each).
+constexpr double kVdlSumTolerance = 1e-4;
+constexpr double kVdlSumToleranceHalf = 3e-3;
+/// |length − 1| allowed for the directions of used VDL slots.
+constexpr double kUnitDirectionTolerance = 1e-3;
+/// Largest irradiance (any channel, any VDL or SH term) a file may hold,
+/// W/m^2: far above any light (the sun gives 1.4e3), far enough below
+/// float's 3.4e38 that the shader's sums and the cosine correction (x4)
+/// stay finite.
+constexpr double kMaxStoredIrradiance = 1e30;
+
+/// The meaning of a light grid's values, one validation for every reader
+/// (readVdlGrid refuses a grid that fails any; `inspect` reports them all):
+/// vdl_count (integers within max_vdls), irradiance_non_negative (the
+/// voxels' and VDLs' irradiance; SH terms may be negative),
+/// irradiance_range (kMaxStoredIrradiance), unit_directions (used VDL
+/// slots), vdl_sum or sh_sum, and layers (the same for surface layers, when
+/// there are any). `halfFloat`: the grids were stored as halves (the sum
+/// tolerance follows the storage precision).
+std::vector<VdbCheck> checkLightGridValues(const VdlGrid& grid, bool halfFloat);
+
 /// Reads a file written by writeVdlGrid. @throws InputError naming the file and
-/// the missing grid / mismatched transform / unreadable content.
+/// the missing grid / mismatched transform / unreadable content, or the first
+/// check of checkLightGridValues it fails (the check `inspect` names).
 /// Files with a format_version above kVdlFormatVersion are refused.
 LoadedVdl readVdlGrid(const std::string& path);
 

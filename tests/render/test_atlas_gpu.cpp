@@ -193,7 +193,9 @@ void expectLayeredBakeMatches(LightRepresentation representation, float toleranc
   op.compact = true;
   op.tolerance = tolerance;
   const GpuOctree octree = buildGpuOctree(baked.grid, op);
-  if (tolerance > 0) ASSERT_GT(octree.collapsedLeaves, 0u);
+  if (tolerance > 0) {
+    ASSERT_GT(octree.collapsedLeaves, 0u);
+  }
   LightmapParams lp;
   lp.atlas.stitchSeams = false;
   const LightmapBake cpu = bakeLightmap(scene, octree, lp);

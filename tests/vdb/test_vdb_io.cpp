@@ -48,18 +48,23 @@ VdlGrid makeGrid(size_t voxels, int maxVdls, uint64_t seed) {
   g.coords.assign(unique.begin(), unique.end());
   std::sort(g.coords.begin(), g.coords.end(), canonicalLess);
   auto vec = [&] { return Vec3(rng.uniform(), rng.uniform() - 0.5f, rng.uniform() * 3.0f); };
+  // Random but meaningful values (the reader checks them, vdb_io.h's
+  // checkLightGridValues): irradiance >= 0 and the sum of the VDLs.
+  auto light = [&] { return Vec3(rng.uniform(), rng.uniform() * 0.5f, rng.uniform() * 3.0f); };
   for (size_t v = 0; v < voxels; ++v) {
     g.normals.push_back(normalize(vec()));
     g.areas.push_back(rng.uniform() * 0.01f);
-    g.irradiance.push_back(vec());
     g.photonCount.push_back(float(rng.uniformInt(301)));
     g.radius.push_back(rng.uniform() * 0.1f);
     g.angularError.push_back(rng.uniform() * 0.5f);
     uint8_t count = uint8_t(rng.uniformInt(uint32_t(maxVdls) + 1));
     g.vdlCount.push_back(count);
+    Vec3 sum{0, 0, 0};
     for (int i = 0; i < maxVdls; ++i) {
-      g.vdls.push_back(i < count ? Vdl{vec(), normalize(vec())} : Vdl{});
+      g.vdls.push_back(i < count ? Vdl{light(), normalize(vec())} : Vdl{});
+      sum += g.vdls.back().irradiance;
     }
+    g.irradiance.push_back(sum);
   }
   return g;
 }

@@ -1,0 +1,147 @@
+#include "core/isolate.h"
+
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <algorithm>
+#include <cstring>
+#include <new>
+#include <thread>
+
+#include "core/resources.h"
+
+namespace lo {
+
+namespace {
+
+/// Virtual memory of this process now (VmSize), bytes; 0 if unknown.
+size_t virtualBytes() {
+  std::ifstream statm("/proc/self/statm");
+  size_t pages = 0;
+  if (!(statm >> pages)) return 0;
+  return pages * size_t(sysconf(_SC_PAGESIZE));
+}
+
+}  // namespace
+
+std::string IsolatedRun::ToString(const IsolationLimits& limits) const {
+  char text[160];
+  switch (outcome) {
+    case Outcome::Finished:
+      return "";
+    case Outcome::OutOfMemory:
+      return "needed more than " + formatBytes(limits.memoryBytes) + " of memory";
+    case Outcome::TimedOut:
+      std::snprintf(text, sizeof text, "took longer than %.0f s", limits.seconds);
+      return text;
+    case Outcome::Crashed:
+      return std::string("crashed the reader (signal ") + std::to_string(signal) + ", " +
+             strsignal(signal) + ")";
+    case Outcome::NotIsolated:
+      return "could not be read in a separate process";
+  }
+  return "";
+}
+
+IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
+                        const IsolationLimits& limits) {
+  IsolatedRun run;
+  int channel[2];
+  if (pipe(channel) != 0) return run;
+  std::fflush(nullptr);  // no buffered output written twice
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(channel[0]);
+    close(channel[1]);
+    return run;
+  }
+  if (pid == 0) {
+    // The child: limits, then the work. _exit: no atexit handlers, no
+    // destructors of the parent's objects.
+    close(channel[0]);
+#if !defined(__SANITIZE_ADDRESS__)
+    const size_t base = virtualBytes();
+    if (base > 0) {
+      const rlim_t cap = rlim_t(base + limits.memoryBytes);
+      const rlimit as{cap, cap};
+      setrlimit(RLIMIT_AS, &as);
+    }
+#endif
+    const rlim_t cpu = rlim_t(std::ceil(limits.seconds));
+    const rlimit cpuLimit{cpu, cpu + 1};
+    setrlimit(RLIMIT_CPU, &cpuLimit);
+    const rlimit noCore{0, 0};
+    setrlimit(RLIMIT_CORE, &noCore);
+    int code = 125;
+    std::string message;
+    try {
+      code = work(message);
+    } catch (const std::bad_alloc&) {
+      code = 124;
+    } catch (const std::exception& e) {
+      code = 125;
+      try {
+        message = e.what();
+      } catch (...) {
+        message.clear();
+      }
+    } catch (...) {
+      code = 125;
+    }
+    const size_t n = std::min(message.size(), kIsolatedMessageBytes);
+    for (size_t sent = 0; sent < n;) {
+      const ssize_t w = write(channel[1], message.data() + sent, n - sent);
+      if (w <= 0) break;
+      sent += size_t(w);
+    }
+    close(channel[1]);
+    _exit(code);
+  }
+  close(channel[1]);
+  // The parent: wait, killing the child at the wall-clock limit.
+  const auto start = std::chrono::steady_clock::now();
+  int status = 0;
+  bool killed = false;
+  for (auto pause = std::chrono::microseconds(200);;) {
+    const pid_t done = waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0) {  // lost the child: not isolated
+      close(channel[0]);
+      return run;
+    }
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!killed && elapsed > limits.seconds) {
+      kill(pid, SIGKILL);
+      killed = true;
+    }
+    std::this_thread::sleep_for(pause);
+    pause = std::min(pause * 2, std::chrono::microseconds(20000));
+  }
+  char buffer[512];
+  for (ssize_t r; (r = read(channel[0], buffer, sizeof buffer)) > 0;) {
+    run.message.append(buffer, size_t(r));
+  }
+  close(channel[0]);
+  if (killed) {
+    run.outcome = IsolatedRun::Outcome::TimedOut;
+  } else if (WIFEXITED(status)) {
+    run.exitCode = WEXITSTATUS(status);
+    run.outcome = run.exitCode == 124 ? IsolatedRun::Outcome::OutOfMemory
+                                      : IsolatedRun::Outcome::Finished;
+  } else if (WIFSIGNALED(status)) {
+    run.signal = WTERMSIG(status);
+    run.outcome = run.signal == SIGXCPU || run.signal == SIGKILL
+                      ? IsolatedRun::Outcome::TimedOut
+                      : IsolatedRun::Outcome::Crashed;
+  }
+  return run;
+}
+
+}  // namespace lo

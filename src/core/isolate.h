@@ -1,0 +1,51 @@
+#pragma once
+/// @file core/isolate.h
+/// @brief Runs a piece of work on untrusted input in a child process under a
+/// memory and time limit (docs/robustness.md, "Reading untrusted files"). A
+/// damaged file can make a third-party reader allocate gigabytes, loop for
+/// minutes or corrupt the heap; in the child that costs a refusal, not the
+/// caller's process. POSIX (fork); the work must not need other threads.
+
+#include <cstddef>
+#include <functional>
+#include <string>
+
+namespace lo {
+
+struct IsolationLimits {
+  size_t memoryBytes = size_t(1) << 30;  ///< address space the work may add
+  double seconds = 20;                   ///< wall-clock and CPU time
+};
+
+struct IsolatedRun {
+  enum class Outcome {
+    Finished,     ///< the work returned; `exitCode` is its return value
+    OutOfMemory,  ///< it threw std::bad_alloc under the memory limit
+    TimedOut,     ///< killed at the time limit
+    Crashed,      ///< ended by a signal (`signal`): a segfault, an abort
+    NotIsolated,  ///< fork failed: the caller decides (e.g. runs the work itself)
+  };
+  Outcome outcome = Outcome::NotIsolated;
+  int exitCode = 0;
+  int signal = 0;
+  /// What the work put in its message (at most kIsolatedMessageBytes), e.g.
+  /// the text of the exception that ended it.
+  std::string message;
+  /// One sentence for an error message, e.g. "needed more than 1.00 GiB of
+  /// memory"; empty when Finished.
+  std::string ToString(const IsolationLimits& limits) const;
+};
+
+/// Longest message a child passes back; longer ones are cut there.
+constexpr size_t kIsolatedMessageBytes = 2000;
+
+/// Runs `work` in a forked child under `limits` and reports how it ended.
+/// The child's return value is its exit code (0-123) and `message` (set by
+/// the work) comes back in IsolatedRun::message; an exception other than
+/// std::bad_alloc ends it with exit code 125 and its what() as the message.
+/// Under AddressSanitizer the memory limit is not applied (its shadow memory
+/// needs the address space).
+IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
+                        const IsolationLimits& limits);
+
+}  // namespace lo
