@@ -369,12 +369,15 @@ class GltfReader {
     if (acc.count > (size_t(1) << 28)) {
       fail(path_, name + " count " + std::to_string(acc.count) + " is out of range");
     }
-    std::vector<double> out(acc.count * size_t(comps), 0.0);
+    // Sizes are checked against the bytes that back them before anything is
+    // allocated: a small file must not cost gigabytes (docs/robustness.md).
     size_t elemSize = size_t(comps) * size_t(csize);
+    const unsigned char* data = nullptr;
+    size_t stride = elemSize;
     if (acc.bufferView >= 0) {
-      const unsigned char* data = viewData(acc.bufferView, name);
+      data = viewData(acc.bufferView, name);
       const tinygltf::BufferView& bv = model_.bufferViews[size_t(acc.bufferView)];
-      size_t stride = bv.byteStride ? bv.byteStride : elemSize;
+      stride = bv.byteStride ? bv.byteStride : elemSize;
       if (stride < elemSize) {
         fail(path_, name + ": byteStride " + std::to_string(stride) +
                         " is smaller than the element size " + std::to_string(elemSize));
@@ -387,6 +390,20 @@ class GltfReader {
                           " bytes, view has " + std::to_string(bv.byteLength) + ")");
         }
       }
+    } else if (acc.sparse.isSparse) {
+      // No bufferView: zeros but for the sparse values. Such an accessor may
+      // hold at most kMaxImplicitElementsPerSparse elements per sparse value.
+      const size_t limit =
+          std::max<size_t>(kMinImplicitElements,
+                           kMaxImplicitElementsPerSparse * size_t(std::max(0, acc.sparse.count)));
+      if (acc.count > limit) {
+        fail(path_, name + " has no bufferView: " + std::to_string(acc.count) +
+                        " implicit zero elements for " + std::to_string(acc.sparse.count) +
+                        " sparse values, more than the " + std::to_string(limit) + " allowed");
+      }
+    }
+    std::vector<double> out(acc.count * size_t(comps), 0.0);
+    if (data) {
       for (size_t e = 0; e < acc.count; ++e)
         for (int c = 0; c < comps; ++c)
           out[e * size_t(comps) + size_t(c)] =

@@ -213,6 +213,13 @@ constexpr float kMaxCoordinate = 1e12f;
 /// parsers recurse once per level, and nothing in glTF needs more.
 constexpr size_t kMaxJsonDepth = 256;
 
+/// A glTF accessor without a bufferView (zeros but for its sparse values)
+/// may hold at most max(kMinImplicitElements, kMaxImplicitElementsPerSparse x
+/// its sparse count) elements: a few hundred bytes must not stand for
+/// gigabytes of zeros. Accessors with a bufferView are bounded by its bytes.
+constexpr size_t kMinImplicitElements = size_t(1) << 16;
+constexpr size_t kMaxImplicitElementsPerSparse = 1024;
+
 /// @brief The index checks every stage that walks the triangles relies on:
 /// index count a multiple of 3, fewer than 2^32 - 1 triangles, every vertex
 /// index inside `positions`, every vertex position finite, one material index

@@ -1,0 +1,125 @@
+// Fuzzing the readers with damaged files, deterministically (seeded), in CI:
+// every mutation of a real .vdb bake and of the bundled glTF scene must load
+// or be refused with an InputError naming the file, never crash, hang or
+// throw anything else (docs/robustness.md). The .vdb readers run each file
+// through their child-process trial read (core/isolate.h) first.
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "core/error.h"
+#include "core/rng.h"
+#include "scene/scene.h"
+#include "test_util.h"
+#include "vdb/vdb_inspect.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+namespace {
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+void writeBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+/// One damage of `bytes`, chosen by `rng`: a flipped bit, a run of random
+/// bytes, a run of 0xff (the sizes and counts a reader trusts, made huge), a
+/// truncation, or a copied block (structure repeated out of place).
+std::string mutate(const std::string& bytes, Rng& rng) {
+  std::string out = bytes;
+  const size_t n = out.size();
+  const uint32_t kind = rng.uniformInt(5);
+  const size_t at = size_t(rng.uniformInt(uint32_t(n)));
+  switch (kind) {
+    case 0:
+      out[at] = char(out[at] ^ char(1u << rng.uniformInt(8)));
+      break;
+    case 1:
+      for (size_t i = at; i < std::min(n, at + 1 + rng.uniformInt(8)); ++i) {
+        out[i] = char(rng.uniformInt(256));
+      }
+      break;
+    case 2:
+      for (size_t i = at; i < std::min(n, at + 4 + rng.uniformInt(5)); ++i) out[i] = char(0xff);
+      break;
+    case 3:
+      out.resize(at);
+      break;
+    default: {
+      const size_t from = size_t(rng.uniformInt(uint32_t(n)));
+      const size_t len = std::min({size_t(1 + rng.uniformInt(64)), n - from, n - at});
+      out.replace(at, len, bytes.substr(from, len));
+    }
+  }
+  return out;
+}
+
+struct Tally {
+  int loaded = 0, refused = 0;
+};
+
+/// Runs `load` on `path`: loaded or an InputError naming the file; anything
+/// else fails the test.
+template <class Load>
+void expectLoadsOrRefuses(const std::string& path, Load load, Tally& tally, const std::string& what) {
+  try {
+    load(path);
+    ++tally.loaded;
+  } catch (const InputError& e) {
+    ++tally.refused;
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << what << ": " << e.what();
+    EXPECT_LT(std::string(e.what()).size(), 3000u) << what << ": a message of "
+                                                    << std::string(e.what()).size() << " bytes";
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << what << ": " << typeid(e).name() << ": " << e.what();
+  }
+}
+
+TEST(Fuzz, DamagedVdbFilesAreReadOrRefusedCleanly) {
+  const std::string dir = test::outputDir("Fuzz.Vdb");
+  const std::string original = readBytes(test::dataDir() + "/../tests/golden/cornell-box-d4.vdb");
+  ASSERT_GT(original.size(), 1000u);
+  Rng rng(2026, 12);
+  Tally reader, inspector;
+  constexpr int kMutations = 120;
+  for (int i = 0; i < kMutations; ++i) {
+    const std::string path = dir + "/m" + std::to_string(i) + ".vdb";
+    writeBytes(path, mutate(original, rng));
+    expectLoadsOrRefuses(path, [](const std::string& p) { readVdlGrid(p); }, reader,
+                         "readVdlGrid, mutation " + std::to_string(i));
+    expectLoadsOrRefuses(path, [](const std::string& p) { inspectVdb(p); }, inspector,
+                         "inspectVdb, mutation " + std::to_string(i));
+  }
+  std::printf(".vdb mutations: reader %d loaded / %d refused; inspect %d read / %d refused\n",
+              reader.loaded, reader.refused, inspector.loaded, inspector.refused);
+  EXPECT_GT(reader.refused, kMutations / 4);  // the damage was real
+}
+
+TEST(Fuzz, DamagedGltfScenesAreLoadedOrRefusedCleanly) {
+  const std::string dir = test::outputDir("Fuzz.Gltf");
+  const std::string original = readBytes(test::dataDir() + "/cornell-box.gltf");
+  ASSERT_GT(original.size(), 1000u);
+  Rng rng(2026, 13);
+  Tally tally;
+  constexpr int kMutations = 300;
+  for (int i = 0; i < kMutations; ++i) {
+    const std::string path = dir + "/m" + std::to_string(i) + ".gltf";
+    writeBytes(path, mutate(original, rng));
+    expectLoadsOrRefuses(path, [](const std::string& p) { loadScene(p); }, tally,
+                         "loadScene, mutation " + std::to_string(i));
+  }
+  std::printf(".gltf mutations: %d loaded / %d refused\n", tally.loaded, tally.refused);
+  EXPECT_GT(tally.refused, kMutations / 4);
+}
+
+}  // namespace
+}  // namespace lo
