@@ -204,6 +204,43 @@ void checkParams(const BakeParams& p) {
 
 }  // namespace
 
+double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bounds3& region) {
+  double area = 0;
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    if (!region.empty()) {
+      Bounds3 b;
+      for (int k = 0; k < 3; ++k) b.extend(scene.positions[scene.indices[3 * t + size_t(k)]]);
+      if (b.lower.x > region.upper.x || b.upper.x < region.lower.x || b.lower.y > region.upper.y ||
+          b.upper.y < region.lower.y || b.lower.z > region.upper.z || b.upper.z < region.lower.z) {
+        continue;
+      }
+    }
+    area += double(scene.triangleArea(t));
+  }
+  const double h = double(frame.voxelSize);
+  return h > 0 ? area / (h * h) : 0.0;
+}
+
+void checkBakeMemory(const Scene& scene, const BakeParams& params) {
+  const size_t available = availableMemoryBytes();
+  if (available == 0 || scene.triangleCount() == 0) return;
+  const GridFrame frame =
+      makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth);
+  const double voxels = estimateActiveVoxels(scene, frame, params.region);
+  const double needed =
+      voxels * double(kBakeBytesPerVoxel) + double(params.photons) * double(kBakeBytesPerPhoton);
+  if (needed > double(available)) {
+    throw InputError("--depth " + std::to_string(params.depth) + ": the scene's surfaces cross " +
+                     "about " + formatCount(size_t(voxels)) + " voxels of " +
+                     formatNumber(frame.voxelSize) + " scene units, which with the photons " +
+                     "need about " + formatBytes(size_t(needed)) + " (" +
+                     std::to_string(kBakeBytesPerVoxel) + " bytes per voxel), more than the " +
+                     formatBytes(available) +
+                     " of memory available: bake at a smaller --depth, or only the part "
+                     "that matters (--bounds)");
+  }
+}
+
 std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
   if (st.emittedPaths == 0 ||
       !(st.storedPhotons < params.photons || 10 * st.emptyPaths > 9 * st.emittedPaths)) {
@@ -235,6 +272,7 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
                        "): bake at a smaller --depth, or the scene in larger units");
     }
   }
+  checkBakeMemory(scene, params);
   BakeResult r;
   BakeStats& s = r.stats;
   s.triangles = scene.triangleCount();

@@ -44,6 +44,11 @@ void checkDepth(int depth, const std::string& what = "--depth");
 /// copy), bytes: checked against the memory available before tracing.
 constexpr size_t kBakeBytesPerPhoton = 120;
 
+/// Peak memory a bake needs per active voxel (the surface grid, the photon
+/// bins, the VDL grid and its layers), bytes: measured on the Cornell box at
+/// depths 7 to 9 (peak RSS / active voxels, 1.04 KB; docs/robustness.md).
+constexpr size_t kBakeBytesPerVoxel = 1000;
+
 /// Smallest voxel a .vdb transform stores, scene units: OpenVDB refuses
 /// scales whose cube is below 3e-15 (with a margin).
 constexpr double kMinStorableVoxel = 1.5e-5;
@@ -180,6 +185,18 @@ struct BakeResult {
 /// its first bounce, which is not stored; a sun over open ground wastes
 /// nearly all of them).
 std::string photonBudgetWarning(const BakeParams& params, const BakeStats& stats);
+
+/// Active voxels a bake at `frame` will have, from the area of the scene's
+/// surfaces (inside `region` when it is set): area / h^2, what a surface
+/// lying along the grid crosses (1.04x that was measured on the Cornell box;
+/// slanted surfaces cross up to sqrt(3)x more, so this rather underestimates).
+double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bounds3& region);
+
+/// Refuses, before any work, a bake whose voxels (estimateActiveVoxels x
+/// kBakeBytesPerVoxel) and photons (kBakeBytesPerPhoton) need more memory
+/// than is available (availableMemoryBytes), naming --depth and the figures.
+void checkBakeMemory(const Scene& scene, const BakeParams& params);
+
 
 /// @brief Bakes `scene` with `params` (paper §3.1). Deterministic. Without
 /// params.region, the scene's marked region (Scene::region) is the region.
