@@ -8,6 +8,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   cmake g++ make pkg-config ninja-build
+  # libFuzzer targets of the readers (tools/fuzz.sh): clang and its fuzzer runtime
+  clang libclang-rt-14-dev
   # scene loading: glTF 2.0 and OBJ/MTL, image decoding for textures
   libtinygltf-dev nlohmann-json3-dev libtinyobjloader-dev libstb-dev
   # photon tracing and parallelism

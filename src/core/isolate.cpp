@@ -16,6 +16,12 @@
 
 #include "core/resources.h"
 
+// Sanitizer runtimes (AddressSanitizer, libFuzzer's) call a death callback
+// when they report an error; a fuzzer's dumps the current input as a finding.
+// In the child an error is the refusal the caller expects, so it is unset
+// there. Weak: absent without a sanitizer.
+extern "C" void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
+
 namespace lo {
 
 namespace {
@@ -63,8 +69,11 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
   }
   if (pid == 0) {
     // The child: limits, then the work. _exit: no atexit handlers, no
-    // destructors of the parent's objects.
+    // destructors of the parent's objects. Fatal signals end it as signals
+    // (a sanitizer's or fuzzer's handler would turn them into exit codes).
     close(channel[0]);
+    for (int fatal : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) signal(fatal, SIG_DFL);
+    if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
 #if !defined(__SANITIZE_ADDRESS__)
     const size_t base = virtualBytes();
     if (base > 0) {
