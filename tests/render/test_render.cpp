@@ -1128,7 +1128,8 @@ TEST(RenderImage, MirrorReflectsTheWallItsRayHits) {
   EXPECT_LT(c[2], 0.05f) << "the ceiling's blue: the reflection was not box-projected";
   // Without the probe, nothing lights the mirror.
   p.reflections = false;
-  const float* off = renderer.render(camera, p).pixel(p.width / 2, p.height / 2);
+  const RgbImage dark = renderer.render(camera, p);  // kept: pixel() points into it
+  const float* off = dark.pixel(p.width / 2, p.height / 2);
   EXPECT_LT(off[0] + off[1] + off[2], 1e-4f);
 }
 

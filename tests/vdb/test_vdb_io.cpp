@@ -2,6 +2,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <functional>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -481,6 +482,59 @@ TEST(VdbIo, ConvertChainsKeepTheVdlSums) {
     }
     in = readVdlGrid(path);
   }
+}
+
+// Every conversion chain keeps the contract (issue "hardening, second
+// list"): all sequences of up to three steps among half-float storage, 1
+// and 8 VDLs, one depth coarser and one finer, from a small bake; after each
+// step the file passes every check of `inspect` (and so the reader).
+TEST(VdbIo, EveryConversionChainOfUpToThreeStepsKeepsTheContract) {
+  const Scene scene = test::pointLitRoom();
+  const BakeResult baked = smallRoomBake();
+  const std::string dir = test::outputDir("VdbIo.ConvertChains");
+  const std::vector<std::string> steps = {"half", "vdls 1", "vdls 8", "depth -1", "depth +1"};
+  size_t files = 0;
+  // Depth-first over the chains, each prefix converted once.
+  std::function<void(const LoadedVdl&, const std::string&, int)> extend =
+      [&](const LoadedVdl& in, const std::string& chain, int length) {
+        if (length == 3) return;
+        for (size_t k = 0; k < steps.size(); ++k) {
+          const std::string& step = steps[k];
+          const int depth = in.grid.frame.depth;
+          if ((step == "depth -1" && depth <= 2) || (step == "depth +1" && depth >= 5)) continue;
+          const std::string name = chain + (chain.empty() ? "" : "_") + std::to_string(k);
+          const std::string path = dir + "/" + name + ".vdb";
+          if (step == "half") {
+            VdlWriteOptions half;
+            half.halfFloat = true;
+            writeVdlGrid(path, in.grid, in.meta, half);
+          } else {
+            ConvertParams cp;
+            if (step.rfind("vdls", 0) == 0) cp.vdls = step.substr(5);
+            if (step == "depth -1") cp.depth = depth - 1;
+            if (step == "depth +1") {
+              cp.depth = depth + 1;
+              cp.scene = &scene;
+            }
+            const ConvertResult out = convertLightGrid(in.grid, in.meta, cp);
+            // A half-float input stays half-float, as `convert` keeps the storage.
+            VdlWriteOptions options;
+            options.halfFloat = in.halfFloat;
+            writeVdlGrid(path, out.grid, out.metadata, options);
+          }
+          ++files;
+          for (const VdbCheck& c : inspectVdb(path).checks) {
+            ASSERT_TRUE(c.passed) << "chain " << name << " (" << step << "): " << c.name << ": "
+                                  << c.detail;
+          }
+          extend(readVdlGrid(path), name, length + 1);
+        }
+      };
+  const std::string start = dir + "/start.vdb";
+  writeVdlGrid(start, baked.grid, baked.metadata);
+  extend(readVdlGrid(start), "", 0);
+  std::printf("conversion chains: %zu files, every one passes inspect\n", files);
+  EXPECT_GT(files, 120u);
 }
 
 }  // namespace
