@@ -262,6 +262,20 @@ TEST(Inspect, DamagedFilesFailTheirCheck) {
   expectCheck(damaged("negative", [](VdlGrid& g) { g.vdls[3].irradiance.y = -0.1f; }),
               "irradiance_non_negative", false);
   expectCheck(damaged("nan", [](VdlGrid& g) { g.radius[7] = NAN; }), "finite", false);
+  // A VDL of 3e38 (finite, but the shader's cosine correction and sums would
+  // overflow): irradiance_range.
+  expectCheck(damaged("huge", [](VdlGrid& g) {
+                g.vdls[0].irradiance.x = 3e38f;
+                g.irradiance[0].x = 3e38f;
+              }),
+              "irradiance_range", false);
+  // The reader every command uses refuses what inspect fails, naming the check.
+  for (const char* name : {"short", "sum", "negative", "huge"}) {
+    const std::string msg = readError(dir + "/" + name + ".vdb");
+    EXPECT_NE(msg.find("check "), std::string::npos) << name << ": " << msg;
+  }
+  EXPECT_NE(readError(dir + "/negative.vdb").find("irradiance_non_negative"), std::string::npos);
+  EXPECT_NE(readError(dir + "/huge.vdb").find("irradiance_range"), std::string::npos);
 }
 
 TEST(Inspect, CorruptedFilesAreInputErrors) {
