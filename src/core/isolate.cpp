@@ -1,5 +1,6 @@
 #include "core/isolate.h"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -8,7 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <algorithm>
 #include <cstring>
 #include <new>
@@ -26,11 +26,20 @@ namespace lo {
 
 namespace {
 
-/// Virtual memory of this process now (VmSize), bytes; 0 if unknown.
+/// Virtual memory of this process now (VmSize), bytes; 0 if unknown. Plain
+/// system calls: it runs in the forked child, where only async-signal-safe
+/// work is sure not to wait on a lock another thread of the parent held.
 size_t virtualBytes() {
-  std::ifstream statm("/proc/self/statm");
+  const int fd = open("/proc/self/statm", O_RDONLY);
+  if (fd < 0) return 0;
+  char text[64];
+  const ssize_t n = read(fd, text, sizeof text - 1);
+  close(fd);
+  if (n <= 0) return 0;
   size_t pages = 0;
-  if (!(statm >> pages)) return 0;
+  for (ssize_t i = 0; i < n && text[i] >= '0' && text[i] <= '9'; ++i) {
+    pages = pages * 10 + size_t(text[i] - '0');
+  }
   return pages * size_t(sysconf(_SC_PAGESIZE));
 }
 

@@ -22,11 +22,12 @@ void initOpenVdb();
 /// Reading untrusted files: a child process reads the file first with at
 /// most kReadMemoryBaseBytes + kReadMemoryPerFileByte x its size of memory
 /// and kReadSecondsBase + kReadSecondsPerByte x its size of time
-/// (core/isolate.h); a file it cannot read within them, or that crashes it,
-/// is refused without being read here.
+/// (core/isolate.h); a file it cannot read within them, or that crashes it
+/// (twice: a time-out or crash is tried again once), is refused without
+/// being read here.
 constexpr size_t kReadMemoryBaseBytes = size_t(512) << 20;
 constexpr double kReadMemoryPerFileByte = 64;
-constexpr double kReadSecondsBase = 20;
+constexpr double kReadSecondsBase = 10;
 constexpr double kReadSecondsPerByte = 1e-7;  // 10 s per 100 MB
 
 /// Reads every grid and the file metadata, without delayed loading so that

@@ -61,16 +61,22 @@ OpenedFile openFile(const std::string& path) {
   // here (docs/robustness.md, "Reading untrusted files").
   const uintmax_t bytes = std::filesystem::file_size(path, ec);
   const IsolationLimits limits = readLimits(ec ? 0 : bytes);
-  const IsolatedRun trial = runIsolated(
-      [&](std::string&) {
-        openvdb::io::File file(path);
-        file.open(false);
-        file.getMetadata();
-        file.getGrids();
-        file.close();
-        return 0;
-      },
-      limits);
+  auto trialRead = [&](std::string&) {
+    openvdb::io::File file(path);
+    file.open(false);
+    file.getMetadata();
+    file.getGrids();
+    file.close();
+    return 0;
+  };
+  IsolatedRun trial = runIsolated(trialRead, limits);
+  // A child forked from a process with other threads can, rarely, wait
+  // forever on a lock one of them held at the fork: a time-out or crash is
+  // tried once more before the file is refused (a damaged file fails again).
+  if (trial.outcome == IsolatedRun::Outcome::TimedOut ||
+      trial.outcome == IsolatedRun::Outcome::Crashed) {
+    trial = runIsolated(trialRead, limits);
+  }
   if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode != 0) {
     throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(trial.message));
   }
