@@ -158,6 +158,7 @@ TEST(Fuzz, SeedsAreLoadedOrRefusedCleanly) {
   std::printf("seeds: %d loaded, %d refused (%s)\n", tally.loaded, tally.refused, list.c_str());
   for (const char* reproducer : {"deep-extras.gltf", "index-beyond-int32.gltf",
                                  "huge-translation.gltf", "sparse-implicit-zeros.gltf",
+                                 "no-bufferview-no-sparse.gltf",
                                  "index-out-of-range.obj"}) {
     EXPECT_NE(std::find(refused.begin(), refused.end(), reproducer), refused.end()) << reproducer;
   }
