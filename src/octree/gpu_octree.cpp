@@ -464,13 +464,8 @@ GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
         (size_t(loVdlTexelY(uint(index))) * width + size_t(loVdlTexelX(uint(index)))) * 4;
     const Vec3 d = normalize(vdl.direction);
     const float packed = loPackDirection(d.x, d.y, d.z);
-    Vec3 irradiance = vdl.irradiance;
-    if (lengthSquared(normal) > 0.5f) {
-      // The cosine the shader will apply: with the decoded direction.
-      const Vec3 dq{loUnpackDirectionX(packed), loUnpackDirectionY(packed),
-                    loUnpackDirectionZ(packed)};
-      irradiance = irradiance / std::max(std::fabs(dot(normal, dq)), kMinCorrectionCosine);
-    }
+    // The cosine the shader will apply, with the decoded direction (zero normal: none).
+    const Vec3 irradiance = vdlIntensity(vdl, normal, true);
     if (out.compact) {
       const uint32_t bits = encodeRgb9e5(irradiance / out.irradianceScale);
       out.vdlTexelsHalf[offset] = uint16_t(bits & 0xffffu);
