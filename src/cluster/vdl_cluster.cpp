@@ -94,13 +94,16 @@ struct BakeBody {
   const std::vector<Photon>& photons;
   const ClusterParams& cluster;
   const LayerParams* layerParams;
+  const std::vector<uint32_t>* subset;
   tbb::enumerable_thread_specific<Worker>& workers;
   Progress& progress;
   VdlGrid& out;
 
   /// K-means of the gathered photons' directions. Each photon's share of the
   /// irradiance estimate E = sum(power) / (pi r_k^2 coverage) (W/m^2), so the
-  /// VDLs sum to the estimate. Layer l > 0 of voxel v seeds its stream with v + l n.
+  /// VDLs sum to the estimate. Layer l of the voxel at c seeds its stream with
+  /// canonicalVoxelKey(c) + l 2^36: the voxel's name whatever other voxels
+  /// the grid holds (a tile of a distributed bake seeds as the whole grid).
   ClusterResult clusterGathered(Worker& w, uint64_t stream, Vec3* sh) const {
     const GatherResult& g = w.gathered;
     w.samples.clear();
@@ -125,7 +128,9 @@ struct BakeBody {
     double gatherSeconds = 0, clusterSeconds = 0;
     const size_t maxVdls = size_t(out.maxVdls);
     SurfaceLayer found[kMaxLayers];
-    for (size_t v = range.begin(); v != range.end(); ++v) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const size_t v = subset ? size_t((*subset)[i]) : i;
+      const uint64_t stream = canonicalVoxelKey(grid.coords[v]);
       Clock::time_point t0 = Clock::now();
       const int layers = layerParams ? w.gatherer.findSurfaceLayers(v, *layerParams, found) : 0;
       // A voxel whose geometry faces several ways gathers along its layers'
@@ -142,7 +147,7 @@ struct BakeBody {
       const GatherResult& g = w.gathered;
       Clock::time_point t1 = Clock::now();
       const size_t terms = size_t(out.shTerms);
-      ClusterResult c = clusterGathered(w, v, out.sh.data() + v * terms);
+      ClusterResult c = clusterGathered(w, stream, out.sh.data() + v * terms);
       Clock::time_point t2 = Clock::now();
       gatherSeconds += secondsBetween(t0, t1);
       clusterSeconds += secondsBetween(t1, t2);
@@ -164,7 +169,7 @@ struct BakeBody {
         Worker::Layer layer{uint32_t(v), l, w.gathered.normal, found[l].point,
                             w.gathered.irradiance, float(w.gathered.photons.size()),
                             w.gathered.radius, ClusterResult{}, {}};
-        layer.vdls = clusterGathered(w, uint64_t(v) + uint64_t(l) * grid.size(), layer.sh.data());
+        layer.vdls = clusterGathered(w, stream + (uint64_t(l) << kCanonicalKeyBits), layer.sh.data());
         w.layers.push_back(layer);
         gatherSeconds += secondsBetween(t3, t4);
         clusterSeconds += secondsBetween(t4, Clock::now());
@@ -180,7 +185,8 @@ struct BakeBody {
 
 VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons,
                      const GatherParams& gather, const ClusterParams& cluster,
-                     ProgressSink* progress, BakeTimings* timings, const LayerParams* layers) {
+                     ProgressSink* progress, BakeTimings* timings, const LayerParams* layers,
+                     const std::vector<uint32_t>* subset) {
   using namespace vdl_grid_internal;
   if (cluster.vdls < 1 || cluster.vdls > kMaxVdls) {
     throw InputError("VDL count " + std::to_string(cluster.vdls) + " is outside [1, " +
@@ -215,11 +221,19 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
   tbb::enumerable_thread_specific<Worker> workers(
       [&] { return Worker(grid, photons, binned, gather); });
   {
-    Progress bar(progress, "gather + cluster", n);
+    const size_t count = subset ? subset->size() : n;
+    if (subset) {
+      for (size_t i = 0; i < count; ++i) {
+        LO_CHECK_LT(size_t((*subset)[i]), n);
+        if (i > 0) LO_CHECK_LT((*subset)[i - 1], (*subset)[i]);
+      }
+    }
+    Progress bar(progress, "gather + cluster", count);
     // Every voxel writes only its own slots and seeds its K-means with its
-    // index, so the result does not depend on the partition or thread count.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrainVoxels),
-                      BakeBody{grid, photons, cluster, layers, workers, bar, out});
+    // coordinate, so the result does not depend on the partition, the thread
+    // count or which other voxels the grid holds.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrainVoxels),
+                      BakeBody{grid, photons, cluster, layers, subset, workers, bar, out});
   }
 
   // Layers 1 and 2, gathered by whichever thread, in voxel and layer order.

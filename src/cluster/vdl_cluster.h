@@ -71,7 +71,9 @@ struct BakeTimings {
 };
 
 /// Gathers and clusters every active voxel (TBB over blocks of voxels,
-/// deterministic: each voxel's K-means stream is its index). With `layers`,
+/// deterministic: each voxel's K-means stream is its canonicalVoxelKey), or
+/// only the voxels `subset` lists (ascending indices; the others stay unlit
+/// and empty: a tile of a distributed bake). With `layers`,
 /// a voxel whose own photons face clearly different ways
 /// (Gatherer::findSurfaceLayers) gets one gather and one set of VDLs per
 /// orientation: layer 0 in the grid's arrays, the others in
@@ -79,7 +81,8 @@ struct BakeTimings {
 VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons,
                      const GatherParams& gather, const ClusterParams& cluster,
                      ProgressSink* progress = nullptr, BakeTimings* timings = nullptr,
-                     const LayerParams* layers = nullptr);
+                     const LayerParams* layers = nullptr,
+                     const std::vector<uint32_t>* subset = nullptr);
 
 /// Layer-aware smoothing of the estimates (docs/accuracy.md, "Less noise"):
 /// each voxel of one layer takes the weighted mean of its own irradiance and

@@ -419,6 +419,11 @@ float resolveRadius(const GatherParams& params, const GridFrame& frame) {
   return params.radius > 0 ? params.radius : kDefaultRadiusVoxels * frame.voxelSize;
 }
 
+double gatherReach(const GatherParams& params, const GridFrame& frame) {
+  gather_internal::checkParams(params);
+  return gather_internal::euclideanReach(params, resolveRadius(params, frame));
+}
+
 Gatherer::Gatherer(const SurfaceGrid& grid, const std::vector<Photon>& photons,
                    const GatherParams& params)
     : Gatherer(grid, photons, nullptr, params) {}

@@ -77,6 +77,16 @@ constexpr float kDefaultRadiusVoxels = 1.5f;
 
 float resolveRadius(const GatherParams& params, const GridFrame& frame);
 
+/// How far (world units) from its query point a gather reads photons: the
+/// radius along the ellipsoid's widest axis. It reads the bins of the voxels
+/// within that distance grown by SurfaceGrid::binMargin, which is at most
+/// kMaxBinMarginVoxels voxel sizes: what a tile of a distributed bake must
+/// hold around its voxels (src/distributed).
+double gatherReach(const GatherParams& params, const GridFrame& frame);
+/// splatPhotons moves a photon only to a voxel of its 3x3x3 neighbourhood,
+/// so at most a voxel's diagonal from that voxel's box: sqrt(3) voxel sizes.
+constexpr double kMaxBinMarginVoxels = 1.7320508075688772;
+
 struct GatherResult {
   std::vector<uint32_t> photons;  ///< indices of the gathered photons (<= k), in no particular (but
                                   ///< deterministic) order

@@ -112,14 +112,7 @@ double clippedArea(const D3 v[3], const D3& h, D3& areaCentroid) {
   return area;
 }
 
-/// Canonical voxel order key: 8^3 block (OpenVDB leaf, coord >> 3) in x-major
-/// order, then the leaf's own offset (x&7)<<6 | (y&7)<<3 | (z&7). Coordinates
-/// are in [0, 2^12), so blocks take 9 bits per axis.
-inline uint64_t canonicalKey(const Coord& c) {
-  const uint64_t bx = uint64_t(c.x >> 3), by = uint64_t(c.y >> 3), bz = uint64_t(c.z >> 3);
-  const uint64_t offset = uint64_t(((c.x & 7) << 6) | ((c.y & 7) << 3) | (c.z & 7));
-  return (((bx << 9 | by) << 9 | bz) << 9) | offset;
-}
+inline uint64_t canonicalKey(const Coord& c) { return canonicalVoxelKey(c); }
 
 inline Coord coordFromKey(uint64_t key) {
   const int offset = int(key & 511);
@@ -168,6 +161,7 @@ inline int32_t clampedFloor(double t) {
 struct VoxelizeBody {
   const Scene& scene;
   const FrameD& frame;
+  const GridParams& params;
   tbb::enumerable_thread_specific<std::vector<Contribution>>& out;
   Progress& progress;
 
@@ -178,6 +172,8 @@ struct VoxelizeBody {
     // Index-space slack so that a vertex exactly on a voxel face (or a rounding
     // error away from it) tests both voxels; the exact test then decides.
     constexpr double kSlack = 1e-6;
+    const int clipLo[3] = {params.clipLower.x, params.clipLower.y, params.clipLower.z};
+    const int clipHi[3] = {params.clipUpper.x, params.clipUpper.y, params.clipUpper.z};
     for (size_t t = range.begin(); t != range.end(); ++t) {
       D3 w[3];
       for (int i = 0; i < 3; ++i) w[i] = D3(scene.positions[scene.indices[3 * t + size_t(i)]]);
@@ -186,8 +182,10 @@ struct VoxelizeBody {
       for (int a = 0; a < 3; ++a) {
         const double mn = std::min({w[0][a], w[1][a], w[2][a]});
         const double mx = std::max({w[0][a], w[1][a], w[2][a]});
-        lo[a] = std::max(0, clampedFloor((mn - frame.origin[a]) / vs - kSlack));
-        hi[a] = std::min(frame.resolution - 1, clampedFloor((mx - frame.origin[a]) / vs + kSlack));
+        lo[a] = std::max({0, clampedFloor((mn - frame.origin[a]) / vs - kSlack),
+                          clipLo[a]});
+        hi[a] = std::min({frame.resolution - 1, clampedFloor((mx - frame.origin[a]) / vs + kSlack),
+                          clipHi[a]});
         outside |= lo[a] > hi[a];
       }
       if (outside) continue;
@@ -196,6 +194,7 @@ struct VoxelizeBody {
         for (int y = lo[1]; y <= hi[1]; ++y) {
           for (int z = lo[2]; z <= hi[2]; ++z) {
             const Coord c{x, y, z};
+            if (params.keepBlock && !params.keepBlock(Coord{x >> 3, y >> 3, z >> 3})) continue;
             const D3 center = frame.center(c);
             const D3 v[3] = {w[0] - center, w[1] - center, w[2] - center};
             if (!overlapsCentered(v, h)) continue;
@@ -275,7 +274,7 @@ SurfaceGrid buildSurfaceGrid(const Scene& scene, const GridParams& params, Progr
   {
     Progress bar(progress, "voxelize", triangles);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, 256),
-                      VoxelizeBody{scene, frame, perThread, bar});
+                      VoxelizeBody{scene, frame, params, perThread, bar});
   }
   std::vector<Contribution> all;
   {

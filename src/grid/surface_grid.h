@@ -9,6 +9,7 @@
 /// later stages do not compile OpenVDB headers.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -25,6 +26,13 @@ struct GridParams {
   /// The grid covers this box (a region of interest) instead of the scene's
   /// bounds; geometry outside it has no voxels. Empty = the scene's bounds.
   Bounds3 region;
+  /// Voxelize only the voxels of the 8^3 blocks (coord >> 3) this accepts
+  /// and that lie in [clipLower, clipUpper] (inclusive voxel indices): a tile
+  /// of a distributed bake with its halo. Each kept voxel gets exactly what
+  /// the whole grid gives it. Empty / default: every voxel.
+  std::function<bool(const Coord& block)> keepBlock;
+  Coord clipLower{0, 0, 0};
+  Coord clipUpper{1 << 30, 1 << 30, 1 << 30};
 };
 
 /// Active voxels in canonical order: sorted by 8^3 block (OpenVDB leaf), then

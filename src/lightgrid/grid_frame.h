@@ -4,6 +4,8 @@
 /// shares: the surface grid voxelizes in it, the light grid is stored in it,
 /// the GPU octree is built on it. Plain data, no third-party library.
 
+#include <cstdint>
+
 #include "core/math.h"
 
 namespace lo {
@@ -25,6 +27,21 @@ struct GridFrame {
   Coord coordOf(const Vec3& p) const;
   std::string ToString() const;
 };
+
+/// The canonical order of a grid's voxels, as an integer: the 8^3 block
+/// (OpenVDB leaf, coord >> 3) in x-major order, then the voxel's offset in the
+/// block, (x&7)<<6 | (y&7)<<3 | (z&7). Every voxel array of the bake (the
+/// surface grid, the light grid) is sorted by it; it also names a voxel
+/// independently of which other voxels exist (the K-means streams, the
+/// merge of a distributed bake's tiles). Coordinates must lie in
+/// [0, 2^kMaxGridDepth): blocks take 9 bits per axis, 36 bits in all.
+inline uint64_t canonicalVoxelKey(const Coord& c) {
+  const uint64_t bx = uint64_t(c.x >> 3), by = uint64_t(c.y >> 3), bz = uint64_t(c.z >> 3);
+  const uint64_t offset = uint64_t(((c.x & 7) << 6) | ((c.y & 7) << 3) | (c.z & 7));
+  return (((bx << 9 | by) << 9 | bz) << 9) | offset;
+}
+/// Bits of canonicalVoxelKey.
+constexpr int kCanonicalKeyBits = 36;
 
 /// Deepest grid the project builds (2^12 = 4096 voxels per axis: the 24-bit
 /// addresses of the GPU octree and int32 coordinates both hold it).

@@ -367,120 +367,174 @@ struct TraceChunks {
   }
 };
 
-PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params, ProgressSink* progress);
-
 }  // namespace photon_internal
 
-PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressSink* progress) {
-  // Far from the origin, trace in a frame centred on the scene (see
-  // Scene::tracingOrigin) and move the stored photons back: only their final
-  // positions round to world floats.
-  const Vec3 origin = scene.tracingOrigin();
-  if (origin == Vec3{0, 0, 0}) return photon_internal::traceInSceneFrame(scene, params, progress);
-  PhotonParams shifted = params;
-  if (!shifted.region.empty()) {
-    shifted.region.lower -= origin;
-    shifted.region.upper -= origin;
-  }
-  PhotonMap map = photon_internal::traceInSceneFrame(scene.translated(-origin), shifted, progress);
-  for (Photon& photon : map.photons) photon.position += origin;
-  return map;
-}
+/// The tracing context of one scene: the emitters, materials and the Embree
+/// scene, in a frame centred on the scene when it lies far from the origin
+/// (Scene::tracingOrigin): only the stored photons' final positions round
+/// to world floats.
+struct PhotonTracer::State {
+  std::unique_ptr<Scene> shifted;  ///< the scene moved by -origin, when origin is not 0
+  Vec3 origin{0, 0, 0};
+  photon_internal::Context ctx;
+  std::unique_ptr<RayTracer> tracer;
+  Vec3 emittedPower{0, 0, 0};
+  mutable std::vector<photon_internal::ChunkResult> chunks;
+};
 
-namespace photon_internal {
-
-PhotonMap traceInSceneFrame(const Scene& scene, const PhotonParams& params,
-                            ProgressSink* progress) {
+PhotonTracer::PhotonTracer(const Scene& scene, const PhotonParams& params)
+    : state_(std::make_unique<State>()) {
+  using namespace photon_internal;
   if (params.maxBounces < 0)
     throw InputError("PhotonParams.maxBounces must be >= 0, got " +
                      std::to_string(params.maxBounces));
-  checkSceneIndices(scene);
+  State& st = *state_;
+  st.origin = scene.tracingOrigin();
+  Bounds3 region = params.region;
+  if (st.origin != Vec3{0, 0, 0}) {
+    st.shifted = std::make_unique<Scene>(scene.translated(-st.origin));
+    if (!region.empty()) {
+      region.lower -= st.origin;
+      region.upper -= st.origin;
+    }
+  }
+  const Scene& traced = st.shifted ? *st.shifted : scene;
+  checkSceneIndices(traced);
 
-  Context ctx;
-  ctx.scene = &scene;
-  ctx.bounds = scene.bounds();
-  ctx.region = params.region;
-  ctx.emitBounds = params.region.empty() ? ctx.bounds : params.region;
+  Context& ctx = st.ctx;
+  ctx.scene = &traced;
+  ctx.bounds = traced.bounds();
+  ctx.region = region;
+  ctx.emitBounds = region.empty() ? ctx.bounds : region;
   ctx.maxBounces = params.maxBounces;
   ctx.includeDirect = params.includeDirect;
   ctx.seed = params.seed;
 
-  ctx.triangles.resize(scene.triangleCount());
-  for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    const int32_t m = scene.triangleMaterial[t];
-    ctx.triangles[t].normal = scene.faceNormal(t);
+  ctx.triangles.resize(traced.triangleCount());
+  for (size_t t = 0; t < traced.triangleCount(); ++t) {
+    const int32_t m = traced.triangleMaterial[t];
+    ctx.triangles[t].normal = traced.faceNormal(t);
     ctx.triangles[t].material = uint32_t(m);
   }
-  ctx.materials.resize(scene.materials.size());
-  for (size_t i = 0; i < scene.materials.size(); ++i) {
-    ctx.materials[i] = bsdfLobes(scene.materials[i]);
+  ctx.materials.resize(traced.materials.size());
+  for (size_t i = 0; i < traced.materials.size(); ++i) {
+    ctx.materials[i] = bsdfLobes(traced.materials[i]);
   }
-
-  PhotonMap map;
-  buildEmitters(scene, ctx, map.emittedPower);
-  if (params.storedPhotons == 0 || scene.triangleCount() == 0) return map;
+  buildEmitters(traced, ctx, st.emittedPower);
+  if (traced.triangleCount() == 0) return;
 
   Vec3 ext = ctx.bounds.extent();
   float scale = length(ext) + maxComponent(max(abs3(ctx.bounds.lower), abs3(ctx.bounds.upper)));
   ctx.epsilon = kRayEpsilonScale * std::max(scale, 1e-6f);
+  st.tracer = std::make_unique<RayTracer>(traced);
+  ctx.tracer = st.tracer.get();
+}
 
-  RayTracer tracer(scene);
-  ctx.tracer = &tracer;
+PhotonTracer::~PhotonTracer() = default;
+
+Vec3 PhotonTracer::emittedPower() const { return state_->emittedPower; }
+
+bool PhotonTracer::canStore() const { return state_->tracer != nullptr; }
+
+void PhotonTracer::trace(uint64_t first, size_t count, std::vector<Photon>& photons,
+                         std::vector<uint32_t>& pathPhotons, std::vector<uint32_t>* pathRays) const {
+  using namespace photon_internal;
+  if (count == 0 || !state_->tracer) {
+    pathPhotons.insert(pathPhotons.end(), count, 0u);
+    if (pathRays) pathRays->insert(pathRays->end(), count, 0u);
+    return;
+  }
+  std::vector<ChunkResult>& chunks = state_->chunks;
+  const size_t nChunks = (count + kChunkPaths - 1) / kChunkPaths;
+  if (chunks.size() < nChunks) chunks.resize(nChunks);
+  TraceChunks body{&state_->ctx, &chunks, first, count};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nChunks, 1), body, tbb::simple_partitioner());
+  size_t total = 0;
+  for (size_t c = 0; c < nChunks; ++c) total += chunks[c].photons.size();
+  photons.reserve(photons.size() + total);
+  pathPhotons.reserve(pathPhotons.size() + count);
+  const Vec3 origin = state_->origin;
+  for (size_t c = 0; c < nChunks; ++c) {
+    ChunkResult& chunk = chunks[c];
+    const size_t before = photons.size();
+    photons.insert(photons.end(), chunk.photons.begin(), chunk.photons.end());
+    if (origin != Vec3{0, 0, 0}) {
+      for (size_t i = before; i < photons.size(); ++i) photons[i].position += origin;
+    }
+    pathPhotons.insert(pathPhotons.end(), chunk.pathPhotons.begin(), chunk.pathPhotons.end());
+    if (pathRays) pathRays->insert(pathRays->end(), chunk.pathRays.begin(), chunk.pathRays.end());
+  }
+}
+
+size_t photonBatchPaths(size_t target, size_t stored, size_t emitted, size_t maxEmitted) {
+  using namespace photon_internal;
+  if (emitted >= maxEmitted) return 0;
+  if (emitted == 0) return std::min(maxEmitted, std::clamp(target, kMinBatchPaths, size_t(65536)));
+  // The paths the photons-per-path ratio so far says are still needed, plus
+  // a margin. Only the amount of wasted work depends on it.
+  double need = stored > 0 ? double(target - stored) * double(emitted) / double(stored) * 1.03 + 1024
+                           : 4.0 * double(emitted);
+  need = std::clamp(need, double(kMinBatchPaths), double(kMaxBatchPaths));
+  return std::min(maxEmitted - emitted, size_t(need));
+}
+
+size_t maxEmittedPaths(const PhotonParams& params) {
+  return params.maxEmitted ? params.maxEmitted : 64 * params.storedPhotons;
+}
+
+PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressSink* progress) {
+  PhotonTracer tracer(scene, params);
+  PhotonMap map;
+  map.emittedPower = tracer.emittedPower();
+  if (params.storedPhotons == 0 || !tracer.canStore()) return map;
 
   const size_t target = params.storedPhotons;
-  const size_t maxEmitted = params.maxEmitted ? params.maxEmitted : 64 * target;
+  const size_t maxEmitted = maxEmittedPaths(params);
   Progress bar(progress, "Tracing photons", target);
   map.photons.reserve(target);
 
-  std::vector<ChunkResult> chunks;
+  std::vector<Photon> batchPhotons;
+  std::vector<uint32_t> pathPhotons, pathRays;
   size_t emitted = 0;  // paths whose photons are in map.photons
   size_t empty = 0;    // of those, paths that stored nothing
   size_t rays = 0;
   bool done = false;
-  size_t batch = std::min(maxEmitted, std::clamp(target, kMinBatchPaths, size_t(65536)));
-  while (!done && emitted < maxEmitted) {
-    size_t nChunks = (batch + kChunkPaths - 1) / kChunkPaths;
-    if (chunks.size() < nChunks) chunks.resize(nChunks);
-    TraceChunks body{&ctx, &chunks, uint64_t(emitted), batch};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nChunks, 1), body, tbb::simple_partitioner());
-
-    // Concatenate in path order; stop inside the path that reaches the target.
-    size_t before = map.photons.size();
-    for (size_t c = 0; c < nChunks && !done; ++c) {
-      const ChunkResult& chunk = chunks[c];
-      size_t offset = 0;
-      for (size_t i = 0; i < chunk.pathPhotons.size(); ++i) {
-        size_t take = std::min<size_t>(chunk.pathPhotons[i], target - map.photons.size());
-        map.photons.insert(map.photons.end(), chunk.photons.begin() + offset,
-                           chunk.photons.begin() + offset + take);
-        offset += chunk.pathPhotons[i];
-        rays += chunk.pathRays[i];
-        ++emitted;
-        empty += chunk.pathPhotons[i] == 0;
-        if (map.photons.size() == target) {
-          done = true;
-          break;
-        }
+  while (!done) {
+    const size_t batch = photonBatchPaths(target, map.photons.size(), emitted, maxEmitted);
+    if (batch == 0) break;
+    batchPhotons.clear();
+    pathPhotons.clear();
+    pathRays.clear();
+    tracer.trace(uint64_t(emitted), batch, batchPhotons, pathPhotons, &pathRays);
+    // Append in path order; stop inside the path that reaches the target.
+    const size_t before = map.photons.size();
+    size_t offset = 0;
+    for (size_t i = 0; i < pathPhotons.size(); ++i) {
+      const size_t take = std::min<size_t>(pathPhotons[i], target - map.photons.size());
+      map.photons.insert(map.photons.end(), batchPhotons.begin() + std::ptrdiff_t(offset),
+                         batchPhotons.begin() + std::ptrdiff_t(offset + take));
+      offset += pathPhotons[i];
+      rays += pathRays[i];
+      ++emitted;
+      empty += pathPhotons[i] == 0;
+      if (map.photons.size() == target) {
+        done = true;
+        break;
       }
     }
     bar.advance(map.photons.size() - before);
-
-    // Next batch: the paths the photons-per-path ratio so far says are still
-    // needed, plus a margin. Only the amount of wasted work depends on it.
-    size_t have = map.photons.size();
-    double need = have > 0 ? double(target - have) * double(emitted) / double(have) * 1.03 + 1024
-                           : 4.0 * double(emitted);
-    need = std::clamp(need, double(kMinBatchPaths), double(kMaxBatchPaths));
-    batch = std::min(maxEmitted - emitted, size_t(need));
   }
 
   map.emittedPaths = emitted;
   map.emptyPaths = empty;
   map.raysTraced = rays;
-  float invPaths = emitted > 0 ? float(1.0 / double(emitted)) : 0.0f;
-  for (Photon& ph : map.photons) ph.power *= invPaths;
+  scalePhotonPower(map.photons, emitted);
   return map;
 }
 
-}  // namespace photon_internal
+void scalePhotonPower(std::vector<Photon>& photons, size_t emittedPaths) {
+  const float invPaths = emittedPaths > 0 ? float(1.0 / double(emittedPaths)) : 0.0f;
+  for (Photon& ph : photons) ph.power *= invPaths;
+}
+
 }  // namespace lo

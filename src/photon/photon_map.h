@@ -4,6 +4,7 @@
 /// octree compresses). Embree is visible only inside src/photon.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/math.h"
@@ -43,5 +44,46 @@ struct PhotonMap {
 /// @throws InputError if the scene has no light with positive power.
 PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params,
                        ProgressSink* progress = nullptr);
+
+/// Traces any range of a bake's global path index space: path i draws its
+/// random numbers from Rng(seed, i) alone, so a photon map can be traced in
+/// parts (tracePhotons' batches, or the ranks of a distributed bake, each
+/// tracing a disjoint range) and the photons do not depend on the split.
+/// A photon map is the photons of paths 0, 1, 2, ... in path order, cut at
+/// PhotonParams::storedPhotons, with powers divided by the paths that made
+/// them (scalePhotonPower).
+class PhotonTracer {
+ public:
+  /// @throws InputError as tracePhotons does (no light, bad indices).
+  PhotonTracer(const Scene& scene, const PhotonParams& params);
+  ~PhotonTracer();
+  PhotonTracer(const PhotonTracer&) = delete;
+  PhotonTracer& operator=(const PhotonTracer&) = delete;
+
+  /// Traces paths [first, first + count) in parallel (TBB): appends their
+  /// photons (world space, power not yet scaled) in path order to `photons`
+  /// and each path's photon count to `pathPhotons` (and its rays to
+  /// `pathRays`, when given). Not reentrant (one call at a time per tracer).
+  void trace(uint64_t first, size_t count, std::vector<Photon>& photons,
+             std::vector<uint32_t>& pathPhotons, std::vector<uint32_t>* pathRays = nullptr) const;
+  Vec3 emittedPower() const;  ///< total RGB power of all lights, W
+  bool canStore() const;      ///< false when the scene has no triangle to store on
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+/// Paths of the next batch of a photon map that holds `stored` of `target`
+/// photons from `emitted` paths: the paths the photons per path so far say
+/// are still needed, with a margin, within [4096, 2^19] (the first batch:
+/// min(target, 65536)), and never beyond `maxEmitted`. 0: stop. Only the
+/// work wasted past the target depends on it, never the photons.
+size_t photonBatchPaths(size_t target, size_t stored, size_t emitted, size_t maxEmitted);
+/// PhotonParams::maxEmitted, or its default 64 * storedPhotons.
+size_t maxEmittedPaths(const PhotonParams& params);
+/// Divides every photon's power by the paths emitted to obtain them (the
+/// Monte Carlo estimator of the emitted flux): the last step of a map.
+void scalePhotonPower(std::vector<Photon>& photons, size_t emittedPaths);
 
 }  // namespace lo
