@@ -3,6 +3,7 @@
 
 #include "bake/bake.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -166,7 +167,7 @@ void checkDepth(int depth, const std::string& what) {
 
 namespace {
 
-void checkParams(const BakeParams& p) {
+void checkParams(const BakeParams& p, int processes) {
   checkDepth(p.depth);
   if (p.photons < 1) throw InputError("--photons must be at least 1");
   if (!p.region.empty() &&
@@ -177,7 +178,7 @@ void checkParams(const BakeParams& p) {
   // The photon map and its bins cost about kBakeBytesPerPhoton each (measured
   // at depths 6 to 8, docs/scale.md): refuse before tracing what cannot fit.
   const size_t available = availableMemoryBytes();
-  const double needed = double(p.photons) * double(kBakeBytesPerPhoton);
+  const double needed = double(p.photons) * double(kBakeBytesPerPhoton) / double(processes);
   if (available > 0 && needed > double(available)) {
     throw InputError("--photons " + std::to_string(p.photons) + " needs about " +
                      formatBytes(size_t(needed)) + " (" + std::to_string(kBakeBytesPerPhoton) +
@@ -221,14 +222,15 @@ double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bo
   return h > 0 ? area / (h * h) : 0.0;
 }
 
-void checkBakeMemory(const Scene& scene, const BakeParams& params) {
+void checkBakeMemory(const Scene& scene, const BakeParams& params, int processes) {
   const size_t available = availableMemoryBytes();
   if (available == 0 || scene.triangleCount() == 0) return;
   const GridFrame frame =
       makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth);
   const double voxels = estimateActiveVoxels(scene, frame, params.region);
   const double needed =
-      voxels * double(kBakeBytesPerVoxel) + double(params.photons) * double(kBakeBytesPerPhoton);
+      (voxels * double(kBakeBytesPerVoxel) + double(params.photons) * double(kBakeBytesPerPhoton)) /
+      double(std::max(processes, 1));
   if (needed > double(available)) {
     throw InputError("--depth " + std::to_string(params.depth) + ": the scene's surfaces cross " +
                      "about " + formatCount(size_t(voxels)) + " voxels of " +
@@ -254,11 +256,11 @@ std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
          "): bake the part that matters with --bounds";
 }
 
-BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* progress) {
+BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, int processes) {
   // The scene's own region of interest (a glTF marker node) when none is given.
   BakeParams params = requested;
   if (params.region.empty()) params.region = scene.region;
-  checkParams(params);
+  checkParams(params, processes);
   // What the .vdb can store, checked before any work: OpenVDB refuses a
   // transform whose scale cubed is below 3e-15 (math::ScaleMap).
   if (scene.triangleCount() > 0) {
@@ -272,7 +274,43 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
                        "): bake at a smaller --depth, or the scene in larger units");
     }
   }
-  checkBakeMemory(scene, params);
+  checkBakeMemory(scene, params, processes);
+  return params;
+}
+
+BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t photons,
+                          int64_t emittedPaths, float radius) {
+  BakeMetadata meta;
+  meta.depth = params.depth;
+  meta.photons = photons;
+  meta.emittedPaths = emittedPaths;
+  meta.knn = params.knn;
+  meta.radius = radius;
+  meta.vdls = params.vdls.ToString();
+  meta.representation = representationName(params.representation);
+  meta.seed = int64_t(params.seed);
+  meta.sceneBounds = scene.bounds();
+  meta.surfaceLayers = params.layers ? 1 : 0;
+  meta.gatherOcclusion = params.occlusion ? 1 : 0;
+  meta.edgeCorrection = params.edgeCorrection ? 1 : 0;
+  meta.includeDirect = params.includeDirect ? 1 : 0;
+  meta.region = params.region;
+  return meta;
+}
+
+LevelParams BakeParams::levelParams() const {
+  LevelParams level;
+  level.grid = gridParams();
+  level.gather = gatherParams();
+  level.cluster = clusterParams();
+  level.layers = layers;
+  level.occlusion = occlusion;
+  level.smoothing = smoothing;
+  return level;
+}
+
+BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* progress) {
+  const BakeParams params = checkedBakeParams(scene, requested);
   BakeResult r;
   BakeStats& s = r.stats;
   s.triangles = scene.triangleCount();
@@ -286,30 +324,9 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
   s.traceSeconds = trace.finish(formatCount(photons.photons.size()) + " photons from " +
                                 formatCount(photons.emittedPaths) + " paths");
 
-  LevelParams level;
-  level.grid = params.gridParams();
-  level.gather = params.gatherParams();
-  level.cluster = params.clusterParams();
-  level.layers = params.layers;
-  level.occlusion = params.occlusion;
-  level.smoothing = params.smoothing;
-  r.grid = bakeLevel(scene, photons.photons, level, progress, &s.level, &s.stages);
-
-  BakeMetadata& meta = r.metadata;
-  meta.depth = params.depth;
-  meta.photons = int64_t(photons.photons.size());
-  meta.emittedPaths = int64_t(photons.emittedPaths);
-  meta.knn = params.knn;
-  meta.radius = s.level.radius;
-  meta.vdls = params.vdls.ToString();
-  meta.representation = representationName(params.representation);
-  meta.seed = int64_t(params.seed);
-  meta.sceneBounds = scene.bounds();
-  meta.surfaceLayers = params.layers ? 1 : 0;
-  meta.gatherOcclusion = params.occlusion ? 1 : 0;
-  meta.edgeCorrection = params.edgeCorrection ? 1 : 0;
-  meta.includeDirect = params.includeDirect ? 1 : 0;
-  meta.region = params.region;
+  r.grid = bakeLevel(scene, photons.photons, params.levelParams(), progress, &s.level, &s.stages);
+  r.metadata = bakeMetadata(scene, params, int64_t(photons.photons.size()),
+                            int64_t(photons.emittedPaths), s.level.radius);
   if (params.keepPhotons) r.photons = std::move(photons);
   return r;
 }

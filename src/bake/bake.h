@@ -53,6 +53,8 @@ constexpr size_t kBakeBytesPerVoxel = 1000;
 /// scales whose cube is below 3e-15 (with a margin).
 constexpr double kMinStorableVoxel = 1.5e-5;
 
+struct LevelParams;
+
 /// Every setting of a bake, with the defaults of `lightoctree bake`.
 struct BakeParams {
   int depth = 6;            ///< 2^depth voxels across the padded bounding cube (paper's delta)
@@ -90,6 +92,7 @@ struct BakeParams {
   Bounds3 region;
 
   PhotonParams photonParams() const;
+  LevelParams levelParams() const;  ///< the grid, gather and cluster settings together
   GridParams gridParams() const;
   GatherParams gatherParams() const;
   ClusterParams clusterParams() const;
@@ -195,7 +198,21 @@ double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bo
 /// Refuses, before any work, a bake whose voxels (estimateActiveVoxels x
 /// kBakeBytesPerVoxel) and photons (kBakeBytesPerPhoton) need more memory
 /// than is available (availableMemoryBytes), naming --depth and the figures.
-void checkBakeMemory(const Scene& scene, const BakeParams& params);
+/// `processes` > 1: a distributed bake, each process holding about its share.
+void checkBakeMemory(const Scene& scene, const BakeParams& params, int processes = 1);
+
+/// What bake() does before any work, shared with the distributed bake
+/// (src/distributed): the scene's marked region (Scene::region) when
+/// `requested` has none, then every check (parameter ranges, a voxel the
+/// .vdb can store, the memory: checkBakeMemory). Returns the parameters the
+/// bake runs with. @throws InputError naming the flag.
+BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, int processes = 1);
+
+/// The file metadata of a bake of `scene` with `params` (sourceScene left to
+/// the caller) that stored `photons` from `emittedPaths` paths and gathered
+/// within `radius` (world units).
+BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t photons,
+                          int64_t emittedPaths, float radius);
 
 
 /// @brief Bakes `scene` with `params` (paper §3.1). Deterministic. Without

@@ -1,0 +1,26 @@
+// MpiSession in a build without MPI (LO_WITH_MPI=OFF): it refuses to start.
+
+#include "core/error.h"
+#include "distributed/mpi_session.h"
+
+#include <cstdlib>
+
+namespace lo {
+
+struct MpiSession::State {};
+
+bool mpiAvailable() { return false; }
+
+MpiSession::MpiSession() {
+  throw InputError(
+      "this lightoctree was built without MPI: rebuild with -DLO_WITH_MPI=ON (tools/build.sh "
+      "does) to bake on several processes");
+}
+
+MpiSession::~MpiSession() = default;
+
+Communicator& MpiSession::world() { std::abort(); }
+
+void MpiSession::abort(int code) { std::_Exit(code); }
+
+}  // namespace lo

@@ -1,0 +1,151 @@
+#pragma once
+/// @file distributed/tiled_bake.h
+/// @brief The bake on several processes (docs/scale.md): the same .vdb
+/// bytes as bake() (src/bake) with the same parameters, whatever the number
+/// of ranks, while each rank holds only its share of the photons and voxels.
+///
+///  1. Photons by rank: each batch of the global path index space is split
+///     into one contiguous range per rank (PhotonTracer), so the photon set
+///     does not depend on the rank count; the counts per rank say where the
+///     map's last photon is.
+///  2. Tiles: the grid is cut into tiles of (2^depth / tilesPerAxis)^3
+///     voxels, given to the ranks in contiguous runs along a Z-order curve,
+///     balanced by estimated work (the first batch's photons per tile, and
+///     the area of the geometry in it). Each batch's photons are sent
+///     (alltoallv) to the owner of their tile and to every rank whose tiles
+///     lie within the halo: the gather's reach, the smoothing's neighbours
+///     and the photon splat's one-voxel move (photonHaloVoxels).
+///  3. Each rank voxelizes its tiles and their halo, splats its photons and
+///     gathers + clusters its own voxels and the ring of neighbours the
+///     smoothing reads, with the single-process stages unchanged; the bins'
+///     margin is the global maximum.
+///  4. The owned voxels go to rank 0, which merges them in canonical order.
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/bake.h"
+#include "distributed/communicator.h"
+
+namespace lo {
+
+/// Most tiles per axis: the tile tables are dense (64^3 entries at most).
+constexpr int kMaxTilesPerAxis = 64;
+
+struct TileParams {
+  /// Tiles per axis of the grid: a power of two from 1 to
+  /// maxTilesPerAxis(depth); 0 = auto (autoTilesPerAxis).
+  int tilesPerAxis = 0;
+};
+
+/// min(kMaxTilesPerAxis, 2^depth / 8), at least 1: tiles of at least one
+/// 8^3 block.
+int maxTilesPerAxis(int depth);
+/// min(32, maxTilesPerAxis(depth)): enough tiles to balance a few dozen ranks.
+int autoTilesPerAxis(int depth);
+
+/// Which rank owns which tile of a grid.
+struct TilePlan {
+  int depth = 0;          ///< the grid's (2^depth voxels per axis)
+  int tileShift = 0;      ///< tile edge = 2^tileShift voxels
+  int tilesPerAxis = 1;
+  int ranks = 1;
+  int photonHalo = 0;     ///< voxels around a rank's tiles whose photons it receives
+  std::vector<int32_t> owner;  ///< per tile, index (x * T + y) * T + z
+  std::vector<double> work;    ///< estimated work per tile (photon-equivalents)
+
+  /// Tile of voxel c, clamped into the grid.
+  size_t tileOf(const Coord& c) const;
+  int ownerOf(const Coord& c) const { return owner[tileOf(c)]; }
+  /// Calls f(rank) once for each rank that owns a tile within `halo` voxels
+  /// (per axis) of voxel c; none when c lies farther than that outside the grid.
+  template <typename F>
+  void forOwnersNear(const Coord& c, int halo, F&& f) const;
+  std::string ToString() const;
+};
+
+/// The photon halo a gather with `gather` on `frame` needs: the bins it
+/// reads (gatherReach grown by the largest bin margin, as Gatherer counts
+/// voxels) around the voxels a rank computes (its own and their neighbours,
+/// which the smoothing reads), and the neighbours a splatted photon can move
+/// from. Voxels are voxelized one further out.
+int photonHaloVoxels(const GatherParams& gather, const GridFrame& frame);
+
+/// Splits the tiles among `ranks`: along the Z-order curve of the tile grid,
+/// rank r gets the tiles whose work midpoint lies in [r W / ranks,
+/// (r + 1) W / ranks), W the total. Deterministic.
+TilePlan planTiles(int depth, int tilesPerAxis, const std::vector<double>& work, int ranks,
+                   int photonHalo);
+
+/// Figures of one rank, for --stats-json and docs/scale.md.
+struct RankStats {
+  int32_t rank = 0;
+  double traceSeconds = 0;     ///< tracing this rank's paths
+  double exchangeSeconds = 0;  ///< sending and receiving photons (waits included)
+  double voxelizeSeconds = 0, splatSeconds = 0, gatherClusterSeconds = 0;
+  double mergeSeconds = 0;     ///< sending the voxels to rank 0 (and merging them there)
+  double totalSeconds = 0;
+  uint64_t bytesSent = 0, bytesReceived = 0;  ///< photons to and from other ranks
+  uint64_t photonsTraced = 0;  ///< of the map, traced here
+  uint64_t photonsHeld = 0;    ///< received: its tiles' and their halo's
+  uint64_t tilesOwned = 0;
+  double workShare = 0;        ///< of the estimated work, 0..1
+  uint64_t voxelsOwned = 0, voxelsComputed = 0, voxelsHeld = 0;
+  uint64_t peakRssBytes = 0;   ///< of this process (threads ranks share one)
+};
+
+struct DistributedStats {
+  int tilesPerAxis = 0;
+  int photonHalo = 0;
+  std::vector<int32_t> tileOwner;  ///< TilePlan::owner
+  std::vector<RankStats> ranks;  ///< rank 0: every rank's, in rank order; others: their own
+};
+
+/// @brief bake() on the ranks of `comm` (every rank calls it with the same
+/// scene and parameters). Rank 0 returns the whole BakeResult (grid,
+/// metadata, stats); the other ranks return an empty grid. The grid is the
+/// one bake() returns, value for value. @throws InputError as bake() does,
+/// and for BakeParams::keepPhotons (the map is spread over the ranks) or a
+/// bad tile count.
+BakeResult distributedBake(const Scene& scene, const BakeParams& params, const TileParams& tiles,
+                           Communicator& comm, ProgressSink* progress = nullptr,
+                           DistributedStats* stats = nullptr);
+
+// ---------------------------------------------------------------------------
+
+template <typename F>
+void TilePlan::forOwnersNear(const Coord& c, int halo, F&& f) const {
+  const int res = 1 << depth;
+  int lo[3], hi[3];
+  const int v[3] = {c.x, c.y, c.z};
+  for (int a = 0; a < 3; ++a) {
+    if (v[a] + halo < 0 || v[a] - halo > res - 1) return;
+    lo[a] = std::max(0, v[a] - halo) >> tileShift;
+    hi[a] = std::min(res - 1, v[a] + halo) >> tileShift;
+  }
+  int seen[8];
+  int nSeen = 0;
+  std::vector<int> more;
+  for (int x = lo[0]; x <= hi[0]; ++x) {
+    for (int y = lo[1]; y <= hi[1]; ++y) {
+      for (int z = lo[2]; z <= hi[2]; ++z) {
+        const int r = owner[(size_t(x) * size_t(tilesPerAxis) + size_t(y)) * size_t(tilesPerAxis) +
+                            size_t(z)];
+        bool dup = false;
+        for (int i = 0; i < nSeen; ++i) dup = dup || seen[i] == r;
+        for (int m : more) dup = dup || m == r;
+        if (dup) continue;
+        if (nSeen < 8) {
+          seen[nSeen++] = r;
+        } else {
+          more.push_back(r);
+        }
+        f(r);
+      }
+    }
+  }
+}
+
+}  // namespace lo

@@ -1,0 +1,333 @@
+// The distributed bake (src/distributed) on thread ranks: the same grid,
+// value for value and .vdb byte for byte, as the one-process bake, for 1 to
+// 4 ranks; its parts (tile plan, halo lookup, grid parts, communicator)
+// against brute force.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <fstream>
+#include <iterator>
+#include <mutex>
+#include <random>
+#include <set>
+
+#include "bake/bake.h"
+#include "core/error.h"
+#include "distributed/communicator.h"
+#include "distributed/tiled_bake.h"
+#include "distributed/vdl_grid_parts.h"
+#include "scene/scene.h"
+#include "test_util.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+namespace {
+
+std::string fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// The first voxel where two grids differ, or "" when they are equal value
+/// for value (every array, the layers included).
+std::string firstDifference(const VdlGrid& a, const VdlGrid& b) {
+  if (a.size() != b.size()) {
+    return "voxels " + std::to_string(a.size()) + " vs " + std::to_string(b.size());
+  }
+  if (a.layers.size() != b.layers.size()) {
+    return "layers " + std::to_string(a.layers.size()) + " vs " + std::to_string(b.layers.size());
+  }
+  for (size_t v = 0; v < a.size(); ++v) {
+    const VdlGrid one = selectVoxels(a, {uint32_t(v)}), two = selectVoxels(b, {uint32_t(v)});
+    if (serializeVdlGrid(one) != serializeVdlGrid(two)) {
+      return "voxel " + std::to_string(v) + " at " + a.coords[v].ToString() + ": irradiance " +
+             a.irradiance[v].ToString() + " vs " + b.irradiance[v].ToString() + ", photons " +
+             std::to_string(a.photonCount[v]) + " vs " + std::to_string(b.photonCount[v]);
+    }
+  }
+  return serializeVdlGrid(a) == serializeVdlGrid(b) ? "" : "the frames or payloads differ";
+}
+
+struct RankRun {
+  BakeResult result;
+  DistributedStats stats;
+};
+
+RankRun bakeOnThreadRanks(const Scene& scene, const BakeParams& params, int ranks, int tiles) {
+  RankRun run;
+  std::mutex mutex;
+  TileParams tileParams;
+  tileParams.tilesPerAxis = tiles;
+  runThreadRanks(ranks, [&](Communicator& comm) {
+    DistributedStats stats;
+    BakeResult r = distributedBake(scene, params, tileParams, comm, nullptr, &stats);
+    if (comm.rank() == 0) {
+      std::lock_guard<std::mutex> lock(mutex);
+      run.result = std::move(r);
+      run.stats = std::move(stats);
+    } else {
+      EXPECT_EQ(r.grid.size(), 0u) << "rank " << comm.rank() << " returns no grid";
+    }
+  });
+  return run;
+}
+
+/// Bakes `scene` on one process and on 1..4 thread ranks; every grid and
+/// its .vdb bytes must be the same.
+void expectSameAsOneProcess(const Scene& scene, const BakeParams& params, int tiles,
+                            const std::string& name) {
+  const BakeResult single = bake(scene, params);
+  ASSERT_GT(single.grid.size(), 100u);
+  const std::string dir = test::outputDir(name);
+  writeVdlGrid(dir + "/single.vdb", single.grid, single.metadata);
+  const std::string expected = fileBytes(dir + "/single.vdb");
+  for (int ranks = 1; ranks <= 4; ++ranks) {
+    const RankRun run = bakeOnThreadRanks(scene, params, ranks, tiles);
+    EXPECT_EQ(firstDifference(single.grid, run.result.grid), "") << ranks << " ranks";
+    const std::string path = dir + "/ranks" + std::to_string(ranks) + ".vdb";
+    writeVdlGrid(path, run.result.grid, run.result.metadata);
+    EXPECT_TRUE(fileBytes(path) == expected) << ranks << " ranks: " << path << " differs";
+    EXPECT_EQ(run.result.stats.storedPhotons, single.stats.storedPhotons);
+    EXPECT_EQ(run.result.stats.emittedPaths, single.stats.emittedPaths);
+    EXPECT_EQ(run.result.stats.emptyPaths, single.stats.emptyPaths);
+    EXPECT_EQ(run.result.stats.level.activeVoxels, single.stats.level.activeVoxels);
+    EXPECT_EQ(run.result.stats.level.droppedPhotons, single.stats.level.droppedPhotons);
+    // Each rank held and owned a part: the work was split.
+    ASSERT_EQ(run.stats.ranks.size(), size_t(ranks));
+    uint64_t owned = 0, traced = 0;
+    for (const RankStats& s : run.stats.ranks) {
+      EXPECT_GT(s.voxelsOwned, 0u) << "rank " << s.rank << " of " << ranks;
+      if (ranks > 1) {
+        EXPECT_LT(s.photonsHeld, single.stats.storedPhotons) << "rank " << s.rank;
+      }
+      owned += s.voxelsOwned;
+      traced += s.photonsTraced;
+    }
+    EXPECT_EQ(owned, single.grid.size());
+    EXPECT_EQ(traced, single.stats.storedPhotons);
+  }
+}
+
+TEST(TiledBake, CornellBoxIsTheOneProcessBakeFor1To4Ranks) {
+  const Scene scene = loadScene(test::sharedScenesDir() + "/composed/cornell-box.glb");
+  BakeParams params;
+  params.depth = 5;
+  params.photons = 60000;
+  params.knn = 80;
+  expectSameAsOneProcess(scene, params, 4, "TiledBake.Cornell");
+}
+
+TEST(TiledBake, DragonWithShIsTheOneProcessBakeFor1To4Ranks) {
+  const Scene scene = loadScene(test::sharedScenesDir() + "/composed/cornell-dragon.glb");
+  BakeParams params;
+  params.depth = 5;
+  params.photons = 40000;
+  params.knn = 60;
+  params.representation = LightRepresentation::Sh1;
+  params.includeDirect = true;
+  expectSameAsOneProcess(scene, params, 4, "TiledBake.Dragon");
+}
+
+TEST(TiledBake, AutoVdlsAndAWideRadiusAreTheOneProcessBake) {
+  // A radius of 3 voxels widens the halo; --vdls auto and no smoothing.
+  Scene scene = test::pointLitRoom();
+  BakeParams params;
+  params.depth = 5;
+  params.photons = 30000;
+  params.knn = 40;
+  params.radius = 3.0f / 32.0f;
+  params.vdls = parseVdlCount("auto");
+  params.smoothing = false;
+  expectSameAsOneProcess(scene, params, 2, "TiledBake.Room");
+}
+
+TEST(TiledBake, ATileBoundaryThroughAWallJointChangesNothing) {
+  // A floor with a wall standing on it at x = 0, lit from both sides: the
+  // grid's cube is centred on x = 0, so with 2 tiles per axis and 2 ranks
+  // the ranks' boundary is the plane of the wall, through its joint with
+  // the floor.
+  Scene scene;
+  Material grey;
+  grey.baseColor = Vec3(0.7f);
+  grey.doubleSided = true;
+  scene.materials.push_back(grey);
+  test::addQuad(scene, Vec3(-1, 0, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), Vec3(0, 1, 0), 0);
+  test::addQuad(scene, Vec3(0, 0, -1), Vec3(0, 0, 2), Vec3(0, 1, 0), Vec3(1, 0, 0), 0);
+  for (float x : {-0.5f, 0.5f}) {
+    Light light;
+    light.position = Vec3(x, 0.6f, 0.2f * x);
+    light.intensity = 1.0f;
+    scene.lights.push_back(light);
+  }
+  BakeParams params;
+  params.depth = 5;
+  params.photons = 40000;
+  params.knn = 60;
+  params.includeDirect = true;
+  const BakeResult single = bake(scene, params);
+  const RankRun run = bakeOnThreadRanks(scene, params, 2, 2);
+  EXPECT_EQ(firstDifference(single.grid, run.result.grid), "");
+
+  // The boundary is where it was meant to be: rank 0 owns x < 16, rank 1
+  // x >= 16, and both sides of the joint hold lit voxels of the wall.
+  ASSERT_EQ(run.stats.tileOwner.size(), 8u);
+  for (size_t t = 0; t < 8; ++t) EXPECT_EQ(run.stats.tileOwner[t], t < 4 ? 0 : 1) << "tile " << t;
+  const Coord wall = single.grid.frame.coordOf(Vec3(0, 0, 0));
+  ASSERT_EQ(wall.x, 16);
+  int joint[2] = {0, 0};
+  for (size_t v = 0; v < single.grid.size(); ++v) {
+    const Coord c = single.grid.coords[v];
+    if (c.y == wall.y && (c.x == 15 || c.x == 16) && single.grid.lit(v)) ++joint[c.x == 16];
+  }
+  EXPECT_GT(joint[0], 10);
+  EXPECT_GT(joint[1], 10);
+}
+
+TEST(TiledBake, RefusesAPhotonMapAndBadTileCounts) {
+  const Scene scene = test::pointLitRoom();
+  BakeParams params;
+  params.depth = 4;
+  params.photons = 2000;
+  params.keepPhotons = true;
+  EXPECT_THROW(bakeOnThreadRanks(scene, params, 2, 0), InputError);
+  params.keepPhotons = false;
+  for (int tiles : {3, 4, -1}) {  // depth 4: at most 2 per axis
+    try {
+      bakeOnThreadRanks(scene, params, 2, tiles);
+      ADD_FAILURE() << tiles << " tiles were accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--tiles"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(TilePlan, SplitsTheWorkEvenlyAlongTheCurve) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 10.0);
+  const int T = 8;
+  std::vector<double> work(size_t(T * T * T));
+  for (double& w : work) w = u(rng) < 3.0 ? 0.0 : u(rng);
+  double total = 0, largest = 0;
+  for (double w : work) {
+    total += w;
+    largest = std::max(largest, w);
+  }
+  for (int ranks = 1; ranks <= 5; ++ranks) {
+    const TilePlan plan = planTiles(6, T, work, ranks, 4);
+    std::vector<double> share(size_t(ranks), 0.0);
+    for (size_t t = 0; t < work.size(); ++t) {
+      ASSERT_GE(plan.owner[t], 0);
+      ASSERT_LT(plan.owner[t], ranks);
+      share[size_t(plan.owner[t])] += work[t];
+    }
+    // Each share is within one tile's work of the mean.
+    for (int r = 0; r < ranks; ++r) {
+      EXPECT_NEAR(share[size_t(r)], total / ranks, largest) << r << " of " << ranks;
+    }
+  }
+}
+
+TEST(TilePlan, OwnersNearAVoxelAreThoseABruteForceFinds) {
+  std::mt19937 rng(3);
+  const int T = 4, depth = 5, res = 32;
+  std::vector<double> work(size_t(T * T * T));
+  for (double& w : work) w = double(rng() % 100);
+  const TilePlan plan = planTiles(depth, T, work, 3, 3);
+  for (int i = 0; i < 2000; ++i) {
+    const Coord c{int(rng() % 44) - 6, int(rng() % 44) - 6, int(rng() % 44) - 6};
+    const int halo = int(rng() % 10);
+    std::set<int> expected;
+    for (int x = c.x - halo; x <= c.x + halo; ++x)
+      for (int y = c.y - halo; y <= c.y + halo; ++y)
+        for (int z = c.z - halo; z <= c.z + halo; ++z)
+          if (x >= 0 && y >= 0 && z >= 0 && x < res && y < res && z < res)
+            expected.insert(plan.ownerOf({x, y, z}));
+    std::multiset<int> found;
+    plan.forOwnersNear(c, halo, [&](int r) { found.insert(r); });
+    EXPECT_EQ(std::set<int>(found.begin(), found.end()), expected) << c.ToString() << " " << halo;
+    EXPECT_EQ(found.size(), expected.size()) << "each owner once";
+  }
+}
+
+TEST(VdlGridParts, AGridSplitAnyWayMergesBackToItself) {
+  Scene scene = test::pointLitRoom();
+  BakeParams params;
+  params.depth = 5;
+  params.photons = 20000;
+  params.knn = 40;
+  const VdlGrid grid = bake(scene, params).grid;
+  ASSERT_GT(grid.layers.size(), 0u) << "the room's edges have layers";
+  std::mt19937 rng(11);
+  for (int parts : {1, 2, 5}) {
+    std::vector<std::vector<uint32_t>> split(static_cast<size_t>(parts));
+    for (uint32_t v = 0; v < grid.size(); ++v) split[rng() % uint32_t(parts)].push_back(v);
+    std::vector<VdlGrid> pieces;
+    for (const auto& voxels : split) {
+      pieces.push_back(deserializeVdlGrid(serializeVdlGrid(selectVoxels(grid, voxels))));
+    }
+    std::shuffle(pieces.begin(), pieces.end(), rng);
+    EXPECT_EQ(firstDifference(grid, mergeVdlGrids(std::move(pieces))), "") << parts << " parts";
+  }
+  // A voxel in two parts, and damaged bytes, are refused.
+  EXPECT_THROW(mergeVdlGrids({selectVoxels(grid, {0, 1}), selectVoxels(grid, {1, 2})}), IoError);
+  std::vector<char> bytes = serializeVdlGrid(selectVoxels(grid, {0, 1, 2}));
+  bytes.resize(bytes.size() - 3);
+  EXPECT_THROW(deserializeVdlGrid(bytes), IoError);
+}
+
+TEST(ThreadRanks, CollectivesGiveWhatEachRankSent) {
+  for (int ranks = 1; ranks <= 4; ++ranks) {
+    runThreadRanks(ranks, [&](Communicator& comm) {
+      const int me = comm.rank(), n = comm.size();
+      uint64_t sum[2] = {uint64_t(me), 1};
+      comm.allreduceSum(sum, 2);
+      EXPECT_EQ(sum[0], uint64_t(n * (n - 1) / 2));
+      EXPECT_EQ(sum[1], uint64_t(n));
+      double m = double(me) * 1.5;
+      comm.allreduceMax(&m, 1);
+      EXPECT_EQ(m, 1.5 * (n - 1));
+      const std::vector<uint64_t> all = comm.allgather(uint64_t(10 * me));
+      for (int r = 0; r < n; ++r) EXPECT_EQ(all[size_t(r)], uint64_t(10 * r));
+      // Rank s sends (s + 1) * (d + 1) items of value 100 s + d to rank d.
+      std::vector<uint64_t> begin(size_t(n) + 1, 0);
+      std::vector<int> items;
+      for (int d = 0; d < n; ++d) {
+        for (int i = 0; i < (me + 1) * (d + 1); ++i) items.push_back(100 * me + d);
+        begin[size_t(d) + 1] = items.size();
+      }
+      std::vector<int> got = {-1};
+      exchangeItems(comm, items, begin, got);
+      std::vector<int> expected = {-1};
+      for (int s = 0; s < n; ++s) expected.insert(expected.end(), size_t((s + 1) * (me + 1)), 100 * s + me);
+      EXPECT_EQ(got, expected);
+      const auto gathered = comm.gatherBytes(std::vector<char>(size_t(me), char(me)), n - 1);
+      if (me == n - 1) {
+        ASSERT_EQ(gathered.size(), size_t(n));
+        for (int r = 0; r < n; ++r) EXPECT_EQ(gathered[size_t(r)], std::vector<char>(size_t(r), char(r)));
+      } else {
+        EXPECT_TRUE(gathered.empty());
+      }
+    });
+  }
+}
+
+TEST(ThreadRanks, ARankThatFailsEndsTheOthersWaits) {
+  std::atomic<int> reached{0};
+  try {
+    runThreadRanks(3, [&](Communicator& comm) {
+      if (comm.rank() == 1) throw InputError("rank 1 fails");
+      uint64_t x = 1;
+      comm.allreduceSum(&x, 1);  // would wait forever for rank 1
+      ++reached;
+    });
+    ADD_FAILURE() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "rank 1 fails");
+  }
+  EXPECT_EQ(reached.load(), 0);
+}
+
+}  // namespace
+}  // namespace lo
