@@ -13,6 +13,8 @@
 #include "core/error.h"
 #include "core/file.h"
 #include "core/threads.h"
+#include "distributed/mpi_session.h"
+#include "distributed/tiled_bake.h"
 #include "report.h"
 #include "scene/scene.h"
 #include "vdb/vdb_io.h"
@@ -41,10 +43,37 @@ struct BakeOptions {
   std::vector<double> bounds;  // x0 y0 z0 x1 y1 z1, empty = the whole scene
   std::string photonMap;
   std::string statsJson;
+  std::string tiles = "auto";
   bool quiet = false;
 };
 
-int runBake(const BakeOptions& opt) {
+/// One row per rank of a distributed bake.
+void printRanks(const DistributedStats& d, size_t storedPhotons) {
+  std::printf("\n%d^3 tiles, photon halo %d voxels\n", d.tilesPerAxis, d.photonHalo);
+  std::printf("%4s %12s %12s %10s %10s %7s %12s %10s %8s\n", "rank", "photons", "held",
+              "voxels", "computed", "work", "sent", "peak RSS", "seconds");
+  for (const RankStats& r : d.ranks) {
+    std::printf("%4d %12s %12s %10s %10s %6.1f%% %12s %10s %8.2f\n", r.rank,
+                formatCount(size_t(r.photonsTraced)).c_str(),
+                formatCount(size_t(r.photonsHeld)).c_str(),
+                formatCount(size_t(r.voxelsOwned)).c_str(),
+                formatCount(size_t(r.voxelsComputed)).c_str(), 100.0 * r.workShare,
+                formatBytes(size_t(r.bytesSent)).c_str(), formatBytes(size_t(r.peakRssBytes)).c_str(),
+                r.totalSeconds);
+  }
+  uint64_t sent = 0;
+  for (const RankStats& r : d.ranks) sent += r.bytesSent;
+  if (storedPhotons > 0) {
+    std::printf("photons exchanged: %.1f bytes per stored photon\n",
+                double(sent) / double(storedPhotons));
+  }
+}
+
+int runBakeOn(const BakeOptions& options, Communicator* comm) {
+  const int rank = comm ? comm->rank() : 0;
+  BakeOptions opt = options;
+  // Only rank 0 reports and writes; the others bake their tiles in silence.
+  opt.quiet = opt.quiet || rank != 0;
   checkOutputFolder(opt.output, "--output");
   if (!opt.photonMap.empty()) checkOutputFolder(opt.photonMap, "--photon-map");
   if (!opt.statsJson.empty()) checkOutputFolder(opt.statsJson, "--stats-json");
@@ -54,6 +83,9 @@ int runBake(const BakeOptions& opt) {
 
   ThreadLimit threadLimit(opt.threads);
   ConsoleProgress progress(opt.quiet);
+  if (comm && !opt.quiet) {
+    std::printf("baking on %d ranks (mpirun)\n", comm->size());
+  }
   std::vector<StageReport> rows;
 
   StageTimer loadTimer(rows, "load scene");
@@ -88,7 +120,12 @@ int runBake(const BakeOptions& opt) {
     params.region.extend(Vec3{float(opt.bounds[3]), float(opt.bounds[4]), float(opt.bounds[5])});
   }
   params.keepPhotons = !opt.photonMap.empty();
-  BakeResult baked = bake(scene, params, &progress);
+  DistributedStats distributed;
+  TileParams tiles;
+  tiles.tilesPerAxis = opt.tiles == "auto" ? 0 : std::stoi(opt.tiles);
+  BakeResult baked = comm ? distributedBake(scene, params, tiles, *comm, &progress, &distributed)
+                          : bake(scene, params, &progress);
+  if (rank != 0) return 0;
   rows.insert(rows.end(), baked.stats.stages.begin(), baked.stats.stages.end());
   const std::string missed = photonBudgetWarning(params, baked.stats);
   if (!missed.empty()) std::fprintf(stderr, "warning: %s\n", missed.c_str());
@@ -106,6 +143,7 @@ int runBake(const BakeOptions& opt) {
   }
 
   if (!opt.quiet) printSummary(stdout, rows);
+  if (!opt.quiet && comm) printRanks(distributed, baked.stats.storedPhotons);
 
   if (!opt.statsJson.empty()) {
     const BakeStats& st = baked.stats;
@@ -140,10 +178,63 @@ int runBake(const BakeOptions& opt) {
     j["stages"] = stages;
     j["total_seconds"] = total;
     j["peak_rss_bytes"] = peakRssBytes();
+    if (comm) {
+      nlohmann::json ranks = nlohmann::json::array();
+      uint64_t sent = 0;
+      for (const RankStats& r : distributed.ranks) {
+        sent += r.bytesSent;
+        ranks.push_back({{"rank", r.rank},
+                         {"photons_traced", r.photonsTraced},
+                         {"photons_held", r.photonsHeld},
+                         {"tiles_owned", r.tilesOwned},
+                         {"work_share", r.workShare},
+                         {"voxels_owned", r.voxelsOwned},
+                         {"voxels_computed", r.voxelsComputed},
+                         {"voxels_held", r.voxelsHeld},
+                         {"bytes_sent", r.bytesSent},
+                         {"bytes_received", r.bytesReceived},
+                         {"peak_rss_bytes", r.peakRssBytes},
+                         {"seconds", {{"trace", r.traceSeconds},
+                                      {"exchange", r.exchangeSeconds},
+                                      {"voxelize", r.voxelizeSeconds},
+                                      {"splat", r.splatSeconds},
+                                      {"gather_cluster", r.gatherClusterSeconds},
+                                      {"merge", r.mergeSeconds},
+                                      {"total", r.totalSeconds}}}});
+      }
+      j["distributed"] = {
+          {"ranks", comm->size()},
+          {"tiles_per_axis", distributed.tilesPerAxis},
+          {"photon_halo_voxels", distributed.photonHalo},
+          {"bytes_exchanged_per_photon",
+           st.storedPhotons ? double(sent) / double(st.storedPhotons) : 0.0},
+          {"per_rank", ranks}};
+    }
     writeTextAtomically(opt.statsJson, j.dump(2) + "\n");
   }
   if (!opt.quiet) std::printf("\nwrote %s\n", opt.output.c_str());
   return 0;
+}
+
+/// Under mpirun (an MPI build), every rank bakes its tiles; a rank that
+/// fails ends the whole job (MpiSession::abort), so none waits forever and
+/// rank 0 writes nothing.
+int runBake(const BakeOptions& opt) {
+  const int launched = mpiLaunchSize();
+  if (launched == 0 || (launched == 1 && !mpiAvailable())) return runBakeOn(opt, nullptr);
+  MpiSession session;  // throws, naming the fix, when built without MPI
+  const int rank = session.world().rank();
+  try {
+    return runBakeOn(opt, &session.world());
+  } catch (const std::exception& e) {
+    // Rank 0 says what went wrong; the others add only what is their own.
+    if (rank == 0 || !dynamic_cast<const InputError*>(&e)) {
+      std::fprintf(stderr, "lightoctree: error%s: %s\n",
+                   rank == 0 ? "" : (" on rank " + std::to_string(rank)).c_str(), e.what());
+    }
+    std::fflush(stderr);
+    session.abort(1);
+  }
 }
 
 }  // namespace
@@ -226,7 +317,17 @@ std::function<int()> addBakeCommand(CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--photon-map", opt->photonMap,
                   "Also write the photons as an OpenVDB point grid for inspection");
-  cmd->add_option("--stats-json", opt->statsJson, "Write the per-stage figures as JSON");
+  cmd->add_option("--stats-json", opt->statsJson,
+                  "Write the per-stage figures as JSON (under mpirun, per rank too: time, "
+                  "bytes sent, peak memory)");
+  cmd->add_option("--tiles", opt->tiles,
+                  "Under mpirun (mpirun -np N lightoctree bake ...): tiles per axis the grid is "
+                  "cut into and shared among the ranks by estimated work, a power of two with "
+                  "tiles of at least 8^3 voxels, or 'auto' (32, fewer for shallow grids). The "
+                  ".vdb bytes are the one-process bake's whatever the tiles and ranks "
+                  "(docs/scale.md)")
+      ->check(tilesValidator())
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress or summary, only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runBake(*opt) : -1; };
 }

@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "bake/bake.h"
+#include "distributed/tiled_bake.h"
 
 namespace lo::tool {
 
@@ -29,6 +30,22 @@ CLI::Validator seedValidator() {
         return {};
       },
       "0..2^64-1", "Seed");
+}
+
+CLI::Validator tilesValidator() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        if (s == "auto") return {};
+        const bool digits = !s.empty() && s.size() <= 3 &&
+                            s.find_first_not_of("0123456789") == std::string::npos;
+        const int n = digits ? std::stoi(s) : 0;
+        if (n < 1 || n > kMaxTilesPerAxis || (n & (n - 1)) != 0) {
+          return "must be 'auto' or a power of two from 1 to " + std::to_string(kMaxTilesPerAxis) +
+                 " (tiles per axis), got '" + s + "'";
+        }
+        return {};
+      },
+      "auto|1,2,4,..", "Tiles");
 }
 
 CLI::Validator finitePositive() {

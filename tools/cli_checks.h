@@ -17,6 +17,8 @@ CLI::Validator depthValidator();
 /// `--seed`: decimal digits only, at most 2^64 - 1: "-1", "1e23" or a number
 /// beyond 64 bits would otherwise wrap to some other seed without a word.
 CLI::Validator seedValidator();
+/// `bake --tiles`: "auto" or a power of two up to kMaxTilesPerAxis.
+CLI::Validator tilesValidator();
 
 /// A finite number > 0 ("nan" and "inf" refused, unlike CLI::PositiveNumber).
 CLI::Validator finitePositive();

@@ -16,6 +16,8 @@ PACKAGES=(
   libembree-dev libtbb-dev
   # sparse grids and .vdb files (OpenVDB's CMake module needs boost-iostreams)
   libopenvdb-dev libboost-iostreams-dev libblosc-dev libopenvdb-tools
+  # the bake on several processes (mpirun -np N lightoctree bake, -DLO_WITH_MPI=ON)
+  openmpi-bin libopenmpi-dev
   # kd-tree baseline of the gather benchmark, CLI, tests
   libnanoflann-dev libcli11-dev libgtest-dev
   # lightmap UVs: the sparse LSCM solve (header-only; stb_rect_pack comes with libstb-dev)

@@ -17,6 +17,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <numeric>
 #include <sstream>
@@ -256,7 +258,7 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
   mine.rank = me;
 
   // 1. Photons by rank, sent batch by batch to the tiles that hold them.
-  StageTimer traceTimer(st.stages, "trace + exchange photons");
+  StageTimer traceTimer(st.stages, "trace + exchange");
   const PhotonParams photonParams = params.photonParams();
   PhotonTracer tracer(scene, photonParams);
   const size_t target = photonParams.storedPhotons;
@@ -324,6 +326,12 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
     }
   }
   if (!planned) makePlan({}, 0);
+  // The tests' stand-in for a machine lost mid-bake (docs/scale.md): this
+  // rank dies as a killed process does, between the photon exchange and the
+  // gather.
+  if (const char* kill = std::getenv("LIGHTOCTREE_KILL_RANK")) {
+    if (std::string(kill) == std::to_string(me)) std::raise(SIGKILL);
+  }
   std::vector<Photon>().swap(batch);
   scalePhotonPower(held, size_t(emitted));
   st.storedPhotons = size_t(stored);
