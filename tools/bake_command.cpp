@@ -49,7 +49,8 @@ struct BakeOptions {
 
 /// One row per rank of a distributed bake.
 void printRanks(const DistributedStats& d, size_t storedPhotons) {
-  std::printf("\n%d^3 tiles, photon halo %d voxels\n", d.tilesPerAxis, d.photonHalo);
+  std::printf("\n%d^3 tiles, photon halo %d voxels%s\n", d.tilesPerAxis, d.photonHalo,
+              d.attempts > 1 ? " (second attempt: the bins' margin exceeded the first halo's)" : "");
   std::printf("%4s %12s %12s %10s %10s %7s %12s %10s %8s\n", "rank", "photons", "held",
               "voxels", "computed", "work", "sent", "peak RSS", "seconds");
   for (const RankStats& r : d.ranks) {
@@ -206,6 +207,8 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
           {"ranks", comm->size()},
           {"tiles_per_axis", distributed.tilesPerAxis},
           {"photon_halo_voxels", distributed.photonHalo},
+          {"attempts", distributed.attempts},
+          {"bin_margin_voxels", distributed.binMarginVoxels},
           {"bytes_exchanged_per_photon",
            st.storedPhotons ? double(sent) / double(st.storedPhotons) : 0.0},
           {"per_rank", ranks}};

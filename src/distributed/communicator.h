@@ -37,8 +37,7 @@ class Communicator {
   virtual std::vector<uint64_t> alltoallCounts(const std::vector<uint64_t>& counts) = 0;
   /// Rank `root` receives every rank's bytes in rank order (its own
   /// included); the other ranks get an empty vector.
-  virtual std::vector<std::vector<char>> gatherBytes(const std::vector<char>& bytes,
-                                                     int root) = 0;
+  virtual std::vector<std::vector<char>> gatherBytes(const std::vector<char>& bytes, int root) = 0;
 };
 
 /// Sends items[begin[r] .. begin[r + 1]) to rank r (items grouped by

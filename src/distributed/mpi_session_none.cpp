@@ -1,9 +1,9 @@
 // MpiSession in a build without MPI (LO_WITH_MPI=OFF): it refuses to start.
 
+#include <cstdlib>
+
 #include "core/error.h"
 #include "distributed/mpi_session.h"
-
-#include <cstdlib>
 
 namespace lo {
 

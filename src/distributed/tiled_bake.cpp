@@ -35,7 +35,10 @@ namespace distributed_internal {
 /// Estimated work of an active voxel against a stored photon (gather,
 /// K-means and layers against splat and binning), from the cost model of
 /// docs/scale.md.
-constexpr double kVoxelWorkPhotons = 100.0;
+/// Memory per voxel against memory per photon: the work is balanced by the
+/// memory the bake needs (what a distributed bake is for), which also
+/// follows the time closely on surfaces of uniform photon density.
+constexpr double kVoxelWorkPhotons = double(kBakeBytesPerVoxel) / double(kBakeBytesPerPhoton);
 
 inline int log2Exact(int v) {
   int s = 0;
@@ -59,8 +62,8 @@ void checkTilesPerAxis(int tiles, int depth) {
   if (tiles < 1 || tiles > most || (tiles & (tiles - 1)) != 0) {
     throw InputError("--tiles " + std::to_string(tiles) + " must be a power of two from 1 to " +
                      std::to_string(most) + " at --depth " + std::to_string(depth) +
-                     " (tiles of at least 8^3 voxels, at most " +
-                     std::to_string(kMaxTilesPerAxis) + " per axis)");
+                     " (tiles of at least 8^3 voxels, at most " + std::to_string(kMaxTilesPerAxis) +
+                     " per axis)");
   }
 }
 
@@ -76,13 +79,13 @@ std::vector<double> estimateWork(const Scene& scene, const GridParams& grid, int
     coarse.depth = log2Exact(tilesPerAxis);
     coarse.keepBlock = nullptr;
     const SurfaceGrid areas = buildSurfaceGrid(scene, coarse);
-    const GridFrame fine = makeGridFrame(grid.region.empty() ? scene.bounds() : grid.region,
-                                         grid.depth, grid.padding);
+    const GridFrame fine =
+        makeGridFrame(grid.region.empty() ? scene.bounds() : grid.region, grid.depth, grid.padding);
     const double voxelArea = double(fine.voxelSize) * double(fine.voxelSize);
     for (size_t i = 0; i < areas.size(); ++i) {
       const Coord& c = areas.coords[i];
-      const size_t t = (size_t(c.x) * size_t(tilesPerAxis) + size_t(c.y)) * size_t(tilesPerAxis) +
-                       size_t(c.z);
+      const size_t t =
+          (size_t(c.x) * size_t(tilesPerAxis) + size_t(c.y)) * size_t(tilesPerAxis) + size_t(c.z);
       work[t] += double(areas.areas[i]) / voxelArea * kVoxelWorkPhotons;
     }
   }
@@ -178,8 +181,8 @@ std::string TilePlan::ToString() const {
   return os.str();
 }
 
-int photonHaloVoxels(const GatherParams& gather, const GridFrame& frame) {
-  const double reach = gatherReach(gather, frame) / double(frame.voxelSize) + kMaxBinMarginVoxels;
+int photonHaloVoxels(const GatherParams& gather, const GridFrame& frame, double marginVoxels) {
+  const double reach = gatherReach(gather, frame) / double(frame.voxelSize) + marginVoxels;
   // Gatherer's reach in voxels with its relative slack, plus one for a query
   // point on its voxel's upper face.
   const double slack = reach * (1.0 + 1e-4) + 1e-6;
@@ -230,8 +233,8 @@ TilePlan planTiles(int depth, int tilesPerAxis, const std::vector<double>& work,
 }
 
 BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
-                           const TileParams& tileParams, Communicator& comm,
-                           ProgressSink* progress, DistributedStats* stats) {
+                           const TileParams& tileParams, Communicator& comm, ProgressSink* progress,
+                           DistributedStats* stats) {
   using namespace distributed_internal;
   const int ranks = comm.size(), me = comm.rank();
   Stopwatch total;
@@ -242,160 +245,189 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
         "it); write it from a bake on one process");
   }
   const LevelParams level = params.levelParams();
-  const GridFrame frame =
-      makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth,
-                    level.grid.padding);
+  const GridFrame frame = makeGridFrame(params.region.empty() ? scene.bounds() : params.region,
+                                        params.depth, level.grid.padding);
   const int tilesPerAxis =
       tileParams.tilesPerAxis != 0 ? tileParams.tilesPerAxis : autoTilesPerAxis(params.depth);
   checkTilesPerAxis(tilesPerAxis, params.depth);
-  const int halo = photonHaloVoxels(level.gather, frame);
 
   BakeResult result;
   BakeStats& st = result.stats;
-  st.triangles = scene.triangleCount();
-  st.denseVoxels = size_t(1) << (3 * params.depth);
   RankStats mine;
-  mine.rank = me;
-
-  // 1. Photons by rank, sent batch by batch to the tiles that hold them.
-  StageTimer traceTimer(st.stages, "trace + exchange");
-  const PhotonParams photonParams = params.photonParams();
-  PhotonTracer tracer(scene, photonParams);
-  const size_t target = photonParams.storedPhotons;
-  const size_t maxEmitted = maxEmittedPaths(photonParams);
   std::vector<Photon> held;  // this rank's tiles and halo, in map order
-  std::vector<Photon> batch;
-  std::vector<uint32_t> pathPhotons;
-  uint64_t stored = 0, emitted = 0, empty = 0, unsent = 0;
   TilePlan plan;
-  bool planned = false;
-  auto makePlan = [&](const std::vector<Photon>& pilot, uint64_t pilotStored) {
-    const size_t T = size_t(tilesPerAxis);
-    std::vector<uint64_t> counts(T * T * T, 0);
-    TilePlan probe;  // tile lookup only
-    probe.depth = params.depth;
-    probe.tilesPerAxis = tilesPerAxis;
-    probe.tileShift = params.depth - log2Exact(tilesPerAxis);
-    for (const Photon& p : pilot) ++counts[probe.tileOf(frame.coordOf(p.position))];
-    comm.allreduceSum(counts.data(), counts.size());
-    const double scale = pilotStored > 0 ? double(target) / double(pilotStored) : 0.0;
-    plan = planTiles(params.depth, tilesPerAxis,
-                     estimateWork(scene, level.grid, tilesPerAxis, counts, scale), ranks, halo);
-    planned = true;
-  };
-  {
-    Progress bar(progress, "Tracing photons", target);
-    while (target > 0 && tracer.canStore() && stored < target) {
-      const size_t paths = photonBatchPaths(target, size_t(stored), size_t(emitted), maxEmitted);
-      if (paths == 0) break;
-      // This rank's contiguous share of the batch's paths.
-      const uint64_t first = emitted + uint64_t(paths) * uint64_t(me) / uint64_t(ranks);
-      const uint64_t last = emitted + uint64_t(paths) * uint64_t(me + 1) / uint64_t(ranks);
-      batch.clear();
-      pathPhotons.clear();
-      Stopwatch traceClock;
-      tracer.trace(first, size_t(last - first), batch, pathPhotons);
-      mine.traceSeconds += traceClock.seconds();
+  SurfaceGrid grid;
+  uint64_t stored = 0, emitted = 0, empty = 0, unsent = 0;
+  int halo = 0, attempts = 0;
+  for (const double assumedMargin :
+       {std::min(tileParams.assumedMarginVoxels, kMaxBinMarginVoxels), kMaxBinMarginVoxels}) {
+    ++attempts;
+    halo = photonHaloVoxels(level.gather, frame, assumedMargin);
+    st = BakeStats{};
+    st.triangles = scene.triangleCount();
+    st.denseVoxels = size_t(1) << (3 * params.depth);
+    mine = RankStats{};
+    mine.rank = me;
+    std::vector<Photon>().swap(held);
+    stored = emitted = empty = unsent = 0;
 
-      // Where the map's last photon lies: the ranks before hold `before`.
-      Stopwatch exchangeClock;
-      const std::vector<uint64_t> counts = comm.allgather(batch.size());
-      uint64_t before = stored;
-      for (int r = 0; r < me; ++r) before += counts[size_t(r)];
-      uint64_t keptPaths = 0, keptEmpty = 0;
-      size_t keptPhotons = 0;
-      for (size_t i = 0; i < pathPhotons.size() && before + keptPhotons < target; ++i) {
-        keptPhotons += std::min<uint64_t>(pathPhotons[i], target - before - keptPhotons);
-        ++keptPaths;
-        keptEmpty += pathPhotons[i] == 0;
+    // 1. Photons by rank, sent batch by batch to the tiles that hold them.
+    StageTimer traceTimer(st.stages, "trace + exchange");
+    const PhotonParams photonParams = params.photonParams();
+    PhotonTracer tracer(scene, photonParams);
+    const size_t target = photonParams.storedPhotons;
+    const size_t maxEmitted = maxEmittedPaths(photonParams);
+    std::vector<Photon> batch;
+    std::vector<uint32_t> pathPhotons;
+    bool planned = false;
+    auto makePlan = [&](const std::vector<Photon>& pilot, uint64_t pilotStored) {
+      const size_t T = size_t(tilesPerAxis);
+      std::vector<uint64_t> counts(T * T * T, 0);
+      TilePlan probe;  // tile lookup only
+      probe.depth = params.depth;
+      probe.tilesPerAxis = tilesPerAxis;
+      probe.tileShift = params.depth - log2Exact(tilesPerAxis);
+      for (const Photon& p : pilot) ++counts[probe.tileOf(frame.coordOf(p.position))];
+      comm.allreduceSum(counts.data(), counts.size());
+      const double scale = pilotStored > 0 ? double(target) / double(pilotStored) : 0.0;
+      plan = planTiles(params.depth, tilesPerAxis,
+                       estimateWork(scene, level.grid, tilesPerAxis, counts, scale), ranks, halo);
+      if (!tileParams.owner.empty()) {
+        if (tileParams.owner.size() != plan.owner.size()) {
+          throw InputError("a tile owner table of " + std::to_string(tileParams.owner.size()) +
+                           " entries for " + std::to_string(plan.owner.size()) + " tiles");
+        }
+        for (int32_t r : tileParams.owner) {
+          if (r < 0 || r >= ranks) {
+            throw InputError("tile owner " + std::to_string(r) + " is not one of the " +
+                             std::to_string(ranks) + " ranks");
+          }
+        }
+        plan.owner = tileParams.owner;
       }
-      batch.resize(keptPhotons);
-      uint64_t sums[3] = {keptPaths, keptEmpty, uint64_t(keptPhotons)};
-      comm.allreduceSum(sums, 3);
-      emitted += sums[0];
-      empty += sums[1];
-      stored += sums[2];
-      mine.photonsTraced += keptPhotons;
-      if (!planned) makePlan(batch, sums[2]);
-      const ExchangeResult ex = exchangePhotons(comm, plan, frame, batch, held);
-      mine.bytesSent += ex.sent;
-      mine.bytesReceived += ex.received;
-      unsent += ex.unsent;
-      mine.exchangeSeconds += exchangeClock.seconds();
-      bar.advance(size_t(sums[2]));
-    }
-  }
-  if (!planned) makePlan({}, 0);
-  // The tests' stand-in for a machine lost mid-bake (docs/scale.md): this
-  // rank dies as a killed process does, between the photon exchange and the
-  // gather.
-  if (const char* kill = std::getenv("LIGHTOCTREE_KILL_RANK")) {
-    if (std::string(kill) == std::to_string(me)) std::raise(SIGKILL);
-  }
-  std::vector<Photon>().swap(batch);
-  scalePhotonPower(held, size_t(emitted));
-  st.storedPhotons = size_t(stored);
-  st.emittedPaths = size_t(emitted);
-  st.emptyPaths = size_t(empty);
-  mine.photonsHeld = held.size();
-  st.traceSeconds = traceTimer.finish(formatCount(size_t(stored)) + " photons from " +
-                                      formatCount(size_t(emitted)) + " paths on " +
-                                      std::to_string(ranks) + " ranks");
-  for (size_t t = 0; t < plan.owner.size(); ++t) {
-    if (plan.owner[t] == me && plan.work[t] > 0) ++mine.tilesOwned;
-  }
-  {
-    double all = 0, own = 0;
-    for (size_t t = 0; t < plan.work.size(); ++t) {
-      all += plan.work[t];
-      if (plan.owner[t] == me) own += plan.work[t];
-    }
-    mine.workShare = all > 0 ? own / all : 0.0;
-  }
+      planned = true;
+    };
+    {
+      Progress bar(progress, "Tracing photons", target);
+      while (target > 0 && tracer.canStore() && stored < target) {
+        const size_t paths = photonBatchPaths(target, size_t(stored), size_t(emitted), maxEmitted);
+        if (paths == 0) break;
+        // This rank's contiguous share of the batch's paths.
+        const uint64_t first = emitted + uint64_t(paths) * uint64_t(me) / uint64_t(ranks);
+        const uint64_t last = emitted + uint64_t(paths) * uint64_t(me + 1) / uint64_t(ranks);
+        batch.clear();
+        pathPhotons.clear();
+        Stopwatch traceClock;
+        tracer.trace(first, size_t(last - first), batch, pathPhotons);
+        mine.traceSeconds += traceClock.seconds();
 
-  // 2. This rank's tiles and halo, voxelized; its photons splatted.
-  StageTimer voxelizeTimer(st.stages, "voxelize");
-  LocalRegion region{&plan, me, halo + 1};
-  GridParams gridParams = level.grid;
-  {
-    const int res = 1 << params.depth, edge = 1 << plan.tileShift;
-    Coord lo{res, res, res}, hi{-1, -1, -1};
-    const size_t T = size_t(tilesPerAxis);
+        // Where the map's last photon lies: the ranks before hold `before`.
+        Stopwatch exchangeClock;
+        const std::vector<uint64_t> counts = comm.allgather(batch.size());
+        uint64_t before = stored;
+        for (int r = 0; r < me; ++r) before += counts[size_t(r)];
+        uint64_t keptPaths = 0, keptEmpty = 0;
+        size_t keptPhotons = 0;
+        for (size_t i = 0; i < pathPhotons.size() && before + keptPhotons < target; ++i) {
+          keptPhotons += std::min<uint64_t>(pathPhotons[i], target - before - keptPhotons);
+          ++keptPaths;
+          keptEmpty += pathPhotons[i] == 0;
+        }
+        batch.resize(keptPhotons);
+        uint64_t sums[3] = {keptPaths, keptEmpty, uint64_t(keptPhotons)};
+        comm.allreduceSum(sums, 3);
+        emitted += sums[0];
+        empty += sums[1];
+        stored += sums[2];
+        mine.photonsTraced += keptPhotons;
+        if (!planned) makePlan(batch, sums[2]);
+        const ExchangeResult ex = exchangePhotons(comm, plan, frame, batch, held);
+        mine.bytesSent += ex.sent;
+        mine.bytesReceived += ex.received;
+        unsent += ex.unsent;
+        mine.exchangeSeconds += exchangeClock.seconds();
+        bar.advance(size_t(sums[2]));
+      }
+    }
+    if (!planned) makePlan({}, 0);
+    // The tests' stand-in for a machine lost mid-bake (docs/scale.md): this
+    // rank dies as a killed process does, between the photon exchange and the
+    // gather.
+    if (const char* kill = std::getenv("LIGHTOCTREE_KILL_RANK")) {
+      if (std::string(kill) == std::to_string(me)) std::raise(SIGKILL);
+    }
+    std::vector<Photon>().swap(batch);
+    scalePhotonPower(held, size_t(emitted));
+    st.storedPhotons = size_t(stored);
+    st.emittedPaths = size_t(emitted);
+    st.emptyPaths = size_t(empty);
+    mine.photonsHeld = held.size();
+    st.traceSeconds = traceTimer.finish(formatCount(size_t(stored)) + " photons from " +
+                                        formatCount(size_t(emitted)) + " paths on " +
+                                        std::to_string(ranks) + " ranks");
     for (size_t t = 0; t < plan.owner.size(); ++t) {
-      if (plan.owner[t] != me) continue;
-      const int x = int(t / (T * T)), y = int(t / T % T), z = int(t % T);
-      lo = {std::min(lo.x, x * edge), std::min(lo.y, y * edge), std::min(lo.z, z * edge)};
-      hi = {std::max(hi.x, x * edge + edge - 1), std::max(hi.y, y * edge + edge - 1),
-            std::max(hi.z, z * edge + edge - 1)};
+      if (plan.owner[t] == me && plan.work[t] > 0) ++mine.tilesOwned;
     }
-    gridParams.clipLower = {lo.x - region.halo, lo.y - region.halo, lo.z - region.halo};
-    gridParams.clipUpper = {hi.x + region.halo, hi.y + region.halo, hi.z + region.halo};
-    gridParams.keepBlock = [&region](const Coord& b) { return region.keepBlock(b); };
-  }
-  SurfaceGrid grid = buildSurfaceGrid(scene, gridParams, progress);
-  mine.voxelsHeld = grid.size();
-  mine.voxelizeSeconds = voxelizeTimer.finish(formatCount(grid.size()) + " voxels held on rank " + std::to_string(me));
+    {
+      double all = 0, own = 0;
+      for (size_t t = 0; t < plan.work.size(); ++t) {
+        all += plan.work[t];
+        if (plan.owner[t] == me) own += plan.work[t];
+      }
+      mine.workShare = all > 0 ? own / all : 0.0;
+    }
 
-  StageTimer splatTimer(st.stages, "splat photons");
-  splatPhotons(grid, held);
-  {
-    double margin = double(grid.binMargin);
-    comm.allreduceMax(&margin, 1);
-    grid.binMargin = float(margin);  // a float already: the maximum of the ranks' floats
-  }
-  // Photons outside every active voxel's neighbourhood, each counted by the
-  // owner of its tile (or by its tracer, when no rank holds it).
-  uint64_t dropped = unsent;
-  {
-    std::vector<char> binned(held.size(), 0);
-    for (uint32_t i : grid.binPhotons) binned[i] = 1;
-    for (size_t i = 0; i < held.size(); ++i) {
-      if (!binned[i] && plan.ownerOf(frame.coordOf(held[i].position)) == me) ++dropped;
+    // 2. This rank's tiles and halo, voxelized; its photons splatted.
+    StageTimer voxelizeTimer(st.stages, "voxelize");
+    LocalRegion region{&plan, me, halo + 1};
+    GridParams gridParams = level.grid;
+    {
+      const int res = 1 << params.depth, edge = 1 << plan.tileShift;
+      Coord lo{res, res, res}, hi{-1, -1, -1};
+      const size_t T = size_t(tilesPerAxis);
+      for (size_t t = 0; t < plan.owner.size(); ++t) {
+        if (plan.owner[t] != me) continue;
+        const int x = int(t / (T * T)), y = int(t / T % T), z = int(t % T);
+        lo = {std::min(lo.x, x * edge), std::min(lo.y, y * edge), std::min(lo.z, z * edge)};
+        hi = {std::max(hi.x, x * edge + edge - 1), std::max(hi.y, y * edge + edge - 1),
+              std::max(hi.z, z * edge + edge - 1)};
+      }
+      gridParams.clipLower = {lo.x - region.halo, lo.y - region.halo, lo.z - region.halo};
+      gridParams.clipUpper = {hi.x + region.halo, hi.y + region.halo, hi.z + region.halo};
+      gridParams.keepBlock = [&region](const Coord& b) { return region.keepBlock(b); };
     }
+    grid = buildSurfaceGrid(scene, gridParams, progress);
+    mine.voxelsHeld = grid.size();
+    mine.voxelizeSeconds = voxelizeTimer.finish(formatCount(grid.size()) + " voxels held on rank " +
+                                                std::to_string(me));
+
+    StageTimer splatTimer(st.stages, "splat photons");
+    splatPhotons(grid, held);
+    {
+      double margin = double(grid.binMargin);
+      comm.allreduceMax(&margin, 1);
+      grid.binMargin = float(margin);  // a float already: the maximum of the ranks' floats
+    }
+    // Every rank sees the same margin, so all start again together.
+    if (double(grid.binMargin) > assumedMargin * double(frame.voxelSize)) continue;
+    // Photons outside every active voxel's neighbourhood, each counted by the
+    // owner of its tile (or by its tracer, when no rank holds it).
+    uint64_t dropped = unsent;
+    {
+      std::vector<char> binned(held.size(), 0);
+      for (uint32_t i : grid.binPhotons) binned[i] = 1;
+      for (size_t i = 0; i < held.size(); ++i) {
+        if (!binned[i] && plan.ownerOf(frame.coordOf(held[i].position)) == me) ++dropped;
+      }
+    }
+    comm.allreduceSum(&dropped, 1);
+    st.level.droppedPhotons = size_t(dropped);
+    mine.splatSeconds = splatTimer.finish();
+    break;
   }
-  comm.allreduceSum(&dropped, 1);
-  st.level.droppedPhotons = size_t(dropped);
-  mine.splatSeconds = splatTimer.finish();
+  const float binMargin = grid.binMargin;
+  // The bound always holds: the second attempt never continues.
+  LO_CHECK_LE(double(grid.binMargin), kMaxBinMarginVoxels * double(frame.voxelSize));
 
   // 3. Gather + cluster: this rank's voxels and the ring the smoothing reads.
   StageTimer clusterTimer(st.stages, "gather + cluster");
@@ -428,15 +460,14 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
     gather.blocked = occlusion->test();
   }
   const LayerParams layerParams;
-  VdlGrid local = buildVdlGrid(grid, held, gather, level.cluster, progress,
-                               &st.level.threadSeconds, level.layers ? &layerParams : nullptr,
-                               &computed);
+  VdlGrid local = buildVdlGrid(grid, held, gather, level.cluster, progress, &st.level.threadSeconds,
+                               level.layers ? &layerParams : nullptr, &computed);
   if (level.smoothing) smoothVdlGrid(grid, local);
   std::vector<Photon>().swap(held);
   grid = SurfaceGrid{};
-  mine.gatherClusterSeconds = clusterTimer.finish(
-      formatCount(owned.size()) + " voxels owned, " + formatCount(computed.size()) +
-      " computed on rank " + std::to_string(me));
+  mine.gatherClusterSeconds =
+      clusterTimer.finish(formatCount(owned.size()) + " voxels owned, " +
+                          formatCount(computed.size()) + " computed on rank " + std::to_string(me));
 
   // 4. The owned voxels, merged on rank 0.
   StageTimer mergeTimer(st.stages, "merge on rank 0");
@@ -469,8 +500,7 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
     st.level.layeredVoxels = layered;
     st.level.extraLayers = L.size();
   }
-  result.metadata =
-      bakeMetadata(scene, params, int64_t(stored), int64_t(emitted), st.level.radius);
+  result.metadata = bakeMetadata(scene, params, int64_t(stored), int64_t(emitted), st.level.radius);
 
   mine.totalSeconds = total.seconds();
   mine.peakRssBytes = peakRssBytes();
@@ -479,7 +509,10 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
   if (stats) {
     stats->tilesPerAxis = tilesPerAxis;
     stats->photonHalo = halo;
+    stats->attempts = attempts;
+    stats->binMarginVoxels = double(binMargin) / double(frame.voxelSize);
     stats->tileOwner = plan.owner;
+    stats->tileWork = plan.work;
     stats->ranks.clear();
     if (me == 0) {
       for (const std::vector<char>& bytes : all) {

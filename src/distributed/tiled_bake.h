@@ -38,6 +38,14 @@ struct TileParams {
   /// Tiles per axis of the grid: a power of two from 1 to
   /// maxTilesPerAxis(depth); 0 = auto (autoTilesPerAxis).
   int tilesPerAxis = 0;
+  /// A given owner rank per tile (TilePlan::owner's layout) instead of the
+  /// split by work: a boundary placed where a test wants it. Empty = by work.
+  std::vector<int32_t> owner;
+  /// The bins' margin (SurfaceGrid::binMargin, voxel sizes) the photon halo
+  /// first assumes: a photon lies on a surface, so splatting moves it off
+  /// its voxel only by the rounding of its hit point. When the bake finds a
+  /// larger one, it starts again with the bound kMaxBinMarginVoxels.
+  double assumedMarginVoxels = 0.25;
 };
 
 /// min(kMaxTilesPerAxis, 2^depth / 8), at least 1: tiles of at least one
@@ -48,11 +56,11 @@ int autoTilesPerAxis(int depth);
 
 /// Which rank owns which tile of a grid.
 struct TilePlan {
-  int depth = 0;          ///< the grid's (2^depth voxels per axis)
-  int tileShift = 0;      ///< tile edge = 2^tileShift voxels
+  int depth = 0;      ///< the grid's (2^depth voxels per axis)
+  int tileShift = 0;  ///< tile edge = 2^tileShift voxels
   int tilesPerAxis = 1;
   int ranks = 1;
-  int photonHalo = 0;     ///< voxels around a rank's tiles whose photons it receives
+  int photonHalo = 0;          ///< voxels around a rank's tiles whose photons it receives
   std::vector<int32_t> owner;  ///< per tile, index (x * T + y) * T + z
   std::vector<double> work;    ///< estimated work per tile (photon-equivalents)
 
@@ -67,11 +75,12 @@ struct TilePlan {
 };
 
 /// The photon halo a gather with `gather` on `frame` needs: the bins it
-/// reads (gatherReach grown by the largest bin margin, as Gatherer counts
-/// voxels) around the voxels a rank computes (its own and their neighbours,
-/// which the smoothing reads), and the neighbours a splatted photon can move
-/// from. Voxels are voxelized one further out.
-int photonHaloVoxels(const GatherParams& gather, const GridFrame& frame);
+/// reads (gatherReach grown by the bins' margin, `marginVoxels` voxel sizes,
+/// as Gatherer counts voxels) around the voxels a rank computes (its own and
+/// their neighbours, which the smoothing reads), and the neighbours a
+/// splatted photon can move from. Voxels are voxelized one further out.
+int photonHaloVoxels(const GatherParams& gather, const GridFrame& frame,
+                     double marginVoxels = kMaxBinMarginVoxels);
 
 /// Splits the tiles among `ranks`: along the Z-order curve of the tile grid,
 /// rank r gets the tiles whose work midpoint lies in [r W / ranks,
@@ -85,22 +94,27 @@ struct RankStats {
   double traceSeconds = 0;     ///< tracing this rank's paths
   double exchangeSeconds = 0;  ///< sending and receiving photons (waits included)
   double voxelizeSeconds = 0, splatSeconds = 0, gatherClusterSeconds = 0;
-  double mergeSeconds = 0;     ///< sending the voxels to rank 0 (and merging them there)
+  double mergeSeconds = 0;  ///< sending the voxels to rank 0 (and merging them there)
   double totalSeconds = 0;
   uint64_t bytesSent = 0, bytesReceived = 0;  ///< photons to and from other ranks
-  uint64_t photonsTraced = 0;  ///< of the map, traced here
-  uint64_t photonsHeld = 0;    ///< received: its tiles' and their halo's
+  uint64_t photonsTraced = 0;                 ///< of the map, traced here
+  uint64_t photonsHeld = 0;                   ///< received: its tiles' and their halo's
   uint64_t tilesOwned = 0;
-  double workShare = 0;        ///< of the estimated work, 0..1
+  double workShare = 0;  ///< of the estimated work, 0..1
   uint64_t voxelsOwned = 0, voxelsComputed = 0, voxelsHeld = 0;
-  uint64_t peakRssBytes = 0;   ///< of this process (threads ranks share one)
+  uint64_t peakRssBytes = 0;  ///< of this process (threads ranks share one)
 };
 
 struct DistributedStats {
   int tilesPerAxis = 0;
   int photonHalo = 0;
+  /// 2 when the bins' margin was larger than first assumed and the bake ran
+  /// again with the bound (photonHaloVoxels), else 1.
+  int attempts = 1;
+  double binMarginVoxels = 0;      ///< the bins' margin found, voxel sizes
   std::vector<int32_t> tileOwner;  ///< TilePlan::owner
-  std::vector<RankStats> ranks;  ///< rank 0: every rank's, in rank order; others: their own
+  std::vector<double> tileWork;    ///< TilePlan::work
+  std::vector<RankStats> ranks;    ///< rank 0: every rank's, in rank order; others: their own
 };
 
 /// @brief bake() on the ranks of `comm` (every rank calls it with the same

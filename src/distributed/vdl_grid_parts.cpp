@@ -53,8 +53,9 @@ void gatherRuns(const std::vector<T>& in, size_t per, const std::vector<size_t>&
                 std::vector<T>& out) {
   out.clear();
   out.reserve(order.size() * per);
-  for (size_t i : order) out.insert(out.end(), in.begin() + std::ptrdiff_t(i * per),
-                                    in.begin() + std::ptrdiff_t((i + 1) * per));
+  for (size_t i : order)
+    out.insert(out.end(), in.begin() + std::ptrdiff_t(i * per),
+               in.begin() + std::ptrdiff_t((i + 1) * per));
 }
 
 /// The grid's arrays reordered: voxel i of the result is `voxels[i]`, its
@@ -189,7 +190,8 @@ VdlGrid deserializeVdlGrid(const std::vector<char>& bytes) {
   const size_t n = g.size(), m = g.layers.size();
   bool ok = g.maxVdls >= 1 && g.maxVdls <= kMaxVdls && g.shTerms >= 0 && g.shTerms <= 9;
   if (ok) {
-    eachVoxelArray(g, [&](const auto& a, size_t per) { ok = ok && (per == 0 || a.size() == n * per); });
+    eachVoxelArray(
+        g, [&](const auto& a, size_t per) { ok = ok && (per == 0 || a.size() == n * per); });
     eachLayerArray(g, [&](const auto& a, size_t per) { ok = ok && a.size() == m * per; });
     for (uint32_t v : g.layers.voxel) ok = ok && v < n;
   }

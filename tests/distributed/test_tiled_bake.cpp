@@ -55,11 +55,14 @@ struct RankRun {
   DistributedStats stats;
 };
 
-RankRun bakeOnThreadRanks(const Scene& scene, const BakeParams& params, int ranks, int tiles) {
+RankRun bakeOnThreadRanks(const Scene& scene, const BakeParams& params, int ranks, int tiles,
+                          const std::vector<int32_t>& owner = {}, double assumedMargin = 0.25) {
   RankRun run;
   std::mutex mutex;
   TileParams tileParams;
+  tileParams.assumedMarginVoxels = assumedMargin;
   tileParams.tilesPerAxis = tiles;
+  tileParams.owner = owner;
   runThreadRanks(ranks, [&](Communicator& comm) {
     DistributedStats stats;
     BakeResult r = distributedBake(scene, params, tileParams, comm, nullptr, &stats);
@@ -145,9 +148,9 @@ TEST(TiledBake, AutoVdlsAndAWideRadiusAreTheOneProcessBake) {
 
 TEST(TiledBake, ATileBoundaryThroughAWallJointChangesNothing) {
   // A floor with a wall standing on it at x = 0, lit from both sides: the
-  // grid's cube is centred on x = 0, so with 2 tiles per axis and 2 ranks
-  // the ranks' boundary is the plane of the wall, through its joint with
-  // the floor.
+  // grid's cube is centred on x = 0, so with 2 tiles per axis, rank 0 owning
+  // x < 0 and rank 1 x >= 0, the ranks' boundary is the plane of the wall,
+  // through its joint with the floor.
   Scene scene;
   Material grey;
   grey.baseColor = Vec3(0.7f);
@@ -167,13 +170,12 @@ TEST(TiledBake, ATileBoundaryThroughAWallJointChangesNothing) {
   params.knn = 60;
   params.includeDirect = true;
   const BakeResult single = bake(scene, params);
-  const RankRun run = bakeOnThreadRanks(scene, params, 2, 2);
+  const RankRun run = bakeOnThreadRanks(scene, params, 2, 2, {0, 0, 0, 0, 1, 1, 1, 1});
   EXPECT_EQ(firstDifference(single.grid, run.result.grid), "");
 
-  // The boundary is where it was meant to be: rank 0 owns x < 16, rank 1
-  // x >= 16, and both sides of the joint hold lit voxels of the wall.
-  ASSERT_EQ(run.stats.tileOwner.size(), 8u);
-  for (size_t t = 0; t < 8; ++t) EXPECT_EQ(run.stats.tileOwner[t], t < 4 ? 0 : 1) << "tile " << t;
+  // The boundary is where it was meant to be: the wall lies on voxel
+  // x = 16's lower face, and both sides of the joint hold lit voxels.
+  ASSERT_EQ(run.stats.tileOwner, std::vector<int32_t>({0, 0, 0, 0, 1, 1, 1, 1}));
   const Coord wall = single.grid.frame.coordOf(Vec3(0, 0, 0));
   ASSERT_EQ(wall.x, 16);
   int joint[2] = {0, 0};
@@ -183,6 +185,24 @@ TEST(TiledBake, ATileBoundaryThroughAWallJointChangesNothing) {
   }
   EXPECT_GT(joint[0], 10);
   EXPECT_GT(joint[1], 10);
+}
+
+TEST(TiledBake, ABinMarginBeyondTheAssumedOneStartsAgainWithTheBound) {
+  // An assumed margin below zero is always exceeded: the second attempt,
+  // with the bound's wider halo, must give the same grid.
+  const Scene scene = test::pointLitRoom();
+  BakeParams params;
+  params.depth = 5;
+  params.photons = 20000;
+  params.knn = 40;
+  const BakeResult single = bake(scene, params);
+  const RankRun first = bakeOnThreadRanks(scene, params, 3, 2);
+  const RankRun again = bakeOnThreadRanks(scene, params, 3, 2, {}, -1.0);
+  EXPECT_EQ(first.stats.attempts, 1);
+  EXPECT_EQ(again.stats.attempts, 2);
+  EXPECT_GT(again.stats.photonHalo, first.stats.photonHalo);
+  EXPECT_EQ(firstDifference(single.grid, again.result.grid), "");
+  EXPECT_EQ(again.result.stats.storedPhotons, single.stats.storedPhotons);
 }
 
 TEST(TiledBake, RefusesAPhotonMapAndBadTileCounts) {
@@ -300,12 +320,14 @@ TEST(ThreadRanks, CollectivesGiveWhatEachRankSent) {
       std::vector<int> got = {-1};
       exchangeItems(comm, items, begin, got);
       std::vector<int> expected = {-1};
-      for (int s = 0; s < n; ++s) expected.insert(expected.end(), size_t((s + 1) * (me + 1)), 100 * s + me);
+      for (int s = 0; s < n; ++s)
+        expected.insert(expected.end(), size_t((s + 1) * (me + 1)), 100 * s + me);
       EXPECT_EQ(got, expected);
       const auto gathered = comm.gatherBytes(std::vector<char>(size_t(me), char(me)), n - 1);
       if (me == n - 1) {
         ASSERT_EQ(gathered.size(), size_t(n));
-        for (int r = 0; r < n; ++r) EXPECT_EQ(gathered[size_t(r)], std::vector<char>(size_t(r), char(r)));
+        for (int r = 0; r < n; ++r)
+          EXPECT_EQ(gathered[size_t(r)], std::vector<char>(size_t(r), char(r)));
       } else {
         EXPECT_TRUE(gathered.empty());
       }
