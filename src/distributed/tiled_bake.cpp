@@ -86,7 +86,26 @@ std::vector<double> estimateWork(const Scene& scene, const GridParams& grid, int
       const Coord& c = areas.coords[i];
       const size_t t =
           (size_t(c.x) * size_t(tilesPerAxis) + size_t(c.y)) * size_t(tilesPerAxis) + size_t(c.z);
-      work[t] += double(areas.areas[i]) / voxelArea * kVoxelWorkPhotons;
+      // A plane of normal n crosses (|nx| + |ny| + |nz|) A / h^2 voxels (its
+      // projections on the three axis planes): per orientation of the tile's
+      // geometry, else its mean normal (1 where opposite faces cancel).
+      double voxels = 0;
+      const uint32_t first = areas.orientationStart[i], last = areas.orientationStart[i + 1];
+      auto crossing = [](const Vec3& n) {
+        const double f = double(std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z));
+        return f > 0 ? f : 1.0;
+      };
+      if (first == last) {
+        voxels = double(areas.areas[i]) * crossing(areas.normals[i]);
+      } else {
+        double covered = 0;
+        for (uint32_t o = first; o < last; ++o) {
+          voxels += double(areas.orientations[o].area) * crossing(areas.orientations[o].normal);
+          covered += double(areas.orientations[o].area);
+        }
+        voxels += std::max(0.0, double(areas.areas[i]) - covered);  // the small clusters dropped
+      }
+      work[t] += voxels / voxelArea * kVoxelWorkPhotons;
     }
   }
   return work;

@@ -1,15 +1,65 @@
 // OSMesa back end: Mesa's software rasterizer (llvmpipe) with no display.
+//
+// libOSMesa is opened on first use (dlopen), not linked: it brings LLVM,
+// whose relocation alone makes ~50 MiB resident in every process that loads
+// it, and the commands that never draw headless (bake, the ranks of a
+// distributed bake) should not carry it.
 
+#include <dlfcn.h>
 #include <glad/gl.h>
 // glad's header defines __gl_h_, so osmesa.h takes glad's GL types.
 #include <GL/osmesa.h>
 
+#include <mutex>
+#include <string>
 #include <vector>
 
 #include "render/context_internal.h"
 
 namespace lo::render_internal {
 namespace {
+
+/// The OSMesa entry points the context uses, from the library opened once.
+struct OsMesaApi {
+  decltype(&OSMesaCreateContextAttribs) createContextAttribs = nullptr;
+  decltype(&OSMesaMakeCurrent) makeCurrent = nullptr;
+  decltype(&OSMesaGetProcAddress) getProcAddress = nullptr;
+  decltype(&OSMesaDestroyContext) destroyContext = nullptr;
+};
+
+const OsMesaApi& osMesa() {
+  static OsMesaApi api;
+  static std::string error;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    void* lib = nullptr;
+    for (const char* name : {"libOSMesa.so.8", "libOSMesa.so"}) {
+      lib = dlopen(name, RTLD_NOW | RTLD_LOCAL);
+      if (lib) break;
+    }
+    if (!lib) {
+      const char* why = dlerror();
+      error = std::string("osmesa: cannot open libOSMesa.so.8 (") + (why ? why : "?") +
+              "): install libosmesa6 (tools/setup.sh does)";
+      return;
+    }
+    // Never closed: the GL functions glad loaded point into it.
+    api.createContextAttribs = reinterpret_cast<decltype(api.createContextAttribs)>(
+        dlsym(lib, "OSMesaCreateContextAttribs"));
+    api.makeCurrent = reinterpret_cast<decltype(api.makeCurrent)>(dlsym(lib, "OSMesaMakeCurrent"));
+    api.getProcAddress =
+        reinterpret_cast<decltype(api.getProcAddress)>(dlsym(lib, "OSMesaGetProcAddress"));
+    api.destroyContext =
+        reinterpret_cast<decltype(api.destroyContext)>(dlsym(lib, "OSMesaDestroyContext"));
+    if (!api.createContextAttribs || !api.makeCurrent || !api.getProcAddress ||
+        !api.destroyContext) {
+      api = OsMesaApi{};
+      error = "osmesa: libOSMesa lacks OSMesaCreateContextAttribs (Mesa 11.2 or later needed)";
+    }
+  });
+  if (!api.createContextAttribs) throw GlError(error);
+  return api;
+}
 
 class OsMesaContext final : public GlContext {
  public:
@@ -27,7 +77,7 @@ class OsMesaContext final : public GlContext {
                              OSMESA_CONTEXT_MINOR_VERSION,
                              minorMajor % 10,
                              0};
-      context_ = OSMesaCreateContextAttribs(attribs, nullptr);
+      context_ = osMesa().createContextAttribs(attribs, nullptr);
       if (context_) break;
     }
     if (!context_) {
@@ -36,13 +86,13 @@ class OsMesaContext final : public GlContext {
     makeCurrentImpl();
     initialize(params.debugOutput);
   }
-  ~OsMesaContext() override { OSMesaDestroyContext(context_); }
+  ~OsMesaContext() override { osMesa().destroyContext(context_); }
 
  protected:
   void makeCurrentImpl() override {
     // The renderer draws into its own FBOs; OSMesa still wants a colour buffer
     // to make the context current, so a small one is enough.
-    if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, kSize, kSize)) {
+    if (!osMesa().makeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, kSize, kSize)) {
       throw GlError("osmesa: OSMesaMakeCurrent failed");
     }
   }
@@ -50,7 +100,7 @@ class OsMesaContext final : public GlContext {
 
  private:
   static void (*loader(const char* name))() {
-    return reinterpret_cast<void (*)()>(OSMesaGetProcAddress(name));
+    return reinterpret_cast<void (*)()>(osMesa().getProcAddress(name));
   }
   static constexpr int kSize = 16;
   OSMesaContext context_ = nullptr;

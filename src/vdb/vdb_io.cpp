@@ -5,6 +5,7 @@
 #include "vdb/vdb_io.h"
 
 #include <openvdb/io/File.h>
+#include <openvdb/io/GridDescriptor.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/points/PointCount.h>
@@ -17,8 +18,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -321,108 +325,209 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   return m;
 }
 
-openvdb::GridPtrVec buildVdlGrids(const VdlGrid& g, const Transform::Ptr& xform) {
+/// One grid of a VDL file, built when it is written (writeGridByGrid): the
+/// file's grids are never all in memory at once.
+struct GridSource {
+  std::string name;
+  std::function<openvdb::GridBase::Ptr()> make;
+};
+
+/// The grids of the VDL file contract for `g` (which must outlive them), in
+/// file order.
+std::vector<GridSource> vdlGridSources(const VdlGrid& g, const Transform::Ptr& xform) {
   const auto& c = g.coords;
-  openvdb::GridPtrVec grids;
-  grids.push_back(vectorGrid(kIrradiance, kIrradianceUnits, openvdb::VEC_INVARIANT, xform, c,
-                             [&](size_t v) { return g.irradiance[v]; }));
-  grids.push_back(vectorGrid(kNormal, "unit vector, world space", openvdb::VEC_COVARIANT_NORMALIZE,
-                             xform, c, [&](size_t v) { return g.normals[v]; }));
-  grids.push_back(
-      floatGrid(kPhotonCount, "photons", xform, c, [&](size_t v) { return g.photonCount[v]; }));
-  grids.push_back(floatGrid(kAngularError, "chord length (0..2), weighted std. deviation", xform, c,
-                            [&](size_t v) { return g.angularError[v]; }));
-  grids.push_back(
-      floatGrid(kVdlCount, "count", xform, c, [&](size_t v) { return float(g.vdlCount[v]); }));
-  grids.push_back(
-      floatGrid(kRadius, "world units", xform, c, [&](size_t v) { return g.radius[v]; }));
-  grids.push_back(
-      floatGrid(kArea, "world units^2", xform, c, [&](size_t v) { return g.areas[v]; }));
+  std::vector<GridSource> grids;
+  auto add = [&](const std::string& name, std::function<openvdb::GridBase::Ptr()> make) {
+    grids.push_back({name, std::move(make)});
+  };
+  add(kIrradiance, [&g, &c, xform] {
+    return vectorGrid(kIrradiance, kIrradianceUnits, openvdb::VEC_INVARIANT, xform, c,
+                      [&](size_t v) { return g.irradiance[v]; });
+  });
+  add(kNormal, [&g, &c, xform] {
+    return vectorGrid(kNormal, "unit vector, world space", openvdb::VEC_COVARIANT_NORMALIZE, xform,
+                      c, [&](size_t v) { return g.normals[v]; });
+  });
+  add(kPhotonCount, [&g, &c, xform] {
+    return floatGrid(kPhotonCount, "photons", xform, c, [&](size_t v) { return g.photonCount[v]; });
+  });
+  add(kAngularError, [&g, &c, xform] {
+    return floatGrid(kAngularError, "chord length (0..2), weighted std. deviation", xform, c,
+                     [&](size_t v) { return g.angularError[v]; });
+  });
+  add(kVdlCount, [&g, &c, xform] {
+    return floatGrid(kVdlCount, "count", xform, c, [&](size_t v) { return float(g.vdlCount[v]); });
+  });
+  add(kRadius, [&g, &c, xform] {
+    return floatGrid(kRadius, "world units", xform, c, [&](size_t v) { return g.radius[v]; });
+  });
+  add(kArea, [&g, &c, xform] {
+    return floatGrid(kArea, "world units^2", xform, c, [&](size_t v) { return g.areas[v]; });
+  });
   // VDL i only where the voxel has more than i VDLs (sparse: a voxel with
   // fewer stores no zeros in the higher grids).
-  std::vector<size_t> withVdl;
-  std::vector<Coord> withVdlCoords;
   for (int i = 0; i < g.maxVdls; ++i) {
-    withVdl.clear();
-    withVdlCoords.clear();
-    for (size_t v = 0; v < g.size(); ++v) {
-      if (g.vdlCount[v] > i) {
-        withVdl.push_back(v);
-        withVdlCoords.push_back(c[v]);
+    auto withVdl = [&g, &c, i](std::vector<size_t>& voxels, std::vector<Coord>& coords) {
+      for (size_t v = 0; v < g.size(); ++v) {
+        if (g.vdlCount[v] > i) {
+          voxels.push_back(v);
+          coords.push_back(c[v]);
+        }
       }
-    }
-    grids.push_back(vectorGrid(vdlIrradianceName(i), kIrradianceUnits, openvdb::VEC_INVARIANT,
-                               xform, withVdlCoords,
-                               [&](size_t k) { return g.vdlsOf(withVdl[k])[i].irradiance; }));
-    grids.push_back(vectorGrid(vdlDirectionName(i), "unit vector towards the light, world space",
-                               openvdb::VEC_INVARIANT, xform, withVdlCoords,
-                               [&](size_t k) { return g.vdlsOf(withVdl[k])[i].direction; }));
+    };
+    add(vdlIrradianceName(i), [&g, xform, i, withVdl] {
+      std::vector<size_t> voxels;
+      std::vector<Coord> coords;
+      withVdl(voxels, coords);
+      return vectorGrid(vdlIrradianceName(i), kIrradianceUnits, openvdb::VEC_INVARIANT, xform,
+                        coords, [&](size_t k) { return g.vdlsOf(voxels[k])[i].irradiance; });
+    });
+    add(vdlDirectionName(i), [&g, xform, i, withVdl] {
+      std::vector<size_t> voxels;
+      std::vector<Coord> coords;
+      withVdl(voxels, coords);
+      return vectorGrid(vdlDirectionName(i), "unit vector towards the light, world space",
+                        openvdb::VEC_INVARIANT, xform, coords,
+                        [&](size_t k) { return g.vdlsOf(voxels[k])[i].direction; });
+    });
   }
   for (int i = 0; i < g.shTerms; ++i) {
-    grids.push_back(vectorGrid(shName(i), kShUnits, openvdb::VEC_INVARIANT, xform, c,
-                               [&](size_t v) { return g.shOf(v)[i]; }));
+    add(shName(i), [&g, &c, xform, i] {
+      return vectorGrid(shName(i), kShUnits, openvdb::VEC_INVARIANT, xform, c,
+                        [&](size_t v) { return g.shOf(v)[i]; });
+    });
   }
   if (g.layers.size() == 0) return grids;
 
   // Surface layers: per layer index, its entries and their voxels.
+  struct LayerIndex {
+    std::vector<size_t> entries[kMaxLayers];
+    std::vector<Coord> coords[kMaxLayers];
+  };
+  auto index = std::make_shared<LayerIndex>();
   const VdlLayers& L = g.layers;
-  std::vector<size_t> entries[kMaxLayers];
-  std::vector<Coord> coords[kMaxLayers];
   for (size_t e = 0; e < L.size(); ++e) {
     const int layer = e > 0 && L.voxel[e - 1] == L.voxel[e] ? 2 : 1;
-    entries[layer].push_back(e);
-    coords[layer].push_back(c[L.voxel[e]]);
+    index->entries[layer].push_back(e);
+    index->coords[layer].push_back(c[L.voxel[e]]);
     if (layer == 1) {
-      entries[0].push_back(L.voxel[e]);
-      coords[0].push_back(c[L.voxel[e]]);
+      index->entries[0].push_back(L.voxel[e]);
+      index->coords[0].push_back(c[L.voxel[e]]);
     }
   }
-  grids.push_back(vectorGrid(kLayerPoint, "world space", openvdb::VEC_CONTRAVARIANT_ABSOLUTE,
-                             xform, coords[0],
-                             [&](size_t k) { return g.points[entries[0][k]]; }));
+  add(kLayerPoint, [&g, xform, index] {
+    return vectorGrid(kLayerPoint, "world space", openvdb::VEC_CONTRAVARIANT_ABSOLUTE, xform,
+                      index->coords[0], [&](size_t k) { return g.points[index->entries[0][k]]; });
+  });
   for (int layer = 1; layer < kMaxLayers; ++layer) {
-    const std::vector<size_t>& es = entries[layer];
-    const std::vector<Coord>& lc = coords[layer];
-    if (es.empty()) continue;
+    if (index->entries[layer].empty()) continue;
+    const std::vector<size_t>& es = index->entries[layer];
+    const std::vector<Coord>& lc = index->coords[layer];
     auto name = [layer](const std::string& n) { return layerName(layer, n); };
-    grids.push_back(vectorGrid(name(kIrradiance), kIrradianceUnits, openvdb::VEC_INVARIANT, xform,
-                               lc, [&](size_t k) { return L.irradiance[es[k]]; }));
-    grids.push_back(vectorGrid(name(kNormal), "unit vector, world space",
-                               openvdb::VEC_COVARIANT_NORMALIZE, xform, lc,
-                               [&](size_t k) { return L.normals[es[k]]; }));
-    grids.push_back(vectorGrid(name("point"), "world space", openvdb::VEC_CONTRAVARIANT_ABSOLUTE,
-                               xform, lc, [&](size_t k) { return L.points[es[k]]; }));
-    grids.push_back(floatGrid(name(kPhotonCount), "photons", xform, lc,
-                              [&](size_t k) { return L.photonCount[es[k]]; }));
-    grids.push_back(floatGrid(name(kAngularError), "chord length (0..2), weighted std. deviation",
-                              xform, lc, [&](size_t k) { return L.angularError[es[k]]; }));
-    grids.push_back(floatGrid(name(kVdlCount), "count", xform, lc,
-                              [&](size_t k) { return float(L.vdlCount[es[k]]); }));
-    grids.push_back(floatGrid(name(kRadius), "world units", xform, lc,
-                              [&](size_t k) { return L.radius[es[k]]; }));
+    // Each source keeps the index alive; es and lc point into it.
+    auto vector = [&](const std::string& n, const std::string& units, openvdb::VecType type,
+                      std::function<Vec3(size_t)> value) {
+      add(name(n), [n = name(n), units, type, value, xform, index, &lc] {
+        return vectorGrid(n, units, type, xform, lc, value);
+      });
+    };
+    auto scalar = [&](const std::string& n, const std::string& units,
+                      std::function<float(size_t)> value) {
+      add(name(n), [n = name(n), units, value, xform, index, &lc] {
+        return floatGrid(n, units, xform, lc, value);
+      });
+    };
+    vector(kIrradiance, kIrradianceUnits, openvdb::VEC_INVARIANT,
+           [&L, &es](size_t k) { return L.irradiance[es[k]]; });
+    vector(kNormal, "unit vector, world space", openvdb::VEC_COVARIANT_NORMALIZE,
+           [&L, &es](size_t k) { return L.normals[es[k]]; });
+    vector("point", "world space", openvdb::VEC_CONTRAVARIANT_ABSOLUTE,
+           [&L, &es](size_t k) { return L.points[es[k]]; });
+    scalar(kPhotonCount, "photons", [&L, &es](size_t k) { return L.photonCount[es[k]]; });
+    scalar(kAngularError, "chord length (0..2), weighted std. deviation",
+           [&L, &es](size_t k) { return L.angularError[es[k]]; });
+    scalar(kVdlCount, "count", [&L, &es](size_t k) { return float(L.vdlCount[es[k]]); });
+    scalar(kRadius, "world units", [&L, &es](size_t k) { return L.radius[es[k]]; });
     for (int i = 0; i < g.maxVdls; ++i) {
-      std::vector<size_t> ek;
-      std::vector<Coord> kc;
-      for (size_t k = 0; k < es.size(); ++k) {
-        if (L.vdlCount[es[k]] > i) {
-          ek.push_back(es[k]);
-          kc.push_back(lc[k]);
+      auto withVdl = [&L, &es, &lc, i](std::vector<size_t>& entries, std::vector<Coord>& coords) {
+        for (size_t k = 0; k < es.size(); ++k) {
+          if (L.vdlCount[es[k]] > i) {
+            entries.push_back(es[k]);
+            coords.push_back(lc[k]);
+          }
         }
-      }
-      grids.push_back(vectorGrid(name(vdlIrradianceName(i)), kIrradianceUnits,
-                                 openvdb::VEC_INVARIANT, xform, kc,
-                                 [&](size_t k) { return g.layerVdlsOf(ek[k])[i].irradiance; }));
-      grids.push_back(vectorGrid(name(vdlDirectionName(i)),
-                                 "unit vector towards the light, world space",
-                                 openvdb::VEC_INVARIANT, xform, kc,
-                                 [&](size_t k) { return g.layerVdlsOf(ek[k])[i].direction; }));
+      };
+      add(name(vdlIrradianceName(i)), [&g, xform, index, i, withVdl, n = name(vdlIrradianceName(i))] {
+        std::vector<size_t> ek;
+        std::vector<Coord> kc;
+        withVdl(ek, kc);
+        return vectorGrid(n, kIrradianceUnits, openvdb::VEC_INVARIANT, xform, kc,
+                          [&](size_t k) { return g.layerVdlsOf(ek[k])[i].irradiance; });
+      });
+      add(name(vdlDirectionName(i)), [&g, xform, index, i, withVdl, n = name(vdlDirectionName(i))] {
+        std::vector<size_t> ek;
+        std::vector<Coord> kc;
+        withVdl(ek, kc);
+        return vectorGrid(n, "unit vector towards the light, world space", openvdb::VEC_INVARIANT,
+                          xform, kc, [&](size_t k) { return g.layerVdlsOf(ek[k])[i].direction; });
+      });
     }
     for (int i = 0; i < g.shTerms; ++i) {
-      grids.push_back(vectorGrid(name(shName(i)), kShUnits, openvdb::VEC_INVARIANT, xform, lc,
-                                 [&](size_t k) { return g.layerShOf(es[k])[i]; }));
+      vector(shName(i), kShUnits, openvdb::VEC_INVARIANT,
+             [&g, &es, i](size_t k) { return g.layerShOf(es[k])[i]; });
     }
   }
   return grids;
+}
+
+/// io::File::write's archive, but each grid is built just before it is
+/// written and freed after: the bytes io::Archive::write gives a file of
+/// grids with distinct names (header, file metadata, grid count, then each
+/// grid's descriptor, offsets and data), without every grid in memory at
+/// once (a depth-8 Cornell box's grids take ~1 KB per voxel in OpenVDB's
+/// dense 8^3 leaves).
+class GridByGridArchive : public openvdb::io::Archive {
+ public:
+  void write(std::ostream& os, const std::vector<GridSource>& sources,
+             const openvdb::MetaMap& meta) const {
+    openvdb::io::StreamMetadata::Ptr streamMetadata(new openvdb::io::StreamMetadata);
+    openvdb::io::setStreamMetadataPtr(os, streamMetadata, /*transfer=*/false);
+    openvdb::io::setDataCompression(os, compression());
+    openvdb::io::setWriteGridStatsMetadata(os, isGridStatsMetadataEnabled());
+    writeHeader(os, /*seekable=*/true);
+    meta.writeMeta(os);
+    const int32_t count = int32_t(sources.size());
+    os.write(reinterpret_cast<const char*>(&count), sizeof count);
+    std::set<std::string> names;
+    for (const GridSource& source : sources) {
+      openvdb::GridBase::ConstPtr grid = source.make();
+      // Archive::write would rename a repeated or empty name.
+      LO_CHECK(!grid->getName().empty() && names.insert(grid->getName()).second);
+      openvdb::io::GridDescriptor descriptor(grid->getName(), grid->type(),
+                                             grid->saveFloatAsHalf());
+      writeGrid(descriptor, grid, os, /*seekable=*/true);
+      openvdb::io::setDataCompression(os, compression());
+    }
+  }
+};
+
+// Writes through a temporary file (core/file.h), grid by grid.
+void writeVdbFileGridByGrid(const std::string& path, const std::vector<GridSource>& sources,
+                            const openvdb::MetaMap& meta) {
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent)) {
+    throw IoError(path + ": cannot write: folder '" + parent.string() + "' does not exist");
+  }
+  writeAtomically(path, [&](const std::string& tmp) {
+    {
+      std::ofstream file(tmp, std::ios_base::out | std::ios_base::binary);
+      if (!file) throw std::runtime_error("cannot open the file");
+      GridByGridArchive().write(file, sources, meta);
+      file.close();
+      if (file.fail()) throw std::runtime_error("cannot write the file");
+    }
+    makeUuidDeterministic(tmp);
+  });
 }
 
 bool isOptionalGrid(const std::string& name) {
@@ -463,20 +568,25 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
   }
   Transform::Ptr xform = frameTransform(grid.frame);
   if (damage && damage->rotateTransform) xform->postRotate(0.3, openvdb::math::Z_AXIS);
-  openvdb::GridPtrVec grids = buildVdlGrids(grid, xform);
-  openvdb::GridCPtrVec out;
-  for (const auto& g : grids) {
-    if (damage && g->getName() == damage->omitGrid) continue;
-    if (std::find(options.drop.begin(), options.drop.end(), g->getName()) != options.drop.end()) {
+  std::vector<GridSource> sources;
+  for (GridSource& source : vdlGridSources(grid, xform)) {
+    if (damage && source.name == damage->omitGrid) continue;
+    if (std::find(options.drop.begin(), options.drop.end(), source.name) != options.drop.end()) {
       continue;
     }
-    if (options.halfFloat && !keepsFullPrecision(g->getName())) g->setSaveFloatAsHalf(true);
-    if (damage && g->getName() == damage->shiftGrid) {
-      Transform::Ptr shifted = xform->copy();
-      shifted->postTranslate(openvdb::Vec3d(grid.frame.voxelSize, 0, 0));
-      g->setTransform(shifted);
-    }
-    out.push_back(g);
+    const std::string name = source.name;
+    const bool half = options.halfFloat && !keepsFullPrecision(name);
+    const bool shift = damage && name == damage->shiftGrid;
+    sources.push_back({name, [make = std::move(source.make), half, shift, xform, &grid] {
+                         openvdb::GridBase::Ptr g = make();
+                         if (half) g->setSaveFloatAsHalf(true);
+                         if (shift) {
+                           Transform::Ptr shifted = xform->copy();
+                           shifted->postTranslate(openvdb::Vec3d(grid.frame.voxelSize, 0, 0));
+                           g->setTransform(shifted);
+                         }
+                         return g;
+                       }});
   }
   openvdb::MetaMap fileMeta = fileMetadata(meta, grid);
   if (damage && damage->formatVersion != kVdlFormatVersion) {
@@ -485,7 +595,7 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
       fileMeta.insertMeta("format_version", openvdb::Int32Metadata(damage->formatVersion));
     }
   }
-  writeVdbFile(path, out, fileMeta);
+  writeVdbFileGridByGrid(path, sources, fileMeta);
 }
 
 // ---------------------------------------------------------------------------
