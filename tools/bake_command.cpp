@@ -87,6 +87,14 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   if (comm && !opt.quiet) {
     std::printf("baking on %d ranks (mpirun)\n", comm->size());
   }
+  // Each rank runs its stages on threads; a rank pinned to one core (mpirun's
+  // default binding) runs them one at a time.
+  if (comm && usableCores() < hardwareThreads() && usableCores() < 2) {
+    std::fprintf(stderr,
+                 "warning: rank %d may use %d of this machine's %d cores (mpirun binds each rank "
+                 "to a core by default): run mpirun --bind-to none, or one rank per machine\n",
+                 rank, usableCores(), hardwareThreads());
+  }
   std::vector<StageReport> rows;
 
   StageTimer loadTimer(rows, "load scene");

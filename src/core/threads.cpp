@@ -2,6 +2,9 @@
 
 #include <tbb/global_control.h>
 
+#include <sched.h>
+#include <unistd.h>
+
 #include <optional>
 
 namespace lo {
@@ -17,5 +20,17 @@ ThreadLimit::ThreadLimit(int threads) : impl_(std::make_unique<Impl>()) {
 }
 
 ThreadLimit::~ThreadLimit() = default;
+
+int usableCores() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof set, &set) != 0) return hardwareThreads();
+  return CPU_COUNT(&set);
+}
+
+int hardwareThreads() {
+  const long n = sysconf(_SC_NPROCESSORS_ONLN);
+  return n > 0 ? int(n) : 1;
+}
 
 }  // namespace lo

@@ -21,4 +21,10 @@ class ThreadLimit {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Cores this process may run on (its CPU affinity mask), and the machine's
+/// hardware threads: fewer usable than present means a launcher pinned the
+/// process (mpirun binds each rank to one core by default).
+int usableCores();
+int hardwareThreads();
+
 }  // namespace lo

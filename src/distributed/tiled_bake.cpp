@@ -359,8 +359,15 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
         empty += sums[1];
         stored += sums[2];
         mine.photonsTraced += keptPhotons;
-        if (!planned) makePlan(batch, sums[2]);
+        const bool firstBatch = !planned;
+        if (firstBatch) makePlan(batch, sums[2]);
         const ExchangeResult ex = exchangePhotons(comm, plan, frame, batch, held);
+        if (firstBatch && sums[2] > 0 && stored < target) {
+          // This rank's share of the map, from the first batch's: reserved
+          // once, not grown by doubling (which would hold up to twice it).
+          const double share = double(held.size()) / double(sums[2]);
+          held.reserve(size_t(share * double(target) * 1.02) + 4096);
+        }
         mine.bytesSent += ex.sent;
         mine.bytesReceived += ex.received;
         unsent += ex.unsent;
