@@ -219,7 +219,10 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
           {"bin_margin_voxels", distributed.binMarginVoxels},
           {"bytes_exchanged_per_photon",
            st.storedPhotons ? double(sent) / double(st.storedPhotons) : 0.0},
-          {"per_rank", ranks}};
+          {"per_rank", ranks},
+          // Tile (x * T + y) * T + z: its rank and estimated work (docs/scale.md).
+          {"tile_owner", distributed.tileOwner},
+          {"tile_work", distributed.tileWork}};
     }
     writeTextAtomically(opt.statsJson, j.dump(2) + "\n");
   }

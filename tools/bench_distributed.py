@@ -26,6 +26,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE = os.path.join(ROOT, "..", "shared", "scenes", "composed", "cornell-box.glb")
 MIB = 1024.0 * 1024.0
+PHOTON_BYTES = 52  # sizeof(lo::Photon): position, direction, power, normal, bounce
 
 
 def run_bake(cli, out_dir, name, depth, photons, ranks=0, extra=()):
@@ -80,6 +81,44 @@ def fit_memory(rows):
             mk[i][k] = v[i]
         out.append(det(mk) / d)
     return out  # base, bytes per photon, bytes per voxel
+
+
+COLOURS = ["#4477aa", "#ee6677", "#228833", "#ccbb44", "#66ccee", "#aa3377", "#bbbbbb",
+           "#000000"]
+
+
+def write_tile_picture(run, path):
+    """Two projections of the tile grid, each cell coloured by the owner of the
+    tile with the most work along the projection axis."""
+    d = run["distributed"]
+    t = d["tiles_per_axis"]
+    owner, work = d["tile_owner"], d["tile_work"]
+    cell, gap = 10, 30
+    width, height = 2 * t * cell + gap, t * cell + 40
+    out = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" '
+           'font-family="sans-serif" font-size="12">' % (width, height)]
+    for view, (ox, name) in enumerate(((0, "front (x, y)"), (t * cell + gap, "top (x, z)"))):
+        out.append('<text x="%d" y="%d">%s</text>' % (ox, t * cell + 16, name))
+        for a in range(t):
+            for b in range(t):
+                best, best_work = -1, 0.0
+                for c in range(t):
+                    x, y, z = (a, b, c) if view == 0 else (a, c, b)
+                    i = (x * t + y) * t + z
+                    if work[i] > best_work:
+                        best, best_work = i, work[i]
+                if best < 0:
+                    continue
+                row = (t - 1 - b) if view == 0 else b  # y up in the front view
+                out.append('<rect x="%d" y="%d" width="%d" height="%d" fill="%s"/>' % (
+                    ox + a * cell, row * cell, cell - 1, cell - 1, COLOURS[owner[best] % 8]))
+    for r in range(len(d["per_rank"])):
+        out.append('<rect x="%d" y="%d" width="10" height="10" fill="%s"/><text x="%d" y="%d">'
+                   'rank %d</text>' % (r * 70, t * cell + 24, COLOURS[r % 8], r * 70 + 14,
+                                       t * cell + 33, r))
+    out.append("</svg>")
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
 
 
 def main():
@@ -204,6 +243,15 @@ def main():
                              100.0 * (held_total - stored) / stored))
         say()
 
+        if not args.quick:
+            write_tile_picture(four, os.path.join(ROOT, "docs", "images", "scale-tiles.svg"))
+            say("![Tiles of the 4-rank run, coloured by rank](../images/scale-tiles.svg)")
+            say()
+            say("*The 4-rank run's tiles seen from the front (x right, y up; each square the "
+                "tile with the most estimated work along z) and from above (x right, z down), "
+                "coloured by the rank that owns them; empty tiles are left out.*")
+            say()
+
         # 3. Projection: a building at depth 11.
         say("## 3. Projection: a depth-11 building bake on N machines")
         say()
@@ -213,15 +261,16 @@ def main():
             "density of the depth-8 run above (%.0f stored photons per active voxel) and at 200 "
             "per voxel. Memory per machine = base + (fitted bytes per photon x photons x (1 + "
             "halo share) + bytes per voxel x voxels) / N; time = (photons x (trace + splat) + "
-            "voxels x per-voxel time) / N on this machine's %d threads; sent per machine = "
-            "bytes exchanged per photon x photons / N. The halo share is the measured one at 4 "
-            "ranks; with more ranks the regions shrink and it grows (about as N^(1/2) for "
-            "surfaces), which the table includes." % (
+            "voxels x per-voxel time) / N with this machine's %d threads per machine (a "
+            "32-thread machine would take about a sixteenth); sent per machine = 52 bytes x "
+            "(N - 1) / N x (1 + halo share) x photons / N (this gives the measured bytes per "
+            "photon at 4 ranks). The halo share is the measured one at 4 ranks; with more "
+            "ranks the regions shrink and it grows (about as N^(1/2) for surfaces), which the "
+            "table includes." % (
                 stored / four["counts"]["active_voxels"], os.cpu_count()))
         say()
         voxels = 60000.0 / (102.0 / 2048) ** 2 * 1.04
         halo_share4 = (held_total - stored) / stored
-        per_photon_sent = four["distributed"]["bytes_exchanged_per_photon"]
         say("| photons per voxel | photons | machines | memory per machine | time per machine "
             "| sent per machine |")
         say("|---:|---:|---:|---:|---:|---:|")
@@ -233,8 +282,9 @@ def main():
                               per_voxel * voxels) / n
                 seconds = (total_photons * (t_trace + t_splat) * (1 + halo_share) +
                            voxels * t_voxel) / n
-                sent = 0.0 if n == 1 else per_photon_sent * total_photons / n * (
-                    (1 + halo_share) / (1 + halo_share4)) * ((n - 1) / n) / (3.0 / 4.0)
+                # Each photon goes to its tile's owner, another rank (N-1)/N of the
+                # time, and to the halo's ranks: 52 bytes each.
+                sent = PHOTON_BYTES * (n - 1) / n * (1 + halo_share) * total_photons / n
                 say("| %.0f | %.2g | %d | %.1f GiB | %.1f min | %.2f GiB |" % (
                     density, total_photons, n, mem / MIB / 1024, seconds / 60, sent / MIB / 1024))
         say()
