@@ -251,307 +251,356 @@ TilePlan planTiles(int depth, int tilesPerAxis, const std::vector<double>& work,
   return plan;
 }
 
-BakeResult distributedBake(const Scene& scene, const BakeParams& requested,
-                           const TileParams& tileParams, Communicator& comm, ProgressSink* progress,
-                           DistributedStats* stats) {
-  using namespace distributed_internal;
-  const int ranks = comm.size(), me = comm.rank();
-  Stopwatch total;
-  const BakeParams params = checkedBakeParams(scene, requested, ranks);
+namespace distributed_internal {
+
+/// One rank's distributed bake: the steps of tiled_bake.h as methods over
+/// the state they hand on (the photons held, the tile plan, the local grid).
+class RankBake {
+ public:
+  RankBake(const Scene& scene, const BakeParams& params, const TileParams& tiles,
+           Communicator& comm, ProgressSink* progress)
+      : scene_(scene),
+        params_(params),
+        tiles_(tiles),
+        comm_(comm),
+        progress_(progress),
+        ranks_(comm.size()),
+        me_(comm.rank()),
+        level_(params.levelParams()),
+        frame_(makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth,
+                             level_.grid.padding)),
+        tilesPerAxis_(tiles.tilesPerAxis != 0 ? tiles.tilesPerAxis
+                                              : autoTilesPerAxis(params.depth)) {
+    checkTilesPerAxis(tilesPerAxis_, params.depth);
+  }
+
+  BakeResult run(DistributedStats* stats) {
+    Stopwatch total;
+    // The halo first assumes a small bins' margin; a larger one found by
+    // the splat starts the photon steps again with the bound (all ranks
+    // see the same reduced margin, so all start again together).
+    for (const double margin :
+         {std::min(tiles_.assumedMarginVoxels, kMaxBinMarginVoxels), kMaxBinMarginVoxels}) {
+      ++attempts_;
+      halo_ = photonHaloVoxels(level_.gather, frame_, margin);
+      st_ = BakeStats{};
+      st_.triangles = scene_.triangleCount();
+      st_.denseVoxels = size_t(1) << (3 * params_.depth);
+      mine_ = RankStats{};
+      mine_.rank = me_;
+      traceAndExchange();
+      voxelizeRegion();
+      if (splat(margin)) break;
+    }
+    // The bound always holds: the second attempt never starts a third.
+    LO_CHECK_LE(double(grid_.binMargin), kMaxBinMarginVoxels * double(frame_.voxelSize));
+    binMargin_ = grid_.binMargin;
+    gatherAndCluster();
+    mergeOnRankZero();
+
+    st_.level.radius = resolveRadius(level_.gather, frame_);
+    st_.level.voxelizeSeconds = mine_.voxelizeSeconds;
+    st_.level.splatSeconds = mine_.splatSeconds;
+    st_.level.gatherClusterSeconds = mine_.gatherClusterSeconds;
+    BakeResult result;
+    result.grid = std::move(merged_);
+    result.metadata =
+        bakeMetadata(scene_, params_, int64_t(stored_), int64_t(emitted_), st_.level.radius);
+    if (me_ == 0) {
+      const VdlLayers& L = result.grid.layers;
+      for (size_t e = 0; e < L.size(); ++e) {
+        if (e == 0 || L.voxel[e] != L.voxel[e - 1]) ++st_.level.layeredVoxels;
+      }
+      st_.level.extraLayers = L.size();
+    }
+    result.stats = std::move(st_);
+    mine_.totalSeconds = total.seconds();
+    mine_.peakRssBytes = peakRssBytes();
+    report(stats);
+    return result;
+  }
+
+ private:
+  /// 1. Photons by rank, sent batch by batch to the tiles that hold them.
+  void traceAndExchange() {
+    StageTimer timer(st_.stages, "trace + exchange");
+    const PhotonParams photonParams = params_.photonParams();
+    PhotonTracer tracer(scene_, photonParams);
+    const size_t target = photonParams.storedPhotons;
+    const size_t maxEmitted = maxEmittedPaths(photonParams);
+    std::vector<Photon>().swap(held_);
+    stored_ = emitted_ = empty_ = unsent_ = 0;
+    bool planned = false;
+    std::vector<Photon> batch;
+    std::vector<uint32_t> pathPhotons;
+    Progress bar(progress_, "Tracing photons", target);
+    while (target > 0 && tracer.canStore() && stored_ < target) {
+      const size_t paths = photonBatchPaths(target, size_t(stored_), size_t(emitted_), maxEmitted);
+      if (paths == 0) break;
+      // This rank's contiguous share of the batch's paths.
+      const uint64_t first = emitted_ + uint64_t(paths) * uint64_t(me_) / uint64_t(ranks_);
+      const uint64_t last = emitted_ + uint64_t(paths) * uint64_t(me_ + 1) / uint64_t(ranks_);
+      batch.clear();
+      pathPhotons.clear();
+      Stopwatch traceClock;
+      tracer.trace(first, size_t(last - first), batch, pathPhotons);
+      mine_.traceSeconds += traceClock.seconds();
+
+      // Where the map's last photon lies: the ranks before hold `before`.
+      Stopwatch exchangeClock;
+      const std::vector<uint64_t> counts = comm_.allgather(batch.size());
+      uint64_t before = stored_;
+      for (int r = 0; r < me_; ++r) before += counts[size_t(r)];
+      uint64_t kept[3] = {0, 0, 0};  // paths, of them empty, photons
+      for (size_t i = 0; i < pathPhotons.size() && before + kept[2] < target; ++i) {
+        kept[2] += std::min<uint64_t>(pathPhotons[i], target - before - kept[2]);
+        ++kept[0];
+        kept[1] += pathPhotons[i] == 0;
+      }
+      batch.resize(size_t(kept[2]));
+      mine_.photonsTraced += kept[2];
+      comm_.allreduceSum(kept, 3);
+      emitted_ += kept[0];
+      empty_ += kept[1];
+      stored_ += kept[2];
+      const bool firstBatch = !planned;
+      if (firstBatch) {
+        makePlan(batch, kept[2]);
+        planned = true;
+      }
+      const ExchangeResult ex = exchangePhotons(comm_, plan_, frame_, batch, held_);
+      if (firstBatch && kept[2] > 0 && stored_ < target) {
+        // This rank's share of the map, from the first batch's: reserved
+        // once, not grown by doubling (which would hold up to twice it).
+        const double share = double(held_.size()) / double(kept[2]);
+        held_.reserve(size_t(share * double(target) * 1.02) + 4096);
+      }
+      mine_.bytesSent += ex.sent;
+      mine_.bytesReceived += ex.received;
+      unsent_ += ex.unsent;
+      mine_.exchangeSeconds += exchangeClock.seconds();
+      bar.advance(size_t(kept[2]));
+    }
+    if (!planned) makePlan({}, 0);
+    // The tests' stand-in for a machine lost mid-bake (docs/scale.md): this
+    // rank dies as a killed process does, between the exchange and the gather.
+    if (const char* kill = std::getenv("LIGHTOCTREE_KILL_RANK")) {
+      if (std::string(kill) == std::to_string(me_)) std::raise(SIGKILL);
+    }
+    scalePhotonPower(held_, size_t(emitted_));
+    st_.storedPhotons = size_t(stored_);
+    st_.emittedPaths = size_t(emitted_);
+    st_.emptyPaths = size_t(empty_);
+    mine_.photonsHeld = held_.size();
+    double all = 0, own = 0;
+    for (size_t t = 0; t < plan_.owner.size(); ++t) {
+      all += plan_.work[t];
+      if (plan_.owner[t] != me_) continue;
+      own += plan_.work[t];
+      if (plan_.work[t] > 0) ++mine_.tilesOwned;
+    }
+    mine_.workShare = all > 0 ? own / all : 0.0;
+    st_.traceSeconds = timer.finish(formatCount(size_t(stored_)) + " photons from " +
+                                    formatCount(size_t(emitted_)) + " paths on " +
+                                    std::to_string(ranks_) + " ranks");
+  }
+
+  /// The tile plan from the first batch's photons (`pilot`, this rank's part
+  /// of `pilotStored`): every rank computes the same one.
+  void makePlan(const std::vector<Photon>& pilot, uint64_t pilotStored) {
+    const size_t T = size_t(tilesPerAxis_);
+    std::vector<uint64_t> counts(T * T * T, 0);
+    TilePlan probe;  // tile lookup only
+    probe.depth = params_.depth;
+    probe.tilesPerAxis = tilesPerAxis_;
+    probe.tileShift = params_.depth - log2Exact(tilesPerAxis_);
+    for (const Photon& p : pilot) ++counts[probe.tileOf(frame_.coordOf(p.position))];
+    comm_.allreduceSum(counts.data(), counts.size());
+    const double scale = pilotStored > 0 ? double(params_.photons) / double(pilotStored) : 0.0;
+    plan_ =
+        planTiles(params_.depth, tilesPerAxis_,
+                  estimateWork(scene_, level_.grid, tilesPerAxis_, counts, scale), ranks_, halo_);
+    if (tiles_.owner.empty()) return;
+    if (tiles_.owner.size() != plan_.owner.size()) {
+      throw InputError("a tile owner table of " + std::to_string(tiles_.owner.size()) +
+                       " entries for " + std::to_string(plan_.owner.size()) + " tiles");
+    }
+    for (int32_t r : tiles_.owner) {
+      if (r < 0 || r >= ranks_) {
+        throw InputError("tile owner " + std::to_string(r) + " is not one of the " +
+                         std::to_string(ranks_) + " ranks");
+      }
+    }
+    plan_.owner = tiles_.owner;
+  }
+
+  /// 2. This rank's tiles and one voxel beyond the photon halo, voxelized.
+  void voxelizeRegion() {
+    StageTimer timer(st_.stages, "voxelize");
+    const LocalRegion region{&plan_, me_, halo_ + 1};
+    GridParams gridParams = level_.grid;
+    const int res = 1 << params_.depth, edge = 1 << plan_.tileShift;
+    Coord lo{res, res, res}, hi{-1, -1, -1};
+    const size_t T = size_t(tilesPerAxis_);
+    for (size_t t = 0; t < plan_.owner.size(); ++t) {
+      if (plan_.owner[t] != me_) continue;
+      const int x = int(t / (T * T)), y = int(t / T % T), z = int(t % T);
+      lo = {std::min(lo.x, x * edge), std::min(lo.y, y * edge), std::min(lo.z, z * edge)};
+      hi = {std::max(hi.x, x * edge + edge - 1), std::max(hi.y, y * edge + edge - 1),
+            std::max(hi.z, z * edge + edge - 1)};
+    }
+    gridParams.clipLower = {lo.x - region.halo, lo.y - region.halo, lo.z - region.halo};
+    gridParams.clipUpper = {hi.x + region.halo, hi.y + region.halo, hi.z + region.halo};
+    gridParams.keepBlock = [&region](const Coord& b) { return region.keepBlock(b); };
+    grid_ = buildSurfaceGrid(scene_, gridParams, progress_);
+    mine_.voxelsHeld = grid_.size();
+    mine_.voxelizeSeconds =
+        timer.finish(formatCount(grid_.size()) + " voxels held on rank " + std::to_string(me_));
+  }
+
+  /// This rank's photons into its grid's bins, with the global bins'
+  /// margin. False when that margin exceeds `assumedMargin` voxels (the
+  /// halo was too thin: every rank starts again).
+  bool splat(double assumedMargin) {
+    StageTimer timer(st_.stages, "splat photons");
+    splatPhotons(grid_, held_);
+    double margin = double(grid_.binMargin);
+    comm_.allreduceMax(&margin, 1);
+    grid_.binMargin = float(margin);  // a float already: the maximum of the ranks' floats
+    if (double(grid_.binMargin) > assumedMargin * double(frame_.voxelSize)) return false;
+    // Photons outside every active voxel's neighbourhood, each counted by the
+    // owner of its tile (or by its tracer, when no rank holds it).
+    uint64_t dropped = unsent_;
+    std::vector<char> binned(held_.size(), 0);
+    for (uint32_t i : grid_.binPhotons) binned[i] = 1;
+    for (size_t i = 0; i < held_.size(); ++i) {
+      if (!binned[i] && plan_.ownerOf(frame_.coordOf(held_[i].position)) == me_) ++dropped;
+    }
+    comm_.allreduceSum(&dropped, 1);
+    st_.level.droppedPhotons = size_t(dropped);
+    mine_.splatSeconds = timer.finish();
+    return true;
+  }
+
+  /// 3. Gather + cluster this rank's voxels and the neighbours the smoothing
+  /// reads; smooth.
+  void gatherAndCluster() {
+    StageTimer timer(st_.stages, "gather + cluster");
+    std::vector<char> compute(grid_.size(), 0);
+    for (size_t v = 0; v < grid_.size(); ++v) {
+      if (plan_.ownerOf(grid_.coords[v]) != me_) continue;
+      owned_.push_back(uint32_t(v));
+      compute[v] = 1;
+      if (!level_.smoothing) continue;
+      const Coord c = grid_.coords[v];
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const int64_t w = grid_.find({c.x + dx, c.y + dy, c.z + dz});
+            if (w >= 0) compute[size_t(w)] = 1;
+          }
+    }
+    std::vector<uint32_t> computed;
+    for (size_t v = 0; v < grid_.size(); ++v) {
+      if (compute[v]) computed.push_back(uint32_t(v));
+    }
+    mine_.voxelsOwned = owned_.size();
+    mine_.voxelsComputed = computed.size();
+    GatherParams gather = level_.gather;
+    std::unique_ptr<GatherOcclusion> occlusion;
+    if (level_.occlusion && scene_.triangleCount() > 0) {
+      occlusion = std::make_unique<GatherOcclusion>(scene_);
+      gather.blocked = occlusion->test();
+    }
+    const LayerParams layerParams;
+    local_ = buildVdlGrid(grid_, held_, gather, level_.cluster, progress_, &st_.level.threadSeconds,
+                          level_.layers ? &layerParams : nullptr, &computed);
+    if (level_.smoothing) smoothVdlGrid(grid_, local_);
+    std::vector<Photon>().swap(held_);
+    grid_ = SurfaceGrid{};
+    mine_.gatherClusterSeconds =
+        timer.finish(formatCount(owned_.size()) + " voxels owned, " + formatCount(computed.size()) +
+                     " computed on rank " + std::to_string(me_));
+  }
+
+  /// 4. The owned voxels, merged on rank 0.
+  void mergeOnRankZero() {
+    StageTimer timer(st_.stages, "merge on rank 0");
+    std::vector<std::vector<char>> parts =
+        comm_.gatherBytes(serializeVdlGrid(selectVoxels(local_, owned_)), 0);
+    local_ = VdlGrid{};
+    if (me_ == 0) {
+      std::vector<VdlGrid> grids;
+      for (std::vector<char>& bytes : parts) {
+        grids.push_back(deserializeVdlGrid(bytes));
+        std::vector<char>().swap(bytes);
+      }
+      merged_ = mergeVdlGrids(std::move(grids));
+    }
+    uint64_t active = mine_.voxelsOwned;
+    comm_.allreduceSum(&active, 1);
+    st_.level.activeVoxels = size_t(active);
+    mine_.mergeSeconds = timer.finish();
+  }
+
+  /// Every rank's figures to rank 0 (every rank takes part, whether or not
+  /// it asked for them).
+  void report(DistributedStats* stats) const {
+    const std::vector<std::vector<char>> all = comm_.gatherBytes(rankStatsBytes(mine_), 0);
+    if (!stats) return;
+    stats->tilesPerAxis = tilesPerAxis_;
+    stats->photonHalo = halo_;
+    stats->attempts = attempts_;
+    stats->binMarginVoxels = double(binMargin_) / double(frame_.voxelSize);
+    stats->tileOwner = plan_.owner;
+    stats->tileWork = plan_.work;
+    stats->ranks.clear();
+    if (me_ != 0) {
+      stats->ranks.push_back(mine_);
+      return;
+    }
+    for (const std::vector<char>& bytes : all) {
+      LO_CHECK_EQ(bytes.size(), sizeof(RankStats));
+      RankStats s;
+      std::memcpy(&s, bytes.data(), sizeof s);
+      stats->ranks.push_back(s);
+    }
+  }
+
+  const Scene& scene_;
+  const BakeParams& params_;
+  const TileParams& tiles_;
+  Communicator& comm_;
+  ProgressSink* progress_;
+  const int ranks_, me_;
+  const LevelParams level_;
+  const GridFrame frame_;
+  const int tilesPerAxis_;
+
+  int halo_ = 0, attempts_ = 0;
+  float binMargin_ = 0;
+  BakeStats st_;
+  RankStats mine_;
+  TilePlan plan_;
+  std::vector<Photon> held_;  ///< this rank's tiles' and halo's photons, in map order
+  uint64_t stored_ = 0, emitted_ = 0, empty_ = 0, unsent_ = 0;
+  SurfaceGrid grid_;             ///< this rank's tiles and halo
+  std::vector<uint32_t> owned_;  ///< grid_ indices of this rank's voxels
+  VdlGrid local_;                ///< the computed voxels, in grid_ order
+  VdlGrid merged_;               ///< rank 0: every rank's voxels
+};
+
+}  // namespace distributed_internal
+
+BakeResult distributedBake(const Scene& scene, const BakeParams& requested, const TileParams& tiles,
+                           Communicator& comm, ProgressSink* progress, DistributedStats* stats) {
+  const BakeParams params = checkedBakeParams(scene, requested, comm.size());
   if (params.keepPhotons) {
     throw InputError(
         "--photon-map: a bake on several processes keeps no photon map (each holds a part of "
         "it); write it from a bake on one process");
   }
-  const LevelParams level = params.levelParams();
-  const GridFrame frame = makeGridFrame(params.region.empty() ? scene.bounds() : params.region,
-                                        params.depth, level.grid.padding);
-  const int tilesPerAxis =
-      tileParams.tilesPerAxis != 0 ? tileParams.tilesPerAxis : autoTilesPerAxis(params.depth);
-  checkTilesPerAxis(tilesPerAxis, params.depth);
-
-  BakeResult result;
-  BakeStats& st = result.stats;
-  RankStats mine;
-  std::vector<Photon> held;  // this rank's tiles and halo, in map order
-  TilePlan plan;
-  SurfaceGrid grid;
-  uint64_t stored = 0, emitted = 0, empty = 0, unsent = 0;
-  int halo = 0, attempts = 0;
-  for (const double assumedMargin :
-       {std::min(tileParams.assumedMarginVoxels, kMaxBinMarginVoxels), kMaxBinMarginVoxels}) {
-    ++attempts;
-    halo = photonHaloVoxels(level.gather, frame, assumedMargin);
-    st = BakeStats{};
-    st.triangles = scene.triangleCount();
-    st.denseVoxels = size_t(1) << (3 * params.depth);
-    mine = RankStats{};
-    mine.rank = me;
-    std::vector<Photon>().swap(held);
-    stored = emitted = empty = unsent = 0;
-
-    // 1. Photons by rank, sent batch by batch to the tiles that hold them.
-    StageTimer traceTimer(st.stages, "trace + exchange");
-    const PhotonParams photonParams = params.photonParams();
-    PhotonTracer tracer(scene, photonParams);
-    const size_t target = photonParams.storedPhotons;
-    const size_t maxEmitted = maxEmittedPaths(photonParams);
-    std::vector<Photon> batch;
-    std::vector<uint32_t> pathPhotons;
-    bool planned = false;
-    auto makePlan = [&](const std::vector<Photon>& pilot, uint64_t pilotStored) {
-      const size_t T = size_t(tilesPerAxis);
-      std::vector<uint64_t> counts(T * T * T, 0);
-      TilePlan probe;  // tile lookup only
-      probe.depth = params.depth;
-      probe.tilesPerAxis = tilesPerAxis;
-      probe.tileShift = params.depth - log2Exact(tilesPerAxis);
-      for (const Photon& p : pilot) ++counts[probe.tileOf(frame.coordOf(p.position))];
-      comm.allreduceSum(counts.data(), counts.size());
-      const double scale = pilotStored > 0 ? double(target) / double(pilotStored) : 0.0;
-      plan = planTiles(params.depth, tilesPerAxis,
-                       estimateWork(scene, level.grid, tilesPerAxis, counts, scale), ranks, halo);
-      if (!tileParams.owner.empty()) {
-        if (tileParams.owner.size() != plan.owner.size()) {
-          throw InputError("a tile owner table of " + std::to_string(tileParams.owner.size()) +
-                           " entries for " + std::to_string(plan.owner.size()) + " tiles");
-        }
-        for (int32_t r : tileParams.owner) {
-          if (r < 0 || r >= ranks) {
-            throw InputError("tile owner " + std::to_string(r) + " is not one of the " +
-                             std::to_string(ranks) + " ranks");
-          }
-        }
-        plan.owner = tileParams.owner;
-      }
-      planned = true;
-    };
-    {
-      Progress bar(progress, "Tracing photons", target);
-      while (target > 0 && tracer.canStore() && stored < target) {
-        const size_t paths = photonBatchPaths(target, size_t(stored), size_t(emitted), maxEmitted);
-        if (paths == 0) break;
-        // This rank's contiguous share of the batch's paths.
-        const uint64_t first = emitted + uint64_t(paths) * uint64_t(me) / uint64_t(ranks);
-        const uint64_t last = emitted + uint64_t(paths) * uint64_t(me + 1) / uint64_t(ranks);
-        batch.clear();
-        pathPhotons.clear();
-        Stopwatch traceClock;
-        tracer.trace(first, size_t(last - first), batch, pathPhotons);
-        mine.traceSeconds += traceClock.seconds();
-
-        // Where the map's last photon lies: the ranks before hold `before`.
-        Stopwatch exchangeClock;
-        const std::vector<uint64_t> counts = comm.allgather(batch.size());
-        uint64_t before = stored;
-        for (int r = 0; r < me; ++r) before += counts[size_t(r)];
-        uint64_t keptPaths = 0, keptEmpty = 0;
-        size_t keptPhotons = 0;
-        for (size_t i = 0; i < pathPhotons.size() && before + keptPhotons < target; ++i) {
-          keptPhotons += std::min<uint64_t>(pathPhotons[i], target - before - keptPhotons);
-          ++keptPaths;
-          keptEmpty += pathPhotons[i] == 0;
-        }
-        batch.resize(keptPhotons);
-        uint64_t sums[3] = {keptPaths, keptEmpty, uint64_t(keptPhotons)};
-        comm.allreduceSum(sums, 3);
-        emitted += sums[0];
-        empty += sums[1];
-        stored += sums[2];
-        mine.photonsTraced += keptPhotons;
-        const bool firstBatch = !planned;
-        if (firstBatch) makePlan(batch, sums[2]);
-        const ExchangeResult ex = exchangePhotons(comm, plan, frame, batch, held);
-        if (firstBatch && sums[2] > 0 && stored < target) {
-          // This rank's share of the map, from the first batch's: reserved
-          // once, not grown by doubling (which would hold up to twice it).
-          const double share = double(held.size()) / double(sums[2]);
-          held.reserve(size_t(share * double(target) * 1.02) + 4096);
-        }
-        mine.bytesSent += ex.sent;
-        mine.bytesReceived += ex.received;
-        unsent += ex.unsent;
-        mine.exchangeSeconds += exchangeClock.seconds();
-        bar.advance(size_t(sums[2]));
-      }
-    }
-    if (!planned) makePlan({}, 0);
-    // The tests' stand-in for a machine lost mid-bake (docs/scale.md): this
-    // rank dies as a killed process does, between the photon exchange and the
-    // gather.
-    if (const char* kill = std::getenv("LIGHTOCTREE_KILL_RANK")) {
-      if (std::string(kill) == std::to_string(me)) std::raise(SIGKILL);
-    }
-    std::vector<Photon>().swap(batch);
-    scalePhotonPower(held, size_t(emitted));
-    st.storedPhotons = size_t(stored);
-    st.emittedPaths = size_t(emitted);
-    st.emptyPaths = size_t(empty);
-    mine.photonsHeld = held.size();
-    st.traceSeconds = traceTimer.finish(formatCount(size_t(stored)) + " photons from " +
-                                        formatCount(size_t(emitted)) + " paths on " +
-                                        std::to_string(ranks) + " ranks");
-    for (size_t t = 0; t < plan.owner.size(); ++t) {
-      if (plan.owner[t] == me && plan.work[t] > 0) ++mine.tilesOwned;
-    }
-    {
-      double all = 0, own = 0;
-      for (size_t t = 0; t < plan.work.size(); ++t) {
-        all += plan.work[t];
-        if (plan.owner[t] == me) own += plan.work[t];
-      }
-      mine.workShare = all > 0 ? own / all : 0.0;
-    }
-
-    // 2. This rank's tiles and halo, voxelized; its photons splatted.
-    StageTimer voxelizeTimer(st.stages, "voxelize");
-    LocalRegion region{&plan, me, halo + 1};
-    GridParams gridParams = level.grid;
-    {
-      const int res = 1 << params.depth, edge = 1 << plan.tileShift;
-      Coord lo{res, res, res}, hi{-1, -1, -1};
-      const size_t T = size_t(tilesPerAxis);
-      for (size_t t = 0; t < plan.owner.size(); ++t) {
-        if (plan.owner[t] != me) continue;
-        const int x = int(t / (T * T)), y = int(t / T % T), z = int(t % T);
-        lo = {std::min(lo.x, x * edge), std::min(lo.y, y * edge), std::min(lo.z, z * edge)};
-        hi = {std::max(hi.x, x * edge + edge - 1), std::max(hi.y, y * edge + edge - 1),
-              std::max(hi.z, z * edge + edge - 1)};
-      }
-      gridParams.clipLower = {lo.x - region.halo, lo.y - region.halo, lo.z - region.halo};
-      gridParams.clipUpper = {hi.x + region.halo, hi.y + region.halo, hi.z + region.halo};
-      gridParams.keepBlock = [&region](const Coord& b) { return region.keepBlock(b); };
-    }
-    grid = buildSurfaceGrid(scene, gridParams, progress);
-    mine.voxelsHeld = grid.size();
-    mine.voxelizeSeconds = voxelizeTimer.finish(formatCount(grid.size()) + " voxels held on rank " +
-                                                std::to_string(me));
-
-    StageTimer splatTimer(st.stages, "splat photons");
-    splatPhotons(grid, held);
-    {
-      double margin = double(grid.binMargin);
-      comm.allreduceMax(&margin, 1);
-      grid.binMargin = float(margin);  // a float already: the maximum of the ranks' floats
-    }
-    // Every rank sees the same margin, so all start again together.
-    if (double(grid.binMargin) > assumedMargin * double(frame.voxelSize)) continue;
-    // Photons outside every active voxel's neighbourhood, each counted by the
-    // owner of its tile (or by its tracer, when no rank holds it).
-    uint64_t dropped = unsent;
-    {
-      std::vector<char> binned(held.size(), 0);
-      for (uint32_t i : grid.binPhotons) binned[i] = 1;
-      for (size_t i = 0; i < held.size(); ++i) {
-        if (!binned[i] && plan.ownerOf(frame.coordOf(held[i].position)) == me) ++dropped;
-      }
-    }
-    comm.allreduceSum(&dropped, 1);
-    st.level.droppedPhotons = size_t(dropped);
-    mine.splatSeconds = splatTimer.finish();
-    break;
-  }
-  const float binMargin = grid.binMargin;
-  // The bound always holds: the second attempt never continues.
-  LO_CHECK_LE(double(grid.binMargin), kMaxBinMarginVoxels * double(frame.voxelSize));
-
-  // 3. Gather + cluster: this rank's voxels and the ring the smoothing reads.
-  StageTimer clusterTimer(st.stages, "gather + cluster");
-  std::vector<uint32_t> owned, computed;
-  {
-    std::vector<char> compute(grid.size(), 0);
-    for (size_t v = 0; v < grid.size(); ++v) {
-      if (plan.ownerOf(grid.coords[v]) != me) continue;
-      owned.push_back(uint32_t(v));
-      compute[v] = 1;
-      if (!level.smoothing) continue;
-      const Coord c = grid.coords[v];
-      for (int dx = -1; dx <= 1; ++dx)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dz = -1; dz <= 1; ++dz) {
-            const int64_t w = grid.find({c.x + dx, c.y + dy, c.z + dz});
-            if (w >= 0) compute[size_t(w)] = 1;
-          }
-    }
-    for (size_t v = 0; v < grid.size(); ++v) {
-      if (compute[v]) computed.push_back(uint32_t(v));
-    }
-  }
-  mine.voxelsOwned = owned.size();
-  mine.voxelsComputed = computed.size();
-  GatherParams gather = level.gather;
-  std::unique_ptr<GatherOcclusion> occlusion;
-  if (level.occlusion && scene.triangleCount() > 0) {
-    occlusion = std::make_unique<GatherOcclusion>(scene);
-    gather.blocked = occlusion->test();
-  }
-  const LayerParams layerParams;
-  VdlGrid local = buildVdlGrid(grid, held, gather, level.cluster, progress, &st.level.threadSeconds,
-                               level.layers ? &layerParams : nullptr, &computed);
-  if (level.smoothing) smoothVdlGrid(grid, local);
-  std::vector<Photon>().swap(held);
-  grid = SurfaceGrid{};
-  mine.gatherClusterSeconds =
-      clusterTimer.finish(formatCount(owned.size()) + " voxels owned, " +
-                          formatCount(computed.size()) + " computed on rank " + std::to_string(me));
-
-  // 4. The owned voxels, merged on rank 0.
-  StageTimer mergeTimer(st.stages, "merge on rank 0");
-  std::vector<std::vector<char>> parts =
-      comm.gatherBytes(serializeVdlGrid(selectVoxels(local, owned)), 0);
-  local = VdlGrid{};
-  if (me == 0) {
-    std::vector<VdlGrid> grids;
-    for (std::vector<char>& bytes : parts) {
-      grids.push_back(deserializeVdlGrid(bytes));
-      std::vector<char>().swap(bytes);
-    }
-    result.grid = mergeVdlGrids(std::move(grids));
-  }
-  mine.mergeSeconds = mergeTimer.finish();
-
-  uint64_t active = mine.voxelsOwned;
-  comm.allreduceSum(&active, 1);
-  st.level.activeVoxels = size_t(active);
-  st.level.radius = resolveRadius(level.gather, frame);
-  st.level.voxelizeSeconds = mine.voxelizeSeconds;
-  st.level.splatSeconds = mine.splatSeconds;
-  st.level.gatherClusterSeconds = mine.gatherClusterSeconds;
-  if (me == 0) {
-    size_t layered = 0;
-    const VdlLayers& L = result.grid.layers;
-    for (size_t e = 0; e < L.size(); ++e) {
-      if (e == 0 || L.voxel[e] != L.voxel[e - 1]) ++layered;
-    }
-    st.level.layeredVoxels = layered;
-    st.level.extraLayers = L.size();
-  }
-  result.metadata = bakeMetadata(scene, params, int64_t(stored), int64_t(emitted), st.level.radius);
-
-  mine.totalSeconds = total.seconds();
-  mine.peakRssBytes = peakRssBytes();
-  // Every rank takes part, whether or not it asked for the figures.
-  const std::vector<std::vector<char>> all = comm.gatherBytes(rankStatsBytes(mine), 0);
-  if (stats) {
-    stats->tilesPerAxis = tilesPerAxis;
-    stats->photonHalo = halo;
-    stats->attempts = attempts;
-    stats->binMarginVoxels = double(binMargin) / double(frame.voxelSize);
-    stats->tileOwner = plan.owner;
-    stats->tileWork = plan.work;
-    stats->ranks.clear();
-    if (me == 0) {
-      for (const std::vector<char>& bytes : all) {
-        LO_CHECK_EQ(bytes.size(), sizeof(RankStats));
-        RankStats s;
-        std::memcpy(&s, bytes.data(), sizeof s);
-        stats->ranks.push_back(s);
-      }
-    } else {
-      stats->ranks.push_back(mine);
-    }
-  }
-  return result;
+  return distributed_internal::RankBake(scene, params, tiles, comm, progress).run(stats);
 }
 
 }  // namespace lo

@@ -254,6 +254,38 @@ TEST(Photons, DeterministicAcrossThreadCounts) {
       0);
 }
 
+TEST(Photons, PathRangesTracedInAnyPartsGiveTheMap) {
+  // The map is the photons of paths 0, 1, 2, ... cut at the count: traced
+  // as one range or as uneven parts (a distributed bake's ranks), the same.
+  Scene scene = mixedScene();
+  PhotonParams params;
+  params.storedPhotons = 20000;
+  params.seed = 5;
+  const PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  PhotonTracer tracer(scene, params);
+  for (const std::vector<size_t>& parts :
+       {std::vector<size_t>{map.emittedPaths}, std::vector<size_t>{1, 999, 4000, 7, 50000}}) {
+    std::vector<Photon> photons;
+    std::vector<uint32_t> pathPhotons;
+    uint64_t first = 0;
+    for (size_t count : parts) {
+      tracer.trace(first, count, photons, pathPhotons);
+      first += count;
+    }
+    ASSERT_GE(pathPhotons.size(), map.emittedPaths);
+    // Cut where the one-process map was cut: after path emittedPaths - 1.
+    size_t kept = 0;
+    for (size_t i = 0; i < map.emittedPaths; ++i) kept += pathPhotons[i];
+    ASSERT_GE(kept, map.photons.size());
+    ASSERT_LT(kept - pathPhotons[map.emittedPaths - 1], map.photons.size()) << "the last path cut";
+    photons.resize(map.photons.size());
+    scalePhotonPower(photons, map.emittedPaths);
+    EXPECT_EQ(std::memcmp(photons.data(), map.photons.data(), photons.size() * sizeof(Photon)), 0)
+        << parts.size() << " parts";
+  }
+}
+
 TEST(Photons, StoresExactCount) {
   Scene scene = mixedScene();
   for (size_t count : {size_t(1), size_t(777), size_t(12345)}) {
