@@ -27,6 +27,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE = os.path.join(ROOT, "..", "shared", "scenes", "composed", "cornell-box.glb")
 MIB = 1024.0 * 1024.0
 PHOTON_BYTES = 52  # sizeof(lo::Photon): position, direction, power, normal, bounce
+# A VdlGrid voxel with 4 VDLs: coordinate, normal, area, irradiance, photon
+# count, radius, angular error, VDL count, 4 x (irradiance, direction), point.
+MERGED_BYTES_PER_VOXEL = 12 + 12 + 4 + 12 + 4 + 4 + 4 + 1 + 4 * 24 + 12
 
 
 def run_bake(cli, out_dir, name, depth, photons, ranks=0, extra=()):
@@ -274,6 +277,10 @@ def main():
         say("| photons per voxel | photons | machines | memory per machine | time per machine "
             "| sent per machine |")
         say("|---:|---:|---:|---:|---:|---:|")
+
+        def duration(seconds):
+            return "%.1f min" % (seconds / 60) if seconds >= 60 else "%.1f s" % seconds
+
         for density in (stored / four["counts"]["active_voxels"], 200.0):
             total_photons = voxels * density
             for n in (1, 4, 16, 64, 256):
@@ -285,9 +292,13 @@ def main():
                 # Each photon goes to its tile's owner, another rank (N-1)/N of the
                 # time, and to the halo's ranks: 52 bytes each.
                 sent = PHOTON_BYTES * (n - 1) / n * (1 + halo_share) * total_photons / n
-                say("| %.0f | %.2g | %d | %.1f GiB | %.1f min | %.2f GiB |" % (
-                    density, total_photons, n, mem / MIB / 1024, seconds / 60, sent / MIB / 1024))
+                say("| %.0f | %.2g | %d | %.1f GiB | %s | %.2f GiB |" % (
+                    density, total_photons, n, mem / MIB / 1024, duration(seconds),
+                    sent / MIB / 1024))
         say()
+        say("Rank 0 also holds the merged light grid to write it: about %d bytes per voxel "
+            "(4 VDLs), %.1f GiB here, whatever N (docs/scale.md, limits)." % (
+                MERGED_BYTES_PER_VOXEL, MERGED_BYTES_PER_VOXEL * voxels / MIB / 1024))
 
     if not args.quick:
         out = os.path.join(ROOT, "docs", "results", "scale.md")

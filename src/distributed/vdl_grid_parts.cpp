@@ -130,7 +130,7 @@ struct Reader {
                     " values runs past its end");
     }
     values.resize(size_t(n));
-    std::memcpy(values.data(), bytes.data() + at, size_t(n) * sizeof(T));
+    if (n > 0) std::memcpy(values.data(), bytes.data() + at, size_t(n) * sizeof(T));
     at += size_t(n) * sizeof(T);
   }
 };

@@ -33,6 +33,7 @@ std::string fileBytes(const std::string& path) {
 /// The first voxel where two grids differ, or "" when they are equal value
 /// for value (every array, the layers included).
 std::string firstDifference(const VdlGrid& a, const VdlGrid& b) {
+  if (serializeVdlGrid(a) == serializeVdlGrid(b)) return "";
   if (a.size() != b.size()) {
     return "voxels " + std::to_string(a.size()) + " vs " + std::to_string(b.size());
   }
@@ -47,7 +48,7 @@ std::string firstDifference(const VdlGrid& a, const VdlGrid& b) {
              std::to_string(a.photonCount[v]) + " vs " + std::to_string(b.photonCount[v]);
     }
   }
-  return serializeVdlGrid(a) == serializeVdlGrid(b) ? "" : "the frames or payloads differ";
+  return "the frames or payloads differ";
 }
 
 struct RankRun {
