@@ -206,6 +206,34 @@ TEST(TiledBake, ABinMarginBeyondTheAssumedOneStartsAgainWithTheBound) {
   EXPECT_EQ(again.result.stats.storedPhotons, single.stats.storedPhotons);
 }
 
+TEST(TiledBake, RanksWithoutTilesHoldNothingAndChangeNothing) {
+  // One tile for three ranks: two own nothing, trace their paths and send
+  // every photon away.
+  const Scene scene = test::pointLitRoom();
+  BakeParams params;
+  params.depth = 4;
+  params.photons = 10000;
+  params.knn = 30;
+  const BakeResult single = bake(scene, params);
+  const RankRun run = bakeOnThreadRanks(scene, params, 3, 1);
+  EXPECT_EQ(firstDifference(single.grid, run.result.grid), "");
+  ASSERT_EQ(run.stats.ranks.size(), 3u);
+  int owners = 0;
+  uint64_t traced = 0;
+  for (const RankStats& r : run.stats.ranks) {
+    traced += r.photonsTraced;
+    if (r.voxelsOwned == 0) {
+      EXPECT_EQ(r.photonsHeld, 0u) << "rank " << r.rank;
+      continue;
+    }
+    ++owners;
+    EXPECT_EQ(r.voxelsOwned, single.grid.size());
+    EXPECT_EQ(r.photonsHeld, single.stats.storedPhotons);
+  }
+  EXPECT_EQ(owners, 1);
+  EXPECT_EQ(traced, single.stats.storedPhotons);
+}
+
 TEST(TiledBake, RefusesAPhotonMapAndBadTileCounts) {
   const Scene scene = test::pointLitRoom();
   BakeParams params;
