@@ -126,8 +126,9 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
   const auto start = std::chrono::steady_clock::now();
   int status = 0;
   bool killed = false;
+  struct rusage usage {};
   for (auto pause = std::chrono::microseconds(200);;) {
-    const pid_t done = waitpid(pid, &status, WNOHANG);
+    const pid_t done = wait4(pid, &status, WNOHANG, &usage);
     if (done == pid) break;
     if (done < 0) {  // lost the child: not isolated
       close(channel[0]);
@@ -147,8 +148,13 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
     run.message.append(buffer, size_t(r));
   }
   close(channel[0]);
+  // Killed at its CPU limit, or at the wall-clock one after computing for at
+  // least half of it: not a wait on a lock.
+  const double cpu = double(usage.ru_utime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec) +
+                     double(usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_stime.tv_usec);
   if (killed) {
     run.outcome = IsolatedRun::Outcome::TimedOut;
+    run.usedItsCpu = cpu >= 0.5 * limits.seconds;
   } else if (WIFEXITED(status)) {
     run.exitCode = WEXITSTATUS(status);
     run.outcome = run.exitCode == 124 ? IsolatedRun::Outcome::OutOfMemory
@@ -158,6 +164,7 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
     run.outcome = run.signal == SIGXCPU || run.signal == SIGKILL
                       ? IsolatedRun::Outcome::TimedOut
                       : IsolatedRun::Outcome::Crashed;
+    run.usedItsCpu = run.signal == SIGXCPU || cpu >= 0.5 * limits.seconds;
   }
   return run;
 }

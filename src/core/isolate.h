@@ -28,6 +28,10 @@ struct IsolatedRun {
   Outcome outcome = Outcome::NotIsolated;
   int exitCode = 0;
   int signal = 0;
+  /// TimedOut by its CPU limit: it computed all along (a reader looping on
+  /// a damaged file), rather than waiting past the wall-clock limit (e.g.
+  /// on a lock held at the fork), so trying again would only repeat it.
+  bool usedItsCpu = false;
   /// What the work put in its message (at most kIsolatedMessageBytes), e.g.
   /// the text of the exception that ended it.
   std::string message;

@@ -75,9 +75,11 @@ OpenedFile openFile(const std::string& path) {
   };
   IsolatedRun trial = runIsolated(trialRead, limits);
   // A child forked from a process with other threads can, rarely, wait
-  // forever on a lock one of them held at the fork: a time-out or crash is
-  // tried once more before the file is refused (a damaged file fails again).
-  if (trial.outcome == IsolatedRun::Outcome::TimedOut ||
+  // forever on a lock one of them held at the fork: a wait past the time
+  // limit, or a crash, is tried once more before the file is refused (a
+  // damaged file fails again). A child that spent its whole CPU time reading
+  // was not waiting: the file is refused at once.
+  if ((trial.outcome == IsolatedRun::Outcome::TimedOut && !trial.usedItsCpu) ||
       trial.outcome == IsolatedRun::Outcome::Crashed) {
     trial = runIsolated(trialRead, limits);
   }

@@ -6,6 +6,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <thread>
 #include <cstring>
 #include <new>
 #include <stdexcept>
@@ -70,6 +71,21 @@ TEST(Isolate, AnEndlessLoopIsKilledAtTheTimeLimit) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(run.outcome, IsolatedRun::Outcome::TimedOut);
   EXPECT_LT(seconds, 5.0);
+}
+
+TEST(Isolate, AChildThatWaitsPastTheLimitDidNotUseItsCpu) {
+  // What a lock held at the fork looks like: a wait, not a computation; the
+  // .vdb reader tries such a read once more (a looping one it does not).
+  IsolationLimits limits;
+  limits.seconds = 0.3;
+  const IsolatedRun run = runIsolated(
+      [](std::string&) {
+        std::this_thread::sleep_for(std::chrono::seconds(5));
+        return 0;
+      },
+      limits);
+  EXPECT_EQ(run.outcome, IsolatedRun::Outcome::TimedOut);
+  EXPECT_FALSE(run.usedItsCpu);
 }
 
 TEST(Isolate, ACrashIsReportedNotSuffered) {
