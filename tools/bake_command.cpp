@@ -336,7 +336,7 @@ std::function<int()> addBakeCommand(CLI::App& app) {
                   "bytes sent, peak memory)");
   cmd->add_option("--tiles", opt->tiles,
                   "Under mpirun (mpirun -np N lightoctree bake ...): tiles per axis the grid is "
-                  "cut into and shared among the ranks by estimated work, a power of two with "
+                  "cut into and shared among the ranks by estimated memory, a power of two with "
                   "tiles of at least 8^3 voxels, or 'auto' (32, fewer for shallow grids). The "
                   ".vdb bytes are the one-process bake's whatever the tiles and ranks "
                   "(docs/scale.md)")
