@@ -188,18 +188,60 @@ void makeUuidDeterministic(const std::string& file) {
   if (!f) throw std::runtime_error("cannot rewrite the file header");
 }
 
-// Writes through a temporary file (core/file.h): a reader never sees a half file.
-void writeVdbFile(const std::string& path, const openvdb::GridCPtrVec& grids,
+/// One grid of a file, built when it is written (writeVdbFile): a file's
+/// grids are never all in memory at once.
+struct GridSource {
+  std::string name;
+  std::function<openvdb::GridBase::Ptr()> make;
+};
+
+/// io::File::write's archive, but each grid is built just before it is
+/// written and freed after: the bytes io::Archive::write gives a file of
+/// grids with distinct names (header, file metadata, grid count, then each
+/// grid's descriptor, offsets and data), without every grid in memory at
+/// once (a depth-8 Cornell box's grids take ~1 KB per voxel in OpenVDB's
+/// dense 8^3 leaves).
+class GridByGridArchive : public openvdb::io::Archive {
+ public:
+  void write(std::ostream& os, const std::vector<GridSource>& sources,
+             const openvdb::MetaMap& meta) const {
+    openvdb::io::StreamMetadata::Ptr streamMetadata(new openvdb::io::StreamMetadata);
+    openvdb::io::setStreamMetadataPtr(os, streamMetadata, /*transfer=*/false);
+    openvdb::io::setDataCompression(os, compression());
+    openvdb::io::setWriteGridStatsMetadata(os, isGridStatsMetadataEnabled());
+    writeHeader(os, /*seekable=*/true);
+    meta.writeMeta(os);
+    const int32_t count = int32_t(sources.size());
+    os.write(reinterpret_cast<const char*>(&count), sizeof count);
+    std::set<std::string> names;
+    for (const GridSource& source : sources) {
+      openvdb::GridBase::ConstPtr grid = source.make();
+      // Archive::write would rename a repeated or empty name.
+      LO_CHECK(!grid->getName().empty() && names.insert(grid->getName()).second);
+      openvdb::io::GridDescriptor descriptor(grid->getName(), grid->type(),
+                                             grid->saveFloatAsHalf());
+      writeGrid(descriptor, grid, os, /*seekable=*/true);
+      openvdb::io::setDataCompression(os, compression());
+    }
+  }
+};
+
+// Writes through a temporary file (core/file.h), grid by grid: a reader
+// never sees a half file.
+void writeVdbFile(const std::string& path, const std::vector<GridSource>& sources,
                   const openvdb::MetaMap& meta) {
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty() && !fs::is_directory(parent)) {
     throw IoError(path + ": cannot write: folder '" + parent.string() + "' does not exist");
   }
   writeAtomically(path, [&](const std::string& tmp) {
-    openvdb::io::File file(tmp);
-    // Default compression: active mask + Blosc (libopenvdb is built with it).
-    file.write(grids, meta);
-    file.close();
+    {
+      std::ofstream file(tmp, std::ios_base::out | std::ios_base::binary);
+      if (!file) throw std::runtime_error("cannot open the file");
+      GridByGridArchive().write(file, sources, meta);
+      file.close();
+      if (file.fail()) throw std::runtime_error("cannot write the file");
+    }
     makeUuidDeterministic(tmp);
   });
 }
@@ -326,13 +368,6 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   }
   return m;
 }
-
-/// One grid of a VDL file, built when it is written (writeGridByGrid): the
-/// file's grids are never all in memory at once.
-struct GridSource {
-  std::string name;
-  std::function<openvdb::GridBase::Ptr()> make;
-};
 
 /// The grids of the VDL file contract for `g` (which must outlive them), in
 /// file order.
@@ -482,56 +517,6 @@ std::vector<GridSource> vdlGridSources(const VdlGrid& g, const Transform::Ptr& x
   return grids;
 }
 
-/// io::File::write's archive, but each grid is built just before it is
-/// written and freed after: the bytes io::Archive::write gives a file of
-/// grids with distinct names (header, file metadata, grid count, then each
-/// grid's descriptor, offsets and data), without every grid in memory at
-/// once (a depth-8 Cornell box's grids take ~1 KB per voxel in OpenVDB's
-/// dense 8^3 leaves).
-class GridByGridArchive : public openvdb::io::Archive {
- public:
-  void write(std::ostream& os, const std::vector<GridSource>& sources,
-             const openvdb::MetaMap& meta) const {
-    openvdb::io::StreamMetadata::Ptr streamMetadata(new openvdb::io::StreamMetadata);
-    openvdb::io::setStreamMetadataPtr(os, streamMetadata, /*transfer=*/false);
-    openvdb::io::setDataCompression(os, compression());
-    openvdb::io::setWriteGridStatsMetadata(os, isGridStatsMetadataEnabled());
-    writeHeader(os, /*seekable=*/true);
-    meta.writeMeta(os);
-    const int32_t count = int32_t(sources.size());
-    os.write(reinterpret_cast<const char*>(&count), sizeof count);
-    std::set<std::string> names;
-    for (const GridSource& source : sources) {
-      openvdb::GridBase::ConstPtr grid = source.make();
-      // Archive::write would rename a repeated or empty name.
-      LO_CHECK(!grid->getName().empty() && names.insert(grid->getName()).second);
-      openvdb::io::GridDescriptor descriptor(grid->getName(), grid->type(),
-                                             grid->saveFloatAsHalf());
-      writeGrid(descriptor, grid, os, /*seekable=*/true);
-      openvdb::io::setDataCompression(os, compression());
-    }
-  }
-};
-
-// Writes through a temporary file (core/file.h), grid by grid.
-void writeVdbFileGridByGrid(const std::string& path, const std::vector<GridSource>& sources,
-                            const openvdb::MetaMap& meta) {
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty() && !fs::is_directory(parent)) {
-    throw IoError(path + ": cannot write: folder '" + parent.string() + "' does not exist");
-  }
-  writeAtomically(path, [&](const std::string& tmp) {
-    {
-      std::ofstream file(tmp, std::ios_base::out | std::ios_base::binary);
-      if (!file) throw std::runtime_error("cannot open the file");
-      GridByGridArchive().write(file, sources, meta);
-      file.close();
-      if (file.fail()) throw std::runtime_error("cannot write the file");
-    }
-    makeUuidDeterministic(tmp);
-  });
-}
-
 bool isOptionalGrid(const std::string& name) {
   const auto& names = optionalVdlGridNames();
   return std::find(names.begin(), names.end(), name) != names.end();
@@ -597,7 +582,7 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
       fileMeta.insertMeta("format_version", openvdb::Int32Metadata(damage->formatVersion));
     }
   }
-  writeVdbFileGridByGrid(path, sources, fileMeta);
+  writeVdbFile(path, sources, fileMeta);
 }
 
 // ---------------------------------------------------------------------------
@@ -1135,7 +1120,7 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   meta.insertMeta("generator", openvdb::StringMetadata("lightoctree"));
   meta.insertMeta("version", openvdb::StringMetadata(LO_VERSION));
   meta.insertMeta("photons", openvdb::Int64Metadata(int64_t(n)));
-  writeVdbFile(path, openvdb::GridCPtrVec{grid}, meta);
+  writeVdbFile(path, {{"photons", [&grid] { return openvdb::GridBase::Ptr(grid); }}}, meta);
 }
 
 std::vector<Photon> readPoints(const std::string& path) {
