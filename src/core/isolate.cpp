@@ -154,7 +154,6 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
                      double(usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_stime.tv_usec);
   if (killed) {
     run.outcome = IsolatedRun::Outcome::TimedOut;
-    run.usedItsCpu = cpu >= 0.5 * limits.seconds;
   } else if (WIFEXITED(status)) {
     run.exitCode = WEXITSTATUS(status);
     run.outcome = run.exitCode == 124 ? IsolatedRun::Outcome::OutOfMemory
@@ -164,8 +163,9 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
     run.outcome = run.signal == SIGXCPU || run.signal == SIGKILL
                       ? IsolatedRun::Outcome::TimedOut
                       : IsolatedRun::Outcome::Crashed;
-    run.usedItsCpu = run.signal == SIGXCPU || cpu >= 0.5 * limits.seconds;
   }
+  run.usedItsCpu = run.outcome == IsolatedRun::Outcome::TimedOut &&
+                   (run.signal == SIGXCPU || cpu >= 0.5 * limits.seconds);
   return run;
 }
 

@@ -69,23 +69,20 @@ void checkTilesPerAxis(int tiles, int depth) {
 
 /// Estimated work per tile: the geometry's area in it (a voxelization at the
 /// tile resolution) in voxels, and `pilot` photons per tile scaled to the map.
-std::vector<double> estimateWork(const Scene& scene, const GridParams& grid, int tilesPerAxis,
-                                 const std::vector<uint64_t>& pilot, double photonScale) {
-  const size_t tiles = size_t(tilesPerAxis) * size_t(tilesPerAxis) * size_t(tilesPerAxis);
-  std::vector<double> work(tiles, 0.0);
-  for (size_t t = 0; t < tiles; ++t) work[t] = double(pilot[t]) * photonScale;
-  if (tilesPerAxis > 1 && scene.triangleCount() > 0) {
+std::vector<double> estimateWork(const Scene& scene, const GridParams& grid, const GridFrame& frame,
+                                 const TilePlan& tiles, const std::vector<uint64_t>& pilot,
+                                 double photonScale) {
+  std::vector<double> work(pilot.size(), 0.0);
+  for (size_t t = 0; t < pilot.size(); ++t) work[t] = double(pilot[t]) * photonScale;
+  if (tiles.tilesPerAxis > 1 && scene.triangleCount() > 0) {
     GridParams coarse = grid;
-    coarse.depth = log2Exact(tilesPerAxis);
+    coarse.depth = log2Exact(tiles.tilesPerAxis);
     coarse.keepBlock = nullptr;
     const SurfaceGrid areas = buildSurfaceGrid(scene, coarse);
-    const GridFrame fine =
-        makeGridFrame(grid.region.empty() ? scene.bounds() : grid.region, grid.depth, grid.padding);
-    const double voxelArea = double(fine.voxelSize) * double(fine.voxelSize);
+    const double voxelArea = double(frame.voxelSize) * double(frame.voxelSize);
     for (size_t i = 0; i < areas.size(); ++i) {
       const Coord& c = areas.coords[i];
-      const size_t t =
-          (size_t(c.x) * size_t(tilesPerAxis) + size_t(c.y)) * size_t(tilesPerAxis) + size_t(c.z);
+      const size_t t = tiles.tileIndex(c.x, c.y, c.z);
       // A plane of normal n crosses (|nx| + |ny| + |nz|) A / h^2 voxels (its
       // projections on the three axis planes): per orientation of the tile's
       // geometry, else its mean normal (1 where opposite faces cancel).
@@ -116,24 +113,13 @@ struct LocalRegion {
   const TilePlan* plan = nullptr;
   int rank = 0;
   int halo = 0;
-  bool owns(int tx, int ty, int tz) const {
-    const int T = plan->tilesPerAxis;
-    return plan->owner[(size_t(tx) * size_t(T) + size_t(ty)) * size_t(T) + size_t(tz)] == rank;
-  }
   /// Whether any tile of this rank lies within `halo` voxels of the block.
   bool keepBlock(const Coord& b) const {
-    const int res = 1 << plan->depth;
-    int lo[3], hi[3];
-    const int v[3] = {b.x, b.y, b.z};
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, v[a] * 8 - halo) >> plan->tileShift;
-      hi[a] = std::min(res - 1, v[a] * 8 + 7 + halo) >> plan->tileShift;
-    }
-    for (int x = lo[0]; x <= hi[0]; ++x)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int z = lo[2]; z <= hi[2]; ++z)
-          if (owns(x, y, z)) return true;
-    return false;
+    bool owned = false;
+    plan->forTilesIn({b.x * 8 - halo, b.y * 8 - halo, b.z * 8 - halo},
+                     {b.x * 8 + 7 + halo, b.y * 8 + 7 + halo, b.z * 8 + 7 + halo},
+                     [&](size_t t) { owned = owned || plan->owner[t] == rank; });
+    return owned;
   }
 };
 
@@ -189,8 +175,20 @@ size_t TilePlan::tileOf(const Coord& c) const {
   const size_t x = size_t(std::clamp(c.x, 0, res - 1) >> tileShift);
   const size_t y = size_t(std::clamp(c.y, 0, res - 1) >> tileShift);
   const size_t z = size_t(std::clamp(c.z, 0, res - 1) >> tileShift);
+  return tileIndex(int(x), int(y), int(z));
+}
+
+TilePlan tileGrid(int depth, int tilesPerAxis) {
+  using namespace distributed_internal;
+  checkTilesPerAxis(tilesPerAxis, depth);
+  TilePlan plan;
+  plan.depth = depth;
+  plan.tilesPerAxis = tilesPerAxis;
+  plan.tileShift = depth - log2Exact(tilesPerAxis);
   const size_t T = size_t(tilesPerAxis);
-  return (x * T + y) * T + z;
+  plan.owner.assign(T * T * T, 0);
+  plan.work.assign(T * T * T, 0.0);
+  return plan;
 }
 
 std::string TilePlan::ToString() const {
@@ -218,28 +216,23 @@ int photonHaloVoxels(const GatherParams& gather, const GridFrame& frame, double 
 TilePlan planTiles(int depth, int tilesPerAxis, const std::vector<double>& work, int ranks,
                    int photonHalo) {
   using namespace distributed_internal;
-  checkTilesPerAxis(tilesPerAxis, depth);
   if (ranks < 1) throw InputError("ranks " + std::to_string(ranks) + " must be at least 1");
-  TilePlan plan;
-  plan.depth = depth;
-  plan.tilesPerAxis = tilesPerAxis;
-  plan.tileShift = depth - log2Exact(tilesPerAxis);
+  TilePlan plan = tileGrid(depth, tilesPerAxis);
   plan.ranks = ranks;
   plan.photonHalo = photonHalo;
-  const size_t T = size_t(tilesPerAxis), tiles = T * T * T;
-  LO_CHECK_EQ(work.size(), tiles);
+  LO_CHECK_EQ(work.size(), plan.owner.size());
   plan.work = work;
-  std::vector<std::pair<uint32_t, size_t>> curve(tiles);
-  for (size_t x = 0; x < T; ++x)
-    for (size_t y = 0; y < T; ++y)
-      for (size_t z = 0; z < T; ++z) {
-        const size_t t = (x * T + y) * T + z;
-        curve[t] = {mortonCode(uint32_t(x), uint32_t(y), uint32_t(z)), t};
+  std::vector<std::pair<uint32_t, size_t>> curve;
+  curve.reserve(work.size());
+  for (int x = 0; x < tilesPerAxis; ++x)
+    for (int y = 0; y < tilesPerAxis; ++y)
+      for (int z = 0; z < tilesPerAxis; ++z) {
+        curve.emplace_back(mortonCode(uint32_t(x), uint32_t(y), uint32_t(z)),
+                           plan.tileIndex(x, y, z));
       }
   std::sort(curve.begin(), curve.end());
   double total = 0;
   for (double w : work) total += std::max(0.0, w);
-  plan.owner.assign(tiles, 0);
   double before = 0;
   for (const auto& [code, t] : curve) {
     const double w = std::max(0.0, work[t]);
@@ -408,18 +401,14 @@ class RankBake {
   /// The tile plan from the first batch's photons (`pilot`, this rank's part
   /// of `pilotStored`): every rank computes the same one.
   void makePlan(const std::vector<Photon>& pilot, uint64_t pilotStored) {
-    const size_t T = size_t(tilesPerAxis_);
-    std::vector<uint64_t> counts(T * T * T, 0);
-    TilePlan probe;  // tile lookup only
-    probe.depth = params_.depth;
-    probe.tilesPerAxis = tilesPerAxis_;
-    probe.tileShift = params_.depth - log2Exact(tilesPerAxis_);
-    for (const Photon& p : pilot) ++counts[probe.tileOf(frame_.coordOf(p.position))];
+    const TilePlan tiles = tileGrid(params_.depth, tilesPerAxis_);
+    std::vector<uint64_t> counts(tiles.owner.size(), 0);
+    for (const Photon& p : pilot) ++counts[tiles.tileOf(frame_.coordOf(p.position))];
     comm_.allreduceSum(counts.data(), counts.size());
     const double scale = pilotStored > 0 ? double(params_.photons) / double(pilotStored) : 0.0;
     plan_ =
         planTiles(params_.depth, tilesPerAxis_,
-                  estimateWork(scene_, level_.grid, tilesPerAxis_, counts, scale), ranks_, halo_);
+                  estimateWork(scene_, level_.grid, frame_, tiles, counts, scale), ranks_, halo_);
     if (tiles_.owner.empty()) return;
     if (tiles_.owner.size() != plan_.owner.size()) {
       throw InputError("a tile owner table of " + std::to_string(tiles_.owner.size()) +

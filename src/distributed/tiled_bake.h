@@ -10,8 +10,8 @@
 ///     map's last photon is.
 ///  2. Tiles: the grid is cut into tiles of (2^depth / tilesPerAxis)^3
 ///     voxels, given to the ranks in contiguous runs along a Z-order curve,
-///     balanced by estimated work (the first batch's photons per tile, and
-///     the area of the geometry in it). Each batch's photons are sent
+///     balanced by estimated memory (the first batch's photons per tile, and
+///     the voxels its geometry crosses). Each batch's photons are sent
 ///     (alltoallv) to the owner of their tile and to every rank whose tiles
 ///     lie within the halo: the gather's reach, the smoothing's neighbours
 ///     and the photon splat's one-voxel move (photonHaloVoxels).
@@ -62,11 +62,20 @@ struct TilePlan {
   int ranks = 1;
   int photonHalo = 0;          ///< voxels around a rank's tiles whose photons it receives
   std::vector<int32_t> owner;  ///< per tile, index (x * T + y) * T + z
-  std::vector<double> work;    ///< estimated work per tile (photon-equivalents)
+  std::vector<double> work;    ///< estimated memory per tile, in stored photons' worth
 
+  /// Index of tile (tx, ty, tz) in `owner` and `work`.
+  size_t tileIndex(int tx, int ty, int tz) const {
+    const size_t T = size_t(tilesPerAxis);
+    return (size_t(tx) * T + size_t(ty)) * T + size_t(tz);
+  }
   /// Tile of voxel c, clamped into the grid.
   size_t tileOf(const Coord& c) const;
   int ownerOf(const Coord& c) const { return owner[tileOf(c)]; }
+  /// Calls f(tile index) for each tile meeting the voxels [lo, hi]
+  /// (inclusive per axis, clamped into the grid).
+  template <typename F>
+  void forTilesIn(const Coord& lo, const Coord& hi, F&& f) const;
   /// Calls f(rank) once for each rank that owns a tile within `halo` voxels
   /// (per axis) of voxel c; none when c lies farther than that outside the grid.
   template <typename F>
@@ -81,6 +90,11 @@ struct TilePlan {
 /// splatted photon can move from. Voxels are voxelized one further out.
 int photonHaloVoxels(const GatherParams& gather, const GridFrame& frame,
                      double marginVoxels = kMaxBinMarginVoxels);
+
+/// The tiles of a grid (depth, tile count, edge), every one owned by rank 0:
+/// tile lookups before the tiles are shared out. @throws InputError for a
+/// bad tile count (`--tiles`).
+TilePlan tileGrid(int depth, int tilesPerAxis);
 
 /// Splits the tiles among `ranks`: along the Z-order curve of the tile grid,
 /// rank r gets the tiles whose work midpoint lies in [r W / ranks,
@@ -130,36 +144,42 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& params, const T
 // ---------------------------------------------------------------------------
 
 template <typename F>
+void TilePlan::forTilesIn(const Coord& lo, const Coord& hi, F&& f) const {
+  const int last = (1 << depth) - 1;
+  const int a[3] = {std::max(0, lo.x) >> tileShift, std::max(0, lo.y) >> tileShift,
+                    std::max(0, lo.z) >> tileShift};
+  const int b[3] = {std::min(last, hi.x) >> tileShift, std::min(last, hi.y) >> tileShift,
+                    std::min(last, hi.z) >> tileShift};
+  for (int x = a[0]; x <= b[0]; ++x)
+    for (int y = a[1]; y <= b[1]; ++y)
+      for (int z = a[2]; z <= b[2]; ++z) f(tileIndex(x, y, z));
+}
+
+template <typename F>
 void TilePlan::forOwnersNear(const Coord& c, int halo, F&& f) const {
-  const int res = 1 << depth;
-  int lo[3], hi[3];
-  const int v[3] = {c.x, c.y, c.z};
-  for (int a = 0; a < 3; ++a) {
-    if (v[a] + halo < 0 || v[a] - halo > res - 1) return;
-    lo[a] = std::max(0, v[a] - halo) >> tileShift;
-    hi[a] = std::min(res - 1, v[a] + halo) >> tileShift;
+  const int last = (1 << depth) - 1;
+  for (int v : {c.x, c.y, c.z}) {
+    if (v + halo < 0 || v - halo > last) return;
   }
   int seen[8];
   int nSeen = 0;
-  std::vector<int> more;
-  for (int x = lo[0]; x <= hi[0]; ++x) {
-    for (int y = lo[1]; y <= hi[1]; ++y) {
-      for (int z = lo[2]; z <= hi[2]; ++z) {
-        const int r = owner[(size_t(x) * size_t(tilesPerAxis) + size_t(y)) * size_t(tilesPerAxis) +
-                            size_t(z)];
-        bool dup = false;
-        for (int i = 0; i < nSeen; ++i) dup = dup || seen[i] == r;
-        for (int m : more) dup = dup || m == r;
-        if (dup) continue;
-        if (nSeen < 8) {
-          seen[nSeen++] = r;
-        } else {
-          more.push_back(r);
-        }
-        f(r);
-      }
-    }
-  }
+  std::vector<int> more;  // only for a halo wider than a tile
+  forTilesIn({c.x - halo, c.y - halo, c.z - halo}, {c.x + halo, c.y + halo, c.z + halo},
+             [&](size_t t) {
+               const int r = owner[t];
+               for (int i = 0; i < nSeen; ++i) {
+                 if (seen[i] == r) return;
+               }
+               for (int m : more) {
+                 if (m == r) return;
+               }
+               if (nSeen < 8) {
+                 seen[nSeen++] = r;
+               } else {
+                 more.push_back(r);
+               }
+               f(r);
+             });
 }
 
 }  // namespace lo

@@ -112,8 +112,6 @@ double clippedArea(const D3 v[3], const D3& h, D3& areaCentroid) {
   return area;
 }
 
-inline uint64_t canonicalKey(const Coord& c) { return canonicalVoxelKey(c); }
-
 inline Coord coordFromKey(uint64_t key) {
   const int offset = int(key & 511);
   const int bz = int((key >> 9) & 511), by = int((key >> 18) & 511), bx = int((key >> 27) & 511);
@@ -122,7 +120,7 @@ inline Coord coordFromKey(uint64_t key) {
 
 /// One triangle's share of one voxel.
 struct Contribution {
-  uint64_t key;  ///< canonicalKey of the voxel
+  uint64_t key;  ///< canonicalVoxelKey of the voxel
   uint32_t triangle;
   double area;  ///< clipped area, world units^2
   D3 centroid;  ///< area * clipped centroid, or (area 0) the voxel-clamped triangle centroid;
@@ -199,7 +197,7 @@ struct VoxelizeBody {
             const D3 v[3] = {w[0] - center, w[1] - center, w[2] - center};
             if (!overlapsCentered(v, h)) continue;
             Contribution k;
-            k.key = canonicalKey(c);
+            k.key = canonicalVoxelKey(c);
             k.triangle = uint32_t(t);
             k.area = clippedArea(v, h, k.centroid);
             if (!(k.area > 0)) {
