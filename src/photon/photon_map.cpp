@@ -436,12 +436,13 @@ Vec3 PhotonTracer::emittedPower() const { return state_->emittedPower; }
 
 bool PhotonTracer::canStore() const { return state_->tracer != nullptr; }
 
-void PhotonTracer::trace(uint64_t first, size_t count, std::vector<Photon>& photons,
-                         std::vector<uint32_t>& pathPhotons, std::vector<uint32_t>* pathRays) const {
+void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath) const {
   using namespace photon_internal;
-  if (count == 0 || !state_->tracer) {
-    pathPhotons.insert(pathPhotons.end(), count, 0u);
-    if (pathRays) pathRays->insert(pathRays->end(), count, 0u);
+  if (count == 0) return;
+  if (!state_->tracer) {
+    for (size_t i = 0; i < count; ++i) {
+      if (!onPath(nullptr, 0, 0)) return;
+    }
     return;
   }
   std::vector<ChunkResult>& chunks = state_->chunks;
@@ -449,21 +450,28 @@ void PhotonTracer::trace(uint64_t first, size_t count, std::vector<Photon>& phot
   if (chunks.size() < nChunks) chunks.resize(nChunks);
   TraceChunks body{&state_->ctx, &chunks, first, count};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nChunks, 1), body, tbb::simple_partitioner());
-  size_t total = 0;
-  for (size_t c = 0; c < nChunks; ++c) total += chunks[c].photons.size();
-  photons.reserve(photons.size() + total);
-  pathPhotons.reserve(pathPhotons.size() + count);
   const Vec3 origin = state_->origin;
   for (size_t c = 0; c < nChunks; ++c) {
     ChunkResult& chunk = chunks[c];
-    const size_t before = photons.size();
-    photons.insert(photons.end(), chunk.photons.begin(), chunk.photons.end());
     if (origin != Vec3{0, 0, 0}) {
-      for (size_t i = before; i < photons.size(); ++i) photons[i].position += origin;
+      for (Photon& photon : chunk.photons) photon.position += origin;
     }
-    pathPhotons.insert(pathPhotons.end(), chunk.pathPhotons.begin(), chunk.pathPhotons.end());
-    if (pathRays) pathRays->insert(pathRays->end(), chunk.pathRays.begin(), chunk.pathRays.end());
+    const Photon* photons = chunk.photons.data();
+    for (size_t i = 0; i < chunk.pathPhotons.size(); ++i) {
+      if (!onPath(photons, chunk.pathPhotons[i], chunk.pathRays[i])) return;
+      photons += chunk.pathPhotons[i];
+    }
   }
+}
+
+void PhotonTracer::trace(uint64_t first, size_t count, std::vector<Photon>& photons,
+                         std::vector<uint32_t>& pathPhotons) const {
+  pathPhotons.reserve(pathPhotons.size() + count);
+  trace(first, count, [&](const Photon* path, uint32_t n, uint32_t) {
+    if (n > 0) photons.insert(photons.end(), path, path + n);
+    pathPhotons.push_back(n);
+    return true;
+  });
 }
 
 size_t photonBatchPaths(size_t target, size_t stored, size_t emitted, size_t maxEmitted) {
@@ -493,35 +501,24 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   Progress bar(progress, "Tracing photons", target);
   map.photons.reserve(target);
 
-  std::vector<Photon> batchPhotons;
-  std::vector<uint32_t> pathPhotons, pathRays;
   size_t emitted = 0;  // paths whose photons are in map.photons
   size_t empty = 0;    // of those, paths that stored nothing
   size_t rays = 0;
-  bool done = false;
-  while (!done) {
+  // Each path's photons go straight into the map, in path order; the path
+  // that reaches the target is the last one taken.
+  const PhotonTracer::PathSink take = [&](const Photon* photons, uint32_t n, uint32_t pathRays) {
+    const size_t kept = std::min<size_t>(n, target - map.photons.size());
+    if (kept > 0) map.photons.insert(map.photons.end(), photons, photons + kept);
+    rays += pathRays;
+    ++emitted;
+    empty += n == 0;
+    return map.photons.size() < target;
+  };
+  while (map.photons.size() < target) {
     const size_t batch = photonBatchPaths(target, map.photons.size(), emitted, maxEmitted);
     if (batch == 0) break;
-    batchPhotons.clear();
-    pathPhotons.clear();
-    pathRays.clear();
-    tracer.trace(uint64_t(emitted), batch, batchPhotons, pathPhotons, &pathRays);
-    // Append in path order; stop inside the path that reaches the target.
     const size_t before = map.photons.size();
-    size_t offset = 0;
-    for (size_t i = 0; i < pathPhotons.size(); ++i) {
-      const size_t take = std::min<size_t>(pathPhotons[i], target - map.photons.size());
-      map.photons.insert(map.photons.end(), batchPhotons.begin() + std::ptrdiff_t(offset),
-                         batchPhotons.begin() + std::ptrdiff_t(offset + take));
-      offset += pathPhotons[i];
-      rays += pathRays[i];
-      ++emitted;
-      empty += pathPhotons[i] == 0;
-      if (map.photons.size() == target) {
-        done = true;
-        break;
-      }
-    }
+    tracer.trace(uint64_t(emitted), batch, take);
     bar.advance(map.photons.size() - before);
   }
 

@@ -4,6 +4,7 @@
 /// octree compresses). Embree is visible only inside src/photon.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -60,12 +61,17 @@ class PhotonTracer {
   PhotonTracer(const PhotonTracer&) = delete;
   PhotonTracer& operator=(const PhotonTracer&) = delete;
 
-  /// Traces paths [first, first + count) in parallel (TBB): appends their
-  /// photons (world space, power not yet scaled) in path order to `photons`
-  /// and each path's photon count to `pathPhotons` (and its rays to
-  /// `pathRays`, when given). Not reentrant (one call at a time per tracer).
+  /// Called once per path, in path order, with the path's photons (world
+  /// space, power not yet scaled), their count and the rays it traced;
+  /// returning false stops handing on the call's remaining paths.
+  using PathSink = std::function<bool(const Photon* photons, uint32_t count, uint32_t rays)>;
+  /// Traces paths [first, first + count) in parallel (TBB) and hands each to
+  /// `onPath` in path order. Not reentrant (one call at a time per tracer).
+  void trace(uint64_t first, size_t count, const PathSink& onPath) const;
+  /// The same, appending the photons to `photons` and each path's photon
+  /// count to `pathPhotons`.
   void trace(uint64_t first, size_t count, std::vector<Photon>& photons,
-             std::vector<uint32_t>& pathPhotons, std::vector<uint32_t>* pathRays = nullptr) const;
+             std::vector<uint32_t>& pathPhotons) const;
   Vec3 emittedPower() const;  ///< total RGB power of all lights, W
   bool canStore() const;      ///< false when the scene has no triangle to store on
 
