@@ -203,7 +203,7 @@ struct GridSource {
 /// dense 8^3 leaves).
 class GridByGridArchive : public openvdb::io::Archive {
  public:
-  void write(std::ostream& os, const std::vector<GridSource>& sources,
+  void writeGrids(std::ostream& os, const std::vector<GridSource>& sources,
              const openvdb::MetaMap& meta) const {
     openvdb::io::StreamMetadata::Ptr streamMetadata(new openvdb::io::StreamMetadata);
     openvdb::io::setStreamMetadataPtr(os, streamMetadata, /*transfer=*/false);
@@ -238,7 +238,7 @@ void writeVdbFile(const std::string& path, const std::vector<GridSource>& source
     {
       std::ofstream file(tmp, std::ios_base::out | std::ios_base::binary);
       if (!file) throw std::runtime_error("cannot open the file");
-      GridByGridArchive().write(file, sources, meta);
+      GridByGridArchive().writeGrids(file, sources, meta);
       file.close();
       if (file.fail()) throw std::runtime_error("cannot write the file");
     }
