@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "core/error.h"
-#include "photon/ray_tracer.h"
+#include "raytrace/ray_tracer.h"
 
 namespace lo {
 

@@ -1,6 +1,6 @@
 /// @file photon/photon_map.cpp
-/// @brief Photon tracing (paper §4.1) through photon/ray_tracer.h (Embree 3)
-/// and the shared material model photon/bsdf.h. See docs/photon.md for
+/// @brief Photon tracing (paper §4.1) through raytrace/ray_tracer.h (Embree 3)
+/// and the shared material model material/bsdf.h. See docs/photon.md for
 /// the method, units and the determinism scheme.
 ///
 /// Units: photon power is flux in W (RGB). A path starts with the power of its
@@ -21,8 +21,9 @@
 
 #include "core/error.h"
 #include "core/rng.h"
-#include "photon/bsdf.h"
-#include "photon/ray_tracer.h"
+#include "material/bsdf.h"
+#include "raytrace/ray_tracer.h"
+#include "scene/emitter_sampler.h"
 
 namespace lo {
 
@@ -308,20 +309,14 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
                        "' has non-finite power " + e.samplePower.ToString());
     if (average(e.power) > 0) ctx.emitters.push_back(e);
   }
-  for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    const Material& m = scene.materials[ctx.triangles[t].material];
-    if (!m.isEmissive()) continue;
-    // Lambertian emitter of radiance L: flux pi L A per emitting side.
-    float sides = m.doubleSided ? 2.0f : 1.0f;
+  const EmitterSampler triangles = buildEmitterSampler(scene);
+  for (size_t k = 0; k < triangles.size(); ++k) {
     Emitter e;
     e.kind = Emitter::Kind::Triangle;
-    e.index = uint32_t(t);
-    e.power = scene.triangleEmission(t) * (sides * kPi * scene.triangleArea(t));
+    e.index = triangles.triangles[k];
+    e.power = triangles.power[k];
     e.samplePower = e.power;
-    if (!isFinite(e.power))
-      throw InputError("material '" + m.name + "' of triangle " + std::to_string(t) +
-                       " emits non-finite power " + e.power.ToString());
-    if (average(e.power) > 0) ctx.emitters.push_back(e);
+    ctx.emitters.push_back(e);
   }
   double total = 0;
   ctx.emitterCdf.reserve(ctx.emitters.size());

@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "core/rng.h"
-#include "photon/ray_tracer.h"
+#include "raytrace/ray_tracer.h"
 
 namespace lo {
 

@@ -1,7 +1,7 @@
 /// @file reference/path_tracer.cpp
 /// @brief Path tracing with next-event estimation and multiple importance
-/// sampling (Veach 1997, §9.2, power heuristic beta = 2) over photon/ray_tracer.h
-/// and the photon tracer's material model photon/bsdf.h.
+/// sampling (Veach 1997, §9.2, power heuristic beta = 2) over raytrace/ray_tracer.h
+/// and the photon tracer's material model material/bsdf.h.
 
 #include "reference/path_tracer.h"
 
@@ -18,8 +18,9 @@
 
 #include "core/error.h"
 #include "core/rng.h"
-#include "photon/bsdf.h"
-#include "photon/ray_tracer.h"
+#include "material/bsdf.h"
+#include "raytrace/ray_tracer.h"
+#include "scene/emitter_sampler.h"
 
 namespace lo {
 
@@ -58,10 +59,9 @@ struct Context {
   const Scene* scene = nullptr;
   const RayTracer* tracer = nullptr;
   std::vector<BsdfLobes> lobes;    ///< per material
-  std::vector<uint32_t> emitters;  ///< emissive triangles
-  std::vector<double> emitterCdf;  ///< cumulative power, back() = total
+  EmitterSampler emitters;  ///< emissive triangles, picked by power
   std::vector<float>
-      emitterPickPdf;                ///< per triangle: pick probability / area (0 = not an emitter)
+      emitterPickPdf;  ///< per triangle: pick probability / area (0 = not an emitter)
   std::vector<const Light*> lights;  ///< punctual lights with positive intensity
   float epsilon = 0;
   int maxBounces = 0;
@@ -138,10 +138,8 @@ inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, 
   if (!ctx.emitters.empty()) {
     const Scene& scene = *ctx.scene;
     uint64_t bits = (uint64_t(rng.next()) << 21) ^ uint64_t(rng.next());
-    double pick = double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53 * ctx.emitterCdf.back();
-    size_t k = size_t(std::upper_bound(ctx.emitterCdf.begin(), ctx.emitterCdf.end(), pick) -
-                      ctx.emitterCdf.begin());
-    uint32_t tri = ctx.emitters[std::min(k, ctx.emitters.size() - 1)];
+    uint32_t tri = ctx.emitters.triangles[ctx.emitters.pick(
+        double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53)];
     float s = std::sqrt(rng.uniform());
     float b1 = 1.0f - s, b2 = rng.uniform() * s;
     const Vec3& p0 = scene.positions[scene.indices[3 * tri]];
@@ -284,25 +282,8 @@ void buildContext(const Scene& scene, const ReferenceParams& params, Context& ct
                        std::to_string(m) + " outside [0, " +
                        std::to_string(scene.materials.size()) + ")");
   }
-  ctx.emitterPickPdf.assign(scene.triangleCount(), 0.0f);
-  double total = 0;
-  std::vector<double> power;
-  for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    const Material& m = scene.materials[scene.triangleMaterial[t]];
-    float area = scene.triangleArea(t);
-    if (!m.isEmissive() || !(area > 0)) continue;
-    // Picked in proportion to power, as the photon tracer picks emitters.
-    double w = double(average(scene.triangleEmission(t))) * area * (m.doubleSided ? 2.0 : 1.0);
-    if (!(w > 0) || !std::isfinite(w)) continue;
-    total += w;
-    ctx.emitters.push_back(uint32_t(t));
-    ctx.emitterCdf.push_back(total);
-    power.push_back(w);
-  }
-  for (size_t i = 0; i < ctx.emitters.size(); ++i) {
-    uint32_t t = ctx.emitters[i];
-    ctx.emitterPickPdf[t] = float(power[i] / total) / scene.triangleArea(t);
-  }
+  ctx.emitters = buildEmitterSampler(scene);
+  ctx.emitterPickPdf = ctx.emitters.areaPdfs(scene);
   for (const Light& light : scene.lights)
     if (light.intensity > 0 && maxComponent(light.color) > 0) ctx.lights.push_back(&light);
   Bounds3 bounds = scene.bounds();

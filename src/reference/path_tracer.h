@@ -1,7 +1,7 @@
 #pragma once
 /// @file reference/path_tracer.h
 /// @brief Unbiased reference renderer: a path tracer over the same Scene and
-/// the same material model (photon/bsdf.h) as the photon tracer, to measure
+/// the same material model (material/bsdf.h) as the photon tracer, to measure
 /// the light octree's error. See docs/reference.md for the estimator.
 ///
 /// Output is linear radiance W/(m^2 sr) in the scene's light units

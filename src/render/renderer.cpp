@@ -21,6 +21,7 @@
 #include "render/gl_util.h"
 #include "render/layout_probe.h"
 #include "render/octree_textures.h"
+#include "scene/emitter_sampler.h"
 
 namespace lo {
 namespace render_internal {
@@ -507,31 +508,21 @@ struct Renderer::Impl {
   }
 
   /// Emissive triangles -> `count` virtual point lights, chosen in proportion
-  /// to emitted power (average emission x area) by stratified, deterministic
-  /// sampling; each carries the power of its stratum as the intensity of a
-  /// Lambertian patch I(theta) = L A cos(theta).
+  /// to emitted power (EmitterSampler: the tracers' distribution) by
+  /// stratified, deterministic sampling; each carries the power of its
+  /// stratum as the intensity of a one-sided Lambertian patch I(theta) =
+  /// L A cos(theta). A double-sided emitter's samples alternate sides.
   std::vector<GpuLight> emitterVpls(const Scene& scene, int count) {
-    std::vector<size_t> tris;
-    std::vector<double> cdf;
-    double total = 0;
-    for (size_t t = 0; t < scene.triangleCount(); ++t) {
-      int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
-      if (m < 0 || size_t(m) >= scene.materials.size()) continue;
-      double w = double(average(scene.triangleEmission(t))) * scene.triangleArea(t);
-      if (!(w > 0)) continue;
-      total += w;
-      tris.push_back(t);
-      cdf.push_back(total);
-    }
+    const EmitterSampler emitters = buildEmitterSampler(scene);
     std::vector<GpuLight> out;
-    if (tris.empty() || count <= 0) return out;
+    if (emitters.empty() || count <= 0) return out;
+    const double total = emitters.total();
     for (int i = 0; i < count; ++i) {
-      double u = (i + 0.5) / count * total;
-      size_t k = size_t(std::lower_bound(cdf.begin(), cdf.end(), u) - cdf.begin());
-      k = std::min(k, tris.size() - 1);
-      size_t t = tris[k];
-      double lo = k > 0 ? cdf[k - 1] : 0.0;
-      float s = float((u - lo) / (cdf[k] - lo));
+      double u = (i + 0.5) / count;
+      size_t k = emitters.pick(u);
+      size_t t = emitters.triangles[k];
+      double lo = k > 0 ? emitters.cdf[k - 1] : 0.0;
+      float s = float((u * total - lo) / (emitters.cdf[k] - lo));
       // Second coordinate from the base-2 radical inverse of i.
       uint32_t bits = uint32_t(i);
       bits = (bits << 16u) | (bits >> 16u);
@@ -545,11 +536,13 @@ struct Renderer::Impl {
       const Vec3 p0 = toRender(scene.positions[scene.indices[t * 3]]);
       const Vec3 p1 = toRender(scene.positions[scene.indices[t * 3 + 1]]);
       const Vec3 p2 = toRender(scene.positions[scene.indices[t * 3 + 2]]);
-      Vec3 n = scene.faceNormal(t);
+      const bool back = scene.materials[size_t(scene.triangleMaterial[t])].doubleSided && (i & 1);
+      Vec3 n = back ? -scene.faceNormal(t) : scene.faceNormal(t);
       Vec3 p = p0 * (1 - b1 - b2) + p1 * b1 + p2 * b2 + n * (1e-3f * sceneSize);
       const Vec3 emission = scene.triangleEmission(t);
-      // Area this sample stands for: the whole emitter power shared by count.
-      float area = float(total / double(average(emission)) / count);
+      // Area this sample stands for: the emitted power shared by count, as
+      // one side of a Lambertian patch (power pi L A).
+      float area = float(total / (kPi * double(average(emission))) / count);
       GpuLight l{};
       setVec4(l.positionType, p, float(kEmitter));
       setVec4(l.directionRange, n, 0);

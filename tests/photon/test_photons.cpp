@@ -519,78 +519,6 @@ TEST(Photons, RejectsNegativeMaxBounces) {
   EXPECT_THROW(tracePhotons(scene, params), InputError);
 }
 
-}  // namespace
-}  // namespace lo
-
-#include "photon/ray_tracer.h"
-
-namespace lo {
-namespace {
-
-/// A unit quad in z = 0 (normal +z) whose UVs run u = x, v = y over [0, 1]^2,
-/// with one material; the scene's only geometry.
-Scene alphaQuad(const Material& material, const Texture* texture) {
-  Scene scene;
-  scene.materials.push_back(material);
-  if (texture) {
-    scene.textures.push_back(*texture);
-    scene.materials[0].baseColorTexture = 0;
-  }
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 0);
-  for (const Vec3& p : scene.positions) {
-    scene.texcoords0.push_back(p.x);
-    scene.texcoords0.push_back(p.y);
-  }
-  return scene;
-}
-
-// Alpha MASK in the tracer: a ray through the cut-out half passes, one
-// through the opaque half hits; the same for shadow rays.
-TEST(RayTracerAlpha, MaskCutsRaysThroughTransparentTexels) {
-  Texture half;
-  half.width = 2;
-  half.height = 1;
-  half.texels = {Vec3{1, 1, 1}, Vec3{1, 1, 1}};
-  half.alpha = {0.0f, 1.0f};  // u < 0.5 cut out
-  Material m;
-  m.alphaMode = AlphaMode::Mask;
-  const Scene scene = alphaQuad(m, &half);
-  RayTracer tracer(scene);
-  Hit hit;
-  EXPECT_FALSE(tracer.intersect({0.25f, 0.5f, 1}, {0, 0, -1}, hit));
-  EXPECT_FALSE(tracer.occluded({0.25f, 0.5f, 1}, {0, 0, -1}, 2));
-  ASSERT_TRUE(tracer.intersect({0.75f, 0.5f, 1}, {0, 0, -1}, hit));
-  EXPECT_NEAR(hit.t, 1.0f, 1e-5f);
-  EXPECT_TRUE(tracer.occluded({0.75f, 0.5f, 1}, {0, 0, -1}, 2));
-  // Opaque mode ignores the alpha.
-  Scene opaque = scene;
-  opaque.materials[0].alphaMode = AlphaMode::Opaque;
-  EXPECT_TRUE(RayTracer(opaque).intersect({0.25f, 0.5f, 1}, {0, 0, -1}, hit));
-}
-
-// Alpha BLEND in the tracer: a share alpha of the rays hits, decided per
-// ray (the same ray always decides the same way).
-TEST(RayTracerAlpha, BlendStopsAlphaOfTheRays) {
-  Material m;
-  m.alphaMode = AlphaMode::Blend;
-  m.baseAlpha = 0.3f;
-  const Scene scene = alphaQuad(m, nullptr);
-  RayTracer tracer(scene);
-  const int n = 20000;
-  int hits = 0, occluded = 0;
-  for (int i = 0; i < n; ++i) {
-    const float x = (float(i % 200) + 0.5f) / 200.0f, y = (float(i / 200) + 0.5f) / 100.0f;
-    Hit hit;
-    const bool h = tracer.intersect({x, y, 1}, {0.01f, 0, -1}, hit);
-    hits += h ? 1 : 0;
-    occluded += tracer.occluded({x, y, 1}, {0.01f, 0, -1}, 2) ? 1 : 0;
-    ASSERT_EQ(h, tracer.intersect({x, y, 1}, {0.01f, 0, -1}, hit)) << "ray " << i;
-  }
-  const double sigma = std::sqrt(0.3 * 0.7 / n);
-  EXPECT_NEAR(double(hits) / n, 0.3, 4 * sigma);
-  EXPECT_EQ(hits, occluded) << "closest-hit and shadow rays agree ray by ray";
-}
-
 // An emissive texture: the quad's emitted power is pi A times the mean
 // radiance over it, and photons start only where the texture emits.
 TEST(Photons, EmissiveTextureWeightsThePhotons) {
@@ -634,11 +562,6 @@ TEST(Photons, EmissiveTextureWeightsThePhotons) {
   EXPECT_GT(left, 5.0 * right) << "left " << left << " right " << right;
 }
 
-}  // namespace
-}  // namespace lo
-
-namespace lo {
-namespace {
 
 // The photon tracer reads a metallic-roughness map as the renderer does: a
 // mirror by its factors (metallic 1, roughness 0.05) whose map says
@@ -677,11 +600,6 @@ TEST(Photons, MetallicRoughnessMapMakesAMirrorDiffuse) {
   EXPECT_GT(floorPhotons(true), 300u);
 }
 
-}  // namespace
-}  // namespace lo
-
-namespace lo {
-namespace {
 
 // A thin-walled pane (no volume): light passes straight through it, as
 // direct light: photons that crossed it keep bounce 0 (the renderer draws

@@ -1,7 +1,7 @@
 /// @file photon/bsdf.cpp
 /// @brief The shared diffuse + GGX metal + Fresnel glass material model.
 
-#include "photon/bsdf.h"
+#include "material/bsdf.h"
 
 #include <algorithm>
 #include <cmath>

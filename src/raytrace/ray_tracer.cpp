@@ -1,7 +1,7 @@
 /// @file photon/ray_tracer.cpp
-/// @brief Embree 3 scene setup and ray queries behind photon/ray_tracer.h.
+/// @brief Embree 3 scene setup and ray queries behind raytrace/ray_tracer.h.
 
-#include "photon/ray_tracer.h"
+#include "raytrace/ray_tracer.h"
 
 #include <embree3/rtcore.h>
 

@@ -1,5 +1,5 @@
 #pragma once
-/// @file photon/ray_tracer.h
+/// @file raytrace/ray_tracer.h
 /// @brief Closest-hit and shadow rays against a Scene's triangles. The only
 /// place Embree is set up; the public API is plain values so that other
 /// stages (src/reference) trace rays without seeing Embree.

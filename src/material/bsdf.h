@@ -1,5 +1,5 @@
 #pragma once
-/// @file photon/bsdf.h
+/// @file material/bsdf.h
 /// @brief The material model the photon tracer scatters with, shared with the
 /// reference path tracer (src/reference) so both estimate the same transport.
 ///

@@ -1,0 +1,50 @@
+#pragma once
+/// @file scene/emitter_sampler.h
+/// @brief The power distribution over a scene's emissive triangles, built once
+/// for every stage that picks emitters by power: the photon tracer (where a
+/// photon path starts), the reference path tracer (next-event estimation) and
+/// the renderer (virtual point lights). One rule for all three, so that they
+/// agree on which triangles emit and how much.
+///
+/// A triangle emits when its material is emissive, its area is positive and
+/// its mean emission (Scene::triangleEmission) is positive. Its power is that
+/// of a Lambertian emitter of radiance L over area A: pi L A per emitting
+/// side, glTF `doubleSided` emitting from both (W, per RGB channel).
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/math.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+struct EmitterSampler {
+  /// Emissive triangles, ascending, into the Scene's triangles.
+  std::vector<uint32_t> triangles;
+  /// Per entry: emitted power pi L A * sides, W (RGB).
+  std::vector<Vec3> power;
+  /// Per entry: the cumulative sum of average(power) up to and including it;
+  /// back() is the total. Summed in double in triangle order.
+  std::vector<double> cdf;
+
+  bool empty() const { return triangles.empty(); }
+  size_t size() const { return triangles.size(); }
+  /// Sum of average(power) over every emitter, W.
+  double total() const { return cdf.empty() ? 0.0 : cdf.back(); }
+  /// The entry whose stretch of the cdf holds u * total(), u in [0, 1).
+  size_t pick(double u) const;
+  /// Probability that pick() returns entry k.
+  double pickProbability(size_t k) const;
+  /// Per triangle of the scene: pick probability / area (the area density
+  /// of a point drawn uniformly on the picked triangle), 0 for triangles that
+  /// do not emit. size() = the scene's triangle count.
+  std::vector<float> areaPdfs(const Scene& scene) const;
+};
+
+/// @throws InputError naming the material and triangle when an emitter's
+/// power is not finite (an emission so large that pi L A overflows).
+EmitterSampler buildEmitterSampler(const Scene& scene);
+
+}  // namespace lo
