@@ -1,25 +1,12 @@
 #include "test_util.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 
-#include "render/context.h"
-
 namespace lo::test {
-
-GlContext* osmesaContext() {
-  static std::unique_ptr<GlContext> context;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    try {
-      context = createGlContext({GlBackend::OSMesa});
-    } catch (const std::exception&) {
-    }
-  }
-  if (context) context->makeCurrent();
-  return context.get();
-}
 
 std::string sharedScenesDir() { return std::string(LO_SHARED_DIR) + "/scenes"; }
 std::string dataDir() { return LO_DATA_DIR; }
@@ -45,6 +32,33 @@ void addQuad(Scene& scene, const Vec3& corner, const Vec3& edgeU, const Vec3& ed
     for (uint32_t i : t) scene.indices.push_back(base + i);
     scene.triangleMaterial.push_back(material);
   }
+}
+
+Scene boxWithTwoBlocks(const Bounds3& block1, const Bounds3& block2) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  addClosedBox(scene, {0, 0, 0}, {1, 1, 1}, 0);
+  addBlock(scene, block1.lower, block1.upper, 0);
+  addBlock(scene, block2.lower, block2.upper, 0);
+  return scene;
+}
+
+Vec3 randomUnit(Rng& rng) {
+  const float z = 2.0f * rng.uniform() - 1.0f;
+  const float phi = 2.0f * kPi * rng.uniform();
+  const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+std::string runCommand(const std::string& command) {
+  std::string out;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return out;
+  char buffer[4096];
+  size_t got;
+  while ((got = fread(buffer, 1, sizeof(buffer), pipe)) > 0) out.append(buffer, got);
+  pclose(pipe);
+  return out;
 }
 
 void addClosedBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "octree/gpu_octree.h"
+#include "core/rng.h"
 #include "scene/scene.h"
 
 namespace lo {
@@ -34,6 +35,17 @@ void addClosedBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
 
 /// A block standing on y = lo.y: five outward-facing quads (no bottom face).
 void addBlock(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
+
+/// The closed unit box (inward faces, default material) with two blocks
+/// standing on its floor (outward faces, no bottom face): a Cornell-like room.
+Scene boxWithTwoBlocks(const Bounds3& block1, const Bounds3& block2);
+
+/// A direction uniform on the unit sphere (z uniform in [-1, 1], then the
+/// azimuth): two numbers from `rng`.
+Vec3 randomUnit(Rng& rng);
+
+/// Runs `command` through the shell; its standard output ("" if it cannot start).
+std::string runCommand(const std::string& command);
 
 /// The unit room (albedo 0.6) with a block on the floor, lit by a point light
 /// of intensity 1 at (0.5, 0.8, 0.5): a small scene for whole-bake tests.

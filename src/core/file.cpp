@@ -107,6 +107,19 @@ std::string notReplaceable(const std::string& path) {
 
 }  // namespace file_internal
 
+std::string readFile(const std::string& path) {
+  // A FIFO or a device would block or never end: only regular files are read.
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) throw IoError("cannot read '" + path + "': no such file");
+  if (!fs::is_regular_file(status)) throw IoError("cannot read '" + path + "': not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError("cannot open '" + path + "': " + std::strerror(errno));
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw IoError("cannot read '" + path + "': " + std::strerror(errno));
+  return bytes;
+}
+
 std::string temporaryPathFor(const std::string& path) {
   static std::atomic<uint64_t> counter{0};
   static const uint64_t seed = [] {

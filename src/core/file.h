@@ -1,6 +1,6 @@
 #pragma once
 /// @file core/file.h
-/// @brief Output files: every writer of the project goes through these, so
+/// @brief Reading a whole file, and output files: every writer of the project goes through these, so
 /// that an interrupted or failed write never leaves a half file under the
 /// final name, nothing is written through a link or over what is not a
 /// regular file, and a bad output path is reported before any long work.
@@ -12,6 +12,10 @@
 #include <vector>
 
 namespace lo {
+
+/// @brief The whole content of the file at `path`, as bytes.
+/// @throws IoError naming `path` when it cannot be opened or read.
+std::string readFile(const std::string& path);
 
 /// @brief Writes `path` through a temporary file beside it: a new name per
 /// call (temporaryPathFor), created exclusively (an existing file or link of

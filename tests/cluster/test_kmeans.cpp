@@ -7,21 +7,14 @@
 #include "cluster/vdl_cluster.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "test_util.h"
 
 namespace lo {
 namespace {
 
-Vec3 randomUnit(Rng& rng) {
-  // Uniform on the sphere (Archimedes): z uniform, azimuth uniform.
-  float z = 1.0f - 2.0f * rng.uniform();
-  float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-  float phi = 2.0f * kPi * rng.uniform();
-  return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
 // Direction within `jitter` (chord-ish) of `axis`.
 Vec3 jittered(const Vec3& axis, float jitter, Rng& rng) {
-  return normalize(axis + randomUnit(rng) * (jitter * rng.uniform()));
+  return normalize(axis + test::randomUnit(rng) * (jitter * rng.uniform()));
 }
 
 Vec3 sumValues(const std::vector<DirectionSample>& s) {
@@ -91,7 +84,7 @@ TEST(KMeans, VdlsSumToTotalForRandomInputs) {
     int k = 1 + int(rng.uniformInt(kMaxVdls));
     std::vector<DirectionSample> s(n);
     for (auto& d : s) {
-      d.direction = randomUnit(rng);
+      d.direction = test::randomUnit(rng);
       d.value = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 0.05f;
       if (rng.uniform() < 0.1f) d.value = Vec3{};  // some zero-weight samples
     }
@@ -121,7 +114,7 @@ TEST(KMeans, ConvergedResultIsALloydFixedPoint) {
   for (int trial = 0; trial < 50; ++trial) {
     std::vector<DirectionSample> s(250);
     for (auto& d : s) {
-      d.direction = randomUnit(rng);
+      d.direction = test::randomUnit(rng);
       d.value = Vec3(rng.uniform() + 0.1f);
     }
     ClusterResult r = cluster(s, 4, uint64_t(trial), params);
@@ -198,7 +191,7 @@ TEST(KMeans, ZeroWeightSamplesNeverSeedOrPull) {
   std::vector<DirectionSample> s;
   for (int i = 0; i < 20; ++i) s.push_back({lit, {1, 1, 1}});
   Rng rng(9, 0);
-  for (int i = 0; i < 20; ++i) s.push_back({randomUnit(rng), {0, 0, 0}});
+  for (int i = 0; i < 20; ++i) s.push_back({test::randomUnit(rng), {0, 0, 0}});
   for (uint64_t stream = 0; stream < 10; ++stream) {
     ClusterResult r = cluster(s, 4, stream);
     ASSERT_EQ(r.count, 1);
@@ -254,14 +247,14 @@ TEST(KMeans, AutoCountPicksFewestAcceptable) {
   // Uniform directions never reach a tiny threshold: the cap is used.
   params.autoThreshold = 1e-4f;
   std::vector<DirectionSample> uniform;
-  for (int i = 0; i < 300; ++i) uniform.push_back({randomUnit(rng), {1, 1, 1}});
+  for (int i = 0; i < 300; ++i) uniform.push_back({test::randomUnit(rng), {1, 1, 1}});
   EXPECT_EQ(cluster(uniform, 5, 0, params).count, 5);
 }
 
 TEST(KMeans, DeterministicPerStream) {
   Rng rng(13, 0);
   std::vector<DirectionSample> s;
-  for (int i = 0; i < 300; ++i) s.push_back({randomUnit(rng), {rng.uniform(), 0.5f, 0.2f}});
+  for (int i = 0; i < 300; ++i) s.push_back({test::randomUnit(rng), {rng.uniform(), 0.5f, 0.2f}});
   auto same = [](const ClusterResult& a, const ClusterResult& b) {
     if (a.count != b.count || a.angularError != b.angularError) return false;
     for (int i = 0; i < kMaxVdls; ++i) {

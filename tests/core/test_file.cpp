@@ -22,11 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string readAll(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-
 TEST(OutputFiles, TemporaryNamesAreFreshHiddenAndBesideTheTarget) {
   const std::string dir = test::outputDir("OutputFiles.Names");
   std::set<std::string> names;
@@ -45,12 +40,12 @@ TEST(OutputFiles, ReplacesARegularFileAndLeavesNothingBehind) {
   const std::string path = dir + "/a.txt";
   writeTextAtomically(path, "old");
   writeTextAtomically(path, "new");
-  EXPECT_EQ(readAll(path), "new");
+  EXPECT_EQ(readFile(path), "new");
   EXPECT_TRUE(leftoverTemporaries(path).empty());
   // A failing writer: the target keeps its old bytes, no temporary remains.
   EXPECT_THROW(writeAtomically(path, [](const std::string&) { throw std::runtime_error("boom"); }),
                IoError);
-  EXPECT_EQ(readAll(path), "new");
+  EXPECT_EQ(readFile(path), "new");
   EXPECT_TRUE(leftoverTemporaries(path).empty());
 }
 
@@ -66,7 +61,7 @@ TEST(OutputFiles, NeverWritesThroughALinkOrOverWhatIsNotARegularFile) {
   } catch (const IoError& e) {
     EXPECT_NE(std::string(e.what()).find("symbolic link"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(readAll(victim), "precious");
+  EXPECT_EQ(readFile(victim), "precious");
   EXPECT_TRUE(fs::is_symlink(link));
   EXPECT_THROW(checkOutputFolder(link, "--output"), InputError);
   const std::string folder = dir + "/a-folder";
@@ -118,7 +113,7 @@ TEST(OutputFiles, SigintRemovesTheTemporaryFile) {
   int status = 0;
   ASSERT_EQ(waitpid(child, &status, 0), child);
   EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
-  EXPECT_EQ(readAll(path), "before");
+  EXPECT_EQ(readFile(path), "before");
   EXPECT_TRUE(leftoverTemporaries(path).empty());
 }
 

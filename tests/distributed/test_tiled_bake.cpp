@@ -20,15 +20,11 @@
 #include "distributed/vdl_grid_parts.h"
 #include "scene/scene.h"
 #include "test_util.h"
+#include "core/file.h"
 #include "vdb/vdb_io.h"
 
 namespace lo {
 namespace {
-
-std::string fileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 /// The first voxel where two grids differ, or "" when they are equal value
 /// for value (every array, the layers included).
@@ -86,13 +82,13 @@ void expectSameAsOneProcess(const Scene& scene, const BakeParams& params, int ti
   ASSERT_GT(single.grid.size(), 100u);
   const std::string dir = test::outputDir(name);
   writeVdlGrid(dir + "/single.vdb", single.grid, single.metadata);
-  const std::string expected = fileBytes(dir + "/single.vdb");
+  const std::string expected = readFile(dir + "/single.vdb");
   for (int ranks = 1; ranks <= 4; ++ranks) {
     const RankRun run = bakeOnThreadRanks(scene, params, ranks, tiles);
     EXPECT_EQ(firstDifference(single.grid, run.result.grid), "") << ranks << " ranks";
     const std::string path = dir + "/ranks" + std::to_string(ranks) + ".vdb";
     writeVdlGrid(path, run.result.grid, run.result.metadata);
-    EXPECT_TRUE(fileBytes(path) == expected) << ranks << " ranks: " << path << " differs";
+    EXPECT_TRUE(readFile(path) == expected) << ranks << " ranks: " << path << " differs";
     EXPECT_EQ(run.result.stats.storedPhotons, single.stats.storedPhotons);
     EXPECT_EQ(run.result.stats.emittedPaths, single.stats.emittedPaths);
     EXPECT_EQ(run.result.stats.emptyPaths, single.stats.emptyPaths);

@@ -23,13 +23,8 @@ namespace {
 // standing on the floor (outward faces, no bottom face), placed off the voxel
 // grid's planes.
 Scene cornellLikeBox() {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addClosedBox(scene, {0, 0, 0}, {1, 1, 1}, 0);
-  auto addBlock = [&](Vec3 lo, Vec3 hi) { test::addBlock(scene, lo, hi, 0); };
-  addBlock({0.13f, 0.0f, 0.097f}, {0.43f, 0.3f, 0.41f});
-  addBlock({0.551f, 0.0f, 0.523f}, {0.847f, 0.61f, 0.83f});
-  return scene;
+  return test::boxWithTwoBlocks({{0.13f, 0.0f, 0.097f}, {0.43f, 0.3f, 0.41f}},
+                                {{0.551f, 0.0f, 0.523f}, {0.847f, 0.61f, 0.83f}});
 }
 
 // `count` photons spread uniformly (by area) over the scene's triangles, each

@@ -175,13 +175,9 @@ TEST(GridFrame, MakeGridFrame) {
 // Scenes
 
 Scene cornellLikeBox(float scale = 1.0f, Vec3 offset = {}) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addClosedBox(scene, {0, 0, 0}, {1, 1, 1}, 0);
-  auto addBlock = [&](Vec3 lo, Vec3 hi) { test::addBlock(scene, lo, hi, 0); };
   // Multiples of 1/64: exact in float even 1e5 away from the origin.
-  addBlock({9 / 64.0f, 0, 7 / 64.0f}, {27 / 64.0f, 19 / 64.0f, 25 / 64.0f});
-  addBlock({37 / 64.0f, 0, 34 / 64.0f}, {53 / 64.0f, 39 / 64.0f, 52 / 64.0f});
+  Scene scene = test::boxWithTwoBlocks({{9 / 64.0f, 0, 7 / 64.0f}, {27 / 64.0f, 19 / 64.0f, 25 / 64.0f}},
+                                       {{37 / 64.0f, 0, 34 / 64.0f}, {53 / 64.0f, 39 / 64.0f, 52 / 64.0f}});
   for (Vec3& p : scene.positions) p = p * scale + offset;
   return scene;
 }

@@ -60,13 +60,6 @@ Vec3 decode(float packed) {
   return {loUnpackDirectionX(packed), loUnpackDirectionY(packed), loUnpackDirectionZ(packed)};
 }
 
-Vec3 randomUnit(Rng& rng) {
-  const float z = 2.0f * rng.uniform() - 1.0f;
-  const float phi = 2.0f * kPi * rng.uniform();
-  const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-  return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
 // Directions where the packing has edge cases: the poles (phi undefined), phi
 // just above 0 and just below 2pi (rounds to phiQ 256 -> wraps to 0), and the
 // theta rounding boundary next to the pole.
@@ -113,7 +106,7 @@ TEST(OctreeLayout, RandomDirectionsRoundTripWithinTheBound) {
   Rng rng(7, 0);
   double worstRatio = 0, worstAngle = 0;
   std::vector<Vec3> dirs = specialDirections();
-  for (int i = 0; i < 200000; ++i) dirs.push_back(randomUnit(rng));
+  for (int i = 0; i < 200000; ++i) dirs.push_back(test::randomUnit(rng));
   for (const Vec3& d : dirs) {
     const float packed = loPackDirection(d.x, d.y, d.z);
     ASSERT_EQ(packed, std::floor(packed));
@@ -259,7 +252,7 @@ VdlGrid randomGrid(int depth, size_t voxels, uint64_t seed, int maxVdls = kMaxVd
         const auto level = [&rng] { return std::pow(10.0f, 6.0f * rng.uniform() - 3.0f); };
         vdl.irradiance = {level(), level(), level()};
         vdl.direction =
-            rng.uniform() < 0.1f ? special[specialNext++ % special.size()] : randomUnit(rng);
+            rng.uniform() < 0.1f ? special[specialNext++ % special.size()] : test::randomUnit(rng);
       }
       g.vdls.push_back(vdl);
     }

@@ -206,12 +206,6 @@ TEST(OctreeIrradiance, FirstHitImageOfALitPlaneIsTheAnalyticValueAtEveryPixel) {
 // octreeIrradianceSample is a C++ twin of the shader's loOctreeIndirect that
 // also sums the VDL directions: its E must be octreeIrradiance's, and its
 // direction sum the luminance-weighted one of the VDLs the lookup reads.
-Vec3 randomUnit(Rng& rng) {
-  const float z = 2 * rng.uniform() - 1, phi = 2 * kPi * rng.uniform();
-  const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-  return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
 TEST(OctreeIrradiance, SampleGivesTheLookupsIrradianceAndItsDirection) {
   // A slab of random VDLs, a few voxels empty (so interpolation renormalizes
   // and the nearest-leaf fallback runs).
@@ -222,7 +216,7 @@ TEST(OctreeIrradiance, SampleGivesTheLookupsIrradianceAndItsDirection) {
     g.vdlCount[v] = uint8_t(count);
     for (int i = 0; i < count; ++i)
       g.vdls[v * kMaxVdls + size_t(i)] =
-          vdl(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 3.0f, randomUnit(rng));
+          vdl(Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 3.0f, test::randomUnit(rng));
   }
   GpuOctreeParams half = test::paperCosine();
   half.halfFloat = true;
@@ -233,7 +227,7 @@ TEST(OctreeIrradiance, SampleGivesTheLookupsIrradianceAndItsDirection) {
       p.maxVdls = 1 + trial % 4;
       const Vec3 q{0.2f + 7.6f * rng.uniform(), 0.2f + 7.6f * rng.uniform(),
                    0.05f + 2.9f * rng.uniform()};
-      const Vec3 pos = q * kVoxel, n = randomUnit(rng);
+      const Vec3 pos = q * kVoxel, n = test::randomUnit(rng);
       const OctreeIrradianceSample s = octreeIrradianceSample(o, pos, n, p);
       const Vec3 e = octreeIrradiance(o, pos, n, p);
       for (int c = 0; c < 3; ++c) ASSERT_NEAR(s.irradiance[c], e[c], 1e-6f * (1 + e[c])) << trial;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "test_util.h"
+#include "core/file.h"
 #include "core/error.h"
 #include "scene/scene.h"
 
@@ -26,11 +27,6 @@ void writeFile(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
   out.write(bytes.data(), std::streamsize(bytes.size()));
   ASSERT_TRUE(out.good()) << path;
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 std::string base64(const std::string& in) {

@@ -18,16 +18,12 @@
 #include "core/rng.h"
 #include "scene/scene.h"
 #include "test_util.h"
+#include "core/file.h"
 #include "vdb/vdb_inspect.h"
 #include "vdb/vdb_io.h"
 
 namespace lo {
 namespace {
-
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), {});
-}
 
 void writeBytes(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -93,7 +89,7 @@ void expectLoadsOrRefuses(const std::string& path, Load load, Tally& tally, cons
 
 TEST(Fuzz, DamagedVdbFilesAreReadOrRefusedCleanly) {
   const std::string dir = test::outputDir("Fuzz.Vdb");
-  const std::string original = readBytes(test::dataDir() + "/../tests/golden/cornell-box-d4.vdb");
+  const std::string original = readFile(test::dataDir() + "/../tests/golden/cornell-box-d4.vdb");
   ASSERT_GT(original.size(), 1000u);
   Rng rng(2026, 12);
   Tally reader, inspector;
@@ -117,7 +113,7 @@ TEST(Fuzz, DamagedVdbFilesAreReadOrRefusedCleanly) {
 
 TEST(Fuzz, DamagedGltfScenesAreLoadedOrRefusedCleanly) {
   const std::string dir = test::outputDir("Fuzz.Gltf");
-  const std::string original = readBytes(test::dataDir() + "/cornell-box.gltf");
+  const std::string original = readFile(test::dataDir() + "/cornell-box.gltf");
   ASSERT_GT(original.size(), 1000u);
   Rng rng(2026, 13);
   Tally tally;

@@ -337,17 +337,6 @@ TEST(PhotonPoints, ReadBackEqualsWritten) {
   EXPECT_EQ(inspectVdb(dir + "/p.vdb").kind, "photons");
 }
 
-std::string runCommand(const std::string& cmd) {
-  std::string out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return out;
-  char buffer[4096];
-  size_t got;
-  while ((got = fread(buffer, 1, sizeof(buffer), pipe)) > 0) out.append(buffer, got);
-  pclose(pipe);
-  return out;
-}
-
 TEST(Convert, VdbPrintListsTheGridsOfAConvertedFile) {
   const char* vdbPrint = "/usr/bin/vdb_print";
   if (!fs::exists(vdbPrint)) GTEST_SKIP() << vdbPrint << " not installed";
@@ -361,7 +350,7 @@ TEST(Convert, VdbPrintListsTheGridsOfAConvertedFile) {
   BakeMetadata m = meta();
   m.depth = coarse.frame.depth;
   writeVdlGrid(dir + "/c.vdb", coarse, m, opt);
-  std::string out = runCommand(std::string(vdbPrint) + " -l -m " + dir + "/c.vdb 2>&1");
+  std::string out = test::runCommand(std::string(vdbPrint) + " -l -m " + dir + "/c.vdb 2>&1");
   for (const char* name : {"irradiance", "normal", "photon_count", "vdl_count", "radius", "area",
                            "vdl0_irradiance", "vdl0_direction", "vdl1_direction"}) {
     EXPECT_NE(out.find("\nName: " + std::string(name) + "\n"), std::string::npos) << name << "\n"

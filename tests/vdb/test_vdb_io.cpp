@@ -85,11 +85,6 @@ BakeMetadata makeMeta() {
   return m;
 }
 
-std::string readBytes(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-
 void writeBytes(const std::string& path, const std::string& bytes) {
   std::ofstream f(path, std::ios::binary);
   f.write(bytes.data(), std::streamsize(bytes.size()));
@@ -174,24 +169,13 @@ TEST(VdbIo, SameInputGivesSameBytes) {
   VdlGrid g = makeGrid(200, 4, 3);
   writeVdlGrid(dir + "/a.vdb", g, makeMeta());
   writeVdlGrid(dir + "/b.vdb", g, makeMeta());
-  std::string a = readBytes(dir + "/a.vdb");
+  std::string a = readFile(dir + "/a.vdb");
   EXPECT_GT(a.size(), 1000u);
-  EXPECT_TRUE(a == readBytes(dir + "/b.vdb"));
+  EXPECT_TRUE(a == readFile(dir + "/b.vdb"));
   // A different grid gets a different (content-derived) file UUID.
   g.irradiance[0].x += 1.0f;
   writeVdlGrid(dir + "/c.vdb", g, makeMeta());
-  EXPECT_NE(a.substr(21, 36), readBytes(dir + "/c.vdb").substr(21, 36));
-}
-
-std::string runCommand(const std::string& command) {
-  std::string out;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return out;
-  char buffer[4096];
-  size_t got;
-  while ((got = fread(buffer, 1, sizeof(buffer), pipe)) > 0) out.append(buffer, got);
-  pclose(pipe);
-  return out;
+  EXPECT_NE(a.substr(21, 36), readFile(dir + "/c.vdb").substr(21, 36));
 }
 
 TEST(VdbIo, VdbPrintListsTheContractGrids) {
@@ -200,7 +184,7 @@ TEST(VdbIo, VdbPrintListsTheContractGrids) {
   std::string dir = test::outputDir("VdbIo.VdbPrint");
   VdlGrid g = makeGrid(100, 2, 5);
   writeVdlGrid(dir + "/g.vdb", g, makeMeta());
-  std::string out = runCommand(std::string(vdbPrint) + " -m " + dir + "/g.vdb 2>&1");
+  std::string out = test::runCommand(std::string(vdbPrint) + " -m " + dir + "/g.vdb 2>&1");
   for (const char* name :
        {"irradiance", "normal", "photon_count", "angular_error", "vdl_count", "radius", "area",
         "vdl0_irradiance", "vdl0_direction", "vdl1_irradiance", "vdl1_direction"}) {
@@ -214,7 +198,7 @@ TEST(VdbIo, VdbPrintListsTheContractGrids) {
   std::vector<Photon> photons(50);
   for (size_t i = 0; i < photons.size(); ++i) photons[i].position = Vec3(float(i) * 0.01f);
   writePhotonPoints(dir + "/p.vdb", photons, 0.1f);
-  out = runCommand(std::string(vdbPrint) + " " + dir + "/p.vdb 2>&1");
+  out = test::runCommand(std::string(vdbPrint) + " " + dir + "/p.vdb 2>&1");
   EXPECT_EQ(out.rfind("photons ", 0), 0u) << out;
 }
 
@@ -251,7 +235,7 @@ TEST(VdbIo, DamagedFilesAreInputErrorsNotCrashes) {
   std::string dir = test::outputDir("VdbIo.Damaged");
   VdlGrid g = makeGrid(200, 2, 9);
   writeVdlGrid(dir + "/good.vdb", g, makeMeta());
-  const std::string bytes = readBytes(dir + "/good.vdb");
+  const std::string bytes = readFile(dir + "/good.vdb");
   ASSERT_GT(bytes.size(), 200u);
   // Truncated at the header, in the metadata, in the grid descriptors, in the
   // middle of the data and just before the end.
@@ -352,7 +336,7 @@ TEST(VdbIo, PhotonPointsAreDeterministicAndMayBeEmpty) {
     tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
     writePhotonPoints(dir + "/b.vdb", photons, 0.05f);
   }
-  EXPECT_TRUE(readBytes(dir + "/a.vdb") == readBytes(dir + "/b.vdb"));
+  EXPECT_TRUE(readFile(dir + "/a.vdb") == readFile(dir + "/b.vdb"));
 
   writePhotonPoints(dir + "/empty.vdb", {}, 0.05f);
   vdb_internal::PointFileInfo info = vdb_internal::inspectPointFile(dir + "/empty.vdb");
