@@ -158,10 +158,17 @@ inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, 
       if (maxComponent(f) > 0) {
         float pdfLight = ctx.emitterPickPdf[tri] * dist2 / cosLight;  // solid angle
         float w = misWeights ? powerHeuristic(pdfLight, pdfBsdf(lobes, wo, wi, n)) : 1.0f;
-        Vec3 org = offsetOrigin(ctx, p, normal, wi);
+        // Both ends lifted off their surfaces, the far one towards p's side
+        // of the emitter: the segment never reaches the emitter's plane, at
+        // any angle (stopping short along the ray instead does not clear
+        // the plane when the ray meets it at a grazing angle).
+        const Vec3 org = offsetOrigin(ctx, p, normal, wi);
+        const Vec3 target = offsetOrigin(ctx, q, lightNormal, -wi);
+        const Vec3 seg = target - org;
+        const float segLength = length(seg);
         ++rays;
-        // Stop short of the emitter by twice the offset so it does not occlude itself.
-        if (!ctx.tracer->occluded(org, wi, std::max(0.0f, dist - 2.0f * ctx.epsilon)))
+        if (segLength > 0 && dot(seg, wi) > 0 &&
+            !ctx.tracer->occluded(org, seg / segLength, segLength * (1.0f - 1e-4f)))
           sum += f * le * (w / pdfLight);
       }
     }

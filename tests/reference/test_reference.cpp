@@ -9,9 +9,11 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <vector>
 
 #include "core/error.h"
 #include "image/image.h"
@@ -310,6 +312,45 @@ TEST(DirectIrradiance, SquareEmitterAndPointLightAnalytic) {
   addQuad(lit, {0.2f, 1.0f, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, {0, -1, 0}, 0);
   DirectIrradiance blocked(lit);
   EXPECT_EQ(blocked.at(q, 0, n, 1, 1, 0).x, 0.0f);
+}
+
+// Irradiance at the origin (normal n) from a uniform Lambertian polygon of
+// radiance L whose corners are given relative to it: Lambert's contour
+// integral E = L/2 |sum_i angle(v_i, v_i+1) n . unit(v_i x v_i+1)|.
+double polygonIrradiance(double radiance, const std::vector<Vec3>& corners, const Vec3& n) {
+  double sum = 0;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    const Vec3 a = normalize(corners[i]), b = normalize(corners[(i + 1) % corners.size()]);
+    const Vec3 c = cross(a, b);
+    const double len = length(c);
+    const double angle = std::acos(std::clamp(double(dot(a, b)), -1.0, 1.0));
+    if (len > 0) sum += angle * double(dot(n, c)) / len;
+  }
+  return 0.5 * radiance * std::fabs(sum);
+}
+
+// A small down-facing emitter over a floor lights it at every angle: points
+// from under it to 80 degrees off its normal get Lambert's exact irradiance
+// (the emitter's own plane must not shadow its light at grazing angles).
+TEST(DirectIrradiance, EmitterLightsAPlaneAtEveryAngle) {
+  Scene scene = floorScene();
+  const int emitter = addMaterial(scene, Vec3(0.0f), Vec3(5.0f));
+  const float h = 0.5f, side = 0.2f;
+  const Vec3 corner{-0.1f, h, -0.1f};
+  addQuad(scene, corner, {side, 0, 0}, {0, 0, side}, {0, -1, 0}, emitter);
+  DirectIrradiance direct(scene);
+  const Vec3 n{0, 1, 0};
+  for (float x : {0.0f, 0.3f, 0.6f, 1.0f, 1.5f, 2.8f}) {
+    const Vec3 p{x, 0, 0.013f};
+    const std::vector<Vec3> corners = {corner - p, corner + Vec3{side, 0, 0} - p,
+                                       corner + Vec3{side, 0, side} - p,
+                                       corner + Vec3{0, 0, side} - p};
+    const double expected = polygonIrradiance(5.0, corners, n);
+    const Vec3 e = direct.at(p, 0, n, 20000, 1, uint64_t(x * 100));
+    // 20,000 area samples of a nearly uniform integrand: well under 2%.
+    EXPECT_NEAR(e.x, expected, 0.02 * expected)
+        << "x " << x << " (" << std::atan2(x, h) * 180 / kPi << " degrees off the emitter's normal)";
+  }
 }
 
 }  // namespace
