@@ -256,6 +256,17 @@ std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
          "): bake the part that matters with --bounds";
 }
 
+void checkPhotonsStored(const BakeParams& params, const BakeStats& st) {
+  if (st.storedPhotons > 0) return;
+  throw InputError(
+      "no photon was stored: " + formatCount(st.emittedPaths) + " photon paths were traced and " +
+      "none left light on a surface after a bounce" +
+      (params.region.empty() ? std::string() : std::string(" inside --bounds")) +
+      " (the light's first hit is direct light, which the renderer draws and the bake stores "
+      "only with --include-direct): check that the lights reach the geometry" +
+      (params.region.empty() ? std::string() : std::string(" and that --bounds holds lit surfaces")));
+}
+
 BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, int processes) {
   // The scene's own region of interest (a glTF marker node) when none is given.
   BakeParams params = requested;
@@ -321,6 +332,7 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
   s.storedPhotons = photons.photons.size();
   s.emittedPaths = photons.emittedPaths;
   s.emptyPaths = photons.emptyPaths;
+  checkPhotonsStored(params, s);
   s.traceSeconds = trace.finish(formatCount(photons.photons.size()) + " photons from " +
                                 formatCount(photons.emittedPaths) + " paths");
 

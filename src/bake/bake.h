@@ -189,6 +189,10 @@ struct BakeResult {
 /// nearly all of them).
 std::string photonBudgetWarning(const BakeParams& params, const BakeStats& stats);
 
+/// @throws InputError saying why, when the photon tracing stored no photon
+/// at all (a bake of nothing but zeros is never what was asked for).
+void checkPhotonsStored(const BakeParams& params, const BakeStats& stats);
+
 /// Active voxels a bake at `frame` will have, from the area of the scene's
 /// surfaces (inside `region` when it is set): area / h^2, what a surface
 /// lying along the grid crosses (1.04x that was measured on the Cornell box;

@@ -384,6 +384,7 @@ class RankBake {
     st_.storedPhotons = size_t(stored_);
     st_.emittedPaths = size_t(emitted_);
     st_.emptyPaths = size_t(empty_);
+    checkPhotonsStored(params_, st_);
     mine_.photonsHeld = held_.size();
     double all = 0, own = 0;
     for (size_t t = 0; t < plan_.owner.size(); ++t) {

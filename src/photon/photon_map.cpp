@@ -160,19 +160,35 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
     }
     case Emitter::Kind::Directional: {
       const Light& light = scene.lights[e.index];
-      // A disc of the covered bounding sphere's radius (the same disc
-      // Light::power uses), perpendicular to the light, placed outside the
-      // whole scene (occluders beyond a region of interest still cast).
-      float radius = 0.5f * length(ctx.emitBounds.extent());
-      const float away = length(ctx.emitBounds.center() - ctx.bounds.center()) +
-                         0.5f * length(ctx.bounds.extent());
-      Vec3 n = normalize(light.direction), t, b;
-      orthonormalBasis(n, t, b);
-      float r = radius * std::sqrt(rng.uniform());
-      float phi = 2.0f * kPi * rng.uniform();
-      out.origin = ctx.emitBounds.center() - n * (std::max(radius, away) + 4.0f * ctx.epsilon) +
-                   t * (r * std::cos(phi)) + b * (r * std::sin(phi));
-      out.direction = n;
+      // Aimed at the covered box's silhouette (what Light::power counts): a
+      // point on one of the box faces the light enters through, picked by
+      // its projected area, then moved back against the light to outside
+      // the whole scene (occluders beyond a region of interest still cast).
+      // No path is spent on the empty corners of a bounding disc.
+      const Vec3 d = normalize(light.direction);
+      const Bounds3& box = ctx.emitBounds;
+      const Vec3 ext = box.extent();
+      const float w[3] = {std::fabs(d.x) * ext.y * ext.z, std::fabs(d.y) * ext.x * ext.z,
+                          std::fabs(d.z) * ext.x * ext.y};
+      const float u0 = rng.uniform() * (w[0] + w[1] + w[2]);
+      const int axis = u0 < w[0] ? 0 : (u0 < w[0] + w[1] ? 1 : 2);
+      const float u1 = rng.uniform(), u2 = rng.uniform();
+      Vec3 q;
+      const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+      q[axis] = d[axis] > 0 ? box.lower[axis] : box.upper[axis];
+      q[a1] = box.lower[a1] + u1 * ext[a1];
+      q[a2] = box.lower[a2] + u2 * ext[a2];
+      // Where the ray q - s d leaves the scene's bounds (and the box): the
+      // nearest slab it crosses.
+      Bounds3 all = ctx.bounds;
+      all.extend(box);
+      float exit = std::numeric_limits<float>::infinity();
+      for (int i = 0; i < 3; ++i) {
+        if (d[i] > 0) exit = std::min(exit, (q[i] - all.lower[i]) / d[i]);
+        if (d[i] < 0) exit = std::min(exit, (q[i] - all.upper[i]) / d[i]);
+      }
+      out.origin = q - d * (std::max(0.0f, exit) + 4.0f * ctx.epsilon);
+      out.direction = d;
       return true;
     }
     case Emitter::Kind::Triangle: {

@@ -59,8 +59,12 @@ Vec3 Light::power(const Bounds3& sceneBounds) const {
       return radiant * solidAngle;
     }
     case Type::Directional: {
-      float r = 0.5f * length(sceneBounds.extent());
-      return radiant * (kPi * r * r);
+      // The flux through the box's silhouette seen from the light: the
+      // projected areas of the three faces the light enters through.
+      const Vec3 d = normalize(direction), e = sceneBounds.extent();
+      const float area = std::fabs(d.x) * e.y * e.z + std::fabs(d.y) * e.x * e.z +
+                         std::fabs(d.z) * e.x * e.y;
+      return radiant * area;
     }
   }
   return {};

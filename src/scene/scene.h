@@ -116,7 +116,8 @@ struct Light {
   float outerConeAngle = kPi / 4.0f;  ///< radians (spot)
 
   /// Total emitted power in W (RGB). Directional lights need the scene's
-  /// bounds: their power is the flux through the scene's bounding disc.
+  /// bounds: their power is the flux through the bounds' silhouette seen
+  /// from the light (the box's projection along the light's direction).
   Vec3 power(const Bounds3& sceneBounds) const;
   std::string ToString() const;
 };
