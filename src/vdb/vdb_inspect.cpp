@@ -1,6 +1,6 @@
 // `lightoctree inspect`: a generic report of an OpenVDB file and the checks of
-// the VDL contract. Own translation unit so that vdb_io.cpp and this file
-// compile in parallel; both include OpenVDB, nothing outside src/vdb does.
+// the VDL contract. Own translation unit so that it and the reader and writer
+// compile in parallel; they include OpenVDB, nothing outside src/vdb does.
 
 #include "vdb/vdb_inspect.h"
 
@@ -17,6 +17,7 @@
 
 #include "lightgrid/vdl_grid.h"
 #include "core/error.h"
+#include "vdb/vdb_contract.h"
 #include "vdb/vdb_file.h"
 #include "vdb/vdb_io.h"
 
@@ -152,8 +153,8 @@ class VdlChecker {
   int readShTerms() const {
     auto typed = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f_.meta)["representation"]);
     if (!typed) return (*f_.meta)["representation"] ? -1 : 0;
-    const std::string& r = typed->value();
-    return r == "vdl" ? 0 : r == "sh1" ? 4 : r == "sh2" ? 9 : -1;
+    LightRepresentation r = LightRepresentation::Vdl;
+    return parseRepresentation(typed->value(), &r) ? shTermsOf(r) : -1;
   }
 
   int readMaxVdls() const {
@@ -175,25 +176,27 @@ class VdlChecker {
                     ("grid '" + name + "' has type " + g->valueType() + ", expected " + valueType);
       }
     };
-    if (maxVdls < 1 || maxVdls > kMaxVdls) {
+    const bool maxVdlsValid = maxVdls >= 1 && maxVdls <= kMaxVdls;
+    if (!maxVdlsValid) {
       problems = "file metadata max_vdls is " +
                  (maxVdls < 0 ? std::string("missing or not int32") : std::to_string(maxVdls)) +
                  ", expected 1.." + std::to_string(kMaxVdls);
-    } else {
-      for (int i = 0; i < maxVdls; ++i) {
-        need("vdl" + std::to_string(i) + "_irradiance", "vec3s", true);
-        need("vdl" + std::to_string(i) + "_direction", "vec3s", true);
-      }
     }
-    need("irradiance", "vec3s", true);
-    need("normal", "vec3s", true);
-    need("vdl_count", "float", true);
     const int shTerms = readShTerms();
     if (shTerms < 0) {
       problems += std::string(problems.empty() ? "" : "; ") +
                   "file metadata representation is not 'vdl', 'sh1' or 'sh2'";
     }
-    for (int i = 0; i < shTerms; ++i) need("sh" + std::to_string(i), "vec3s", true);
+    // The voxels' required grids of the field table.
+    forEachField([&](const auto& row) {
+      using T = typename std::decay_t<decltype(row)>::Value;
+      if (row.optional || row.arity == FieldArity::OneOrNone) return;
+      const char* type = std::is_same_v<T, Vec3> || std::is_same_v<T, Vdl> ? "vec3s" : "float";
+      for (const vdb_internal::FieldGrid& grid :
+           vdb_internal::fieldGrids(row, 0, maxVdlsValid ? maxVdls : 0, std::max(shTerms, 0))) {
+        need(grid.name, type, true);
+      }
+    });
     std::string absent;
     for (const std::string& name : optionalVdlGridNames()) {
       need(name, "float", false);
