@@ -109,10 +109,19 @@ inline bool parseRepresentation(const std::string& text, LightRepresentation* ou
   }
   return false;
 }
-/// Every representation's name, for flag checks and messages: "vdl, sh1, sh2".
+/// Every representation's name, for flag checks and messages.
 inline std::vector<std::string> representationNames() {
   return {representationName(LightRepresentation::Vdl), representationName(LightRepresentation::Sh1),
           representationName(LightRepresentation::Sh2)};
+}
+/// The names as a message lists them: "vdl, sh1 or sh2".
+inline std::string representationChoices() {
+  const std::vector<std::string> names = representationNames();
+  std::string text;
+  for (size_t i = 0; i < names.size(); ++i) {
+    text += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  return text;
 }
 
 /// LightGridVoxels with up to `maxVdls` VDLs per voxel (paper §3.1.2); the

@@ -476,7 +476,7 @@ BakeParams bakeParamsOf(const SweepPoint& point, const Scene& scene, uint64_t se
   b.smoothing = point.smoothing;
   if (!parseRepresentation(point.representation, &b.representation)) {
     throw InputError("sweep point representation '" + point.representation +
-                     "': expected vdl, sh1 or sh2");
+                     "': expected " + representationChoices());
   }
   // 0 lets the gather apply its own default (kDefaultRadiusVoxels voxels).
   if (point.radiusVoxels != kDefaultRadiusVoxels) {

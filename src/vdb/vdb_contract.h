@@ -83,6 +83,13 @@ std::string layerGridNameOf(std::vector<T> C::*member, int layer) {
 /// The grid whose active voxels are the file's voxels.
 inline const char* keyGridName() { return gridNameOf(&VdlGrid::vdlCount); }
 
+/// File metadata keys read or written in more than one place (the others
+/// are written and read side by side: vdb_file.cpp).
+inline constexpr const char* kMetaDepth = "depth";
+inline constexpr const char* kMetaMaxVdls = "max_vdls";
+inline constexpr const char* kMetaFormatVersion = "format_version";
+inline constexpr const char* kMetaRepresentation = "representation";
+
 /// Whether `name` is a grid of the voxels (not a layer's) a file must hold
 /// for some max_vdls and representation.
 bool isRequiredVoxelGrid(const std::string& name);

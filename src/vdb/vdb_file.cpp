@@ -169,7 +169,7 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   m.insertMeta("version", openvdb::StringMetadata(meta.version));
   m.insertMeta("source_scene", openvdb::StringMetadata(meta.sourceScene));
   // The grid's own frame is the truth for depth; see the check in writeVdlGrid.
-  m.insertMeta("depth", openvdb::Int32Metadata(grid.frame.depth));
+  m.insertMeta(kMetaDepth, openvdb::Int32Metadata(grid.frame.depth));
   m.insertMeta("photons", openvdb::Int64Metadata(meta.photons));
   m.insertMeta("emitted_paths", openvdb::Int64Metadata(meta.emittedPaths));
   m.insertMeta("knn", openvdb::Int32Metadata(meta.knn));
@@ -179,12 +179,12 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   m.insertMeta("scene_bounds_min", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.lower)));
   m.insertMeta("scene_bounds_max", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.upper)));
   m.insertMeta("units", openvdb::StringMetadata(meta.units));
-  m.insertMeta("max_vdls", openvdb::Int32Metadata(grid.maxVdls));
+  m.insertMeta(kMetaMaxVdls, openvdb::Int32Metadata(grid.maxVdls));
   // The lowest version that holds the file (lightgrid/vdl_grid.h).
-  m.insertMeta("format_version", openvdb::Int32Metadata(grid.shTerms > 0 ? kVdlFormatVersion
+  m.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(grid.shTerms > 0 ? kVdlFormatVersion
                                                                           : kVdlFormatVersionVdl));
   if (grid.shTerms > 0) {
-    m.insertMeta("representation",
+    m.insertMeta(kMetaRepresentation,
                  openvdb::StringMetadata(representationName(grid.representation())));
   }
   if (!meta.convertedFrom.empty()) {
@@ -248,21 +248,21 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.generator = metaValue<std::string>(path, m, "generator", false, "");
   meta.version = metaValue<std::string>(path, m, "version", false, "");
   meta.sourceScene = metaValue<std::string>(path, m, "source_scene", false, "");
-  meta.depth = metaValue<int32_t>(path, m, "depth", true, 0);
+  meta.depth = metaValue<int32_t>(path, m, kMetaDepth, true, 0);
   meta.photons = metaValue<int64_t>(path, m, "photons", false, 0);
   meta.emittedPaths = metaValue<int64_t>(path, m, "emitted_paths", false, 0);
   meta.knn = metaValue<int32_t>(path, m, "knn", false, 0);
   meta.radius = metaValue<float>(path, m, "radius", false, 0.0f);
   meta.vdls = metaValue<std::string>(path, m, "vdls", false, "");
   meta.representation = metaValue<std::string>(
-      path, m, "representation", false, representationName(LightRepresentation::Vdl));
+      path, m, kMetaRepresentation, false, representationName(LightRepresentation::Vdl));
   meta.seed = metaValue<int64_t>(path, m, "seed", false, 0);
   meta.sceneBounds.lower = fromVdb(
       metaValue<openvdb::Vec3s>(path, m, "scene_bounds_min", false, openvdb::Vec3s(INFINITY)));
   meta.sceneBounds.upper = fromVdb(
       metaValue<openvdb::Vec3s>(path, m, "scene_bounds_max", false, openvdb::Vec3s(-INFINITY)));
   meta.units = metaValue<std::string>(path, m, "units", false, "");
-  meta.formatVersion = metaValue<int32_t>(path, m, "format_version", false, 0);
+  meta.formatVersion = metaValue<int32_t>(path, m, kMetaFormatVersion, false, 0);
   meta.convertedFrom = metaValue<std::string>(path, m, "converted_from", false, "");
   meta.surfaceLayers = metaValue<int32_t>(path, m, "surface_layers", false, -1);
   meta.gatherOcclusion = metaValue<int32_t>(path, m, "gather_occlusion", false, -1);

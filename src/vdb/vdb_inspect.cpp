@@ -149,16 +149,18 @@ class VdlChecker {
   }
 
   /// SH terms per voxel from the metadata `representation`: 0 for VDLs (and
-  /// files without the key), 4 for sh1, 9 for sh2, -1 for anything else.
+  /// files without the key), shTermsOf the representation it names, -1 for
+  /// anything else.
   int readShTerms() const {
-    auto typed = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f_.meta)["representation"]);
-    if (!typed) return (*f_.meta)["representation"] ? -1 : 0;
+    const openvdb::Metadata::ConstPtr m = (*f_.meta)[vdb_internal::kMetaRepresentation];
+    auto typed = openvdb::DynamicPtrCast<const openvdb::StringMetadata>(m);
+    if (!typed) return m ? -1 : 0;
     LightRepresentation r = LightRepresentation::Vdl;
     return parseRepresentation(typed->value(), &r) ? shTermsOf(r) : -1;
   }
 
   int readMaxVdls() const {
-    auto m = (*f_.meta)["max_vdls"];
+    auto m = (*f_.meta)[vdb_internal::kMetaMaxVdls];
     auto typed = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m);
     return typed ? typed->value() : -1;
   }
@@ -185,7 +187,7 @@ class VdlChecker {
     const int shTerms = readShTerms();
     if (shTerms < 0) {
       problems += std::string(problems.empty() ? "" : "; ") +
-                  "file metadata representation is not 'vdl', 'sh1' or 'sh2'";
+                  "file metadata representation is not " + representationChoices();
     }
     // The voxels' required grids of the field table.
     forEachField([&](const auto& row) {
@@ -211,7 +213,7 @@ class VdlChecker {
   }
 
   void checkFormatVersion() {
-    auto m = (*f_.meta)["format_version"];
+    auto m = (*f_.meta)[vdb_internal::kMetaFormatVersion];
     if (!m) {
       add("format_version", true, "absent: a file written before format_version 1 (read as 1)");
       return;
@@ -257,7 +259,7 @@ class VdlChecker {
   /// Which active set a grid shares: the voxels' (0), or surface layer l's
   /// (layer_point goes with layer 1: the voxels that have layers).
   static int layerGroup(const std::string& name) {
-    if (name == "layer_point") return 1;
+    if (name == vdb_internal::gridNameOf(&VdlGrid::points)) return 1;
     if (name.rfind("layer", 0) == 0 && name.size() > 6 && name[6] == '_' && name[5] >= '1' &&
         name[5] <= '9') {
       return name[5] - '0';
@@ -270,7 +272,7 @@ class VdlChecker {
   /// depth metadata within [1, kMaxGridDepth], a transform of uniform scale
   /// and translation only, and every voxel within [0, 2^depth) on each axis.
   void checkDepthAndBounds() {
-    auto m = (*f_.meta)["depth"];
+    auto m = (*f_.meta)[vdb_internal::kMetaDepth];
     int depth = -1;
     if (auto i32 = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m)) depth = i32->value();
     if (auto i64 = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(m)) {
@@ -393,7 +395,7 @@ VdbReport inspectVdb(const std::string& path) {
   bool hasIrradiance = false, hasPhotons = false;
   for (const auto& g : *f.grids) {
     if (!g) continue;
-    hasIrradiance = hasIrradiance || g->getName() == "irradiance";
+    hasIrradiance = hasIrradiance || g->getName() == vdb_internal::gridNameOf(&VdlGrid::irradiance);
     hasPhotons =
         hasPhotons || (g->getName() == "photons" && g->isType<openvdb::points::PointDataGrid>());
   }

@@ -215,7 +215,7 @@ LoadedVdl readVdlStructure(const std::string& path) {
         std::to_string(kVdlFormatVersion) +
         (out.meta.formatVersion > kVdlFormatVersion ? "; use a newer lightoctree" : ""));
   }
-  const int maxVdls = metaInt(path, *f.meta, "max_vdls", true, 0);
+  const int maxVdls = metaInt(path, *f.meta, kMetaMaxVdls, true, 0);
   if (maxVdls < 1 || maxVdls > kMaxVdls) {
     throw InputError(path + ": file metadata max_vdls = " + std::to_string(maxVdls) +
                      " is outside [1, " + std::to_string(kMaxVdls) + "]");
@@ -225,7 +225,7 @@ LoadedVdl readVdlStructure(const std::string& path) {
   LightRepresentation parsed = LightRepresentation::Vdl;
   if (!parseRepresentation(representation, &parsed)) {
     throw InputError(path + ": file metadata representation = '" + representation +
-                     "'; expected vdl, sh1 or sh2");
+                     "'; expected " + representationChoices());
   }
   const int shTerms = shTermsOf(parsed);
   if (shTerms > 0 && out.meta.formatVersion < 3) {

@@ -217,9 +217,9 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
   }
   openvdb::MetaMap fileMeta = fileMetadata(meta, grid);
   if (damage && damage->formatVersion != kVdlFormatVersion) {
-    fileMeta.removeMeta("format_version");
+    fileMeta.removeMeta(kMetaFormatVersion);
     if (damage->formatVersion != 0) {
-      fileMeta.insertMeta("format_version", openvdb::Int32Metadata(damage->formatVersion));
+      fileMeta.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(damage->formatVersion));
     }
   }
   writeVdbFile(path, sources, fileMeta);
