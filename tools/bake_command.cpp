@@ -121,9 +121,7 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   params.smoothing = opt.smoothing == "on";
   params.autoCap = opt.autoCap;
   params.autoThreshold = opt.autoThreshold;
-  params.representation = opt.representation == "sh1"   ? LightRepresentation::Sh1
-                          : opt.representation == "sh2" ? LightRepresentation::Sh2
-                                                        : LightRepresentation::Vdl;
+  parseRepresentation(opt.representation, &params.representation);  // checked by the flag
   if (!opt.bounds.empty()) {
     params.region.extend(Vec3{float(opt.bounds[0]), float(opt.bounds[1]), float(opt.bounds[2])});
     params.region.extend(Vec3{float(opt.bounds[3]), float(opt.bounds[4]), float(opt.bounds[5])});
@@ -285,7 +283,7 @@ std::function<int()> addBakeCommand(CLI::App& app) {
                   "How each voxel stores its light: 'vdl' (virtual directional lights, the "
                   "paper's), or the irradiance as spherical harmonics of order 1 ('sh1', 4 terms) "
                   "or 2 ('sh2', 9 terms); docs/accuracy.md compares them")
-      ->check(CLI::IsMember({"vdl", "sh1", "sh2"}))
+      ->check(CLI::IsMember(representationNames()))
       ->capture_default_str();
   cmd->add_option("--auto-cap", opt->autoCap, "With --vdls auto: at most this many VDLs per voxel")
       ->check(CLI::Range(1, kMaxVdls))

@@ -21,7 +21,7 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
   checkDepth(depth);
   if (in.shTerms > 0) {
     throw InputError(std::string("convert works on VDL files; this one holds ") +
-                     (in.shTerms == 4 ? "sh1" : "sh2") +
+                     representationName(in.representation()) +
                      " spherical harmonics (bake --representation): bake it again with the "
                      "settings wanted");
   }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "lightgrid/light_grid_schema.h"
 
 namespace lo {
 namespace resample_internal {
@@ -43,14 +44,7 @@ VdlGrid emptyLike(const GridFrame& frame, int maxVdls, size_t n) {
   out.frame = frame;
   out.maxVdls = maxVdls;
   out.coords.resize(n);
-  out.normals.assign(n, Vec3{});
-  out.areas.assign(n, 0.0f);
-  out.irradiance.assign(n, Vec3{});
-  out.photonCount.assign(n, 0.0f);
-  out.radius.assign(n, 0.0f);
-  out.angularError.assign(n, 0.0f);
-  out.vdlCount.assign(n, 0);
-  out.vdls.assign(n * size_t(maxVdls), Vdl{});
+  resizeVoxelArrays(out);
   return out;
 }
 
@@ -327,24 +321,18 @@ VdlGrid reclusterVdlGrid(const VdlGrid& grid, const ClusterParams& params) {
   LO_CHECK_EQ(grid.vdls.size(), n * size_t(grid.maxVdls));
   VdlGrid out = emptyLike(grid.frame, params.vdls, n);
   out.coords = grid.coords;
-  out.normals = grid.normals;
-  out.areas = grid.areas;
+  // Re-clustering keeps the surface and the gathered totals of the voxels
+  // and their layers (the field table's roles) and makes the light again.
+  copyFieldsOfRole(grid, out, FieldRole::Surface);
+  copyFieldsOfRole(grid, out, FieldRole::Gather);
   Mixers mixers;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrainVoxels),
                     ReclusterBody{grid, params, mixers, out});
   // Surface layers: the same, layer by layer (a few per cent of the voxels).
   const VdlLayers& in = grid.layers;
   VdlLayers& L = out.layers;
-  out.points = grid.points;
   L.voxel = in.voxel;
-  L.normals = in.normals;
-  L.points = in.points;
-  L.irradiance = in.irradiance;
-  L.photonCount = in.photonCount;
-  L.radius = in.radius;
-  L.angularError.resize(in.size());
-  L.vdlCount.resize(in.size());
-  L.vdls.assign(in.size() * size_t(out.maxVdls), Vdl{});
+  resizeLayerArrays(out, in.size());  // the light's arrays, for the new VDL slots
   std::vector<DirectionSample> samples;
   for (size_t e = 0; e < in.size(); ++e) {
     samples.clear();

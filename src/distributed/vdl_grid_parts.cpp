@@ -1,6 +1,7 @@
 // selectVoxels, serializeVdlGrid and mergeVdlGrids: every per-voxel and
-// per-layer array of a VdlGrid is moved by the same two helpers (`each` over
-// the arrays), so a field added to VdlGrid is added here once.
+// per-layer array of a VdlGrid is moved by walking the light grid's field
+// table (lightgrid/light_grid_schema.h), so a field added there is split,
+// sent and merged without a change here.
 
 #include "distributed/vdl_grid_parts.h"
 
@@ -11,41 +12,11 @@
 #include <type_traits>
 
 #include "core/error.h"
+#include "lightgrid/light_grid_schema.h"
 
 namespace lo {
 
 namespace distributed_internal {
-
-/// Calls f(array, valuesPerVoxel) for every per-voxel array of `g`.
-template <typename Grid, typename F>
-void eachVoxelArray(Grid& g, F&& f) {
-  f(g.coords, 1);
-  f(g.normals, 1);
-  f(g.areas, 1);
-  f(g.irradiance, 1);
-  f(g.photonCount, 1);
-  f(g.radius, 1);
-  f(g.angularError, 1);
-  f(g.vdlCount, 1);
-  f(g.vdls, size_t(g.maxVdls));
-  f(g.sh, size_t(g.shTerms));
-  f(g.points, g.points.empty() ? 0 : 1);
-}
-
-/// Likewise for every per-layer array (VdlGrid::layers) but the voxel index.
-template <typename Grid, typename F>
-void eachLayerArray(Grid& g, F&& f) {
-  auto& L = g.layers;
-  f(L.normals, 1);
-  f(L.points, 1);
-  f(L.irradiance, 1);
-  f(L.photonCount, 1);
-  f(L.radius, 1);
-  f(L.angularError, 1);
-  f(L.vdlCount, 1);
-  f(L.vdls, size_t(g.maxVdls));
-  f(L.sh, size_t(g.shTerms));
-}
 
 /// out = the runs of `per` values at each index of `order`, appended.
 template <typename T>
@@ -67,23 +38,13 @@ VdlGrid reorder(const VdlGrid& g, const std::vector<size_t>& voxels,
   out.frame = g.frame;
   out.maxVdls = g.maxVdls;
   out.shTerms = g.shTerms;
-  // The same array of `out` as `in` by position in the field list.
-  std::vector<std::pair<const void*, size_t>> fields;
-  auto index = [&](auto& in, size_t per) { fields.emplace_back(&in, per); };
-  eachVoxelArray(g, index);
-  size_t k = 0;
-  const std::vector<size_t>* order = &voxels;
-  auto fill = [&](auto& dst, size_t) {
-    using V = std::decay_t<decltype(dst)>;
-    const auto& [src, per] = fields[k++];
-    gatherRuns(*static_cast<const V*>(src), per, *order, dst);
-  };
-  eachVoxelArray(out, fill);
-  fields.clear();
-  k = 0;
-  order = &layers;
-  eachLayerArray(g, index);
-  eachLayerArray(out, fill);
+  gatherRuns(g.coords, 1, voxels, out.coords);
+  forEachField([&](const auto& row) {
+    gatherRuns(g.*row.voxels, valuesPerVoxel(g, row), voxels, out.*row.voxels);
+    if (row.layers) {
+      gatherRuns(g.layers.*row.layers, valuesPerLayer(g, row), layers, out.layers.*row.layers);
+    }
+  });
   out.layers.voxel = std::move(layerVoxel);
   return out;
 }
@@ -167,9 +128,9 @@ std::vector<char> serializeVdlGrid(const VdlGrid& grid) {
   w.put(int32_t(grid.maxVdls));
   w.put(int32_t(grid.shTerms));
   auto put = [&](const auto& array, size_t per) { w.putArray(array, per); };
-  eachVoxelArray(grid, put);
+  forEachVoxelArray(grid, put);
   w.putArray(grid.layers.voxel, 1);
-  eachLayerArray(grid, put);
+  forEachLayerArray(grid, put);
   return std::move(w.bytes);
 }
 
@@ -182,17 +143,17 @@ VdlGrid deserializeVdlGrid(const std::vector<char>& bytes) {
   g.maxVdls = r.get<int32_t>();
   g.shTerms = r.get<int32_t>();
   auto get = [&](auto& array, size_t per) { r.getArray(array, per); };
-  eachVoxelArray(g, get);
+  forEachVoxelArray(g, get);
   r.getArray(g.layers.voxel, 1);
-  eachLayerArray(g, get);
+  forEachLayerArray(g, get);
   if (r.at != bytes.size()) throw IoError("a light grid part has bytes after its end");
   // Every array's length agrees with the voxel and layer counts.
   const size_t n = g.size(), m = g.layers.size();
   bool ok = g.maxVdls >= 1 && g.maxVdls <= kMaxVdls && g.shTerms >= 0 && g.shTerms <= 9;
   if (ok) {
-    eachVoxelArray(
+    forEachVoxelArray(
         g, [&](const auto& a, size_t per) { ok = ok && (per == 0 || a.size() == n * per); });
-    eachLayerArray(g, [&](const auto& a, size_t per) { ok = ok && a.size() == m * per; });
+    forEachLayerArray(g, [&](const auto& a, size_t per) { ok = ok && a.size() == m * per; });
     for (uint32_t v : g.layers.voxel) ok = ok && v < n;
   }
   if (!ok) throw IoError("a light grid part's arrays disagree in length");
@@ -220,17 +181,10 @@ VdlGrid mergeVdlGrids(std::vector<VdlGrid> parts) {
     }
     const uint32_t offset = uint32_t(all.size());
     auto append = [](auto& dst, auto& src) { dst.insert(dst.end(), src.begin(), src.end()); };
-    std::vector<std::pair<void*, size_t>> fields;
-    eachVoxelArray(p, [&](auto& a, size_t) { fields.emplace_back(&a, 0); });
-    size_t k = 0;
-    eachVoxelArray(all, [&](auto& a, size_t) {
-      append(a, *static_cast<std::decay_t<decltype(a)>*>(fields[k++].first));
-    });
-    fields.clear();
-    k = 0;
-    eachLayerArray(p, [&](auto& a, size_t) { fields.emplace_back(&a, 0); });
-    eachLayerArray(all, [&](auto& a, size_t) {
-      append(a, *static_cast<std::decay_t<decltype(a)>*>(fields[k++].first));
+    append(all.coords, p.coords);
+    forEachField([&](const auto& row) {
+      append(all.*row.voxels, p.*row.voxels);
+      if (row.layers) append(all.layers.*row.layers, p.layers.*row.layers);
     });
     for (uint32_t v : p.layers.voxel) all.layers.voxel.push_back(v + offset);
     p = VdlGrid{};  // frees the part

@@ -81,9 +81,47 @@ enum class LightRepresentation { Vdl, Sh1, Sh2 };
 inline int shTermsOf(LightRepresentation r) {
   return r == LightRepresentation::Sh1 ? 4 : r == LightRepresentation::Sh2 ? 9 : 0;
 }
-/// "vdl", "sh1", "sh2": the flag's and the file metadata's spelling.
+/// The representation with `terms` SH terms per voxel (0: VDLs); false
+/// when no representation has that many.
+inline bool representationOfShTerms(int terms, LightRepresentation* out) {
+  for (LightRepresentation r :
+       {LightRepresentation::Vdl, LightRepresentation::Sh1, LightRepresentation::Sh2}) {
+    if (shTermsOf(r) == terms) {
+      *out = r;
+      return true;
+    }
+  }
+  return false;
+}
+/// "vdl", "sh1", "sh2": the flag's and the file metadata's spelling, the
+/// one place it is written (parseRepresentation reads it).
 inline const char* representationName(LightRepresentation r) {
   return r == LightRepresentation::Sh1 ? "sh1" : r == LightRepresentation::Sh2 ? "sh2" : "vdl";
+}
+/// representationName's inverse: false for any other text.
+inline bool parseRepresentation(const std::string& text, LightRepresentation* out) {
+  for (LightRepresentation r :
+       {LightRepresentation::Vdl, LightRepresentation::Sh1, LightRepresentation::Sh2}) {
+    if (text == representationName(r)) {
+      *out = r;
+      return true;
+    }
+  }
+  return false;
+}
+/// Every representation's name, for flag checks and messages.
+inline std::vector<std::string> representationNames() {
+  return {representationName(LightRepresentation::Vdl), representationName(LightRepresentation::Sh1),
+          representationName(LightRepresentation::Sh2)};
+}
+/// The names as a message lists them: "vdl, sh1 or sh2".
+inline std::string representationChoices() {
+  const std::vector<std::string> names = representationNames();
+  std::string text;
+  for (size_t i = 0; i < names.size(); ++i) {
+    text += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  return text;
 }
 
 /// LightGridVoxels with up to `maxVdls` VDLs per voxel (paper §3.1.2); the
@@ -112,6 +150,12 @@ struct VdlGrid : LightGridVoxels {
   const Vdl* layerVdlsOf(size_t e) const { return layers.vdls.data() + e * size_t(maxVdls); }
   const Vec3* shOf(size_t v) const { return sh.data() + v * size_t(shTerms); }
   const Vec3* layerShOf(size_t e) const { return layers.sh.data() + e * size_t(shTerms); }
+  /// The representation the payload holds (shTerms: 0, 4 or 9).
+  LightRepresentation representation() const {
+    LightRepresentation r = LightRepresentation::Vdl;
+    representationOfShTerms(shTerms, &r);
+    return r;
+  }
   /// Whether voxel v carries light to draw (VDLs, or SH terms).
   bool lit(size_t v) const {
     return shTerms > 0 ? (irradiance[v].x != 0 || irradiance[v].y != 0 || irradiance[v].z != 0)

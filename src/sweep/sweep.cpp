@@ -99,9 +99,10 @@ BakeParams bakeParamsOf(const SweepPoint& point, const Scene& scene, uint64_t se
   b.occlusion = point.occlusion;
   b.edgeCorrection = point.edgeCorrection;
   b.smoothing = point.smoothing;
-  b.representation = point.representation == "sh1"   ? LightRepresentation::Sh1
-                     : point.representation == "sh2" ? LightRepresentation::Sh2
-                                                     : LightRepresentation::Vdl;
+  if (!parseRepresentation(point.representation, &b.representation)) {
+    throw InputError("sweep point representation '" + point.representation +
+                     "': expected " + representationChoices());
+  }
   // 0 lets the gather apply its own default (kDefaultRadiusVoxels voxels).
   if (point.radiusVoxels != kDefaultRadiusVoxels) {
     b.radius = point.radiusVoxels * makeGridFrame(scene.bounds(), point.depth).voxelSize;

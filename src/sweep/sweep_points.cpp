@@ -37,7 +37,7 @@ std::string SweepPoint::label() const {
   if (!occlusion) s += " no-occlusion";
   if (!edgeCorrection) s += " no-edge";
   if (smoothing != BakeParams{}.smoothing) s += smoothing ? " smooth" : " no-smooth";
-  if (representation != "vdl") s += " " + representation;
+  if (representation != representationName(LightRepresentation::Vdl)) s += " " + representation;
   if (tolerance > 0) s += " tol" + formatNumber(tolerance);
   return s;
 }
@@ -48,7 +48,7 @@ std::string SweepPoint::bakeKey() const {
          "-r" + formatNumber(radiusVoxels) + "-v" + vdls + (layers ? "" : "-l0") +
          (occlusion ? "" : "-o0") + (edgeCorrection ? "" : "-e0") +
          (smoothing == BakeParams{}.smoothing ? "" : (smoothing ? "-s1" : "-s0")) +
-         (representation == "vdl" ? "" : "-" + representation);
+         (representation == representationName(LightRepresentation::Vdl) ? "" : "-" + representation);
 }
 
 std::string SweepPoint::key() const {
@@ -118,12 +118,12 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale) {
     p.smoothing = false;
   });
   // Spherical harmonics beside the VDLs (the paper's future work).
-  vary("representation", [](SweepPoint& p) { p.representation = "sh1"; });
-  vary("representation", [](SweepPoint& p) { p.representation = "sh2"; });
+  vary("representation", [](SweepPoint& p) { p.representation = representationName(LightRepresentation::Sh1); });
+  vary("representation", [](SweepPoint& p) { p.representation = representationName(LightRepresentation::Sh2); });
   // Adaptive leaves (docs/octree.md): the same bake, coarser leaves where the light agrees.
   for (float t : {0.05f, 0.1f, 0.2f, 0.4f}) vary("tolerance", [t](SweepPoint& p) { p.tolerance = t; });
   vary("tolerance", [](SweepPoint& p) {
-    p.representation = "sh1";
+    p.representation = representationName(LightRepresentation::Sh1);
     p.tolerance = 0.1f;
   });
   // Combined points: cheaper photon maps with a matching k (the photon

@@ -1,12 +1,17 @@
 #pragma once
 /// @file vdb/vdb_file.h
-/// @brief Private to src/vdb (OpenVDB types): opening a .vdb file whole, for
-/// the reader (vdb_io.cpp) and `inspect` (vdb_inspect.cpp).
+/// @brief Private to src/vdb (OpenVDB types): opening a .vdb file whole (for
+/// the reader, the photon points and `inspect`), writing one grid by grid,
+/// the file metadata both ways, and the grid look-ups they share.
 
 #include <openvdb/openvdb.h>
 
+#include <functional>
 #include <string>
+#include <vector>
 
+#include "core/error.h"
+#include "vdb/vdb_internal.h"
 #include "vdb/vdb_io.h"
 
 namespace lo::vdb_internal {
@@ -37,9 +42,53 @@ constexpr double kReadSecondsPerByte = 1e-7;  // 10 s per 100 MB
 /// the limits (error texts cut at 400 characters).
 OpenedFile openFile(const std::string& path);
 
-/// readVdlGrid without checkLightGridValues: the grid as the file holds it,
-/// for `inspect` to report every check. @throws InputError as readVdlGrid
-/// for what makes a file unreadable (contract, transforms, counts, NaN).
-LoadedVdl readVdlStructure(const std::string& path);
+/// One grid of a file, built when it is written (writeVdbFile): a file's
+/// grids are never all in memory at once.
+struct GridSource {
+  std::string name;
+  std::function<openvdb::GridBase::Ptr()> make;
+  bool halfFloat = false;  ///< may be stored as half floats (VdlWriteOptions)
+};
+
+/// Writes the grids `sources` make, in order, with the file metadata `meta`
+/// to `path` through a temporary file (core/file.h), then gives the file
+/// its deterministic UUID (vdb_contract.h). @throws IoError.
+void writeVdbFile(const std::string& path, const std::vector<GridSource>& sources,
+                  const openvdb::MetaMap& meta);
+
+/// The file metadata of a light grid (docs/vdb-contract.md).
+openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid);
+/// BakeMetadata from a file's metadata. @throws InputError naming `path`
+/// and the key when a required key is missing or a key has another type.
+BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m);
+/// The int32 file metadata `key`; `fallback` when absent and not required.
+/// @throws InputError as readMetadata.
+int32_t metaInt(const std::string& path, const openvdb::MetaMap& m, const std::string& key,
+                bool required, int32_t fallback);
+
+inline openvdb::Vec3s toVdb(const Vec3& v) { return {v.x, v.y, v.z}; }
+inline openvdb::Coord toVdb(const Coord& c) { return {c.x, c.y, c.z}; }
+inline Vec3 fromVdb(const openvdb::Vec3s& v) { return {v.x(), v.y(), v.z()}; }
+inline Coord fromVdb(const openvdb::Coord& c) { return {c.x(), c.y(), c.z()}; }
+
+/// The grid of the file named `name`, or null.
+openvdb::GridBase::Ptr findGrid(const OpenedFile& f, const std::string& name);
+
+/// The grid named `name`, of type GridT. @throws InputError naming `path`
+/// and the grid when it is missing or of another type.
+template <typename GridT>
+typename GridT::Ptr requireGrid(const std::string& path, const OpenedFile& f,
+                                const std::string& name) {
+  openvdb::GridBase::Ptr base = findGrid(f, name);
+  if (!base) {
+    throw InputError(path + ": missing grid '" + name + "' \u2014 not a lightoctree VDL file?");
+  }
+  typename GridT::Ptr typed = openvdb::gridPtrCast<GridT>(base);
+  if (!typed) {
+    throw InputError(path + ": grid '" + name + "' has type " + base->valueType() + ", expected " +
+                     openvdb::typeNameAsString<typename GridT::ValueType>());
+  }
+  return typed;
+}
 
 }  // namespace lo::vdb_internal

@@ -1,6 +1,6 @@
 // `lightoctree inspect`: a generic report of an OpenVDB file and the checks of
-// the VDL contract. Own translation unit so that vdb_io.cpp and this file
-// compile in parallel; both include OpenVDB, nothing outside src/vdb does.
+// the VDL contract. Own translation unit so that it and the reader and writer
+// compile in parallel; they include OpenVDB, nothing outside src/vdb does.
 
 #include "vdb/vdb_inspect.h"
 
@@ -17,6 +17,7 @@
 
 #include "lightgrid/vdl_grid.h"
 #include "core/error.h"
+#include "vdb/vdb_contract.h"
 #include "vdb/vdb_file.h"
 #include "vdb/vdb_io.h"
 
@@ -148,16 +149,18 @@ class VdlChecker {
   }
 
   /// SH terms per voxel from the metadata `representation`: 0 for VDLs (and
-  /// files without the key), 4 for sh1, 9 for sh2, -1 for anything else.
+  /// files without the key), shTermsOf the representation it names, -1 for
+  /// anything else.
   int readShTerms() const {
-    auto typed = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f_.meta)["representation"]);
-    if (!typed) return (*f_.meta)["representation"] ? -1 : 0;
-    const std::string& r = typed->value();
-    return r == "vdl" ? 0 : r == "sh1" ? 4 : r == "sh2" ? 9 : -1;
+    const openvdb::Metadata::ConstPtr m = (*f_.meta)[vdb_internal::kMetaRepresentation];
+    auto typed = openvdb::DynamicPtrCast<const openvdb::StringMetadata>(m);
+    if (!typed) return m ? -1 : 0;
+    LightRepresentation r = LightRepresentation::Vdl;
+    return parseRepresentation(typed->value(), &r) ? shTermsOf(r) : -1;
   }
 
   int readMaxVdls() const {
-    auto m = (*f_.meta)["max_vdls"];
+    auto m = (*f_.meta)[vdb_internal::kMetaMaxVdls];
     auto typed = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m);
     return typed ? typed->value() : -1;
   }
@@ -175,25 +178,27 @@ class VdlChecker {
                     ("grid '" + name + "' has type " + g->valueType() + ", expected " + valueType);
       }
     };
-    if (maxVdls < 1 || maxVdls > kMaxVdls) {
+    const bool maxVdlsValid = maxVdls >= 1 && maxVdls <= kMaxVdls;
+    if (!maxVdlsValid) {
       problems = "file metadata max_vdls is " +
                  (maxVdls < 0 ? std::string("missing or not int32") : std::to_string(maxVdls)) +
                  ", expected 1.." + std::to_string(kMaxVdls);
-    } else {
-      for (int i = 0; i < maxVdls; ++i) {
-        need("vdl" + std::to_string(i) + "_irradiance", "vec3s", true);
-        need("vdl" + std::to_string(i) + "_direction", "vec3s", true);
-      }
     }
-    need("irradiance", "vec3s", true);
-    need("normal", "vec3s", true);
-    need("vdl_count", "float", true);
     const int shTerms = readShTerms();
     if (shTerms < 0) {
       problems += std::string(problems.empty() ? "" : "; ") +
-                  "file metadata representation is not 'vdl', 'sh1' or 'sh2'";
+                  "file metadata representation is not " + representationChoices();
     }
-    for (int i = 0; i < shTerms; ++i) need("sh" + std::to_string(i), "vec3s", true);
+    // The voxels' required grids of the field table.
+    forEachField([&](const auto& row) {
+      using T = typename std::decay_t<decltype(row)>::Value;
+      if (row.optional || row.arity == FieldArity::OneOrNone) return;
+      const char* type = std::is_same_v<T, Vec3> || std::is_same_v<T, Vdl> ? "vec3s" : "float";
+      for (const vdb_internal::FieldGrid& grid :
+           vdb_internal::fieldGrids(row, 0, maxVdlsValid ? maxVdls : 0, std::max(shTerms, 0))) {
+        need(grid.name, type, true);
+      }
+    });
     std::string absent;
     for (const std::string& name : optionalVdlGridNames()) {
       need(name, "float", false);
@@ -208,7 +213,7 @@ class VdlChecker {
   }
 
   void checkFormatVersion() {
-    auto m = (*f_.meta)["format_version"];
+    auto m = (*f_.meta)[vdb_internal::kMetaFormatVersion];
     if (!m) {
       add("format_version", true, "absent: a file written before format_version 1 (read as 1)");
       return;
@@ -254,7 +259,7 @@ class VdlChecker {
   /// Which active set a grid shares: the voxels' (0), or surface layer l's
   /// (layer_point goes with layer 1: the voxels that have layers).
   static int layerGroup(const std::string& name) {
-    if (name == "layer_point") return 1;
+    if (name == vdb_internal::gridNameOf(&VdlGrid::points)) return 1;
     if (name.rfind("layer", 0) == 0 && name.size() > 6 && name[6] == '_' && name[5] >= '1' &&
         name[5] <= '9') {
       return name[5] - '0';
@@ -267,7 +272,7 @@ class VdlChecker {
   /// depth metadata within [1, kMaxGridDepth], a transform of uniform scale
   /// and translation only, and every voxel within [0, 2^depth) on each axis.
   void checkDepthAndBounds() {
-    auto m = (*f_.meta)["depth"];
+    auto m = (*f_.meta)[vdb_internal::kMetaDepth];
     int depth = -1;
     if (auto i32 = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m)) depth = i32->value();
     if (auto i64 = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(m)) {
@@ -390,7 +395,7 @@ VdbReport inspectVdb(const std::string& path) {
   bool hasIrradiance = false, hasPhotons = false;
   for (const auto& g : *f.grids) {
     if (!g) continue;
-    hasIrradiance = hasIrradiance || g->getName() == "irradiance";
+    hasIrradiance = hasIrradiance || g->getName() == vdb_internal::gridNameOf(&VdlGrid::irradiance);
     hasPhotons =
         hasPhotons || (g->getName() == "photons" && g->isType<openvdb::points::PointDataGrid>());
   }

@@ -26,6 +26,11 @@ struct Damage {
 void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
                          const Damage& damage);
 
+/// readVdlGrid without checkLightGridValues: the grid as the file holds it,
+/// for `inspect` to report every check. @throws InputError as readVdlGrid
+/// for what makes a file unreadable (contract, transforms, counts, NaN).
+LoadedVdl readVdlStructure(const std::string& path);
+
 /// What a photon point file holds, read back through OpenVDB.
 struct PointFileInfo {
   std::vector<std::string> gridNames;

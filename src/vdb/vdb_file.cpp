@@ -1,0 +1,279 @@
+// .vdb files as files: opening one whole (in a child process first), writing
+// one grid by grid with a deterministic identity, and the light grid's file
+// metadata both ways (docs/vdb-contract.md).
+
+#include <openvdb/io/File.h>
+#include <openvdb/io/GridDescriptor.h>
+#include <openvdb/openvdb.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <set>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "core/error.h"
+#include "core/file.h"
+#include "core/isolate.h"
+#include "vdb/vdb_contract.h"
+#include "vdb/vdb_file.h"
+
+namespace lo {
+namespace vdb_internal {
+
+void initOpenVdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+std::string clipped(const std::string& text) {
+  constexpr size_t kMax = 400;
+  if (text.size() <= kMax) return text;
+  return text.substr(0, kMax) + "... (" + std::to_string(text.size() - kMax) + " more characters)";
+}
+
+IsolationLimits readLimits(uintmax_t fileBytes) {
+  IsolationLimits limits;
+  limits.memoryBytes = kReadMemoryBaseBytes + size_t(kReadMemoryPerFileByte * double(fileBytes));
+  limits.seconds = kReadSecondsBase + double(fileBytes) * kReadSecondsPerByte;
+  return limits;
+}
+
+OpenedFile openFile(const std::string& path) {
+  initOpenVdb();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path + ": file does not exist");
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
+  // OpenVDB trusts the sizes a file states: a damaged file can make it
+  // allocate gigabytes, loop for minutes or corrupt the heap. A child
+  // process reads it first under limits; only a file it read whole is read
+  // here (docs/robustness.md, "Reading untrusted files").
+  const uintmax_t bytes = std::filesystem::file_size(path, ec);
+  const IsolationLimits limits = readLimits(ec ? 0 : bytes);
+  auto trialRead = [&](std::string&) {
+    openvdb::io::File file(path);
+    file.open(false);
+    file.getMetadata();
+    file.getGrids();
+    file.close();
+    return 0;
+  };
+  IsolatedRun trial = runIsolated(trialRead, limits);
+  // A child forked from a process with other threads can, rarely, wait
+  // forever on a lock one of them held at the fork: a wait past the time
+  // limit, or a crash, is tried once more before the file is refused (a
+  // damaged file fails again). A child that spent its whole CPU time reading
+  // was not waiting: the file is refused at once.
+  if ((trial.outcome == IsolatedRun::Outcome::TimedOut && !trial.usedItsCpu) ||
+      trial.outcome == IsolatedRun::Outcome::Crashed) {
+    trial = runIsolated(trialRead, limits);
+  }
+  if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode != 0) {
+    throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(trial.message));
+  }
+  if (trial.outcome != IsolatedRun::Outcome::Finished &&
+      trial.outcome != IsolatedRun::Outcome::NotIsolated) {
+    throw InputError(path + ": damaged or not an OpenVDB file: reading it " +
+                     trial.ToString(limits));
+  }
+  OpenedFile f;
+  try {
+    openvdb::io::File file(path);
+    // No delayed loading: every read error surfaces here, inside the try,
+    // rather than on first access to a leaf.
+    file.open(false);
+    f.meta = file.getMetadata();
+    f.grids = file.getGrids();
+    file.close();
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(e.what()));
+  }
+  if (!f.grids || !f.meta) throw InputError(path + ": cannot read as an OpenVDB file");
+  return f;
+}
+
+openvdb::GridBase::Ptr findGrid(const OpenedFile& f, const std::string& name) {
+  for (const auto& g : *f.grids) {
+    if (g && g->getName() == name) return g;
+  }
+  return nullptr;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// io::File::write's archive, but each grid is built just before it is
+/// written and freed after: the bytes io::Archive::write gives a file of
+/// grids with distinct names (header, file metadata, grid count, then each
+/// grid's descriptor, offsets and data), without every grid in memory at
+/// once (a depth-8 Cornell box's grids take ~1 KB per voxel in OpenVDB's
+/// dense 8^3 leaves).
+class GridByGridArchive : public openvdb::io::Archive {
+ public:
+  void writeGrids(std::ostream& os, const std::vector<GridSource>& sources,
+             const openvdb::MetaMap& meta) const {
+    openvdb::io::StreamMetadata::Ptr streamMetadata(new openvdb::io::StreamMetadata);
+    openvdb::io::setStreamMetadataPtr(os, streamMetadata, /*transfer=*/false);
+    openvdb::io::setDataCompression(os, compression());
+    openvdb::io::setWriteGridStatsMetadata(os, isGridStatsMetadataEnabled());
+    writeHeader(os, /*seekable=*/true);
+    meta.writeMeta(os);
+    const int32_t count = int32_t(sources.size());
+    os.write(reinterpret_cast<const char*>(&count), sizeof count);
+    std::set<std::string> names;
+    for (const GridSource& source : sources) {
+      openvdb::GridBase::ConstPtr grid = source.make();
+      // Archive::write would rename a repeated or empty name.
+      LO_CHECK(!grid->getName().empty() && names.insert(grid->getName()).second);
+      openvdb::io::GridDescriptor descriptor(grid->getName(), grid->type(),
+                                             grid->saveFloatAsHalf());
+      writeGrid(descriptor, grid, os, /*seekable=*/true);
+      openvdb::io::setDataCompression(os, compression());
+    }
+  }
+};
+
+}  // namespace
+
+// Writes through a temporary file (core/file.h), grid by grid: a reader
+// never sees a half file.
+void writeVdbFile(const std::string& path, const std::vector<GridSource>& sources,
+                  const openvdb::MetaMap& meta) {
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent)) {
+    throw IoError(path + ": cannot write: folder '" + parent.string() + "' does not exist");
+  }
+  writeAtomically(path, [&](const std::string& tmp) {
+    {
+      std::ofstream file(tmp, std::ios_base::out | std::ios_base::binary);
+      if (!file) throw std::runtime_error("cannot open the file");
+      GridByGridArchive().writeGrids(file, sources, meta);
+      file.close();
+      if (file.fail()) throw std::runtime_error("cannot write the file");
+    }
+    makeUuidDeterministic(tmp);
+  });
+}
+
+// ---------------------------------------------------------------------------
+// The file metadata.
+
+openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
+  openvdb::MetaMap m;
+  m.insertMeta("generator", openvdb::StringMetadata(meta.generator));
+  m.insertMeta("version", openvdb::StringMetadata(meta.version));
+  m.insertMeta("source_scene", openvdb::StringMetadata(meta.sourceScene));
+  // The grid's own frame is the truth for depth; see the check in writeVdlGrid.
+  m.insertMeta(kMetaDepth, openvdb::Int32Metadata(grid.frame.depth));
+  m.insertMeta("photons", openvdb::Int64Metadata(meta.photons));
+  m.insertMeta("emitted_paths", openvdb::Int64Metadata(meta.emittedPaths));
+  m.insertMeta("knn", openvdb::Int32Metadata(meta.knn));
+  m.insertMeta("radius", openvdb::FloatMetadata(meta.radius));
+  m.insertMeta("vdls", openvdb::StringMetadata(meta.vdls));
+  m.insertMeta("seed", openvdb::Int64Metadata(meta.seed));
+  m.insertMeta("scene_bounds_min", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.lower)));
+  m.insertMeta("scene_bounds_max", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.upper)));
+  m.insertMeta("units", openvdb::StringMetadata(meta.units));
+  m.insertMeta(kMetaMaxVdls, openvdb::Int32Metadata(grid.maxVdls));
+  // The lowest version that holds the file (lightgrid/vdl_grid.h).
+  m.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(grid.shTerms > 0 ? kVdlFormatVersion
+                                                                          : kVdlFormatVersionVdl));
+  if (grid.shTerms > 0) {
+    m.insertMeta(kMetaRepresentation,
+                 openvdb::StringMetadata(representationName(grid.representation())));
+  }
+  if (!meta.convertedFrom.empty()) {
+    m.insertMeta("converted_from", openvdb::StringMetadata(meta.convertedFrom));
+  }
+  if (meta.surfaceLayers >= 0) m.insertMeta("surface_layers", openvdb::Int32Metadata(meta.surfaceLayers));
+  if (meta.gatherOcclusion >= 0) {
+    m.insertMeta("gather_occlusion", openvdb::Int32Metadata(meta.gatherOcclusion));
+  }
+  if (meta.edgeCorrection >= 0) m.insertMeta("edge_correction", openvdb::Int32Metadata(meta.edgeCorrection));
+  if (meta.includeDirect >= 0) m.insertMeta("include_direct", openvdb::Int32Metadata(meta.includeDirect));
+  if (!meta.region.empty()) {
+    m.insertMeta("region_min", openvdb::Vec3SMetadata(toVdb(meta.region.lower)));
+    m.insertMeta("region_max", openvdb::Vec3SMetadata(toVdb(meta.region.upper)));
+  }
+  return m;
+}
+
+namespace {
+
+template <typename T>
+T metaValue(const std::string& path, const openvdb::MetaMap& meta, const std::string& key,
+            bool required, T fallback) {
+  openvdb::Metadata::ConstPtr m = meta[key];
+  if (!m) {
+    if (required) throw InputError(path + ": missing file metadata '" + key + "'");
+    return fallback;
+  }
+  auto typed = openvdb::DynamicPtrCast<const openvdb::TypedMetadata<T>>(m);
+  if (!typed) {
+    // Integers of the other width (pyopenvdb writes every Python int as
+    // int32 when it fits, and int64 otherwise): the same value.
+    if constexpr (std::is_same_v<T, int64_t>) {
+      if (auto narrow = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m)) {
+        return int64_t(narrow->value());
+      }
+    }
+    if constexpr (std::is_same_v<T, int32_t>) {
+      if (auto wide = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(m)) {
+        if (wide->value() >= std::numeric_limits<int32_t>::min() &&
+            wide->value() <= std::numeric_limits<int32_t>::max()) {
+          return int32_t(wide->value());
+        }
+      }
+    }
+    throw InputError(path + ": file metadata '" + key + "' has type " + m->typeName() +
+                     ", expected " + openvdb::typeNameAsString<T>());
+  }
+  return typed->value();
+}
+
+}  // namespace
+
+int32_t metaInt(const std::string& path, const openvdb::MetaMap& m, const std::string& key,
+                bool required, int32_t fallback) {
+  return metaValue<int32_t>(path, m, key, required, fallback);
+}
+
+BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
+  BakeMetadata meta;
+  meta.generator = metaValue<std::string>(path, m, "generator", false, "");
+  meta.version = metaValue<std::string>(path, m, "version", false, "");
+  meta.sourceScene = metaValue<std::string>(path, m, "source_scene", false, "");
+  meta.depth = metaValue<int32_t>(path, m, kMetaDepth, true, 0);
+  meta.photons = metaValue<int64_t>(path, m, "photons", false, 0);
+  meta.emittedPaths = metaValue<int64_t>(path, m, "emitted_paths", false, 0);
+  meta.knn = metaValue<int32_t>(path, m, "knn", false, 0);
+  meta.radius = metaValue<float>(path, m, "radius", false, 0.0f);
+  meta.vdls = metaValue<std::string>(path, m, "vdls", false, "");
+  meta.representation = metaValue<std::string>(
+      path, m, kMetaRepresentation, false, representationName(LightRepresentation::Vdl));
+  meta.seed = metaValue<int64_t>(path, m, "seed", false, 0);
+  meta.sceneBounds.lower = fromVdb(
+      metaValue<openvdb::Vec3s>(path, m, "scene_bounds_min", false, openvdb::Vec3s(INFINITY)));
+  meta.sceneBounds.upper = fromVdb(
+      metaValue<openvdb::Vec3s>(path, m, "scene_bounds_max", false, openvdb::Vec3s(-INFINITY)));
+  meta.units = metaValue<std::string>(path, m, "units", false, "");
+  meta.formatVersion = metaValue<int32_t>(path, m, kMetaFormatVersion, false, 0);
+  meta.convertedFrom = metaValue<std::string>(path, m, "converted_from", false, "");
+  meta.surfaceLayers = metaValue<int32_t>(path, m, "surface_layers", false, -1);
+  meta.gatherOcclusion = metaValue<int32_t>(path, m, "gather_occlusion", false, -1);
+  meta.edgeCorrection = metaValue<int32_t>(path, m, "edge_correction", false, -1);
+  meta.includeDirect = metaValue<int32_t>(path, m, "include_direct", false, -1);
+  meta.region.lower = fromVdb(
+      metaValue<openvdb::Vec3s>(path, m, "region_min", false, openvdb::Vec3s(INFINITY)));
+  meta.region.upper = fromVdb(
+      metaValue<openvdb::Vec3s>(path, m, "region_max", false, openvdb::Vec3s(-INFINITY)));
+  return meta;
+}
+
+}  // namespace vdb_internal
+}  // namespace lo

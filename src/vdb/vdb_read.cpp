@@ -1,0 +1,317 @@
+// Reading a light grid from .vdb grids (docs/vdb-contract.md): the grids of
+// the field table (lightgrid/light_grid_schema.h), checked for structure
+// (types, transforms, active voxels) before any value is read.
+
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "core/error.h"
+#include "vdb/vdb_contract.h"
+#include "vdb/vdb_file.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+namespace vdb_internal {
+namespace {
+
+using openvdb::FloatGrid;
+using openvdb::Vec3SGrid;
+using openvdb::math::Transform;
+
+// The canonical voxel order readers get: by 8^3 block (floor(c / 8), compared
+// x, then y, then z), then by offset inside the block (c & 7, x, y, z) --
+// OpenVDB's leaf-local order. Arithmetic shift: floor division for negatives.
+bool canonicalLess(const Coord& a, const Coord& b) {
+  Coord ba{a.x >> 3, a.y >> 3, a.z >> 3}, bb{b.x >> 3, b.y >> 3, b.z >> 3};
+  if (ba != bb) return ba < bb;
+  Coord oa{a.x & 7, a.y & 7, a.z & 7}, ob{b.x & 7, b.y & 7, b.z & 7};
+  return oa < ob;
+}
+
+GridFrame readFrame(const std::string& path, const Transform& xform, int depth) {
+  const openvdb::math::MapBase::ConstPtr map = xform.baseMap();
+  const bool axisAligned = map->isType<openvdb::math::UniformScaleTranslateMap>() ||
+                           map->isType<openvdb::math::UniformScaleMap>();
+  if (!xform.isLinear() || !axisAligned) {
+    throw InputError(path + ": transform is " + xform.mapType() +
+                     ", expected a uniform scale and translation");
+  }
+  const double h = xform.voxelSize()[0];
+  const openvdb::Vec3d centre0 = xform.indexToWorld(openvdb::Vec3d(0.0));
+  GridFrame frame;
+  frame.voxelSize = float(h);
+  frame.origin = Vec3(float(centre0.x() - 0.5 * h), float(centre0.y() - 0.5 * h),
+                      float(centre0.z() - 0.5 * h));
+  frame.depth = depth;
+  return frame;
+}
+
+/// The OpenVDB grid type a row of value type T is stored as.
+template <typename T>
+using GridOf =
+    std::conditional_t<std::is_same_v<T, Vec3> || std::is_same_v<T, Vdl>, Vec3SGrid, FloatGrid>;
+
+void checkTransform(const std::string& path, const openvdb::GridBase& grid, const Transform& xform) {
+  if (!(grid.transform() == xform)) {
+    throw InputError(path + ": mismatched transforms: grid '" + grid.getName() +
+                     "' differs from '" + keyGridName() + "'");
+  }
+}
+
+/// Reads the grids of `row` (the voxels' for layer 0, else surface layer
+/// `layer`'s) at `coords` into values[entries[k] * per + slot] (entries
+/// empty: k). Absent optional grids of the voxels leave zeros. With `xform`,
+/// each grid must be on it (the voxels' grids were checked before).
+template <typename T>
+void readField(const std::string& path, const OpenedFile& f, const LightGridField<T>& row,
+               int layer, int maxVdls, int shTerms, const Transform* xform,
+               const std::vector<Coord>& coords, const std::vector<size_t>& entries,
+               std::vector<T>& values) {
+  const size_t per = row.arity == FieldArity::VdlSlots  ? size_t(maxVdls)
+                     : row.arity == FieldArity::ShTerms ? size_t(shTerms)
+                                                        : 1;
+  for (const FieldGrid& fg : fieldGrids(row, layer, maxVdls, shTerms)) {
+    if (layer == 0 && row.optional && !findGrid(f, fg.name)) continue;
+    auto grid = requireGrid<GridOf<T>>(path, f, fg.name);
+    if (xform) checkTransform(path, *grid, *xform);
+    auto acc = grid->getConstAccessor();
+    for (size_t k = 0; k < coords.size(); ++k) {
+      const size_t at = (entries.empty() ? k : entries[k]) * per + size_t(fg.slot);
+      const auto value = acc.getValue(toVdb(coords[k]));
+      if constexpr (std::is_same_v<T, Vdl>) {
+        values[at].*(fg.component->member) = fromVdb(value);
+      } else if constexpr (std::is_same_v<T, Vec3>) {
+        values[at] = fromVdb(value);
+      } else if constexpr (std::is_same_v<T, uint8_t>) {
+        // Counts of VDL slots.
+        if (!(value >= 0 && value <= float(maxVdls)) || value != std::floor(value)) {
+          throw InputError(path + ": " + fg.name + " at " + coords[k].ToString() + " is " +
+                           std::to_string(value) + ", expected an integer in [0, " +
+                           std::to_string(maxVdls) + "]");
+        }
+        values[at] = uint8_t(value);
+      } else {
+        values[at] = value;
+      }
+    }
+  }
+}
+
+/// The surface layers of a version-2 file (none when it has no
+/// "layer1_normal" grid): every grid of a layer present, on the file's
+/// transform, each layer's voxels among the file's voxels, layer 2's among
+/// layer 1's.
+void readLayers(const std::string& path, const OpenedFile& f, const Transform& xform,
+                LoadedVdl& out) {
+  VdlGrid& g = out.grid;
+  const size_t n = g.size();
+  const std::string firstNormal = layerGridNameOf(&VdlGrid::normals, 1);
+  if (!findGrid(f, firstNormal)) {
+    for (const auto& grid : *f.grids) {
+      if (grid && grid->getName().rfind("layer", 0) == 0) {
+        throw InputError(path + ": grid '" + grid->getName() + "' without '" + firstNormal +
+                         "': incomplete surface layers");
+      }
+    }
+    return;
+  }
+  auto voxelOf = [&](const openvdb::Coord& c, const std::string& grid) -> uint32_t {
+    const Coord k = fromVdb(c);
+    auto it = std::lower_bound(g.coords.begin(), g.coords.end(), k, canonicalLess);
+    if (it == g.coords.end() || *it != k) {
+      throw InputError(path + ": grid '" + grid + "' is active at " + k.ToString() +
+                       ", which is not a voxel of the file");
+    }
+    return uint32_t(it - g.coords.begin());
+  };
+  // Layer 0's points (the one OneOrNone row), on the voxels with layers;
+  // the voxel's centre elsewhere.
+  const std::string pointName = gridNameOf(&VdlGrid::points);
+  g.points.assign(n, Vec3{});
+  for (size_t v = 0; v < n; ++v) {
+    g.points[v] = g.frame.origin + (Vec3{float(g.coords[v].x), float(g.coords[v].y),
+                                         float(g.coords[v].z)} + Vec3(0.5f)) * g.frame.voxelSize;
+  }
+  auto points = requireGrid<Vec3SGrid>(path, f, pointName);
+  checkTransform(path, *points, xform);
+  for (auto it = points->cbeginValueOn(); it; ++it) {
+    g.points[voxelOf(it.getCoord(), pointName)] = fromVdb(*it);
+  }
+  struct Entry {
+    uint32_t voxel;
+    int layer;
+  };
+  std::vector<Entry> entries;
+  std::vector<char> hasLayer1(n, 0);
+  for (int layer = 1; layer < kMaxLayers; ++layer) {
+    const std::string countName = layerGridNameOf(&VdlGrid::vdlCount, layer);
+    if (!findGrid(f, countName)) {
+      if (layer == 1) requireGrid<FloatGrid>(path, f, countName);  // names it as missing
+      break;
+    }
+    auto count = requireGrid<FloatGrid>(path, f, countName);
+    checkTransform(path, *count, xform);
+    for (auto it = count->cbeginValueOn(); it; ++it) {
+      const uint32_t v = voxelOf(it.getCoord(), countName);
+      if (layer == 1) hasLayer1[v] = 1;
+      if (layer == 2 && !hasLayer1[v]) {
+        throw InputError(path + ": voxel " + g.coords[v].ToString() +
+                         " has surface layer 2 but not layer 1");
+      }
+      entries.push_back({v, layer});
+    }
+  }
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return a.voxel < b.voxel || (a.voxel == b.voxel && a.layer < b.layer);
+  });
+  for (size_t v = 0; v < n; ++v) {
+    if (!hasLayer1[v]) continue;
+    if (!points->tree().isValueOn(toVdb(g.coords[v]))) {
+      throw InputError(path + ": grid '" + pointName + "' has no value at " +
+                       g.coords[v].ToString() + ", a voxel with surface layers");
+    }
+  }
+  resizeLayerArrays(g, entries.size());
+  for (size_t e = 0; e < entries.size(); ++e) g.layers.voxel[e] = entries[e].voxel;
+  for (int layer = 1; layer < kMaxLayers; ++layer) {
+    std::vector<size_t> at;
+    std::vector<Coord> coords;
+    for (size_t e = 0; e < entries.size(); ++e) {
+      if (entries[e].layer != layer) continue;
+      at.push_back(e);
+      coords.push_back(g.coords[entries[e].voxel]);
+    }
+    if (at.empty()) continue;
+    forEachField([&](const auto& row) {
+      if (row.layers) {
+        readField(path, f, row, layer, g.maxVdls, g.shTerms, &xform, coords, at,
+                  g.layers.*row.layers);
+      }
+    });
+  }
+}
+
+}  // namespace
+
+LoadedVdl readVdlStructure(const std::string& path) {
+  OpenedFile f = openFile(path);
+  LoadedVdl out;
+  out.meta = readMetadata(path, *f.meta);
+  if (out.meta.formatVersion == 0) {
+    // Files baked before the key existed follow version 1 of the contract.
+    out.meta.formatVersion = 1;
+    out.notes.push_back("no format_version metadata: read as format version 1");
+  } else if (out.meta.formatVersion > kVdlFormatVersion || out.meta.formatVersion < 1) {
+    throw InputError(
+        path + ": format_version " + std::to_string(out.meta.formatVersion) +
+        " is not supported: this lightoctree (" LO_VERSION
+        ") reads VDL files up to "
+        "format version " +
+        std::to_string(kVdlFormatVersion) +
+        (out.meta.formatVersion > kVdlFormatVersion ? "; use a newer lightoctree" : ""));
+  }
+  const int maxVdls = metaInt(path, *f.meta, kMetaMaxVdls, true, 0);
+  if (maxVdls < 1 || maxVdls > kMaxVdls) {
+    throw InputError(path + ": file metadata max_vdls = " + std::to_string(maxVdls) +
+                     " is outside [1, " + std::to_string(kMaxVdls) + "]");
+  }
+  // The representation: VDLs, or SH terms (format version 3).
+  const std::string& representation = out.meta.representation;
+  LightRepresentation parsed = LightRepresentation::Vdl;
+  if (!parseRepresentation(representation, &parsed)) {
+    throw InputError(path + ": file metadata representation = '" + representation +
+                     "'; expected " + representationChoices());
+  }
+  const int shTerms = shTermsOf(parsed);
+  if (shTerms > 0 && out.meta.formatVersion < 3) {
+    throw InputError(path + ": representation " + representation + " in a format version " +
+                     std::to_string(out.meta.formatVersion) +
+                     " file (SH grids came with version 3): the file is inconsistent");
+  }
+
+  // Every grid of the voxels, typed, before anything is interpreted.
+  // Optional grids may be absent (a file converted with --drop): read as 0.
+  std::vector<openvdb::GridBase::Ptr> dense, sparse;
+  forEachField([&](const auto& row) {
+    using T = typename std::decay_t<decltype(row)>::Value;
+    if (row.arity == FieldArity::OneOrNone) return;  // surface layers: readLayers
+    for (const FieldGrid& fg : fieldGrids(row, 0, maxVdls, shTerms)) {
+      if (row.optional && !findGrid(f, fg.name)) {
+        out.absentGrids.push_back(fg.name);
+        continue;
+      }
+      openvdb::GridBase::Ptr grid = requireGrid<GridOf<T>>(path, f, fg.name);
+      (std::is_same_v<T, Vdl> ? sparse : dense).push_back(grid);
+    }
+  });
+  out.halfFloat = findGrid(f, gridNameOf(&VdlGrid::irradiance))->saveFloatAsHalf();
+  auto key = requireGrid<FloatGrid>(path, f, keyGridName());
+
+  const Transform& xform = key->transform();
+  const openvdb::Index64 active = key->activeVoxelCount();
+  for (const auto& grid : dense) {
+    checkTransform(path, *grid, xform);
+    if (grid->activeVoxelCount() != active) {
+      throw InputError(path + ": grid '" + grid->getName() + "' has " +
+                       std::to_string(grid->activeVoxelCount()) + " active voxels, '" +
+                       keyGridName() + "' has " + std::to_string(active));
+    }
+  }
+  // VDL grids: active where the voxel has that VDL (sparse), or on every voxel
+  // (files before version 2 store zeros); never beyond the voxels.
+  for (const auto& grid : sparse) {
+    checkTransform(path, *grid, xform);
+    auto typed = openvdb::gridPtrCast<Vec3SGrid>(grid);
+    for (auto it = typed->cbeginValueOn(); it; ++it) {
+      if (!key->tree().isValueOn(it.getCoord())) {
+        throw InputError(path + ": grid '" + grid->getName() + "' is active at " +
+                         fromVdb(it.getCoord()).ToString() + ", which is not a voxel of the file");
+      }
+    }
+  }
+
+  VdlGrid& g = out.grid;
+  g.frame = readFrame(path, xform, out.meta.depth);
+  g.maxVdls = maxVdls;
+  g.shTerms = shTerms;
+  g.coords.reserve(size_t(active));
+  for (auto it = key->cbeginValueOn(); it; ++it) g.coords.push_back(fromVdb(it.getCoord()));
+  std::sort(g.coords.begin(), g.coords.end(), canonicalLess);
+  resizeVoxelArrays(g);
+  forEachField([&](const auto& row) {
+    if (row.arity == FieldArity::OneOrNone) return;
+    readField(path, f, row, 0, maxVdls, shTerms, nullptr, g.coords, {}, g.*row.voxels);
+  });
+  if (shTerms > 0) {
+    for (size_t v = 0; v < g.size(); ++v) {
+      if (g.vdlCount[v] != 0) {
+        throw InputError(path + ": voxel " + g.coords[v].ToString() + " of an " + representation +
+                         " file has " + std::to_string(g.vdlCount[v]) +
+                         " VDLs; SH files hold none");
+      }
+    }
+  }
+  readLayers(path, f, xform, out);
+  checkReadableValues(path, out.grid);
+  return out;
+}
+
+}  // namespace vdb_internal
+
+LoadedVdl readVdlGrid(const std::string& path) {
+  LoadedVdl loaded = vdb_internal::readVdlStructure(path);
+  for (const VdbCheck& c : checkLightGridValues(loaded.grid, loaded.halfFloat)) {
+    if (!c.passed) {
+      throw InputError(path + ": check " + c.name + " fails: " + c.detail +
+                       " (`lightoctree inspect` lists every check)");
+    }
+  }
+  return loaded;
+}
+
+}  // namespace lo

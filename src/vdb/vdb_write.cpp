@@ -1,0 +1,242 @@
+// Writing a light grid as .vdb grids (docs/vdb-contract.md): one source per
+// grid of the field table (lightgrid/light_grid_schema.h), built just before
+// it is written.
+
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "core/error.h"
+#include "vdb/vdb_contract.h"
+#include "vdb/vdb_file.h"
+#include "vdb/vdb_internal.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+namespace vdb_internal {
+namespace {
+
+using openvdb::FloatGrid;
+using openvdb::Vec3SGrid;
+using openvdb::math::Transform;
+
+// Voxel (i,j,k) of a GridFrame covers origin + ijk * h .. + h; OpenVDB's
+// integer index points are voxel centres, so index ijk must map to
+// origin + (ijk + 0.5) * h.
+Transform::Ptr frameTransform(const GridFrame& frame) {
+  const double h = frame.voxelSize;
+  Transform::Ptr xform = Transform::createLinearTransform(h);
+  xform->postTranslate(openvdb::Vec3d(double(frame.origin.x) + 0.5 * h,
+                                      double(frame.origin.y) + 0.5 * h,
+                                      double(frame.origin.z) + 0.5 * h));
+  return xform;
+}
+
+template <typename GridT>
+void describe(GridT& grid, const std::string& name, const std::string& units,
+              const Transform::Ptr& xform) {
+  grid.setName(name);
+  grid.setTransform(xform);
+  grid.setGridClass(openvdb::GRID_UNKNOWN);
+  grid.setSaveFloatAsHalf(false);
+  grid.insertMeta("units", openvdb::StringMetadata(units));
+}
+
+template <typename Fn>
+FloatGrid::Ptr floatGrid(const std::string& name, const std::string& units,
+                         const Transform::Ptr& xform, const std::vector<Coord>& coords, Fn value) {
+  FloatGrid::Ptr grid = FloatGrid::create(0.0f);
+  describe(*grid, name, units, xform);
+  auto acc = grid->getAccessor();
+  for (size_t v = 0; v < coords.size(); ++v) acc.setValueOn(toVdb(coords[v]), value(v));
+  return grid;
+}
+
+template <typename Fn>
+Vec3SGrid::Ptr vectorGrid(const std::string& name, const std::string& units,
+                          openvdb::VecType vecType, const Transform::Ptr& xform,
+                          const std::vector<Coord>& coords, Fn value) {
+  Vec3SGrid::Ptr grid = Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  describe(*grid, name, units, xform);
+  grid->setVectorType(vecType);
+  auto acc = grid->getAccessor();
+  for (size_t v = 0; v < coords.size(); ++v) acc.setValueOn(toVdb(coords[v]), toVdb(value(v)));
+  return grid;
+}
+
+openvdb::VecType vecTypeOf(FieldVecType type) {
+  switch (type) {
+    case FieldVecType::CovariantNormalize: return openvdb::VEC_COVARIANT_NORMALIZE;
+    case FieldVecType::ContravariantAbsolute: return openvdb::VEC_CONTRAVARIANT_ABSOLUTE;
+    case FieldVecType::Invariant:
+    case FieldVecType::None: break;
+  }
+  return openvdb::VEC_INVARIANT;
+}
+
+/// The entries one group of grids covers: the voxels, the voxels with
+/// surface layers (layer 0's points) or surface layer l's entries.
+struct Level {
+  int layer = 0;          ///< grid names: 0 the voxels' grids, l "layer<l>_"
+  bool ofLayers = false;  ///< the values: VdlLayers' arrays, else VdlGrid's
+  std::vector<size_t> entries;  ///< array index of value k; empty: k itself
+  std::vector<Coord> coords;    ///< voxel of value k; empty: the grid's coords
+  size_t entry(size_t k) const { return entries.empty() ? k : entries[k]; }
+};
+
+/// The grids of `row` at `level`. Each source keeps the level alive; `g`
+/// must outlive the sources.
+template <typename T>
+void addFieldSources(std::vector<GridSource>& out, const VdlGrid& g, const LightGridField<T>& row,
+                     const std::shared_ptr<const Level>& level, const Transform::Ptr& xform) {
+  const std::vector<T>& values = level->ofLayers ? g.layers.*row.layers : g.*row.voxels;
+  const size_t per = level->ofLayers ? valuesPerLayer(g, row) : valuesPerVoxel(g, row);
+  const std::vector<Coord>& coords = level->coords.empty() ? g.coords : level->coords;
+  for (const FieldGrid& grid : fieldGrids(row, level->layer, g.maxVdls, g.shTerms)) {
+    auto make = [&g, &values, &coords, per, grid, level, xform]() -> openvdb::GridBase::Ptr {
+      const size_t slot = size_t(grid.slot);
+      if constexpr (std::is_same_v<T, Vdl>) {
+        // VDL slot i only where the voxel has more than i VDLs (sparse: a
+        // voxel with fewer stores no zeros in the higher grids).
+        const std::vector<uint8_t>& count = level->ofLayers ? g.layers.vdlCount : g.vdlCount;
+        std::vector<size_t> used;
+        std::vector<Coord> usedCoords;
+        for (size_t k = 0; k < coords.size(); ++k) {
+          if (count[level->entry(k)] > grid.slot) {
+            used.push_back(level->entry(k));
+            usedCoords.push_back(coords[k]);
+          }
+        }
+        const Vec3 Vdl::*member = grid.component->member;
+        return vectorGrid(grid.name, grid.units, vecTypeOf(grid.vecType), xform, usedCoords,
+                          [&](size_t k) { return values[used[k] * per + slot].*member; });
+      } else if constexpr (std::is_same_v<T, Vec3>) {
+        return vectorGrid(grid.name, grid.units, vecTypeOf(grid.vecType), xform, coords,
+                          [&](size_t k) { return values[level->entry(k) * per + slot]; });
+      } else {
+        return floatGrid(grid.name, grid.units, xform, coords,
+                         [&](size_t k) { return float(values[level->entry(k) * per + slot]); });
+      }
+    };
+    out.push_back({grid.name, make, row.halfFloat});
+  }
+}
+
+/// The grids of the VDL file contract for `g` (which must outlive them), in
+/// file order: the voxels' grids in table order, then, with surface layers,
+/// the OneOrNone rows on the voxels with layers ("layer_point") and each
+/// layer's grids in table order.
+std::vector<GridSource> vdlGridSources(const VdlGrid& g, const Transform::Ptr& xform) {
+  std::vector<GridSource> grids;
+  auto voxels = std::make_shared<const Level>();
+  forEachField([&](const auto& row) {
+    if (row.arity != FieldArity::OneOrNone) addFieldSources(grids, g, row, voxels, xform);
+  });
+  if (g.layers.size() == 0) return grids;
+
+  std::array<std::shared_ptr<Level>, kMaxLayers> levels;
+  for (int l = 0; l < kMaxLayers; ++l) {
+    levels[size_t(l)] = std::make_shared<Level>();
+    levels[size_t(l)]->layer = l;
+    levels[size_t(l)]->ofLayers = l > 0;
+  }
+  const VdlLayers& L = g.layers;
+  for (size_t e = 0; e < L.size(); ++e) {
+    const int layer = e > 0 && L.voxel[e - 1] == L.voxel[e] ? 2 : 1;
+    levels[size_t(layer)]->entries.push_back(e);
+    levels[size_t(layer)]->coords.push_back(g.coords[L.voxel[e]]);
+    if (layer == 1) {
+      levels[0]->entries.push_back(L.voxel[e]);
+      levels[0]->coords.push_back(g.coords[L.voxel[e]]);
+    }
+  }
+  forEachField([&](const auto& row) {
+    if (row.arity == FieldArity::OneOrNone) addFieldSources(grids, g, row, levels[0], xform);
+  });
+  for (int l = 1; l < kMaxLayers; ++l) {
+    if (levels[size_t(l)]->entries.empty()) continue;
+    forEachField([&](const auto& row) {
+      if (row.layers) addFieldSources(grids, g, row, levels[size_t(l)], xform);
+    });
+  }
+  return grids;
+}
+
+bool isOptionalGrid(const std::string& name) {
+  const auto& names = optionalVdlGridNames();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
+              const VdlWriteOptions& options, const Damage* damage) {
+  initOpenVdb();
+  for (const std::string& name : options.drop) {
+    if (!isOptionalGrid(name)) {
+      std::string list;
+      for (const auto& o : optionalVdlGridNames()) list += (list.empty() ? "" : ", ") + o;
+      throw InputError("--drop: grid '" + name + "' " +
+                       (isRequiredVoxelGrid(name) ? "is required by the VDL file contract"
+                                                  : "is not a grid of the VDL file contract") +
+                       "; only optional grids can be dropped: " + list);
+    }
+  }
+  checkLightGridArrays(grid);
+  LO_CHECK(grid.maxVdls >= 1 && grid.maxVdls <= kMaxVdls);
+  if (meta.depth != 0) LO_CHECK_EQ(meta.depth, grid.frame.depth);
+  if (!(grid.frame.voxelSize > 0) || !std::isfinite(grid.frame.voxelSize)) {
+    throw InputError(path + ": cannot write a grid with voxel size " +
+                     std::to_string(grid.frame.voxelSize));
+  }
+  Transform::Ptr xform = frameTransform(grid.frame);
+  if (damage && damage->rotateTransform) xform->postRotate(0.3, openvdb::math::Z_AXIS);
+  std::vector<GridSource> sources;
+  for (GridSource& source : vdlGridSources(grid, xform)) {
+    if (damage && source.name == damage->omitGrid) continue;
+    if (std::find(options.drop.begin(), options.drop.end(), source.name) != options.drop.end()) {
+      continue;
+    }
+    const std::string name = source.name;
+    const bool half = options.halfFloat && source.halfFloat;
+    const bool shift = damage && name == damage->shiftGrid;
+    sources.push_back({name, [make = std::move(source.make), half, shift, xform, &grid] {
+                         openvdb::GridBase::Ptr g = make();
+                         if (half) g->setSaveFloatAsHalf(true);
+                         if (shift) {
+                           Transform::Ptr shifted = xform->copy();
+                           shifted->postTranslate(openvdb::Vec3d(grid.frame.voxelSize, 0, 0));
+                           g->setTransform(shifted);
+                         }
+                         return g;
+                       }});
+  }
+  openvdb::MetaMap fileMeta = fileMetadata(meta, grid);
+  if (damage && damage->formatVersion != kVdlFormatVersion) {
+    fileMeta.removeMeta(kMetaFormatVersion);
+    if (damage->formatVersion != 0) {
+      fileMeta.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(damage->formatVersion));
+    }
+  }
+  writeVdbFile(path, sources, fileMeta);
+}
+
+}  // namespace
+
+void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
+                         const Damage& damage) {
+  writeVdl(path, grid, meta, damage.options, &damage);
+}
+
+}  // namespace vdb_internal
+
+void writeVdlGrid(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
+                  const VdlWriteOptions& options) {
+  vdb_internal::writeVdl(path, grid, meta, options, nullptr);
+}
+
+}  // namespace lo
