@@ -9,6 +9,7 @@
 #include "render/atlas_lighting.h"
 #include "render/context.h"
 #include "render/renderer.h"
+#include "scene/pinhole_camera.h"
 #include "scene/scene.h"
 #include "test_util.h"
 #include "vdb/vdb_io.h"
@@ -42,7 +43,12 @@ TEST(AtlasLighting, AtlasIsBakedWithTheGivenSettingsAndSet) {
   p.stitchSeams = false;
   const std::optional<LightmapBake> atlas = prepareLighting(renderer, scene, octree, p);
   ASSERT_TRUE(atlas.has_value());
-  EXPECT_TRUE(renderer.hasAtlas());
+  ASSERT_TRUE(renderer.hasAtlas());
+  RenderParams frame;
+  frame.width = frame.height = 16;
+  frame.lighting = Lighting::Atlas;
+  EXPECT_NO_THROW(renderer.render(PinholeCamera::fromScene(scene.cameras.at(0)), frame))
+      << "a frame drawn from the atlas set";
   LightmapParams lp;
   lp.atlas.shade.interpolation = false;
   lp.atlas.stitchSeams = false;
