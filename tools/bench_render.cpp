@@ -30,6 +30,7 @@
 #include "lightmap/lightmap_bake.h"
 #include "octree/gpu_octree.h"
 #include "render/atlas_gpu.h"
+#include "render/atlas_lighting.h"
 #include "render/context.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -222,8 +223,9 @@ int main(int argc, char** argv) try {
     lo::Renderer renderer(b.scene, o);
     // The octree rendered into a lightmap atlas (CPU, the renderer's lookup
     // with interpolation), once per scene.
-    const lo::LightmapBake atlas = lo::bakeLightmap(b.scene, o);
-    renderer.setAtlas(atlas.uvs, atlas.atlas);
+    lo::LightingParams lighting;
+    lighting.lighting = lo::Lighting::Atlas;
+    const lo::LightmapBake atlas = *lo::prepareLighting(renderer, b.scene, o, lighting);
     std::printf("  atlas: %s\n", atlas.ToString().c_str());
     // The same atlas baked in this GL context (render/atlas_gpu.h); the
     // program is linked before the bake's clocks start.

@@ -3,10 +3,9 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <memory>
+#include <optional>
 
 #include "lightmap/lightmap_bake.h"
-#include "render/atlas_gpu.h"
 
 namespace lo::tool {
 
@@ -43,25 +42,22 @@ GpuOctreeParams ShadingOptions::octreeParams(const GlInfo* info) const {
   return p;
 }
 
+LightingParams ShadingOptions::lightingParams() const {
+  LightingParams p;
+  p.lighting = parseLighting(lighting);
+  p.uvSource = parseUvSource(uv);
+  p.shade = shadeParamsOf(renderParams(RenderMode::Full));
+  p.stitchSeams = stitchSeams == "on";
+  p.atlasOnGpu = atlasOn == "gpu";
+  return p;
+}
+
 void ShadingOptions::prepareLighting(Renderer& renderer, const Scene& scene,
                                      const GpuOctree& octree, bool quiet) const {
-  if (parseLighting(lighting) != Lighting::Atlas) return;
-  LightmapParams params;
-  params.uvSource = parseUvSource(uv);
-  const RenderParams frame = renderParams(RenderMode::Full);
-  params.atlas.shade.interpolation = frame.interpolation;
-  params.atlas.shade.maxVdls = frame.maxVdls;
-  params.atlas.shade.normalOffset = frame.normalOffset;
-  params.atlas.stitchSeams = stitchSeams == "on";
-  std::unique_ptr<GpuAtlasEvaluator> gpu;
-  if (atlasOn == "gpu") {
-    gpu = std::make_unique<GpuAtlasEvaluator>();
-    params.atlas.evaluator = gpu.get();
-  }
-  const LightmapBake baked = bakeLightmap(scene, octree, params);
-  renderer.setAtlas(baked.uvs, baked.atlas);
-  if (!quiet) {
-    std::printf("atlas: %s; %.1f MiB on the GPU\n", baked.ToString().c_str(),
+  const std::optional<LightmapBake> baked =
+      lo::prepareLighting(renderer, scene, octree, lightingParams());
+  if (baked && !quiet) {
+    std::printf("atlas: %s; %.1f MiB on the GPU\n", baked->ToString().c_str(),
                 double(renderer.atlasBytes()) / (1024.0 * 1024.0));
   }
 }

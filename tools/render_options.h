@@ -10,6 +10,7 @@
 
 #include "lightgrid/vdl_grid.h"
 #include "octree/gpu_octree.h"
+#include "render/atlas_lighting.h"
 #include "render/context.h"
 #include "render/renderer.h"
 
@@ -46,10 +47,12 @@ struct ShadingOptions {
   RendererParams rendererParams() const;
   /// The octree's texel format, within the limits of `info` when given.
   GpuOctreeParams octreeParams(const GlInfo* info = nullptr) const;
-  /// With --lighting atlas: bakes lightmap UVs and the octree into their
-  /// atlas (src/lightmap, the renderer's lookup settings; with --atlas-on
-  /// gpu in the renderer's GL context, render/atlas_gpu.h) and hands them to
-  /// `renderer`; prints what was baked unless `quiet`. No-op for octree.
+  /// --lighting, --uv, --stitch-seams, --atlas-on, with the frames' lookup
+  /// settings (render/atlas_lighting.h).
+  LightingParams lightingParams() const;
+  /// lo::prepareLighting with lightingParams() (with --lighting atlas: the
+  /// atlas baked and handed to `renderer`); prints what was baked unless
+  /// `quiet`. No-op for octree.
   void prepareLighting(Renderer& renderer, const Scene& scene, const GpuOctree& octree,
                        bool quiet) const;
 };

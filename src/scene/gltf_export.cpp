@@ -742,12 +742,10 @@ GltfFiles encodeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,
   return files;
 }
 
-void writeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,
-                       const std::string& path) {
-  const GltfFiles files = encodeLightmapGltf(scene, lightmap, path);
+std::vector<std::string> writeGltfFiles(const GltfFiles& files, const std::string& path) {
   if (files.binUri.empty()) {
     writeTextAtomically(path, files.gltf);
-    return;
+    return {path};
   }
   const std::string binPath = (std::filesystem::path(path).parent_path() / files.binUri).string();
   writeTextAtomically(binPath, files.bin);
@@ -758,6 +756,12 @@ void writeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,
     std::filesystem::remove(binPath, ignored);
     throw;
   }
+  return {binPath, path};
+}
+
+void writeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,
+                       const std::string& path) {
+  writeGltfFiles(encodeLightmapGltf(scene, lightmap, path), path);
 }
 
 }  // namespace lo

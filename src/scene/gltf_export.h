@@ -80,8 +80,13 @@ struct GltfFiles {
 GltfFiles encodeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,
                              const std::string& path);
 
-/// @brief encodeLightmapGltf, then the file(s) written atomically (core/file.h;
-/// a .gltf's .bin first, removed again if the .gltf cannot be written).
+/// @brief Writes `files`, encodeLightmapGltf's for `path`, atomically
+/// (core/file.h): a .gltf's .bin first, removed again if the .gltf cannot be
+/// written. Returns the paths written, the .bin first.
+/// @throws IoError naming the file.
+std::vector<std::string> writeGltfFiles(const GltfFiles& files, const std::string& path);
+
+/// @brief encodeLightmapGltf, then writeGltfFiles.
 /// @throws InputError as encodeLightmapGltf; IoError naming the file.
 void writeLightmapGltf(const Scene& scene, const LightmapExport& lightmap, const std::string& path);
 

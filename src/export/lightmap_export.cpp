@@ -1,0 +1,239 @@
+#include "export/lightmap_export.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <memory>
+
+#include "core/error.h"
+#include "core/file.h"
+#include "image/image.h"
+#include "octree/gpu_octree.h"
+#include "reference/path_tracer.h"
+#include "render/atlas_gpu.h"
+#include "scene/gltf_export.h"
+#include "vdb/vdb_io.h"
+
+namespace lo {
+
+namespace fs = std::filesystem;
+
+namespace lightmap_export_internal {
+
+/// RGBM's range: the next power of two at or above the brightest texel, so
+/// the pages use the 8 bits they have (recorded in the extras).
+float rgbmRangeFor(const std::vector<RgbImage>& pages) {
+  float brightest = 0;
+  for (const RgbImage& page : pages)
+    for (float v : page.rgb)
+      if (std::isfinite(v)) brightest = std::max(brightest, v);
+  return brightest > 0 ? std::exp2(std::ceil(std::log2(brightest))) : 1.0f;
+}
+
+/// D/OUT<suffix> for output D/OUT.glb or .gltf.
+std::string besideOutput(const std::string& output, const std::string& suffix) {
+  const fs::path out(output);
+  return (out.parent_path() / (out.stem().string() + suffix)).string();
+}
+
+/// Files this export has written, removed again if a later one fails, so
+/// that a failed export leaves nothing behind.
+class WrittenFiles {
+ public:
+  void add(const std::string& path) { paths_.push_back(path); }
+  void keep() { paths_.clear(); }
+  ~WrittenFiles() {
+    for (const std::string& p : paths_) {
+      std::error_code ignored;
+      fs::remove(p, ignored);
+    }
+  }
+
+ private:
+  std::vector<std::string> paths_;
+};
+
+void addRow(std::vector<StageReport>& rows, const std::string& name, double seconds,
+            const std::string& detail) {
+  StageReport r;
+  r.name = name;
+  r.seconds = seconds;
+  r.rssBytes = currentRssBytes();
+  r.peakBytes = peakRssBytes();
+  r.detail = detail;
+  rows.push_back(r);
+}
+
+/// The export, its octree made by `makeOctree` in the "octree" row.
+LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctree()>& makeOctree,
+                                const LightmapExportParams& params) {
+  checkLightmapExportPath(params.output);
+  LightmapExportResult result;
+  result.output = params.output;
+  std::vector<StageReport>& rows = result.stages;
+
+  StageTimer octreeTimer(rows, "octree");
+  const GpuOctree octree = makeOctree();
+  result.octreeLeaves = octree.leafCount;
+  result.octreePoolBytes = octree.poolBytes();
+  result.octreeVdlBytes = octree.vdlBytes();
+  octreeTimer.finish(formatCount(octree.leafCount) + " leaves, " +
+                     formatBytes(octree.poolBytes() + octree.vdlBytes()));
+
+  LightmapParams bake = params.lightmap;
+  bake.atlas.radiance = params.preview;  // the preview's base colour
+  // AtlasContent::Full: the direct light by the path tracer's own light
+  // sampling (src/reference), handed to the atlas bake as a function so
+  // that the lightmap stage links no ray tracer.
+  std::unique_ptr<DirectIrradiance> direct;
+  if (params.content == AtlasContent::Full) {
+    direct = std::make_unique<DirectIrradiance>(scene);
+    bake.atlas.directLight = [&direct, samples = params.directSamples](
+                                 const std::vector<AtlasSurfacePoint>& texels, int page) {
+      std::vector<DirectIrradiance::Point> points(texels.size());
+      for (size_t i = 0; i < texels.size(); ++i) {
+        points[i] = {texels[i].position, texels[i].triangle, texels[i].normal};
+      }
+      return direct->atMany(points, samples, /*seed=*/1, uint64_t(page) << 32);
+    };
+  }
+  // The octree rendered into the atlas by GL (render/atlas_gpu.h) in a
+  // headless context of the kind asked for.
+  std::unique_ptr<GlContext> context;
+  std::unique_ptr<GpuAtlasEvaluator> gpu;
+  if (params.atlasGl) {
+    GlContextParams contextParams;
+    contextParams.backend = *params.atlasGl;
+    context = createGlContext(contextParams);
+    result.glInfo = context->info().ToString();
+    gpu = std::make_unique<GpuAtlasEvaluator>();
+    bake.atlas.evaluator = gpu.get();
+  }
+  result.lightmap = bakeLightmap(scene, octree, bake);
+  const LightmapUvs& uvs = result.lightmap.uvs;
+  const LightmapAtlas& atlas = result.lightmap.atlas;
+  addRow(rows, "UVs", result.lightmap.uvSeconds,
+         std::string(result.lightmap.fromTexcoord1 ? "TEXCOORD_1, " : "automatic, ") +
+             formatCount(size_t(uvs.chartCount)) + " charts");
+  addRow(rows, "atlas: raster", atlas.rasterSeconds,
+         formatCount(atlas.coveredTexels) + " covered texels");
+  addRow(rows, "atlas: evaluate", atlas.evaluateSeconds,
+         params.preview ? "irradiance and radiance" : "irradiance");
+  addRow(
+      rows, "atlas: dilate", atlas.dilateSeconds,
+      formatCount(atlas.dilatedTexels) + " texels, " + std::to_string(atlas.dilation) + " rings");
+  addRow(rows, "atlas: stitch", atlas.stitchSeconds,
+         formatCount(atlas.seamEdges) + " seam edges, mismatch " +
+             formatNumber(atlas.seamMismatchBefore) + " -> " +
+             formatNumber(atlas.seamMismatchAfter) + " W/m^2");
+
+  // Everything is encoded in memory first; the files are written last.
+  StageTimer encodeTimer(rows, "encode");
+  LightmapExport ex;
+  ex.uv = uvs.uv;
+  ex.trianglePage = uvs.trianglePage;
+  ex.width = atlas.width;
+  ex.height = atlas.height;
+  ex.content = toString(params.content);
+  ex.encoding = params.rgbm ? "rgbm-png" : "linear-exr";
+  std::vector<std::string> rgbmPages;
+  if (params.rgbm) {
+    ex.rgbmRange = rgbmRangeFor(atlas.irradiance);
+    result.rgbmRange = ex.rgbmRange;
+    for (const RgbImage& page : atlas.irradiance) {
+      const std::vector<unsigned char> png = encodeRgbmPng(page, ex.rgbmRange);
+      rgbmPages.emplace_back(png.begin(), png.end());
+    }
+  }
+  for (int p = 0; p < atlas.pageCount; ++p) {
+    result.pagePaths.push_back(lightmapPagePath(params.output, p, params.rgbm));
+    ex.pageUris.push_back(fs::path(result.pagePaths.back()).filename().string());
+  }
+  const GltfFiles lit = encodeLightmapGltf(scene, ex, params.output);
+  GltfFiles unlit;
+  if (params.preview) {
+    result.previewPath = besideOutput(params.output, "-preview.glb");
+    LightmapExport preview = ex;
+    preview.unlit = true;
+    preview.previewExposureEv = params.previewExposureEv;
+    for (const RgbImage& page : atlas.radiance)
+      preview.previewPng.push_back(encodePng(page, params.previewExposureEv));
+    unlit = encodeLightmapGltf(scene, preview, result.previewPath);
+  }
+  result.outputBytes = lit.gltf.size() + lit.bin.size();
+  result.previewBytes = unlit.gltf.size();
+  encodeTimer.finish(ex.encoding + (params.preview ? " + unlit preview" : ""));
+
+  StageTimer writeTimer(rows, "write");
+  WrittenFiles written;
+  for (int p = 0; p < atlas.pageCount; ++p) {
+    const std::string& path = result.pagePaths[size_t(p)];
+    if (params.rgbm) {
+      writeTextAtomically(path, rgbmPages[size_t(p)]);
+    } else {
+      writeExr(path, atlas.irradiance[size_t(p)]);
+    }
+    written.add(path);
+    result.pageFileBytes += size_t(fs::file_size(path));
+  }
+  for (const std::string& path : writeGltfFiles(lit, params.output)) written.add(path);
+  if (params.preview) {
+    for (const std::string& path : writeGltfFiles(unlit, result.previewPath)) written.add(path);
+  }
+  if (params.chartImages) {
+    for (int p = 0; p < uvs.pageCount; ++p) {
+      result.chartPaths.push_back(besideOutput(params.output, "-charts" + std::to_string(p) + ".png"));
+      const std::vector<uint8_t> png = encodePng(chartLayoutImage(uvs, p));
+      writeTextAtomically(result.chartPaths.back(), std::string(png.begin(), png.end()));
+      written.add(result.chartPaths.back());
+    }
+  }
+  written.keep();
+  writeTimer.finish(formatCount(size_t(atlas.pageCount) + 1 + (params.preview ? 1 : 0) +
+                                result.chartPaths.size()) +
+                    " files");
+  return result;
+}
+
+}  // namespace lightmap_export_internal
+
+AtlasContent parseAtlasContent(const std::string& name) {
+  if (name == "indirect") return AtlasContent::Indirect;
+  if (name == "full") return AtlasContent::Full;
+  throw InputError("--content: '" + name + "' (expected indirect or full)");
+}
+
+const char* toString(AtlasContent content) {
+  return content == AtlasContent::Full ? "full" : "indirect";
+}
+
+void checkLightmapExportPath(const std::string& output, const char* flag) {
+  if (!hasExtension(output, ".glb") && !hasExtension(output, ".gltf")) {
+    throw InputError(std::string(flag) + ": '" + output + "' must end in .glb or .gltf");
+  }
+}
+
+std::string lightmapPagePath(const std::string& output, int page, bool rgbm) {
+  return lightmap_export_internal::besideOutput(
+      output, "-lightmap" + std::to_string(page) + (rgbm ? ".png" : ".exr"));
+}
+
+LightmapExportResult exportLightmap(const Scene& scene, const VdlGrid& grid,
+                                    const LightmapExportParams& params) {
+  // The renderer's octree (cosine correction on, float VDLs): GpuOctreeParams'
+  // defaults, as `render` builds it, so that the atlas holds what the
+  // renderer would compute.
+  return lightmap_export_internal::exportWith(
+      scene, [&grid] { return buildGpuOctree(grid, GpuOctreeParams{}); }, params);
+}
+
+LightmapExportResult exportLightmap(const Scene& scene, const std::string& lightsPath,
+                                    const LightmapExportParams& params) {
+  return lightmap_export_internal::exportWith(
+      scene,
+      [&lightsPath] { return buildGpuOctree(readVdlGrid(lightsPath).grid, GpuOctreeParams{}); },
+      params);
+}
+
+}  // namespace lo

@@ -1,0 +1,121 @@
+#include "bake_options.h"
+
+#include <CLI/CLI.hpp>
+
+#include "cli_checks.h"
+#include "core/resources.h"
+
+namespace lo::tool {
+
+BakeParams BakeOptions::bakeParams() const {
+  BakeParams params;
+  params.depth = depth;
+  params.photons = photons;
+  params.knn = knn;
+  params.radius = radius;
+  params.vdls = parseVdlCount(vdls);
+  params.seed = seed;
+  params.includeDirect = includeDirect;
+  params.layers = layers == "on";
+  params.occlusion = occlusion == "on";
+  params.edgeCorrection = edgeCorrection == "on";
+  params.smoothing = smoothing == "on";
+  params.autoCap = autoCap;
+  params.autoThreshold = autoThreshold;
+  parseRepresentation(representation, &params.representation);  // checked by the flag
+  if (!bounds.empty()) {
+    params.region.extend(Vec3{float(bounds[0]), float(bounds[1]), float(bounds[2])});
+    params.region.extend(Vec3{float(bounds[3]), float(bounds[4]), float(bounds[5])});
+  }
+  params.keepPhotons = !photonMap.empty();
+  return params;
+}
+
+void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
+  cmd->add_option("scene", opt.scene, "Scene to bake: .gltf, .glb or .obj")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", opt.output, "Output .vdb file (written atomically)")->required();
+  cmd->add_option("--depth", opt.depth,
+                  "Octree depth: 2^depth voxels across the scene's bounding cube")
+      ->check(depthValidator())
+      ->capture_default_str();
+  cmd->add_option("--photons", opt.photons, "Photons to store in the photon map")
+      ->check(CLI::Range(size_t(1), size_t(200000000)))
+      ->capture_default_str();
+  cmd->add_option("--knn", opt.knn, "Nearest photons gathered per voxel (paper: 300)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--radius", opt.radius,
+                  "Gathering radius in scene units (default: " + formatNumber(kDefaultRadiusVoxels) + " voxel sizes)")
+      ->check(finitePositive());
+  cmd->add_option("--vdls", opt.vdls,
+                  "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest (up to --auto-cap) whose "
+                  "angular error is under --auto-threshold")
+      ->check(vdlCountValidator())
+      ->capture_default_str();
+  cmd->add_option("--representation", opt.representation,
+                  "How each voxel stores its light: 'vdl' (virtual directional lights, the "
+                  "paper's), or the irradiance as spherical harmonics of order 1 ('sh1', 4 terms) "
+                  "or 2 ('sh2', 9 terms); docs/accuracy.md compares them")
+      ->check(CLI::IsMember(representationNames()))
+      ->capture_default_str();
+  cmd->add_option("--auto-cap", opt.autoCap, "With --vdls auto: at most this many VDLs per voxel")
+      ->check(CLI::Range(1, kMaxVdls))
+      ->capture_default_str();
+  cmd->add_option("--auto-threshold", opt.autoThreshold,
+                  "With --vdls auto: the fewest VDLs whose angular error (chord-length deviation, "
+                  "0..2; 0.35 is about 20 degrees) is under this")
+      ->check(finitePositive())
+      ->capture_default_str();
+  cmd->add_option("--seed", opt.seed, "Random seed (same seed, same bytes)")
+      ->check(seedValidator())->capture_default_str();
+  cmd->add_option("--threads", opt.threads, "Worker threads (0 = all cores)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  cmd->add_flag("--include-direct", opt.includeDirect,
+                "Also store direct-light photons (by default the GL renderer draws direct light)");
+  cmd->add_option("--layers", opt.layers,
+                  "Surface layers: a voxel whose photons land on surfaces facing clearly "
+                  "different ways (an edge, the two sides of a thin wall) keeps one gather and "
+                  "one set of VDLs per orientation (docs/accuracy.md)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--gather-occlusion", opt.occlusion,
+                  "Leave out photons that lie behind geometry seen from the voxel: no light "
+                  "gathered through thin walls (one shadow ray per neighbouring photon group)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--edge-correction", opt.edgeCorrection,
+                  "Divide the gathered power by the part of the gather disc that lies on the "
+                  "surface, not the whole disc: next to an edge the plain estimate is too dark")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--smoothing", opt.smoothing,
+                  "Smooth each voxel's estimate with its neighbours on the same surface, where "
+                  "they differ by no more than the photon noise explains (shadow edges kept)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--bounds", opt.bounds,
+                  "A region of interest, x0,y0,z0,x1,y1,z1 in scene units: the grid covers it "
+                  "alone, photons are stored only inside it and suns shine on its footprint "
+                  "(a room on a large ground plane)")
+      ->expected(6)
+      ->delimiter(',');
+  cmd->add_option("--photon-map", opt.photonMap,
+                  "Also write the photons as an OpenVDB point grid for inspection");
+  cmd->add_option("--stats-json", opt.statsJson,
+                  "Write the per-stage figures as JSON (under mpirun, per rank too: time, "
+                  "bytes sent, peak memory)");
+  cmd->add_option("--tiles", opt.tiles,
+                  "Under mpirun (mpirun -np N lightoctree bake ...): tiles per axis the grid is "
+                  "cut into and shared among the ranks by estimated memory, a power of two with "
+                  "tiles of at least 8^3 voxels, or 'auto' (32, fewer for shallow grids). The "
+                  ".vdb bytes are the one-process bake's whatever the tiles and ranks "
+                  "(docs/scale.md)")
+      ->check(tilesValidator())
+      ->capture_default_str();
+  cmd->add_flag("-q,--quiet", opt.quiet, "No progress or summary, only errors");
+}
+
+}  // namespace lo::tool

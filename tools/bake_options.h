@@ -1,0 +1,49 @@
+#pragma once
+/// @file tools/bake_options.h
+/// @brief The flags of `bake` and their translation into BakeParams.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/bake.h"
+
+namespace CLI {
+class App;
+}
+
+namespace lo::tool {
+
+/// The flags of `bake`, as given.
+struct BakeOptions {
+  std::string scene;
+  std::string output;
+  int depth = 6;
+  size_t photons = 600000;
+  int knn = 300;
+  float radius = 0;  // 0 = auto
+  std::string vdls = "4";
+  std::string representation = "vdl";
+  uint64_t seed = 1;
+  int threads = 0;  // 0 = all cores
+  bool includeDirect = false;
+  std::string layers = "on";
+  std::string occlusion = "on";
+  std::string edgeCorrection = "on";
+  std::string smoothing = "on";
+  int autoCap = BakeParams{}.autoCap;
+  float autoThreshold = BakeParams{}.autoThreshold;
+  std::vector<double> bounds;  // x0 y0 z0 x1 y1 z1, empty = the whole scene
+  std::string photonMap;
+  std::string statsJson;
+  std::string tiles = "auto";
+  bool quiet = false;
+
+  /// The bake's settings from the flags (keepPhotons: --photon-map given).
+  BakeParams bakeParams() const;
+};
+
+/// Registers the flags of `bake` on `cmd`.
+void addBakeOptions(CLI::App* cmd, BakeOptions& opt);
+
+}  // namespace lo::tool
