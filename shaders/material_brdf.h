@@ -74,7 +74,8 @@ LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metall
   float a2 = a * a;
   float dd = nh * nh * (a2 - 1.0f) + 1.0f;
   float D = a2 / (LO_BRDF_PI * dd * dd);
-  float vis = 0.5f / (nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2));
+  float vis =
+      0.5f / (nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2));
   vec3 f0 = mix(vec3(0.04f), baseColor, metallic);
   vec3 F = f0 + (1.0f - f0) * pow(1.0f - vh, 5.0f);
   diffuse *= 1.0f - F;

@@ -2,7 +2,7 @@
 // Evaluates the shared BRDF of material_brdf.h on the samples of uInputs (one
 // per column: 4 texels of inputs), one output row per function, so a test can
 // compare the GLSL results with the same functions compiled as C++
-// (render/brdf_probe.h lists the rows).
+// (render/shader_probes.h lists the rows).
 uniform sampler2D uInputs;  // RGBA32F, 4 rows
 out vec4 result;
 #include "material_brdf.h"

@@ -30,9 +30,12 @@ static_assert(sizeof(vec4) == 16 && sizeof(ivec4) == 16 && sizeof(mat4) == 64 &&
 /* One light. Render space: world minus the scene's centre. */
 struct GpuLight {
   vec4 positionType;   /* xyz position, w type (LO_LIGHT_*) */
-  vec4 directionRange; /* xyz unit direction light travels (spot, directional, emitter normal), w range (0 = none) */
-  vec4 colorFar;       /* rgb: W/sr (point, spot, emitter at normal incidence), W/m^2 (directional), W/(m^2 sr) (area); w shadow far */
-  vec4 params;         /* x cos outer, y cos inner, z first shadow layer (-1 = none), w near-field area (m^2) */
+  vec4 directionRange; /* xyz unit direction light travels (spot, directional, emitter
+                          normal), w range (0 = none) */
+  vec4 colorFar;       /* rgb: W/sr (point, spot, emitter at normal incidence), W/m^2
+                          (directional), W/(m^2 sr) (area); w shadow far */
+  vec4 params;         /* x cos outer, y cos inner, z first shadow layer (-1 = none),
+                          w near-field area (m^2) */
   vec4 corner0;        /* area light: the triangle's corners; corner0.w = sqrt(area) */
   vec4 corner1;
   vec4 corner2;

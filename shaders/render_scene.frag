@@ -45,6 +45,73 @@ vec3 hashColor(ivec3 c) {
 
 #include "render_scene_surface.glsl"
 
+// Indirect light at the fragment (paper §3.2): the octree's VDLs (or the
+// lightmap atlas's one rebuilt VDL) through the BRDF, and the probe's share
+// of the specular lobe. ng: the geometric normal, turned to the viewer.
+vec3 indirectLight(vec3 n, vec3 v, vec3 ng, vec3 baseColor, float metallic, float roughness,
+                   vec3 nLayer) {
+  LoSurface s = LoSurface(n, v, baseColor, metallic, roughness, nLayer);
+  float probe = probeWeight(roughness);
+  gVdlSpecular = 1.0 - probe;
+  vec3 indirect;
+  // The atlas programs (LO_ATLAS_LIGHTING) leave the octree walk out: on
+  // a software rasterizer the code's mere presence costs (scene_pass.cpp).
+#ifdef LO_ATLAS_LIGHTING
+  if (true) {
+#else
+  if (uAtlas) {
+#endif
+    // Render to atlas (paper §4.2.3): one VDL rebuilt from the texel's
+    // irradiance E (baked for the interpolated vertex normal) and mean
+    // direction d: E / (n_bake . d) along d, through the same BRDF.
+    vec3 E = texture(uAtlasIrradiance, vLightmap).rgb;
+    vec3 d = texture(uAtlasDirection, vLightmap).rgb;
+    float dl = length(d);
+    indirect = vec3(0.0);
+    if (dl > 1e-3) {
+      d /= dl;
+      vec3 nb = normalize(vNormal);
+      if (dot(nb, ng) < 0.0) nb = -nb;
+      indirect = loVdlResponse(s, d) * E / max(dot(nb, d), 0.05);
+    }
+  } else {
+#ifndef LO_ATLAS_LIGHTING
+    indirect = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
+                                uInterpolation, uMaxVdls, s);
+#endif
+  }
+  if (probe > 0.0) {
+    indirect += probe * probeSpecular(vPosition, n, v, baseColor, metallic, roughness);
+  }
+  return indirect;
+}
+
+// Light through a transmissive surface (KHR_materials_transmission).
+vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
+  // Thin-walled transmission (glTF without KHR_materials_volume): the
+  // surface replaces that share of its diffuse lobe by the scene behind
+  // it, seen straight through, tinted by the base colour and weighted by
+  // the Fresnel transmittance at the viewing angle (Schlick, F0 = 0.04).
+  // Thin-walled: seen straight through. With a volume: screen-space
+  // refraction, the image read where the refracted ray leaves a slab of the
+  // material's thickness (an approximation: the real exit depends on the
+  // shape behind the surface).
+  vec3 behind;
+  if (uThickness > 0.0) {
+    vec3 t = refract(-v, n, 1.0 / max(uIor, 1.0));
+    if (dot(t, t) == 0.0) t = -v;
+    vec4 clip = uViewProj * vec4(vPosition + t * uThickness, 1.0);
+    vec2 uv = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
+    behind = textureLod(uBehind, uv, 0.0).rgb;
+  } else {
+    behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0).rgb;
+  }
+  if (uEncodeSrgb) behind = srgbDecode(behind);
+  behind /= uExposureScale;
+  float fresnel = 0.04 + 0.96 * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);
+  return uTransmission * (1.0 - fresnel) * baseColor * behind;
+}
+
 void main() {
   vec3 v = normalize(uEye - vPosition);
   vec3 n = normalize(vNormal);
@@ -108,70 +175,14 @@ void main() {
     }
 #endif
     if (uMode == LO_MODE_FULL || uMode == LO_MODE_INDIRECT) {
-      LoSurface s = LoSurface(n, v, baseColor, metallic, roughness, nLayer);
       // glTF: occlusion darkens the indirect light only.
       float occlusion = uHasOcclusionTexture
                             ? 1.0 + uOcclusionStrength * (texture(uOcclusionTexture, vOcclusionUv).r - 1.0)
                             : 1.0;
-      float probe = probeWeight(roughness);
-      gVdlSpecular = 1.0 - probe;
-      vec3 indirect;
-      // The atlas programs (LO_ATLAS_LIGHTING) leave the octree walk out: on
-      // a software rasterizer the code's mere presence costs (scene_pass.cpp).
-#ifdef LO_ATLAS_LIGHTING
-      if (true) {
-#else
-      if (uAtlas) {
-#endif
-        // Render to atlas (paper §4.2.3): one VDL rebuilt from the texel's
-        // irradiance E (baked for the interpolated vertex normal) and mean
-        // direction d: E / (n_bake . d) along d, through the same BRDF.
-        vec3 E = texture(uAtlasIrradiance, vLightmap).rgb;
-        vec3 d = texture(uAtlasDirection, vLightmap).rgb;
-        float dl = length(d);
-        indirect = vec3(0.0);
-        if (dl > 1e-3) {
-          d /= dl;
-          vec3 nb = normalize(vNormal);
-          if (dot(nb, ng) < 0.0) nb = -nb;
-          indirect = loVdlResponse(s, d) * E / max(dot(nb, d), 0.05);
-        }
-      } else {
-#ifndef LO_ATLAS_LIGHTING
-        indirect = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
-                                    uInterpolation, uMaxVdls, s);
-#endif
-      }
-      if (probe > 0.0) {
-        indirect += probe * probeSpecular(vPosition, n, v, baseColor, metallic, roughness);
-      }
-      radiance += occlusion * indirect;
+      radiance += occlusion * indirectLight(n, v, ng, baseColor, metallic, roughness, nLayer);
     }
   }
-  if (uTransmission > 0.0) {
-    // Thin-walled transmission (glTF without KHR_materials_volume): the
-    // surface replaces that share of its diffuse lobe by the scene behind
-    // it, seen straight through, tinted by the base colour and weighted by
-    // the Fresnel transmittance at the viewing angle (Schlick, F0 = 0.04).
-    // Thin-walled: seen straight through. With a volume: screen-space
-    // refraction, the image read where the refracted ray leaves a slab of the
-    // material's thickness (an approximation: the real exit depends on the
-    // shape behind the surface).
-    vec3 behind;
-    if (uThickness > 0.0) {
-      vec3 t = refract(-v, n, 1.0 / max(uIor, 1.0));
-      if (dot(t, t) == 0.0) t = -v;
-      vec4 clip = uViewProj * vec4(vPosition + t * uThickness, 1.0);
-      vec2 uv = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
-      behind = textureLod(uBehind, uv, 0.0).rgb;
-    } else {
-      behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0).rgb;
-    }
-    if (uEncodeSrgb) behind = srgbDecode(behind);
-    behind /= uExposureScale;
-    float fresnel = 0.04 + 0.96 * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);
-    radiance += uTransmission * (1.0 - fresnel) * baseColor * behind;
-  }
+  if (uTransmission > 0.0) radiance += transmittedLight(n, v, baseColor);
   if (cutOut) discard;
   radiance *= uExposureScale;
   fragColor = vec4(uEncodeSrgb ? srgbEncode(radiance) : radiance, coverage);

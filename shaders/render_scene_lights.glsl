@@ -62,90 +62,103 @@ vec3 closestOnTriangle(vec3 p, vec3 a, vec3 b, vec3 c) {
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
+// Light reflected towards v from area light i: the exact irradiance of its
+// triangle, softly shadowed (areaShadow), through the BRDF.
+vec3 areaLight(int i, vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughness) {
+#define L uLights[i]
+  // One-sided Lambertian emitter: nothing behind its plane is lit, and
+  // a point in the plane (the ceiling around a ceiling light) sees it at
+  // grazing incidence: nothing either (the clipped edge sum would be
+  // all rounding there).
+  if (dot(p - L.corner0.xyz, L.directionRange.xyz) <= 1e-3 * L.corner0.w) return vec3(0.0);
+  vec3 lightCentre;
+  float solid = polygonIrradiance(p, n, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz, lightCentre);
+  if (solid <= 0.0) return vec3(0.0);
+  vec3 la = normalize(lightCentre - p);
+  float visible = areaShadow(i, p, gGeometricNormal, la);
+  if (visible <= 0.0) return vec3(0.0);
+  // Diffuse: the lobe in the direction of the light's visible part times
+  // the exact projected solid angle.
+  vec3 diffuse, specular;
+  float a = loBrdfAlpha(roughness);
+  loBrdfLobes(n, v, la, baseColor, metallic, a, uTransmission, diffuse, specular);
+  if (!uSpecular) diffuse = loBrdfDiffuseOnly(baseColor, metallic, uTransmission);
+  vec3 f = diffuse * solid;
+  if (uSpecular) {
+    // Specular: a representative point (Karis 2013): the point of the
+    // triangle nearest the reflected ray, the GGX lobe evaluated towards
+    // it with its own alpha and scaled by (alpha / alpha')^2, alpha'
+    // widened by the light's angular radius: a glossy surface shows the
+    // light's shape, not a highlight of the lobe's size at its centre.
+    vec3 r = reflect(-v, n);
+    vec3 nE = L.directionRange.xyz;
+    float towards = dot(r, nE);
+    vec3 q = lightCentre;
+    if (towards < -1e-4) q = p + r * max(dot(L.corner0.xyz - p, nE) / towards, 0.0);
+    q = closestOnTriangle(q, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz);
+    vec3 ls = normalize(q - p);
+    float nls = dot(n, ls);
+    if (nls > 0.0) {
+      float distance = length(lightCentre - p);
+      float radius = L.corner0.w * 0.5641896;  // sqrt(area / pi)
+      float wide = clamp(a + radius / (2.0 * distance), a, 1.0);
+      vec3 dRep, sRep;
+      loBrdfLobes(n, v, ls, baseColor, metallic, a, uTransmission, dRep, sRep);
+      float omega = solid / max(dot(n, la), 1e-4);  // the light's solid angle
+      f += sRep * (a * a / (wide * wide)) * nls * omega;
+    }
+  }
+  return f * L.colorFar.rgb * visible;
+#undef L
+}
+
+// Light reflected towards v from punctual light or VPL i, shadowed.
+vec3 punctualLight(int i, vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic,
+                   float roughness) {
+  // The light read in place (a copy of the 7-vec4 struct is dear on llvmpipe).
+#define L uLights[i]
+  int type = int(L.positionType.w);
+  vec3 l;
+  vec3 E = L.colorFar.rgb;  // irradiance on a surface facing the light, W/m^2
+  if (type == LO_LIGHT_DIRECTIONAL) {
+    l = -L.directionRange.xyz;
+  } else {
+    vec3 tl = L.positionType.xyz - p;
+    float dist2 = dot(tl, tl);
+    float dist = sqrt(dist2);
+    l = tl / dist;
+    // Near-field clamp for emitter VPLs: never closer than the patch allows.
+    E /= max(dist2, L.params.w);
+    float range = L.directionRange.w;
+    if (range > 0.0) {
+      float r = dist / range;
+      E *= pow(clamp(1.0 - r * r * r * r, 0.0, 1.0), 2.0);
+    }
+    float cd = dot(-l, L.directionRange.xyz);
+    if (type == LO_LIGHT_SPOT) {
+      E *= L.params.y > L.params.x ? smoothstep(L.params.x, L.params.y, cd) : step(L.params.x, cd);
+    } else if (type == LO_LIGHT_EMITTER) {
+      E *= max(cd, 0.0);  // Lambertian emitter patch: intensity falls with the cosine
+    }
+  }
+  if (dot(n, l) <= 0.0 || max(E.r, max(E.g, E.b)) <= 0.0) return vec3(0.0);
+  float visible = type == LO_LIGHT_DIRECTIONAL ? sunShadow(i, p, gGeometricNormal, l)
+                                                 : shadow(i, p, gGeometricNormal, l);
+  return loBrdfCos(n, v, l, baseColor, metallic, roughness, uTransmission, uSpecular) * E *
+         visible;
+#undef L
+}
+
 vec3 direct(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughness) {
   vec3 sum = vec3(0.0);
   // Area lights come last in the block (uLightCount.y of the uLightCount.x):
   // their own loop keeps the other lights' loop small, which llvmpipe runs
   // several times faster.
   for (int i = uLightCount.x - uLightCount.y; i < uLightCount.x; ++i) {
-#define L uLights[i]
-    // One-sided Lambertian emitter: nothing behind its plane is lit, and
-    // a point in the plane (the ceiling around a ceiling light) sees it at
-    // grazing incidence: nothing either (the clipped edge sum would be
-    // all rounding there).
-    if (dot(p - L.corner0.xyz, L.directionRange.xyz) <= 1e-3 * L.corner0.w) continue;
-    vec3 lightCentre;
-    float solid = polygonIrradiance(p, n, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz, lightCentre);
-    if (solid <= 0.0) continue;
-    vec3 la = normalize(lightCentre - p);
-    float visible = areaShadow(i, p, gGeometricNormal, la);
-    if (visible <= 0.0) continue;
-    // Diffuse: the lobe in the direction of the light's visible part times
-    // the exact projected solid angle.
-    vec3 diffuse, specular;
-    float a = loBrdfAlpha(roughness);
-    loBrdfLobes(n, v, la, baseColor, metallic, a, uTransmission, diffuse, specular);
-    if (!uSpecular) diffuse = loBrdfDiffuseOnly(baseColor, metallic, uTransmission);
-    vec3 f = diffuse * solid;
-    if (uSpecular) {
-      // Specular: a representative point (Karis 2013): the point of the
-      // triangle nearest the reflected ray, the GGX lobe evaluated towards
-      // it with its own alpha and scaled by (alpha / alpha')^2, alpha'
-      // widened by the light's angular radius: a glossy surface shows the
-      // light's shape, not a highlight of the lobe's size at its centre.
-      vec3 r = reflect(-v, n);
-      vec3 nE = L.directionRange.xyz;
-      float towards = dot(r, nE);
-      vec3 q = lightCentre;
-      if (towards < -1e-4) q = p + r * max(dot(L.corner0.xyz - p, nE) / towards, 0.0);
-      q = closestOnTriangle(q, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz);
-      vec3 ls = normalize(q - p);
-      float nls = dot(n, ls);
-      if (nls > 0.0) {
-        float distance = length(lightCentre - p);
-        float radius = L.corner0.w * 0.5641896;  // sqrt(area / pi)
-        float wide = clamp(a + radius / (2.0 * distance), a, 1.0);
-        vec3 dRep, sRep;
-        loBrdfLobes(n, v, ls, baseColor, metallic, a, uTransmission, dRep, sRep);
-        float omega = solid / max(dot(n, la), 1e-4);  // the light's solid angle
-        f += sRep * (a * a / (wide * wide)) * nls * omega;
-      }
-    }
-    sum += f * L.colorFar.rgb * visible;
-#undef L
+    sum += areaLight(i, p, n, v, baseColor, metallic, roughness);
   }
   for (int i = 0; i < uLightCount.x - uLightCount.y; ++i) {
-    // The light read in place (a copy of the 7-vec4 struct is dear on llvmpipe).
-#define L uLights[i]
-    int type = int(L.positionType.w);
-    vec3 l;
-    vec3 E = L.colorFar.rgb;  // irradiance on a surface facing the light, W/m^2
-    if (type == LO_LIGHT_DIRECTIONAL) {
-      l = -L.directionRange.xyz;
-    } else {
-      vec3 tl = L.positionType.xyz - p;
-      float dist2 = dot(tl, tl);
-      float dist = sqrt(dist2);
-      l = tl / dist;
-      // Near-field clamp for emitter VPLs: never closer than the patch allows.
-      E /= max(dist2, L.params.w);
-      float range = L.directionRange.w;
-      if (range > 0.0) {
-        float r = dist / range;
-        E *= pow(clamp(1.0 - r * r * r * r, 0.0, 1.0), 2.0);
-      }
-      float cd = dot(-l, L.directionRange.xyz);
-      if (type == LO_LIGHT_SPOT) {
-        E *= L.params.y > L.params.x ? smoothstep(L.params.x, L.params.y, cd) : step(L.params.x, cd);
-      } else if (type == LO_LIGHT_EMITTER) {
-        E *= max(cd, 0.0);  // Lambertian emitter patch: intensity falls with the cosine
-      }
-    }
-    if (dot(n, l) <= 0.0 || max(E.r, max(E.g, E.b)) <= 0.0) continue;
-    float visible = type == LO_LIGHT_DIRECTIONAL ? sunShadow(i, p, gGeometricNormal, l)
-                                                   : shadow(i, p, gGeometricNormal, l);
-    sum += loBrdfCos(n, v, l, baseColor, metallic, roughness, uTransmission, uSpecular) * E *
-           visible;
+    sum += punctualLight(i, p, n, v, baseColor, metallic, roughness);
   }
   return sum;
 }

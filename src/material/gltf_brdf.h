@@ -18,8 +18,8 @@ namespace lo {
 struct GltfBrdfMaterial {
   Vec3 baseColor{1, 1, 1};  ///< linear RGB
   float metallic = 0;
-  float roughness = 1;      ///< perceptual; GGX alpha = roughness^2 (floored at 2e-3)
-  float transmission = 0;   ///< KHR_materials_transmission
+  float roughness = 1;     ///< perceptual; GGX alpha = roughness^2 (floored at 2e-3)
+  float transmission = 0;  ///< KHR_materials_transmission
 };
 
 /// The two lobes of f(v, l) without the cosine: (1 - F) diffuse and F D V.
@@ -28,8 +28,7 @@ struct GltfBrdfLobes {
   Vec3 diffuse;
   Vec3 specular;
 };
-GltfBrdfLobes gltfBrdfLobes(const GltfBrdfMaterial& m, const Vec3& n, const Vec3& v,
-                            const Vec3& l);
+GltfBrdfLobes gltfBrdfLobes(const GltfBrdfMaterial& m, const Vec3& n, const Vec3& v, const Vec3& l);
 
 /// f(v, l), both lobes, no cosine; zero when l is below the surface.
 Vec3 gltfBrdf(const GltfBrdfMaterial& m, const Vec3& n, const Vec3& v, const Vec3& l);

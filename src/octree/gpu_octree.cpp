@@ -426,12 +426,11 @@ class OctreeBuilder {
     if (width_ > limit || height > limit) {
       const bool wide = width_ > limit;
       const size_t size = wide ? width_ : height;
-      throw InputError("GPU octree: the VDL texture needs " + std::to_string(width_) + " x " +
-                       std::to_string(height) + " texels for " + std::to_string(vdlTotal_) +
-                       " VDLs; its " + (wide ? "width" : "height") +
-                       " exceeds the 2D texture size " + "limit " +
-                       std::to_string(params_.max2DTextureSize) + " by " +
-                       std::to_string(size - limit));
+      throw InputError(
+          "GPU octree: the VDL texture needs " + std::to_string(width_) + " x " +
+          std::to_string(height) + " texels for " + std::to_string(vdlTotal_) + " VDLs; its " +
+          (wide ? "width" : "height") + " exceeds the 2D texture size " + "limit " +
+          std::to_string(params_.max2DTextureSize) + " by " + std::to_string(size - limit));
     }
     out_.vdlWidth = int(width_);
     out_.vdlHeight = int(height);
@@ -624,8 +623,7 @@ class OctreeBuilder {
       counts[l] = float(texelsOf(grid_.layers.vdlCount[e0 + uint32_t(l) - 1]));
     }
     writeTexel(nextVdl_++, counts, float(layers));
-    const Vec3 corner{float(grid_.coords[v].x), float(grid_.coords[v].y),
-                      float(grid_.coords[v].z)};
+    const Vec3 corner{float(grid_.coords[v].x), float(grid_.coords[v].y), float(grid_.coords[v].z)};
     auto local = [&](const Vec3& world) {
       return (world - grid_.frame.origin) / grid_.frame.voxelSize - corner;
     };
@@ -640,12 +638,10 @@ class OctreeBuilder {
       const Vec3 correction = params_.cosineCorrection ? n : Vec3{0, 0, 0};
       for (int i = 0; i < layerCount; ++i) writeVdl(nextVdl_++, layerVdls[i], correction);
     };
-    const Vec3 point0 =
-        grid_.points.empty()
-            ? grid_.frame.origin + (corner + Vec3(0.5f)) * grid_.frame.voxelSize
-            : grid_.points[v];
-    writeLayer(grid_.normals[v], point0, grid_.vdlsOf(v), count,
-               sh_ ? grid_.shOf(v) : nullptr);
+    const Vec3 point0 = grid_.points.empty()
+                            ? grid_.frame.origin + (corner + Vec3(0.5f)) * grid_.frame.voxelSize
+                            : grid_.points[v];
+    writeLayer(grid_.normals[v], point0, grid_.vdlsOf(v), count, sh_ ? grid_.shOf(v) : nullptr);
     for (int l = 1; l < layers; ++l) {
       const uint32_t e = e0 + uint32_t(l) - 1;
       writeLayer(grid_.layers.normals[e], grid_.layers.points[e], grid_.layerVdlsOf(e),
@@ -666,8 +662,8 @@ class OctreeBuilder {
   std::vector<std::vector<size_t>> levelTile_;
   size_t tileCount_ = 0;
   size_t vdlTotal_ = 0;
-  size_t width_ = 1;     ///< of the VDL texture
-  size_t nextVdl_ = 0;   ///< the next VDL texel to write
+  size_t width_ = 1;    ///< of the VDL texture
+  size_t nextVdl_ = 0;  ///< the next VDL texel to write
   GpuOctree out_;
 };
 

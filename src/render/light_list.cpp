@@ -41,8 +41,8 @@ std::vector<GpuLight> areaLights(const Scene& scene, const RenderSpace& space) {
     const Vec3 n = scene.faceNormal(t);
     GpuLight l{};
     // The shadow cube sits at the triangle's centroid, just in front of it.
-    l.positionType = toVec4((p0 + p1 + p2) / 3.0f + n * (1e-3f * space.sceneSize),
-                            float(shader::LO_LIGHT_AREA));
+    l.positionType =
+        toVec4((p0 + p1 + p2) / 3.0f + n * (1e-3f * space.sceneSize), float(shader::LO_LIGHT_AREA));
     l.directionRange = toVec4(n, 0);
     l.colorFar = toVec4(emission, 0);  // the mean radiance of a textured emitter
     l.params = toVec4(Vec3(-1, 1, -1), area);

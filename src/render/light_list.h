@@ -2,10 +2,10 @@
 // Internal to src/render, free of GL: the lights of a scene as the scene
 // shader's light block holds them (shaders/render_lights.h).
 
-#include <vector>
-
 #include <render_constants.h>
 #include <render_lights.h>
+
+#include <vector>
 
 #include "render/render_space.h"
 #include "scene/scene.h"

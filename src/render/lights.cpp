@@ -277,9 +277,10 @@ void SceneLights::fitCascadeMatrices(const RenderSpace& space, const glm::vec3& 
       block.uShadowMatrices[layer] =
           glm::ortho(-radius, radius, -radius, radius, 0.0f, cascadeDepth[c]) *
           glm::lookAt(lightEye, snapped, perpendicular(dir));
-      glBufferSubData(GL_UNIFORM_BUFFER,
-                      GLintptr(offsetof(LightBlock, uShadowMatrices) + sizeof(glm::mat4) * size_t(layer)),
-                      sizeof(glm::mat4), glm::value_ptr(block.uShadowMatrices[layer]));
+      glBufferSubData(
+          GL_UNIFORM_BUFFER,
+          GLintptr(offsetof(LightBlock, uShadowMatrices) + sizeof(glm::mat4) * size_t(layer)),
+          sizeof(glm::mat4), glm::value_ptr(block.uShadowMatrices[layer]));
     }
   }
   glBindBuffer(GL_UNIFORM_BUFFER, 0);

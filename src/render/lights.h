@@ -2,13 +2,12 @@
 // Internal to src/render: the scene's lights as the scene shader reads them
 // (the std140 block of shaders/render_lights.h) and their shadow maps.
 
-#include <glm/glm.hpp>
-#include <glm/gtc/type_ptr.hpp>
+#include <render_constants.h>
 
 #include <array>
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <vector>
-
-#include <render_constants.h>
 
 #include "render/gl_resources.h"
 #include "render/light_list.h"
@@ -19,14 +18,14 @@ namespace lo::render_internal {
 /// The light block and the shadow maps of a scene (lights.cpp).
 struct SceneLights {
   LightBlock block{};
-  GlBuffer ubo;              ///< the block, binding point 0
-  GlTexture shadowTexture;   ///< depth array: the layers of every shadowed light
+  GlBuffer ubo;             ///< the block, binding point 0
+  GlTexture shadowTexture;  ///< depth array: the layers of every shadowed light
   GlFramebuffer shadowFbo;
-  GlSampler depthSampler;    ///< reads the shadow maps' depths (no comparison): PCSS blocker search
+  GlSampler depthSampler;  ///< reads the shadow maps' depths (no comparison): PCSS blocker search
   GlProgram shadowProgram;
   int shadowMapSize = 1;
-  int emitterLights = 0;     ///< VPLs in the block
-  int areaLightCount = 0;    ///< area lights in the block (the last ones)
+  int emitterLights = 0;   ///< VPLs in the block
+  int areaLightCount = 0;  ///< area lights in the block (the last ones)
   /// Directional lights with cascaded shadow maps (indices into the light
   /// block), their cascades refitted when the camera moves.
   std::vector<int> sunLights;
@@ -39,8 +38,8 @@ struct SceneLights {
   /// it and renders every shadow map once, drawing `draw`'s depth-only
   /// geometry with the vertex array `vao`. @throws InputError past LO_MAX_LIGHTS.
   template <class DrawDepthOnly>
-  void setup(const Scene& scene, const RenderSpace& space, const RendererParams& params,
-             GLuint vao, const DrawDepthOnly& draw) {
+  void setup(const Scene& scene, const RenderSpace& space, const RendererParams& params, GLuint vao,
+             const DrawDepthOnly& draw) {
     build(scene, space, params);
     allocateShadowMaps();
     renderShadowMaps(vao, draw);
@@ -71,9 +70,8 @@ struct SceneLights {
   /// Points the shadow framebuffer at `layer` and clears it; the program's
   /// view-projection is that layer's matrix.
   void beginLayer(int layer, bool checkComplete);
-  void fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye,
-                          const glm::vec3& forward, float yfov, float aspect, float znear,
-                          float zfar);
+  void fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
+                          float yfov, float aspect, float znear, float zfar);
   int layerCount() const;
 
   template <class DrawDepthOnly>

@@ -23,9 +23,7 @@ Lighting parseLighting(const std::string& name) {
   throw InputError("unknown lighting '" + name + "' (expected octree or atlas)");
 }
 
-std::string toString(Lighting lighting) {
-  return lighting == Lighting::Atlas ? "atlas" : "octree";
-}
+std::string toString(Lighting lighting) { return lighting == Lighting::Atlas ? "atlas" : "octree"; }
 
 RenderMode parseRenderMode(const std::string& name) {
   if (name == "full") return RenderMode::Full;
@@ -86,11 +84,12 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.uploadOctree(octree);
   r.geometry.upload(scene, r.space);
   r.geometry.sceneTriangles = scene.triangleCount();
-  r.lights.setup(scene, r.space, params, r.geometry.vao.get(),
-                 [&r](GLuint program, bool shadows) { r.geometry.drawDepthOnly(program, shadows); });
+  r.lights.setup(scene, r.space, params, r.geometry.vao.get(), [&r](GLuint program, bool shadows) {
+    r.geometry.drawDepthOnly(program, shadows);
+  });
   for (const Material& m : scene.materials) {
-    r.probe.wanted = r.probe.wanted || m.roughness < shader::LO_PROBE_NONE ||
-                    m.metallicRoughnessTexture >= 0;
+    r.probe.wanted =
+        r.probe.wanted || m.roughness < shader::LO_PROBE_NONE || m.metallicRoughnessTexture >= 0;
   }
 }
 
@@ -143,8 +142,8 @@ void Renderer::setAtlas(const LightmapUvs& uvs, const LightmapAtlas& atlas) {
                     bool clampNegative) {
     if (!texture) texture = GlTexture::create();
     glBindTexture(GL_TEXTURE_2D_ARRAY, texture.get());
-    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GLint(format), atlas.width, atlas.height,
-                 atlas.pageCount, 0, GL_RGB, GL_FLOAT, nullptr);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GLint(format), atlas.width, atlas.height, atlas.pageCount,
+                 0, GL_RGB, GL_FLOAT, nullptr);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     for (int p = 0; p < atlas.pageCount; ++p) {
       std::vector<float> texels = pages[size_t(p)].rgb;
@@ -236,10 +235,8 @@ void compileAllShaders() {
   for (const std::vector<std::string>& files : allPrograms()) {
     const GlProgram program(buildProgram(files));
   }
-  for (const std::vector<std::string>& defines :
-       std::vector<std::vector<std::string>>{{"LO_DIRECT_LIGHT"},
-                                             {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"},
-                                             {"LO_ATLAS_LIGHTING"}}) {
+  for (const std::vector<std::string>& defines : std::vector<std::vector<std::string>>{
+           {"LO_DIRECT_LIGHT"}, {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"}, {"LO_ATLAS_LIGHTING"}}) {
     const GlProgram program(buildProgram({"render_scene.vert", "render_scene.frag"}, defines));
   }
 }

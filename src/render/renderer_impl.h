@@ -1,20 +1,21 @@
 #pragma once
 // Internal to src/render: the renderer's parts, one file each.
-//   scene_geometry.cpp  the scene on the GPU: vertices by material, textures,
-//                       draw order, depth-only draws, the blended sort
-//   lights.cpp          the light block, VPLs, area lights, shadow maps, cascades
+//   scene_geometry.cpp   the scene on the GPU: vertices by material, textures,
+//                        draw order, depth-only draws, the blended sort
+//   light_list.cpp       area lights and VPLs (no GL: light_list.h)
+//   lights.cpp           the light block, shadow maps, sun cascades (lights.h)
 //   reflection_probe.cpp the probe's cube map, captured with the scene pass
-//   scene_pass.cpp      a frame: depth pre-pass, the scene pass, transmission
-//   renderer.cpp        the public Renderer, which ties them together
+//   scene_pass.cpp       a frame: depth pre-pass, the scene pass, transmission
+//   renderer.cpp         the public Renderer, which ties them together
+// GL objects are held by the handles of gl_resources.h.
 // Render space: world minus the centre of the scene's bounds (see RenderSpace).
 
-#include <glm/glm.hpp>
+#include <render_constants.h>
 
 #include <array>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <vector>
-
-#include <render_constants.h>
 
 #include "core/math.h"
 #include "render/gl_resources.h"
@@ -34,7 +35,7 @@ struct Vertex {
   float baseColor[3];  ///< the material's base colour factor (textures apply per pixel)
   float metallicRoughness[2];
   float emission[3];
-  float uv[2];  ///< the texture coordinates the base colour texture names (TEXCOORD_0 or _1)
+  float uv[2];        ///< the texture coordinates the base colour texture names (TEXCOORD_0 or _1)
   float normalUv[2];  ///< the texture coordinates of the normal map
   float metallicRoughnessUv[2];
   float occlusionUv[2];
@@ -73,7 +74,7 @@ struct SceneGeometry {
   GlVertexArray vao;
   GlBuffer vbo;
   GlVertexArray emptyVao;
-  std::vector<DrawRange> ranges;            ///< the vertex buffer by material, in DrawCategory order
+  std::vector<DrawRange> ranges;  ///< the vertex buffer by material, in DrawCategory order
   std::vector<DrawCategory> rangeCategory;  ///< per range
   GLsizei opaqueCount = 0;  ///< vertices of the kSolid ranges (one call in depth passes)
   /// Blended triangles' centroids (render space), one per triangle of the
@@ -90,9 +91,7 @@ struct SceneGeometry {
 
   void upload(const Scene& scene, const RenderSpace& space);
   /// The GL name of Scene::textures[texture], 0 for -1.
-  GLuint texture(int index) const {
-    return index >= 0 ? textures[size_t(index)].get() : 0;
-  }
+  GLuint texture(int index) const { return index >= 0 ? textures[size_t(index)].get() : 0; }
   /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
   /// `program` in use and the vao bound; see scene_geometry.cpp.
   void drawDepthOnly(GLuint program, bool shadows) const;
@@ -101,6 +100,11 @@ struct SceneGeometry {
 
  private:
   GlTexture uploadTexture(const Texture& t) const;
+  /// Scene::textures[index] on the GPU, uploaded on first use; returns index.
+  int useTexture(const Scene& scene, int index);
+  /// The textures and uniforms material `mat` draws with.
+  DrawRange rangeOf(const Scene& scene, const Material& mat);
+  void uploadVertices(const std::vector<Vertex>& vertices);
 };
 
 /// The reflection probe: a mipmapped RGBA16F cube map of the lit scene seen
@@ -148,7 +152,8 @@ struct Renderer::Impl {
   render_internal::GlRenderbuffer targetDepth;
   int targetWidth = 0, targetHeight = 0;
 
-  render_internal::GlTexture behindTexture;  ///< the opaque image, seen through transmissive surfaces
+  render_internal::GlTexture
+      behindTexture;  ///< the opaque image, seen through transmissive surfaces
   int behindWidth = 0, behindHeight = 0;
   bool behindFloat = false;
 

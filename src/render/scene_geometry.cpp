@@ -51,8 +51,7 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t) const {
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   // Half floats: linear colour with 11 bits of precision, filterable and
   // mipmappable on every GL 3.3 context.
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT,
-               rgba.data());
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT, rgba.data());
   glGenerateMipmap(GL_TEXTURE_2D);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -63,115 +62,137 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t) const {
   return id;
 }
 
+namespace {
+
+const Material& materialOf(const Scene& scene, size_t t) {
+  static const Material fallback;
+  const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+  return m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
+}
+
+/// Triangles in runs of one material (so that the scene pass binds each
+/// material's textures once), in DrawCategory order: opaque first,
+/// transmissive runs last, drawn after the opaque scene they show.
+std::vector<std::vector<size_t>> trianglesByMaterial(const Scene& scene) {
+  const size_t slots = scene.materials.size() + 1;
+  std::vector<std::vector<size_t>> byMaterial(kCategories * slots);
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+    const size_t slot = m >= 0 && size_t(m) < scene.materials.size() ? size_t(m) + 1 : 0;
+    byMaterial[size_t(categoryOf(materialOf(scene, t))) * slots + slot].push_back(t);
+  }
+  return byMaterial;
+}
+
+const std::vector<float>& uvSet(const Scene& scene, int texCoord) {
+  return texCoord == 1 ? scene.texcoords1 : scene.texcoords0;
+}
+
+bool usable(const Scene& scene, int texture, int texCoord) {
+  return texture >= 0 && size_t(texture) < scene.textures.size() &&
+         uvSet(scene, texCoord).size() == 2 * scene.positions.size();
+}
+
+/// Corner k of triangle t as drawn with `range` (which textures it reads).
+Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& mat,
+                  const DrawRange& range, size_t t, int k, const Vec3& faceNormal) {
+  const uint32_t index = scene.indices[t * 3 + size_t(k)];
+  // Texture transforms are affine: applied per vertex they are exact.
+  auto setUv = [&](float* out, int texCoord, const TextureTransform& transform) {
+    const std::vector<float>& uv = uvSet(scene, texCoord);
+    out[0] = uv[2 * index];
+    out[1] = uv[2 * index + 1];
+    transform.apply(out[0], out[1]);
+  };
+  Vertex v{};
+  const Vec3 p = space.toRender(scene.positions[index]);
+  const Vec3 n = scene.normals.empty() ? faceNormal : scene.normals[index];
+  std::memcpy(v.position, &p, sizeof v.position);
+  std::memcpy(v.normal, &n, sizeof v.normal);
+  std::memcpy(v.baseColor, &mat.baseColor, sizeof v.baseColor);
+  v.metallicRoughness[0] = mat.metallic;
+  v.metallicRoughness[1] = mat.roughness;
+  std::memcpy(v.emission, &mat.emission, sizeof v.emission);
+  if (range.texture >= 0) setUv(v.uv, mat.baseColorTexCoord, mat.baseColorTransform);
+  if (range.normalTexture >= 0) setUv(v.normalUv, mat.normalTexCoord, mat.normalTransform);
+  if (range.metallicRoughnessTexture >= 0) {
+    setUv(v.metallicRoughnessUv, mat.metallicRoughnessTexCoord, mat.metallicRoughnessTransform);
+  }
+  if (range.occlusionTexture >= 0) {
+    setUv(v.occlusionUv, mat.occlusionTexCoord, mat.occlusionTransform);
+  }
+  if (range.emissiveTexture >= 0) setUv(v.emissiveUv, mat.emissiveTexCoord, mat.emissiveTransform);
+  if (scene.tangents.size() == 4 * scene.positions.size()) {
+    std::memcpy(v.tangent, &scene.tangents[4 * size_t(index)], sizeof v.tangent);
+  }
+  return v;
+}
+
+}  // namespace
+
+int SceneGeometry::useTexture(const Scene& scene, int index) {
+  if (!textures[size_t(index)])
+    textures[size_t(index)] = uploadTexture(scene.textures[size_t(index)]);
+  return index;
+}
+
+DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat) {
+  DrawRange range;
+  range.transmission = mat.transmission;
+  range.thickness = mat.thickness;
+  range.ior = mat.ior;
+  range.alphaMode = alphaModeOf(mat);
+  range.baseAlpha = mat.baseAlpha;
+  range.alphaCutoff = mat.alphaCutoff;
+  range.doubleSided = mat.doubleSided;
+  if (usable(scene, mat.emissiveTexture, mat.emissiveTexCoord) && mat.isEmissive()) {
+    range.emissiveTexture = useTexture(scene, mat.emissiveTexture);
+  }
+  if (usable(scene, mat.baseColorTexture, mat.baseColorTexCoord)) {
+    range.texture = useTexture(scene, mat.baseColorTexture);
+  }
+  if (usable(scene, mat.normalTexture, mat.normalTexCoord)) {
+    range.normalTexture = useTexture(scene, mat.normalTexture);
+    range.normalScale = mat.normalScale;
+  }
+  if (usable(scene, mat.metallicRoughnessTexture, mat.metallicRoughnessTexCoord)) {
+    range.metallicRoughnessTexture = useTexture(scene, mat.metallicRoughnessTexture);
+  }
+  if (usable(scene, mat.occlusionTexture, mat.occlusionTexCoord)) {
+    range.occlusionTexture = useTexture(scene, mat.occlusionTexture);
+    range.occlusionStrength = mat.occlusionStrength;
+  }
+  return range;
+}
+
 void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
   // Anisotropic filtering: core in GL 4.6, an extension before.
   if (GLAD_GL_ARB_texture_filter_anisotropic || GLAD_GL_EXT_texture_filter_anisotropic) {
     glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &maxAnisotropy);
     maxAnisotropy = std::min(maxAnisotropy, 16.0f);
   }
-  // Triangles in runs of one material (so that the scene pass binds each
-  // material's textures once), opaque first; transmissive runs last, drawn
-  // after the opaque scene they show.
-  const Material fallback;
-  auto materialOf = [&](size_t t) -> const Material& {
-    const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
-    return m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
-  };
-  const size_t slots = scene.materials.size() + 1;
-  std::vector<std::vector<size_t>> byMaterial(kCategories * slots);
-  for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
-    const size_t slot = m >= 0 && size_t(m) < scene.materials.size() ? size_t(m) + 1 : 0;
-    byMaterial[size_t(categoryOf(materialOf(t))) * slots + slot].push_back(t);
-  }
-  auto uvSet = [&](int texCoord) -> const std::vector<float>& {
-    return texCoord == 1 ? scene.texcoords1 : scene.texcoords0;
-  };
-  auto usable = [&](int texture, int texCoord) {
-    return texture >= 0 && size_t(texture) < scene.textures.size() &&
-           uvSet(texCoord).size() == 2 * scene.positions.size();
-  };
-  std::vector<Vertex> vertices;
-  vertices.reserve(scene.triangleCount() * 3);
   textures.clear();
   textures.resize(scene.textures.size());
-  auto textureId = [&](int texture) {
-    if (!textures[size_t(texture)]) {
-      textures[size_t(texture)] = uploadTexture(scene.textures[size_t(texture)]);
-    }
-    return texture;
-  };
-  for (const std::vector<size_t>& group : byMaterial) {
+  std::vector<Vertex> vertices;
+  vertices.reserve(scene.triangleCount() * 3);
+  for (const std::vector<size_t>& group : trianglesByMaterial(scene)) {
     if (group.empty()) continue;
-    const Material& mat = materialOf(group.front());
-    DrawRange range;
+    const Material& mat = materialOf(scene, group.front());
     const DrawCategory category = categoryOf(mat);
-    range.transmission = mat.transmission;
-    range.thickness = mat.thickness;
-    range.ior = mat.ior;
-    range.alphaMode = alphaModeOf(mat);
-    range.baseAlpha = mat.baseAlpha;
-    range.alphaCutoff = mat.alphaCutoff;
-    range.doubleSided = mat.doubleSided;
-    if (usable(mat.emissiveTexture, mat.emissiveTexCoord) && mat.isEmissive()) {
-      range.emissiveTexture = textureId(mat.emissiveTexture);
-    }
-    if (usable(mat.baseColorTexture, mat.baseColorTexCoord)) range.texture = textureId(mat.baseColorTexture);
-    if (usable(mat.normalTexture, mat.normalTexCoord)) {
-      range.normalTexture = textureId(mat.normalTexture);
-      range.normalScale = mat.normalScale;
-    }
-    if (usable(mat.metallicRoughnessTexture, mat.metallicRoughnessTexCoord)) {
-      range.metallicRoughnessTexture = textureId(mat.metallicRoughnessTexture);
-    }
-    if (usable(mat.occlusionTexture, mat.occlusionTexCoord)) {
-      range.occlusionTexture = textureId(mat.occlusionTexture);
-      range.occlusionStrength = mat.occlusionStrength;
-    }
+    DrawRange range = rangeOf(scene, mat);
     range.first = GLint(vertices.size());
     for (size_t t : group) {
-      Vec3 faceN = scene.faceNormal(t);
+      const Vec3 faceNormal = scene.faceNormal(t);
       for (int k = 0; k < 3; ++k) {
-        uint32_t index = scene.indices[t * 3 + size_t(k)];
-        // Texture transforms are affine: applied per vertex they are exact.
-        auto setUv = [&](float* out, int texCoord, const TextureTransform& transform) {
-          const std::vector<float>& uv = uvSet(texCoord);
-          out[0] = uv[2 * index];
-          out[1] = uv[2 * index + 1];
-          transform.apply(out[0], out[1]);
-        };
-        Vertex v{};
-        Vec3 p = space.toRender(scene.positions[index]);
-        Vec3 n = scene.normals.empty() ? faceN : scene.normals[index];
-        std::memcpy(v.position, &p, sizeof v.position);
-        std::memcpy(v.normal, &n, sizeof v.normal);
-        std::memcpy(v.baseColor, &mat.baseColor, sizeof v.baseColor);
-        v.metallicRoughness[0] = mat.metallic;
-        v.metallicRoughness[1] = mat.roughness;
-        std::memcpy(v.emission, &mat.emission, sizeof v.emission);
-        if (range.texture >= 0) setUv(v.uv, mat.baseColorTexCoord, mat.baseColorTransform);
-        if (range.normalTexture >= 0) setUv(v.normalUv, mat.normalTexCoord, mat.normalTransform);
-        if (range.metallicRoughnessTexture >= 0) {
-          setUv(v.metallicRoughnessUv, mat.metallicRoughnessTexCoord,
-                mat.metallicRoughnessTransform);
-        }
-        if (range.occlusionTexture >= 0) {
-          setUv(v.occlusionUv, mat.occlusionTexCoord, mat.occlusionTransform);
-        }
-        if (range.emissiveTexture >= 0) {
-          setUv(v.emissiveUv, mat.emissiveTexCoord, mat.emissiveTransform);
-        }
-        if (scene.tangents.size() == 4 * scene.positions.size()) {
-          std::memcpy(v.tangent, &scene.tangents[4 * size_t(index)], sizeof v.tangent);
-        }
-        vertices.push_back(v);
+        vertices.push_back(makeVertex(scene, space, mat, range, t, k, faceNormal));
         vertexCorner.push_back(uint32_t(3 * t + size_t(k)));
       }
       if (category == kBlended) {
         const Vertex* tri = &vertices[vertices.size() - 3];
-        blendCentroids.push_back(
-            (glm::make_vec3(tri[0].position) + glm::make_vec3(tri[1].position) +
-             glm::make_vec3(tri[2].position)) / 3.0f);
+        blendCentroids.push_back((glm::make_vec3(tri[0].position) +
+                                  glm::make_vec3(tri[1].position) +
+                                  glm::make_vec3(tri[2].position)) /
+                                 3.0f);
       }
     }
     range.count = GLsizei(vertices.size()) - range.first;
@@ -180,6 +201,10 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
     if (category == kSolid) opaqueCount = GLsizei(vertices.size());
     if (category < kBlended) blendFirst = GLsizei(vertices.size());
   }
+  uploadVertices(vertices);
+}
+
+void SceneGeometry::uploadVertices(const std::vector<Vertex>& vertices) {
   vao = GlVertexArray::create();
   glBindVertexArray(vao.get());
   vbo = GlBuffer::create();
@@ -207,7 +232,6 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
   emptyVao = GlVertexArray::create();
   checkGl("uploading the scene");
 }
-
 
 /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
 /// `program` in use: the solid ranges in one call, then the masked ranges
@@ -269,7 +293,8 @@ void SceneGeometry::sortBlended(const glm::vec3& eye) {
     std::stable_sort(order.begin() + long(begin), order.begin() + long(end),
                      [&](uint32_t a, uint32_t b) { return distance[a] > distance[b]; });
     for (size_t k = begin; k < end; ++k, ++tri) {
-      for (uint32_t c = 0; c < 3; ++c) indices[3 * tri + c] = uint32_t(blendFirst) + 3 * order[k] + c;
+      for (uint32_t c = 0; c < 3; ++c)
+        indices[3 * tri + c] = uint32_t(blendFirst) + 3 * order[k] + c;
     }
   }
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, blendEbo.get());

@@ -76,8 +76,8 @@ void Renderer::Impl::copyBehind(int width, int height, bool floatTarget) {
       behindFloat != floatTarget) {
     if (!behindTexture) behindTexture = GlTexture::create();
     glBindTexture(GL_TEXTURE_2D, behindTexture.get());
-    glTexImage2D(GL_TEXTURE_2D, 0, floatTarget ? GL_RGBA32F : GL_RGBA8, width, height, 0,
-                 GL_RGBA, floatTarget ? GL_FLOAT : GL_UNSIGNED_BYTE, nullptr);
+    glTexImage2D(GL_TEXTURE_2D, 0, floatTarget ? GL_RGBA32F : GL_RGBA8, width, height, 0, GL_RGBA,
+                 floatTarget ? GL_FLOAT : GL_UNSIGNED_BYTE, nullptr);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     behindWidth = width;
@@ -99,8 +99,8 @@ GLuint Renderer::Impl::sceneProgramFor(const RenderParams& rp, bool withDirect) 
                                                {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"}));
     glUniformBlockBinding(sceneAtlasProgram.get(),
                           glGetUniformBlockIndex(sceneAtlasProgram.get(), "LightBlock"), 0);
-    sceneIndirectAtlasProgram = GlProgram(
-        buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_ATLAS_LIGHTING"}));
+    sceneIndirectAtlasProgram =
+        GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_ATLAS_LIGHTING"}));
   }
   const GlProgram& p = atlasProgram ? (withDirect ? sceneAtlasProgram : sceneIndirectAtlasProgram)
                                     : (withDirect ? sceneProgram : sceneIndirectProgram);
@@ -109,9 +109,9 @@ GLuint Renderer::Impl::sceneProgramFor(const RenderParams& rp, bool withDirect) 
 
 /// The uniforms and textures of the scene program `p` (in use) that hold
 /// for the whole frame.
-void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera,
-                                      const RenderParams& rp, const glm::mat4& viewProj,
-                                      bool reflect, float exposureScale, bool encodeSrgb) {
+void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, const RenderParams& rp,
+                                      const glm::mat4& viewProj, bool reflect, float exposureScale,
+                                      bool encodeSrgb) {
   auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
   const Vec3 eyeRender = space.toRender(camera.eye);
   const Bounds3& bounds = space.bounds;
@@ -129,9 +129,9 @@ void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera,
   const bool atlas = rp.lighting == Lighting::Atlas && !probe.capturing;
   // The probe leaves out emitters that the direct pass draws as lights:
   // their reflection comes from the lights' specular term already.
-  glUniform1f(loc("uEmissionScale"),
-              probe.capturing && (lights.areaLightCount > 0 || lights.emitterLights > 0) ? 0.0f
-                                                                                          : 1.0f);
+  glUniform1f(
+      loc("uEmissionScale"),
+      probe.capturing && (lights.areaLightCount > 0 || lights.emitterLights > 0) ? 0.0f : 1.0f);
   glUniform1i(loc("uAtlas"), atlas ? 1 : 0);
   glUniform1i(loc("uAtlasIrradiance"), 12);
   glUniform1i(loc("uAtlasDirection"), 13);
@@ -271,8 +271,9 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
                      std::to_string(rp.maxVdls));
   }
   if (rp.lighting == Lighting::Atlas && !atlasVbo) {
-    throw InputError("render: lighting 'atlas' needs an atlas (Renderer::setAtlas, or "
-                     "`render --lighting atlas`, which bakes one)");
+    throw InputError(
+        "render: lighting 'atlas' needs an atlas (Renderer::setAtlas, or "
+        "`render --lighting atlas`, which bakes one)");
   }
   // The probe shows the lit scene: captured before the first frame that
   // reflects it (it draws six frames of its own through this function).
@@ -280,20 +281,19 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
                        (rp.mode == RenderMode::Full || rp.mode == RenderMode::Indirect);
   if (reflect && !probe.valid) captureProbe(rp);
   const glm::vec3 eye = toGlm(space.toRender(camera.eye));
-  const float zfar = camera.zfar > 0 ? camera.zfar
-                                     : glm::length(eye - toGlm(space.bounds.center())) +
-                                           space.sceneSize + 1e-3f;
+  const float zfar =
+      camera.zfar > 0 ? camera.zfar
+                      : glm::length(eye - toGlm(space.bounds.center())) + space.sceneSize + 1e-3f;
   const float znear = std::min(camera.znear > 0 ? camera.znear : 0.01f, 0.5f * zfar);
   const float aspect = float(width) / float(height);
   const glm::mat4 viewProj = glm::perspective(camera.yfov, aspect, znear, zfar) *
                              glm::lookAt(eye, eye + toGlm(camera.forward), toGlm(camera.up));
   const bool withDirect = drawsDirectLight(rp.mode);
   if (withDirect) {
-    lights.fitCascades(space, eye, glm::normalize(toGlm(camera.forward)), toGlm(camera.up),
-                       camera.yfov, aspect, znear, zfar, geometry.vao.get(),
-                       [this](GLuint program, bool shadows) {
-                         geometry.drawDepthOnly(program, shadows);
-                       });
+    lights.fitCascades(
+        space, eye, glm::normalize(toGlm(camera.forward)), toGlm(camera.up), camera.yfov, aspect,
+        znear, zfar, geometry.vao.get(),
+        [this](GLuint program, bool shadows) { geometry.drawDepthOnly(program, shadows); });
   }
 
   glViewport(0, 0, width, height);

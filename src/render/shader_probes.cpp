@@ -1,9 +1,10 @@
 // Shader probes: the GLSL builds of the headers shared with C++ run on
-// inputs (layout_probe.h, brdf_probe.h), and the light block's GL layout.
+// inputs (layout_probe.h, shader_probes.h), and the light block's GL layout.
+
+#include "render/shader_probes.h"
 
 #include <glad/gl.h>
 
-#include "render/brdf_probe.h"
 #include "render/context.h"
 #include "render/gl_resources.h"
 #include "render/gl_util.h"
@@ -20,8 +21,8 @@ namespace {
 /// returns the target's texels, row-major. `setUniforms` runs with the
 /// program in use.
 template <class SetUniforms>
-std::vector<float> runProbe(GLuint program, const std::vector<float>& inputs, int width,
-                            int inRows, int outRows, const SetUniforms& setUniforms) {
+std::vector<float> runProbe(GLuint program, const std::vector<float>& inputs, int width, int inRows,
+                            int outRows, const SetUniforms& setUniforms) {
   std::vector<float> out(size_t(width) * size_t(outRows) * 4);
   GlTexture input = GlTexture::create(), output = GlTexture::create();
   glBindTexture(GL_TEXTURE_2D, input.get());
@@ -118,8 +119,7 @@ std::vector<BrdfProbeOutput> runBrdfProbe(const std::vector<BrdfProbeInput>& inp
 namespace {
 
 GlProgram sceneProgramWithLights() {
-  return GlProgram(
-      buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT"}));
+  return GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT"}));
 }
 
 }  // namespace

@@ -71,8 +71,8 @@ TEST(GltfBrdf, MetalAlbedoNeverExceedsOne) {
   float largest = 0;
   for (float roughness : {0.3f, 0.5f, 0.8f, 1.0f}) {
     for (float theta : {0.0f, 45.0f, 75.0f, 88.0f}) {
-      SCOPED_TRACE("roughness " + std::to_string(roughness) + ", view " +
-                   std::to_string(theta) + " deg");
+      SCOPED_TRACE("roughness " + std::to_string(roughness) + ", view " + std::to_string(theta) +
+                   " deg");
       const float a = whiteAlbedo(1, roughness, theta);
       EXPECT_LE(a, 1.0f);
       EXPECT_GT(a, 0.3f);
@@ -93,8 +93,8 @@ TEST(GltfBrdf, DielectricAlbedoExceedsOneOnlyTowardsGrazingViews) {
   // (docs/render.md), pinned here so that a change of the mix shows.
   for (float roughness : {0.3f, 0.5f, 0.8f, 1.0f}) {
     for (float theta : {0.0f, 15.0f, 30.0f}) {
-      SCOPED_TRACE("roughness " + std::to_string(roughness) + ", view " +
-                   std::to_string(theta) + " deg");
+      SCOPED_TRACE("roughness " + std::to_string(roughness) + ", view " + std::to_string(theta) +
+                   " deg");
       const float a = whiteAlbedo(0, roughness, theta);
       EXPECT_LE(a, 1.0f);
       EXPECT_GT(a, 0.9f);  // the diffuse lobe takes nearly all the rest

@@ -12,16 +12,16 @@
 #include <string>
 
 #include "material/gltf_brdf.h"
-#include "render/brdf_probe.h"
 #include "render/light_list.h"
+#include "render/shader_probes.h"
 #include "scene/emitter_sampler.h"
 #include "test_util.h"
 
 namespace lo {
 namespace {
 
-#define REQUIRE_OSMESA()                                                           \
-  do {                                                                             \
+#define REQUIRE_OSMESA()                                                       \
+  do {                                                                         \
     if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available"; \
   } while (0)
 
@@ -64,9 +64,8 @@ std::vector<BrdfProbeInput> randomInputs(int count) {
   for (int c = 0; c < 3; ++c) {
     const float scale = std::max(std::fabs(glsl[c]), std::fabs(cpp[c]));
     if (!(std::fabs(glsl[c] - cpp[c]) <= std::max(relative * scale, absolute))) {
-      return ::testing::AssertionFailure()
-             << what << " of input " << i << ": GLSL " << glsl.ToString() << ", C++ "
-             << cpp.ToString();
+      return ::testing::AssertionFailure() << what << " of input " << i << ": GLSL "
+                                           << glsl.ToString() << ", C++ " << cpp.ToString();
     }
   }
   return ::testing::AssertionSuccess();
@@ -105,15 +104,14 @@ TEST(RenderBrdf, GlslMatchesCpp) {
                       gltfBrdfCos(m, in.n, in.v, in.l, true, in.specularWeight), withSpecular,
                       absolute));
     EXPECT_TRUE(close("diffuse lobe", i, out[i].diffuse, lobes.diffuse, relative, absolute));
-    EXPECT_TRUE(
-        close("specular lobe", i, out[i].specular, lobes.specular, withSpecular, absolute));
+    EXPECT_TRUE(close("specular lobe", i, out[i].specular, lobes.specular, withSpecular, absolute));
     EXPECT_TRUE(close("environment BRDF", i, out[i].environment,
                       gltfEnvironmentBrdf(m, std::clamp(dot(in.n, in.v), 0.0f, 1.0f)), relative,
                       absolute));
     EXPECT_TRUE(
         close("brdf", i, out[i].brdf, gltfBrdf(m, in.n, in.v, in.l), withSpecular, absolute));
-    EXPECT_TRUE(close("diffuse only", i, out[i].diffuseCos,
-                      gltfBrdfCos(m, in.n, in.v, in.l, false), relative, absolute));
+    EXPECT_TRUE(close("diffuse only", i, out[i].diffuseCos, gltfBrdfCos(m, in.n, in.v, in.l, false),
+                      relative, absolute));
     EXPECT_FLOAT_EQ(out[i].alpha, std::max(in.roughness * in.roughness, 2e-3f));
     if (dot(in.n, in.l) > 0 && maxComponent(out[i].cosWeighted) > 0) ++checked;
     if (HasFailure()) break;  // one input's report is enough
@@ -196,8 +194,8 @@ TEST(RenderLights, VplPowerIsTheEmitterSamplersPower) {
   double expected = 0;
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
     const Material& m = scene.materials[size_t(scene.triangleMaterial[t])];
-    expected += kPi * double(average(m.emission)) * scene.triangleArea(t) *
-                (m.doubleSided ? 2.0 : 1.0);
+    expected +=
+        kPi * double(average(m.emission)) * scene.triangleArea(t) * (m.doubleSided ? 2.0 : 1.0);
   }
   ASSERT_NEAR(sampler.total(), expected, 1e-5 * expected);
 

@@ -1,5 +1,5 @@
 #pragma once
-/// @file render/brdf_probe.h
+/// @file render/shader_probes.h
 /// @brief Runs the GLSL build of shaders/material_brdf.h on inputs, so a test
 /// can check that the shader's BRDF and the C++ build (material/gltf_brdf.h)
 /// agree, and reads the light block's layout back from the GL, so a test can
