@@ -1,5 +1,5 @@
 /* render_constants.h: constants shared by the scene shader and the renderer
- * (src/render/renderer.cpp), valid in both C++ and GLSL, so that the value of
+ * (src/render), valid in both C++ and GLSL, so that the value of
  * a mode or a light type is written once: both builds compile this text.
  */
 #ifndef LO_RENDER_CONSTANTS_H

@@ -242,348 +242,436 @@ float halfToFloat(uint16_t bits) {
   return f;
 }
 
-GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
-  using namespace gpu_octree_internal;
-  validate(grid, params);
-  const int depth = grid.frame.depth;
+namespace gpu_octree_internal {
 
-  // Lit voxels in Morton order. A voxel without VDLs is left out entirely: the
-  // flag cannot say "leaf with 0 VDLs" (0 = empty), and an empty branch reads
-  // as no indirect light, which is what a voxel without VDLs contributes.
-  // With adaptive leaves, voxels a collapsed leaf holds are replaced by it.
+/// buildGpuOctree in named steps, in the order it runs them: the leaves in
+/// Morton order, the nodes per level and their tiles, the pool's and the
+/// VDL texture's sizes, the compact scale, then every node's texel (and a
+/// leaf's VDL texels) written level by level.
+class OctreeBuilder {
+ public:
+  OctreeBuilder(const VdlGrid& grid, const GpuOctreeParams& params)
+      : grid_(grid),
+        params_(params),
+        depth_(grid.frame.depth),
+        sh_(grid.shTerms > 0),
+        adaptive_(collapseLeaves(grid, params.tolerance, params.cosineCorrection)) {}
+
+  GpuOctree build() {
+    indexLayers();
+    collectLeaves();
+    buildLevels();
+    arrangeTiles();
+    sizeVdlTexture();
+    chooseScale();
+    allocate();
+    for (int l = 1; l <= depth_; ++l) writeLevel(l);
+    LO_CHECK_EQ(nextVdl_, vdlTotal_);
+    out_.leafCount = leaves_.size();
+    out_.collapsedLeaves = adaptive_.leaves.size();
+    out_.collapsedVoxels = adaptive_.voxelsCollapsed;
+    out_.nodeCount = tileCount_;
+    out_.vdlCount = vdlTotal_;
+    return std::move(out_);
+  }
+
+ private:
+  /// A leaf of the octree: a lit voxel at the grid's depth, or a collapsed
+  /// leaf (adaptive leaves) higher up.
   struct Leaf {
     uint64_t code;   ///< Morton code at `depth` of the leaf's first voxel
     uint32_t voxel;  ///< grid voxel, or index into adaptive.leaves when collapsed
     int level;       ///< depth, or the collapsed leaf's level
   };
-  const AdaptiveLeaves adaptive =
-      collapseLeaves(grid, params.tolerance, params.cosineCorrection);
-  // Each voxel's extra surface layers: entries extraFirst[v] .. + extraCount[v]
-  // of grid.layers (validated: ascending by voxel).
-  std::vector<uint32_t> extraFirst(grid.size(), 0);
-  std::vector<uint8_t> extraCount(grid.size(), 0);
-  for (size_t e = 0; e < grid.layers.size(); ++e) {
-    const uint32_t v = grid.layers.voxel[e];
-    if (extraCount[v]++ == 0) extraFirst[v] = uint32_t(e);
-  }
-  // Texels of one layer's light: its VDLs, or its SH terms.
-  const bool sh = grid.shTerms > 0;
-  auto texelsOf = [&](int vdlCount) { return sh ? size_t(grid.shTerms) : size_t(vdlCount); };
-  // Texels of a leaf: its light, or a layer block (octree_layout.h).
-  auto leafTexels = [&](size_t v) -> size_t {
-    if (extraCount[v] == 0) return texelsOf(grid.vdlCount[v]);
-    size_t n = 2 + texelsOf(grid.vdlCount[v]);
-    for (uint32_t e = extraFirst[v]; e < extraFirst[v] + extraCount[v]; ++e) {
-      n += 1 + texelsOf(grid.layers.vdlCount[e]);
-    }
-    return n;
-  };
-  std::vector<Leaf> leaves;
-  leaves.reserve(grid.size());
-  for (size_t v = 0; v < grid.size(); ++v) {
-    if ((grid.lit(v) || extraCount[v] > 0) && !adaptive.collapsed[v]) {
-      leaves.push_back({mortonCode(grid.coords[v], depth), uint32_t(v), depth});
-    }
-  }
-  for (size_t k = 0; k < adaptive.leaves.size(); ++k) {
-    const CollapsedLeaf& c = adaptive.leaves[k];
-    const uint64_t code = mortonCode(c.coord, c.level) << (3 * (depth - c.level));
-    leaves.push_back({code, uint32_t(k), c.level});
-  }
-  // Texels of a leaf: a collapsed one holds its light's texels.
-  auto texelsOfLeaf = [&](const Leaf& leaf) -> size_t {
-    if (leaf.level == depth) return leafTexels(leaf.voxel);
-    const CollapsedLeaf& c = adaptive.leaves[leaf.voxel];
-    return sh ? c.sh.size() : c.vdls.size();
-  };
-  std::sort(leaves.begin(), leaves.end(),
-            [](const Leaf& a, const Leaf& b) { return a.code < b.code; });
-  for (size_t i = 1; i < leaves.size(); ++i) {
-    if (leaves[i].code == leaves[i - 1].code) {
-      throw InputError("GPU octree: voxel " + grid.coords[leaves[i].voxel].ToString() +
-                       " appears twice (indices " + std::to_string(leaves[i - 1].voxel) + " and " +
-                       std::to_string(leaves[i].voxel) + ")");
+
+  /// Each voxel's extra surface layers: entries extraFirst[v] .. + extraCount[v]
+  /// of grid.layers (validated: ascending by voxel).
+  void indexLayers() {
+    extraFirst_.assign(grid_.size(), 0);
+    extraCount_.assign(grid_.size(), 0);
+    for (size_t e = 0; e < grid_.layers.size(); ++e) {
+      const uint32_t v = grid_.layers.voxel[e];
+      if (extraCount_[v]++ == 0) extraFirst_[v] = uint32_t(e);
     }
   }
 
-  // Nodes per level, sorted: level l holds the distinct ancestors code >> 3(depth - l)
-  // of the leaves at level l or below; a node is a leaf (levelLeaf = its index
-  // in `leaves`) or inner (-1). Tiles are allocated breadth first: one tile
-  // per inner node, in level order, Morton order inside a level (= BFS with
-  // children visited in child-index order), so the layout does not depend on
-  // the input order.
-  std::vector<std::vector<uint64_t>> levels(size_t(depth) + 1);
-  std::vector<std::vector<int64_t>> levelLeaf(size_t(depth) + 1);
-  levels[0].push_back(0);
-  levelLeaf[0].push_back(-1);
-  for (int l = 1; l <= depth; ++l) {
-    std::vector<uint64_t>& nodes = levels[size_t(l)];
-    const int shift = 3 * (depth - l);
-    for (size_t i = 0; i < leaves.size(); ++i) {
-      const Leaf& leaf = leaves[i];
-      if (leaf.level < l) continue;
-      uint64_t code = leaf.code >> shift;
-      if (nodes.empty() || nodes.back() != code) {
-        nodes.push_back(code);
-        levelLeaf[size_t(l)].push_back(leaf.level == l ? int64_t(i) : -1);
+  /// Texels of one layer's light: its VDLs, or its SH terms.
+  size_t texelsOf(int vdlCount) const { return sh_ ? size_t(grid_.shTerms) : size_t(vdlCount); }
+
+  /// Texels of a voxel's leaf: its light, or a layer block (octree_layout.h).
+  size_t voxelTexels(size_t v) const {
+    if (extraCount_[v] == 0) return texelsOf(grid_.vdlCount[v]);
+    size_t n = 2 + texelsOf(grid_.vdlCount[v]);
+    for (uint32_t e = extraFirst_[v]; e < extraFirst_[v] + extraCount_[v]; ++e) {
+      n += 1 + texelsOf(grid_.layers.vdlCount[e]);
+    }
+    return n;
+  }
+
+  /// Texels of a leaf: a collapsed one holds its light's texels.
+  size_t leafTexels(const Leaf& leaf) const {
+    if (leaf.level == depth_) return voxelTexels(leaf.voxel);
+    const CollapsedLeaf& c = adaptive_.leaves[leaf.voxel];
+    return sh_ ? c.sh.size() : c.vdls.size();
+  }
+
+  /// Lit voxels in Morton order. A voxel without VDLs is left out entirely:
+  /// the flag cannot say "leaf with 0 VDLs" (0 = empty), and an empty branch
+  /// reads as no indirect light, which is what a voxel without VDLs
+  /// contributes. With adaptive leaves, voxels a collapsed leaf holds are
+  /// replaced by it.
+  void collectLeaves() {
+    leaves_.reserve(grid_.size());
+    for (size_t v = 0; v < grid_.size(); ++v) {
+      if ((grid_.lit(v) || extraCount_[v] > 0) && !adaptive_.collapsed[v]) {
+        leaves_.push_back({mortonCode(grid_.coords[v], depth_), uint32_t(v), depth_});
+      }
+    }
+    for (size_t k = 0; k < adaptive_.leaves.size(); ++k) {
+      const CollapsedLeaf& c = adaptive_.leaves[k];
+      const uint64_t code = mortonCode(c.coord, c.level) << (3 * (depth_ - c.level));
+      leaves_.push_back({code, uint32_t(k), c.level});
+    }
+    std::sort(leaves_.begin(), leaves_.end(),
+              [](const Leaf& a, const Leaf& b) { return a.code < b.code; });
+    for (size_t i = 1; i < leaves_.size(); ++i) {
+      if (leaves_[i].code == leaves_[i - 1].code) {
+        throw InputError("GPU octree: voxel " + grid_.coords[leaves_[i].voxel].ToString() +
+                         " appears twice (indices " + std::to_string(leaves_[i - 1].voxel) +
+                         " and " + std::to_string(leaves_[i].voxel) + ")");
       }
     }
   }
-  // Tile of each inner node: levelTile[l][j] (unused for leaves).
-  std::vector<std::vector<size_t>> levelTile(size_t(depth) + 1);
-  size_t tileCount = 0;
-  for (int l = 0; l < depth; ++l) {
-    levelTile[size_t(l)].assign(levels[size_t(l)].size(), 0);
-    for (size_t j = 0; j < levels[size_t(l)].size(); ++j) {
-      if (levelLeaf[size_t(l)][j] < 0) levelTile[size_t(l)][j] = tileCount++;
+
+  /// Nodes per level, sorted: level l holds the distinct ancestors code >>
+  /// 3(depth - l) of the leaves at level l or below; a node is a leaf
+  /// (levelLeaf = its index in `leaves`) or inner (-1). Tiles are allocated
+  /// breadth first: one tile per inner node, in level order, Morton order
+  /// inside a level (= BFS with children visited in child-index order), so
+  /// the layout does not depend on the input order.
+  void buildLevels() {
+    levels_.assign(size_t(depth_) + 1, {});
+    levelLeaf_.assign(size_t(depth_) + 1, {});
+    levels_[0].push_back(0);
+    levelLeaf_[0].push_back(-1);
+    for (int l = 1; l <= depth_; ++l) {
+      std::vector<uint64_t>& nodes = levels_[size_t(l)];
+      const int shift = 3 * (depth_ - l);
+      for (size_t i = 0; i < leaves_.size(); ++i) {
+        const Leaf& leaf = leaves_[i];
+        if (leaf.level < l) continue;
+        uint64_t code = leaf.code >> shift;
+        if (nodes.empty() || nodes.back() != code) {
+          nodes.push_back(code);
+          levelLeaf_[size_t(l)].push_back(leaf.level == l ? int64_t(i) : -1);
+        }
+      }
+    }
+    // Tile of each inner node: levelTile[l][j] (unused for leaves).
+    levelTile_.assign(size_t(depth_) + 1, {});
+    for (int l = 0; l < depth_; ++l) {
+      levelTile_[size_t(l)].assign(levels_[size_t(l)].size(), 0);
+      for (size_t j = 0; j < levels_[size_t(l)].size(); ++j) {
+        if (levelLeaf_[size_t(l)][j] < 0) levelTile_[size_t(l)][j] = tileCount_++;
+      }
     }
   }
 
-  // Near-cubic tile arrangement within the 8-bit tile coordinates and the
-  // context's 3D texture size (2 texels per tile per axis).
-  const int64_t maxPerAxis =
-      std::min<int64_t>(LO_MAX_TILES_PER_AXIS, int64_t(params.max3DTextureSize / 2));
-  const int64_t maxTiles = maxPerAxis * maxPerAxis * maxPerAxis;
-  if (int64_t(tileCount) > maxTiles) {
-    std::ostringstream os;
-    os << "GPU octree: " << tileCount << " node tiles needed but the pool holds at most "
-       << maxTiles << " (" << maxPerAxis << "^3 tiles: ";
-    if (maxPerAxis < int64_t(LO_MAX_TILES_PER_AXIS)) {
-      os << "3D texture size limit " << params.max3DTextureSize << " texels / 2 per tile";
-    } else {
-      os << "8-bit tile coordinates, 256 per axis";
+  /// Near-cubic tile arrangement within the 8-bit tile coordinates and the
+  /// context's 3D texture size (2 texels per tile per axis).
+  void arrangeTiles() {
+    const int64_t maxPerAxis =
+        std::min<int64_t>(LO_MAX_TILES_PER_AXIS, int64_t(params_.max3DTextureSize / 2));
+    const int64_t maxTiles = maxPerAxis * maxPerAxis * maxPerAxis;
+    if (int64_t(tileCount_) > maxTiles) {
+      std::ostringstream os;
+      os << "GPU octree: " << tileCount_ << " node tiles needed but the pool holds at most "
+         << maxTiles << " (" << maxPerAxis << "^3 tiles: ";
+      if (maxPerAxis < int64_t(LO_MAX_TILES_PER_AXIS)) {
+        os << "3D texture size limit " << params_.max3DTextureSize << " texels / 2 per tile";
+      } else {
+        os << "8-bit tile coordinates, 256 per axis";
+      }
+      os << "); over by " << int64_t(tileCount_) - maxTiles << " tiles. Lower the grid depth "
+         << depth_ << " or light fewer voxels";
+      throw InputError(os.str());
     }
-    os << "); over by " << int64_t(tileCount) - maxTiles << " tiles. Lower the grid depth " << depth
-       << " or light fewer voxels";
-    throw InputError(os.str());
-  }
-  GpuOctree out;
-  out.depth = depth;
-  out.origin = grid.frame.origin;
-  out.cubeSize = grid.frame.voxelSize * float(grid.frame.resolution());
-  {
-    const int64_t n = int64_t(tileCount);
+    out_.depth = depth_;
+    out_.origin = grid_.frame.origin;
+    out_.cubeSize = grid_.frame.voxelSize * float(grid_.frame.resolution());
+    const int64_t n = int64_t(tileCount_);
     const int64_t tx = std::min(maxPerAxis, ceilRoot(n, 3));
     const int64_t rest = (n + tx - 1) / tx;
     const int64_t ty = std::min(maxPerAxis, ceilRoot(rest, 2));
     const int64_t tz = (n + tx * ty - 1) / (tx * ty);
     LO_CHECK_LE(tz, maxPerAxis);
-    out.tilesX = int(tx);
-    out.tilesY = int(ty);
-    out.tilesZ = int(tz);
+    out_.tilesX = int(tx);
+    out_.tilesY = int(ty);
+    out_.tilesZ = int(tz);
   }
 
-  // VDL texture size and the 24-bit address space.
-  size_t vdlTotal = 0;
-  for (const Leaf& leaf : leaves) vdlTotal += texelsOfLeaf(leaf);
-  const size_t addressSpace = size_t(LO_MAX_ADDRESS) + 1;
-  if (vdlTotal > addressSpace) {
-    throw InputError("GPU octree: " + std::to_string(vdlTotal) +
-                     " VDLs exceed the 24-bit VDL address space (" + std::to_string(addressSpace) +
-                     ") by " + std::to_string(vdlTotal - addressSpace));
-  }
-  const size_t width = std::max<size_t>(1, std::min<size_t>(LO_VDL_TEXTURE_WIDTH, vdlTotal));
-  const size_t height = std::max<size_t>(1, (vdlTotal + width - 1) / width);
-  if (width > size_t(params.max2DTextureSize) || height > size_t(params.max2DTextureSize)) {
-    const bool wide = width > size_t(params.max2DTextureSize);
-    const size_t size = wide ? width : height;
-    throw InputError("GPU octree: the VDL texture needs " + std::to_string(width) + " x " +
-                     std::to_string(height) + " texels for " + std::to_string(vdlTotal) +
-                     " VDLs; its " + (wide ? "width" : "height") + " exceeds the 2D texture size " +
-                     "limit " + std::to_string(params.max2DTextureSize) + " by " +
-                     std::to_string(size - size_t(params.max2DTextureSize)));
-  }
-  out.vdlWidth = int(width);
-  out.vdlHeight = int(height);
-  out.halfFloat = params.halfFloat || params.compact;
-  out.compact = params.compact;
-  out.shTerms = grid.shTerms;
-  if (out.compact && sh) {
-    // Signed SH terms ride as halves times the scale (octree_layout.h): the
-    // largest magnitude fits under 2^14 of the half's 65504.
-    float largest = 0;
-    for (const Vec3& t : grid.sh) largest = std::max({largest, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z)});
-    for (const Vec3& t : grid.layers.sh) {
-      largest = std::max({largest, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z)});
+  /// VDL texture size and the 24-bit address space.
+  void sizeVdlTexture() {
+    for (const Leaf& leaf : leaves_) vdlTotal_ += leafTexels(leaf);
+    const size_t addressSpace = size_t(LO_MAX_ADDRESS) + 1;
+    if (vdlTotal_ > addressSpace) {
+      throw InputError("GPU octree: " + std::to_string(vdlTotal_) +
+                       " VDLs exceed the 24-bit VDL address space (" +
+                       std::to_string(addressSpace) + ") by " +
+                       std::to_string(vdlTotal_ - addressSpace));
     }
-    out.irradianceScale =
-        largest > 0 ? std::exp2(std::ceil(std::log2(double(largest) / 16384.0))) : 1.0f;
-  } else if (out.compact) {
-    // The brightest texel after the cosine correction (at most 1 / the
-    // smallest cosine it divides by) fits under 2^15 of RGB9E5's 65408.
-    float brightest = 0;
-    for (const Vdl& v : grid.vdls) brightest = std::max({brightest, v.irradiance.x, v.irradiance.y, v.irradiance.z});
-    for (const Vdl& v : grid.layers.vdls) {
-      brightest = std::max({brightest, v.irradiance.x, v.irradiance.y, v.irradiance.z});
+    width_ = std::max<size_t>(1, std::min<size_t>(LO_VDL_TEXTURE_WIDTH, vdlTotal_));
+    const size_t height = std::max<size_t>(1, (vdlTotal_ + width_ - 1) / width_);
+    const size_t limit = size_t(params_.max2DTextureSize);
+    if (width_ > limit || height > limit) {
+      const bool wide = width_ > limit;
+      const size_t size = wide ? width_ : height;
+      throw InputError(
+          "GPU octree: the VDL texture needs " + std::to_string(width_) + " x " +
+          std::to_string(height) + " texels for " + std::to_string(vdlTotal_) + " VDLs; its " +
+          (wide ? "width" : "height") + " exceeds the 2D texture size " + "limit " +
+          std::to_string(params_.max2DTextureSize) + " by " + std::to_string(size - limit));
     }
-    brightest /= kMinCorrectionCosine;
-    out.irradianceScale =
-        brightest > 0 ? std::exp2(std::ceil(std::log2(double(brightest) / 32768.0))) : 1.0f;
-  }
-  if (out.halfFloat) {
-    out.vdlTexelsHalf.assign(width * height * 4, 0);
-  } else {
-    out.vdlTexels.assign(width * height * 4, 0.0f);
+    out_.vdlWidth = int(width_);
+    out_.vdlHeight = int(height);
+    out_.halfFloat = params_.halfFloat || params_.compact;
+    out_.compact = params_.compact;
+    out_.shTerms = grid_.shTerms;
   }
 
-  const size_t poolW = size_t(out.poolWidth()), poolH = size_t(out.poolHeight());
-  out.pool.assign(poolW * poolH * size_t(out.poolDepth()) * 4, 0);
-  auto tileCoord = [&](size_t tile, uint32_t& tx, uint32_t& ty, uint32_t& tz) {
-    tx = uint32_t(tile % size_t(out.tilesX));
-    ty = uint32_t((tile / size_t(out.tilesX)) % size_t(out.tilesY));
-    tz = uint32_t(tile / (size_t(out.tilesX) * size_t(out.tilesY)));
-  };
-  auto texel = [&](size_t tile, uint32_t child) -> uint8_t* {
+  /// The compact texels' power-of-two scale.
+  void chooseScale() {
+    if (out_.compact && sh_) {
+      // Signed SH terms ride as halves times the scale (octree_layout.h): the
+      // largest magnitude fits under 2^14 of the half's 65504.
+      float largest = 0;
+      for (const Vec3& t : grid_.sh) {
+        largest = std::max({largest, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z)});
+      }
+      for (const Vec3& t : grid_.layers.sh) {
+        largest = std::max({largest, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z)});
+      }
+      out_.irradianceScale =
+          largest > 0 ? std::exp2(std::ceil(std::log2(double(largest) / 16384.0))) : 1.0f;
+    } else if (out_.compact) {
+      // The brightest texel after the cosine correction (at most 1 / the
+      // smallest cosine it divides by) fits under 2^15 of RGB9E5's 65408.
+      float brightest = 0;
+      for (const Vdl& v : grid_.vdls) {
+        brightest = std::max({brightest, v.irradiance.x, v.irradiance.y, v.irradiance.z});
+      }
+      for (const Vdl& v : grid_.layers.vdls) {
+        brightest = std::max({brightest, v.irradiance.x, v.irradiance.y, v.irradiance.z});
+      }
+      brightest /= kMinCorrectionCosine;
+      out_.irradianceScale =
+          brightest > 0 ? std::exp2(std::ceil(std::log2(double(brightest) / 32768.0))) : 1.0f;
+    }
+  }
+
+  void allocate() {
+    const size_t vdlFloats = size_t(out_.vdlWidth) * size_t(out_.vdlHeight) * 4;
+    if (out_.halfFloat) {
+      out_.vdlTexelsHalf.assign(vdlFloats, 0);
+    } else {
+      out_.vdlTexels.assign(vdlFloats, 0.0f);
+    }
+    out_.pool.assign(
+        size_t(out_.poolWidth()) * size_t(out_.poolHeight()) * size_t(out_.poolDepth()) * 4, 0);
+  }
+
+  void tileCoord(size_t tile, uint32_t& tx, uint32_t& ty, uint32_t& tz) const {
+    tx = uint32_t(tile % size_t(out_.tilesX));
+    ty = uint32_t((tile / size_t(out_.tilesX)) % size_t(out_.tilesY));
+    tz = uint32_t(tile / (size_t(out_.tilesX) * size_t(out_.tilesY)));
+  }
+
+  /// The pool texel of child `child` of tile `tile`.
+  uint8_t* poolTexel(size_t tile, uint32_t child) {
     uint32_t tx, ty, tz;
     tileCoord(tile, tx, ty, tz);
+    const size_t poolW = size_t(out_.poolWidth()), poolH = size_t(out_.poolHeight());
     const size_t x = 2 * tx + (child & 1u), y = 2 * ty + ((child >> 1) & 1u),
                  z = 2 * tz + ((child >> 2) & 1u);
-    return &out.pool[((z * poolH + y) * poolW + x) * 4];
-  };
-  // One texel: rgb as floats (halves in the half texture), a as the float
-  // of an integer (the packed direction, a count).
-  auto writeTexel = [&](size_t index, const Vec3& rgb, float a) {
-    const size_t offset =
-        (size_t(loVdlTexelY(uint(index))) * width + size_t(loVdlTexelX(uint(index)))) * 4;
-    if (out.compact && !sh) {  // headers: without the scale
+    return &out_.pool[((z * poolH + y) * poolW + x) * 4];
+  }
+
+  size_t vdlOffset(size_t index) const {
+    return (size_t(loVdlTexelY(uint(index))) * width_ + size_t(loVdlTexelX(uint(index)))) * 4;
+  }
+
+  /// One texel: rgb as floats (halves in the half texture), a as the float
+  /// of an integer (the packed direction, a count).
+  void writeTexel(size_t index, const Vec3& rgb, float a) {
+    const size_t offset = vdlOffset(index);
+    if (out_.compact && !sh_) {  // headers: without the scale
       const uint32_t bits = encodeRgb9e5(rgb);
-      out.vdlTexelsHalf[offset] = uint16_t(bits & 0xffffu);
-      out.vdlTexelsHalf[offset + 1] = uint16_t(bits >> 16);
-      out.vdlTexelsHalf[offset + 3] = uint16_t(a);
-    } else if (out.halfFloat) {
-      for (int c = 0; c < 3; ++c) out.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(rgb[c]);
-      out.vdlTexelsHalf[offset + 3] = uint16_t(a);
+      out_.vdlTexelsHalf[offset] = uint16_t(bits & 0xffffu);
+      out_.vdlTexelsHalf[offset + 1] = uint16_t(bits >> 16);
+      out_.vdlTexelsHalf[offset + 3] = uint16_t(a);
+    } else if (out_.halfFloat) {
+      for (int c = 0; c < 3; ++c) out_.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(rgb[c]);
+      out_.vdlTexelsHalf[offset + 3] = uint16_t(a);
     } else {
-      for (int c = 0; c < 3; ++c) out.vdlTexels[offset + size_t(c)] = rgb[c];
-      out.vdlTexels[offset + 3] = a;
+      for (int c = 0; c < 3; ++c) out_.vdlTexels[offset + size_t(c)] = rgb[c];
+      out_.vdlTexels[offset + 3] = a;
     }
-  };
-  // `normal`: the voxel's normal for params.cosineCorrection, else zero.
-  auto writeVdl = [&](size_t index, const Vdl& vdl, const Vec3& normal) {
-    const size_t offset =
-        (size_t(loVdlTexelY(uint(index))) * width + size_t(loVdlTexelX(uint(index)))) * 4;
+  }
+
+  /// `normal`: the voxel's normal for params.cosineCorrection, else zero.
+  void writeVdl(size_t index, const Vdl& vdl, const Vec3& normal) {
+    const size_t offset = vdlOffset(index);
     const Vec3 d = normalize(vdl.direction);
     const float packed = loPackDirection(d.x, d.y, d.z);
     // The cosine the shader will apply, with the decoded direction (zero normal: none).
     const Vec3 irradiance = vdlIntensity(vdl, normal, true);
-    if (out.compact) {
-      const uint32_t bits = encodeRgb9e5(irradiance / out.irradianceScale);
-      out.vdlTexelsHalf[offset] = uint16_t(bits & 0xffffu);
-      out.vdlTexelsHalf[offset + 1] = uint16_t(bits >> 16);
-      out.vdlTexelsHalf[offset + 3] = uint16_t(packed);
-    } else if (out.halfFloat) {
-      for (int c = 0; c < 3; ++c)
-        out.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(irradiance[c]);
-      out.vdlTexelsHalf[offset + 3] = uint16_t(packed);
+    if (out_.compact) {
+      const uint32_t bits = encodeRgb9e5(irradiance / out_.irradianceScale);
+      out_.vdlTexelsHalf[offset] = uint16_t(bits & 0xffffu);
+      out_.vdlTexelsHalf[offset + 1] = uint16_t(bits >> 16);
+      out_.vdlTexelsHalf[offset + 3] = uint16_t(packed);
+    } else if (out_.halfFloat) {
+      for (int c = 0; c < 3; ++c) {
+        out_.vdlTexelsHalf[offset + size_t(c)] = floatToHalf(irradiance[c]);
+      }
+      out_.vdlTexelsHalf[offset + 3] = uint16_t(packed);
     } else {
-      for (int c = 0; c < 3; ++c) out.vdlTexels[offset + size_t(c)] = irradiance[c];
-      out.vdlTexels[offset + 3] = packed;
+      for (int c = 0; c < 3; ++c) out_.vdlTexels[offset + size_t(c)] = irradiance[c];
+      out_.vdlTexels[offset + 3] = packed;
     }
-  };
+  }
 
-  // One SH term: compact ones as halves divided by the scale.
-  auto writeSh = [&](size_t index, const Vec3& term) {
-    writeTexel(index, out.compact ? term / out.irradianceScale : term, 0.0f);
-  };
+  /// One SH term: compact ones as halves divided by the scale.
+  void writeSh(size_t index, const Vec3& term) {
+    writeTexel(index, out_.compact ? term / out_.irradianceScale : term, 0.0f);
+  }
 
-  // Each node at level l >= 1 is one texel in its parent's tile. Parents are
-  // found by walking the sorted parent level alongside the sorted children.
-  size_t nextVdl = 0;
-  for (int l = 1; l <= depth; ++l) {
-    const std::vector<uint64_t>& parents = levels[size_t(l) - 1];
-    const std::vector<uint64_t>& nodes = levels[size_t(l)];
+  /// A leaf's pool texel: the address of its first VDL texel and `flag`.
+  void writeLeafTexel(uint8_t* t, uint8_t flag) const {
+    const uint address = uint(nextVdl_);
+    t[0] = uint8_t(loPackAddressR(address));
+    t[1] = uint8_t(loPackAddressG(address));
+    t[2] = uint8_t(loPackAddressB(address));
+    t[3] = flag;
+  }
+
+  /// Each node at level l >= 1 is one texel in its parent's tile. Parents
+  /// are found by walking the sorted parent level alongside the sorted children.
+  void writeLevel(int l) {
+    const std::vector<uint64_t>& parents = levels_[size_t(l) - 1];
+    const std::vector<uint64_t>& nodes = levels_[size_t(l)];
     size_t p = 0;
     for (size_t j = 0; j < nodes.size(); ++j) {
       const uint64_t code = nodes[j];
       while (parents[p] != code >> 3) ++p;
-      uint8_t* t = texel(levelTile[size_t(l) - 1][p], uint32_t(code & 7u));
-      const int64_t leafIndex = levelLeaf[size_t(l)][j];
+      uint8_t* t = poolTexel(levelTile_[size_t(l) - 1][p], uint32_t(code & 7u));
+      const int64_t leafIndex = levelLeaf_[size_t(l)][j];
       if (leafIndex < 0) {
         uint32_t tx, ty, tz;
-        tileCoord(levelTile[size_t(l)][j], tx, ty, tz);
+        tileCoord(levelTile_[size_t(l)][j], tx, ty, tz);
         t[0] = uint8_t(tx);
         t[1] = uint8_t(ty);
         t[2] = uint8_t(tz);
         t[3] = uint8_t(LO_FLAG_INNER);
-      } else if (l < depth) {
-        // A collapsed leaf: its texels, stored as they are (intensities, SH terms).
-        const CollapsedLeaf& c = adaptive.leaves[leaves[size_t(leafIndex)].voxel];
-        const uint address = uint(nextVdl);
-        t[0] = uint8_t(loPackAddressR(address));
-        t[1] = uint8_t(loPackAddressG(address));
-        t[2] = uint8_t(loPackAddressB(address));
-        t[3] = uint8_t(sh ? 1u : uint(c.vdls.size()));
-        if (sh) {
-          for (const Vec3& term : c.sh) writeSh(nextVdl++, term);
-        } else {
-          for (const Vdl& vdl : c.vdls) writeVdl(nextVdl++, vdl, Vec3{0, 0, 0});
-        }
+      } else if (l < depth_) {
+        writeCollapsedLeaf(t, adaptive_.leaves[leaves_[size_t(leafIndex)].voxel]);
       } else {
-        const Leaf& leaf = leaves[size_t(leafIndex)];
+        const Leaf& leaf = leaves_[size_t(leafIndex)];
         LO_CHECK_EQ(leaf.code, code);
-        const size_t v = leaf.voxel;
-        const int count = grid.vdlCount[v];
-        const uint address = uint(nextVdl);
-        t[0] = uint8_t(loPackAddressR(address));
-        t[1] = uint8_t(loPackAddressG(address));
-        t[2] = uint8_t(loPackAddressB(address));
-        // An SH leaf's flag is 1 (a leaf); its texel count is the octree's shTerms.
-        t[3] = uint8_t(extraCount[v] > 0 ? LO_FLAG_LAYERED : sh ? 1u : uint(count));
-        const Vdl* vdls = grid.vdlsOf(v);
-        const Vec3 normal = params.cosineCorrection && grid.normals.size() == grid.size()
-                                ? normalize(grid.normals[v])
-                                : Vec3{0, 0, 0};
-        if (extraCount[v] == 0) {
-          if (sh) {
-            for (int i = 0; i < grid.shTerms; ++i) writeSh(nextVdl++, grid.shOf(v)[i]);
-            continue;
-          }
-          for (int i = 0; i < count; ++i) writeVdl(nextVdl++, vdls[i], normal);
-          continue;
-        }
-        // A layer block: header, then per layer its header and VDLs.
-        const uint32_t e0 = extraFirst[v];
-        const int layers = 1 + extraCount[v];
-        Vec3 counts{float(texelsOf(count)), 0, 0};
-        for (int l = 1; l < layers; ++l) {
-          counts[l] = float(texelsOf(grid.layers.vdlCount[e0 + uint32_t(l) - 1]));
-        }
-        writeTexel(nextVdl++, counts, float(layers));
-        const Vec3 corner{float(grid.coords[v].x), float(grid.coords[v].y),
-                          float(grid.coords[v].z)};
-        auto local = [&](const Vec3& world) {
-          return (world - grid.frame.origin) / grid.frame.voxelSize - corner;
-        };
-        auto writeLayer = [&](const Vec3& layerNormal, const Vec3& point, const Vdl* layerVdls,
-                              int layerCount, const Vec3* layerSh) {
-          const Vec3 n = normalize(layerNormal);
-          writeTexel(nextVdl++, local(point), loPackDirection(n.x, n.y, n.z));
-          if (sh) {
-            for (int i = 0; i < grid.shTerms; ++i) writeSh(nextVdl++, layerSh[i]);
-            return;
-          }
-          const Vec3 correction = params.cosineCorrection ? n : Vec3{0, 0, 0};
-          for (int i = 0; i < layerCount; ++i) writeVdl(nextVdl++, layerVdls[i], correction);
-        };
-        const Vec3 point0 = grid.points.empty() ? grid.frame.origin + (corner + Vec3(0.5f)) *
-                                                                          grid.frame.voxelSize
-                                                : grid.points[v];
-        writeLayer(grid.normals[v], point0, vdls, count, sh ? grid.shOf(v) : nullptr);
-        for (int l = 1; l < layers; ++l) {
-          const uint32_t e = e0 + uint32_t(l) - 1;
-          writeLayer(grid.layers.normals[e], grid.layers.points[e], grid.layerVdlsOf(e),
-                     grid.layers.vdlCount[e], sh ? grid.layerShOf(e) : nullptr);
-        }
+        writeVoxelLeaf(t, leaf.voxel);
       }
     }
   }
-  LO_CHECK_EQ(nextVdl, vdlTotal);
-  out.leafCount = leaves.size();
-  out.collapsedLeaves = adaptive.leaves.size();
-  out.collapsedVoxels = adaptive.voxelsCollapsed;
-  out.nodeCount = tileCount;
-  out.vdlCount = vdlTotal;
-  return out;
+
+  /// A collapsed leaf: its texels, stored as they are (intensities, SH terms).
+  void writeCollapsedLeaf(uint8_t* t, const CollapsedLeaf& c) {
+    writeLeafTexel(t, uint8_t(sh_ ? 1u : uint(c.vdls.size())));
+    if (sh_) {
+      for (const Vec3& term : c.sh) writeSh(nextVdl_++, term);
+    } else {
+      for (const Vdl& vdl : c.vdls) writeVdl(nextVdl_++, vdl, Vec3{0, 0, 0});
+    }
+  }
+
+  /// A voxel's leaf: its VDLs (or SH terms), or a layer block.
+  void writeVoxelLeaf(uint8_t* t, size_t v) {
+    const int count = grid_.vdlCount[v];
+    // An SH leaf's flag is 1 (a leaf); its texel count is the octree's shTerms.
+    writeLeafTexel(t, uint8_t(extraCount_[v] > 0 ? LO_FLAG_LAYERED : sh_ ? 1u : uint(count)));
+    if (extraCount_[v] > 0) {
+      writeLayerBlock(v);
+      return;
+    }
+    if (sh_) {
+      for (int i = 0; i < grid_.shTerms; ++i) writeSh(nextVdl_++, grid_.shOf(v)[i]);
+      return;
+    }
+    const Vdl* vdls = grid_.vdlsOf(v);
+    const Vec3 normal = params_.cosineCorrection && grid_.normals.size() == grid_.size()
+                            ? normalize(grid_.normals[v])
+                            : Vec3{0, 0, 0};
+    for (int i = 0; i < count; ++i) writeVdl(nextVdl_++, vdls[i], normal);
+  }
+
+  /// A layer block (octree_layout.h): header, then per layer its header and VDLs.
+  void writeLayerBlock(size_t v) {
+    const int count = grid_.vdlCount[v];
+    const uint32_t e0 = extraFirst_[v];
+    const int layers = 1 + extraCount_[v];
+    Vec3 counts{float(texelsOf(count)), 0, 0};
+    for (int l = 1; l < layers; ++l) {
+      counts[l] = float(texelsOf(grid_.layers.vdlCount[e0 + uint32_t(l) - 1]));
+    }
+    writeTexel(nextVdl_++, counts, float(layers));
+    const Vec3 corner{float(grid_.coords[v].x), float(grid_.coords[v].y), float(grid_.coords[v].z)};
+    auto local = [&](const Vec3& world) {
+      return (world - grid_.frame.origin) / grid_.frame.voxelSize - corner;
+    };
+    auto writeLayer = [&](const Vec3& layerNormal, const Vec3& point, const Vdl* layerVdls,
+                          int layerCount, const Vec3* layerSh) {
+      const Vec3 n = normalize(layerNormal);
+      writeTexel(nextVdl_++, local(point), loPackDirection(n.x, n.y, n.z));
+      if (sh_) {
+        for (int i = 0; i < grid_.shTerms; ++i) writeSh(nextVdl_++, layerSh[i]);
+        return;
+      }
+      const Vec3 correction = params_.cosineCorrection ? n : Vec3{0, 0, 0};
+      for (int i = 0; i < layerCount; ++i) writeVdl(nextVdl_++, layerVdls[i], correction);
+    };
+    const Vec3 point0 = grid_.points.empty()
+                            ? grid_.frame.origin + (corner + Vec3(0.5f)) * grid_.frame.voxelSize
+                            : grid_.points[v];
+    writeLayer(grid_.normals[v], point0, grid_.vdlsOf(v), count, sh_ ? grid_.shOf(v) : nullptr);
+    for (int l = 1; l < layers; ++l) {
+      const uint32_t e = e0 + uint32_t(l) - 1;
+      writeLayer(grid_.layers.normals[e], grid_.layers.points[e], grid_.layerVdlsOf(e),
+                 grid_.layers.vdlCount[e], sh_ ? grid_.layerShOf(e) : nullptr);
+    }
+  }
+
+  const VdlGrid& grid_;
+  const GpuOctreeParams& params_;
+  const int depth_;
+  const bool sh_;
+  const AdaptiveLeaves adaptive_;
+  std::vector<uint32_t> extraFirst_;
+  std::vector<uint8_t> extraCount_;
+  std::vector<Leaf> leaves_;
+  std::vector<std::vector<uint64_t>> levels_;
+  std::vector<std::vector<int64_t>> levelLeaf_;
+  std::vector<std::vector<size_t>> levelTile_;
+  size_t tileCount_ = 0;
+  size_t vdlTotal_ = 0;
+  size_t width_ = 1;    ///< of the VDL texture
+  size_t nextVdl_ = 0;  ///< the next VDL texel to write
+  GpuOctree out_;
+};
+
+}  // namespace gpu_octree_internal
+
+GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
+  gpu_octree_internal::validate(grid, params);
+  return gpu_octree_internal::OctreeBuilder(grid, params).build();
 }
 
 std::string GpuOctree::ToString() const {

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "render/context.h"
+#include "render/gl_resources.h"
 #include "render/gl_util.h"
 #include "render/octree_textures.h"
 
@@ -26,23 +27,18 @@ struct AtlasVertex {
 }  // namespace
 
 struct GpuAtlasEvaluator::Impl {
-  GLuint program = 0, vao = 0, vbo = 0, fbo = 0, depth = 0;
-  GLuint colour[3] = {0, 0, 0};  ///< irradiance, direction (RGBA32F), triangle (R32I)
+  GlProgram program;
+  GlVertexArray vao;
+  GlBuffer vbo;
+  GlFramebuffer fbo;
+  GlRenderbuffer depth;
+  GlRenderbuffer colour[3];  ///< irradiance, direction (RGBA32F), triangle (R32I)
   OctreeTextures octree;
   const Scene* scene = nullptr;
   const LightmapUvs* uvs = nullptr;
   OctreeShadeParams shade;
   Vec3 origin{0, 0, 0};
   int width = 0, height = 0;
-
-  ~Impl() {
-    if (program) glDeleteProgram(program);
-    glDeleteBuffers(1, &vbo);
-    glDeleteVertexArrays(1, &vao);
-    glDeleteFramebuffers(1, &fbo);
-    glDeleteRenderbuffers(1, &depth);
-    glDeleteRenderbuffers(3, colour);
-  }
 
   void makeTarget() {
     GLint maxSize = 0;
@@ -52,24 +48,21 @@ struct GpuAtlasEvaluator::Impl {
                        " texels exceeds GL_MAX_RENDERBUFFER_SIZE = " + std::to_string(maxSize) +
                        ": bake it with a smaller --atlas, or on the CPU");
     }
-    glDeleteFramebuffers(1, &fbo);
-    glDeleteRenderbuffers(1, &depth);
-    glDeleteRenderbuffers(3, colour);
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glGenRenderbuffers(3, colour);
+    fbo = GlFramebuffer::create();
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo.get());
     const GLenum formats[3] = {GL_RGBA32F, GL_RGBA32F, GL_R32I};
     for (int i = 0; i < 3; ++i) {
-      glBindRenderbuffer(GL_RENDERBUFFER, colour[i]);
+      colour[i] = GlRenderbuffer::create();
+      glBindRenderbuffer(GL_RENDERBUFFER, colour[i].get());
       glRenderbufferStorage(GL_RENDERBUFFER, formats[i], width, height);
       glFramebufferRenderbuffer(GL_FRAMEBUFFER, GLenum(GL_COLOR_ATTACHMENT0 + i), GL_RENDERBUFFER,
-                                colour[i]);
+                                colour[i].get());
     }
     // Float depth: the squared distances compare exactly, as on the CPU.
-    glGenRenderbuffers(1, &depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, depth);
+    depth = GlRenderbuffer::create();
+    glBindRenderbuffer(GL_RENDERBUFFER, depth.get());
     glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth.get());
     const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
@@ -82,11 +75,11 @@ struct GpuAtlasEvaluator::Impl {
 
 GpuAtlasEvaluator::GpuAtlasEvaluator() : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
-  r.program = buildProgram({"atlas_bake.vert", "atlas_bake.geom", "atlas_bake.frag"});
-  glGenVertexArrays(1, &r.vao);
-  glGenBuffers(1, &r.vbo);
-  glBindVertexArray(r.vao);
-  glBindBuffer(GL_ARRAY_BUFFER, r.vbo);
+  r.program = GlProgram(buildProgram({"atlas_bake.vert", "atlas_bake.geom", "atlas_bake.frag"}));
+  r.vao = GlVertexArray::create();
+  r.vbo = GlBuffer::create();
+  glBindVertexArray(r.vao.get());
+  glBindBuffer(GL_ARRAY_BUFFER, r.vbo.get());
   const GLsizei stride = sizeof(AtlasVertex);
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride,
@@ -147,7 +140,7 @@ AtlasPageTexels GpuAtlasEvaluator::evaluatePage(int page, const std::vector<int3
     }
   }
 
-  glBindFramebuffer(GL_FRAMEBUFFER, r.fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, r.fbo.get());
   const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
   glDrawBuffers(3, buffers);
   glViewport(0, 0, r.width, r.height);
@@ -164,18 +157,18 @@ AtlasPageTexels GpuAtlasEvaluator::evaluatePage(int page, const std::vector<int3
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
 
-  glUseProgram(r.program);
-  auto loc = [&r](const char* name) { return glGetUniformLocation(r.program, name); };
+  glUseProgram(r.program.get());
+  auto loc = [&r](const char* name) { return glGetUniformLocation(r.program.get(), name); };
   glUniform2f(loc("uPageSize"), float(r.width), float(r.height));
   glUniform1f(loc("uVoxelSize"), r.octree.voxelSize);
   glUniform1i(loc("uDepth"), r.octree.depth);
   glUniform1f(loc("uNormalOffset"), r.shade.normalOffset);
   glUniform1i(loc("uInterpolation"), r.shade.interpolation ? 1 : 0);
   glUniform1i(loc("uMaxVdls"), r.shade.maxVdls);
-  r.octree.bind(r.program, 0, 1, 2);
+  r.octree.bind(r.program.get(), 0, 1, 2);
 
-  glBindVertexArray(r.vao);
-  glBindBuffer(GL_ARRAY_BUFFER, r.vbo);
+  glBindVertexArray(r.vao.get());
+  glBindBuffer(GL_ARRAY_BUFFER, r.vbo.get());
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(AtlasVertex)),
                vertices.empty() ? nullptr : vertices.data(), GL_STREAM_DRAW);
   if (!vertices.empty()) glDrawArrays(GL_TRIANGLES, 0, GLsizei(vertices.size()));

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "render/context.h"
+#include "render/gl_resources.h"
 
 namespace lo::render_internal {
 namespace {
@@ -90,40 +91,30 @@ std::string shaderSource(const std::string& name, const std::vector<std::string>
 
 GLuint buildProgram(const std::vector<std::string>& files,
                     const std::vector<std::string>& defines) {
-  GLuint program = glCreateProgram();
-  std::vector<GLuint> shaders;
-  auto cleanup = [&]() {
-    for (GLuint s : shaders) glDeleteShader(s);
-  };
+  GlProgram program = GlProgram::create();
+  std::vector<GlShader> shaders;  // deleted on return: the linked program keeps its code
   for (const std::string& file : files) {
     std::string source = shaderSource(file, defines);
-    GLuint shader = glCreateShader(stageOf(file));
-    shaders.push_back(shader);
+    shaders.emplace_back(glCreateShader(stageOf(file)));
+    const GLuint shader = shaders.back().get();
     const char* text = source.c_str();
     glShaderSource(shader, 1, &text, nullptr);
     glCompileShader(shader);
     GLint ok = 0;
     glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-      std::string log = infoLog(shader, false);
-      cleanup();
-      glDeleteProgram(program);
-      throw GlError("shaders/" + file + " does not compile:\n" + log);
-    }
-    glAttachShader(program, shader);
+    if (!ok) throw GlError("shaders/" + file + " does not compile:\n" + infoLog(shader, false));
+    glAttachShader(program.get(), shader);
   }
-  glLinkProgram(program);
+  glLinkProgram(program.get());
   GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  cleanup();
+  glGetProgramiv(program.get(), GL_LINK_STATUS, &ok);
   if (!ok) {
-    std::string log = infoLog(program, true);
-    glDeleteProgram(program);
+    std::string log = infoLog(program.get(), true);
     std::string names;
     for (const std::string& f : files) names += (names.empty() ? "" : " + ") + f;
     throw GlError("program " + names + " does not link:\n" + log);
   }
-  return program;
+  return program.release();
 }
 
 std::vector<std::vector<std::string>> allPrograms() {
@@ -131,6 +122,7 @@ std::vector<std::vector<std::string>> allPrograms() {
           {"render_shadow.vert", "render_shadow.frag"},
           {"render_depth.vert", "render_depth.frag"},
           {"render_fullscreen.vert", "render_layout_probe.frag"},
+          {"render_fullscreen.vert", "render_brdf_probe.frag"},
           {"atlas_bake.vert", "atlas_bake.geom", "atlas_bake.frag"}};
 }
 

@@ -16,14 +16,6 @@ std::string texelCount(int w, int h, int d) {
   return os.str();
 }
 
-OctreeTextures::~OctreeTextures() { release(); }
-
-void OctreeTextures::release() {
-  GLuint textures[] = {pool, vdl, vdlHalf};  // 0 where none: no-op
-  glDeleteTextures(3, textures);
-  pool = vdl = vdlHalf = 0;
-}
-
 void OctreeTextures::checkLimits(const GpuOctree& octree, int max3D, int max2D) {
   if (max3D <= 0) glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3D);
   if (max2D <= 0) glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max2D);
@@ -44,10 +36,9 @@ void OctreeTextures::checkLimits(const GpuOctree& octree, int max3D, int max2D) 
 }
 
 void OctreeTextures::upload(const GpuOctree& octree) {
-  release();
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glGenTextures(1, &pool);
-  glBindTexture(GL_TEXTURE_3D, pool);
+  pool = GlTexture::create();
+  glBindTexture(GL_TEXTURE_3D, pool.get());
   glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   const uint8_t emptyTexel[4] = {0, 0, 0, 0};  // LO_FLAG_EMPTY: keeps the sampler complete
@@ -60,9 +51,9 @@ void OctreeTextures::upload(const GpuOctree& octree) {
                GL_RGBA_INTEGER, GL_UNSIGNED_BYTE, hasPool ? octree.pool.data() : emptyTexel);
   checkGl("uploading the octree pool (GL_TEXTURE_3D, GL_RGBA8UI)");
 
-  auto makeTexture = [](GLuint& texture) {
-    glGenTextures(1, &texture);
-    glBindTexture(GL_TEXTURE_2D, texture);
+  auto makeTexture = [](GlTexture& texture) {
+    texture = GlTexture::create();
+    glBindTexture(GL_TEXTURE_2D, texture.get());
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   };
@@ -105,11 +96,11 @@ void OctreeTextures::bind(GLuint program, int poolUnit, int vdlUnit, int halfUni
   glUniform1f(glGetUniformLocation(program, "uVdlScale"), scale);
   glUniform1i(glGetUniformLocation(program, "uShTerms"), shTerms);
   glActiveTexture(GLenum(GL_TEXTURE0 + poolUnit));
-  glBindTexture(GL_TEXTURE_3D, pool);
+  glBindTexture(GL_TEXTURE_3D, pool.get());
   glActiveTexture(GLenum(GL_TEXTURE0 + vdlUnit));
-  glBindTexture(GL_TEXTURE_2D, vdl);
+  glBindTexture(GL_TEXTURE_2D, vdl.get());
   glActiveTexture(GLenum(GL_TEXTURE0 + halfUnit));
-  glBindTexture(GL_TEXTURE_2D, vdlHalf);
+  glBindTexture(GL_TEXTURE_2D, vdlHalf.get());
   glActiveTexture(GL_TEXTURE0);
 }
 

@@ -9,6 +9,7 @@
 
 #include "core/math.h"
 #include "octree/gpu_octree.h"
+#include "render/gl_resources.h"
 
 namespace lo::render_internal {
 
@@ -21,11 +22,6 @@ std::string texelCount(int w, int h, int d);
 /// the octree has. Requires a current GL context; owns its textures.
 class OctreeTextures {
  public:
-  OctreeTextures() = default;
-  ~OctreeTextures();
-  OctreeTextures(const OctreeTextures&) = delete;
-  OctreeTextures& operator=(const OctreeTextures&) = delete;
-
   /// @throws InputError naming GL_MAX_3D_TEXTURE_SIZE / GL_MAX_TEXTURE_SIZE
   /// and by how much when `octree` exceeds them (0 = the context's limit).
   static void checkLimits(const GpuOctree& octree, int max3D = 0, int max2D = 0);
@@ -38,7 +34,7 @@ class OctreeTextures {
   /// program must be in use.
   void bind(GLuint program, int poolUnit, int vdlUnit, int halfUnit) const;
 
-  GLuint pool = 0, vdl = 0, vdlHalf = 0;
+  GlTexture pool, vdl, vdlHalf;
   bool half = false;       ///< the VDL texels are the 16-bit ones
   bool compact = false;    ///< ... holding compact (RGB9E5) irradiance
   float scale = 1;         ///< the compact texels' irradiance scale
@@ -46,9 +42,6 @@ class OctreeTextures {
   int depth = 0;           ///< the octree's depth
   float voxelSize = 1;     ///< world units
   Vec3 origin{0, 0, 0};    ///< world position of the cube's corner
-
- private:
-  void release();
 };
 
 }  // namespace lo::render_internal

@@ -1,0 +1,134 @@
+/* material_brdf.h: the glTF metallic-roughness BRDF, written once for GLSL and
+ * C++ (the practice of octree_lookup.h). The scene shader includes it
+ * (render_scene.frag); the C++ build is material/gltf_brdf.cpp, which gives
+ * the same functions to the tests and, next, to the tracers.
+ *
+ * The BRDF (docs/render.md): Lambert diffuse weighted by (1 - F), plus a GGX
+ * lobe (Walter et al. 2007) with height-correlated Smith visibility (Heitz
+ * 2014, eq. 99) and Schlick's Fresnel, F0 = mix(0.04, baseColor, metallic).
+ * KHR_materials_transmission takes its share of the diffuse lobe away (the
+ * renderer draws the transmitted light separately). With the specular lobe
+ * off the BRDF is exactly baseColor (1 - metallic)(1 - transmission) / pi:
+ * the analytic render tests rely on that.
+ *
+ *   loBrdfAlpha        GGX alpha of a perceptual roughness (roughness^2, floored)
+ *   loBrdfDiffuseOnly  the diffuse lobe alone, no Fresnel weight (specular off)
+ *   loBrdfLobes        the two lobes towards l, no cosine: (1 - F) diffuse, F D V
+ *   loBrdf             their sum, no cosine (what a tracer's f(wo, wi) is)
+ *   loBrdfCosWeighted  f (n.l), the GGX lobe scaled by a weight, 0 below the surface
+ *   loBrdfCos          the same with the whole GGX lobe
+ *   loEnvironmentBrdf  the split-sum environment BRDF in Karis's analytic fit
+ *
+ * Directions are unit, in one space, pointing away from the surface: n the
+ * shading normal, v to the viewer, l to the light. Colours are linear RGB.
+ * In C++ the functions live in namespace lo::brdf, with GLM standing in for
+ * GLSL's types.
+ */
+#ifndef LO_MATERIAL_BRDF_H
+#define LO_MATERIAL_BRDF_H
+
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace lo {
+namespace brdf {
+using namespace glm;
+/* GLSL's built-ins are GLM's here, ahead of lo's own min/max/dot (core/math.h). */
+using glm::clamp;
+using glm::dot;
+using glm::exp2;
+using glm::max;
+using glm::min;
+using glm::mix;
+using glm::normalize;
+using glm::pow;
+using glm::sqrt;
+#define LO_BRDF_FN inline
+#define LO_BRDF_OUT(T) T &
+#else
+#define LO_BRDF_FN
+#define LO_BRDF_OUT(T) out T
+#endif
+
+const float LO_BRDF_PI = 3.14159265358979323846f;
+
+/* The GGX alpha of a perceptual roughness; the floor keeps a mirror's lobe
+ * finite for a point light (a highlight of about one pixel, not a NaN). */
+LO_BRDF_FN float loBrdfAlpha(float roughness) { return max(roughness * roughness, 2e-3f); }
+
+LO_BRDF_FN vec3 loBrdfDiffuseOnly(vec3 baseColor, float metallic, float transmission) {
+  return baseColor * (1.0f - metallic) * (1.0f - transmission) / LO_BRDF_PI;
+}
+
+/* The two lobes of the BRDF (no cosine) towards l: (1 - F) diffuse and
+ * F D V, GGX of alpha a. Meant for n.l > 0; the cosines are floored so that
+ * grazing directions give finite values. */
+LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float a,
+                            float transmission, LO_BRDF_OUT(vec3) diffuse,
+                            LO_BRDF_OUT(vec3) specular) {
+  float nl = max(dot(n, l), 1e-4f);
+  diffuse = loBrdfDiffuseOnly(baseColor, metallic, transmission);
+  float nv = max(dot(n, v), 1e-4f);
+  vec3 h = normalize(l + v);
+  float nh = max(dot(n, h), 0.0f);
+  float vh = clamp(dot(v, h), 0.0f, 1.0f); /* pow(1 - vh, 5) is NaN for vh a rounding above 1 */
+  float a2 = a * a;
+  float dd = nh * nh * (a2 - 1.0f) + 1.0f;
+  float D = a2 / (LO_BRDF_PI * dd * dd);
+  float vis =
+      0.5f / (nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2));
+  vec3 f0 = mix(vec3(0.04f), baseColor, metallic);
+  vec3 F = f0 + (1.0f - f0) * pow(1.0f - vh, 5.0f);
+  diffuse *= 1.0f - F;
+  specular = F * (D * vis);
+}
+
+/* f(v, l): both lobes, no cosine; 0 when l is below the surface. */
+LO_BRDF_FN vec3 loBrdf(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness,
+                       float transmission) {
+  if (dot(n, l) <= 0.0f) return vec3(0.0f);
+  vec3 diffuse, specular;
+  loBrdfLobes(n, v, l, baseColor, metallic, loBrdfAlpha(roughness), transmission, diffuse,
+              specular);
+  return diffuse + specular;
+}
+
+/* f(v, l) (n.l) with the GGX lobe scaled by specularWeight (the VDLs' share
+ * of a surface's specular light when the reflection probe takes the rest);
+ * without `specular`, the diffuse lobe alone and no Fresnel weight. */
+LO_BRDF_FN vec3 loBrdfCosWeighted(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic,
+                                  float roughness, float transmission, bool specular,
+                                  float specularWeight) {
+  float nl = dot(n, l);
+  if (nl <= 0.0f) return vec3(0.0f);
+  if (!specular) return loBrdfDiffuseOnly(baseColor, metallic, transmission) * nl;
+  vec3 diffuseLobe, specularLobe;
+  loBrdfLobes(n, v, l, baseColor, metallic, loBrdfAlpha(roughness), transmission, diffuseLobe,
+              specularLobe);
+  return (diffuseLobe + specularWeight * specularLobe) * nl;
+}
+
+LO_BRDF_FN vec3 loBrdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic,
+                          float roughness, float transmission, bool specular) {
+  return loBrdfCosWeighted(n, v, l, baseColor, metallic, roughness, transmission, specular, 1.0f);
+}
+
+/* The split-sum environment BRDF (Karis 2013): the GGX lobe's directional
+ * albedo as F0 x + y, in Karis's analytic fit (Physically Based Shading on
+ * Mobile, 2014); nv = n.v clamped to [0, 1]. Radiance prefiltered along the
+ * reflected ray times this is the lobe's reflected light. */
+LO_BRDF_FN vec3 loEnvironmentBrdf(vec3 baseColor, float metallic, float roughness, float nv) {
+  const vec4 c0 = vec4(-1.0f, -0.0275f, -0.572f, 0.022f);
+  const vec4 c1 = vec4(1.0f, 0.0425f, 1.04f, -0.04f);
+  vec4 q = roughness * c0 + c1;
+  float a004 = min(q.x * q.x, exp2(-9.28f * nv)) * q.x + q.y;
+  vec2 ab = vec2(-1.04f, 1.04f) * a004 + vec2(q.z, q.w);
+  vec3 f0 = mix(vec3(0.04f), baseColor, metallic);
+  return f0 * ab.x + ab.y;
+}
+
+#ifdef __cplusplus
+}  // namespace brdf
+}  // namespace lo
+#endif
+
+#endif /* LO_MATERIAL_BRDF_H */

@@ -1,0 +1,289 @@
+// The scene's lights for the scene shader: punctual lights, emissive
+// triangles as area lights or VPLs, their shadow maps (cubes, spots, sun
+// cascades). docs/render.md describes the shading.
+
+#include "render/lights.h"
+
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/error.h"
+#include "render/context.h"
+#include "render/gl_util.h"
+
+namespace lo::render_internal {
+namespace {
+
+constexpr int kMaxLights = shader::LO_MAX_LIGHTS;
+constexpr int kMaxShadowLayers = shader::LO_MAX_SHADOW_LAYERS;
+constexpr int kCascades = shader::LO_SUN_CASCADES;
+
+glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
+glm::vec4 toVec4(const Vec3& v, float w) { return {v.x, v.y, v.z, w}; }
+
+/// Any unit vector orthogonal to unit d.
+glm::vec3 perpendicular(const glm::vec3& d) {
+  glm::vec3 a = std::fabs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+  return glm::normalize(glm::cross(d, glm::cross(a, d)));
+}
+
+GpuLight punctualLight(const Light& light, const RenderSpace& space) {
+  GpuLight l{};
+  const Vec3 color = light.color * light.intensity;
+  const int type = light.type == Light::Type::Point  ? shader::LO_LIGHT_POINT
+                   : light.type == Light::Type::Spot ? shader::LO_LIGHT_SPOT
+                                                     : shader::LO_LIGHT_DIRECTIONAL;
+  l.positionType = toVec4(space.toRender(light.position), float(type));
+  l.directionRange = toVec4(normalize(light.direction), light.range);
+  l.colorFar = toVec4(color, 0);
+  l.params = toVec4(Vec3(std::cos(light.outerConeAngle), std::cos(light.innerConeAngle), -1), 0);
+  return l;
+}
+
+}  // namespace
+
+int SceneLights::shadowLayersOf(int type) {
+  if (type == shader::LO_LIGHT_DIRECTIONAL) return kCascades;
+  return type == shader::LO_LIGHT_POINT || type == shader::LO_LIGHT_EMITTER ||
+                 type == shader::LO_LIGHT_AREA
+             ? 6
+             : 1;
+}
+
+int SceneLights::layerCount() const {
+  int layers = 0;
+  for (int i = 0; i < block.uLightCount[0]; ++i) {
+    const GpuLight& l = block.uLights[i];
+    if (l.params[2] >= 0) layers += shadowLayersOf(int(l.positionType[3]));
+  }
+  return layers;
+}
+
+void SceneLights::build(const Scene& scene, const RenderSpace& space,
+                        const RendererParams& params) {
+  shadowMapSize = params.shadowMapSize;
+  std::vector<GpuLight> lights;
+  for (const Light& light : scene.lights) lights.push_back(punctualLight(light, space));
+  std::vector<GpuLight> emitters =
+      params.areaLights ? areaLights(scene, space) : std::vector<GpuLight>{};
+  if (emitters.empty()) {
+    emitters = emitterVpls(scene, space, params.emitterLights);
+    emitterLights = int(emitters.size());
+  } else {
+    areaLightCount = int(emitters.size());
+  }
+  lights.insert(lights.end(), emitters.begin(), emitters.end());
+  if (lights.size() > size_t(kMaxLights)) {
+    throw InputError("scene has " + std::to_string(lights.size()) +
+                     " punctual + emitter lights; the renderer draws at most " +
+                     std::to_string(kMaxLights) + " (lower --emitter-lights)");
+  }
+
+  // Shadow map layers: 6 per point light / emitter VPL (cube faces), 1 per
+  // spot or directional light, while layers last (further lights unshadowed).
+  int layers = 0;
+  const glm::vec3 center = toGlm(space.bounds.center());
+  const float sceneSize = space.sceneSize;
+  const float radius = 0.5f * sceneSize;
+  const float nearPlane = 1e-3f * sceneSize;
+  for (GpuLight& l : lights) {
+    const int type = int(l.positionType[3]);
+    const int need = shadowLayersOf(type);
+    if (layers + need > kMaxShadowLayers) continue;
+    const glm::vec3 pos(l.positionType);
+    const glm::vec3 dir(l.directionRange);
+    const float far = glm::length(pos - center) + radius + nearPlane;
+    l.params[2] = float(layers);
+    if (need == 6) {
+      const glm::vec3 axes[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                 {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+      const glm::mat4 proj = glm::perspective(glm::radians(90.0f), 1.0f, nearPlane, far);
+      for (int f = 0; f < 6; ++f) {
+        block.uShadowMatrices[layers + f] =
+            proj * glm::lookAt(pos, pos + axes[f], perpendicular(axes[f]));
+      }
+      l.colorFar[3] = far;
+    } else if (type == shader::LO_LIGHT_SPOT) {
+      const float fov =
+          std::min(2.0f * std::acos(std::clamp(l.params[0], -1.0f, 1.0f)) + 0.05f, 3.0f);
+      block.uShadowMatrices[layers] = glm::perspective(fov, 1.0f, nearPlane, far) *
+                                      glm::lookAt(pos, pos + dir, perpendicular(dir));
+      l.colorFar[3] = far;
+    } else {
+      // Cascades fitted to the camera's view each frame (fitCascades); until
+      // the first frame, every cascade covers the whole scene.
+      const glm::vec3 eye = center - dir * (2.0f * radius);
+      const glm::mat4 m = glm::ortho(-radius, radius, -radius, radius, 0.0f, 4.0f * radius) *
+                          glm::lookAt(eye, center, perpendicular(dir));
+      for (int c = 0; c < kCascades; ++c) block.uShadowMatrices[layers + c] = m;
+      l.colorFar[3] = 0;
+      sunLights.push_back(int(&l - lights.data()));
+    }
+    layers += need;
+  }
+  std::copy(lights.begin(), lights.end(), block.uLights);
+  block.uLightCount[0] = int32_t(lights.size());
+  block.uLightCount[1] = int32_t(areaLightCount);  // appended last
+  // Depth bias as a fraction of the far plane and a normal offset, both
+  // about one shadow texel at the scene's scale.
+  const float texel = 2.0f * sceneSize / float(params.shadowMapSize);
+  block.uShadowParams[0] = 0.5f * texel / std::max(sceneSize, 1e-6f);
+  block.uShadowParams[1] = 1.5f * texel;
+
+  ubo = GlBuffer::create();
+  glBindBuffer(GL_UNIFORM_BUFFER, ubo.get());
+  glBufferData(GL_UNIFORM_BUFFER, sizeof(LightBlock), &block, GL_STATIC_DRAW);
+  glBindBuffer(GL_UNIFORM_BUFFER, 0);
+}
+
+void SceneLights::allocateShadowMaps() {
+  const int layers = layerCount();
+  shadowTexture = GlTexture::create();
+  glBindTexture(GL_TEXTURE_2D_ARRAY, shadowTexture.get());
+  const int size = layers > 0 ? shadowMapSize : 1;
+  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT24, size, size, std::max(layers, 1), 0,
+               GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  checkGl("allocating the shadow maps");
+
+  // The same maps read as plain depths (PCSS's blocker search): a sampler
+  // object without comparison, bound to its own unit.
+  depthSampler = GlSampler::create();
+  glSamplerParameteri(depthSampler.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glSamplerParameteri(depthSampler.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glSamplerParameteri(depthSampler.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(depthSampler.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(depthSampler.get(), GL_TEXTURE_COMPARE_MODE, GL_NONE);
+
+  shadowFbo = GlFramebuffer::create();
+  glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo.get());
+  glDrawBuffer(GL_NONE);
+  glReadBuffer(GL_NONE);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  shadowProgram = GlProgram(buildProgram({"render_shadow.vert", "render_shadow.frag"}));
+}
+
+GLint SceneLights::beginShadowPass(GLuint vao) {
+  GLint previous = 0;
+  glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous);
+  glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo.get());
+  glViewport(0, 0, shadowMapSize, shadowMapSize);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  glUseProgram(shadowProgram.get());
+  glBindVertexArray(vao);
+  return previous;
+}
+
+void SceneLights::endShadowPass(GLint previous, const char* what) {
+  glBindVertexArray(0);
+  glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
+  checkGl(what);
+}
+
+void SceneLights::beginLayer(int layer, bool checkComplete) {
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadowTexture.get(), 0, layer);
+  if (checkComplete && glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw GlError("shadow map framebuffer incomplete");
+  }
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glUniformMatrix4fv(glGetUniformLocation(shadowProgram.get(), "uViewProj"), 1, GL_FALSE,
+                     glm::value_ptr(block.uShadowMatrices[layer]));
+}
+
+/// Cascaded shadow maps of the directional lights (Engel 2006; Zhang et
+/// al. 2006, parallel-split): the camera's view depth up to the scene's far
+/// end is split into kCascades slices, half logarithmic and half uniform,
+/// and each slice's frustum gets its own orthographic map around the
+/// slice's bounding sphere (a square of the sphere's diameter, so the
+/// texel size does not change as the camera turns), its centre snapped to
+/// whole texels (no shimmer as the camera moves), its depth range the
+/// whole scene's along the light (casters outside the slice still cast).
+void SceneLights::fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye,
+                                     const glm::vec3& forward, float yfov, float aspect,
+                                     float znear, float zfar) {
+  const Bounds3& bounds = space.bounds;
+  const float sceneSize = space.sceneSize;
+  const glm::vec3 center = toGlm(bounds.center());
+  const float sceneRadius = 0.5f * sceneSize;
+  // The slices end where the scene ends along the view.
+  float farthest = 0;
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner((c & 1) ? bounds.upper.x : bounds.lower.x,
+                           (c & 2) ? bounds.upper.y : bounds.lower.y,
+                           (c & 4) ? bounds.upper.z : bounds.lower.z);
+    farthest = std::max(farthest, glm::dot(corner - eye, forward));
+  }
+  const float n = std::max(znear, 1e-4f * sceneSize);
+  const float f = std::max(std::min(zfar, farthest), 2.0f * n);
+  float splits[kCascades + 1];
+  splits[0] = n;
+  for (int i = 1; i <= kCascades; ++i) {
+    const float t = float(i) / float(kCascades);
+    splits[i] = 0.5f * n * std::pow(f / n, t) + 0.5f * (n + (f - n) * t);
+  }
+  const float th = std::tan(0.5f * yfov), tw = th * aspect;
+  glBindBuffer(GL_UNIFORM_BUFFER, ubo.get());
+  for (int c = 0; c < kCascades; ++c) {
+    // The slice's bounding sphere: centred on the view axis where it is
+    // equidistant from the near and far corners.
+    const float d0 = splits[c], d1 = splits[c + 1];
+    const float k2 = tw * tw + th * th;
+    float z = 0.5f * (d0 + d1) * (1.0f + k2);
+    z = std::min(z, d1);
+    const float r0 = std::sqrt((z - d0) * (z - d0) + d0 * d0 * k2);
+    const float r1 = std::sqrt((d1 - z) * (d1 - z) + d1 * d1 * k2);
+    float radius = std::max(r0, r1);
+    glm::vec3 sphere = eye + forward * z;
+    if (radius >= sceneRadius) {
+      radius = sceneRadius;
+      sphere = center;
+    }
+    cascadeFar[c] = c + 1 == kCascades ? 1e30f : d1;
+    cascadeTexel[c] = 2.0f * radius / float(shadowMapSize);
+    for (int light : sunLights) {
+      const GpuLight& l = block.uLights[light];
+      const glm::vec3 dir(l.directionRange);
+      const glm::mat4 view0 = glm::lookAt(glm::vec3(0.0f), dir, perpendicular(dir));
+      // Snap the centre to whole texels in the light's view plane.
+      glm::vec3 ls = glm::vec3(view0 * glm::vec4(sphere, 1.0f));
+      ls.x = std::floor(ls.x / cascadeTexel[c]) * cascadeTexel[c];
+      ls.y = std::floor(ls.y / cascadeTexel[c]) * cascadeTexel[c];
+      const glm::vec3 snapped = glm::vec3(glm::inverse(view0) * glm::vec4(ls, 1.0f));
+      // Depth: the whole scene along the light, from the map's centre.
+      float before = 0, after = 0;
+      for (int k = 0; k < 8; ++k) {
+        const glm::vec3 corner((k & 1) ? bounds.upper.x : bounds.lower.x,
+                               (k & 2) ? bounds.upper.y : bounds.lower.y,
+                               (k & 4) ? bounds.upper.z : bounds.lower.z);
+        const float along = glm::dot(corner - snapped, dir);
+        before = std::max(before, -along);
+        after = std::max(after, along);
+      }
+      const float margin = 1e-3f * sceneSize;
+      const glm::vec3 lightEye = snapped - dir * (before + margin);
+      cascadeDepth[c] = before + after + 2.0f * margin;
+      const int layer = int(l.params[2]) + c;
+      block.uShadowMatrices[layer] =
+          glm::ortho(-radius, radius, -radius, radius, 0.0f, cascadeDepth[c]) *
+          glm::lookAt(lightEye, snapped, perpendicular(dir));
+      glBufferSubData(
+          GL_UNIFORM_BUFFER,
+          GLintptr(offsetof(LightBlock, uShadowMatrices) + sizeof(glm::mat4) * size_t(layer)),
+          sizeof(glm::mat4), glm::value_ptr(block.uShadowMatrices[layer]));
+    }
+  }
+  glBindBuffer(GL_UNIFORM_BUFFER, 0);
+}
+
+}  // namespace lo::render_internal

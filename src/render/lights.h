@@ -1,0 +1,117 @@
+#pragma once
+// Internal to src/render: the scene's lights as the scene shader reads them
+// (the std140 block of shaders/render_lights.h) and their shadow maps.
+
+#include <render_constants.h>
+
+#include <array>
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <vector>
+
+#include "render/gl_resources.h"
+#include "render/light_list.h"
+#include "render/renderer.h"
+
+namespace lo::render_internal {
+
+/// The light block and the shadow maps of a scene (lights.cpp).
+struct SceneLights {
+  LightBlock block{};
+  GlBuffer ubo;             ///< the block, binding point 0
+  GlTexture shadowTexture;  ///< depth array: the layers of every shadowed light
+  GlFramebuffer shadowFbo;
+  GlSampler depthSampler;  ///< reads the shadow maps' depths (no comparison): PCSS blocker search
+  GlProgram shadowProgram;
+  int shadowMapSize = 1;
+  int emitterLights = 0;   ///< VPLs in the block
+  int areaLightCount = 0;  ///< area lights in the block (the last ones)
+  /// Directional lights with cascaded shadow maps (indices into the light
+  /// block), their cascades refitted when the camera moves.
+  std::vector<int> sunLights;
+  float cascadeFar[4] = {0, 0, 0, 0};    ///< view depth where each cascade ends
+  float cascadeTexel[4] = {0, 0, 0, 0};  ///< world size of one texel of each cascade
+  float cascadeDepth[4] = {1, 1, 1, 1};  ///< world depth range of each cascade's map
+  std::array<float, 12> fittedCamera{};  ///< the camera the cascades were fitted to
+
+  /// Builds the block (punctual lights, then area lights or VPLs), uploads
+  /// it and renders every shadow map once, drawing `draw`'s depth-only
+  /// geometry with the vertex array `vao`. @throws InputError past LO_MAX_LIGHTS.
+  template <class DrawDepthOnly>
+  void setup(const Scene& scene, const RenderSpace& space, const RendererParams& params, GLuint vao,
+             const DrawDepthOnly& draw) {
+    build(scene, space, params);
+    allocateShadowMaps();
+    renderShadowMaps(vao, draw);
+  }
+
+  /// Refits the directional lights' cascades to a camera (render space) and
+  /// re-renders those layers, unless the camera is the last one fitted.
+  template <class DrawDepthOnly>
+  void fitCascades(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
+                   const glm::vec3& up, float yfov, float aspect, float znear, float zfar,
+                   GLuint vao, const DrawDepthOnly& draw) {
+    if (sunLights.empty()) return;
+    const std::array<float, 12> key = {eye.x, eye.y, eye.z, forward.x, forward.y, forward.z,
+                                       up.x,  up.y,  up.z,  yfov,      aspect,    znear};
+    if (key == fittedCamera) return;
+    fittedCamera = key;
+    fitCascadeMatrices(space, eye, forward, yfov, aspect, znear, zfar);
+    renderCascades(vao, draw);
+  }
+
+ private:
+  void build(const Scene& scene, const RenderSpace& space, const RendererParams& params);
+  void allocateShadowMaps();
+  /// Binds the shadow framebuffer and the shadow program for depth-only
+  /// draws at the maps' size; returns the framebuffer bound before.
+  GLint beginShadowPass(GLuint vao);
+  void endShadowPass(GLint previous, const char* what);
+  /// Points the shadow framebuffer at `layer` and clears it; the program's
+  /// view-projection is that layer's matrix.
+  void beginLayer(int layer, bool checkComplete);
+  void fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
+                          float yfov, float aspect, float znear, float zfar);
+  int layerCount() const;
+
+  template <class DrawDepthOnly>
+  void renderShadowMaps(GLuint vao, const DrawDepthOnly& draw) {
+    const GLint previous = beginShadowPass(vao);
+    for (int i = 0; i < block.uLightCount[0]; ++i) {
+      const GpuLight& l = block.uLights[i];
+      if (l.params[2] < 0) continue;
+      glUniform3fv(glGetUniformLocation(shadowProgram.get(), "uLightPosition"), 1,
+                   glm::value_ptr(l.positionType));
+      glUniform1f(glGetUniformLocation(shadowProgram.get(), "uFar"), l.colorFar[3]);
+      const int layers = shadowLayersOf(int(l.positionType[3]));
+      for (int f = 0; f < layers; ++f) {
+        beginLayer(int(l.params[2]) + f, true);
+        // Transmissive surfaces cast no shadow (light passes; not tinted).
+        draw(shadowProgram.get(), true);
+      }
+    }
+    endShadowPass(previous, "rendering the shadow maps");
+  }
+
+  template <class DrawDepthOnly>
+  void renderCascades(GLuint vao, const DrawDepthOnly& draw) {
+    const GLint previous = beginShadowPass(vao);
+    glUniform1f(glGetUniformLocation(shadowProgram.get(), "uFar"), 0.0f);
+    for (int light : sunLights) {
+      const GpuLight& l = block.uLights[light];
+      for (int c = 0; c < shader::LO_SUN_CASCADES; ++c) {
+        beginLayer(int(l.params[2]) + c, false);
+        draw(shadowProgram.get(), true);
+      }
+    }
+    endShadowPass(previous, "rendering the cascaded shadow maps");
+  }
+
+ public:
+  /// Shadow map layers a light of shader type `type` takes: a cube (6) for
+  /// lights that shine all around a point, one per cascade for directional
+  /// lights, one for spot lights.
+  static int shadowLayersOf(int type);
+};
+
+}  // namespace lo::render_internal

@@ -1,0 +1,181 @@
+#pragma once
+// Internal to src/render: the renderer's parts, one file each.
+//   scene_geometry.cpp   the scene on the GPU: vertices by material, textures,
+//                        draw order, depth-only draws, the blended sort
+//   light_list.cpp       area lights and VPLs (no GL: light_list.h)
+//   lights.cpp           the light block, shadow maps, sun cascades (lights.h)
+//   reflection_probe.cpp the probe's cube map, captured with the scene pass
+//   scene_pass.cpp       a frame: depth pre-pass, the scene pass, transmission
+//   renderer.cpp         the public Renderer, which ties them together
+// GL objects are held by the handles of gl_resources.h.
+// Render space: world minus the centre of the scene's bounds (see RenderSpace).
+
+#include <render_constants.h>
+
+#include <array>
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "core/math.h"
+#include "render/gl_resources.h"
+#include "render/lights.h"
+#include "render/octree_textures.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+
+namespace lo {
+namespace render_internal {
+
+/// One vertex of the scene's vertex buffer (attribute locations 0-9, 11 of
+/// render_scene.vert; 10 is the lightmap's, in a buffer of its own).
+struct Vertex {
+  float position[3];
+  float normal[3];
+  float baseColor[3];  ///< the material's base colour factor (textures apply per pixel)
+  float metallicRoughness[2];
+  float emission[3];
+  float uv[2];        ///< the texture coordinates the base colour texture names (TEXCOORD_0 or _1)
+  float normalUv[2];  ///< the texture coordinates of the normal map
+  float metallicRoughnessUv[2];
+  float occlusionUv[2];
+  float emissiveUv[2];
+  float tangent[4];  ///< glTF TANGENT (xyz, w = +-1), w = 0 without: derived in the shader
+};
+
+/// Draw order of the scene pass: plain opaque ranges first (one call in the
+/// depth-only passes), then alpha-tested ones, then blended ones (sorted back
+/// to front, no depth writes), then transmissive ones over a copy of the rest.
+enum DrawCategory { kSolid = 0, kMasked = 1, kBlended = 2, kTransmissive = 3, kCategories = 4 };
+
+/// A run of the vertex buffer drawn with one material's textures.
+struct DrawRange {
+  int texture = -1;        ///< base colour texture, index into Scene::textures (-1: none)
+  int normalTexture = -1;  ///< normal map, index into Scene::textures (-1: none)
+  float normalScale = 1;
+  int metallicRoughnessTexture = -1;
+  int occlusionTexture = -1;
+  float occlusionStrength = 1;
+  int emissiveTexture = -1;
+  int alphaMode = shader::LO_ALPHA_OPAQUE;
+  float baseAlpha = 1;
+  float alphaCutoff = 0.5f;
+  bool doubleSided = true;  ///< false: back faces culled from the camera's view (glTF)
+  GLint first = 0;
+  GLsizei count = 0;
+  float transmission = 0;  ///< > 0: drawn after the opaque scene, see-through
+  float thickness = 0;     ///< KHR_materials_volume: > 0 refracts the image behind
+  float ior = 1.5f;
+};
+
+/// The scene's triangles on the GPU, grouped by material in DrawCategory
+/// order, and its textures (scene_geometry.cpp).
+struct SceneGeometry {
+  GlVertexArray vao;
+  GlBuffer vbo;
+  GlVertexArray emptyVao;
+  std::vector<DrawRange> ranges;  ///< the vertex buffer by material, in DrawCategory order
+  std::vector<DrawCategory> rangeCategory;  ///< per range
+  GLsizei opaqueCount = 0;  ///< vertices of the kSolid ranges (one call in depth passes)
+  /// Blended triangles' centroids (render space), one per triangle of the
+  /// kBlended ranges, from vertex blendFirst on; sorted per frame into blendEbo.
+  std::vector<glm::vec3> blendCentroids;
+  GLint blendFirst = 0;
+  GlBuffer blendEbo;
+  std::vector<GlTexture> textures;  ///< per Scene::textures entry; 0 = not used
+  /// Per vertex of the vertex buffer: 3 x its Scene triangle + its corner
+  /// (the buffer is grouped by material, not in triangle order).
+  std::vector<uint32_t> vertexCorner;
+  size_t sceneTriangles = 0;
+  float maxAnisotropy = 1;  ///< of the context (1: no anisotropic filtering)
+
+  void upload(const Scene& scene, const RenderSpace& space);
+  /// The GL name of Scene::textures[texture], 0 for -1.
+  GLuint texture(int index) const { return index >= 0 ? textures[size_t(index)].get() : 0; }
+  /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
+  /// `program` in use and the vao bound; see scene_geometry.cpp.
+  void drawDepthOnly(GLuint program, bool shadows) const;
+  /// Writes the blended triangles' vertex indices into blendEbo, back to front from `eye`.
+  void sortBlended(const glm::vec3& eye);
+
+ private:
+  GlTexture uploadTexture(const Texture& t) const;
+  /// Scene::textures[index] on the GPU, uploaded on first use; returns index.
+  int useTexture(const Scene& scene, int index);
+  /// The textures and uniforms material `mat` draws with.
+  DrawRange rangeOf(const Scene& scene, const Material& mat);
+  void uploadVertices(const std::vector<Vertex>& vertices);
+};
+
+/// The reflection probe: a mipmapped RGBA16F cube map of the lit scene seen
+/// from the scene's centre (render space origin), parallax-corrected to the
+/// scene's bounds in the shader. Captured on the first frame that wants it,
+/// again after setOctree (reflection_probe.cpp).
+struct ReflectionProbe {
+  bool wanted = false;
+  bool valid = false;
+  bool capturing = false;
+  GlTexture texture;
+  GlFramebuffer fbo;
+  GlRenderbuffer depth;
+  int levels = 1;
+};
+
+}  // namespace render_internal
+
+struct Renderer::Impl {
+  RendererParams params;
+  render_internal::RenderSpace space;
+  int depth = 0;
+  Vec3 octreeOrigin;
+  float voxelSize = 1;
+
+  /// The scene pass in two variants: with the direct light compiled in (full,
+  /// direct) and without it (indirect, voxels), so the octree-only modes do
+  /// not pay for the lights' code on a software rasterizer.
+  render_internal::GlProgram sceneProgram, sceneIndirectProgram;
+  /// The same two with the atlas lookup compiled in place of the octree's
+  /// (LO_ATLAS_LIGHTING), built on the first atlas frame.
+  render_internal::GlProgram sceneAtlasProgram, sceneIndirectAtlasProgram;
+  render_internal::GlProgram depthProgram;
+  render_internal::SceneGeometry geometry;
+  render_internal::SceneLights lights;
+  render_internal::ReflectionProbe probe;
+  render_internal::OctreeTextures octreeTextures;
+
+  render_internal::GlBuffer atlasVbo;
+  render_internal::GlTexture atlasIrradiance, atlasDirection;
+  size_t atlasTextureBytes = 0;
+
+  render_internal::GlFramebuffer targetFbo;
+  render_internal::GlTexture targetColor;
+  render_internal::GlRenderbuffer targetDepth;
+  int targetWidth = 0, targetHeight = 0;
+
+  render_internal::GlTexture
+      behindTexture;  ///< the opaque image, seen through transmissive surfaces
+  int behindWidth = 0, behindHeight = 0;
+  bool behindFloat = false;
+
+  void uploadOctree(const GpuOctree& octree);
+
+  // scene_pass.cpp
+  void ensureTarget(int width, int height);
+  void copyBehind(int width, int height, bool floatTarget);
+  /// One frame into the bound framebuffer: depth pre-pass, then the scene
+  /// pass (opaque, masked, blended back to front, transmissive).
+  void draw(const PinholeCamera& camera, const RenderParams& rp, int width, int height,
+            float exposureScale, bool encodeSrgb);
+  GLuint sceneProgramFor(const RenderParams& rp, bool withDirect);
+  void setFrameUniforms(GLuint program, const PinholeCamera& camera, const RenderParams& rp,
+                        const glm::mat4& viewProj, bool reflect, float exposureScale,
+                        bool encodeSrgb);
+  void drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye, GLuint program);
+
+  // reflection_probe.cpp
+  /// Renders the probe's six faces with the full scene program, reflections
+  /// off, then builds the mip chain that rough surfaces read.
+  void captureProbe(const RenderParams& rp);
+};
+
+}  // namespace lo

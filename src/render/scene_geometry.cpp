@@ -1,0 +1,305 @@
+// The scene on the GPU: one vertex buffer grouped by material in draw order,
+// the materials' textures, and the depth-only draws the pre-pass and the
+// shadow maps share.
+
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <cstring>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "render/gl_util.h"
+#include "render/renderer_impl.h"
+
+namespace lo::render_internal {
+namespace {
+
+int alphaModeOf(const Material& m) {
+  switch (m.alphaMode) {
+    case AlphaMode::Mask:
+      return shader::LO_ALPHA_MASK;
+    case AlphaMode::Blend:
+      return shader::LO_ALPHA_BLEND;
+    case AlphaMode::Opaque:
+      break;
+  }
+  return shader::LO_ALPHA_OPAQUE;
+}
+
+DrawCategory categoryOf(const Material& m) {
+  if (m.transmission > 0) return kTransmissive;
+  if (m.alphaMode == AlphaMode::Blend) return kBlended;
+  if (m.alphaMode == AlphaMode::Mask) return kMasked;
+  return kSolid;
+}
+
+}  // namespace
+
+/// Uploads a texture (linear RGB, and its alpha where it has one) with
+/// mipmaps, trilinear and anisotropic filtering, repeat wrap (glTF's
+/// default sampler).
+GlTexture SceneGeometry::uploadTexture(const Texture& t) const {
+  GlTexture id = GlTexture::create();
+  glBindTexture(GL_TEXTURE_2D, id.get());
+  std::vector<float> rgba(t.texels.size() * 4);
+  for (size_t i = 0; i < t.texels.size(); ++i) {
+    rgba[4 * i] = t.texels[i].x;
+    rgba[4 * i + 1] = t.texels[i].y;
+    rgba[4 * i + 2] = t.texels[i].z;
+    rgba[4 * i + 3] = t.alpha.empty() ? 1.0f : t.alpha[i];
+  }
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  // Half floats: linear colour with 11 bits of precision, filterable and
+  // mipmappable on every GL 3.3 context.
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT, rgba.data());
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  if (maxAnisotropy > 1) glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY, maxAnisotropy);
+  checkGl("uploading a base colour texture");
+  return id;
+}
+
+namespace {
+
+const Material& materialOf(const Scene& scene, size_t t) {
+  static const Material fallback;
+  const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+  return m >= 0 && size_t(m) < scene.materials.size() ? scene.materials[size_t(m)] : fallback;
+}
+
+/// Triangles in runs of one material (so that the scene pass binds each
+/// material's textures once), in DrawCategory order: opaque first,
+/// transmissive runs last, drawn after the opaque scene they show.
+std::vector<std::vector<size_t>> trianglesByMaterial(const Scene& scene) {
+  const size_t slots = scene.materials.size() + 1;
+  std::vector<std::vector<size_t>> byMaterial(kCategories * slots);
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
+    const size_t slot = m >= 0 && size_t(m) < scene.materials.size() ? size_t(m) + 1 : 0;
+    byMaterial[size_t(categoryOf(materialOf(scene, t))) * slots + slot].push_back(t);
+  }
+  return byMaterial;
+}
+
+const std::vector<float>& uvSet(const Scene& scene, int texCoord) {
+  return texCoord == 1 ? scene.texcoords1 : scene.texcoords0;
+}
+
+bool usable(const Scene& scene, int texture, int texCoord) {
+  return texture >= 0 && size_t(texture) < scene.textures.size() &&
+         uvSet(scene, texCoord).size() == 2 * scene.positions.size();
+}
+
+/// Corner k of triangle t as drawn with `range` (which textures it reads).
+Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& mat,
+                  const DrawRange& range, size_t t, int k, const Vec3& faceNormal) {
+  const uint32_t index = scene.indices[t * 3 + size_t(k)];
+  // Texture transforms are affine: applied per vertex they are exact.
+  auto setUv = [&](float* out, int texCoord, const TextureTransform& transform) {
+    const std::vector<float>& uv = uvSet(scene, texCoord);
+    out[0] = uv[2 * index];
+    out[1] = uv[2 * index + 1];
+    transform.apply(out[0], out[1]);
+  };
+  Vertex v{};
+  const Vec3 p = space.toRender(scene.positions[index]);
+  const Vec3 n = scene.normals.empty() ? faceNormal : scene.normals[index];
+  std::memcpy(v.position, &p, sizeof v.position);
+  std::memcpy(v.normal, &n, sizeof v.normal);
+  std::memcpy(v.baseColor, &mat.baseColor, sizeof v.baseColor);
+  v.metallicRoughness[0] = mat.metallic;
+  v.metallicRoughness[1] = mat.roughness;
+  std::memcpy(v.emission, &mat.emission, sizeof v.emission);
+  if (range.texture >= 0) setUv(v.uv, mat.baseColorTexCoord, mat.baseColorTransform);
+  if (range.normalTexture >= 0) setUv(v.normalUv, mat.normalTexCoord, mat.normalTransform);
+  if (range.metallicRoughnessTexture >= 0) {
+    setUv(v.metallicRoughnessUv, mat.metallicRoughnessTexCoord, mat.metallicRoughnessTransform);
+  }
+  if (range.occlusionTexture >= 0) {
+    setUv(v.occlusionUv, mat.occlusionTexCoord, mat.occlusionTransform);
+  }
+  if (range.emissiveTexture >= 0) setUv(v.emissiveUv, mat.emissiveTexCoord, mat.emissiveTransform);
+  if (scene.tangents.size() == 4 * scene.positions.size()) {
+    std::memcpy(v.tangent, &scene.tangents[4 * size_t(index)], sizeof v.tangent);
+  }
+  return v;
+}
+
+}  // namespace
+
+int SceneGeometry::useTexture(const Scene& scene, int index) {
+  if (!textures[size_t(index)])
+    textures[size_t(index)] = uploadTexture(scene.textures[size_t(index)]);
+  return index;
+}
+
+DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat) {
+  DrawRange range;
+  range.transmission = mat.transmission;
+  range.thickness = mat.thickness;
+  range.ior = mat.ior;
+  range.alphaMode = alphaModeOf(mat);
+  range.baseAlpha = mat.baseAlpha;
+  range.alphaCutoff = mat.alphaCutoff;
+  range.doubleSided = mat.doubleSided;
+  if (usable(scene, mat.emissiveTexture, mat.emissiveTexCoord) && mat.isEmissive()) {
+    range.emissiveTexture = useTexture(scene, mat.emissiveTexture);
+  }
+  if (usable(scene, mat.baseColorTexture, mat.baseColorTexCoord)) {
+    range.texture = useTexture(scene, mat.baseColorTexture);
+  }
+  if (usable(scene, mat.normalTexture, mat.normalTexCoord)) {
+    range.normalTexture = useTexture(scene, mat.normalTexture);
+    range.normalScale = mat.normalScale;
+  }
+  if (usable(scene, mat.metallicRoughnessTexture, mat.metallicRoughnessTexCoord)) {
+    range.metallicRoughnessTexture = useTexture(scene, mat.metallicRoughnessTexture);
+  }
+  if (usable(scene, mat.occlusionTexture, mat.occlusionTexCoord)) {
+    range.occlusionTexture = useTexture(scene, mat.occlusionTexture);
+    range.occlusionStrength = mat.occlusionStrength;
+  }
+  return range;
+}
+
+void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
+  // Anisotropic filtering: core in GL 4.6, an extension before.
+  if (GLAD_GL_ARB_texture_filter_anisotropic || GLAD_GL_EXT_texture_filter_anisotropic) {
+    glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &maxAnisotropy);
+    maxAnisotropy = std::min(maxAnisotropy, 16.0f);
+  }
+  textures.clear();
+  textures.resize(scene.textures.size());
+  std::vector<Vertex> vertices;
+  vertices.reserve(scene.triangleCount() * 3);
+  for (const std::vector<size_t>& group : trianglesByMaterial(scene)) {
+    if (group.empty()) continue;
+    const Material& mat = materialOf(scene, group.front());
+    const DrawCategory category = categoryOf(mat);
+    DrawRange range = rangeOf(scene, mat);
+    range.first = GLint(vertices.size());
+    for (size_t t : group) {
+      const Vec3 faceNormal = scene.faceNormal(t);
+      for (int k = 0; k < 3; ++k) {
+        vertices.push_back(makeVertex(scene, space, mat, range, t, k, faceNormal));
+        vertexCorner.push_back(uint32_t(3 * t + size_t(k)));
+      }
+      if (category == kBlended) {
+        const Vertex* tri = &vertices[vertices.size() - 3];
+        blendCentroids.push_back((glm::make_vec3(tri[0].position) +
+                                  glm::make_vec3(tri[1].position) +
+                                  glm::make_vec3(tri[2].position)) /
+                                 3.0f);
+      }
+    }
+    range.count = GLsizei(vertices.size()) - range.first;
+    ranges.push_back(range);
+    rangeCategory.push_back(category);
+    if (category == kSolid) opaqueCount = GLsizei(vertices.size());
+    if (category < kBlended) blendFirst = GLsizei(vertices.size());
+  }
+  uploadVertices(vertices);
+}
+
+void SceneGeometry::uploadVertices(const std::vector<Vertex>& vertices) {
+  vao = GlVertexArray::create();
+  glBindVertexArray(vao.get());
+  vbo = GlBuffer::create();
+  glBindBuffer(GL_ARRAY_BUFFER, vbo.get());
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)),
+               vertices.empty() ? nullptr : vertices.data(), GL_STATIC_DRAW);
+  auto attrib = [](GLuint location, GLint size, size_t offset) {
+    glEnableVertexAttribArray(location);
+    glVertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                          reinterpret_cast<const void*>(offset));
+  };
+  attrib(0, 3, offsetof(Vertex, position));
+  attrib(1, 3, offsetof(Vertex, normal));
+  attrib(2, 3, offsetof(Vertex, baseColor));
+  attrib(3, 2, offsetof(Vertex, metallicRoughness));
+  attrib(4, 3, offsetof(Vertex, emission));
+  attrib(5, 2, offsetof(Vertex, uv));
+  attrib(6, 2, offsetof(Vertex, normalUv));
+  attrib(7, 2, offsetof(Vertex, metallicRoughnessUv));
+  attrib(8, 2, offsetof(Vertex, occlusionUv));
+  attrib(9, 2, offsetof(Vertex, emissiveUv));
+  attrib(11, 4, offsetof(Vertex, tangent));
+  if (!blendCentroids.empty()) blendEbo = GlBuffer::create();
+  glBindVertexArray(0);
+  emptyVao = GlVertexArray::create();
+  checkGl("uploading the scene");
+}
+
+/// The geometry of a depth-only pass (depth pre-pass or shadow map) with
+/// `program` in use: the solid ranges in one call, then the masked ranges
+/// alpha-tested one by one, and with `shadows` (a shadow map) the blended
+/// ranges too (a shadow map has no partial coverage: they cast a shadow
+/// where their alpha is at least 1/2) and the transmissive ones with a
+/// volume (a solid glass body focuses what it lets through into a caustic,
+/// which the photon map carries as indirect light: its direct shadow is
+/// dark). Thin-walled transmissive ranges cast no shadow: light passes
+/// them straight, as direct light (the photon tracer agrees).
+void SceneGeometry::drawDepthOnly(GLuint program, bool shadows) const {
+  const GLint alphaTest = glGetUniformLocation(program, "uAlphaTest");
+  glUniform1i(alphaTest, 0);
+  glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
+  glUniform1i(glGetUniformLocation(program, "uBaseColorTexture"), 4);
+  const GLint hasTexture = glGetUniformLocation(program, "uHasBaseColorTexture");
+  const GLint baseAlpha = glGetUniformLocation(program, "uBaseAlpha");
+  const GLint cutoff = glGetUniformLocation(program, "uAlphaCutoff");
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    const DrawRange& range = ranges[i];
+    if (rangeCategory[i] != kMasked && !(shadows && rangeCategory[i] == kBlended)) continue;
+    glUniform1i(alphaTest, 1);
+    glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
+    glUniform1f(baseAlpha, range.baseAlpha);
+    glUniform1f(cutoff, rangeCategory[i] == kMasked ? range.alphaCutoff : 0.5f);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D, texture(range.texture));
+    glDrawArrays(GL_TRIANGLES, range.first, range.count);
+  }
+  if (shadows) {
+    glUniform1i(alphaTest, 0);
+    for (size_t i = 0; i < ranges.size(); ++i) {
+      if (rangeCategory[i] == kTransmissive && ranges[i].thickness > 0) {
+        glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].count);
+      }
+    }
+  }
+  glActiveTexture(GL_TEXTURE0);
+}
+
+/// Writes the blended triangles' vertex indices into blendEbo, each
+/// range's triangles from the farthest to the nearest centroid (render
+/// space distance to `eye`): the order in which blending composes them.
+void SceneGeometry::sortBlended(const glm::vec3& eye) {
+  if (blendCentroids.empty()) return;
+  std::vector<uint32_t> order(blendCentroids.size());
+  std::vector<float> distance(blendCentroids.size());
+  for (size_t t = 0; t < blendCentroids.size(); ++t) {
+    order[t] = uint32_t(t);
+    const glm::vec3 d = blendCentroids[t] - eye;
+    distance[t] = glm::dot(d, d);
+  }
+  std::vector<uint32_t> indices(3 * order.size());
+  size_t tri = 0;
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    if (rangeCategory[i] != kBlended) continue;
+    const size_t begin = size_t(ranges[i].first - blendFirst) / 3;
+    const size_t end = begin + size_t(ranges[i].count) / 3;
+    std::stable_sort(order.begin() + long(begin), order.begin() + long(end),
+                     [&](uint32_t a, uint32_t b) { return distance[a] > distance[b]; });
+    for (size_t k = begin; k < end; ++k, ++tri) {
+      for (uint32_t c = 0; c < 3; ++c)
+        indices[3 * tri + c] = uint32_t(blendFirst) + 3 * order[k] + c;
+    }
+  }
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, blendEbo.get());
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)),
+               indices.data(), GL_STREAM_DRAW);
+}
+
+}  // namespace lo::render_internal

@@ -1,0 +1,334 @@
+// A frame (paper §3.2, §4.2): depth pre-pass, then the scene pass in draw
+// order: opaque, alpha-tested, blended back to front, transmissive over a
+// copy of the opaque image.
+
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "core/error.h"
+#include "render/context.h"
+#include "render/gl_util.h"
+#include "render/renderer_impl.h"
+
+namespace lo {
+
+using namespace render_internal;
+
+namespace {
+
+glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
+
+/// uMode of the scene shader for a render mode.
+int shaderMode(RenderMode mode) {
+  switch (mode) {
+    case RenderMode::Full:
+      return shader::LO_MODE_FULL;
+    case RenderMode::Direct:
+      return shader::LO_MODE_DIRECT;
+    case RenderMode::Indirect:
+      return shader::LO_MODE_INDIRECT;
+    case RenderMode::Voxels:
+      return shader::LO_MODE_VOXELS;
+  }
+  return shader::LO_MODE_FULL;
+}
+
+bool drawsDirectLight(RenderMode mode) {
+  return mode == RenderMode::Full || mode == RenderMode::Direct;
+}
+
+}  // namespace
+
+void Renderer::Impl::ensureTarget(int width, int height) {
+  if (targetFbo && width == targetWidth && height == targetHeight) return;
+  if (!targetFbo) {
+    targetFbo = GlFramebuffer::create();
+    targetColor = GlTexture::create();
+    targetDepth = GlRenderbuffer::create();
+  }
+  glBindTexture(GL_TEXTURE_2D, targetColor.get());
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glBindRenderbuffer(GL_RENDERBUFFER, targetDepth.get());
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, targetFbo.get());
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, targetColor.get(), 0);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                            targetDepth.get());
+  GLenum drawBuffer = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &drawBuffer);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw GlError("render target framebuffer (RGBA32F " + texelCount(width, height, 0) +
+                  ") incomplete");
+  }
+  targetWidth = width;
+  targetHeight = height;
+}
+
+/// Copies the bound framebuffer's colour into behindTexture (float for
+/// the offscreen RGBA32F target, 8-bit for a window's back buffer).
+void Renderer::Impl::copyBehind(int width, int height, bool floatTarget) {
+  if (!behindTexture || behindWidth != width || behindHeight != height ||
+      behindFloat != floatTarget) {
+    if (!behindTexture) behindTexture = GlTexture::create();
+    glBindTexture(GL_TEXTURE_2D, behindTexture.get());
+    glTexImage2D(GL_TEXTURE_2D, 0, floatTarget ? GL_RGBA32F : GL_RGBA8, width, height, 0, GL_RGBA,
+                 floatTarget ? GL_FLOAT : GL_UNSIGNED_BYTE, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    behindWidth = width;
+    behindHeight = height;
+    behindFloat = floatTarget;
+  }
+  glBindTexture(GL_TEXTURE_2D, behindTexture.get());
+  glCopyTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 0, 0, width, height);
+  checkGl("copying the opaque image for transmissive surfaces");
+}
+
+/// The scene program for a frame: with or without the direct light, with
+/// the octree's lookup or the atlas's (built on first use).
+GLuint Renderer::Impl::sceneProgramFor(const RenderParams& rp, bool withDirect) {
+  const bool atlasProgram = rp.lighting == Lighting::Atlas && !probe.capturing &&
+                            rp.mode != RenderMode::Voxels && atlasVbo;
+  if (atlasProgram && !sceneAtlasProgram) {
+    sceneAtlasProgram = GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"},
+                                               {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"}));
+    glUniformBlockBinding(sceneAtlasProgram.get(),
+                          glGetUniformBlockIndex(sceneAtlasProgram.get(), "LightBlock"), 0);
+    sceneIndirectAtlasProgram =
+        GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_ATLAS_LIGHTING"}));
+  }
+  const GlProgram& p = atlasProgram ? (withDirect ? sceneAtlasProgram : sceneIndirectAtlasProgram)
+                                    : (withDirect ? sceneProgram : sceneIndirectProgram);
+  return p.get();
+}
+
+/// The uniforms and textures of the scene program `p` (in use) that hold
+/// for the whole frame.
+void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, const RenderParams& rp,
+                                      const glm::mat4& viewProj, bool reflect, float exposureScale,
+                                      bool encodeSrgb) {
+  auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
+  const Vec3 eyeRender = space.toRender(camera.eye);
+  const Bounds3& bounds = space.bounds;
+  glUniformMatrix4fv(loc("uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
+  glUniform3f(loc("uOctreeOrigin"), octreeOrigin.x, octreeOrigin.y, octreeOrigin.z);
+  glUniform1f(loc("uVoxelSize"), voxelSize);
+  glUniform1i(loc("uDepth"), depth);
+  glUniform3f(loc("uEye"), eyeRender.x, eyeRender.y, eyeRender.z);
+  glUniform1i(loc("uMode"), shaderMode(rp.mode));
+  const glm::vec3 forward = glm::normalize(toGlm(camera.forward));
+  glUniform3f(loc("uViewForward"), forward.x, forward.y, forward.z);
+  glUniform4fv(loc("uCascadeFar"), 1, lights.cascadeFar);
+  glUniform4fv(loc("uCascadeTexel"), 1, lights.cascadeTexel);
+  glUniform4fv(loc("uCascadeDepth"), 1, lights.cascadeDepth);
+  const bool atlas = rp.lighting == Lighting::Atlas && !probe.capturing;
+  // The probe leaves out emitters that the direct pass draws as lights:
+  // their reflection comes from the lights' specular term already.
+  glUniform1f(
+      loc("uEmissionScale"),
+      probe.capturing && (lights.areaLightCount > 0 || lights.emitterLights > 0) ? 0.0f : 1.0f);
+  glUniform1i(loc("uAtlas"), atlas ? 1 : 0);
+  glUniform1i(loc("uAtlasIrradiance"), 12);
+  glUniform1i(loc("uAtlasDirection"), 13);
+  glActiveTexture(GL_TEXTURE12);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, atlas ? atlasIrradiance.get() : 0);
+  glActiveTexture(GL_TEXTURE13);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, atlas ? atlasDirection.get() : 0);
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1i(loc("uHasProbe"), reflect ? 1 : 0);
+  glUniform1i(loc("uProbe"), 11);
+  glUniform3f(loc("uProbeBoxMin"), bounds.lower.x, bounds.lower.y, bounds.lower.z);
+  glUniform3f(loc("uProbeBoxMax"), bounds.upper.x, bounds.upper.y, bounds.upper.z);
+  glUniform1f(loc("uProbeMaxLod"), float(probe.levels - 1));
+  glActiveTexture(GL_TEXTURE11);
+  glBindTexture(GL_TEXTURE_CUBE_MAP, reflect ? probe.texture.get() : 0);
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1i(loc("uInterpolation"), rp.interpolation ? 1 : 0);
+  glUniform1i(loc("uSpecular"), rp.specular ? 1 : 0);
+  glUniform1i(loc("uMaxVdls"), rp.maxVdls);
+  glUniform1f(loc("uNormalOffset"), rp.normalOffset);
+  glUniform1f(loc("uExposureScale"), exposureScale);
+  glUniform1i(loc("uEncodeSrgb"), encodeSrgb ? 1 : 0);
+  octreeTextures.bind(p, 0, 1, 3);
+  glUniform1i(loc("uShadowMaps"), 2);
+  glActiveTexture(GL_TEXTURE2);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, lights.shadowTexture.get());
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1i(loc("uBaseColorTexture"), 4);
+  glUniform1i(loc("uShadowDepths"), 5);
+  glActiveTexture(GL_TEXTURE5);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, lights.shadowTexture.get());
+  glBindSampler(5, lights.depthSampler.get());
+  glActiveTexture(GL_TEXTURE0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, lights.ubo.get());
+  glUniform1i(loc("uNormalTexture"), 7);
+  glUniform1i(loc("uMetallicRoughnessTexture"), 8);
+  glUniform1i(loc("uOcclusionTexture"), 9);
+  glUniform1i(loc("uBehind"), 6);
+  glUniform1i(loc("uEmissiveTexture"), 10);
+  glUniform1f(loc("uTransmission"), 0.0f);
+}
+
+/// The scene's ranges in draw order with the program `p` in use: each with
+/// its material's textures and uniforms; blended ones sorted back to front
+/// from `eye` without depth writes; transmissive ones over a copy of what
+/// was drawn before them.
+void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye,
+                                GLuint p) {
+  auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
+  glBindVertexArray(geometry.vao.get());
+  const GLint hasTexture = loc("uHasBaseColorTexture");
+  const GLint hasNormal = loc("uHasNormalTexture");
+  const GLint normalScale = loc("uNormalScale");
+  const GLint hasMr = loc("uHasMetallicRoughnessTexture");
+  const GLint hasOcclusion = loc("uHasOcclusionTexture");
+  const GLint occlusionStrength = loc("uOcclusionStrength");
+  const GLint transmission = loc("uTransmission");
+  const GLint hasEmissive = loc("uHasEmissiveTexture");
+  const GLint alphaMode = loc("uAlphaMode");
+  const GLint baseAlpha = loc("uBaseAlpha");
+  const GLint alphaCutoff = loc("uAlphaCutoff");
+  const GLint thickness = loc("uThickness");
+  const GLint ior = loc("uIor");
+  // glTF: single-sided materials are culled from behind (counter-clockwise
+  // winding in front, as the loader keeps it).
+  glFrontFace(GL_CCW);
+  glCullFace(GL_BACK);
+  bool copied = false, blending = false;
+  for (size_t i = 0; i < geometry.ranges.size(); ++i) {
+    const DrawRange& range = geometry.ranges[i];
+    const bool blended = geometry.rangeCategory[i] == kBlended;
+    if (blended && !blending) {
+      // Over the opaque scene, back to front, without depth writes.
+      geometry.sortBlended(eye);
+      glEnable(GL_BLEND);
+      glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+      glDepthMask(GL_FALSE);
+      blending = true;
+    } else if (!blended && blending) {
+      glDisable(GL_BLEND);
+      blending = false;
+    }
+    if (range.transmission > 0 && !copied) {
+      // The opaque scene as drawn so far, for the surfaces in front of it
+      // to show (thin-walled transmission: seen straight through).
+      copyBehind(width, height, !encodeSrgb);
+      glActiveTexture(GL_TEXTURE6);
+      glBindTexture(GL_TEXTURE_2D, behindTexture.get());
+      glDepthMask(GL_TRUE);  // the nearest transmissive surface wins
+      glDepthFunc(GL_LESS);
+      copied = true;
+    }
+    auto bind = [this](GLenum unit, int texture) {
+      glActiveTexture(unit);
+      glBindTexture(GL_TEXTURE_2D, geometry.texture(texture));
+    };
+    bind(GL_TEXTURE4, range.texture);
+    bind(GL_TEXTURE7, range.normalTexture);
+    bind(GL_TEXTURE8, range.metallicRoughnessTexture);
+    bind(GL_TEXTURE9, range.occlusionTexture);
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(hasMr, range.metallicRoughnessTexture >= 0 ? 1 : 0);
+    glUniform1i(hasOcclusion, range.occlusionTexture >= 0 ? 1 : 0);
+    glUniform1f(occlusionStrength, range.occlusionStrength);
+    glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
+    glUniform1i(hasNormal, range.normalTexture >= 0 ? 1 : 0);
+    glUniform1f(normalScale, range.normalScale);
+    glUniform1f(transmission, range.transmission);
+    glUniform1f(thickness, range.thickness);
+    glUniform1f(ior, range.ior);
+    bind(GL_TEXTURE10, range.emissiveTexture);
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(hasEmissive, range.emissiveTexture >= 0 ? 1 : 0);
+    glUniform1i(alphaMode, range.alphaMode);
+    glUniform1f(baseAlpha, range.baseAlpha);
+    glUniform1f(alphaCutoff, range.alphaCutoff);
+    if (range.doubleSided) {
+      glDisable(GL_CULL_FACE);
+    } else {
+      glEnable(GL_CULL_FACE);
+    }
+    if (blended) {
+      glDrawElements(GL_TRIANGLES, range.count, GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(size_t(range.first - geometry.blendFirst) * 4));
+    } else {
+      glDrawArrays(GL_TRIANGLES, range.first, range.count);
+    }
+  }
+  if (blending) glDisable(GL_BLEND);
+}
+
+void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, int width,
+                          int height, float exposureScale, bool encodeSrgb) {
+  if (width < 1 || height < 1) throw InputError("render: image size must be at least 1 x 1");
+  if (rp.maxVdls < 1 || rp.maxVdls > kMaxVdls) {
+    throw InputError("render: VDLs per voxel must be 1.." + std::to_string(kMaxVdls) + ", got " +
+                     std::to_string(rp.maxVdls));
+  }
+  if (rp.lighting == Lighting::Atlas && !atlasVbo) {
+    throw InputError(
+        "render: lighting 'atlas' needs an atlas (Renderer::setAtlas, or "
+        "`render --lighting atlas`, which bakes one)");
+  }
+  // The probe shows the lit scene: captured before the first frame that
+  // reflects it (it draws six frames of its own through this function).
+  const bool reflect = rp.reflections && probe.wanted && !probe.capturing &&
+                       (rp.mode == RenderMode::Full || rp.mode == RenderMode::Indirect);
+  if (reflect && !probe.valid) captureProbe(rp);
+  const glm::vec3 eye = toGlm(space.toRender(camera.eye));
+  const float zfar =
+      camera.zfar > 0 ? camera.zfar
+                      : glm::length(eye - toGlm(space.bounds.center())) + space.sceneSize + 1e-3f;
+  const float znear = std::min(camera.znear > 0 ? camera.znear : 0.01f, 0.5f * zfar);
+  const float aspect = float(width) / float(height);
+  const glm::mat4 viewProj = glm::perspective(camera.yfov, aspect, znear, zfar) *
+                             glm::lookAt(eye, eye + toGlm(camera.forward), toGlm(camera.up));
+  const bool withDirect = drawsDirectLight(rp.mode);
+  if (withDirect) {
+    lights.fitCascades(
+        space, eye, glm::normalize(toGlm(camera.forward)), toGlm(camera.up), camera.yfov, aspect,
+        znear, zfar, geometry.vao.get(),
+        [this](GLuint program, bool shadows) { geometry.drawDepthOnly(program, shadows); });
+  }
+
+  glViewport(0, 0, width, height);
+  glClearColor(0, 0, 0, 1);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  // Depth pre-pass: the scene shader then shades each pixel once, not once
+  // per overlapping surface. It pays where shading is dear (shadow lookups
+  // of the direct pass, 8-voxel interpolation); for the cheap modes the
+  // second geometry pass costs more than the overdraw it saves (measured,
+  // docs/results/render.md), so they draw with a plain depth test.
+  const bool prePass = rp.interpolation || withDirect;
+  glDepthFunc(GL_LESS);
+  if (prePass) {
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glUseProgram(depthProgram.get());
+    glUniformMatrix4fv(glGetUniformLocation(depthProgram.get(), "uViewProj"), 1, GL_FALSE,
+                       glm::value_ptr(viewProj));
+    glBindVertexArray(geometry.vao.get());
+    geometry.drawDepthOnly(depthProgram.get(), false);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+  }
+  const GLuint p = sceneProgramFor(rp, withDirect);
+  glUseProgram(p);
+  setFrameUniforms(p, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
+  drawRanges(width, height, encodeSrgb, eye, p);
+  glDisable(GL_CULL_FACE);
+  glBindVertexArray(0);
+  glBindSampler(5, 0);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+  checkGl("drawing the scene");
+}
+
+}  // namespace lo
