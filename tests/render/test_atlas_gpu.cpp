@@ -30,8 +30,6 @@ namespace {
 
 using namespace atlas_test;
 
-GlContext* context() { return test::osmesaContext(); }
-
 /// Texels whose coverage differs, and the largest irradiance and direction
 /// differences over the texels both cover (relative to 1e-3 + |cpu|).
 struct AtlasDifference {
@@ -71,7 +69,7 @@ LightmapAtlas gpuBake(const Scene& scene, const LightmapUvs& uvs, const GpuOctre
 }
 
 TEST(AtlasGpu, PlaneUnderAConstantVdlIsTheCosineLawAtEveryTexel) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   Scene scene = emptyScene();
   addGrid(scene, 6, {0.35f, 0.3f, 0.55f}, {1.2f, 0.25f, 0.1f}, {-0.2f, 0.9f, 0.35f});
   const Vec3 c{2.0f, 1.0f, 0.5f}, d = normalize(Vec3{0.3f, -0.2f, 1.0f});
@@ -104,7 +102,7 @@ TEST(AtlasGpu, PlaneUnderAConstantVdlIsTheCosineLawAtEveryTexel) {
 // A cube under light that varies across voxels, with and without
 // interpolation: texel for texel the CPU's values.
 TEST(AtlasGpu, CubeMatchesTheCpuPathTexelForTexel) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   Scene scene = emptyScene();
   addCube(scene, Vec3(0.55f, 0.6f, 0.65f), 0.8f);
   const GpuOctree octree = denseOctree([](const Coord& v) {
@@ -152,7 +150,7 @@ TEST(AtlasGpu, CubeMatchesTheCpuPathTexelForTexel) {
 // The Cornell box's golden bake through the whole pipeline (automatic
 // charts, dilation, seam stitching) on both paths.
 TEST(AtlasGpu, CornellBoxMatchesTheCpuBake) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
   const GpuOctree octree =
       buildGpuOctree(readVdlGrid(test::dataDir() + "/../tests/golden/cornell-box-d4.vdb").grid);
@@ -220,14 +218,14 @@ void expectLayeredBakeMatches(LightRepresentation representation, float toleranc
 }
 
 TEST(AtlasGpu, LayeredOctreeMatchesTheCpuBake) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   expectLayeredBakeMatches(LightRepresentation::Vdl);
 }
 
 // The SH representation's GLSL (loShIrradiance, signed half texels times the
 // scale) is the C++ one.
 TEST(AtlasGpu, ShOctreeMatchesTheCpuBake) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   expectLayeredBakeMatches(LightRepresentation::Sh1);
   expectLayeredBakeMatches(LightRepresentation::Sh2);
 }
@@ -235,7 +233,7 @@ TEST(AtlasGpu, ShOctreeMatchesTheCpuBake) {
 // Adaptive leaves: the GLSL descent stops at leaves above the grid's depth
 // as the C++ one does.
 TEST(AtlasGpu, AdaptiveOctreeMatchesTheCpuBake) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   expectLayeredBakeMatches(LightRepresentation::Vdl, 0.1f);
   expectLayeredBakeMatches(LightRepresentation::Sh1, 0.1f);
 }

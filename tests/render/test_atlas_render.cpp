@@ -23,10 +23,8 @@
 namespace lo {
 namespace {
 
-GlContext* context() { return test::osmesaContext(); }
-
 TEST(AtlasRender, CornellBoxAtlasEqualsOctree) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
   const LoadedVdl baked = readVdlGrid(test::dataDir() + "/../tests/golden/cornell-box-d4.vdb");
   const GpuOctree octree = buildGpuOctree(baked.grid);

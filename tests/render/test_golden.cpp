@@ -47,8 +47,6 @@ bool updating() {
   return v && std::string(v) == "1";
 }
 
-GlContext* context() { return test::osmesaContext(); }
-
 struct GoldenScene {
   Scene scene;
   GpuOctree octree;
@@ -146,7 +144,7 @@ Mismatch renderAndCompare(const GoldenScene& s, RenderMode mode, bool interpolat
 }
 
 void checkGolden(RenderMode mode) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const std::string name = "golden_cornell_" + toString(mode);
   const std::string reference = goldenDir() + "/cornell-box-" + toString(mode) + ".png";
   Mismatch m = renderAndCompare(setup(), mode, true, reference, name);
@@ -164,7 +162,7 @@ TEST(Golden, CornellBoxDirect) { checkGolden(RenderMode::Direct); }
 // The tolerances must catch a real change: the indirect image without
 // interpolation (blocky voxels) must fail against the interpolated reference.
 TEST(Golden, ToleranceDetectsInterpolationOff) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   if (updating()) GTEST_SKIP() << "updating the references";
   Mismatch m =
       renderAndCompare(setup(), RenderMode::Indirect, false,
@@ -182,7 +180,7 @@ TEST(Golden, ToleranceDetectsInterpolationOff) {
 // (exactly: the differences are representable): only the renderer's
 // precision is under test, with the golden tolerances.
 TEST(Golden, CornellBoxFarFromTheOriginIsTheSamePicture) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   if (updating()) GTEST_SKIP() << "updating the references";
   for (const Vec3& offset : {Vec3(1e4f, -1e4f, 1e4f), Vec3(1e5f, 1e5f, -1e5f)}) {
     const auto far = setup().translated(offset);

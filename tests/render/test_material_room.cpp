@@ -48,8 +48,6 @@ constexpr double kFloorTolerance = 0.12;
 /// Measured 0.966.
 constexpr double kCheckerCorrelation = 0.9;
 
-GlContext* context() { return test::osmesaContext(); }
-
 float luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 
 /// The block [x0, x1) x [y0, y1) of `image`.
@@ -67,7 +65,7 @@ RgbImage crop(const RgbImage& image, int x0, int y0, int x1, int y1) {
 RgbImage rowsFrom(const RgbImage& image, int y0) { return crop(image, 0, y0, image.width, image.height); }
 
 TEST(MaterialRoom, FullRenderAgainstThePathTracer) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const Scene scene = loadScene(test::dataDir() + "/material-room.gltf");
   ASSERT_FALSE(scene.cameras.empty());
   BakeParams bp;

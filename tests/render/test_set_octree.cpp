@@ -17,20 +17,6 @@
 namespace lo {
 namespace {
 
-GlContext* context() {
-  static std::unique_ptr<GlContext> ctx;
-  static bool tried = false;
-  if (!tried) {
-    tried = true;
-    try {
-      ctx = createGlContext({GlBackend::OSMesa});
-    } catch (const std::exception&) {
-    }
-  }
-  if (ctx) ctx->makeCurrent();
-  return ctx.get();
-}
-
 GpuOctree bakeOctree(const Scene& scene, const std::vector<Photon>& photons, int depth) {
   LevelParams params;
   params.grid.depth = depth;
@@ -47,7 +33,7 @@ float maxValue(const RgbImage& image) {
 }
 
 TEST(RendererSetOctree, SwappedLevelRendersLikeAFreshRenderer) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   Scene scene = test::pointLitRoom();
   PhotonParams pp;
   pp.storedPhotons = 20000;
@@ -81,7 +67,7 @@ TEST(RendererSetOctree, SwappedLevelRendersLikeAFreshRenderer) {
 }
 
 TEST(RendererSetOctree, TooLargeForTheLimitsKeepsTheOldOctree) {
-  if (!context()) GTEST_SKIP() << "no OSMesa context available";
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   Scene scene = test::pointLitRoom();
   PhotonParams pp;
   pp.storedPhotons = 5000;
