@@ -100,6 +100,7 @@ void addFieldSources(std::vector<GridSource>& out, const VdlGrid& g, const Light
   const std::vector<Coord>& coords = level->coords.empty() ? g.coords : level->coords;
   for (const FieldGrid& grid : fieldGrids(row, level->layer, g.maxVdls, g.shTerms)) {
     auto make = [&g, &values, &coords, per, grid, level, xform]() -> openvdb::GridBase::Ptr {
+      (void)g;  // read by the VDL rows' branch only
       const size_t slot = size_t(grid.slot);
       if constexpr (std::is_same_v<T, Vdl>) {
         // VDL slot i only where the voxel has more than i VDLs (sparse: a
