@@ -27,6 +27,8 @@
 
 #include "core/file.h"
 #include "image/image.h"
+#include "scene/gltf_prevalidate.h"
+#include "scene/gltf_transform.h"
 #include "scene/scene_internal.h"
 
 namespace lo::scene_internal {
@@ -35,88 +37,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// ---------------------------------------------------------------------------
-// 4x4 transforms, column-major like glTF (m[col * 4 + row]), in double so that
-// deep hierarchies do not accumulate float error.
-struct Mat4 {
-  std::array<double, 16> m{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-
-  double& at(int row, int col) { return m[size_t(col * 4 + row)]; }
-  double at(int row, int col) const { return m[size_t(col * 4 + row)]; }
-
-  Mat4 operator*(const Mat4& b) const {
-    Mat4 r;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) {
-        double s = 0;
-        for (int k = 0; k < 4; ++k) s += at(i, k) * b.at(k, j);
-        r.at(i, j) = s;
-      }
-    return r;
-  }
-  Vec3 point(const Vec3& p) const {
-    double x = at(0, 0) * p.x + at(0, 1) * p.y + at(0, 2) * p.z + at(0, 3);
-    double y = at(1, 0) * p.x + at(1, 1) * p.y + at(1, 2) * p.z + at(1, 3);
-    double z = at(2, 0) * p.x + at(2, 1) * p.y + at(2, 2) * p.z + at(2, 3);
-    return {float(x), float(y), float(z)};
-  }
-  Vec3 vector(const Vec3& v) const {
-    double x = at(0, 0) * v.x + at(0, 1) * v.y + at(0, 2) * v.z;
-    double y = at(1, 0) * v.x + at(1, 1) * v.y + at(1, 2) * v.z;
-    double z = at(2, 0) * v.x + at(2, 1) * v.y + at(2, 2) * v.z;
-    return {float(x), float(y), float(z)};
-  }
-  double det3() const {
-    return at(0, 0) * (at(1, 1) * at(2, 2) - at(1, 2) * at(2, 1)) -
-           at(0, 1) * (at(1, 0) * at(2, 2) - at(1, 2) * at(2, 0)) +
-           at(0, 2) * (at(1, 0) * at(2, 1) - at(1, 1) * at(2, 0));
-  }
-  /// Inverse transpose of the upper 3x3 (normals), up to the positive factor
-  /// |det|: the cofactor matrix times sign(det). Normals are renormalized after.
-  Mat4 normalMatrix() const {
-    Mat4 r;
-    double s = det3() < 0 ? -1.0 : 1.0;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-        r.at(i, j) = s * (at(i1, j1) * at(i2, j2) - at(i1, j2) * at(i2, j1));
-      }
-    return r;
-  }
-};
-
 Mat4 nodeLocalTransform(const tinygltf::Node& node) {
-  Mat4 r;
-  if (node.matrix.size() == 16) {
-    for (size_t i = 0; i < 16; ++i) r.m[i] = node.matrix[i];
-    return r;
-  }
-  Mat4 t, rot, s;
-  if (node.translation.size() == 3) {
-    t.at(0, 3) = node.translation[0];
-    t.at(1, 3) = node.translation[1];
-    t.at(2, 3) = node.translation[2];
-  }
-  if (node.rotation.size() == 4) {
-    double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2], w = node.rotation[3];
-    double n = std::sqrt(x * x + y * y + z * z + w * w);
-    if (n > 0) x /= n, y /= n, z /= n, w /= n;
-    rot.at(0, 0) = 1 - 2 * (y * y + z * z);
-    rot.at(0, 1) = 2 * (x * y - z * w);
-    rot.at(0, 2) = 2 * (x * z + y * w);
-    rot.at(1, 0) = 2 * (x * y + z * w);
-    rot.at(1, 1) = 1 - 2 * (x * x + z * z);
-    rot.at(1, 2) = 2 * (y * z - x * w);
-    rot.at(2, 0) = 2 * (x * z - y * w);
-    rot.at(2, 1) = 2 * (y * z + x * w);
-    rot.at(2, 2) = 1 - 2 * (x * x + y * y);
-  }
-  if (node.scale.size() == 3) {
-    s.at(0, 0) = node.scale[0];
-    s.at(1, 1) = node.scale[1];
-    s.at(2, 2) = node.scale[2];
-  }
-  return t * rot * s;
+  return localTransform(node.matrix, node.translation, node.rotation, node.scale);
 }
 
 // ---------------------------------------------------------------------------
@@ -174,173 +96,6 @@ bool fsWriteWholeFile(std::string* err, const std::string&, const std::vector<un
                       void*) {
   if (err) *err += "the scene loader never writes files";
   return false;
-}
-
-// ---------------------------------------------------------------------------
-// Checks on the raw JSON, before tinygltf dereferences anything.
-
-bool isDataUri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
-
-uint64_t jsonUInt(const nlohmann::json& o, const char* key, uint64_t fallback) {
-  auto it = o.find(key);
-  if (it == o.end() || !it->is_number_unsigned()) return fallback;
-  return it->get<uint64_t>();
-}
-
-void checkJsonNesting(const std::string& path, const std::string& text) {
-  size_t depth = 0;
-  bool inString = false;
-  for (size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (inString) {
-      if (c == '\\') {
-        ++i;  // the escaped character
-      } else if (c == '"') {
-        inString = false;
-      }
-    } else if (c == '"') {
-      inString = true;
-    } else if (c == '{' || c == '[') {
-      if (++depth > kMaxJsonDepth) {
-        fail(path, "invalid glTF: JSON nested more than " + std::to_string(kMaxJsonDepth) +
-                       " levels deep (at byte " + std::to_string(i) + ")");
-      }
-    } else if ((c == '}' || c == ']') && depth > 0) {
-      --depth;
-    }
-  }
-}
-
-/// Integers the glTF gives where tinygltf keeps an int (indices, enums):
-/// beyond int32 they would wrap (2^32 + 3 read as 3, a silently wrong
-/// scene). Sizes (byteLength, byteOffset, count) are 64-bit in tinygltf.
-void checkIntegerRanges(const std::string& path, const nlohmann::json& j,
-                        const std::string& where, int depth) {
-  if (depth > int(kMaxJsonDepth)) return;
-  auto check = [&](const std::string& key, const nlohmann::json& v, const std::string& at) {
-    if (!v.is_number_integer() || key == "byteLength" || key == "byteOffset" || key == "count") {
-      checkIntegerRanges(path, v, at, depth + 1);
-      return;
-    }
-    const bool fits = v.is_number_unsigned()
-                          ? v.get<uint64_t>() <= uint64_t(std::numeric_limits<int32_t>::max())
-                          : v.get<int64_t>() >= std::numeric_limits<int32_t>::min() &&
-                                v.get<int64_t>() <= std::numeric_limits<int32_t>::max();
-    if (!fits) fail(path, "invalid glTF: " + at + " = " + v.dump() + " is out of range");
-  };
-  if (j.is_object()) {
-    for (auto it = j.begin(); it != j.end(); ++it) check(it.key(), it.value(), where + "/" + it.key());
-  } else if (j.is_array()) {
-    for (size_t i = 0; i < j.size(); ++i) check("", j[i], where + "/" + std::to_string(i));
-  }
-}
-
-void prevalidateJson(const std::string& path, const std::string& baseDir, const nlohmann::json& j) {
-  if (!j.is_object()) fail(path, "invalid glTF: the top level is not a JSON object");
-  checkIntegerRanges(path, j, "", 0);
-  std::vector<uint64_t> bufferLengths;
-  auto buffers = j.find("buffers");
-  if (buffers != j.end() && buffers->is_array()) {
-    for (size_t i = 0; i < buffers->size(); ++i) {
-      const nlohmann::json& b = (*buffers)[i];
-      if (!b.is_object()) fail(path, "buffer " + std::to_string(i) + " is not an object");
-      bufferLengths.push_back(jsonUInt(b, "byteLength", 0));
-      auto uri = b.find("uri");
-      if (uri == b.end() || !uri->is_string()) continue;
-      std::string u = uri->get<std::string>();
-      if (isDataUri(u)) continue;
-      std::string what = "buffer " + std::to_string(i);
-      std::string file = resolveInsideFolder(path, baseDir, percentDecode(u), what);
-      std::error_code ec;
-      if (!fs::is_regular_file(file, ec)) {
-        fail(path, "missing buffer file '" + u + "' (" + what + ", not found)");
-      }
-    }
-  }
-  std::vector<char> viewOk;
-  auto views = j.find("bufferViews");
-  if (views != j.end() && views->is_array()) {
-    for (size_t i = 0; i < views->size(); ++i) {
-      const nlohmann::json& v = (*views)[i];
-      if (!v.is_object()) fail(path, "bufferView " + std::to_string(i) + " is not an object");
-      uint64_t buffer = jsonUInt(v, "buffer", std::numeric_limits<uint64_t>::max());
-      if (buffer >= bufferLengths.size()) {
-        fail(path, "bufferView " + std::to_string(i) + " refers to a buffer index out of range");
-      }
-      uint64_t offset = jsonUInt(v, "byteOffset", 0), length = jsonUInt(v, "byteLength", 0);
-      if (offset > bufferLengths[buffer] || length > bufferLengths[buffer] - offset) {
-        fail(path, "bufferView " + std::to_string(i) + " (offset " + std::to_string(offset) +
-                       ", length " + std::to_string(length) + ") is out of range of buffer " +
-                       std::to_string(buffer) + " (" + std::to_string(bufferLengths[buffer]) +
-                       " bytes)");
-      }
-    }
-  }
-  size_t viewCount = views != j.end() && views->is_array() ? views->size() : 0;
-  auto images = j.find("images");
-  if (images != j.end() && images->is_array()) {
-    for (size_t i = 0; i < images->size(); ++i) {
-      const nlohmann::json& im = (*images)[i];
-      if (!im.is_object()) fail(path, "image " + std::to_string(i) + " is not an object");
-      std::string what = "image " + std::to_string(i);
-      auto bv = im.find("bufferView");
-      if (bv != im.end() && !(bv->is_number_unsigned() && bv->get<uint64_t>() < viewCount)) {
-        fail(path, what + " refers to a bufferView index out of range");
-      }
-      auto uri = im.find("uri");
-      if (uri == im.end() || !uri->is_string()) continue;
-      std::string u = uri->get<std::string>();
-      if (isDataUri(u)) continue;
-      std::string file = resolveInsideFolder(path, baseDir, percentDecode(u), what);
-      std::error_code ec;
-      if (!fs::is_regular_file(file, ec)) {
-        fail(path, "unreadable image: missing image file '" + u + "' (" + what + ", not found)");
-      }
-    }
-  }
-}
-
-uint32_t readU32(const unsigned char* p) {
-  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-}
-
-/// Checks the GLB container (https://registry.khronos.org/glTF/specs/2.0/
-/// glTF-2.0.html#binary-gltf-layout) and returns the JSON chunk.
-std::string glbJson(const std::string& path, const std::vector<unsigned char>& bytes) {
-  if (bytes.size() < 20) {
-    fail(path, "truncated .glb: " + std::to_string(bytes.size()) + " bytes, header needs 20");
-  }
-  if (std::memcmp(bytes.data(), "glTF", 4) != 0) fail(path, "not a .glb file (bad magic)");
-  uint32_t version = readU32(&bytes[4]), length = readU32(&bytes[8]);
-  if (version != 2) fail(path, "unsupported .glb version " + std::to_string(version));
-  if (length > bytes.size()) {
-    fail(path, "truncated .glb: header says " + std::to_string(length) + " bytes, file has " +
-                   std::to_string(bytes.size()));
-  }
-  uint64_t jsonLength = readU32(&bytes[12]);
-  if (readU32(&bytes[16]) != 0x4E4F534Au) fail(path, "invalid .glb: first chunk is not JSON");
-  if (20 + jsonLength > length) {
-    fail(path, "truncated .glb: JSON chunk of " + std::to_string(jsonLength) +
-                   " bytes does not fit in the file");
-  }
-  uint64_t binStart = 20 + jsonLength;
-  if (binStart + 8 <= length) {
-    uint64_t binLength = readU32(&bytes[binStart]);
-    if (binStart + 8 + binLength > length) {
-      fail(path, "truncated .glb: BIN chunk of " + std::to_string(binLength) +
-                     " bytes does not fit in the file");
-    }
-  }
-  return std::string(reinterpret_cast<const char*>(&bytes[20]), size_t(jsonLength));
-}
-
-std::string firstLine(std::string s) {
-  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
-  size_t nl = s.find('\n');
-  if (nl != std::string::npos) s = s.substr(0, nl) + " (...)";
-  // tinygltf quotes whole data: URIs; keep messages readable.
-  if (s.size() > 240) s = s.substr(0, 240) + "...";
-  return s;
 }
 
 // ---------------------------------------------------------------------------
@@ -1091,35 +846,6 @@ class SceneBuilder {
 };
 
 }  // namespace
-
-Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
-                    const std::string& what, bool srgb) {
-  DecodedImage d;
-  try {
-    d = decodeImageBytes(bytes, size);
-  } catch (const InputError& e) {
-    fail(scenePath, "unreadable image " + what + ": " + e.what());
-  }
-  Texture t;
-  t.width = d.width;
-  t.height = d.height;
-  t.texels.resize(size_t(d.width) * size_t(d.height));
-  const size_t comp = size_t(d.channels);
-  for (size_t i = 0; i < t.texels.size(); ++i) {
-    const float* px = d.values.data() + i * comp;
-    const float r = px[0];
-    const float g = comp >= 3 ? px[1] : r;
-    const float b = comp >= 3 ? px[2] : r;
-    t.texels[i] = srgb ? Vec3{srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)} : Vec3{r, g, b};
-  }
-  // Alpha is linear in glTF whatever the colour encoding; kept only where
-  // the image has it (grey + alpha or RGBA).
-  if (comp == 2 || comp == 4) {
-    t.alpha.resize(t.texels.size());
-    for (size_t i = 0; i < t.alpha.size(); ++i) t.alpha[i] = d.values[i * comp + comp - 1];
-  }
-  return t;
-}
 
 Scene loadGltf(const std::string& path) {
   fs::path p(path);

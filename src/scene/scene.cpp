@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "image/image.h"
 #include "scene/scene_internal.h"
 
 namespace lo {
@@ -363,6 +364,35 @@ std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std
                                    std::istreambuf_iterator<char>());
   if (in.bad()) fail(scenePath, "cannot read " + what + " '" + file + "'");
   return bytes;
+}
+
+Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
+                    const std::string& what, bool srgb) {
+  DecodedImage d;
+  try {
+    d = decodeImageBytes(bytes, size);
+  } catch (const InputError& e) {
+    fail(scenePath, "unreadable image " + what + ": " + e.what());
+  }
+  Texture t;
+  t.width = d.width;
+  t.height = d.height;
+  t.texels.resize(size_t(d.width) * size_t(d.height));
+  const size_t comp = size_t(d.channels);
+  for (size_t i = 0; i < t.texels.size(); ++i) {
+    const float* px = d.values.data() + i * comp;
+    const float r = px[0];
+    const float g = comp >= 3 ? px[1] : r;
+    const float b = comp >= 3 ? px[2] : r;
+    t.texels[i] = srgb ? Vec3{srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)} : Vec3{r, g, b};
+  }
+  // Alpha is linear in glTF whatever the colour encoding; kept only where
+  // the image has it (grey + alpha or RGBA).
+  if (comp == 2 || comp == 4) {
+    t.alpha.resize(t.texels.size());
+    for (size_t i = 0; i < t.alpha.size(); ++i) t.alpha[i] = d.values[i * comp + comp - 1];
+  }
+  return t;
 }
 
 std::string formatLimit(double v) {

@@ -1,0 +1,28 @@
+#pragma once
+/// @file scene/gltf_prevalidate.h
+/// @brief Checks on a glTF file before tinygltf parses it (internal to
+/// src/scene). Each throws InputError naming `path` and the problem.
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace lo::scene_internal {
+
+/// Refuses JSON nested deeper than kMaxJsonDepth (both JSON parsers recurse
+/// once per level), counted outside strings.
+void checkJsonNesting(const std::string& path, const std::string& text);
+
+/// The parsed JSON's buffers, buffer views and images: indices and sizes in
+/// range, external files inside `baseDir` and present.
+void prevalidateJson(const std::string& path, const std::string& baseDir, const nlohmann::json& j);
+
+/// Checks the GLB container (https://registry.khronos.org/glTF/specs/2.0/
+/// glTF-2.0.html#binary-gltf-layout) and returns the JSON chunk.
+std::string glbJson(const std::string& path, const std::vector<unsigned char>& bytes);
+
+/// The first line of a tinygltf message, at most 240 characters (it quotes
+/// whole data: URIs).
+std::string firstLine(std::string s);
+
+}  // namespace lo::scene_internal
