@@ -1,11 +1,13 @@
 /* material_brdf.h: the glTF metallic-roughness BRDF, written once for GLSL and
  * C++ (the practice of octree_lookup.h). The scene shader includes it
  * (render_scene.frag); the C++ build is material/gltf_brdf.cpp, which gives
- * the same functions to the tests and, next, to the tracers.
+ * the same functions to the tests and to the tracers' BSDF (material/bsdf.cpp).
  *
- * The BRDF (docs/render.md): Lambert diffuse weighted by (1 - F), plus a GGX
- * lobe (Walter et al. 2007) with height-correlated Smith visibility (Heitz
- * 2014, eq. 99) and Schlick's Fresnel, F0 = mix(0.04, baseColor, metallic).
+ * The BRDF (docs/render.md), as glTF 2.0's Appendix B mixes it: a dielectric
+ * (Lambert diffuse weighted by 1 - F plus a GGX specular layer weighted by
+ * F, Schlick's Fresnel with F0 = 0.04) and a metal (the GGX lobe, F0 =
+ * baseColor), mixed by metallic. GGX after Walter et al. 2007, with
+ * height-correlated Smith visibility (Heitz 2014, eq. 99).
  * KHR_materials_transmission takes its share of the diffuse lobe away (the
  * renderer draws the transmitted light separately). With the specular lobe
  * off the BRDF is exactly baseColor (1 - metallic)(1 - transmission) / pi:
@@ -76,10 +78,14 @@ LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metall
   float D = a2 / (LO_BRDF_PI * dd * dd);
   float vis =
       0.5f / (nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2));
-  vec3 f0 = mix(vec3(0.04f), baseColor, metallic);
-  vec3 F = f0 + (1.0f - f0) * pow(1.0f - vh, 5.0f);
-  diffuse *= 1.0f - F;
-  specular = F * (D * vis);
+  /* The specification's mix (glTF 2.0, Appendix B): the dielectric's
+   * Fresnel (F0 = 0.04) weights its diffuse base and its specular layer,
+   * the metal's (F0 = baseColor) its specular lobe alone. */
+  float schlick = pow(1.0f - vh, 5.0f);
+  float fDielectric = 0.04f + 0.96f * schlick;
+  vec3 fMetal = baseColor + (1.0f - baseColor) * schlick;
+  diffuse *= 1.0f - fDielectric;
+  specular = mix(vec3(fDielectric), fMetal, metallic) * (D * vis);
 }
 
 /* f(v, l): both lobes, no cosine; 0 when l is below the surface. */

@@ -10,12 +10,12 @@
 #include "bake/bake.h"
 #include "bake/stats_json.h"
 #include "bake_options.h"
-#include "bake_report.h"
 #include "commands.h"
 #include "core/error.h"
 #include "core/file.h"
 #include "core/threads.h"
 #include "distributed/mpi_session.h"
+#include "distributed/distributed_stats.h"
 #include "distributed/tiled_bake.h"
 #include "report.h"
 #include "scene/scene.h"
@@ -52,7 +52,7 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   std::vector<StageReport> rows;
 
   StageTimer loadTimer(rows, "load scene");
-  Scene scene = loadScene(opt.scene);
+  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
   if (opt.bounds.empty() && !scene.region.empty() && !opt.quiet) {
     std::printf("region of interest marked in the scene: %s (--bounds overrides it)\n",
@@ -85,7 +85,7 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   }
 
   if (!opt.quiet) printSummary(stdout, rows);
-  if (!opt.quiet && comm) printRanks(distributed, baked.stats.storedPhotons);
+  if (!opt.quiet && comm) std::printf("%s", ranksTable(distributed, baked.stats.storedPhotons).c_str());
 
   if (!opt.statsJson.empty()) {
     BakeStatsRecord record;

@@ -36,6 +36,7 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", opt.output, "Output .vdb file (written atomically)")->required();
+  addSceneOptions(cmd, opt.sceneOptions);
   cmd->add_option("--depth", opt.depth,
                   "Octree depth: 2^depth voxels across the scene's bounding cube")
       ->check(depthValidator())

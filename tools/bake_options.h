@@ -2,6 +2,7 @@
 /// @file tools/bake_options.h
 /// @brief The flags of `bake` and their translation into BakeParams.
 
+#include "scene_options.h"
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@ namespace lo::tool {
 /// The flags of `bake`, as given.
 struct BakeOptions {
   std::string scene;
+  SceneOptions sceneOptions;  // --sky
   std::string output;
   int depth = 6;
   size_t photons = 600000;

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "scene_options.h"
 #include "core/file.h"
 #include "export/lightmap_export.h"
 #include "report.h"
@@ -17,6 +18,7 @@ namespace {
 
 struct LightmapOptions {
   std::string scene;
+  SceneOptions sceneOptions;  // --sky
   std::string lights;
   std::string output;
   float texelSize = 0;  // 0 = a quarter voxel (defaultLightmapTexel)
@@ -56,7 +58,7 @@ int runLightmap(const LightmapOptions& opt) {
   const LightmapExportParams params = exportParams(opt);
   std::vector<StageReport> rows;
   StageTimer loadTimer(rows, "load scene");
-  const Scene scene = loadScene(opt.scene);
+  const Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.materials.size()) + " materials");
@@ -109,6 +111,7 @@ std::function<int()> addLightmapCommand(CLI::App& app) {
   cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
       ->required()
       ->check(CLI::ExistingFile);
+  addSceneOptions(cmd, opt->sceneOptions);
   cmd->add_option("lights", opt->lights, "Baked VDL grid (.vdb from `lightoctree bake`)")
       ->required()
       ->check(CLI::ExistingFile);

@@ -9,6 +9,7 @@
 #include "camera_options.h"
 #include "cli_checks.h"
 #include "commands.h"
+#include "scene_options.h"
 #include "core/error.h"
 #include "core/file.h"
 #include "core/threads.h"
@@ -24,6 +25,7 @@ namespace {
 
 struct ReferenceOptions {
   std::string scene;
+  SceneOptions sceneOptions;  // --sky
   std::string output;
   std::string stdErrorOutput;
   CameraOptions camera;
@@ -53,7 +55,7 @@ int runReference(const ReferenceOptions& opt) {
   checkCameraOptions(opt.camera);
   ThreadLimit threadLimit(opt.threads);
 
-  Scene scene = loadScene(opt.scene);
+  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   if (opt.part == "edge-mask") {
@@ -122,6 +124,7 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
   cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
       ->required()
       ->check(CLI::ExistingFile);
+  addSceneOptions(cmd, opt->sceneOptions);
   cmd->add_option("-o,--output", opt->output,
                   "Image: .exr (linear float) or .png (sRGB, for a quick look)")
       ->required();

@@ -9,6 +9,7 @@
 
 #include "camera_options.h"
 #include "render_options.h"
+#include "scene_options.h"
 #include "commands.h"
 #include "core/file.h"
 #include "core/error.h"
@@ -27,6 +28,7 @@ namespace {
 
 struct RenderOptions {
   std::string scene;
+  SceneOptions sceneOptions;  // --sky
   std::string lights;
   std::string output;
   CameraOptions camera;
@@ -79,7 +81,7 @@ int runRender(const RenderOptions& opt) {
   }
   checkCameraOptions(opt.camera);
   if (opt.mode == "irradiance") {
-    Scene scene = loadScene(opt.scene);
+    Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
     printSceneWarnings(scene);
     return renderIrradiance(opt, scene, readVdlGrid(opt.lights));
   }
@@ -87,7 +89,7 @@ int runRender(const RenderOptions& opt) {
   params.width = opt.width;
   params.height = opt.height;
 
-  Scene scene = loadScene(opt.scene);
+  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
   LoadedVdl baked = readVdlGrid(opt.lights);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
@@ -132,6 +134,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
       ->required()
       ->check(CLI::ExistingFile);
+  addSceneOptions(cmd, opt->sceneOptions);
   cmd->add_option("lights", opt->lights, "Baked VDL grid (.vdb from `lightoctree bake`)")
       ->required()
       ->check(CLI::ExistingFile);

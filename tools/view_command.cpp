@@ -7,29 +7,28 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
-#include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "bake/progressive_bake.h"
 #include "camera_options.h"
-#include "render_options.h"
 #include "cli_checks.h"
 #include "commands.h"
 #include "core/error.h"
-#include "core/resources.h"
+#include "core/file.h"
 #include "octree/gpu_octree.h"
-#include "bake/progressive_bake.h"
 #include "render/camera_path.h"
 #include "render/context.h"
-#include "report.h"
 #include "render/fly_camera.h"
 #include "render/renderer.h"
 #include "render/viewer.h"
+#include "render_options.h"
+#include "report.h"
 #include "scene/scene.h"
+#include "scene_options.h"
 #include "vdb/vdb_io.h"
 
 namespace lo::tool {
@@ -37,6 +36,7 @@ namespace {
 
 struct ViewOptions {
   std::string scene;
+  SceneOptions sceneOptions;  // --sky
   std::string lights;
   CameraOptions camera;
   int width = 800, height = 600;
@@ -44,53 +44,9 @@ struct ViewOptions {
   ShadingOptions shading;
   float speed = 0;  // 0 = a quarter of the scene's diagonal per second
   std::string cameraPath;
-  std::string saveFrames;
-  int frames = 0;
-  std::string record = "camera-path.txt";
-  bool continuous = false;
+  ViewerParams view;  // the flags bound to it: --save-frames, --frames, --record, ...
   bool progressive = false;
-  size_t photons = 600000;
-  int depth = 6;
-  int knn = 300;
-  uint64_t seed = 1;
-  bool quiet = false;
-};
-
-/// The progressive bake as the viewer's source of octree levels.
-class ProgressiveLevels final : public OctreeLevelSource {
- public:
-  ProgressiveLevels(ProgressiveBake& bake, int targetDepth)
-      : bake_(bake), targetDepth_(targetDepth) {}
-  bool takeNewest(GpuOctree& octree, int& depth) override {
-    std::optional<ProgressiveLevel> level = bake_.takeNewest();
-    if (!level) return false;
-    octree = std::move(level->octree);
-    depth = level->depth;
-    level->octree = GpuOctree();
-    last_ = std::move(level);
-    return true;
-  }
-  std::string shownReport() const override {
-    if (!last_) return {};
-    const ProgressiveLevel& l = *last_;
-    const double onScreen =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - l.photonsTraced).count();
-    char line[512];
-    std::snprintf(line, sizeof line,
-                  "depth %d on screen %.2f s after the photons were traced (bake %.2f s: voxelize "
-                  "%.2f, splat %.2f, gather + cluster %.2f; octree %.3f s; %zu voxels)%s",
-                  l.depth, onScreen, l.stats.seconds(), l.stats.voxelizeSeconds,
-                  l.stats.splatSeconds, l.stats.gatherClusterSeconds, l.octreeSeconds,
-                  l.stats.activeVoxels, l.depth == targetDepth_ ? " (target)" : "");
-    return line;
-  }
-  bool finished() const override { return bake_.finished(); }
-  std::string status() const override { return bake_.status().ToString(); }
-
- private:
-  ProgressiveBake& bake_;
-  std::optional<ProgressiveLevel> last_;
-  int targetDepth_;
+  ProgressiveParams bake;  // --photons, --depth (target), --knn, --seed
 };
 
 int runView(const ViewOptions& opt) {
@@ -108,25 +64,13 @@ int runView(const ViewOptions& opt) {
   checkCameraOptions(opt.camera);
   std::optional<CameraPath> path;
   if (!opt.cameraPath.empty()) path = readCameraPath(opt.cameraPath);
-  if (!opt.saveFrames.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(opt.saveFrames, ec);
-    if (!std::filesystem::is_directory(opt.saveFrames)) {
-      throw InputError("--save-frames: cannot create the folder '" + opt.saveFrames + "'" +
-                       (ec ? " (" + ec.message() + ")" : ""));
-    }
-  }
-  ViewerParams view;
+  if (!opt.view.saveFrames.empty()) makeOutputFolder(opt.view.saveFrames, "--save-frames");
+  ViewerParams view = opt.view;
   view.render = opt.shading.renderParams(parseRenderMode(opt.mode));
   view.exposure = opt.shading.exposure;
   view.path = std::move(path);
-  view.saveFrames = opt.saveFrames;
-  view.frames = opt.frames;
-  view.record = opt.record;
-  view.continuous = opt.continuous;
-  view.quiet = opt.quiet;
 
-  Scene scene = loadScene(opt.scene);
+  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
   std::optional<LoadedVdl> baked;
   if (!opt.progressive) baked = readVdlGrid(opt.lights);
@@ -144,15 +88,8 @@ int runView(const ViewOptions& opt) {
   contextParams.width = opt.width;
   contextParams.height = opt.height;
   contextParams.title = "Light Octree: " + std::filesystem::path(opt.scene).filename().string();
-  std::unique_ptr<GlContext> context;
-  try {
-    context = createGlContext(contextParams);
-  } catch (const GlError& e) {
-    throw GlError(std::string(e.what()) +
-                  "; `view` needs a display (on a machine without one: xvfb-run -a lightoctree "
-                  "view ..., or `lightoctree render` for images)");
-  }
-  if (!opt.quiet) std::printf("glfw: %s\n", context->info().ToString().c_str());
+  std::unique_ptr<GlContext> context = createGlContext(contextParams);
+  if (!opt.view.quiet) std::printf("glfw: %s\n", context->info().ToString().c_str());
 
   const GpuOctreeParams octreeParams = opt.shading.octreeParams(&context->info());
 
@@ -160,46 +97,35 @@ int runView(const ViewOptions& opt) {
   // upload, shadow maps) so that the two overlap; until the first level is
   // ready the window shows direct light over an empty octree.
   std::unique_ptr<ProgressiveBake> bake;
-  std::unique_ptr<ProgressiveLevels> levels;
+  std::unique_ptr<OctreeLevelSource> levels;
   GpuOctree octree;
   if (opt.progressive) {
-    ProgressiveParams pp;
-    pp.photons.storedPhotons = opt.photons;
-    pp.photons.seed = opt.seed;
-    pp.targetDepth = opt.depth;
-    pp.firstDepth = std::min(4, opt.depth);
-    pp.gather.k = opt.knn;
-    pp.cluster.seed = opt.seed;
+    ProgressiveParams pp = opt.bake;
+    pp.firstDepth = std::min(4, pp.targetDepth);
+    pp.cluster.seed = pp.photons.seed;
     pp.octree = octreeParams;
     bake = std::make_unique<ProgressiveBake>(scene, pp);
-    levels = std::make_unique<ProgressiveLevels>(*bake, pp.targetDepth);
+    levels = progressiveLevelSource(*bake, pp.targetDepth);
     view.firstDepth = pp.firstDepth;
     view.targetDepth = pp.targetDepth;
-    if (!opt.quiet) {
-      std::printf("progressive: tracing %zu photons, then depth %d to %d\n", opt.photons,
+    if (!opt.view.quiet) {
+      std::printf("progressive: tracing %zu photons, then depth %d to %d\n", pp.photons.storedPhotons,
                   pp.firstDepth, pp.targetDepth);
     }
   } else {
     octree = buildGpuOctree(baked->grid, octreeParams);
     view.shownDepth = octree.depth;
-    if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
+    if (!opt.view.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
   }
 
   Renderer renderer(scene, octree, opt.shading.rendererParams());
-  opt.shading.prepareLighting(renderer, scene, octree, opt.quiet);
+  opt.shading.prepareLighting(renderer, scene, octree, opt.view.quiet);
   octree = GpuOctree();  // uploaded; the CPU copy is not needed any more
-  if (!opt.quiet && !view.path) std::printf("%s", viewerKeyHelp());
+  if (!opt.view.quiet && !view.path) std::printf("%s", viewerKeyHelp());
 
   Viewer viewer(*context, renderer, view, levels.get());
   const ViewerStats stats = viewer.run();
-  if (!opt.quiet) {
-    std::printf("%d frames in %.2f s (%.1f ms per frame)", stats.framesDrawn, stats.seconds,
-                stats.framesDrawn ? 1000.0 * stats.seconds / stats.framesDrawn : 0.0);
-    if (stats.framesSaved) {
-      std::printf(", %d saved to %s", stats.framesSaved, opt.saveFrames.c_str());
-    }
-    std::printf("\n");
-  }
+  if (!opt.view.quiet) std::printf("%s\n", stats.ToString(opt.view.saveFrames).c_str());
   return 0;
 }
 
@@ -219,6 +145,7 @@ std::function<int()> addViewCommand(CLI::App& app) {
   cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
       ->required()
       ->check(CLI::ExistingFile);
+  addSceneOptions(cmd, opt->sceneOptions);
   cmd->add_option("lights", opt->lights,
                   "Baked VDL grid (.vdb from `lightoctree bake`); not with --progressive")
       ->check(CLI::ExistingFile);
@@ -240,32 +167,32 @@ std::function<int()> addViewCommand(CLI::App& app) {
   cmd->add_option("--camera-path", opt->cameraPath,
                   "Play this camera path (format below) and exit at its end")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--save-frames", opt->saveFrames,
+  cmd->add_option("--save-frames", opt->view.saveFrames,
                   "Write every frame drawn as DIR/frame_00000.png, ... (created if missing)");
-  cmd->add_option("--frames", opt->frames,
+  cmd->add_option("--frames", opt->view.frames,
                   "Exit after N frames (with --camera-path: N frames evenly spaced along it; "
                   "with --progressive: N frames at the target depth)")
       ->check(CLI::Range(0, 10000000));
-  cmd->add_flag("--continuous", opt->continuous,
+  cmd->add_flag("--continuous", opt->view.continuous,
                 "Redraw every iteration, even when nothing changed (by default a still view "
                 "is not redrawn, which leaves the CPU to a --progressive bake)");
-  cmd->add_option("--record", opt->record, "Path file the P key appends keyframes to")
+  cmd->add_option("--record", opt->view.record, "Path file the P key appends keyframes to")
       ->capture_default_str();
   cmd->add_flag("--progressive", opt->progressive,
                 "Bake from the scene while viewing: trace photons once, show depth 4 as soon "
                 "as it is ready, refine to --depth in the background");
-  cmd->add_option("--photons", opt->photons, "Progressive: photons to store")
+  cmd->add_option("--photons", opt->bake.photons.storedPhotons, "Progressive: photons to store")
       ->check(CLI::Range(size_t(1), size_t(200000000)))
       ->capture_default_str();
-  cmd->add_option("--depth", opt->depth, "Progressive: target octree depth")
+  cmd->add_option("--depth", opt->bake.targetDepth, "Progressive: target octree depth")
       ->check(depthValidator())
       ->capture_default_str();
-  cmd->add_option("--knn", opt->knn, "Progressive: nearest photons gathered per voxel")
+  cmd->add_option("--knn", opt->bake.gather.k, "Progressive: nearest photons gathered per voxel")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  cmd->add_option("--seed", opt->seed, "Progressive: random seed")
+  cmd->add_option("--seed", opt->bake.photons.seed, "Progressive: random seed")
       ->check(seedValidator())->capture_default_str();
-  cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
+  cmd->add_flag("-q,--quiet", opt->view.quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runView(*opt) : -1; };
 }
 

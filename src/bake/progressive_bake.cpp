@@ -3,6 +3,7 @@
 #include "bake/progressive_bake.h"
 
 #include <atomic>
+#include <cstdio>
 #include <exception>
 #include <mutex>
 #include <sstream>
@@ -226,6 +227,51 @@ size_t ProgressiveBake::storedPhotons() const {
 double ProgressiveBake::traceSeconds() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   return impl_->traceSeconds;
+}
+
+namespace {
+
+/// ProgressiveBake as an OctreeLevelSource.
+class ProgressiveLevels final : public OctreeLevelSource {
+ public:
+  ProgressiveLevels(ProgressiveBake& bake, int targetDepth)
+      : bake_(bake), targetDepth_(targetDepth) {}
+  bool takeNewest(GpuOctree& octree, int& depth) override {
+    std::optional<ProgressiveLevel> level = bake_.takeNewest();
+    if (!level) return false;
+    octree = std::move(level->octree);
+    depth = level->depth;
+    level->octree = GpuOctree();
+    last_ = std::move(level);
+    return true;
+  }
+  std::string shownReport() const override {
+    if (!last_) return {};
+    const ProgressiveLevel& l = *last_;
+    const double onScreen =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - l.photonsTraced).count();
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "depth %d on screen %.2f s after the photons were traced (bake %.2f s: voxelize "
+                  "%.2f, splat %.2f, gather + cluster %.2f; octree %.3f s; %zu voxels)%s",
+                  l.depth, onScreen, l.stats.seconds(), l.stats.voxelizeSeconds,
+                  l.stats.splatSeconds, l.stats.gatherClusterSeconds, l.octreeSeconds,
+                  l.stats.activeVoxels, l.depth == targetDepth_ ? " (target)" : "");
+    return line;
+  }
+  bool finished() const override { return bake_.finished(); }
+  std::string status() const override { return bake_.status().ToString(); }
+
+ private:
+  ProgressiveBake& bake_;
+  std::optional<ProgressiveLevel> last_;
+  int targetDepth_;
+};
+
+}  // namespace
+
+std::unique_ptr<OctreeLevelSource> progressiveLevelSource(ProgressiveBake& bake, int targetDepth) {
+  return std::make_unique<ProgressiveLevels>(bake, targetDepth);
 }
 
 }  // namespace lo

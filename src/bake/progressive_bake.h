@@ -15,6 +15,7 @@
 
 #include "bake/bake.h"
 #include "octree/gpu_octree.h"
+#include "octree/octree_level_source.h"
 #include "photon/photon_map.h"
 #include "scene/scene.h"
 
@@ -99,5 +100,10 @@ class ProgressiveBake {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// `bake`'s levels as a viewer's OctreeLevelSource (octree/octree_level_source.h; the viewer draws them): each
+/// level taken is reported with its timings once on screen, the one at
+/// `targetDepth` marked as the target. `bake` must outlive the source.
+std::unique_ptr<OctreeLevelSource> progressiveLevelSource(ProgressiveBake& bake, int targetDepth);
 
 }  // namespace lo

@@ -232,6 +232,15 @@ void checkOutputFolder(const std::string& path, const char* flag) {
   }
 }
 
+void makeOutputFolder(const std::string& path, const char* flag) {
+  std::error_code ec;
+  fs::create_directories(path, ec);
+  if (!fs::is_directory(path)) {
+    throw InputError(std::string(flag) + ": cannot create the folder '" + path + "'" +
+                     (ec ? " (" + ec.message() + ")" : ""));
+  }
+}
+
 void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs) {
   auto same = [](const std::string& a, const std::string& b) {
     std::error_code ec1, ec2;

@@ -46,6 +46,12 @@ std::vector<std::string> leftoverTemporaries(const std::string& path);
 /// anything but a regular file. Called by commands before any long work.
 void checkOutputFolder(const std::string& path, const char* flag);
 
+/// @brief Creates the folder `path` (and its parents) when missing.
+/// @throws InputError naming `flag` and the cause when it cannot be created
+/// or `path` is something other than a folder. Called by commands that
+/// write many files into one folder, before any long work.
+void makeOutputFolder(const std::string& path, const char* flag);
+
 /// @brief A command's files, each with the flag that named it.
 using NamedPaths = std::vector<std::pair<std::string, std::string>>;  // (flag, path)
 

@@ -73,10 +73,13 @@ RgbImage readExr(const std::string& path) {
 
 }  // namespace
 
-unsigned char encodeSrgb8(float linear) {
+float linearToSrgb(float linear) {
   float c = std::isfinite(linear) ? std::clamp(linear, 0.0f, 1.0f) : 0.0f;
-  float s = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-  return static_cast<unsigned char>(std::lround(s * 255.0f));
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+unsigned char encodeSrgb8(float linear) {
+  return static_cast<unsigned char>(std::lround(linearToSrgb(linear) * 255.0f));
 }
 
 void writeExr(const std::string& path, const RgbImage& image) {

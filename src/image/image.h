@@ -46,6 +46,8 @@ DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size);
 
 /// sRGB transfer function (IEC 61966-2-1) to linear, for one channel in [0, 1].
 float srgbToLinear(float s);
+/// Its inverse: linear (clamped to [0, 1]; not finite: 0) to sRGB, in [0, 1].
+float linearToSrgb(float linear);
 
 /// Writes 32-bit float channels R, G, B (ZIP, lossless) to
 /// `path` through `path.tmp` and a rename. @throws IoError naming the file.

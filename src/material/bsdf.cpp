@@ -1,7 +1,10 @@
-/// @file photon/bsdf.cpp
-/// @brief The shared diffuse + GGX metal + Fresnel glass material model.
+/// @file material/bsdf.cpp
+/// @brief The tracers' glTF material: dielectric (diffuse base and specular
+/// layer, evaluated by material/gltf_brdf.h), GGX metal, Fresnel glass.
 
 #include "material/bsdf.h"
+
+#include "material/gltf_brdf.h"
 
 #include <algorithm>
 #include <cmath>
@@ -44,6 +47,49 @@ Vec3 sampleGgxVisibleNormal(const Vec3& wo, float alpha, float u1, float u2) {
 
 Vec3 reflect(const Vec3& wo, const Vec3& n) { return n * (2.0f * dot(wo, n)) - wo; }
 
+/// Solid-angle density of a VNDF-sampled reflection wi of local wo through
+/// the half vector m (local): D_wo(m) / (4 wo.m) = G1(wo) D(m) / (4 cos(wo)).
+float vndfReflectionPdf(const Vec3& woL, const Vec3& m, float alpha) {
+  float g1 = 1.0f / (1.0f + smithLambda(woL, alpha));
+  return g1 * ggxD(m, alpha) / (4.0f * woL.z);
+}
+
+/// The probability with which the dielectric lobe samples its specular
+/// layer rather than the cosine: the layer's expected share of the light
+/// leaving towards wo (Schlick's F at n.wo against the base's (1 - F)
+/// albedo), kept away from 0 and 1 so that neither density vanishes.
+float specularLayerProbability(const BsdfLobes& lobes, const Vec3& albedo, float cosO) {
+  if (!lobes.specularLayer) return 0;
+  float c = 1.0f - std::clamp(cosO, 0.0f, 1.0f);
+  float fresnel = 0.04f + 0.96f * (c * c * c * c * c);
+  float base = (1.0f - fresnel) * (0.2126f * albedo.x + 0.7152f * albedo.y + 0.0722f * albedo.z);
+  return std::clamp(fresnel / std::max(fresnel + base, 1e-6f), 0.1f, 0.9f);
+}
+
+/// The dielectric lobe, f(wo, wi) cos(wi) (wi above the surface): the
+/// glTF BRDF at metallic 0 (both layers), or the Lambert base alone.
+Vec3 dielectricCos(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
+                   const Vec3& n, float cosI) {
+  if (!lobes.specularLayer) return albedo * (kInvPi * cosI);
+  const GltfBrdfLobes l = gltfBrdfLobes({albedo, 0.0f, lobes.roughness, 0.0f}, n, wo, wi);
+  return (l.diffuse + l.specular) * cosI;
+}
+
+/// The metal lobe's f(wo, wi) cos(wi) (non-delta, wi above the surface).
+Vec3 metalCos(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
+              const Vec3& n, float cosI) {
+  return gltfBrdfLobes({albedo, 1.0f, lobes.roughness, 0.0f}, n, wo, wi).specular * cosI;
+}
+
+/// The dielectric lobe's density of wi: the mixture of the cosine and the
+/// specular layer's visible normals.
+float dielectricPdf(const BsdfLobes& lobes, float layerProbability, const Vec3& woL,
+                    const Vec3& m, float cosI) {
+  float pdf = (1.0f - layerProbability) * cosI * kInvPi;
+  if (layerProbability > 0) pdf += layerProbability * vndfReflectionPdf(woL, m, lobes.alpha);
+  return pdf;
+}
+
 Vec3 schlick(const Vec3& f0, float cosine) {
   float c = 1.0f - std::max(0.0f, cosine);
   return f0 + (Vec3{1, 1, 1} - f0) * (c * c * c * c * c);
@@ -61,7 +107,9 @@ BsdfLobes bsdfLobes(const Material& m, float metallicIn, float roughnessIn) {
   info.metalWeight = metallic;
   info.transmissionWeight = (1.0f - metallic) * transmission;
   info.diffuseWeight = (1.0f - metallic) * (1.0f - transmission);
-  info.alpha = roughness * roughness;
+  info.roughness = roughness;
+  info.alpha = std::max(roughness * roughness, kMirrorAlpha);
+  info.specularLayer = m.specularLayer;
   info.ior = m.ior > 0 ? m.ior : 1.5f;
   info.thinWalled = !(m.thickness > 0);
   info.storesPhotons = info.diffuseWeight > 0 || (metallic > 0 && roughness > kGlossyRoughness);
@@ -114,7 +162,7 @@ bool sampleBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, cons
   }
   if (lobe < lobes.transmissionWeight + lobes.metalWeight) {
     // Metal: GGX reflection, Schlick Fresnel with F0 = baseColor.
-    if (lobes.alpha < kMirrorAlpha) {
+    if (lobes.mirrorMetal()) {
       out.wi = reflect(wo, n);
       out.weight = schlick(albedo, dot(wo, n));
       out.delta = true;
@@ -135,9 +183,27 @@ bool sampleBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, cons
   }
   Vec3 tt, bb;
   orthonormalBasis(n, tt, bb);
-  float u1 = rng.uniform(), u2 = rng.uniform();
-  out.wi = fromLocal(cosineHemisphere(u1, u2), tt, bb, n);
-  out.weight = albedo;
+  const float cosO = std::max(1e-6f, dot(wo, n));
+  const float layer = specularLayerProbability(lobes, albedo, cosO);
+  if (layer <= 0) {
+    float u1 = rng.uniform(), u2 = rng.uniform();
+    out.wi = fromLocal(cosineHemisphere(u1, u2), tt, bb, n);
+    out.weight = albedo;
+    return true;
+  }
+  // The dielectric: one direction from the mixture, weighted by the whole
+  // lobe over the mixture's density (one-sample MIS, balance heuristic).
+  const Vec3 woL{dot(wo, tt), dot(wo, bb), cosO};
+  float choice = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+  Vec3 wiL = choice < layer ? reflect(woL, sampleGgxVisibleNormal(woL, lobes.alpha, u1, u2))
+                            : cosineHemisphere(u1, u2);
+  if (wiL.z <= 0) return false;
+  wiL = normalize(wiL);
+  const Vec3 m = normalize(woL + wiL);
+  const float pdf = dielectricPdf(lobes, layer, woL, m, wiL.z);
+  if (!(pdf > 0)) return false;
+  out.wi = fromLocal(wiL, tt, bb, n);
+  out.weight = dielectricCos(lobes, albedo, wo, normalize(out.wi), n, wiL.z) / pdf;
   return true;
 }
 
@@ -145,34 +211,32 @@ Vec3 evalBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const 
               const Vec3& n) {
   float cosI = dot(wi, n), cosO = dot(wo, n);
   if (cosI <= 0 || cosO <= 0) return Vec3{0, 0, 0};
-  Vec3 f = albedo * (lobes.diffuseWeight * kInvPi * cosI);
-  if (lobes.metalWeight > 0 && lobes.alpha >= kMirrorAlpha) {
-    Vec3 h = normalize(wo + wi);
-    Vec3 tt, bb;
-    orthonormalBasis(n, tt, bb);
-    Vec3 woL{dot(wo, tt), dot(wo, bb), cosO}, wiL{dot(wi, tt), dot(wi, bb), cosI};
-    Vec3 m{dot(h, tt), dot(h, bb), dot(h, n)};
-    float g2 = 1.0f / (1.0f + smithLambda(woL, lobes.alpha) + smithLambda(wiL, lobes.alpha));
-    // f cos(wi) = F D G2 / (4 cos(wo)).
-    f += schlick(albedo, dot(wo, h)) *
-         (lobes.metalWeight * ggxD(m, lobes.alpha) * g2 / (4.0f * cosO));
+  Vec3 f{0, 0, 0};
+  if (lobes.diffuseWeight > 0) {
+    f += dielectricCos(lobes, albedo, wo, wi, n, cosI) * lobes.diffuseWeight;
+  }
+  if (lobes.metalWeight > 0 && !lobes.mirrorMetal()) {
+    f += metalCos(lobes, albedo, wo, wi, n, cosI) * lobes.metalWeight;
   }
   return f;
 }
 
-float pdfBsdf(const BsdfLobes& lobes, const Vec3& wo, const Vec3& wi, const Vec3& n) {
+float pdfBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
+              const Vec3& n) {
   float cosI = dot(wi, n), cosO = dot(wo, n);
   if (cosI <= 0 || cosO <= 0) return 0;
-  float pdf = lobes.diffuseWeight * cosI * kInvPi;
-  if (lobes.metalWeight > 0 && lobes.alpha >= kMirrorAlpha) {
-    Vec3 h = normalize(wo + wi);
-    Vec3 tt, bb;
-    orthonormalBasis(n, tt, bb);
-    Vec3 woL{dot(wo, tt), dot(wo, bb), cosO};
-    Vec3 m{dot(h, tt), dot(h, bb), dot(h, n)};
-    // VNDF: D_wo(m) / (4 wo.m) = G1(wo) D(m) / (4 cos(wo)).
-    float g1 = 1.0f / (1.0f + smithLambda(woL, lobes.alpha));
-    pdf += lobes.metalWeight * g1 * ggxD(m, lobes.alpha) / (4.0f * cosO);
+  Vec3 tt, bb;
+  orthonormalBasis(n, tt, bb);
+  const Vec3 woL{dot(wo, tt), dot(wo, bb), cosO};
+  const Vec3 h = normalize(wo + wi);
+  const Vec3 m{dot(h, tt), dot(h, bb), dot(h, n)};
+  float pdf = 0;
+  if (lobes.diffuseWeight > 0) {
+    const float layer = specularLayerProbability(lobes, albedo, std::max(1e-6f, cosO));
+    pdf += lobes.diffuseWeight * dielectricPdf(lobes, layer, woL, m, cosI);
+  }
+  if (lobes.metalWeight > 0 && !lobes.mirrorMetal()) {
+    pdf += lobes.metalWeight * vndfReflectionPdf(woL, m, lobes.alpha);
   }
   return pdf;
 }

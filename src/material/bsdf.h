@@ -5,8 +5,13 @@
 ///
 /// A glTF metallic-roughness material with KHR_materials_transmission is a
 /// mixture of three lobes whose weights sum to 1 (transmission replaces the
-/// diffuse part of the dielectric base; the metal part is unaffected):
-///   - diffuse (weight (1-metallic)(1-transmission)): Lambert, baseColor / pi;
+/// diffuse base of the dielectric; the metal part is unaffected):
+///   - dielectric (weight (1-metallic)(1-transmission)): glTF's fresnel_mix
+///     of a Lambert base, baseColor / pi weighted by 1 - F, and a GGX
+///     specular layer weighted by F (Schlick, F0 = 0.04), evaluated by the
+///     GL renderer's own BRDF text (shaders/material_brdf.h through
+///     material/gltf_brdf.h); sampled by a mixture of the cosine and the
+///     GGX visible normals, chosen by the layer's expected share;
 ///   - metal (weight metallic): GGX (alpha = roughness^2), height-correlated
 ///     Smith G2, Schlick Fresnel with F0 = baseColor; alpha < kMirrorAlpha is a
 ///     perfect mirror (a delta lobe);
@@ -15,8 +20,8 @@
 ///     transmitted ray refracts where the material has a volume
 ///     (KHR_materials_volume thickness > 0) and goes straight through a
 ///     thin-walled one (glTF's default).
-/// There is no dielectric specular layer on the diffuse lobe (unlike the GL
-/// renderer's BRDF, docs/render.md). Shading uses the geometric normal only.
+/// BsdfLobes built by hand (DirectIrradiance's probe) have no specular
+/// layer: a pure Lambert base.
 ///
 /// Directions are unit, world space, pointing away from the surface: wo
 /// towards the viewer (or where a photon came from), wi towards the light.
@@ -30,22 +35,27 @@ namespace lo {
 /// Metal lobes at least this rough (perceptual roughness) count as glossy:
 /// the photon tracer stores photons on them; sharper lobes only redirect.
 constexpr float kGlossyRoughness = 0.2f;
-/// GGX alpha below which a metal is sampled as a perfect mirror.
-constexpr float kMirrorAlpha = 1e-3f;
+/// GGX alpha below which a metal is sampled as a perfect mirror: the floor
+/// of shaders/material_brdf.h's loBrdfAlpha, so that every GGX lobe the
+/// tracers evaluate has the alpha the GL renderer gives it.
+constexpr float kMirrorAlpha = 2e-3f;
 
 /// Lobe weights (probabilities of choosing each lobe; they sum to 1).
 struct BsdfLobes {
   float transmissionWeight = 0;
   float metalWeight = 0;
-  float diffuseWeight = 1;
-  float alpha = 1;  ///< GGX alpha = roughness^2
+  float diffuseWeight = 1;   ///< the dielectric lobe's (base and specular layer)
+  float roughness = 1;       ///< perceptual
+  float alpha = 1;  ///< GGX alpha = roughness^2, floored at kMirrorAlpha
+  /// The dielectric's GGX specular layer (glTF); false: a Lambert base alone.
+  bool specularLayer = false;
   float ior = 1.5f;
   bool thinWalled = true;     ///< transmission passes straight (no KHR_materials_volume)
   bool storesPhotons = true;  ///< diffuse lobe, or metal rougher than kGlossyRoughness
   /// Whether any lobe is not a delta distribution (light sampling can help).
-  bool hasSmoothLobe() const {
-    return diffuseWeight > 0 || (metalWeight > 0 && alpha >= kMirrorAlpha);
-  }
+  bool hasSmoothLobe() const { return diffuseWeight > 0 || (metalWeight > 0 && !mirrorMetal()); }
+  /// Whether the metal lobe is a perfect mirror (roughness^2 < kMirrorAlpha).
+  bool mirrorMetal() const { return roughness * roughness < kMirrorAlpha; }
 };
 BsdfLobes bsdfLobes(const Material& material);
 /// The same with metallic and roughness given (a metallic-roughness map's
@@ -73,7 +83,9 @@ struct BsdfSample {
   bool passThrough = false;
 };
 
-/// Chooses a lobe by its weight and samples it: diffuse cosine-weighted,
+/// Chooses a lobe by its weight and samples it: the dielectric by the
+/// cosine or, for its specular layer, GGX visible normals (the weight is
+/// f cos over the mixture's pdf),
 /// metal by GGX visible normals (Heitz 2018), glass by the Fresnel
 /// probability. `n` is the unit geometric normal turned to wo's side,
 /// `frontFace` whether that is the winding side (so the ray enters the
@@ -88,8 +100,10 @@ bool sampleBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, cons
 Vec3 evalBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
               const Vec3& n);
 /// Solid-angle density with which sampleBsdf produces wi through a smooth
-/// lobe (lobe weight times the lobe's pdf, summed). Used for MIS weights.
-float pdfBsdf(const BsdfLobes& lobes, const Vec3& wo, const Vec3& wi, const Vec3& n);
+/// lobe (lobe weight times the lobe's pdf, summed; the dielectric's mixture
+/// depends on the albedo). Used for MIS weights.
+float pdfBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
+              const Vec3& n);
 
 /// Unpolarised Fresnel reflectance of a smooth dielectric interface, n1 -> n2.
 /// cosT receives the cosine of the refracted direction (0 at total reflection).

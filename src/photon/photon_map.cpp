@@ -49,7 +49,7 @@ struct TriangleInfo {
 };
 
 struct Emitter {
-  enum class Kind { Point, Spot, Directional, Triangle };
+  enum class Kind { Point, Spot, Directional, Triangle, Sky };
   Kind kind = Kind::Point;
   uint32_t index = 0;  ///< into Scene::lights or triangle index
   Vec3 power;          ///< W, RGB, what this emitter actually emits
@@ -115,7 +115,43 @@ struct EmittedRay {
   Vec3 origin, direction, power;
   bool punctual = false;
   float range = 0;
+  /// Stored at its first hit even without --include-direct: light the
+  /// renderer does not draw per frame (the sky's) lives in the octree whole.
+  bool storeFirstHit = false;
 };
+
+/// A start for a ray travelling along `d` (unit) from beyond the scene into
+/// the covered box (ctx.emitBounds): a point on one of the faces the ray
+/// enters through, picked by their projected areas, moved back against `d`
+/// to outside the whole scene (occluders beyond a region of interest still
+/// cast). `projectedArea` receives the box's silhouette area seen along d,
+/// what the start's density is one over. No path is spent on the empty
+/// corners of a bounding disc.
+inline Vec3 startThroughBox(const Context& ctx, const Vec3& d, Rng& rng, float& projectedArea) {
+  const Bounds3& box = ctx.emitBounds;
+  const Vec3 ext = box.extent();
+  const float w[3] = {std::fabs(d.x) * ext.y * ext.z, std::fabs(d.y) * ext.x * ext.z,
+                      std::fabs(d.z) * ext.x * ext.y};
+  projectedArea = w[0] + w[1] + w[2];
+  const float u0 = rng.uniform() * projectedArea;
+  const int axis = u0 < w[0] ? 0 : (u0 < w[0] + w[1] ? 1 : 2);
+  const float u1 = rng.uniform(), u2 = rng.uniform();
+  Vec3 q;
+  const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+  q[axis] = d[axis] > 0 ? box.lower[axis] : box.upper[axis];
+  q[a1] = box.lower[a1] + u1 * ext[a1];
+  q[a2] = box.lower[a2] + u2 * ext[a2];
+  // Where the ray q - s d leaves the scene's bounds (and the box): the
+  // nearest slab it crosses.
+  Bounds3 all = ctx.bounds;
+  all.extend(box);
+  float exit = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] > 0) exit = std::min(exit, (q[i] - all.lower[i]) / d[i]);
+    if (d[i] < 0) exit = std::min(exit, (q[i] - all.upper[i]) / d[i]);
+  }
+  return q - d * (std::max(0.0f, exit) + 4.0f * ctx.epsilon);
+}
 
 inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
   const Scene& scene = *ctx.scene;
@@ -129,6 +165,7 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
   const Emitter& e = ctx.emitters[k];
   out.power = e.pathPower;
   out.punctual = false;
+  out.storeFirstHit = false;
   out.range = 0;
   switch (e.kind) {
     case Emitter::Kind::Point: {
@@ -160,36 +197,30 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
     }
     case Emitter::Kind::Directional: {
       const Light& light = scene.lights[e.index];
-      // Aimed at the covered box's silhouette (what Light::power counts): a
-      // point on one of the box faces the light enters through, picked by
-      // its projected area, then moved back against the light to outside
-      // the whole scene (occluders beyond a region of interest still cast).
-      // No path is spent on the empty corners of a bounding disc.
+      // Aimed at the covered box's silhouette (what Light::power counts).
       const Vec3 d = normalize(light.direction);
-      const Bounds3& box = ctx.emitBounds;
-      const Vec3 ext = box.extent();
-      const float w[3] = {std::fabs(d.x) * ext.y * ext.z, std::fabs(d.y) * ext.x * ext.z,
-                          std::fabs(d.z) * ext.x * ext.y};
-      const float u0 = rng.uniform() * (w[0] + w[1] + w[2]);
-      const int axis = u0 < w[0] ? 0 : (u0 < w[0] + w[1] ? 1 : 2);
-      const float u1 = rng.uniform(), u2 = rng.uniform();
-      Vec3 q;
-      const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-      q[axis] = d[axis] > 0 ? box.lower[axis] : box.upper[axis];
-      q[a1] = box.lower[a1] + u1 * ext[a1];
-      q[a2] = box.lower[a2] + u2 * ext[a2];
-      // Where the ray q - s d leaves the scene's bounds (and the box): the
-      // nearest slab it crosses.
-      Bounds3 all = ctx.bounds;
-      all.extend(box);
-      float exit = std::numeric_limits<float>::infinity();
-      for (int i = 0; i < 3; ++i) {
-        if (d[i] > 0) exit = std::min(exit, (q[i] - all.lower[i]) / d[i]);
-        if (d[i] < 0) exit = std::min(exit, (q[i] - all.upper[i]) / d[i]);
-      }
-      out.origin = q - d * (std::max(0.0f, exit) + 4.0f * ctx.epsilon);
+      float area = 0;
+      out.origin = startThroughBox(ctx, d, rng, area);
       out.direction = d;
       return true;
+    }
+    case Emitter::Kind::Sky: {
+      // A sky direction uniform over the upper hemisphere (pdf 1 / 2 pi),
+      // then a start through the covered box's silhouette seen from it: the
+      // path carries L A(d) 2 pi where Sky::power counts pi L S / 2 on
+      // average (S the box's surface area).
+      const float u1 = rng.uniform(), u2 = rng.uniform();
+      const float y = u1, r = std::sqrt(std::max(0.0f, 1.0f - y * y)), phi = 2.0f * kPi * u2;
+      const Vec3 towards{r * std::cos(phi), y, r * std::sin(phi)};
+      const Vec3 d = -towards;
+      float area = 0;
+      out.origin = startThroughBox(ctx, d, rng, area);
+      out.direction = d;
+      const Vec3 ext = ctx.emitBounds.extent();
+      const float surface = 2.0f * (ext.x * ext.y + ext.y * ext.z + ext.z * ext.x);
+      out.power *= 4.0f * area / surface;
+      out.storeFirstHit = true;
+      return !(y <= 0);
     }
     case Emitter::Kind::Triangle: {
       size_t tri = e.index;
@@ -264,7 +295,7 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     Vec3 n = frontFace ? normal : -normal;  // faces the incoming side
     Vec3 wo = -dir;
 
-    if (mat.storesPhotons && (bounce > 0 || ctx.includeDirect) &&
+    if (mat.storesPhotons && (bounce > 0 || ctx.includeDirect || start.storeFirstHit) &&
         (ctx.region.empty() || (p.x >= ctx.region.lower.x && p.y >= ctx.region.lower.y &&
                                 p.z >= ctx.region.lower.z && p.x <= ctx.region.upper.x &&
                                 p.y <= ctx.region.upper.y && p.z <= ctx.region.upper.z))) {
@@ -325,6 +356,16 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
                        "' has non-finite power " + e.samplePower.ToString());
     if (average(e.power) > 0) ctx.emitters.push_back(e);
   }
+  if (scene.sky.present()) {
+    Emitter e;
+    e.kind = Emitter::Kind::Sky;
+    e.power = scene.sky.power(ctx.emitBounds);
+    e.samplePower = e.power;
+    if (!isFinite(e.power)) {
+      throw InputError("the sky has non-finite power " + e.power.ToString());
+    }
+    if (average(e.power) > 0) ctx.emitters.push_back(e);
+  }
   const EmitterSampler triangles = buildEmitterSampler(scene);
   for (size_t k = 0; k < triangles.size(); ++k) {
     Emitter e;
@@ -344,7 +385,8 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
   if (ctx.emitters.empty() || !(total > 0)) {
     std::ostringstream os;
     os << "scene has no light with positive power (" << scene.lights.size()
-       << " punctual lights, no emissive triangle with positive emission) in '" << scene.sourcePath
+       << " punctual lights, no emissive triangle with positive emission, no sky) in '"
+       << scene.sourcePath
        << "'";
     throw InputError(os.str());
   }

@@ -71,8 +71,8 @@ struct Context {
 /// One path's radiance, split by where the light was last emitted relative
 /// to vertex 1 (see ReferencePart).
 struct PathRadiance {
-  Vec3 emitted;   ///< emission at vertex 1
-  Vec3 direct;    ///< emitter -> vertex 1 (NEE at vertex 1, emission hit at vertex 2)
+  Vec3 emitted;   ///< emission at vertex 1, or the sky seen by the camera
+  Vec3 direct;    ///< emitter or sky -> vertex 1 (NEE at vertex 1, emission or sky at vertex 2)
   Vec3 indirect;  ///< everything else
   uint32_t rays = 0;
 };
@@ -157,7 +157,7 @@ inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, 
       Vec3 f = maxComponent(le) > 0 && cosLight > 0 ? evalBsdf(lobes, albedo, wo, wi, n) : Vec3{};
       if (maxComponent(f) > 0) {
         float pdfLight = ctx.emitterPickPdf[tri] * dist2 / cosLight;  // solid angle
-        float w = misWeights ? powerHeuristic(pdfLight, pdfBsdf(lobes, wo, wi, n)) : 1.0f;
+        float w = misWeights ? powerHeuristic(pdfLight, pdfBsdf(lobes, albedo, wo, wi, n)) : 1.0f;
         // Both ends lifted off their surfaces, the far one towards p's side
         // of the emitter: the segment never reaches the emitter's plane, at
         // any angle (stopping short along the ray instead does not clear
@@ -186,7 +186,16 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
   Hit hit;
   for (int depth = 1;; ++depth) {
     ++out.rays;
-    if (!ctx.tracer->intersect(org, dir, hit)) break;
+    if (!ctx.tracer->intersect(org, dir, hit)) {
+      // Escaped: the sky's light (BSDF sampling alone finds it: the sky is
+      // smooth, no light sample is taken of it). Seen by the camera it is
+      // the background; at vertex 2 it is direct light of vertex 1.
+      const Vec3 sky = ctx.scene->sky.radianceFrom(dir);
+      if (maxComponent(sky) > 0) {
+        (depth == 1 ? out.emitted : depth == 2 ? out.direct : out.indirect) += beta * sky;
+      }
+      break;
+    }
     Vec3 p = org + dir * hit.t;
     const Vec3& normal = hit.geometricNormal;
     bool frontFace = dot(dir, normal) < 0;
@@ -224,7 +233,7 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
     if (lengthSquared(newDir) == 0) break;
     beta *= sample.weight;
     prevDelta = sample.delta;
-    prevPdf = sample.delta ? 0.0f : pdfBsdf(lobes, wo, newDir, n);
+    prevPdf = sample.delta ? 0.0f : pdfBsdf(lobes, albedo, wo, newDir, n);
     if (depth >= ctx.rouletteStart) {
       // Survive with probability min(1, max(beta)); the division keeps the
       // estimator unbiased.

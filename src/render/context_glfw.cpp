@@ -81,10 +81,17 @@ std::string glfwLastError() {
   return description ? description : "unknown error";
 }
 
+/// What a user without a display can do instead.
+constexpr const char* kNeedsDisplay =
+    "; a window needs a display (on a machine without one: xvfb-run -a lightoctree view ..., "
+    "or `lightoctree render` for images)";
+
 class GlfwContext final : public GlContext {
  public:
   explicit GlfwContext(const GlContextParams& params) : GlContext(GlBackend::Glfw) {
-    if (!glfwInit()) throw GlError("glfw: glfwInit failed (" + glfwLastError() + ")");
+    if (!glfwInit()) {
+      throw GlError("glfw: glfwInit failed (" + glfwLastError() + ")" + kNeedsDisplay);
+    }
     for (int version : {45, 33}) {
       glfwDefaultWindowHints();
       glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, version / 10);
@@ -98,7 +105,7 @@ class GlfwContext final : public GlContext {
     if (!window_) {
       std::string why = glfwLastError();
       glfwTerminate();
-      throw GlError("glfw: cannot open a core 4.5 or 3.3 window (" + why + ")");
+      throw GlError("glfw: cannot open a core 4.5 or 3.3 window (" + why + ")" + kNeedsDisplay);
     }
     makeCurrentImpl();
     glfwSwapInterval(0);  // frame times are measured, not capped by vsync

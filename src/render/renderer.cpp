@@ -75,6 +75,7 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.space.bounds.extend(r.space.toRender(world.lower));
   r.space.bounds.extend(r.space.toRender(world.upper));
   r.space.sceneSize = std::max(length(r.space.bounds.extent()), 1e-3f);
+  r.sky = scene.sky.radiance;
   r.sceneProgram =
       GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT"}));
   glUniformBlockBinding(r.sceneProgram.get(),

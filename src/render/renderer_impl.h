@@ -129,6 +129,9 @@ struct Renderer::Impl {
   int depth = 0;
   Vec3 octreeOrigin;
   float voxelSize = 1;
+  /// The sky's radiance (Scene::sky), drawn as the background; its light
+  /// reaches the surfaces through the octree only.
+  Vec3 sky{0, 0, 0};
 
   /// The scene pass in two variants: with the direct light compiled in (full,
   /// direct) and without it (indirect, voxels), so the octree-only modes do

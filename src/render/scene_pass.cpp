@@ -9,6 +9,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "core/error.h"
+#include "image/image.h"
 #include "render/context.h"
 #include "render/gl_util.h"
 #include "render/renderer_impl.h"
@@ -297,7 +298,13 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
   }
 
   glViewport(0, 0, width, height);
-  glClearColor(0, 0, 0, 1);
+  // The background: the sky's radiance where it has one (uniform: the
+  // same in every direction above the horizon, and drawn below it too).
+  Vec3 background = sky * exposureScale;
+  if (encodeSrgb) {
+    for (int c = 0; c < 3; ++c) background[c] = linearToSrgb(background[c]);
+  }
+  glClearColor(background.x, background.y, background.z, 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);

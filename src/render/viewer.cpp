@@ -403,4 +403,13 @@ Viewer::~Viewer() = default;
 
 ViewerStats Viewer::run() { return impl_->run(); }
 
+std::string ViewerStats::ToString(const std::string& saveFrames) const {
+  char line[256];
+  std::snprintf(line, sizeof line, "%d frames in %.2f s (%.1f ms per frame)", framesDrawn,
+                seconds, framesDrawn ? 1000.0 * seconds / framesDrawn : 0.0);
+  std::string text = line;
+  if (framesSaved) text += ", " + std::to_string(framesSaved) + " saved to " + saveFrames;
+  return text;
+}
+
 }  // namespace lo

@@ -5,13 +5,15 @@
 /// handling through the context's input events, the redraw policy (a still
 /// view is not redrawn), camera paths (play, record with P), saved frames and
 /// the window title. New octree levels (a progressive bake) come from an
-/// OctreeLevelSource, so this stage needs no bake. See docs/view.md.
+/// OctreeLevelSource (octree/octree_level_source.h), so this stage needs no
+/// bake. See docs/view.md.
 
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "octree/gpu_octree.h"
+#include "octree/octree_level_source.h"
 #include "render/camera_path.h"
 #include "render/context.h"
 #include "render/fly_camera.h"
@@ -21,21 +23,6 @@ namespace lo {
 
 /// The keys of the viewer, as `view --help` and the H key print them.
 const char* viewerKeyHelp();
-
-/// Where finer octree levels come from while the window is open.
-class OctreeLevelSource {
- public:
-  virtual ~OctreeLevelSource() = default;
-  /// The newest finished level since the last call, if any: its octree
-  /// (moved out) and its depth. @throws the source's failure, once.
-  virtual bool takeNewest(GpuOctree& octree, int& depth) = 0;
-  /// A line for the terminal once the level taken last is on screen.
-  virtual std::string shownReport() const = 0;
-  /// True when no further level will come.
-  virtual bool finished() const = 0;
-  /// What the source is doing, for the window title.
-  virtual std::string status() const = 0;
-};
 
 struct ViewerParams {
   RenderParams render;       ///< start mode, interpolation, GGX lobe, VDLs (size: the window's)
@@ -58,6 +45,9 @@ struct ViewerStats {
   int framesDrawn = 0;
   int framesSaved = 0;
   double seconds = 0;
+  /// "N frames in S s (M ms per frame)", and where the saved ones went
+  /// (`saveFrames`, the folder), for the terminal; no newline.
+  std::string ToString(const std::string& saveFrames) const;
 };
 
 class Viewer {

@@ -316,6 +316,7 @@ class SceneBuilder {
   Scene build() {
     convertMaterials();
     traverse();
+    readSky();
     finishVertexAttributes();
     return std::move(scene_);
   }
@@ -488,6 +489,32 @@ class SceneBuilder {
       scene_.materials.push_back(m);
     }
     return defaultMaterial_;
+  }
+
+  /// The sky: the glTF scene's `"extras": {"lightoctree_sky": [r, g, b]}`,
+  /// radiance in W/(m^2 sr) (no glTF extension describes a uniform sky;
+  /// docs/scene.md, "Sky").
+  void readSky() {
+    const auto& scenes = model_.scenes;
+    const int s = model_.defaultScene >= 0 ? model_.defaultScene : scenes.empty() ? -1 : 0;
+    if (s < 0 || size_t(s) >= scenes.size()) return;
+    const tinygltf::Value& extras = scenes[size_t(s)].extras;
+    if (!extras.IsObject() || !extras.Has("lightoctree_sky")) return;
+    const tinygltf::Value& v = extras.Get("lightoctree_sky");
+    const std::string what = "scene " + std::to_string(s) + ": extras.lightoctree_sky";
+    if (!v.IsArray() || v.ArrayLen() != 3) {
+      fail(path_, what + " must be an array of 3 numbers (radiance, W/(m^2 sr))");
+    }
+    for (int c = 0; c < 3; ++c) {
+      const tinygltf::Value& x = v.Get(c);
+      if (!x.IsNumber()) fail(path_, what + " must be an array of 3 numbers (radiance, W/(m^2 sr))");
+      const double value = x.GetNumberAsDouble();
+      if (!std::isfinite(value) || value < 0 || value > 1e9) {
+        fail(path_, what + "[" + std::to_string(c) + "] = " + std::to_string(value) +
+                        " is not a radiance (finite, 0 to 1e9)");
+      }
+      scene_.sky.radiance[c] = float(value);
+    }
   }
 
   std::vector<int> sceneRoots() const {

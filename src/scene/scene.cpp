@@ -71,6 +71,13 @@ Vec3 Light::power(const Bounds3& sceneBounds) const {
   return {};
 }
 
+Vec3 Sky::power(const Bounds3& box) const {
+  if (box.empty()) return {0, 0, 0};
+  const Vec3 e = box.extent();
+  const float surface = 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
+  return radiance * (0.5f * kPi * surface);
+}
+
 std::string Light::ToString() const {
   static const char* names[] = {"point", "spot", "directional"};
   std::ostringstream os;

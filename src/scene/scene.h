@@ -95,6 +95,11 @@ struct Material {
   /// path tracer, shadows) treats every surface as two-sided except emission,
   /// which leaves one-sided emitters on their front only.
   bool doubleSided = false;
+  /// The glTF dielectric's specular layer (F0 = 0.04), on for every
+  /// material a file defines. false: a pure Lambert base in the tracers,
+  /// for scenes built in code whose answers are analytic only for Lambert
+  /// surfaces (tests); the GL renderer keeps its own --specular switch.
+  bool specularLayer = true;
 
   bool isEmissive() const { return maxComponent(emission) > 0; }
   /// Whether alpha can hide part of the surface (Mask or Blend).
@@ -120,6 +125,28 @@ struct Light {
   /// from the light (the box's projection along the light's direction).
   Vec3 power(const Bounds3& sceneBounds) const;
   std::string ToString() const;
+};
+
+/// Light from infinitely far away (a sky): uniform radiance from every
+/// direction of the upper hemisphere (+Y, glTF's up) that geometry does not
+/// block; nothing from below the horizon (the ground is the scene's, or
+/// nothing). Read from the glTF scene's `extras.lightoctree_sky` or set by
+/// the commands' --sky flag (docs/scene.md, "Sky").
+struct Sky {
+  Vec3 radiance{0, 0, 0};  ///< W/(m^2 sr), linear RGB; zero = no sky
+
+  bool present() const { return maxComponent(radiance) > 0; }
+  /// Radiance arriving from direction `towards` (unit, pointing at the sky).
+  Vec3 radianceFrom(const Vec3& towards) const {
+    return towards.y > 0 ? radiance : Vec3{0, 0, 0};
+  }
+  /// Irradiance on an unoccluded surface facing straight up: pi L.
+  Vec3 zenithIrradiance() const { return radiance * kPi; }
+  /// Total power entering `box` through its faces: L times the integral
+  /// over the sky's directions of the box's projected area, pi L S / 2 for a
+  /// box of surface area S (each face sees the sky's cosine integral, pi,
+  /// over its half of the directions).
+  Vec3 power(const Bounds3& box) const;
 };
 
 /// A perspective camera in world space.
@@ -154,6 +181,7 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Texture> textures;
   std::vector<Light> lights;
+  Sky sky;  ///< light from beyond the scene; none by default
   std::vector<Camera> cameras;
   /// A region of interest marked in the file (glTF: a node whose `extras`
   /// hold `"lightoctree_region": true`; docs/scene.md): the world-space bounds

@@ -35,6 +35,7 @@ struct Dvec3 {
 int addMaterial(Scene& scene, const Vec3& baseColor) {
   Material m;
   m.baseColor = baseColor;
+  m.specularLayer = false;  // Lambert: the answers below are analytic for it
   m.name = "m" + std::to_string(scene.materials.size());
   scene.materials.push_back(m);
   return int(scene.materials.size()) - 1;
@@ -485,6 +486,36 @@ TEST(Photons, DirectionalLightFluxThroughFloor) {
   double hit = 4.0 / (M_PI * radius * radius);
   double stdErr = full * std::sqrt(hit * (1.0 - hit) / double(map.emittedPaths));
   EXPECT_NEAR(sum, sun.intensity * 4.0, 4.0 * stdErr + full / double(map.emittedPaths));
+}
+
+TEST(Photons, SkyLightsAnOpenFloorWithPiL) {
+  // A black floor under a uniform sky of radiance L: irradiance pi L over
+  // area A, every photon stored at its first hit (the sky's light lives in
+  // the octree whole, even without --include-direct), and no path wasted:
+  // the sky's photons enter through the floor's silhouette.
+  Scene scene;
+  int floor = addMaterial(scene, {0, 0, 0});
+  addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, floor);
+  scene.sky.radiance = {0.5f, 1.0f, 2.0f};  // W/(m^2 sr)
+
+  PhotonParams params;
+  params.storedPhotons = 40000;
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  EXPECT_EQ(map.emittedPaths, params.storedPhotons);
+  Dvec3 sum;
+  for (const Photon& p : map.photons) {
+    ASSERT_EQ(p.bounce, 0u);
+    ASSERT_GT(p.direction.y, 0.0f);
+    sum.add(p.power);
+  }
+  // Each photon carries 4 A(d) / S of the sky's power pi L S / 2: here
+  // A(d) = |d.y| A and S = 2 A, so the power varies with the direction
+  // (standard deviation about 0.58 of the mean).
+  for (int c = 0; c < 3; ++c) {
+    const double expected = kPi * scene.sky.radiance[c] * 4.0;
+    EXPECT_NEAR(sum.v[c], expected, 4.0 * 0.58 * expected / std::sqrt(double(map.emittedPaths)));
+  }
 }
 
 struct RecordingSink : ProgressSink {

@@ -29,6 +29,7 @@ using test::addQuad;
 int addMaterial(Scene& scene, const Vec3& baseColor, const Vec3& emission = {0, 0, 0}) {
   Material m;
   m.baseColor = baseColor;
+  m.specularLayer = false;  // Lambert: the answers below are analytic for it
   m.emission = emission;
   m.name = "m" + std::to_string(scene.materials.size());
   scene.materials.push_back(m);
@@ -95,6 +96,38 @@ TEST(Reference, FurnaceFullIsEmissionOverOneMinusAlbedo) {
   }
   EXPECT_LE(outliers, fine.image.pixelCount() * 3 / 100);
   EXPECT_EQ(far, 0u);
+}
+
+TEST(Reference, SkyOverAnOpenFloorGivesAlbedoTimesL) {
+  // A Lambert floor of albedo a under a uniform sky of radiance L: the
+  // irradiance is pi L, so the floor's radiance is a L, all of it direct
+  // light of vertex 1; looking up, the camera sees the sky itself.
+  Scene scene;
+  const int floor = addMaterial(scene, Vec3(0.5f));
+  addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, 1, 0}, floor);
+  scene.sky.radiance = {0.4f, 0.8f, 1.6f};
+  ReferenceParams params;
+  params.width = params.height = 8;
+  params.samplesPerPixel = 256;
+  params.seed = 5;
+  const PinholeCamera down = PinholeCamera::lookAt({0.01f, 1, 0}, {0, 0, 0}, 0.5f);
+  for (ReferencePart part : {ReferencePart::Full, ReferencePart::Direct}) {
+    params.part = part;
+    const ReferenceImage r = renderReference(scene, down, params);
+    for (int c = 0; c < 3; ++c) {
+      double mean = 0, se = 0;
+      imageMean(r, c, mean, se);
+      EXPECT_NEAR(mean, 0.5 * scene.sky.radiance[c], 5.0 * se + 1e-5)
+          << toString(part) << " channel " << c;
+    }
+  }
+  params.part = ReferencePart::Indirect;
+  const ReferenceImage indirect = renderReference(scene, down, params);
+  EXPECT_EQ(*std::max_element(indirect.image.rgb.begin(), indirect.image.rgb.end()), 0.0f);
+  params.part = ReferencePart::Full;
+  const ReferenceImage up =
+      renderReference(scene, PinholeCamera::lookAt({0, 1, 0}, {0.01f, 2, 0}, 0.5f), params);
+  for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(up.image.rgb[size_t(c)], scene.sky.radiance[c]);
 }
 
 TEST(Reference, FurnaceFarFromTheOriginKeepsItsRadiance) {

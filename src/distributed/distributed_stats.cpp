@@ -1,32 +1,46 @@
-#include "bake_report.h"
+#include "distributed/distributed_stats.h"
 
+#include <cstdarg>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "core/resources.h"
 
-namespace lo::tool {
+namespace lo {
 
-void printRanks(const DistributedStats& d, size_t storedPhotons) {
-  std::printf("\n%d^3 tiles, photon halo %d voxels%s\n", d.tilesPerAxis, d.photonHalo,
-              d.attempts > 1 ? " (second attempt: the bins' margin exceeded the first halo's)" : "");
-  std::printf("%4s %12s %12s %10s %10s %7s %12s %10s %8s\n", "rank", "photons", "held",
-              "voxels", "computed", "work", "sent", "peak RSS", "seconds");
+namespace {
+/// printf into a std::string.
+void appendf(std::string& out, const char* format, ...) {
+  char line[512];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(line, sizeof line, format, args);
+  va_end(args);
+  out += line;
+}
+}  // namespace
+
+std::string ranksTable(const DistributedStats& d, size_t storedPhotons) {
+  std::string out;
+  appendf(out, "\n%d^3 tiles, photon halo %d voxels%s\n", d.tilesPerAxis, d.photonHalo,
+          d.attempts > 1 ? " (second attempt: the bins' margin exceeded the first halo's)" : "");
+  appendf(out, "%4s %12s %12s %10s %10s %7s %12s %10s %8s\n", "rank", "photons", "held", "voxels",
+          "computed", "work", "sent", "peak RSS", "seconds");
   for (const RankStats& r : d.ranks) {
-    std::printf("%4d %12s %12s %10s %10s %6.1f%% %12s %10s %8.2f\n", r.rank,
-                formatCount(size_t(r.photonsTraced)).c_str(),
-                formatCount(size_t(r.photonsHeld)).c_str(),
-                formatCount(size_t(r.voxelsOwned)).c_str(),
-                formatCount(size_t(r.voxelsComputed)).c_str(), 100.0 * r.workShare,
-                formatBytes(size_t(r.bytesSent)).c_str(), formatBytes(size_t(r.peakRssBytes)).c_str(),
-                r.totalSeconds);
+    appendf(out, "%4d %12s %12s %10s %10s %6.1f%% %12s %10s %8.2f\n", r.rank,
+            formatCount(size_t(r.photonsTraced)).c_str(),
+            formatCount(size_t(r.photonsHeld)).c_str(), formatCount(size_t(r.voxelsOwned)).c_str(),
+            formatCount(size_t(r.voxelsComputed)).c_str(), 100.0 * r.workShare,
+            formatBytes(size_t(r.bytesSent)).c_str(), formatBytes(size_t(r.peakRssBytes)).c_str(),
+            r.totalSeconds);
   }
   uint64_t sent = 0;
   for (const RankStats& r : d.ranks) sent += r.bytesSent;
   if (storedPhotons > 0) {
-    std::printf("photons exchanged: %.1f bytes per stored photon\n",
-                double(sent) / double(storedPhotons));
+    appendf(out, "photons exchanged: %.1f bytes per stored photon\n",
+            double(sent) / double(storedPhotons));
   }
+  return out;
 }
 
 std::string distributedStatsJson(const DistributedStats& d, int ranks, size_t storedPhotons) {
@@ -67,4 +81,4 @@ std::string distributedStatsJson(const DistributedStats& d, int ranks, size_t st
   return j.dump();
 }
 
-}  // namespace lo::tool
+}  // namespace lo

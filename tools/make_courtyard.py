@@ -1,0 +1,161 @@
+#!/usr/bin/env python3
+"""Writes data/courtyard.gltf: an open scene under a sun and a sky, the case
+that interiors never test (photons must be aimed at the scene, and the sides
+the sun does not reach are lit by the sky alone).
+
+Contents (metres; +Y up):
+  * a 40 x 40 m ground (grey, base colour 0.3);
+  * five blocks around an open courtyard: four buildings 6-12 m tall
+    (off-white, light brick red, light blue, sand) and a low wall, with gaps
+    between them so the sun and the sky reach the courtyard floor;
+  * a sun: a KHR_lights_punctual directional light, 3 W/m^2, 40 degrees
+    above the horizon;
+  * a sky: the scene's extras.lightoctree_sky, radiance (0.12, 0.16, 0.22)
+    W/(m^2 sr) (docs/scene.md, "Sky");
+  * a camera above one corner looking into the courtyard.
+
+Every face is single-sided and wound outwards. The file stands alone (the
+buffer is a base64 data: URI); stdlib only.
+
+Usage: python3 tools/make_courtyard.py [output.gltf]
+"""
+
+import base64
+import json
+import math
+import os
+import struct
+import sys
+
+
+def box_faces(lo, hi):
+    """The 6 outward faces of an axis-aligned box: (corner, edge u, edge v) with
+    u x v pointing out of the box."""
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    dx, dy, dz = x1 - x0, y1 - y0, z1 - z0
+    return [
+        ((x0, y1, z0), (0, 0, dz), (dx, 0, 0)),   # top, +Y
+        ((x0, y0, z0), (dx, 0, 0), (0, 0, dz)),   # bottom, -Y
+        ((x1, y0, z0), (0, dy, 0), (0, 0, dz)),   # +X
+        ((x0, y0, z0), (0, 0, dz), (0, dy, 0)),   # -X
+        ((x0, y0, z1), (dx, 0, 0), (0, dy, 0)),   # +Z
+        ((x0, y0, z0), (0, dy, 0), (dx, 0, 0)),   # -Z
+    ]
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
+        os.path.dirname(__file__), "..", "data", "courtyard.gltf")
+    materials = [
+        ("ground", (0.3, 0.3, 0.3)),
+        ("white", (0.75, 0.73, 0.7)),
+        ("brick", (0.6, 0.3, 0.22)),
+        ("blue", (0.35, 0.45, 0.6)),
+        ("sand", (0.7, 0.6, 0.42)),
+    ]
+    # (material, lower corner, upper corner)
+    blocks = [
+        (1, (-12, 0, -12), (4, 10, -6)),   # north: long, tall
+        (2, (6, 0, -12), (12, 12, 4)),     # east: the tallest
+        (3, (-12, 0, -4), (-6, 6, 12)),    # west: low
+        (4, (-2, 0, 6), (12, 8, 12)),      # south
+        (1, (-5, 0, 8), (-3, 1.5, 10)),    # a low wall in the south-west gap
+    ]
+    quads = [(0, ((-20, 0, -20), (0, 0, 40), (40, 0, 0)))]
+    for material, lo, hi in blocks:
+        for face in box_faces(lo, hi):
+            if face[0][1] == 0 and face[1][1] == 0 and face[2][1] == 0:
+                continue  # the bottom face lies on the ground: never seen
+            quads.append((material, face))
+
+    data = bytearray()
+    views, accessors, meshes, nodes = [], [], [], []
+    for material in range(len(materials)):
+        mine = [q for m, q in quads if m == material]
+        if not mine:
+            continue
+        positions, normals, indices = [], [], []
+        for corner, u, v in mine:
+            n = cross(u, v)
+            length = math.sqrt(sum(c * c for c in n))
+            n = tuple(c / length for c in n)
+            base = len(positions)
+            for a, b in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                positions.append(tuple(corner[i] + a * u[i] + b * v[i] for i in range(3)))
+                normals.append(n)
+            indices += [base, base + 1, base + 2, base, base + 2, base + 3]
+        attributes = {}
+        for name, values in (("POSITION", positions), ("NORMAL", normals)):
+            offset = len(data)
+            for p in values:
+                data += struct.pack("<3f", *p)
+            views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(data) - offset})
+            accessor = {"bufferView": len(views) - 1, "componentType": 5126,
+                        "count": len(values), "type": "VEC3"}
+            if name == "POSITION":
+                accessor["min"] = [min(p[i] for p in values) for i in range(3)]
+                accessor["max"] = [max(p[i] for p in values) for i in range(3)]
+            accessors.append(accessor)
+            attributes[name] = len(accessors) - 1
+        offset = len(data)
+        for i in indices:
+            data += struct.pack("<I", i)
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(data) - offset})
+        accessors.append({"bufferView": len(views) - 1, "componentType": 5125,
+                          "count": len(indices), "type": "SCALAR"})
+        meshes.append({"name": materials[material][0], "primitives": [
+            {"attributes": attributes, "indices": len(accessors) - 1, "material": material}]})
+        nodes.append({"name": materials[material][0], "mesh": len(meshes) - 1})
+
+    # The sun: its -Z axis is the way the light travels; 40 degrees above the
+    # horizon, from the south-west.
+    elevation, azimuth = math.radians(40), math.radians(225)
+    travel = (-math.cos(elevation) * math.sin(azimuth), -math.sin(elevation),
+              -math.cos(elevation) * math.cos(azimuth))
+    # Rotation taking -Z to `travel`: about the axis (-Z) x travel.
+    z = (0.0, 0.0, -1.0)
+    axis = cross(z, travel)
+    s = math.sqrt(sum(c * c for c in axis))
+    angle = math.atan2(s, sum(z[i] * travel[i] for i in range(3)))
+    q = [c / s * math.sin(angle / 2) for c in axis] + [math.cos(angle / 2)]
+    nodes.append({"name": "sun", "rotation": q, "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    # The camera above the south-west corner, looking at the courtyard's centre.
+    eye, target = (-16.0, 14.0, 18.0), (2.0, 0.0, -1.0)
+    forward = [target[i] - eye[i] for i in range(3)]
+    yaw = math.atan2(-forward[0], -forward[2])
+    pitch = math.atan2(forward[1], math.hypot(forward[0], forward[2]))
+    qy = (0.0, math.sin(yaw / 2), 0.0, math.cos(yaw / 2))
+    qx = (math.sin(pitch / 2), 0.0, 0.0, math.cos(pitch / 2))
+    cam_q = (qy[3] * qx[0], qy[1] * qx[3], -qy[1] * qx[0], qy[3] * qx[3])
+    nodes.append({"name": "camera", "camera": 0, "translation": list(eye), "rotation": list(cam_q)})
+
+    gltf = {
+        "asset": {"version": "2.0", "generator": "tools/make_courtyard.py"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "directional", "name": "sun", "color": [1.0, 0.95, 0.85], "intensity": 3.0}]}},
+        "scene": 0,
+        "scenes": [{"nodes": list(range(len(nodes))),
+                    "extras": {"lightoctree_sky": [0.12, 0.16, 0.22]}}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": [{"name": name, "pbrMetallicRoughness": {
+            "baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}
+            for name, color in materials],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1}}],
+        "buffers": [{"byteLength": len(data),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "bufferViews": views,
+        "accessors": accessors,
+    }
+    with open(out, "w") as f:
+        json.dump(gltf, f, indent=1)
+        f.write("\n")
+
+
+if __name__ == "__main__":
+    main()

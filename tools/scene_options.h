@@ -1,0 +1,29 @@
+#pragma once
+/// @file tools/scene_options.h
+/// @brief The flags every command that loads a scene shares: --sky R,G,B (a
+/// uniform sky over the upper hemisphere, scene/scene.h's Sky), which
+/// replaces the scene file's own `extras.lightoctree_sky`. One parser, so
+/// `bake`, `render`, `reference`, `lightmap` and `view` light a scene alike.
+
+#include <string>
+
+#include "scene/scene.h"
+
+namespace CLI {
+class App;
+}
+
+namespace lo::tool {
+
+struct SceneOptions {
+  std::string sky;  ///< "r,g,b" radiance W/(m^2 sr); empty = the file's
+};
+
+/// Registers --sky on `cmd`.
+void addSceneOptions(CLI::App* cmd, SceneOptions& opt);
+
+/// loadScene(path) with the flags applied. @throws InputError naming the flag
+/// (a radiance that is negative or not a number) or the file.
+Scene loadSceneWith(const std::string& path, const SceneOptions& opt);
+
+}  // namespace lo::tool
