@@ -29,6 +29,7 @@ std::string bakeStatsJson(const BakeStats& stats, const BakeStatsRecord& record)
   j["counts"] = {{"triangles", stats.triangles},
                  {"stored_photons", stats.storedPhotons},
                  {"emitted_paths", stats.emittedPaths},
+                 {"empty_paths", stats.emptyPaths},
                  {"active_voxels", stats.level.activeVoxels},
                  {"dense_voxels", stats.denseVoxels},
                  {"photons_outside_grid", stats.level.droppedPhotons},

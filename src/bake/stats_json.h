@@ -11,6 +11,7 @@
 ///                            layers, gather_occlusion, edge_correction,
 ///                            smoothing ("on" / "off")
 ///   counts                   triangles, stored_photons, emitted_paths,
+///                            empty_paths (paths that stored no photon),
 ///                            active_voxels, dense_voxels,
 ///                            photons_outside_grid, vdb_bytes
 ///   thread_seconds           gather, cluster: summed over threads

@@ -22,6 +22,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "material/bsdf.h"
+#include "photon/light_footprint.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/emitter_sampler.h"
 
@@ -57,6 +58,9 @@ struct Emitter {
   /// spot's full outer cone); also the selection weight (its average).
   Vec3 samplePower;
   Vec3 pathPower;  ///< samplePower / pick probability: the power a path starts with
+  /// Directional: its footprint in Context::footprints, or -1 (no triangle
+  /// to aim at: the covered box's silhouette).
+  int footprint = -1;
 };
 
 struct Context {
@@ -66,6 +70,7 @@ struct Context {
   std::vector<BsdfLobes> materials;
   std::vector<Emitter> emitters;
   std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
+  std::vector<LightFootprint> footprints;  ///< of the directional lights
   Bounds3 bounds;
   Bounds3 region;       ///< photons stored only inside (empty: everywhere)
   Bounds3 emitBounds;   ///< what directional lights cover: the region, else the bounds
@@ -197,10 +202,16 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
     }
     case Emitter::Kind::Directional: {
       const Light& light = scene.lights[e.index];
-      // Aimed at the covered box's silhouette (what Light::power counts).
+      // Aimed at the scene's footprint seen from the light (its power is
+      // E times the footprint's area), else at the covered box's silhouette.
       const Vec3 d = normalize(light.direction);
-      float area = 0;
-      out.origin = startThroughBox(ctx, d, rng, area);
+      if (e.footprint >= 0) {
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+        out.origin = ctx.footprints[size_t(e.footprint)].sample(u0, u1, u2);
+      } else {
+        float area = 0;
+        out.origin = startThroughBox(ctx, d, rng, area);
+      }
       out.direction = d;
       return true;
     }
@@ -345,10 +356,18 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
         e.power = spotPower(light);
         e.samplePower = light.power(ctx.bounds);
         break;
-      case Light::Type::Directional:
+      case Light::Type::Directional: {
         e.kind = Emitter::Kind::Directional;
         e.power = light.power(ctx.emitBounds);
+        LightFootprint footprint(scene, light.direction, ctx.region,
+                                 1e-3f * length(ctx.emitBounds.extent()));
+        if (!footprint.empty() && std::isfinite(footprint.area())) {
+          e.power = light.color * float(double(light.intensity) * footprint.area());
+          e.footprint = int(ctx.footprints.size());
+          ctx.footprints.push_back(std::move(footprint));
+        }
         break;
+      }
     }
     if (light.type != Light::Type::Spot) e.samplePower = e.power;
     if (!isFinite(e.samplePower))

@@ -45,6 +45,7 @@ TEST(BakeStatsJson, HoldsTheSchemaWithTheValuesGiven) {
   stats.triangles = 12;
   stats.storedPhotons = 12000;
   stats.emittedPaths = 15000;
+  stats.emptyPaths = 1500;
   stats.denseVoxels = 32768;
   stats.level.activeVoxels = 900;
   stats.level.droppedPhotons = 7;
@@ -74,6 +75,7 @@ TEST(BakeStatsJson, HoldsTheSchemaWithTheValuesGiven) {
   EXPECT_EQ(c["triangles"], 12);
   EXPECT_EQ(c["stored_photons"], 12000);
   EXPECT_EQ(c["emitted_paths"], 15000);
+  EXPECT_EQ(c["empty_paths"], 1500);
   EXPECT_EQ(c["active_voxels"], 900);
   EXPECT_EQ(c["dense_voxels"], 32768);
   EXPECT_EQ(c["photons_outside_grid"], 7);

@@ -488,6 +488,42 @@ TEST(Photons, DirectionalLightFluxThroughFloor) {
   EXPECT_NEAR(sum, sun.intensity * 4.0, 4.0 * stdErr + full / double(map.emittedPaths));
 }
 
+TEST(Photons, TiltedSunOverATallBoxSpendsNoPathBesideTheScene) {
+  // A 2 x 2 black floor with a 1 x 1 x 8 black tower on it, the sun 40
+  // degrees above the horizon: the covered box is tall, and photons started
+  // over its silhouette would pass beside the floor. Aimed at the scene's
+  // footprint, every path but those starting in a footprint cell's
+  // uncovered corner lands, and the flux is the analytic E cos A over the
+  // floor and the tower's lit faces.
+  Scene scene;
+  const int black = addMaterial(scene, {0, 0, 0});
+  addQuad(scene, {-1, 0, -1}, {0, 0, 2}, {2, 0, 0}, {0, 1, 0}, black);
+  test::addBlock(scene, {-0.5f, 0, -0.5f}, {0.5f, 8, 0.5f}, black);
+  Light sun;
+  sun.type = Light::Type::Directional;
+  const float elevation = 40.0f * kPi / 180.0f;
+  sun.direction = normalize(Vec3{std::cos(elevation), -std::sin(elevation), 0.0f});
+  sun.intensity = 2.0f;
+  scene.lights.push_back(sun);
+
+  PhotonParams params;
+  params.storedPhotons = 40000;
+  params.includeDirect = true;
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  EXPECT_LT(double(map.emptyPaths), 0.05 * double(map.emittedPaths));
+  double sum = 0;
+  for (const Photon& p : map.photons) sum += p.power.x;
+  // Lit: the floor outside the tower's base (1 m^2) and its shadow (the
+  // 0.5 m^2 of floor behind it, x from 0.5 to 1), cos = sin 40; the tower's
+  // top (1 m^2, sin 40) and its face towards the sun (8 m^2, cos 40).
+  const double expected = sun.intensity * ((4.0 - 1.0 - 0.5 + 1.0) * std::sin(elevation) +
+                                           8.0 * std::cos(elevation));
+  // Each path carries E A_footprint / N, A_footprint >= the true outline.
+  const double perPath = expected / (1.0 - double(map.emptyPaths) / double(map.emittedPaths));
+  EXPECT_NEAR(sum, expected, 4.0 * perPath / std::sqrt(double(map.emittedPaths)) + 1e-3 * expected);
+}
+
 TEST(Photons, SkyLightsAnOpenFloorWithPiL) {
   // A black floor under a uniform sky of radiance L: irradiance pi L over
   // area A, every photon stored at its first hit (the sky's light lives in

@@ -1,0 +1,45 @@
+#pragma once
+/// @file photon/light_footprint.h
+/// @brief Where a directional light's photons can land: the scene's shadow
+/// outline seen from the light, as the cells of a grid in the plane
+/// perpendicular to the light that some triangle's projection overlaps
+/// (conservative rasterisation). Photons started uniformly over those cells,
+/// behind the scene, hit geometry unless they start in a cell's uncovered
+/// corner; started over the covered box's silhouette instead, an open
+/// scene's photons pass beside a tall box's ground (docs/photon.md).
+
+#include <cstdint>
+#include <vector>
+
+#include "core/math.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+class LightFootprint {
+ public:
+  /// Cells per side of the grid over the projected bounds.
+  static constexpr int kResolution = 256;
+
+  LightFootprint() = default;
+  /// The footprint along `direction` (unit, the way the light travels) of
+  /// the triangles of `scene` that touch `region` (empty: every triangle),
+  /// clipped to the region's own silhouette. Starts lie `margin` behind the
+  /// scene's bounds.
+  LightFootprint(const Scene& scene, const Vec3& direction, const Bounds3& region, float margin);
+
+  /// Total area of the covered cells, scene units^2 (0: nothing to light).
+  double area() const { return double(cells_.size()) * double(cellSize_) * double(cellSize_); }
+  bool empty() const { return cells_.empty(); }
+  /// A start uniform over the covered cells, behind the scene; the ray from
+  /// it along the direction crosses the whole scene.
+  Vec3 sample(float u0, float u1, float u2) const;
+
+ private:
+  Vec3 direction_{0, 0, -1}, tangent_, bitangent_;
+  Vec3 planeOrigin_;  ///< the start plane's point at 2D (0, 0)
+  float minU_ = 0, minV_ = 0, cellSize_ = 1;
+  std::vector<uint32_t> cells_;  ///< covered cells, index v * kResolution + u
+};
+
+}  // namespace lo
