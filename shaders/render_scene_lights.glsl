@@ -136,7 +136,10 @@ vec3 punctualLight(int i, vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic
     }
     float cd = dot(-l, L.directionRange.xyz);
     if (type == LO_LIGHT_SPOT) {
-      E *= L.params.y > L.params.x ? smoothstep(L.params.x, L.params.y, cd) : step(L.params.x, cd);
+      // glTF's cone falloff (KHR_lights_punctual), as the tracers apply it
+      // (material/bsdf.h spotFalloff): ((cos - cosOuter) / (cosInner - cosOuter))^2.
+      float t = clamp((cd - L.params.x) / max(L.params.y - L.params.x, 1e-3), 0.0, 1.0);
+      E *= t * t;
     } else if (type == LO_LIGHT_EMITTER) {
       E *= max(cd, 0.0);  // Lambertian emitter patch: intensity falls with the cosine
     }

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -93,6 +94,28 @@ Scene loadObj(const std::string& path) {
   }
 
   Scene scene;
+  // usemtl with a name no .mtl defines: tinyobjloader gives those faces no
+  // material (they get the default, grey); the user hears it once per name.
+  {
+    std::istringstream lines(warn);
+    std::string line;
+    std::set<std::string> named;
+    while (std::getline(lines, line)) {
+      const std::string head = "material [ ", tail = " ] not found in .mtl";
+      if (line.rfind(head, 0) != 0 || line.size() < head.size() + tail.size() ||
+          line.compare(line.size() - tail.size(), tail.size(), tail) != 0) {
+        continue;
+      }
+      std::string name = line.substr(head.size(), line.size() - head.size() - tail.size());
+      if (name.size() >= 2 && name.front() == '\'' && name.back() == '\'') {
+        name = name.substr(1, name.size() - 2);
+      }
+      if (!named.insert(name).second) continue;
+      scene.warnings.push_back(path + ": usemtl '" + name +
+                               "' names no material of the .mtl files; its faces get the "
+                               "default material (grey, base colour 0.8, untextured)");
+    }
+  }
   const std::vector<tinyobj::real_t>& v = attrib.vertices;
   const std::vector<tinyobj::real_t>& vn = attrib.normals;
   const std::vector<tinyobj::real_t>& vt = attrib.texcoords;

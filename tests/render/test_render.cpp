@@ -417,6 +417,47 @@ TEST(RenderImage, DirectPointLightMatchesInverseSquareLaw) {
   EXPECT_GT(dark.pixel(lit, p.height / 2)[0], 0.05f);
 }
 
+TEST(RenderImage, SpotPoolFollowsTheGltfConeFalloff) {
+  // A spot 1 unit above the quad, pointing down, inner 15 and outer 30
+  // degrees: along a row through the pool's centre the radiance is
+  // albedo / pi * I * falloff(cos) * cos / r^2, falloff =
+  // ((cos - cosOuter) / (cosInner - cosOuter))^2 clamped (glTF), the
+  // profile the photon tracer and the path tracer follow.
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Light spot;
+  spot.type = Light::Type::Spot;
+  spot.position = {0.1f, -0.05f, 1};  // above the view's centre
+  spot.direction = {0, 0, -1};
+  spot.intensity = 2.0f;
+  spot.innerConeAngle = 15.0f * kPi / 180.0f;
+  spot.outerConeAngle = 30.0f * kPi / 180.0f;
+  s.scene.lights.push_back(spot);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  Renderer renderer(s.scene, octree);
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const RgbImage image = renderer.render(s.camera, p);
+  const float worldPerPixel = 2.0f * 2.0f * std::tan(0.5f * s.camera.yfov) / float(p.height);
+  const float cosInner = std::cos(spot.innerConeAngle), cosOuter = std::cos(spot.outerConeAngle);
+  int checked = 0, inPenumbra = 0;
+  for (int px = p.width / 2; px < p.width; ++px) {
+    const float x = (float(px) + 0.5f - 0.5f * float(p.width)) * worldPerPixel;
+    const float y = 0.5f * worldPerPixel;  // the row just off the centre
+    const float r2 = 1.0f + x * x + y * y, cosTheta = 1.0f / std::sqrt(r2);
+    if (std::fabs(x) > 0.85f) break;  // the quad's edge
+    const float t = std::clamp((cosTheta - cosOuter) / (cosInner - cosOuter), 0.0f, 1.0f);
+    const float expected = s.albedo.x * kInvPi * spot.intensity * t * t * cosTheta / r2;
+    const float got = image.pixel(px, p.height / 2)[0];
+    EXPECT_NEAR(got, expected, 3e-3f * expected + 1e-4f) << "x = " << x;
+    ++checked;
+    inPenumbra += cosTheta < cosInner && cosTheta > cosOuter;
+  }
+  EXPECT_GT(checked, 10);
+  EXPECT_GT(inPenumbra, 3);
+}
+
 /// Renders QuadSetup's quad with a red/blue checker (16x16 texels, cells of
 /// 4x4) repeated twice across it under a point light, and checks that the
 /// centres of two neighbouring cells show the colours the bake's own lookup

@@ -812,6 +812,24 @@ TEST(SceneObj, MaterialMappingAndGrouping) {
   ASSERT_EQ(s.texcoords0.size(), 2 * s.positions.size());
 }
 
+TEST(SceneObj, UndefinedMaterialIsWarnedOnceByName) {
+  // usemtl of a name the .mtl does not define (a real asset's "Texture1"):
+  // the faces get the default material, and the user hears of it once.
+  std::string dir = test::outputDir("SceneObj_UndefinedMaterial");
+  writeFile(dir + "/m.mtl", "newmtl wall\nKd 0.5 0.5 0.5\n");
+  writeFile(dir + "/scene.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+            "usemtl Texture1\nf 1 2 3\nusemtl wall\nf 1 3 4\nusemtl Texture1\nf 2 3 4\n");
+  Scene s = loadScene(dir + "/scene.obj");
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("usemtl 'Texture1' names no material"), std::string::npos)
+      << s.warnings[0];
+  ASSERT_EQ(s.triangleCount(), 3u);
+  int defaults = 0;
+  for (int32_t m : s.triangleMaterial) defaults += s.materials[size_t(m)].name == "default";
+  EXPECT_EQ(defaults, 2);
+}
+
 TEST(SceneObj, Rejects) {
   std::string dir = test::outputDir("SceneObj_Rejects");
   fs::create_directories(dir + "/inner");
