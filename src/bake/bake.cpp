@@ -244,16 +244,25 @@ void checkBakeMemory(const Scene& scene, const BakeParams& params, int processes
 }
 
 std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
-  if (st.emittedPaths == 0 ||
-      !(st.storedPhotons < params.photons || 10 * st.emptyPaths > 9 * st.emittedPaths)) {
-    return "";
+  if (st.emittedPaths == 0) return "";
+  const bool mostlyMissed = 2 * st.missedPaths > st.emittedPaths;
+  const std::string missed = formatCount(st.missedPaths) + " of " +
+                             formatCount(st.emittedPaths) +
+                             " photon paths missed every surface" +
+                             (params.region.empty() ? "" : " in --bounds") +
+                             ": bake the part that matters with --bounds";
+  if (st.storedPhotons < params.photons) {
+    const std::string head = "only " + formatCount(st.storedPhotons) + " of " +
+                             formatCount(params.photons) + " photons were stored from " +
+                             formatCount(st.emittedPaths) + " paths (the most a bake traces); ";
+    if (mostlyMissed) return head + missed;
+    return head + formatCount(st.emptyPaths) +
+           " paths reached a surface but stored nothing (their first hit is direct light, "
+           "left to the renderer, and the light they reflect leaves the scene or is "
+           "absorbed): --include-direct stores the first hits too, or --bounds bakes only the "
+           "part that matters";
   }
-  return formatCount(st.emptyPaths) + " of " + formatCount(st.emittedPaths) +
-         " photon paths stored nothing and " + formatCount(st.storedPhotons) + " of " +
-         formatCount(params.photons) + " photons were stored (the light mostly misses the " +
-         "surfaces" +
-         (params.region.empty() ? ", e.g. a sun over a large open scene" : " in --bounds") +
-         "): bake the part that matters with --bounds";
+  return mostlyMissed ? missed : "";
 }
 
 void checkPhotonsStored(const BakeParams& params, const BakeStats& st) {
@@ -332,6 +341,7 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
   s.storedPhotons = photons.photons.size();
   s.emittedPaths = photons.emittedPaths;
   s.emptyPaths = photons.emptyPaths;
+  s.missedPaths = photons.missedPaths;
   checkPhotonsStored(params, s);
   s.traceSeconds = trace.finish(formatCount(photons.photons.size()) + " photons from " +
                                 formatCount(photons.emittedPaths) + " paths");

@@ -162,7 +162,10 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
 struct BakeStats {
   size_t triangles = 0;
   size_t storedPhotons = 0, emittedPaths = 0;
-  size_t emptyPaths = 0;  ///< traced paths that stored no photon (light that missed the grid)
+  size_t emptyPaths = 0;   ///< traced paths that stored no photon
+  /// Of those, paths whose first ray hit no surface (the light aimed past
+  /// the scene; not counted by the distributed bake: 0 there).
+  size_t missedPaths = 0;
   size_t denseVoxels = 0;  ///< 8^depth
   double traceSeconds = 0;
   LevelStats level;        ///< voxelize / splat / gather + cluster
@@ -181,12 +184,14 @@ struct BakeResult {
   PhotonMap photons;  ///< filled when BakeParams::keepPhotons
 };
 
-/// "" when the photon tracing was worth its paths; else a sentence saying
-/// that the light mostly missed the surfaces and suggesting --bounds: when
-/// fewer photons than asked were stored, or nine paths in ten stored nothing
-/// (half the paths of a closed room store nothing: the light is absorbed at
-/// its first bounce, which is not stored; a sun over open ground wastes
-/// nearly all of them).
+/// "" when the photon tracing stored what was asked without aiming most
+/// paths past the scene; else a sentence saying which of the two happened
+/// and what helps. Paths that hit a surface and store nothing are not a
+/// fault: the first hit is direct light, left to the renderer, and in an
+/// open scene most reflected light leaves it (a room corner, a truck on
+/// open ground: nine paths in ten). When that keeps the bake from storing
+/// the photons asked for, the advice is --include-direct; when most paths
+/// miss every surface, --bounds.
 std::string photonBudgetWarning(const BakeParams& params, const BakeStats& stats);
 
 /// @throws InputError saying why, when the photon tracing stored no photon

@@ -85,6 +85,7 @@ struct ChunkResult {
   std::vector<Photon> photons;
   std::vector<uint32_t> pathPhotons;  ///< stored photons per path
   std::vector<uint32_t> pathRays;     ///< rays per path
+  std::vector<uint8_t> pathMissed;    ///< 1: the path's first ray hit nothing
 };
 
 inline Vec3 uniformSphere(float u1, float u2) {
@@ -277,10 +278,11 @@ inline bool roulette(Rng& rng, const Vec3& tint, Vec3& power) {
 
 /// Traces path `pathIndex` and appends its stored photons (unscaled power) to `out`.
 inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon>& out,
-                      uint32_t& photonCount, uint32_t& rayCount) {
+                      uint32_t& photonCount, uint32_t& rayCount, bool& missed) {
   Rng rng(ctx.seed, pathIndex);
   photonCount = 0;
   rayCount = 0;
+  missed = false;
   EmittedRay start;
   if (!emit(ctx, rng, start)) return;
   Vec3 org = start.origin, dir = start.direction, power = start.power;
@@ -288,7 +290,10 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
   Hit hit;
   for (uint32_t bounce = 0;; ++bounce) {
     ++rayCount;
-    if (!ctx.tracer->intersect(org, dir, hit)) return;
+    if (!ctx.tracer->intersect(org, dir, hit)) {
+      missed = bounce == 0;
+      return;
+    }
 
     float t = hit.t;
     // glTF range cut-off of punctual lights, applied as roulette at the first hit.
@@ -428,12 +433,15 @@ struct TraceChunks {
       out.photons.clear();
       out.pathPhotons.clear();
       out.pathRays.clear();
+      out.pathMissed.clear();
       size_t begin = c * kChunkPaths, end = std::min(batchPaths, begin + kChunkPaths);
       for (size_t i = begin; i < end; ++i) {
         uint32_t photons = 0, rays = 0;
-        tracePath(*ctx, firstPath + i, out.photons, photons, rays);
+        bool missed = false;
+        tracePath(*ctx, firstPath + i, out.photons, photons, rays, missed);
         out.pathPhotons.push_back(photons);
         out.pathRays.push_back(rays);
+        out.pathMissed.push_back(missed ? 1 : 0);
       }
     }
   }
@@ -513,7 +521,7 @@ void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath) c
   if (count == 0) return;
   if (!state_->tracer) {
     for (size_t i = 0; i < count; ++i) {
-      if (!onPath(nullptr, 0, 0)) return;
+      if (!onPath(nullptr, 0, 0, true)) return;
     }
     return;
   }
@@ -530,7 +538,9 @@ void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath) c
     }
     const Photon* photons = chunk.photons.data();
     for (size_t i = 0; i < chunk.pathPhotons.size(); ++i) {
-      if (!onPath(photons, chunk.pathPhotons[i], chunk.pathRays[i])) return;
+      if (!onPath(photons, chunk.pathPhotons[i], chunk.pathRays[i], chunk.pathMissed[i] != 0)) {
+        return;
+      }
       photons += chunk.pathPhotons[i];
     }
   }
@@ -539,7 +549,7 @@ void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath) c
 void PhotonTracer::trace(uint64_t first, size_t count, std::vector<Photon>& photons,
                          std::vector<uint32_t>& pathPhotons) const {
   pathPhotons.reserve(pathPhotons.size() + count);
-  trace(first, count, [&](const Photon* path, uint32_t n, uint32_t) {
+  trace(first, count, [&](const Photon* path, uint32_t n, uint32_t, bool) {
     if (n > 0) photons.insert(photons.end(), path, path + n);
     pathPhotons.push_back(n);
     return true;
@@ -578,7 +588,10 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   size_t rays = 0;
   // Each path's photons go straight into the map, in path order; the path
   // that reaches the target is the last one taken.
-  const PhotonTracer::PathSink take = [&](const Photon* photons, uint32_t n, uint32_t pathRays) {
+  size_t missed = 0;   // of those, paths whose first ray hit nothing
+  const PhotonTracer::PathSink take = [&](const Photon* photons, uint32_t n, uint32_t pathRays,
+                                          bool pathMissed) {
+    missed += pathMissed;
     const size_t kept = std::min<size_t>(n, target - map.photons.size());
     if (kept > 0) map.photons.insert(map.photons.end(), photons, photons + kept);
     rays += pathRays;
@@ -596,6 +609,7 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
 
   map.emittedPaths = emitted;
   map.emptyPaths = empty;
+  map.missedPaths = missed;
   map.raysTraced = rays;
   scalePhotonPower(map.photons, emitted);
   return map;

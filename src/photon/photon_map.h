@@ -34,6 +34,10 @@ struct PhotonMap {
   std::vector<Photon> photons;
   size_t emittedPaths = 0;      ///< paths traced to obtain `photons`
   size_t emptyPaths = 0;        ///< of those, paths that stored no photon
+  /// Of those, paths whose first ray hit no surface (light aimed beside the
+  /// scene); the others that stored nothing hit but stored no photon (direct
+  /// light left to the renderer, then absorbed or gone into the open).
+  size_t missedPaths = 0;
   Vec3 emittedPower{0, 0, 0};   ///< total RGB power of all lights, W
   size_t raysTraced = 0;        ///< for statistics
 };
@@ -62,9 +66,11 @@ class PhotonTracer {
   PhotonTracer& operator=(const PhotonTracer&) = delete;
 
   /// Called once per path, in path order, with the path's photons (world
-  /// space, power not yet scaled), their count and the rays it traced;
-  /// returning false stops handing on the call's remaining paths.
-  using PathSink = std::function<bool(const Photon* photons, uint32_t count, uint32_t rays)>;
+  /// space, power not yet scaled), their count, the rays it traced and
+  /// whether its first ray hit nothing; returning false stops handing on the
+  /// call's remaining paths.
+  using PathSink =
+      std::function<bool(const Photon* photons, uint32_t count, uint32_t rays, bool missed)>;
   /// Traces paths [first, first + count) in parallel (TBB) and hands each to
   /// `onPath` in path order. Not reentrant (one call at a time per tracer).
   void trace(uint64_t first, size_t count, const PathSink& onPath) const;

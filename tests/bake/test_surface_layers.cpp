@@ -178,6 +178,28 @@ TEST(BakeLimits, VoxelsTooSmallForAVdbAreRefusedFirst) {
 namespace lo {
 namespace {
 
+TEST(BakeRegion, BudgetWarningSaysWhatHappenedAndWhatHelps) {
+  BakeParams p;
+  p.photons = 1000;
+  BakeStats st;
+  st.storedPhotons = 1000;
+  st.emittedPaths = 20000;
+  st.emptyPaths = 19500;  // open ground: paths land and store nothing
+  st.missedPaths = 100;
+  EXPECT_EQ(photonBudgetWarning(p, st), "");
+  st.storedPhotons = 400;  // ... and the cap is reached
+  std::string w = photonBudgetWarning(p, st);
+  EXPECT_NE(w.find("only 400 of 1,000 photons"), std::string::npos) << w;
+  EXPECT_NE(w.find("--include-direct"), std::string::npos) << w;
+  EXPECT_EQ(w.find("missed"), std::string::npos) << w;
+  st.missedPaths = 15000;  // most light aimed past the surfaces
+  w = photonBudgetWarning(p, st);
+  EXPECT_NE(w.find("15,000 of 20,000 photon paths missed every surface"), std::string::npos) << w;
+  EXPECT_NE(w.find("--bounds"), std::string::npos) << w;
+  st.storedPhotons = 1000;
+  EXPECT_NE(photonBudgetWarning(p, st).find("--bounds"), std::string::npos);
+}
+
 // A small room on a 50 m ground plane under a sun: without a region of
 // interest most photon paths store nothing (the grid spans the ground, the
 // sun shines on all of it); with --bounds on the room, the grid covers the
@@ -211,9 +233,16 @@ TEST(BakeRegion, ARoomOnAGroundPlane) {
               whole.stats.emittedPaths, whole.stats.storedPhotons, 100 * wasted,
               roi.stats.emittedPaths, 100 * wastedRoi);
   EXPECT_GT(wasted, 0.5);
+  // Aimed at the scene's footprint, the sun's paths land (on the ground):
+  // they store nothing because their first hit is direct light and the
+  // ground reflects into the open.
+  // Only the room's walls catch what the ground reflects, so the cap of
+  // paths is reached: the warning says so, and that --bounds helps.
+  EXPECT_LT(whole.stats.missedPaths, whole.stats.emittedPaths / 20);
   p.region = Bounds3{};
-  EXPECT_NE(photonBudgetWarning(p, whole.stats).find("--bounds"), std::string::npos)
-      << "the case bake warns about";
+  const std::string warning = photonBudgetWarning(p, whole.stats);
+  EXPECT_NE(warning.find("reached a surface but stored nothing"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("--bounds"), std::string::npos) << warning;
   EXPECT_EQ(roi.stats.storedPhotons, p.photons);
   EXPECT_LT(wastedRoi, wasted);
   EXPECT_LT(roi.stats.emittedPaths, whole.stats.emittedPaths / 4);
