@@ -5,8 +5,11 @@
  *
  * The BRDF (docs/render.md), as glTF 2.0's Appendix B mixes it: a dielectric
  * (Lambert diffuse weighted by 1 - F plus a GGX specular layer weighted by
- * F, Schlick's Fresnel with F0 = 0.04) and a metal (the GGX lobe, F0 =
- * baseColor), mixed by metallic. GGX after Walter et al. 2007, with
+ * F, Schlick's Fresnel) and a metal (the GGX lobe, F0 = baseColor), mixed by
+ * metallic. The dielectric's layer is `layer` = (F0, weight):
+ * F = weight (F0 + (1 - F0)(1 - v.h)^5), F0 = ((ior - 1) / (ior + 1))^2
+ * (KHR_materials_ior; 0.04 at glTF's default 1.5) and weight
+ * KHR_materials_specular's specularFactor (1 by default; 0: a Lambert base). GGX after Walter et al. 2007, with
  * height-correlated Smith visibility (Heitz 2014, eq. 99).
  * KHR_materials_transmission takes its share of the diffuse lobe away (the
  * renderer draws the transmitted light separately). With the specular lobe
@@ -65,7 +68,7 @@ LO_BRDF_FN vec3 loBrdfDiffuseOnly(vec3 baseColor, float metallic, float transmis
  * F D V, GGX of alpha a. Meant for n.l > 0; the cosines are floored so that
  * grazing directions give finite values. */
 LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float a,
-                            float transmission, LO_BRDF_OUT(vec3) diffuse,
+                            float transmission, vec2 layer, LO_BRDF_OUT(vec3) diffuse,
                             LO_BRDF_OUT(vec3) specular) {
   float nl = max(dot(n, l), 1e-4f);
   diffuse = loBrdfDiffuseOnly(baseColor, metallic, transmission);
@@ -79,10 +82,10 @@ LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metall
   float vis =
       0.5f / (nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2));
   /* The specification's mix (glTF 2.0, Appendix B): the dielectric's
-   * Fresnel (F0 = 0.04) weights its diffuse base and its specular layer,
-   * the metal's (F0 = baseColor) its specular lobe alone. */
+   * Fresnel (its layer's F0 and weight) weights its diffuse base and its
+   * specular layer, the metal's (F0 = baseColor) its specular lobe alone. */
   float schlick = pow(1.0f - vh, 5.0f);
-  float fDielectric = 0.04f + 0.96f * schlick;
+  float fDielectric = layer.y * (layer.x + (1.0f - layer.x) * schlick);
   vec3 fMetal = baseColor + (1.0f - baseColor) * schlick;
   diffuse *= 1.0f - fDielectric;
   specular = mix(vec3(fDielectric), fMetal, metallic) * (D * vis);
@@ -90,10 +93,10 @@ LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metall
 
 /* f(v, l): both lobes, no cosine; 0 when l is below the surface. */
 LO_BRDF_FN vec3 loBrdf(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness,
-                       float transmission) {
+                       float transmission, vec2 layer) {
   if (dot(n, l) <= 0.0f) return vec3(0.0f);
   vec3 diffuse, specular;
-  loBrdfLobes(n, v, l, baseColor, metallic, loBrdfAlpha(roughness), transmission, diffuse,
+  loBrdfLobes(n, v, l, baseColor, metallic, loBrdfAlpha(roughness), transmission, layer, diffuse,
               specular);
   return diffuse + specular;
 }
@@ -102,34 +105,38 @@ LO_BRDF_FN vec3 loBrdf(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, f
  * of a surface's specular light when the reflection probe takes the rest);
  * without `specular`, the diffuse lobe alone and no Fresnel weight. */
 LO_BRDF_FN vec3 loBrdfCosWeighted(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic,
-                                  float roughness, float transmission, bool specular,
+                                  float roughness, float transmission, vec2 layer, bool specular,
                                   float specularWeight) {
   float nl = dot(n, l);
   if (nl <= 0.0f) return vec3(0.0f);
   if (!specular) return loBrdfDiffuseOnly(baseColor, metallic, transmission) * nl;
   vec3 diffuseLobe, specularLobe;
-  loBrdfLobes(n, v, l, baseColor, metallic, loBrdfAlpha(roughness), transmission, diffuseLobe,
-              specularLobe);
+  loBrdfLobes(n, v, l, baseColor, metallic, loBrdfAlpha(roughness), transmission, layer,
+              diffuseLobe, specularLobe);
   return (diffuseLobe + specularWeight * specularLobe) * nl;
 }
 
 LO_BRDF_FN vec3 loBrdfCos(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic,
-                          float roughness, float transmission, bool specular) {
-  return loBrdfCosWeighted(n, v, l, baseColor, metallic, roughness, transmission, specular, 1.0f);
+                          float roughness, float transmission, vec2 layer, bool specular) {
+  return loBrdfCosWeighted(n, v, l, baseColor, metallic, roughness, transmission, layer, specular,
+                           1.0f);
 }
 
 /* The split-sum environment BRDF (Karis 2013): the GGX lobe's directional
  * albedo as F0 x + y, in Karis's analytic fit (Physically Based Shading on
  * Mobile, 2014); nv = n.v clamped to [0, 1]. Radiance prefiltered along the
  * reflected ray times this is the lobe's reflected light. */
-LO_BRDF_FN vec3 loEnvironmentBrdf(vec3 baseColor, float metallic, float roughness, float nv) {
+LO_BRDF_FN vec3 loEnvironmentBrdf(vec3 baseColor, float metallic, float roughness, float nv,
+                                  vec2 layer) {
   const vec4 c0 = vec4(-1.0f, -0.0275f, -0.572f, 0.022f);
   const vec4 c1 = vec4(1.0f, 0.0425f, 1.04f, -0.04f);
   vec4 q = roughness * c0 + c1;
   float a004 = min(q.x * q.x, exp2(-9.28f * nv)) * q.x + q.y;
   vec2 ab = vec2(-1.04f, 1.04f) * a004 + vec2(q.z, q.w);
-  vec3 f0 = mix(vec3(0.04f), baseColor, metallic);
-  return f0 * ab.x + ab.y;
+  /* The dielectric's layer weighted as in loBrdfLobes; F0 x + y is linear in
+   * F0 and in the weight. */
+  vec3 dielectric = vec3(layer.y * (layer.x * ab.x + ab.y));
+  return mix(dielectric, baseColor * ab.x + ab.y, metallic);
 }
 
 #ifdef __cplusplus

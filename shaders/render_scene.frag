@@ -26,7 +26,7 @@
 float gVdlSpecular = 1.0;
 vec3 loVdlResponse(LoSurface s, vec3 d) {
   return loBrdfCosWeighted(s.n, s.v, d, s.baseColor, s.metallic, s.roughness, uTransmission,
-                           uSpecular, gVdlSpecular);
+                           uDielectric, uSpecular, gVdlSpecular);
 }
 
 vec3 hashColor(ivec3 c) {

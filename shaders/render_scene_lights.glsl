@@ -81,7 +81,7 @@ vec3 areaLight(int i, vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, fl
   // the exact projected solid angle.
   vec3 diffuse, specular;
   float a = loBrdfAlpha(roughness);
-  loBrdfLobes(n, v, la, baseColor, metallic, a, uTransmission, diffuse, specular);
+  loBrdfLobes(n, v, la, baseColor, metallic, a, uTransmission, uDielectric, diffuse, specular);
   if (!uSpecular) diffuse = loBrdfDiffuseOnly(baseColor, metallic, uTransmission);
   vec3 f = diffuse * solid;
   if (uSpecular) {
@@ -103,7 +103,7 @@ vec3 areaLight(int i, vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, fl
       float radius = L.corner0.w * 0.5641896;  // sqrt(area / pi)
       float wide = clamp(a + radius / (2.0 * distance), a, 1.0);
       vec3 dRep, sRep;
-      loBrdfLobes(n, v, ls, baseColor, metallic, a, uTransmission, dRep, sRep);
+      loBrdfLobes(n, v, ls, baseColor, metallic, a, uTransmission, uDielectric, dRep, sRep);
       float omega = solid / max(dot(n, la), 1e-4);  // the light's solid angle
       f += sRep * (a * a / (wide * wide)) * nls * omega;
     }
@@ -147,7 +147,7 @@ vec3 punctualLight(int i, vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic
   if (dot(n, l) <= 0.0 || max(E.r, max(E.g, E.b)) <= 0.0) return vec3(0.0);
   float visible = type == LO_LIGHT_DIRECTIONAL ? sunShadow(i, p, gGeometricNormal, l)
                                                  : shadow(i, p, gGeometricNormal, l);
-  return loBrdfCos(n, v, l, baseColor, metallic, roughness, uTransmission, uSpecular) * E *
+  return loBrdfCos(n, v, l, baseColor, metallic, roughness, uTransmission, uDielectric, uSpecular) * E *
          visible;
 #undef L
 }

@@ -22,5 +22,5 @@ vec3 probeSpecular(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float
   vec3 dir = p + r * t;  // from the probe at the render-space origin
   vec3 radiance = textureLod(uProbe, dir, roughness * uProbeMaxLod).rgb;
   float nv = clamp(dot(n, v), 0.0, 1.0);
-  return radiance * loEnvironmentBrdf(baseColor, metallic, roughness, nv);
+  return radiance * loEnvironmentBrdf(baseColor, metallic, roughness, nv, uDielectric);
 }

@@ -59,9 +59,10 @@ float vndfReflectionPdf(const Vec3& woL, const Vec3& m, float alpha) {
 /// leaving towards wo (Schlick's F at n.wo against the base's (1 - F)
 /// albedo), kept away from 0 and 1 so that neither density vanishes.
 float specularLayerProbability(const BsdfLobes& lobes, const Vec3& albedo, float cosO) {
-  if (!lobes.specularLayer) return 0;
+  if (!(lobes.layerWeight > 0)) return 0;
   float c = 1.0f - std::clamp(cosO, 0.0f, 1.0f);
-  float fresnel = 0.04f + 0.96f * (c * c * c * c * c);
+  float fresnel =
+      lobes.layerWeight * (lobes.dielectricF0 + (1.0f - lobes.dielectricF0) * (c * c * c * c * c));
   float base = (1.0f - fresnel) * (0.2126f * albedo.x + 0.7152f * albedo.y + 0.0722f * albedo.z);
   return std::clamp(fresnel / std::max(fresnel + base, 1e-6f), 0.1f, 0.9f);
 }
@@ -70,8 +71,9 @@ float specularLayerProbability(const BsdfLobes& lobes, const Vec3& albedo, float
 /// glTF BRDF at metallic 0 (both layers), or the Lambert base alone.
 Vec3 dielectricCos(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
                    const Vec3& n, float cosI) {
-  if (!lobes.specularLayer) return albedo * (kInvPi * cosI);
-  const GltfBrdfLobes l = gltfBrdfLobes({albedo, 0.0f, lobes.roughness, 0.0f}, n, wo, wi);
+  if (!(lobes.layerWeight > 0)) return albedo * (kInvPi * cosI);
+  const GltfBrdfLobes l = gltfBrdfLobes(
+      {albedo, 0.0f, lobes.roughness, 0.0f, lobes.dielectricF0, lobes.layerWeight}, n, wo, wi);
   return (l.diffuse + l.specular) * cosI;
 }
 
@@ -109,7 +111,8 @@ BsdfLobes bsdfLobes(const Material& m, float metallicIn, float roughnessIn) {
   info.diffuseWeight = (1.0f - metallic) * (1.0f - transmission);
   info.roughness = roughness;
   info.alpha = std::max(roughness * roughness, kMirrorAlpha);
-  info.specularLayer = m.specularLayer;
+  info.dielectricF0 = m.dielectricF0();
+  info.layerWeight = std::clamp(m.specular, 0.0f, 1.0f);
   info.ior = m.ior > 0 ? m.ior : 1.5f;
   info.thinWalled = !(m.thickness > 0);
   info.storesPhotons = info.diffuseWeight > 0 || (metallic > 0 && roughness > kGlossyRoughness);

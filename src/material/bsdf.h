@@ -8,7 +8,8 @@
 /// diffuse base of the dielectric; the metal part is unaffected):
 ///   - dielectric (weight (1-metallic)(1-transmission)): glTF's fresnel_mix
 ///     of a Lambert base, baseColor / pi weighted by 1 - F, and a GGX
-///     specular layer weighted by F (Schlick, F0 = 0.04), evaluated by the
+///     specular layer weighted by F (Schlick, F0 from the ior, times
+///     KHR_materials_specular's weight), evaluated by the
 ///     GL renderer's own BRDF text (shaders/material_brdf.h through
 ///     material/gltf_brdf.h); sampled by a mixture of the cosine and the
 ///     GGX visible normals, chosen by the layer's expected share;
@@ -47,8 +48,10 @@ struct BsdfLobes {
   float diffuseWeight = 1;   ///< the dielectric lobe's (base and specular layer)
   float roughness = 1;       ///< perceptual
   float alpha = 1;  ///< GGX alpha = roughness^2, floored at kMirrorAlpha
-  /// The dielectric's GGX specular layer (glTF); false: a Lambert base alone.
-  bool specularLayer = false;
+  /// The dielectric's GGX specular layer (glTF): its F0 (from the ior) and
+  /// weight (KHR_materials_specular); weight 0: a Lambert base alone.
+  float dielectricF0 = 0.04f;
+  float layerWeight = 0;
   float ior = 1.5f;
   bool thinWalled = true;     ///< transmission passes straight (no KHR_materials_volume)
   bool storesPhotons = true;  ///< diffuse lobe, or metal rougher than kGlossyRoughness

@@ -8,6 +8,7 @@ namespace lo {
 namespace {
 
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
+glm::vec2 layerOf(const GltfBrdfMaterial& m) { return {m.dielectricF0, m.specular}; }
 Vec3 fromGlm(const glm::vec3& v) { return {v.x, v.y, v.z}; }
 
 }  // namespace
@@ -16,24 +17,25 @@ GltfBrdfLobes gltfBrdfLobes(const GltfBrdfMaterial& m, const Vec3& n, const Vec3
                             const Vec3& l) {
   glm::vec3 diffuse, specular;
   brdf::loBrdfLobes(toGlm(n), toGlm(v), toGlm(l), toGlm(m.baseColor), m.metallic,
-                    brdf::loBrdfAlpha(m.roughness), m.transmission, diffuse, specular);
+                    brdf::loBrdfAlpha(m.roughness), m.transmission, layerOf(m), diffuse, specular);
   return {fromGlm(diffuse), fromGlm(specular)};
 }
 
 Vec3 gltfBrdf(const GltfBrdfMaterial& m, const Vec3& n, const Vec3& v, const Vec3& l) {
   return fromGlm(brdf::loBrdf(toGlm(n), toGlm(v), toGlm(l), toGlm(m.baseColor), m.metallic,
-                              m.roughness, m.transmission));
+                              m.roughness, m.transmission, layerOf(m)));
 }
 
 Vec3 gltfBrdfCos(const GltfBrdfMaterial& m, const Vec3& n, const Vec3& v, const Vec3& l,
                  bool specular, float specularWeight) {
   return fromGlm(brdf::loBrdfCosWeighted(toGlm(n), toGlm(v), toGlm(l), toGlm(m.baseColor),
-                                         m.metallic, m.roughness, m.transmission, specular,
-                                         specularWeight));
+                                         m.metallic, m.roughness, m.transmission, layerOf(m),
+                                         specular, specularWeight));
 }
 
 Vec3 gltfEnvironmentBrdf(const GltfBrdfMaterial& m, float nv) {
-  return fromGlm(brdf::loEnvironmentBrdf(toGlm(m.baseColor), m.metallic, m.roughness, nv));
+  return fromGlm(
+      brdf::loEnvironmentBrdf(toGlm(m.baseColor), m.metallic, m.roughness, nv, layerOf(m)));
 }
 
 }  // namespace lo

@@ -4,9 +4,11 @@
 /// same text as the shader's (shaders/material_brdf.h): the C++ twin the
 /// tests check the GLSL build against, and the BRDF the tracers can share.
 ///
-/// Lambert diffuse weighted by (1 - F) plus a GGX lobe (height-correlated
-/// Smith visibility, Schlick Fresnel, F0 = mix(0.04, baseColor, metallic));
-/// transmission takes its share of the diffuse lobe. Directions are unit, in
+/// glTF's Appendix B: a dielectric (Lambert diffuse weighted by 1 - F plus a
+/// GGX specular layer weighted by F = specular (F0 + (1 - F0)(1 - v.h)^5))
+/// and a metal (GGX, Schlick with F0 = baseColor) mixed by metallic
+/// (height-correlated Smith visibility); transmission takes its share of
+/// the diffuse lobe. Directions are unit, in
 /// one space, pointing away from the surface: n the shading normal, v to the
 /// viewer, l to the light. BRDF values are in 1/sr.
 
@@ -20,6 +22,8 @@ struct GltfBrdfMaterial {
   float metallic = 0;
   float roughness = 1;     ///< perceptual; GGX alpha = roughness^2 (floored at 2e-3)
   float transmission = 0;  ///< KHR_materials_transmission
+  float dielectricF0 = 0.04f;  ///< the dielectric layer's F0, ((ior - 1) / (ior + 1))^2
+  float specular = 1;          ///< the dielectric layer's weight (KHR_materials_specular)
 };
 
 /// The two lobes of f(v, l) without the cosine: (1 - F) diffuse and F D V.

@@ -66,6 +66,8 @@ struct DrawRange {
   float transmission = 0;  ///< > 0: drawn after the opaque scene, see-through
   float thickness = 0;     ///< KHR_materials_volume: > 0 refracts the image behind
   float ior = 1.5f;
+  float dielectricF0 = 0.04f;  ///< the dielectric's specular layer (Material::dielectricF0)
+  float specular = 1;          ///< its weight (KHR_materials_specular)
 };
 
 /// The scene's triangles on the GPU, grouped by material in DrawCategory

@@ -173,6 +173,7 @@ void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, con
   glUniform1i(loc("uBehind"), 6);
   glUniform1i(loc("uEmissiveTexture"), 10);
   glUniform1f(loc("uTransmission"), 0.0f);
+  glUniform2f(loc("uDielectric"), 0.04f, 1.0f);
 }
 
 /// The scene's ranges in draw order with the program `p` in use: each with
@@ -196,6 +197,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
   const GLint alphaCutoff = loc("uAlphaCutoff");
   const GLint thickness = loc("uThickness");
   const GLint ior = loc("uIor");
+  const GLint dielectric = loc("uDielectric");
   // glTF: single-sided materials are culled from behind (counter-clockwise
   // winding in front, as the loader keeps it).
   glFrontFace(GL_CCW);
@@ -243,6 +245,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
     glUniform1f(transmission, range.transmission);
     glUniform1f(thickness, range.thickness);
     glUniform1f(ior, range.ior);
+    glUniform2f(dielectric, range.dielectricF0, range.specular);
     bind(GL_TEXTURE10, range.emissiveTexture);
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(hasEmissive, range.emissiveTexture >= 0 ? 1 : 0);

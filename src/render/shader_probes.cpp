@@ -82,7 +82,7 @@ std::vector<BrdfProbeOutput> runBrdfProbe(const std::vector<BrdfProbeInput>& inp
   if (n == 0) return out;
   const GlProgram program(buildProgram({"render_fullscreen.vert", "render_brdf_probe.frag"}));
   // Row r of the input texture holds texel r of every sample.
-  std::vector<float> texels(size_t(n) * 16);
+  std::vector<float> texels(size_t(n) * 20);
   auto put = [&](int row, size_t i, const Vec3& v, float w) {
     float* t = &texels[(size_t(row) * size_t(n) + i) * 4];
     t[0] = v.x;
@@ -96,9 +96,10 @@ std::vector<BrdfProbeOutput> runBrdfProbe(const std::vector<BrdfProbeInput>& inp
     put(1, i, in.v, in.roughness);
     put(2, i, in.l, in.transmission);
     put(3, i, in.baseColor, in.specularWeight);
+    put(4, i, Vec3(in.dielectricF0, in.specular, 0), 0);
   }
   constexpr int kRows = 6;
-  const std::vector<float> result = runProbe(program.get(), texels, n, 4, kRows, [] {});
+  const std::vector<float> result = runProbe(program.get(), texels, n, 5, kRows, [] {});
   auto get = [&](int row, size_t i) {
     const float* t = &result[(size_t(row) * size_t(n) + i) * 4];
     return Vec3(t[0], t[1], t[2]);

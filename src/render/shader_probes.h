@@ -21,7 +21,9 @@ struct BrdfProbeInput {
   float metallic = 0;
   float roughness = 1;
   float transmission = 0;
-  float specularWeight = 1;
+  float specularWeight = 1;  ///< the VDLs' share of the GGX lobe (loBrdfCosWeighted)
+  float dielectricF0 = 0.04f;  ///< the dielectric layer's F0
+  float specular = 1;          ///< the dielectric layer's weight
 };
 
 /// The shader's results for one input (material_brdf.h's functions).

@@ -358,6 +358,18 @@ class SceneBuilder {
       m.transmission =
           float(numberExt(g.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0));
       m.ior = float(numberExt(g.extensions, "KHR_materials_ior", "ior", 1.5));
+      // KHR_materials_specular: the dielectric layer's weight; its colour
+      // (specularColorFactor, a tint of F0) is not read (docs/scene.md).
+      m.specular =
+          float(numberExt(g.extensions, "KHR_materials_specular", "specularFactor", 1.0));
+      if (!(m.specular >= 0 && m.specular <= 1)) {
+        fail(path_, "material " + std::to_string(i) +
+                        ": KHR_materials_specular specularFactor must lie in [0, 1]");
+      }
+      if (!(m.ior == 0 || m.ior >= 1) || !std::isfinite(m.ior)) {
+        fail(path_, "material " + std::to_string(i) +
+                        ": KHR_materials_ior ior must be 0 or at least 1");
+      }
       m.thickness =
           float(numberExt(g.extensions, "KHR_materials_volume", "thicknessFactor", 0.0));
       if (!(m.thickness >= 0)) {
@@ -457,6 +469,37 @@ class SceneBuilder {
     }
   }
 
+  /// The sampler of glTF texture `tex` (glTF's defaults where it has none).
+  TextureSampler samplerOf(int tex) const {
+    TextureSampler out;
+    const int index = model_.textures[size_t(tex)].sampler;
+    if (index < 0) return out;
+    const std::string what = "texture " + std::to_string(tex) + ": sampler " + std::to_string(index);
+    if (size_t(index) >= model_.samplers.size()) fail(path_, what + " out of range");
+    const tinygltf::Sampler& s = model_.samplers[size_t(index)];
+    auto oneOf = [&](int value, std::initializer_list<int> allowed, const char* field) {
+      for (int a : allowed) {
+        if (value == a) return;
+      }
+      fail(path_, what + ": " + field + " " + std::to_string(value) + " is not a glTF value");
+    };
+    if (s.magFilter >= 0) {
+      oneOf(s.magFilter, {TextureSampler::kNearest, TextureSampler::kLinear}, "magFilter");
+      out.magFilter = s.magFilter;
+    }
+    if (s.minFilter >= 0) {
+      oneOf(s.minFilter, {9728, 9729, 9984, 9985, 9986, 9987}, "minFilter");
+      out.minFilter = s.minFilter;
+    }
+    const std::initializer_list<int> wraps = {TextureSampler::kRepeat, TextureSampler::kClampToEdge,
+                                              TextureSampler::kMirroredRepeat};
+    oneOf(s.wrapS, wraps, "wrapS");
+    oneOf(s.wrapT, wraps, "wrapT");
+    out.wrapS = s.wrapS;
+    out.wrapT = s.wrapT;
+    return out;
+  }
+
   int textureFromImage(int source, int tex, bool srgb = true) {
     std::string what =
         "(texture " + std::to_string(tex) + ", image " + std::to_string(source) + ")";
@@ -466,13 +509,15 @@ class SceneBuilder {
     if (!model_.images[size_t(source)].uri.empty()) {
       what = "'" + model_.images[size_t(source)].uri + "' " + what;
     }
-    // Colour and data decodings of one image are two textures.
-    const int key = 2 * source + (srgb ? 0 : 1);
+    // Colour and data decodings of one image are two textures, and so are
+    // two samplers of it.
+    const TextureKey key{source, srgb, samplerOf(tex)};
     auto it = imageToTexture_.find(key);
     if (it != imageToTexture_.end()) return it->second;
     const tinygltf::Image& im = model_.images[size_t(source)];
     if (im.image.empty()) fail(path_, "unreadable image: no data " + what);
     Texture t = decodeImage(path_, im.image.data(), im.image.size(), what, srgb);
+    t.sampler = key.sampler;
     t.name =
         im.name.empty() ? (im.uri.empty() ? "image" + std::to_string(source) : im.uri) : im.name;
     int index = int(scene_.textures.size());
@@ -867,7 +912,18 @@ class SceneBuilder {
   const tinygltf::Model& model_;
   GltfReader reader_;
   Scene scene_;
-  std::map<int, int> imageToTexture_;
+  /// A decoded texture: its image, whether as sRGB colour, its sampler.
+  struct TextureKey {
+    int image;
+    bool srgb;
+    TextureSampler sampler;
+    bool operator<(const TextureKey& o) const {
+      if (image != o.image) return image < o.image;
+      if (srgb != o.srgb) return srgb < o.srgb;
+      return sampler < o.sampler;
+    }
+  };
+  std::map<TextureKey, int> imageToTexture_;
   int defaultMaterial_ = -1;
   bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false;
 };

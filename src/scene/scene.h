@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/math.h"
@@ -22,16 +23,37 @@ namespace lo {
 
 /// A decoded texture: linear RGB floats, row-major, row 0 at the top
 /// (glTF's UV (0,0) is the top-left corner).
+/// A glTF sampler: how a texture is filtered and wrapped, in glTF's (and
+/// OpenGL's) codes. The GL renderer sets them on its texture; the tracers
+/// filter bilinearly unless magFilter is NEAREST (9728) and wrap as asked,
+/// at full resolution (no mipmaps: their rays carry no footprint).
+struct TextureSampler {
+  static constexpr int kNearest = 9728, kLinear = 9729;
+  static constexpr int kRepeat = 10497, kClampToEdge = 33071, kMirroredRepeat = 33648;
+  int magFilter = kLinear;
+  /// glTF minFilter (NEAREST, LINEAR or one of the four *_MIPMAP_*); 0 =
+  /// undefined, which the renderer draws as LINEAR_MIPMAP_LINEAR.
+  int minFilter = 0;
+  int wrapS = kRepeat, wrapT = kRepeat;
+  bool operator<(const TextureSampler& o) const {
+    return std::tie(magFilter, minFilter, wrapS, wrapT) <
+           std::tie(o.magFilter, o.minFilter, o.wrapS, o.wrapT);
+  }
+};
+
 struct Texture {
   std::string name;
+  TextureSampler sampler;
   int width = 0, height = 0;
   std::vector<Vec3> texels;             ///< width * height: colour maps converted from sRGB to
                                         ///< linear, data maps (normal maps) as stored, in [0, 1]
   /// width * height alpha values in [0, 1] (linear, as glTF defines alpha),
   /// or empty when the image has no alpha channel (alpha 1 everywhere).
   std::vector<float> alpha;
-  Vec3 lookup(float u, float v) const;        ///< nearest texel, repeat wrap
-  float lookupAlpha(float u, float v) const;  ///< nearest texel's alpha, repeat wrap
+  /// The texture at (u, v) through its sampler: bilinear (or the nearest
+  /// texel), wrapped as the sampler says; white when empty.
+  Vec3 lookup(float u, float v) const;
+  float lookupAlpha(float u, float v) const;  ///< the same for alpha (1 when none)
 };
 
 /// glTF metallic-roughness material (the subset the bake and renderer use).
@@ -95,11 +117,17 @@ struct Material {
   /// path tracer, shadows) treats every surface as two-sided except emission,
   /// which leaves one-sided emitters on their front only.
   bool doubleSided = false;
-  /// The glTF dielectric's specular layer (F0 = 0.04), on for every
-  /// material a file defines. false: a pure Lambert base in the tracers,
-  /// for scenes built in code whose answers are analytic only for Lambert
-  /// surfaces (tests); the GL renderer keeps its own --specular switch.
-  bool specularLayer = true;
+  /// KHR_materials_specular specularFactor: the weight of the dielectric's
+  /// specular layer (its F0 comes from `ior`). 0: a pure Lambert base, in
+  /// every renderer (scenes whose answers are analytic only for Lambert).
+  float specular = 1.0f;
+
+  /// The dielectric's F0 at normal incidence, ((ior - 1) / (ior + 1))^2
+  /// (0.04 at glTF's default ior 1.5).
+  float dielectricF0() const {
+    const float r = (ior - 1.0f) / (ior + 1.0f);
+    return r * r;
+  }
 
   bool isEmissive() const { return maxComponent(emission) > 0; }
   /// Whether alpha can hide part of the surface (Mask or Blend).

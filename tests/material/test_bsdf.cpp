@@ -19,10 +19,12 @@ Vec3 viewAt(float thetaDegrees) {
   return {std::sin(t), 0.0f, std::cos(t)};
 }
 
-BsdfLobes lobesOf(float metallic, float roughness) {
+BsdfLobes lobesOf(float metallic, float roughness, float ior = 1.5f, float specular = 1.0f) {
   Material m;
   m.metallic = metallic;
   m.roughness = roughness;
+  m.ior = ior;
+  m.specular = specular;
   return bsdfLobes(m);
 }
 
@@ -95,12 +97,15 @@ TEST(Bsdf, SmoothLobesAreTheRenderersGltfBrdf) {
   for (int i = 0; i < 2000; ++i) {
     const float metallic = i % 3 == 0 ? 0.0f : i % 3 == 1 ? 1.0f : rng.uniform();
     const float roughness = 0.05f + 0.95f * rng.uniform();
+    // KHR_materials_ior and KHR_materials_specular: the layer's F0 and weight.
+    const float ior = 1.0f + 2.0f * rng.uniform(), specular = i % 5 == 0 ? 0.0f : rng.uniform();
+    const float f0 = (ior - 1) * (ior - 1) / ((ior + 1) * (ior + 1));
     const Vec3 albedo(rng.uniform(), rng.uniform(), rng.uniform());
     const Vec3 n(0, 0, 1);
     Vec3 wo = normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() + 0.05f));
     Vec3 wi = normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() + 0.05f));
-    const Vec3 tracer = evalBsdf(lobesOf(metallic, roughness), albedo, wo, wi, n);
-    const Vec3 gl = gltfBrdfCos({albedo, metallic, roughness, 0.0f}, n, wo, wi);
+    const Vec3 tracer = evalBsdf(lobesOf(metallic, roughness, ior, specular), albedo, wo, wi, n);
+    const Vec3 gl = gltfBrdfCos({albedo, metallic, roughness, 0.0f, f0, specular}, n, wo, wi);
     SCOPED_TRACE("metallic " + std::to_string(metallic) + ", roughness " +
                  std::to_string(roughness));
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(tracer[c], gl[c], 1e-5f + 1e-4f * std::fabs(gl[c]));
@@ -119,7 +124,9 @@ TEST(Bsdf, SamplingAgreesWithEvaluation) {
       for (float theta : {0.0f, 45.0f, 75.0f}) {
         SCOPED_TRACE("metallic " + std::to_string(metallic) + ", roughness " +
                      std::to_string(roughness) + ", view " + std::to_string(theta));
-        const BsdfLobes lobes = lobesOf(metallic, roughness);
+        // A glass-like ior and half the layer's weight where the metal is half.
+        const BsdfLobes lobes = metallic == 0.5f ? lobesOf(metallic, roughness, 2.2f, 0.5f)
+                                                 : lobesOf(metallic, roughness);
         Vec3 integral;
         double pdf = 0;
         integrate(lobes, albedo, viewAt(theta), integral, pdf);
@@ -149,6 +156,12 @@ TEST(Bsdf, DielectricLayerReflectsMoreTowardsGrazingViews) {
   BsdfLobes lambert;
   integrate(lambert, black, viewAt(80), grazing, pdf);
   EXPECT_EQ(grazing.x, 0.0f);
+  // KHR_materials_specular 0: no layer either; a higher ior: a brighter one.
+  integrate(lobesOf(0, 0.5f, 1.5f, 0.0f), black, viewAt(80), grazing, pdf);
+  EXPECT_EQ(grazing.x, 0.0f);
+  Vec3 dense;
+  integrate(lobesOf(0, 0.5f, 2.5f), black, viewAt(0), dense, pdf);
+  EXPECT_NEAR(dense.x, 0.18f, 0.03f);  // F0 = (1.5 / 3.5)^2 = 0.184
 }
 
 }  // namespace

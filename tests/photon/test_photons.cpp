@@ -35,7 +35,7 @@ struct Dvec3 {
 int addMaterial(Scene& scene, const Vec3& baseColor) {
   Material m;
   m.baseColor = baseColor;
-  m.specularLayer = false;  // Lambert: the answers below are analytic for it
+  m.specular = 0;  // Lambert: the answers below are analytic for it
   m.name = "m" + std::to_string(scene.materials.size());
   scene.materials.push_back(m);
   return int(scene.materials.size()) - 1;

@@ -29,7 +29,7 @@ using test::addQuad;
 int addMaterial(Scene& scene, const Vec3& baseColor, const Vec3& emission = {0, 0, 0}) {
   Material m;
   m.baseColor = baseColor;
-  m.specularLayer = false;  // Lambert: the answers below are analytic for it
+  m.specular = 0;  // Lambert: the answers below are analytic for it
   m.emission = emission;
   m.name = "m" + std::to_string(scene.materials.size());
   scene.materials.push_back(m);

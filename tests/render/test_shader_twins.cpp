@@ -53,6 +53,11 @@ std::vector<BrdfProbeInput> randomInputs(int count) {
     in.roughness = value(2);
     in.transmission = value(3);
     in.specularWeight = value(4);
+    // The dielectric layer: F0 of an ior from 1 to 3 (0.04 at 1.5), weight
+    // over [0, 1] with exact 0 and 1.
+    const float ior = i % 5 == 0 ? 1.5f : 1.0f + 2.0f * u(rng);
+    in.dielectricF0 = (ior - 1) * (ior - 1) / ((ior + 1) * (ior + 1));
+    in.specular = value(5);
     inputs.push_back(in);
   }
   return inputs;
@@ -98,6 +103,8 @@ TEST(RenderBrdf, GlslMatchesCpp) {
     m.metallic = in.metallic;
     m.roughness = in.roughness;
     m.transmission = in.transmission;
+    m.dielectricF0 = in.dielectricF0;
+    m.specular = in.specular;
     const GltfBrdfLobes lobes = gltfBrdfLobes(m, in.n, in.v, in.l);
     const float withSpecular = specularRelative(in);
     EXPECT_TRUE(close("brdfCosWeighted", i, out[i].cosWeighted,
