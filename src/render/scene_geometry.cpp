@@ -35,9 +35,9 @@ DrawCategory categoryOf(const Material& m) {
 
 }  // namespace
 
-/// Uploads a texture (linear RGB, and its alpha where it has one) with
-/// mipmaps, trilinear and anisotropic filtering, repeat wrap (glTF's
-/// default sampler).
+/// Uploads a texture (linear RGB, and its alpha where it has one) with its
+/// glTF sampler's filters and wrap modes; mipmaps and anisotropic filtering
+/// where the minification filter uses mipmaps (glTF's default).
 GlTexture SceneGeometry::uploadTexture(const Texture& t) const {
   GlTexture id = GlTexture::create();
   glBindTexture(GL_TEXTURE_2D, id.get());
@@ -52,12 +52,21 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t) const {
   // Half floats: linear colour with 11 bits of precision, filterable and
   // mipmappable on every GL 3.3 context.
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT, rgba.data());
-  glGenerateMipmap(GL_TEXTURE_2D);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-  if (maxAnisotropy > 1) glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY, maxAnisotropy);
+  // The glTF sampler (its codes are OpenGL's); an undefined minFilter is
+  // trilinear, as glTF viewers draw it.
+  const TextureSampler& sampler = t.sampler;
+  const GLint minFilter = sampler.minFilter ? sampler.minFilter : GL_LINEAR_MIPMAP_LINEAR;
+  const bool mipmapped = minFilter != GL_NEAREST && minFilter != GL_LINEAR;
+  if (mipmapped) glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, minFilter);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, sampler.magFilter);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, sampler.wrapS);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, sampler.wrapT);
+  // Anisotropic filtering only where the sampler filters linearly: some
+  // drivers (llvmpipe) let it override a NEAREST magnification filter.
+  if (maxAnisotropy > 1 && mipmapped && sampler.magFilter == GL_LINEAR) {
+    glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY, maxAnisotropy);
+  }
   checkGl("uploading a base colour texture");
   return id;
 }
@@ -141,6 +150,8 @@ DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat) {
   range.transmission = mat.transmission;
   range.thickness = mat.thickness;
   range.ior = mat.ior;
+  range.dielectricF0 = mat.dielectricF0();
+  range.specular = mat.specular;
   range.alphaMode = alphaModeOf(mat);
   range.baseAlpha = mat.baseAlpha;
   range.alphaCutoff = mat.alphaCutoff;

@@ -16,20 +16,63 @@
 
 namespace lo {
 
+namespace {
+
+/// Texel index i (any integer) of a row of n texels, wrapped by the glTF mode.
+int wrapTexel(int i, int n, int mode) {
+  if (mode == TextureSampler::kClampToEdge) return std::clamp(i, 0, n - 1);
+  if (mode == TextureSampler::kMirroredRepeat) {
+    const int period = 2 * n;
+    int k = i % period;
+    if (k < 0) k += period;
+    return k < n ? k : period - 1 - k;
+  }
+  int k = i % n;
+  return k < 0 ? k + n : k;
+}
+
+/// Texel coordinate (in texels, centres at .5) of u, kept finite and within
+/// int range for any float u: repeating modes fold u by their period (2
+/// covers both), clamping keeps it within a texture's width of [0, 1].
+float texelCoordinate(float u, int n, int mode) {
+  if (!std::isfinite(u)) return 0.5f;
+  if (mode == TextureSampler::kClampToEdge) return std::clamp(u, -1.0f, 2.0f) * float(n);
+  return (u - 2.0f * std::floor(0.5f * u)) * float(n);
+}
+
+/// `fetch(x, y)` filtered at (u, v) by `sampler`.
+template <typename T, typename Fetch>
+T sampleTexels(const TextureSampler& sampler, int width, int height, float u, float v,
+               const Fetch& fetch) {
+  const float x = texelCoordinate(u, width, sampler.wrapS);
+  const float y = texelCoordinate(v, height, sampler.wrapT);
+  if (sampler.magFilter == TextureSampler::kNearest) {
+    return fetch(wrapTexel(int(std::floor(x)), width, sampler.wrapS),
+                 wrapTexel(int(std::floor(y)), height, sampler.wrapT));
+  }
+  const float fx = x - 0.5f, fy = y - 0.5f;
+  const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
+  const float tx = fx - float(x0), ty = fy - float(y0);
+  const int xa = wrapTexel(x0, width, sampler.wrapS), xb = wrapTexel(x0 + 1, width, sampler.wrapS);
+  const int ya = wrapTexel(y0, height, sampler.wrapT), yb = wrapTexel(y0 + 1, height, sampler.wrapT);
+  return (fetch(xa, ya) * (1.0f - tx) + fetch(xb, ya) * tx) * (1.0f - ty) +
+         (fetch(xa, yb) * (1.0f - tx) + fetch(xb, yb) * tx) * ty;
+}
+
+}  // namespace
+
 Vec3 Texture::lookup(float u, float v) const {
   if (width <= 0 || height <= 0) return Vec3{1, 1, 1};
-  float fu = u - std::floor(u), fv = v - std::floor(v);
-  int x = std::min(width - 1, std::max(0, int(fu * float(width))));
-  int y = std::min(height - 1, std::max(0, int(fv * float(height))));
-  return texels[size_t(y) * size_t(width) + size_t(x)];
+  return sampleTexels<Vec3>(sampler, width, height, u, v, [this](int x, int y) {
+    return texels[size_t(y) * size_t(width) + size_t(x)];
+  });
 }
 
 float Texture::lookupAlpha(float u, float v) const {
   if (width <= 0 || height <= 0 || alpha.empty()) return 1.0f;
-  float fu = u - std::floor(u), fv = v - std::floor(v);
-  int x = std::min(width - 1, std::max(0, int(fu * float(width))));
-  int y = std::min(height - 1, std::max(0, int(fv * float(height))));
-  return alpha[size_t(y) * size_t(width) + size_t(x)];
+  return sampleTexels<float>(sampler, width, height, u, v, [this](int x, int y) {
+    return alpha[size_t(y) * size_t(width) + size_t(x)];
+  });
 }
 
 void TextureTransform::apply(float& u, float& v) const {

@@ -401,6 +401,7 @@ TEST(LightmapAtlas, RadianceIsAlbedoOverPiTimesIrradiancePlusEmission) {
     }
   Texture tex;
   tex.width = tex.height = kTex;
+  tex.sampler.magFilter = TextureSampler::kNearest;  // the expected albedo below is per texel
   for (int y = 0; y < kTex; ++y)
     for (int x = 0; x < kTex; ++x)
       tex.texels.push_back({0.1f + 0.2f * float(x), 0.9f - 0.2f * float(y), 0.5f});

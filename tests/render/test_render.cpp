@@ -514,6 +514,48 @@ std::vector<bool> checkCheckerQuad(const TextureTransform& transform, const std:
   return isRed;
 }
 
+// The glTF sampler reaches the GL texture: a NEAREST magnification filter
+// keeps a two-texel texture's halves sharp where LINEAR blends them, as the
+// tracers' Texture::lookup does.
+TEST(RenderImage, GltfSamplerFiltersTheTexture) {
+  REQUIRE_OSMESA();
+  for (int filter : {TextureSampler::kNearest, TextureSampler::kLinear}) {
+    QuadSetup s;
+    Texture halves;  // red | blue along u
+    halves.width = 2;
+    halves.height = 1;
+    halves.texels = {Vec3{0.8f, 0.1f, 0.1f}, Vec3{0.1f, 0.1f, 0.8f}};
+    halves.sampler.magFilter = filter;
+    halves.sampler.wrapS = halves.sampler.wrapT = TextureSampler::kClampToEdge;
+    s.scene.textures.push_back(halves);
+    s.scene.materials[0].baseColor = {1, 1, 1};
+    s.scene.materials[0].baseColorTexture = 0;
+    // u = (x + 1) / 2 across the quad's corners (-1,-1), (1,-1), (1,1), (-1,1).
+    s.scene.texcoords0 = {0, 0.5f, 1, 0.5f, 1, 0.5f, 0, 0.5f};
+    Light light;
+    light.type = Light::Type::Point;
+    light.position = {0.1f, -0.05f, 1.0f};
+    light.intensity = 2.0f;
+    s.scene.lights.push_back(light);
+    GpuOctree octree =
+        makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+    Renderer renderer(s.scene, octree);
+    RenderParams p = QuadSetup::params(false);
+    p.mode = RenderMode::Direct;
+    const RgbImage image = renderer.render(s.camera, p);
+    // x = -0.1 on the quad: u = 0.45, 0.9 texels from the left edge.
+    const float worldPerPixel = 2.0f * 2.0f * std::tan(0.5f * s.camera.yfov) / float(p.height);
+    const int px = p.width / 2 + int(std::floor((-0.1f - 0.1f) / worldPerPixel));
+    const float* c = image.pixel(px, p.height / 2);
+    const float x = 0.1f + (float(px) + 0.5f - 0.5f * float(p.width)) * worldPerPixel;
+    const Vec3 expected = halves.lookup(0.5f * (x + 1.0f), 0.5f);
+    SCOPED_TRACE(filter == TextureSampler::kNearest ? "nearest" : "linear");
+    EXPECT_NEAR(c[0] / c[2], expected.x / expected.z, 0.03f * expected.x / expected.z);
+    if (filter == TextureSampler::kNearest) EXPECT_NEAR(c[0] / c[2], 8.0f, 0.1f);
+    if (filter == TextureSampler::kLinear) EXPECT_LT(c[0] / c[2], 3.0f);
+  }
+}
+
 // glTF base colour textures are sampled per pixel (they were sampled at the
 // vertices, so a checker floor came out one colour).
 TEST(RenderImage, BaseColorTextureIsSampledPerPixel) {

@@ -917,11 +917,13 @@ TEST(SceneGltf, AlphaModesAndEmissiveTexture) {
   EXPECT_EQ(s.coverage(0, 1, 0), 1.0f);
   expectNear(s.emission(0, 0, 0), {1, 0, 0}, 1e-6f, "emission on the red texel");
   expectNear(s.emission(0, 1, 0), {0, 1, 0}, 1e-6f, "emission on the green texel");
-  // Mean over the triangle: u = 0.25 + b1 / 2 is on the red texel where
-  // b1 < 1/2, 3/4 of the triangle's area; 64 stratified samples see both.
+  // Mean over the triangle: u = 0.25 + b1 / 2 runs from the red texel's
+  // centre to the green one's, filtered bilinearly (glTF's default sampler),
+  // so red = 1 - b1, whose mean over the triangle is 2/3; 64 stratified
+  // samples.
   const Vec3 mean = s.triangleEmission(0);
-  EXPECT_NEAR(mean.x + mean.y, 1.0f, 1e-6f);
-  EXPECT_NEAR(mean.x, 0.75f, 0.05f);
+  EXPECT_NEAR(mean.x + mean.y, 1.0f, 1e-5f);
+  EXPECT_NEAR(mean.x, 2.0f / 3.0f, 0.03f);
 }
 
 TEST(SceneGltf, UnknownAlphaModeIsRefused) {
@@ -1039,6 +1041,55 @@ TEST(SceneLimits, BaseColourAboveOneIsClampedWithAWarning) {
   EXPECT_NE(s.warnings[0].find("clamped"), std::string::npos) << s.warnings[0];
   g.materials = R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}])";
   EXPECT_TRUE(loadScene(writeGltf(dir, "fine.gltf", g)).warnings.empty());
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+/// A 2 x 2 texture of texel values 0, 1 (top row), 2, 3 (bottom row).
+Texture fourTexels(const TextureSampler& sampler) {
+  Texture t;
+  t.width = t.height = 2;
+  t.sampler = sampler;
+  for (float v : {0.0f, 1.0f, 2.0f, 3.0f}) t.texels.push_back(Vec3(v));
+  return t;
+}
+
+TEST(SceneTexture, SamplerFiltersAndWrapsAsGltfSays) {
+  TextureSampler nearest;
+  nearest.magFilter = TextureSampler::kNearest;
+  const Texture n = fourTexels(nearest);
+  EXPECT_EQ(n.lookup(0.25f, 0.25f).x, 0.0f);
+  EXPECT_EQ(n.lookup(0.74f, 0.26f).x, 1.0f);
+  EXPECT_EQ(n.lookup(0.51f, 0.99f).x, 3.0f);
+  EXPECT_EQ(n.lookup(1.25f, -0.75f).x, 0.0f);  // repeat
+  // Bilinear (glTF's default): texel centres exact, the middle the mean.
+  const Texture b = fourTexels(TextureSampler{});
+  EXPECT_FLOAT_EQ(b.lookup(0.25f, 0.25f).x, 0.0f);
+  EXPECT_FLOAT_EQ(b.lookup(0.75f, 0.75f).x, 3.0f);
+  EXPECT_FLOAT_EQ(b.lookup(0.5f, 0.25f).x, 0.5f);
+  EXPECT_FLOAT_EQ(b.lookup(0.5f, 0.5f).x, 1.5f);
+  // Repeat: across the left edge the right column's texels blend in.
+  EXPECT_FLOAT_EQ(b.lookup(0.0f, 0.25f).x, 0.5f);
+  // Clamp to edge: the edge texel alone, however far out.
+  TextureSampler clamp;
+  clamp.wrapS = clamp.wrapT = TextureSampler::kClampToEdge;
+  const Texture c = fourTexels(clamp);
+  EXPECT_FLOAT_EQ(c.lookup(0.0f, 0.25f).x, 0.0f);
+  EXPECT_FLOAT_EQ(c.lookup(-7.0f, 0.25f).x, 0.0f);
+  EXPECT_FLOAT_EQ(c.lookup(9.0f, 0.75f).x, 3.0f);
+  // Mirrored repeat: [1, 2) is [0, 1) backwards.
+  TextureSampler mirror = nearest;
+  mirror.wrapS = TextureSampler::kMirroredRepeat;
+  const Texture m = fourTexels(mirror);
+  EXPECT_EQ(m.lookup(1.25f, 0.25f).x, 1.0f);
+  EXPECT_EQ(m.lookup(1.75f, 0.25f).x, 0.0f);
+  EXPECT_EQ(m.lookup(-0.25f, 0.25f).x, 0.0f);
+  // Non-finite or huge coordinates stay inside the texture.
+  EXPECT_TRUE(isFinite(b.lookup(NAN, 1e30f)));
 }
 
 }  // namespace
