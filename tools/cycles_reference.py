@@ -14,8 +14,9 @@ What is matched (docs/scene.md defines the project's units):
   * lights: 1 cd = 1 W/sr and 1 lx = 1 W/m^2, so a point or spot light of
     intensity I gets Blender power 4 pi I W (Cycles gives a spot the intensity
     of the point light of its power), radius 0; a directional light strength I,
-    angle 0. Blender's spot blend is a smoothstep, not glTF's squared falloff:
-    the blend is set so that both reach full intensity at the inner cone;
+    angle 0. A spot is a hard Blender cone of the outer angle whose light
+    shader applies glTF's squared falloff and divides out the cosine Cycles
+    3.4 multiplies spots by;
   * emission: radiance = emissive colour x strength, from the front face only
     (the tracers' one-sided emitters): the back face's emission is switched
     off by the Backfacing output;
@@ -54,6 +55,15 @@ import mathutils  # noqa: E402
 
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    # "--target -0.1,0.2,0" as `reference` takes it: argparse would read the
+    # value as an option.
+    joined = []
+    for a in argv:
+        if joined and joined[-1] in ("--eye", "--target") and a.startswith("-"):
+            joined[-1] += "=" + a
+        else:
+            joined.append(a)
+    argv = joined
     p = argparse.ArgumentParser(prog="cycles_reference.py")
     p.add_argument("scene")
     p.add_argument("output")
@@ -130,9 +140,46 @@ def set_lights(gltf):
                 spot = g.get("spot", {})
                 outer = spot.get("outerConeAngle", math.pi / 4)
                 inner = spot.get("innerConeAngle", 0.0)
-                data.spot_size = 2.0 * outer
-                cos_o, cos_i = math.cos(outer), math.cos(inner)
-                data.spot_blend = max(0.0, min(1.0, (cos_i - cos_o) / max(1e-6, 1.0 - cos_o)))
+                glTF_spot_falloff(obj, outer, inner)
+
+
+def glTF_spot_falloff(obj, outer, inner):
+    """A hard Blender cone of the outer angle whose emission carries glTF's
+    falloff ((cos - cosOuter) / (cosInner - cosOuter))^2 divided by the
+    cosine Cycles 3.4 multiplies a spot's intensity by (its spot
+    attenuation returns dot(direction, axis) inside the cone), from the
+    direction the light shader sees (Texture Coordinate > Normal)."""
+    data = obj.data
+    data.spot_size = 2.0 * outer
+    data.spot_blend = 0.0
+    data.use_nodes = True
+    tree = data.node_tree
+    emission = next(n for n in tree.nodes if n.type == "EMISSION")
+    axis = obj.matrix_world.to_3x3() @ mathutils.Vector((0.0, 0.0, -1.0))
+    axis.normalize()
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    along = tree.nodes.new("ShaderNodeVectorMath")
+    along.operation = "DOT_PRODUCT"
+    along.inputs[1].default_value = axis
+    tree.links.new(coords.outputs["Normal"], along.inputs[0])
+    cosine = tree.nodes.new("ShaderNodeMath")
+    cosine.operation = "ABSOLUTE"
+    tree.links.new(along.outputs["Value"], cosine.inputs[0])
+    cos_o, cos_i = math.cos(outer), math.cos(inner)
+    ramp = tree.nodes.new("ShaderNodeMapRange")  # clamp((c - cosO) / (cosI - cosO), 0, 1)
+    ramp.inputs["From Min"].default_value = cos_o
+    ramp.inputs["From Max"].default_value = max(cos_i, cos_o + 1e-6)
+    ramp.clamp = True
+    tree.links.new(cosine.outputs["Value"], ramp.inputs["Value"])
+    square = tree.nodes.new("ShaderNodeMath")
+    square.operation = "MULTIPLY"
+    tree.links.new(ramp.outputs["Result"], square.inputs[0])
+    tree.links.new(ramp.outputs["Result"], square.inputs[1])
+    strength = tree.nodes.new("ShaderNodeMath")
+    strength.operation = "DIVIDE"
+    tree.links.new(square.outputs["Value"], strength.inputs[0])
+    tree.links.new(cosine.outputs["Value"], strength.inputs[1])
+    tree.links.new(strength.outputs["Value"], emission.inputs["Strength"])
 
 
 def socket_value(socket):
@@ -323,8 +370,11 @@ def main():
     scene.render.image_settings.color_mode = "RGB"
     scene.render.filepath = os.path.abspath(args.output)
     bpy.ops.render.render(write_still=True)
-    print("cycles_reference.py: wrote %s (%d x %d, %d spp, materials: %s)" %
-          (args.output, args.width, args.height, args.spp, args.material))
+    image = bpy.data.images.load(os.path.abspath(args.output))
+    pixels = numpy.array(image.pixels[:]).reshape(-1, 4)[:, :3]
+    mean = pixels.mean(axis=0)
+    print("cycles_reference.py: wrote %s (%d x %d, %d spp, materials: %s); mean RGB %.6g %.6g %.6g" %
+          (args.output, args.width, args.height, args.spp, args.material, mean[0], mean[1], mean[2]))
 
 
 main()

@@ -33,6 +33,12 @@ PACKAGES=(
   # handled below
   nodejs
 )
+# What only the test suite needs (tools/test.sh sets LO_SETUP_TESTS=1): Blender,
+# whose Cycles judges the path tracer (tools/cycles_reference.py, test
+# cycles.lights_in_project_units), and NumPy for its glTF importer.
+if [ "${LO_SETUP_TESTS:-0}" = "1" ]; then
+  PACKAGES+=(blender python3-numpy)
+fi
 
 # The Khronos glTF validator (npm package gltf-validator, pinned), installed
 # into the project-local folder the tests read (git ignores .cache/).

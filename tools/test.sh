@@ -4,7 +4,7 @@
 # and the libFuzzer targets of the readers for 60 s each (docs/robustness.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash tools/build.sh
+LO_SETUP_TESTS=1 bash tools/build.sh
 (cd build && ctest --output-on-failure --timeout 600)
 
 # The whole suite again under the sanitizers, in its own build folder; any
