@@ -123,6 +123,7 @@ std::vector<std::vector<std::string>> allPrograms() {
           {"render_depth.vert", "render_depth.frag"},
           {"render_fullscreen.vert", "render_layout_probe.frag"},
           {"render_fullscreen.vert", "render_brdf_probe.frag"},
+          {"render_fullscreen.vert", "render_sky.frag"},
           {"atlas_bake.vert", "atlas_bake.geom", "atlas_bake.frag"}};
 }
 

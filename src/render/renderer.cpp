@@ -82,6 +82,9 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
                         glGetUniformBlockIndex(r.sceneProgram.get(), "LightBlock"), 0);
   r.sceneIndirectProgram = GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}));
   r.depthProgram = GlProgram(buildProgram({"render_depth.vert", "render_depth.frag"}));
+  if (maxComponent(r.sky) > 0) {
+    r.skyProgram = GlProgram(buildProgram({"render_fullscreen.vert", "render_sky.frag"}));
+  }
   r.uploadOctree(octree);
   r.geometry.upload(scene, r.space);
   r.geometry.sceneTriangles = scene.triangleCount();

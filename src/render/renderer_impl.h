@@ -143,6 +143,7 @@ struct Renderer::Impl {
   /// (LO_ATLAS_LIGHTING), built on the first atlas frame.
   render_internal::GlProgram sceneAtlasProgram, sceneIndirectAtlasProgram;
   render_internal::GlProgram depthProgram;
+  render_internal::GlProgram skyProgram;  ///< the sky's background, built when the scene has one
   render_internal::SceneGeometry geometry;
   render_internal::SceneLights lights;
   render_internal::ReflectionProbe probe;

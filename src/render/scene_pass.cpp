@@ -5,11 +5,11 @@
 #include <glad/gl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "core/error.h"
-#include "image/image.h"
 #include "render/context.h"
 #include "render/gl_util.h"
 #include "render/renderer_impl.h"
@@ -301,14 +301,30 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
   }
 
   glViewport(0, 0, width, height);
-  // The background: the sky's radiance where it has one (uniform: the
-  // same in every direction above the horizon, and drawn below it too).
-  Vec3 background = sky * exposureScale;
-  if (encodeSrgb) {
-    for (int c = 0; c < 3; ++c) background[c] = linearToSrgb(background[c]);
-  }
-  glClearColor(background.x, background.y, background.z, 1);
+  glClearColor(0, 0, 0, 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (skyProgram) {
+    // The background: the sky above the horizon, black below.
+    const float tanHalf = std::tan(0.5f * camera.yfov);
+    const glm::vec3 forward = glm::normalize(toGlm(camera.forward));
+    const glm::vec3 up = glm::normalize(toGlm(camera.up));
+    const glm::vec3 right = glm::normalize(glm::cross(forward, up)) * (tanHalf * aspect);
+    const GLuint program = skyProgram.get();
+    glUseProgram(program);
+    const Vec3 radiance = sky * exposureScale;
+    glUniform3f(glGetUniformLocation(program, "uSky"), radiance.x, radiance.y, radiance.z);
+    glUniform3fv(glGetUniformLocation(program, "uForward"), 1, glm::value_ptr(forward));
+    glUniform3fv(glGetUniformLocation(program, "uRight"), 1, glm::value_ptr(right));
+    const glm::vec3 upScaled = up * tanHalf;
+    glUniform3fv(glGetUniformLocation(program, "uUp"), 1, glm::value_ptr(upScaled));
+    glUniform2f(glGetUniformLocation(program, "uViewport"), float(width), float(height));
+    glUniform1i(glGetUniformLocation(program, "uEncodeSrgb"), encodeSrgb ? 1 : 0);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glBindVertexArray(geometry.emptyVao.get());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDepthMask(GL_TRUE);
+  }
   glEnable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   // Depth pre-pass: the scene shader then shades each pixel once, not once

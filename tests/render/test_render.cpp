@@ -514,6 +514,25 @@ std::vector<bool> checkCheckerQuad(const TextureTransform& transform, const std:
   return isRed;
 }
 
+// The sky is drawn behind the scene where the view looks above the horizon,
+// black below, as the path tracer sees it where a ray escapes.
+TEST(RenderImage, SkyIsTheBackgroundAboveTheHorizon) {
+  REQUIRE_OSMESA();
+  QuadSetup s;  // the quad stands at z = 0, facing +z; the camera looks past it
+  s.scene.sky.radiance = {0.2f, 0.4f, 0.8f};
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  Renderer renderer(s.scene, octree);
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const PinholeCamera level = PinholeCamera::lookAt({5, 0, 5}, {10, 0, 5}, 0.8f);
+  const RgbImage image = renderer.render(level, p);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(image.pixel(p.width / 2, 1)[c], s.scene.sky.radiance[c], 1e-5f);
+    EXPECT_EQ(image.pixel(p.width / 2, p.height - 2)[c], 0.0f);
+  }
+}
+
 // The glTF sampler reaches the GL texture: a NEAREST magnification filter
 // keeps a two-texel texture's halves sharp where LINEAR blends them, as the
 // tracers' Texture::lookup does.
