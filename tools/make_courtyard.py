@@ -17,6 +17,10 @@ Contents (metres; +Y up):
 Every face is single-sided and wound outwards. The file stands alone (the
 buffer is a base64 data: URI); stdlib only.
 
+Beside it, data/courtyard-sky.hdr: a 64 x 32 equirectangular sky (Radiance
+RGBE) for `--sky-image` (docs/scene.md, "Sky"): blue overhead, paler and
+brighter towards the horizon, brightest around the sun's azimuth.
+
 Usage: python3 tools/make_courtyard.py [output.gltf]
 """
 
@@ -41,6 +45,40 @@ def box_faces(lo, hi):
         ((x0, y0, z1), (dx, 0, 0), (0, dy, 0)),   # +Z
         ((x0, y0, z0), (0, dy, 0), (dx, 0, 0)),   # -Z
     ]
+
+
+def write_sky_hdr(path, width=64, height=32, sun_azimuth=225.0):
+    """An equirectangular sky as Radiance RGBE, flat scanlines: row 0 at the
+    zenith, column u at azimuth 2 pi (u - 1/2) from -Z towards +X (as the
+    loader reads it); the lower half black (unused)."""
+    rows = []
+    for y in range(height):
+        theta = math.pi * (y + 0.5) / height
+        row = bytearray()
+        for x in range(width):
+            phi = 2 * math.pi * ((x + 0.5) / width - 0.5)
+            if theta >= math.pi / 2:
+                rgb = (0.0, 0.0, 0.0)
+            else:
+                horizon = (theta / (math.pi / 2)) ** 2  # 0 overhead, 1 at the horizon
+                # Brighter towards the sun's azimuth (travel azimuth 225: the
+                # sun itself stands at 45 degrees).
+                towards = 0.5 + 0.5 * math.cos(phi - math.radians(sun_azimuth - 180.0))
+                glow = 1.0 + 0.8 * towards * horizon
+                rgb = tuple(glow * (a + (b - a) * horizon) for a, b in
+                            ((0.06, 0.16), (0.10, 0.18), (0.22, 0.22)))
+            v = max(rgb)
+            if v < 1e-32:
+                row += bytes(4)
+            else:
+                m, e = math.frexp(v)
+                scale = m * 256.0 / v
+                row += bytes([min(255, int(c * scale)) for c in rgb] + [e + 128])
+        rows.append(bytes(row))
+    with open(path, "wb") as f:
+        f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (height, width))
+        for row in rows:
+            f.write(row)
 
 
 def cross(a, b):
@@ -155,6 +193,7 @@ def main():
     with open(out, "w") as f:
         json.dump(gltf, f, indent=1)
         f.write("\n")
+    write_sky_hdr(os.path.join(os.path.dirname(out), "courtyard-sky.hdr"))
 
 
 if __name__ == "__main__":

@@ -14,6 +14,10 @@ void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
                   "Light the scene with a uniform sky over the upper hemisphere (+Y): radiance "
                   "R,G,B in W/(m^2 sr) (an open surface under it receives pi times that, W/m^2); "
                   "0,0,0 turns the scene file's sky off (docs/scene.md, \"Sky\")");
+  cmd->add_option("--sky-image", opt.skyImage,
+                  "Light the scene with an equirectangular radiance map (.exr or .hdr, linear; "
+                  "its upper half, row 0 at the zenith), scaled by --sky (default 1,1,1)")
+      ->check(CLI::ExistingFile);
 }
 
 Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
@@ -27,8 +31,22 @@ Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
       }
     }
   }
+  std::shared_ptr<const Texture> image;
+  if (!opt.skyImage.empty()) {
+    try {
+      image = loadSkyImage(opt.skyImage);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--sky-image: ") + e.what());
+    }
+  }
   Scene scene = loadScene(path);
-  if (!opt.sky.empty()) scene.sky.radiance = sky;
+  if (image) {
+    scene.sky.image = std::move(image);
+    scene.sky.radiance = opt.sky.empty() ? Vec3{1, 1, 1} : sky;
+  } else if (!opt.sky.empty()) {
+    scene.sky.radiance = sky;
+    scene.sky.image.reset();
+  }
   return scene;
 }
 

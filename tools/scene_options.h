@@ -1,9 +1,10 @@
 #pragma once
 /// @file tools/scene_options.h
 /// @brief The flags every command that loads a scene shares: --sky R,G,B (a
-/// uniform sky over the upper hemisphere, scene/scene.h's Sky), which
-/// replaces the scene file's own `extras.lightoctree_sky`. One parser, so
-/// `bake`, `render`, `reference`, `lightmap` and `view` light a scene alike.
+/// uniform sky over the upper hemisphere, scene/scene.h's Sky) and
+/// --sky-image FILE (an equirectangular radiance map that --sky scales),
+/// which replace the scene file's own sky. One parser, so `bake`, `render`,
+/// `reference`, `lightmap` and `view` light a scene alike.
 
 #include <string>
 
@@ -16,10 +17,11 @@ class App;
 namespace lo::tool {
 
 struct SceneOptions {
-  std::string sky;  ///< "r,g,b" radiance W/(m^2 sr); empty = the file's
+  std::string sky;       ///< "r,g,b" radiance W/(m^2 sr); empty = the file's
+  std::string skyImage;  ///< .exr or .hdr equirectangular map; empty = the file's
 };
 
-/// Registers --sky on `cmd`.
+/// Registers --sky and --sky-image on `cmd`.
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt);
 
 /// loadScene(path) with the flags applied. @throws InputError naming the flag

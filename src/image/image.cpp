@@ -185,9 +185,19 @@ void writeImage(const std::string& path, const RgbImage& image, float exposureEv
 RgbImage readImage(const std::string& path, bool linear8Bit) {
   std::string ext = lowerExtension(path);
   if (ext == ".exr") return readExr(path);
+  if (ext == ".hdr") {
+    // Radiance RGBE: linear floats (stb applies no transfer curve to them).
+    int w = 0, h = 0, n = 0;
+    float* data = stbi_loadf(path.c_str(), &w, &h, &n, 3);
+    if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
+    RgbImage image(w, h);
+    std::copy(data, data + image.rgb.size(), image.rgb.begin());
+    stbi_image_free(data);
+    return image;
+  }
   if (ext != ".png" && ext != ".jpg" && ext != ".jpeg")
     throw InputError(path + ": unsupported image extension '" + ext +
-                     "' (expected .exr, .png or .jpg)");
+                     "' (expected .exr, .hdr, .png or .jpg)");
   int w = 0, h = 0, n = 0;
   unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 3);
   if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");

@@ -55,8 +55,9 @@ void writeExr(const std::string& path, const RgbImage& image);
 /// Writes radiance * 2^exposureEv, clamped, sRGB-encoded, 8-bit RGB.
 void writePng(const std::string& path, const RgbImage& image, float exposureEv = 0.0f);
 /// Reads an EXR's R, G, B channels (missing G/B copy R: single-channel masks
-/// written as Y or R work too) or a PNG/JPEG (8-bit, sRGB decoded to linear
-/// unless `linear8Bit`, in which case v/255). Dispatch by extension.
+/// written as Y or R work too), a Radiance .hdr (linear) or a PNG/JPEG
+/// (8-bit, sRGB decoded to linear unless `linear8Bit`, in which case v/255).
+/// Dispatch by extension.
 /// @throws InputError naming the file for an unknown extension or a failed read.
 RgbImage readImage(const std::string& path, bool linear8Bit = false);
 /// Dispatch by extension: .exr (linear, `exposureEv` ignored) or .png.

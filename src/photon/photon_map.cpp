@@ -71,6 +71,10 @@ struct Context {
   std::vector<Emitter> emitters;
   std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
   std::vector<LightFootprint> footprints;  ///< of the directional lights
+  /// A sky image's texels above the horizon, picked in proportion to their
+  /// mean radiance times the covered box's silhouette area and solid angle
+  /// (index y * width + x; cumulative, back() = total).
+  std::vector<double> skyCdf;
   Bounds3 bounds;
   Bounds3 region;       ///< photons stored only inside (empty: everywhere)
   Bounds3 emitBounds;   ///< what directional lights cover: the region, else the bounds
@@ -159,12 +163,59 @@ inline Vec3 startThroughBox(const Context& ctx, const Vec3& d, Rng& rng, float& 
   return q - d * (std::max(0.0f, exit) + 4.0f * ctx.epsilon);
 }
 
+/// 53 random bits as a double in [0, 1): a 24-bit float would never pick an
+/// entry whose share of a table is below 2^-24.
+inline double uniform53(Rng& rng) {
+  const uint64_t bits = (uint64_t(rng.next()) << 21) ^ uint64_t(rng.next());
+  return double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53;
+}
+
+/// The silhouette area of the covered box seen along d (unit).
+inline float boxSilhouette(const Bounds3& box, const Vec3& d) {
+  const Vec3 e = box.extent();
+  return std::fabs(d.x) * e.y * e.z + std::fabs(d.y) * e.x * e.z + std::fabs(d.z) * e.x * e.y;
+}
+
+/// A sky image's photon: a texel picked by Context::skyCdf, a direction
+/// uniform in its solid angle, a start through the covered box; the path
+/// carries L A(d) / pdf(d) of the sky's power (Sky::power sums the same
+/// over the texels' centres).
+inline bool emitFromSkyImage(const Context& ctx, const Emitter& e, Rng& rng, EmittedRay& out) {
+  const Texture& image = *ctx.scene->sky.image;
+  const int w = image.width, h = image.height;
+  const double total = ctx.skyCdf.back();
+  const double pick = uniform53(rng) * total;
+  size_t k = size_t(std::upper_bound(ctx.skyCdf.begin(), ctx.skyCdf.end(), pick) -
+                    ctx.skyCdf.begin());
+  k = std::min(k, ctx.skyCdf.size() - 1);
+  const double weight = ctx.skyCdf[k] - (k > 0 ? ctx.skyCdf[k - 1] : 0.0);
+  const int x = int(k % size_t(w)), y = int(k / size_t(w));
+  const float u1 = rng.uniform(), u2 = rng.uniform();
+  const float top = kPi * float(y) / float(h);
+  const float bottom = std::min(kPi * float(y + 1) / float(h), 0.5f * kPi);
+  const float cosTheta = std::cos(top) - u1 * (std::cos(top) - std::cos(bottom));
+  const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
+  const float phi = 2.0f * kPi * ((float(x) + u2) / float(w) - 0.5f);
+  const Vec3 towards{sinTheta * std::sin(phi), cosTheta, -sinTheta * std::cos(phi)};
+  const float omega = skyPixelSolidAngle(y, w, h);
+  const double pdf = weight / total / double(omega);
+  if (!(cosTheta > 0) || !(pdf > 0)) return false;
+  const Vec3 d = -towards;
+  float area = 0;
+  out.origin = startThroughBox(ctx, d, rng, area);
+  out.direction = d;
+  const Vec3 carried = ctx.scene->sky.radianceFrom(towards) * float(double(area) / pdf);
+  for (int c = 0; c < 3; ++c) {
+    out.power[c] = e.samplePower[c] > 0 ? out.power[c] * carried[c] / e.samplePower[c] : 0.0f;
+  }
+  out.storeFirstHit = true;
+  return true;
+}
+
 inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
   const Scene& scene = *ctx.scene;
-  // 53 random bits: a 24-bit float would never pick an emitter whose share of
-  // the power is below 2^-24 (scenes with millions of emissive triangles).
-  uint64_t bits = (uint64_t(rng.next()) << 21) ^ uint64_t(rng.next());
-  double pick = double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53 * ctx.emitterCdf.back();
+  // 53 random bits (scenes with millions of emissive triangles).
+  double pick = uniform53(rng) * ctx.emitterCdf.back();
   size_t k = size_t(std::upper_bound(ctx.emitterCdf.begin(), ctx.emitterCdf.end(), pick) -
                     ctx.emitterCdf.begin());
   k = std::min(k, ctx.emitters.size() - 1);
@@ -217,6 +268,7 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
       return true;
     }
     case Emitter::Kind::Sky: {
+      if (scene.sky.image) return emitFromSkyImage(ctx, e, rng, out);
       // A sky direction uniform over the upper hemisphere (pdf 1 / 2 pi),
       // then a start through the covered box's silhouette seen from it: the
       // path carries L A(d) 2 pi where Sky::power counts pi L S / 2 on
@@ -327,9 +379,16 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     if (int(bounce) >= ctx.maxBounces || rayCount > kMaxPathRays) return;
 
     Vec3 albedo = ctx.scene->albedo(hit.triangle, hit.b1, hit.b2);
+    // Scattering about the shading normal (vertex normals, the normal map),
+    // as the path tracer and the renderer shade; the stored photon keeps the
+    // geometric one, which the gather compares with the voxel's.
+    const Vec3 ns = ctx.scene->shadingNormal(hit.triangle, hit.b1, hit.b2, n);
     BsdfSample sample;
     // A lost sample (GGX reflection below the surface) is the lobe's energy loss.
-    if (!sampleBsdf(mat, albedo, wo, n, frontFace, rng, sample)) return;
+    if (!sampleBsdf(mat, albedo, wo, ns, frontFace, rng, sample)) return;
+    // An opaque surface's reflection below its geometric plane (a tilted
+    // shading normal) is lost too: no light through the surface.
+    if (mat.transmissionWeight <= 0 && !(dot(sample.wi, n) > 0)) return;
     const Vec3& tint = sample.weight;
     const Vec3& newDir = sample.wi;
     if (!roulette(rng, tint, power)) return;
@@ -389,6 +448,22 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
       throw InputError("the sky has non-finite power " + e.power.ToString());
     }
     if (average(e.power) > 0) ctx.emitters.push_back(e);
+    if (scene.sky.image) {
+      const Texture& image = *scene.sky.image;
+      const int w = image.width, h = image.height;
+      double total = 0;
+      for (int y = 0; y < h; ++y) {
+        const float omega = skyPixelSolidAngle(y, w, h);
+        if (!(omega > 0)) break;
+        for (int x = 0; x < w; ++x) {
+          const Vec3 d = skyPixelDirection(float(x) + 0.5f, float(y) + 0.5f, w, h);
+          const Vec3 l = scene.sky.radiance * image.texels[size_t(y) * size_t(w) + size_t(x)];
+          total += std::max(0.0, double(average(l)) * double(boxSilhouette(ctx.emitBounds, d)) *
+                                     double(omega));
+          ctx.skyCdf.push_back(total);
+        }
+      }
+    }
   }
   const EmitterSampler triangles = buildEmitterSampler(scene);
   for (size_t k = 0; k < triangles.size(); ++k) {

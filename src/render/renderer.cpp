@@ -84,6 +84,21 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.depthProgram = GlProgram(buildProgram({"render_depth.vert", "render_depth.frag"}));
   if (maxComponent(r.sky) > 0) {
     r.skyProgram = GlProgram(buildProgram({"render_fullscreen.vert", "render_sky.frag"}));
+    if (scene.sky.image) {
+      const Texture& image = *scene.sky.image;
+      r.skyImage = GlTexture::create();
+      glBindTexture(GL_TEXTURE_2D, r.skyImage.get());
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      // Float: a sun in a sky image exceeds half floats' 65504.
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, image.width, image.height, 0, GL_RGB, GL_FLOAT,
+                   image.texels.data());
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      glBindTexture(GL_TEXTURE_2D, 0);
+      checkGl("uploading the sky image");
+    }
   }
   r.uploadOctree(octree);
   r.geometry.upload(scene, r.space);

@@ -144,6 +144,7 @@ struct Renderer::Impl {
   render_internal::GlProgram sceneAtlasProgram, sceneIndirectAtlasProgram;
   render_internal::GlProgram depthProgram;
   render_internal::GlProgram skyProgram;  ///< the sky's background, built when the scene has one
+  render_internal::GlTexture skyImage;    ///< Sky::image (RGB32F), when the sky has one
   render_internal::SceneGeometry geometry;
   render_internal::SceneLights lights;
   render_internal::ReflectionProbe probe;

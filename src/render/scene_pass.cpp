@@ -319,6 +319,11 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
     glUniform3fv(glGetUniformLocation(program, "uUp"), 1, glm::value_ptr(upScaled));
     glUniform2f(glGetUniformLocation(program, "uViewport"), float(width), float(height));
     glUniform1i(glGetUniformLocation(program, "uEncodeSrgb"), encodeSrgb ? 1 : 0);
+    glUniform1i(glGetUniformLocation(program, "uHasSkyImage"), skyImage ? 1 : 0);
+    glUniform1i(glGetUniformLocation(program, "uSkyImage"), 11);
+    glActiveTexture(GL_TEXTURE11);
+    glBindTexture(GL_TEXTURE_2D, skyImage ? skyImage.get() : 0);
+    glActiveTexture(GL_TEXTURE0);
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_FALSE);
     glBindVertexArray(geometry.emptyVao.get());

@@ -537,14 +537,31 @@ class SceneBuilder {
   }
 
   /// The sky: the glTF scene's `"extras": {"lightoctree_sky": [r, g, b]}`,
-  /// radiance in W/(m^2 sr) (no glTF extension describes a uniform sky;
-  /// docs/scene.md, "Sky").
+  /// radiance in W/(m^2 sr), and `"lightoctree_sky_image": "sky.hdr"`, an
+  /// equirectangular map beside the file that the colour then scales (no
+  /// glTF extension describes a sky's radiance; docs/scene.md, "Sky").
   void readSky() {
     const auto& scenes = model_.scenes;
     const int s = model_.defaultScene >= 0 ? model_.defaultScene : scenes.empty() ? -1 : 0;
     if (s < 0 || size_t(s) >= scenes.size()) return;
     const tinygltf::Value& extras = scenes[size_t(s)].extras;
-    if (!extras.IsObject() || !extras.Has("lightoctree_sky")) return;
+    if (!extras.IsObject()) return;
+    if (extras.Has("lightoctree_sky_image")) {
+      // An equirectangular radiance map beside the file (.exr or .hdr).
+      const tinygltf::Value& uri = extras.Get("lightoctree_sky_image");
+      const std::string what = "scene " + std::to_string(s) + ": extras.lightoctree_sky_image";
+      if (!uri.IsString()) fail(path_, what + " must be a file name (.exr or .hdr)");
+      std::string base = std::filesystem::path(path_).parent_path().string();
+      if (base.empty()) base = ".";
+      const std::string file = resolveInsideFolder(path_, base, uri.Get<std::string>(), what);
+      try {
+        scene_.sky.image = loadSkyImage(file);
+      } catch (const InputError& e) {
+        fail(path_, what + ": " + e.what());
+      }
+      scene_.sky.radiance = Vec3{1, 1, 1};  // unless lightoctree_sky scales it
+    }
+    if (!extras.Has("lightoctree_sky")) return;
     const tinygltf::Value& v = extras.Get("lightoctree_sky");
     const std::string what = "scene " + std::to_string(s) + ": extras.lightoctree_sky";
     if (!v.IsArray() || v.ArrayLen() != 3) {

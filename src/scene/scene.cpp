@@ -114,11 +114,84 @@ Vec3 Light::power(const Bounds3& sceneBounds) const {
   return {};
 }
 
+void skyPixelOf(const Vec3& towards, int w, int h, int& x, int& y) {
+  const float u = 0.5f + std::atan2(towards.x, -towards.z) / (2.0f * kPi);
+  const float v = std::acos(std::clamp(towards.y, -1.0f, 1.0f)) / kPi;
+  x = std::clamp(int(u * float(w)), 0, w - 1);
+  y = std::clamp(int(v * float(h)), 0, h - 1);
+}
+
+Vec3 skyPixelDirection(float x, float y, int w, int h) {
+  const float theta = kPi * y / float(h), phi = 2.0f * kPi * (x / float(w) - 0.5f);
+  const float s = std::sin(theta);
+  return {s * std::sin(phi), std::cos(theta), -s * std::cos(phi)};
+}
+
+float skyPixelSolidAngle(int y, int w, int h) {
+  const float top = kPi * float(y) / float(h);
+  const float bottom = std::min(kPi * float(y + 1) / float(h), 0.5f * kPi);
+  if (!(bottom > top)) return 0.0f;
+  return 2.0f * kPi / float(w) * (std::cos(top) - std::cos(bottom));
+}
+
+std::shared_ptr<const Texture> loadSkyImage(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  if (ext != ".exr" && ext != ".hdr") {
+    throw InputError(path + ": a sky image must be linear radiance: .exr or .hdr, not '" + ext +
+                     "'");
+  }
+  const RgbImage image = readImage(path);
+  if (image.width < 2 || image.height < 2 || image.width > 16384 || image.height > 8192) {
+    throw InputError(path + ": a sky image must be 2 x 2 to 16384 x 8192 texels, not " +
+                     std::to_string(image.width) + " x " + std::to_string(image.height));
+  }
+  auto texture = std::make_shared<Texture>();
+  texture->name = path;
+  texture->width = image.width;
+  texture->height = image.height;
+  texture->texels.resize(size_t(image.width) * size_t(image.height));
+  for (size_t i = 0; i < texture->texels.size(); ++i) {
+    const Vec3 v{image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]};
+    if (!isFinite(v) || v.x < 0 || v.y < 0 || v.z < 0) {
+      throw InputError(path + ": texel " + std::to_string(i % size_t(image.width)) + ", " +
+                       std::to_string(i / size_t(image.width)) + " is " + v.ToString() +
+                       ": a radiance is finite and not negative");
+    }
+    texture->texels[i] = v;
+  }
+  return texture;
+}
+
+Vec3 Sky::radianceFrom(const Vec3& towards) const {
+  if (!(towards.y > 0)) return {0, 0, 0};
+  if (!image) return radiance;
+  int x = 0, y = 0;
+  skyPixelOf(towards, image->width, image->height, x, y);
+  return radiance * image->texels[size_t(y) * size_t(image->width) + size_t(x)];
+}
+
 Vec3 Sky::power(const Bounds3& box) const {
   if (box.empty()) return {0, 0, 0};
   const Vec3 e = box.extent();
-  const float surface = 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
-  return radiance * (0.5f * kPi * surface);
+  if (!image) {
+    const float surface = 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
+    return radiance * (0.5f * kPi * surface);
+  }
+  // The box's silhouette area seen from each texel's centre, times its
+  // radiance and solid angle.
+  const int w = image->width, h = image->height;
+  Vec3d sum(0, 0, 0);
+  for (int y = 0; y < h; ++y) {
+    const float omega = skyPixelSolidAngle(y, w, h);
+    if (!(omega > 0)) break;
+    for (int x = 0; x < w; ++x) {
+      const Vec3 d = skyPixelDirection(float(x) + 0.5f, float(y) + 0.5f, w, h);
+      const float area = std::fabs(d.x) * e.y * e.z + std::fabs(d.y) * e.x * e.z +
+                         std::fabs(d.z) * e.x * e.y;
+      sum = sum + Vec3d(image->texels[size_t(y) * size_t(w) + size_t(x)] * (area * omega));
+    }
+  }
+  return radiance * Vec3{float(sum.x), float(sum.y), float(sum.z)};
 }
 
 std::string Light::ToString() const {

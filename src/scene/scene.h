@@ -13,6 +13,7 @@
 /// that a 1 cd point light and a 1 W/(m^2 sr) emitter are in the same units.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -161,21 +162,39 @@ struct Light {
 /// nothing). Read from the glTF scene's `extras.lightoctree_sky` or set by
 /// the commands' --sky flag (docs/scene.md, "Sky").
 struct Sky {
-  Vec3 radiance{0, 0, 0};  ///< W/(m^2 sr), linear RGB; zero = no sky
+  /// W/(m^2 sr), linear RGB: the uniform sky's radiance, or the image's
+  /// multiplier; zero = no sky.
+  Vec3 radiance{0, 0, 0};
+  /// An equirectangular (latitude-longitude) radiance map, linear RGB: row 0
+  /// looks at the zenith (+Y), the middle row at the horizon, column u at the
+  /// azimuth 2 pi (u - 1/2) from -Z towards +X (skyPixelDirection). Its upper
+  /// half is used, texel by texel (no filtering: the photon tracer samples
+  /// the texels exactly). Null: a uniform sky.
+  std::shared_ptr<const Texture> image;
 
   bool present() const { return maxComponent(radiance) > 0; }
   /// Radiance arriving from direction `towards` (unit, pointing at the sky).
-  Vec3 radianceFrom(const Vec3& towards) const {
-    return towards.y > 0 ? radiance : Vec3{0, 0, 0};
-  }
-  /// Irradiance on an unoccluded surface facing straight up: pi L.
-  Vec3 zenithIrradiance() const { return radiance * kPi; }
-  /// Total power entering `box` through its faces: L times the integral
-  /// over the sky's directions of the box's projected area, pi L S / 2 for a
-  /// box of surface area S (each face sees the sky's cosine integral, pi,
-  /// over its half of the directions).
+  Vec3 radianceFrom(const Vec3& towards) const;
+  /// Total power entering `box` through its faces: the integral over the
+  /// sky's directions of L times the box's projected area; for a uniform sky
+  /// pi L S / 2, S the box's surface area (each face sees the sky's cosine
+  /// integral, pi, over its half of the directions); for an image, the sum
+  /// over its texels.
   Vec3 power(const Bounds3& box) const;
 };
+
+/// A sky image (Sky::image) from an .exr or .hdr file of linear radiance.
+/// @throws InputError naming `path` when it cannot be read, is smaller than
+/// 2 x 2 or larger than 16384 x 8192, or holds a negative or non-finite value.
+std::shared_ptr<const Texture> loadSkyImage(const std::string& path);
+
+/// The texel (x, y) of a w x h sky image that direction `towards` looks at.
+void skyPixelOf(const Vec3& towards, int w, int h, int& x, int& y);
+/// The direction at (x + fx, y + fy) of a w x h sky image (fx, fy in [0, 1]).
+Vec3 skyPixelDirection(float x, float y, int w, int h);
+/// The solid angle of row y's texels of a w x h sky image, above the horizon
+/// only (0 for rows below it).
+float skyPixelSolidAngle(int y, int w, int h);
 
 /// A perspective camera in world space.
 struct Camera {

@@ -10,6 +10,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -488,6 +489,34 @@ TEST(Photons, DirectionalLightFluxThroughFloor) {
   EXPECT_NEAR(sum, sun.intensity * 4.0, 4.0 * stdErr + full / double(map.emittedPaths));
 }
 
+TEST(Photons, SkyImageLightsAnOpenFloorWithItsCosineIntegral) {
+  // An 8 x 8 sky image: radiance 4 within 45 degrees of the zenith (rows 0
+  // and 1), 1 down to the horizon (rows 2 and 3), a colour below (unused).
+  // An open floor receives E = 4 pi sin^2(45) + pi cos^2(45) = 2.5 pi, over
+  // its 4 m^2.
+  Scene scene;
+  int floor = addMaterial(scene, {0, 0, 0});
+  addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, floor);
+  auto image = std::make_shared<Texture>();
+  image->width = image->height = 8;
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 8; ++x) image->texels.push_back(Vec3(y < 2 ? 4.0f : y < 4 ? 1.0f : 7.0f));
+  }
+  scene.sky.image = image;
+  scene.sky.radiance = {1.0f, 0.5f, 0.25f};  // scales the image
+  PhotonParams params;
+  params.storedPhotons = 60000;
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  EXPECT_EQ(map.emptyPaths, 0u);
+  Dvec3 sum;
+  for (const Photon& p : map.photons) sum.add(p.power);
+  for (int c = 0; c < 3; ++c) {
+    const double expected = 2.5 * kPi * 4.0 * scene.sky.radiance[c];
+    EXPECT_NEAR(sum.v[c], expected, 0.02 * expected) << "channel " << c;
+  }
+}
+
 TEST(Photons, TiltedSunOverATallBoxSpendsNoPathBesideTheScene) {
   // A 2 x 2 black floor with a 1 x 1 x 8 black tower on it, the sun 40
   // degrees above the horizon: the covered box is tall, and photons started
@@ -552,6 +581,61 @@ TEST(Photons, SkyLightsAnOpenFloorWithPiL) {
     const double expected = kPi * scene.sky.radiance[c] * 4.0;
     EXPECT_NEAR(sum.v[c], expected, 4.0 * 0.58 * expected / std::sqrt(double(map.emittedPaths)));
   }
+}
+
+/// The power stored on a wall at x = 1 (bounce 1 and later) from light a
+/// floor reflects, the floor's shading normal tilted 35 degrees towards the
+/// wall: by its vertex normals (`tilt` 1), by a constant normal map (2), or
+/// not at all (0).
+double wallPowerFromATiltedFloor(int tilt) {
+  Scene scene;
+  const int floor = addMaterial(scene, {0.8f, 0.8f, 0.8f});
+  const int wall = addMaterial(scene, {0, 0, 0});
+  addQuad(scene, {-1, 0, -1}, {0, 0, 2}, {2, 0, 0}, {0, 1, 0}, floor);
+  addQuad(scene, {1, 0, -1}, {0, 2, 0}, {0, 0, 2}, {-1, 0, 0}, wall);
+  const float angle = 35.0f * kPi / 180.0f;
+  const Vec3 tilted{std::sin(angle), std::cos(angle), 0.0f};
+  scene.normals.assign(scene.positions.size(), Vec3{0, 0, 0});
+  for (size_t v = 0; v < 4; ++v) scene.normals[v] = tilt == 1 ? tilted : Vec3{0, 1, 0};
+  for (size_t v = 4; v < 8; ++v) scene.normals[v] = Vec3{-1, 0, 0};
+  if (tilt == 2) {
+    // u along +x: tangent +x, bitangent cross(+y, +x) = -z; the map's
+    // tangent-space normal (sin, 0, cos) is the same tilt towards +x.
+    scene.texcoords0.assign(2 * scene.positions.size(), 0.0f);
+    for (size_t v = 0; v < 4; ++v) {
+      scene.texcoords0[2 * v] = 0.5f * (scene.positions[v].x + 1.0f);
+      scene.texcoords0[2 * v + 1] = 0.5f * (scene.positions[v].z + 1.0f);
+    }
+    Texture map;
+    map.width = map.height = 1;
+    map.texels = {Vec3{0.5f * (std::sin(angle) + 1.0f), 0.5f, 0.5f * (std::cos(angle) + 1.0f)}};
+    scene.textures.push_back(map);
+    scene.materials[size_t(floor)].normalTexture = 0;
+  }
+  scene.lights.push_back(pointLight({-0.5f, 1.0f, 0.0f}, {1, 1, 1}, 5.0f));
+  PhotonParams params;
+  params.storedPhotons = 200000;
+  PhotonMap map = tracePhotons(scene, params);
+  double power = 0;
+  for (const Photon& p : map.photons) {
+    if (p.position.x > 0.999f && p.bounce >= 1) power += p.power.x;
+  }
+  return power;
+}
+
+TEST(Photons, NormalMapTiltsTheScatteringAsVertexNormalsDo) {
+  // The photon tracer scatters about the shading normal, as the path tracer
+  // and the renderer shade: a floor whose normal map tilts it towards a
+  // wall sends the wall what the same tilt in its vertex normals sends, and
+  // clearly more than the untilted floor.
+  const double byVertexNormals = wallPowerFromATiltedFloor(1);
+  const double byNormalMap = wallPowerFromATiltedFloor(2);
+  const double untilted = wallPowerFromATiltedFloor(0);
+  std::printf("wall power: normal map %.4f, vertex normals %.4f, untilted %.4f\n", byNormalMap,
+              byVertexNormals, untilted);
+  EXPECT_NEAR(byNormalMap, byVertexNormals, 0.03 * byVertexNormals);
+  EXPECT_GT(byVertexNormals, 1.15 * untilted)
+      << "tilted " << byVertexNormals << ", untilted " << untilted;
 }
 
 struct RecordingSink : ProgressSink {

@@ -130,6 +130,34 @@ TEST(Reference, SkyOverAnOpenFloorGivesAlbedoTimesL) {
   for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(up.image.rgb[size_t(c)], scene.sky.radiance[c]);
 }
 
+TEST(Reference, SkyImageOverAnOpenFloorGivesAlbedoTimesItsIrradiance) {
+  // The image of Photons.SkyImageLightsAnOpenFloorWithItsCosineIntegral:
+  // E = 2.5 pi, so a Lambert floor of albedo a has radiance 2.5 a.
+  Scene scene;
+  const int floor = addMaterial(scene, Vec3(0.5f));
+  addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, 1, 0}, floor);
+  auto image = std::make_shared<Texture>();
+  image->width = image->height = 8;
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 8; ++x) image->texels.push_back(Vec3(y < 2 ? 4.0f : y < 4 ? 1.0f : 7.0f));
+  }
+  scene.sky.image = image;
+  scene.sky.radiance = {1, 1, 1};
+  ReferenceParams params;
+  params.width = params.height = 8;
+  params.samplesPerPixel = 512;
+  params.seed = 5;
+  const ReferenceImage r =
+      renderReference(scene, PinholeCamera::lookAt({0.01f, 1, 0}, {0, 0, 0}, 0.5f), params);
+  double mean = 0, se = 0;
+  imageMean(r, 0, mean, se);
+  EXPECT_NEAR(mean, 2.5 * 0.5, 5.0 * se + 1e-5);
+  // Looking up, the camera sees the zenith's texels.
+  const ReferenceImage up =
+      renderReference(scene, PinholeCamera::lookAt({0, 1, 0}, {0.01f, 2, 0}, 0.2f), params);
+  EXPECT_FLOAT_EQ(up.image.rgb[0], 4.0f);
+}
+
 TEST(Reference, FurnaceFarFromTheOriginKeepsItsRadiance) {
   // A 2 m furnace 1e5 m away: float spacing there is 0.008 m, so tracing in
   // world coordinates would lose the walls; the renderer traces around the
