@@ -49,4 +49,12 @@ class Rng {
   uint64_t inc_ = 1;
 };
 
+/// 53 random bits as a double in [0, 1) (two draws): for picking from tables
+/// whose entries' shares can be below a float's 2^-24 (millions of emissive
+/// triangles, a sky image's texels).
+inline double uniform53(Rng& rng) {
+  const uint64_t bits = (uint64_t(rng.next()) << 21) ^ uint64_t(rng.next());
+  return double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53;
+}
+
 }  // namespace lo

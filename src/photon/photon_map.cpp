@@ -25,6 +25,7 @@
 #include "photon/light_footprint.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/emitter_sampler.h"
+#include "scene/sky_sampler.h"
 
 namespace lo {
 
@@ -71,10 +72,9 @@ struct Context {
   std::vector<Emitter> emitters;
   std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
   std::vector<LightFootprint> footprints;  ///< of the directional lights
-  /// A sky image's texels above the horizon, picked in proportion to their
-  /// mean radiance times the covered box's silhouette area and solid angle
-  /// (index y * width + x; cumulative, back() = total).
-  std::vector<double> skyCdf;
+  /// A sky image's directions, its texels weighted by the covered box's
+  /// silhouette seen from them.
+  SkySampler skySampler;
   Bounds3 bounds;
   Bounds3 region;       ///< photons stored only inside (empty: everywhere)
   Bounds3 emitBounds;   ///< what directional lights cover: the region, else the bounds
@@ -163,48 +163,27 @@ inline Vec3 startThroughBox(const Context& ctx, const Vec3& d, Rng& rng, float& 
   return q - d * (std::max(0.0f, exit) + 4.0f * ctx.epsilon);
 }
 
-/// 53 random bits as a double in [0, 1): a 24-bit float would never pick an
-/// entry whose share of a table is below 2^-24.
-inline double uniform53(Rng& rng) {
-  const uint64_t bits = (uint64_t(rng.next()) << 21) ^ uint64_t(rng.next());
-  return double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53;
-}
-
 /// The silhouette area of the covered box seen along d (unit).
 inline float boxSilhouette(const Bounds3& box, const Vec3& d) {
   const Vec3 e = box.extent();
   return std::fabs(d.x) * e.y * e.z + std::fabs(d.y) * e.x * e.z + std::fabs(d.z) * e.x * e.y;
 }
 
-/// A sky image's photon: a texel picked by Context::skyCdf, a direction
-/// uniform in its solid angle, a start through the covered box; the path
-/// carries L A(d) / pdf(d) of the sky's power (Sky::power sums the same
-/// over the texels' centres).
+/// A sky image's photon: a direction from Context::skySampler (texels by
+/// radiance times the covered box's silhouette and solid angle), a start
+/// through the box; the path carries L A(d) / pdf(d) of the sky's power
+/// (Sky::power sums the same over the texels' centres).
 inline bool emitFromSkyImage(const Context& ctx, const Emitter& e, Rng& rng, EmittedRay& out) {
-  const Texture& image = *ctx.scene->sky.image;
-  const int w = image.width, h = image.height;
-  const double total = ctx.skyCdf.back();
-  const double pick = uniform53(rng) * total;
-  size_t k = size_t(std::upper_bound(ctx.skyCdf.begin(), ctx.skyCdf.end(), pick) -
-                    ctx.skyCdf.begin());
-  k = std::min(k, ctx.skyCdf.size() - 1);
-  const double weight = ctx.skyCdf[k] - (k > 0 ? ctx.skyCdf[k - 1] : 0.0);
-  const int x = int(k % size_t(w)), y = int(k / size_t(w));
+  const double u0 = uniform53(rng);
   const float u1 = rng.uniform(), u2 = rng.uniform();
-  const float top = kPi * float(y) / float(h);
-  const float bottom = std::min(kPi * float(y + 1) / float(h), 0.5f * kPi);
-  const float cosTheta = std::cos(top) - u1 * (std::cos(top) - std::cos(bottom));
-  const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
-  const float phi = 2.0f * kPi * ((float(x) + u2) / float(w) - 0.5f);
-  const Vec3 towards{sinTheta * std::sin(phi), cosTheta, -sinTheta * std::cos(phi)};
-  const float omega = skyPixelSolidAngle(y, w, h);
-  const double pdf = weight / total / double(omega);
-  if (!(cosTheta > 0) || !(pdf > 0)) return false;
+  Vec3 towards;
+  float pdf = 0;
+  if (!ctx.skySampler.sample(u0, u1, u2, towards, pdf)) return false;
   const Vec3 d = -towards;
   float area = 0;
   out.origin = startThroughBox(ctx, d, rng, area);
   out.direction = d;
-  const Vec3 carried = ctx.scene->sky.radianceFrom(towards) * float(double(area) / pdf);
+  const Vec3 carried = ctx.scene->sky.radianceFrom(towards) * float(double(area) / double(pdf));
   for (int c = 0; c < 3; ++c) {
     out.power[c] = e.samplePower[c] > 0 ? out.power[c] * carried[c] / e.samplePower[c] : 0.0f;
   }
@@ -449,20 +428,9 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
     }
     if (average(e.power) > 0) ctx.emitters.push_back(e);
     if (scene.sky.image) {
-      const Texture& image = *scene.sky.image;
-      const int w = image.width, h = image.height;
-      double total = 0;
-      for (int y = 0; y < h; ++y) {
-        const float omega = skyPixelSolidAngle(y, w, h);
-        if (!(omega > 0)) break;
-        for (int x = 0; x < w; ++x) {
-          const Vec3 d = skyPixelDirection(float(x) + 0.5f, float(y) + 0.5f, w, h);
-          const Vec3 l = scene.sky.radiance * image.texels[size_t(y) * size_t(w) + size_t(x)];
-          total += std::max(0.0, double(average(l)) * double(boxSilhouette(ctx.emitBounds, d)) *
-                                     double(omega));
-          ctx.skyCdf.push_back(total);
-        }
-      }
+      const Bounds3 box = ctx.emitBounds;
+      ctx.skySampler =
+          SkySampler(scene.sky, [box](const Vec3& d) { return boxSilhouette(box, d); });
     }
   }
   const EmitterSampler triangles = buildEmitterSampler(scene);

@@ -21,6 +21,7 @@
 #include "material/bsdf.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/emitter_sampler.h"
+#include "scene/sky_sampler.h"
 
 namespace lo {
 
@@ -63,6 +64,7 @@ struct Context {
   std::vector<float>
       emitterPickPdf;  ///< per triangle: pick probability / area (0 = not an emitter)
   std::vector<const Light*> lights;  ///< punctual lights with positive intensity
+  SkySampler sky;                    ///< the sky's directions by radiance (empty: no sky)
   float epsilon = 0;
   int maxBounces = 0;
   int rouletteStart = 0;
@@ -104,7 +106,7 @@ inline Vec3 offsetOrigin(const Context& ctx, const Vec3& p, const Vec3& normal, 
 /// alone estimates the integral: DirectIrradiance).
 inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, const Vec3& n,
                          const Vec3& wo, const BsdfLobes& lobes, const Vec3& albedo, Rng& rng,
-                         uint32_t& rays, bool misWeights = true) {
+                         uint32_t& rays, bool misWeights = true, bool withSky = true) {
   Vec3 sum{0, 0, 0};
   for (const Light* light : ctx.lights) {
     Vec3 wi;
@@ -137,9 +139,7 @@ inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, 
 
   if (!ctx.emitters.empty()) {
     const Scene& scene = *ctx.scene;
-    uint64_t bits = (uint64_t(rng.next()) << 21) ^ uint64_t(rng.next());
-    uint32_t tri = ctx.emitters.triangles[ctx.emitters.pick(
-        double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53)];
+    uint32_t tri = ctx.emitters.triangles[ctx.emitters.pick(uniform53(rng))];
     float s = std::sqrt(rng.uniform());
     float b1 = 1.0f - s, b2 = rng.uniform() * s;
     const Vec3& p0 = scene.positions[scene.indices[3 * tri]];
@@ -173,6 +173,27 @@ inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, 
       }
     }
   }
+
+  // The sky: one direction by its radiance, MIS-weighted against BSDF
+  // sampling (which finds it where a path escapes, tracePath).
+  if (withSky && !ctx.sky.empty()) {
+    const double u0 = uniform53(rng);
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    Vec3 towards;
+    float pdfSky = 0;
+    if (ctx.sky.sample(u0, u1, u2, towards, pdfSky) && dot(towards, normal) > 0) {
+      const Vec3 f = evalBsdf(lobes, albedo, wo, towards, n);
+      const Vec3 l = ctx.scene->sky.radianceFrom(towards);
+      if (maxComponent(f) > 0 && maxComponent(l) > 0) {
+        const float w = powerHeuristic(pdfSky, pdfBsdf(lobes, albedo, wo, towards, n));
+        ++rays;
+        if (!ctx.tracer->occluded(offsetOrigin(ctx, p, normal, towards), towards,
+                                  std::numeric_limits<float>::infinity())) {
+          sum += f * l * (w / pdfSky);
+        }
+      }
+    }
+  }
   return sum;
 }
 
@@ -187,12 +208,14 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
   for (int depth = 1;; ++depth) {
     ++out.rays;
     if (!ctx.tracer->intersect(org, dir, hit)) {
-      // Escaped: the sky's light (BSDF sampling alone finds it: the sky is
-      // smooth, no light sample is taken of it). Seen by the camera it is
-      // the background; at vertex 2 it is direct light of vertex 1.
+      // Escaped: the sky's light, MIS-weighted against the sky's light
+      // sample at the previous vertex (none after a mirror or glass). Seen by
+      // the camera it is the background; at vertex 2 it is direct light of
+      // vertex 1.
       const Vec3 sky = ctx.scene->sky.radianceFrom(dir);
       if (maxComponent(sky) > 0) {
-        (depth == 1 ? out.emitted : depth == 2 ? out.direct : out.indirect) += beta * sky;
+        const float w = prevDelta ? 1.0f : powerHeuristic(prevPdf, ctx.sky.pdf(dir));
+        (depth == 1 ? out.emitted : depth == 2 ? out.direct : out.indirect) += beta * sky * w;
       }
       break;
     }
@@ -300,6 +323,7 @@ void buildContext(const Scene& scene, const ReferenceParams& params, Context& ct
   }
   ctx.emitters = buildEmitterSampler(scene);
   ctx.emitterPickPdf = ctx.emitters.areaPdfs(scene);
+  ctx.sky = SkySampler(scene.sky);
   for (const Light& light : scene.lights)
     if (light.intensity > 0 && maxComponent(light.color) > 0) ctx.lights.push_back(&light);
   Bounds3 bounds = scene.bounds();
@@ -496,8 +520,9 @@ Vec3 DirectIrradiance::at(const Vec3& p, uint32_t triangle, const Vec3& n, int s
   const int count = std::max(samples, 1);
   Vec3 sum{0, 0, 0};
   for (int i = 0; i < count; ++i) {
+    // The sky is not direct light here: the octree carries all of it.
     sum += reference_internal::sampleLights(ctx, p, normal, n, n, lambert, albedo, rng, rays,
-                                            /*misWeights=*/false);
+                                            /*misWeights=*/false, /*withSky=*/false);
   }
   return sum / float(count);
 }

@@ -76,8 +76,9 @@ ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
 /// rays, by the path tracer's own light sampling: punctual lights exactly,
 /// emissive triangles by `samples` samples, each an emitter picked by power
 /// (mean emission x area) and a uniform point on it (emissive textures and
-/// one-sided emission as the path tracer reads them). For lightmaps that
-/// hold the direct light too (`lightmap --content full`). Thread-safe.
+/// one-sided emission as the path tracer reads them). Not the sky's: the
+/// bake stores all of its light in the octree. For lightmaps that hold the
+/// direct light too (`lightmap --content full`). Thread-safe.
 class DirectIrradiance {
  public:
   /// @throws InputError for bad scene indices; builds an Embree scene.

@@ -13,6 +13,8 @@
 
 #include "test_util.h"
 #include "core/file.h"
+#include "core/rng.h"
+#include "scene/sky_sampler.h"
 #include "core/error.h"
 #include "scene/scene.h"
 
@@ -1090,6 +1092,71 @@ TEST(SceneTexture, SamplerFiltersAndWrapsAsGltfSays) {
   EXPECT_EQ(m.lookup(-0.25f, 0.25f).x, 0.0f);
   // Non-finite or huge coordinates stay inside the texture.
   EXPECT_TRUE(isFinite(b.lookup(NAN, 1e30f)));
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+TEST(SkySampler, DensityIntegratesToOneAndMatchesItsDraws) {
+  // A 16 x 8 sky image with one bright texel (a sun) and a dim rest: the
+  // density over the upper hemisphere integrates to 1, the draws report the
+  // density pdf() gives their direction, and the sun's texel gets its share.
+  auto image = std::make_shared<Texture>();
+  image->width = 16;
+  image->height = 8;
+  image->texels.assign(16 * 8, Vec3(0.2f));
+  image->texels[2 * 16 + 5] = Vec3(500.0f);
+  Sky sky;
+  sky.image = image;
+  sky.radiance = {1, 1, 1};
+  const SkySampler sampler(sky);
+  ASSERT_FALSE(sampler.empty());
+  double integral = 0;
+  const int steps = 512;
+  for (int i = 0; i < steps; ++i) {
+    const float y = (float(i) + 0.5f) / float(steps);  // cos theta, uniform in solid angle
+    for (int j = 0; j < 2 * steps; ++j) {
+      const float phi = 2.0f * kPi * (float(j) + 0.5f) / float(2 * steps);
+      const float r = std::sqrt(1.0f - y * y);
+      integral += sampler.pdf(Vec3(r * std::cos(phi), y, r * std::sin(phi)));
+    }
+  }
+  integral *= 2.0 * kPi / (double(steps) * double(2 * steps));
+  EXPECT_NEAR(integral, 1.0, 0.01);
+  Rng rng(3, 9);
+  int sun = 0;
+  const int draws = 20000;
+  for (int i = 0; i < draws; ++i) {
+    const double u0 = uniform53(rng);
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    Vec3 towards;
+    float pdf = 0;
+    ASSERT_TRUE(sampler.sample(u0, u1, u2, towards, pdf));
+    ASSERT_GT(towards.y, 0.0f);
+    EXPECT_NEAR(sampler.pdf(towards), pdf, 1e-3f * pdf);
+    int x = 0, y = 0;
+    skyPixelOf(towards, 16, 8, x, y);
+    sun += x == 5 && y == 2;
+  }
+  // The sun texel's share of radiance x solid angle.
+  double total = 0, sunShare = 0;
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 16; ++x) {
+      const double w = average(image->texels[size_t(y * 16 + x)]) * skyPixelSolidAngle(y, 16, 8);
+      total += w;
+      if (x == 5 && y == 2) sunShare = w;
+    }
+  }
+  EXPECT_NEAR(double(sun) / draws, sunShare / total, 0.01);
+  // A uniform sky: the upper hemisphere, 1 / 2 pi.
+  Sky uniform;
+  uniform.radiance = {1, 1, 1};
+  EXPECT_FLOAT_EQ(SkySampler(uniform).pdf(Vec3(0, 1, 0)), 1.0f / (2.0f * kPi));
+  EXPECT_EQ(SkySampler(uniform).pdf(Vec3(0, -1, 0)), 0.0f);
+  EXPECT_TRUE(SkySampler(Sky{}).empty());
 }
 
 }  // namespace
