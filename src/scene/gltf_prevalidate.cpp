@@ -128,11 +128,9 @@ void prevalidateJson(const std::string& path, const std::string& baseDir, const 
       if (uri == im.end() || !uri->is_string()) continue;
       std::string u = uri->get<std::string>();
       if (isDataUri(u)) continue;
-      std::string file = resolveInsideFolder(path, baseDir, percentDecode(u), what);
-      std::error_code ec;
-      if (!fs::is_regular_file(file, ec)) {
-        fail(path, "unreadable image: missing image file '" + u + "' (" + what + ", not found)");
-      }
+      // Inside the folder, or refused; a missing file is the loader's
+      // warning (the materials keep their factors), not an error.
+      resolveInsideFolder(path, baseDir, percentDecode(u), what);
     }
   }
 }

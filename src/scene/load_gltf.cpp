@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -515,6 +516,20 @@ class SceneBuilder {
     auto it = imageToTexture_.find(key);
     if (it != imageToTexture_.end()) return it->second;
     const tinygltf::Image& im = model_.images[size_t(source)];
+    if (im.image.empty() && !im.uri.empty() && im.uri.rfind("data:", 0) != 0) {
+      // A file the folder does not hold (an asset copied without all of its
+      // textures): the materials show their factors; the user hears it once.
+      std::error_code ec;
+      const fs::path file = fs::path(path_).parent_path() / percentDecode(im.uri);
+      if (!fs::is_regular_file(file, ec)) {
+        if (missingImages_.insert(source).second) {
+          scene_.warnings.push_back(path_ + ": texture image '" + im.uri + "' " + what +
+                                    " is missing; the materials using it show their factors "
+                                    "alone");
+        }
+        return -1;
+      }
+    }
     if (im.image.empty()) fail(path_, "unreadable image: no data " + what);
     Texture t = decodeImage(path_, im.image.data(), im.image.size(), what, srgb);
     t.sampler = key.sampler;
@@ -941,6 +956,7 @@ class SceneBuilder {
     }
   };
   std::map<TextureKey, int> imageToTexture_;
+  std::set<int> missingImages_;  ///< images whose file is missing, warned once
   int defaultMaterial_ = -1;
   bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false;
 };

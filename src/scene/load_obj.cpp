@@ -150,7 +150,12 @@ Scene loadObj(const std::string& path) {
         std::string file = resolveInsideFolder(path, baseDir, o.diffuse_texname, what);
         std::error_code ec;
         if (!fs::is_regular_file(file, ec)) {
-          fail(path, "unreadable image: missing texture file " + what + " (not found)");
+          // Warned once; the materials that use it show their Kd alone.
+          scene.warnings.push_back(path + ": texture file " + what +
+                                   " is missing; the materials using it show their Kd alone");
+          textureByFile[o.diffuse_texname] = -1;
+          scene.materials.push_back(std::move(m));
+          continue;
         }
         std::vector<unsigned char> bytes = readFileBytes(path, file, "texture");
         Texture t = decodeImage(path, bytes.data(), bytes.size(), "(" + what + ")");

@@ -734,9 +734,25 @@ TEST(SceneReject, UnreadableImage) {
   std::string path = writeGltf(dir, "image.gltf", g);
   expectInputError(path, "unreadable image");
   expectInputError(path, "garbage.png");
-  // A missing image file is unreadable too.
+}
+
+TEST(SceneGltf, MissingTextureFileIsWarnedOnceByName) {
+  // An asset copied without one of its textures: the scene loads, the
+  // materials using it keep their factors, and the warning names the file
+  // once, however many materials use it.
+  std::string dir = test::outputDir("SceneGltf_MissingTexture");
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 1],
+                     "baseColorTexture": {"index": 0}}, "normalTexture": {"index": 0}}])";
   g.extraTop = R"("textures": [{"source": 0}], "images": [{"uri": "absent.png"}], )";
-  expectInputError(writeGltf(dir, "absent.gltf", g), "unreadable image");
+  const Scene s = loadScene(writeGltf(dir, "absent.gltf", g));
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("'absent.png'"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("missing"), std::string::npos) << s.warnings[0];
+  EXPECT_EQ(s.materials[0].baseColorTexture, -1);
+  EXPECT_EQ(s.materials[0].normalTexture, -1);
+  expectNear(s.materials[0].baseColor, {0.5f, 0.25f, 1.0f}, 1e-6f);
 }
 
 TEST(SceneReject, TruncatedGlb) {
@@ -830,6 +846,20 @@ TEST(SceneObj, UndefinedMaterialIsWarnedOnceByName) {
   int defaults = 0;
   for (int32_t m : s.triangleMaterial) defaults += s.materials[size_t(m)].name == "default";
   EXPECT_EQ(defaults, 2);
+}
+
+TEST(SceneObj, MissingTextureFileIsWarnedOnceByName) {
+  std::string dir = test::outputDir("SceneObj_MissingTexture");
+  writeFile(dir + "/m.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n"
+                            "newmtl b\nKd 0.2 0.2 0.2\nmap_Kd gone.png\n");
+  writeFile(dir + "/scene.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                "usemtl a\nf 1 2 3\nusemtl b\nf 1 3 4\n");
+  Scene s = loadScene(dir + "/scene.obj");
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("map_Kd 'gone.png' is missing"), std::string::npos) << s.warnings[0];
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].baseColorTexture, -1);
+  EXPECT_EQ(s.materials[1].baseColorTexture, -1);
 }
 
 TEST(SceneObj, Rejects) {
