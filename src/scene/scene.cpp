@@ -524,6 +524,72 @@ std::string formatLimit(double v) {
   return buf;
 }
 
+namespace {
+
+/// A factor glTF defines on [0, 1] (metallic, roughness, transmission, an
+/// emissive or light colour channel): clamped into it, with a warning naming
+/// `what`; not finite: refused.
+void clampUnit(Scene& scene, float& value, const std::string& what) {
+  if (!std::isfinite(value)) fail(scene.sourcePath, what + " is not a finite number");
+  const float clamped = std::clamp(value, 0.0f, 1.0f);
+  if (clamped != value) {
+    scene.warnings.push_back(scene.sourcePath + ": " + what + " is " + formatLimit(value) +
+                             ", outside [0, 1]: clamped to " + formatLimit(clamped));
+    value = clamped;
+  }
+}
+
+void clampUnit(Scene& scene, Vec3& value, const std::string& what) {
+  for (int c = 0; c < 3; ++c) {
+    clampUnit(scene, value[c], what + " channel " + std::to_string(c));
+  }
+}
+
+}  // namespace
+
+void checkLightAndMaterialValues(Scene& scene) {
+  // The ranges the bake can carry in float without overflow or negative
+  // light (docs/scene.md, "Limits"): emission up to kMaxRadiance, light
+  // intensities up to kMaxLightIntensity; glTF's [0, 1] factors clamped.
+  for (Material& m : scene.materials) {
+    const std::string name = "material '" + m.name + "'";
+    clampUnit(scene, m.metallic, name + " metallic");
+    clampUnit(scene, m.roughness, name + " roughness");
+    clampUnit(scene, m.transmission, name + " transmission");
+    clampUnit(scene, m.specular, name + " specular");
+    for (int c = 0; c < 3; ++c) {
+      float& e = m.emission[c];
+      if (!std::isfinite(e) || e > kMaxRadiance) {
+        fail(scene.sourcePath, name + " emits " + formatLimit(e) + " W/(m^2 sr) in channel " +
+                                   std::to_string(c) + ", beyond " + formatLimit(kMaxRadiance) +
+                                   " (emissive factor x strength)");
+      }
+      if (e < 0) {
+        scene.warnings.push_back(scene.sourcePath + ": " + name + " has a negative emission (" +
+                                 formatLimit(e) + " in channel " + std::to_string(c) +
+                                 "): taken as 0");
+        e = 0;
+      }
+    }
+  }
+  for (Light& light : scene.lights) {
+    const std::string name = "light '" + light.name + "'";
+    clampUnit(scene, light.color, name + " colour");
+    if (!std::isfinite(light.intensity) || light.intensity < 0 ||
+        light.intensity > kMaxLightIntensity) {
+      fail(scene.sourcePath, name + " has intensity " + formatLimit(light.intensity) +
+                                 ", outside [0, " + formatLimit(kMaxLightIntensity) +
+                                 "] (cd or lx, as W/sr or W/m^2)");
+    }
+    const float reach = std::max({std::fabs(light.position.x), std::fabs(light.position.y),
+                                  std::fabs(light.position.z)});
+    if (!std::isfinite(reach) || reach > kMaxCoordinate) {
+      fail(scene.sourcePath, name + " lies at " + light.position.ToString() + ", beyond " +
+                                 formatLimit(kMaxCoordinate) + " scene units from the origin");
+    }
+  }
+}
+
 void validateScene(Scene& scene) {
   if (scene.triangleCount() == 0) fail(scene.sourcePath, "no triangles in the scene");
   checkSceneIndices(scene);
@@ -551,6 +617,7 @@ void validateScene(Scene& scene) {
       m.baseColor = clamped;
     }
   }
+  checkLightAndMaterialValues(scene);
   LO_CHECK(scene.normals.empty() || scene.normals.size() == scene.positions.size());
   LO_CHECK(scene.texcoords0.empty() || scene.texcoords0.size() == 2 * scene.positions.size());
   LO_CHECK(scene.texcoords1.empty() || scene.texcoords1.size() == 2 * scene.positions.size());

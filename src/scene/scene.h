@@ -285,6 +285,15 @@ struct Scene {
 /// on the scene; loadScene refuses vertices beyond this, naming the vertex.
 constexpr float kMaxCoordinate = 1e12f;
 
+/// Largest emitted radiance a material may have, W/(m^2 sr) (emissive
+/// factor x KHR_materials_emissive_strength, OBJ Ke): 1e9, fifty times the
+/// sun's disc; loadScene refuses more, naming the material.
+constexpr float kMaxRadiance = 1e9f;
+/// Largest light intensity, W/sr (cd) for point and spot lights, W/m^2 (lx)
+/// for directional ones: 1e12 (the sun gives about 1.2e5 lx); loadScene
+/// refuses more, or a negative one, naming the light.
+constexpr float kMaxLightIntensity = 1e12f;
+
 /// Deepest nesting of objects and arrays a glTF's JSON may have: both JSON
 /// parsers recurse once per level, and nothing in glTF needs more.
 constexpr size_t kMaxJsonDepth = 256;

@@ -39,6 +39,14 @@ Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, si
 Scene loadGltf(const std::string& path);
 Scene loadObj(const std::string& path);
 
+/// The light and material numbers within their documented ranges
+/// (docs/scene.md, "Limits"): glTF's [0, 1] factors (metallic, roughness,
+/// transmission, specular, light colours) clamped with a warning naming
+/// them; a negative emission taken as 0 with a warning; an emission above
+/// kMaxRadiance, a light intensity outside [0, kMaxLightIntensity] or a
+/// light beyond kMaxCoordinate refused.
+void checkLightAndMaterialValues(Scene& scene);
+
 /// Final checks shared by both loaders: at least one triangle, finite vertices
 /// within kMaxCoordinate, every index in range, one material per triangle in
 /// range; base colours clamped to [0, 1] (Scene::warnings says so).

@@ -736,6 +736,45 @@ TEST(SceneReject, UnreadableImage) {
   expectInputError(path, "garbage.png");
 }
 
+TEST(SceneGltf, LightAndMaterialValuesStayInTheirRanges) {
+  // glTF's [0, 1] factors are clamped with a warning naming them; a negative
+  // emission is taken as 0, warned; intensities and positions beyond what
+  // the bake can carry are refused, naming the light (docs/scene.md, "Limits").
+  std::string dir = test::outputDir("SceneGltf_ValueRanges");
+  auto withLight = [](const std::string& light, const std::string& translation) {
+    MiniGltf g = oneTriangle();
+    g.material = 0;
+    g.materials = R"([{"name": "odd", "emissiveFactor": [1, -0.5, 1],
+                       "pbrMetallicRoughness": {"metallicFactor": 1e30, "roughnessFactor": -3}}])";
+    g.nodes = R"([{"mesh": 0}, {"name": "L", "translation": )" + translation +
+              R"(, "extensions": {"KHR_lights_punctual": {"light": 0}}}])";
+    g.sceneNodes = "[0, 1]";
+    g.extraTop = R"("extensionsUsed": ["KHR_lights_punctual"], "extensions": {"KHR_lights_punctual":
+                    {"lights": [)" + light + R"(]}}, )";
+    return g;
+  };
+  MiniGltf g = withLight(R"({"name": "lamp", "type": "point", "color": [1, -0.5, 1], "intensity": 2})",
+                         "[0, 1, 0]");
+  const Scene s = loadScene(writeGltf(dir, "odd.gltf", g));
+  EXPECT_EQ(s.materials[0].metallic, 1.0f);
+  EXPECT_EQ(s.materials[0].roughness, 0.0f);
+  EXPECT_EQ(s.materials[0].emission.y, 0.0f);
+  EXPECT_EQ(s.lights[0].color.y, 0.0f);
+  std::string all;
+  for (const std::string& w : s.warnings) all += w + "\n";
+  EXPECT_NE(all.find("material 'odd' metallic is 1e+30, outside [0, 1]"), std::string::npos) << all;
+  EXPECT_NE(all.find("material 'odd' roughness is -3"), std::string::npos) << all;
+  EXPECT_NE(all.find("material 'odd' has a negative emission"), std::string::npos) << all;
+  EXPECT_NE(all.find("light 'L' colour channel 1 is -0.5"), std::string::npos) << all;
+  expectInputError(
+      writeGltf(dir, "bright.gltf",
+                withLight(R"({"type": "point", "intensity": 1e37})", "[0, 1, 0]")),
+      "light 'L' has intensity 1e+37");
+  expectInputError(
+      writeGltf(dir, "far.gltf", withLight(R"({"type": "point", "intensity": 1})", "[1e19, 0, 0]")),
+      "light 'L' lies at");
+}
+
 TEST(SceneGltf, MissingTextureFileIsWarnedOnceByName) {
   // An asset copied without one of its textures: the scene loads, the
   // materials using it keep their factors, and the warning names the file
