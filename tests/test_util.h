@@ -2,6 +2,7 @@
 /// @file tests/test_util.h
 /// @brief Small scenes built in code, and paths to test data.
 
+#include <memory>
 #include <string>
 
 #include "octree/gpu_octree.h"
@@ -50,6 +51,12 @@ std::string runCommand(const std::string& command);
 /// The unit room (albedo 0.6) with a block on the floor, lit by a point light
 /// of intensity 1 at (0.5, 0.8, 0.5): a small scene for whole-bake tests.
 Scene pointLitRoom();
+
+/// An 8 x 8 sky image (Sky::image): radiance 4 within 45 degrees of the
+/// zenith (rows 0 and 1), 1 down to the horizon (rows 2 and 3), 7 below
+/// (unused). An open surface facing up receives E = 4 pi sin^2(45) +
+/// pi cos^2(45) = 2.5 pi from it.
+std::shared_ptr<const Texture> twoBandSkyImage();
 
 /// GPU octree parameters with the texels of the paper's form (no cosine
 /// correction): tests of the layout and the lookup compare texels with the

@@ -72,8 +72,8 @@ struct Context {
   std::vector<Emitter> emitters;
   std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
   std::vector<LightFootprint> footprints;  ///< of the directional lights
-  /// A sky image's directions, its texels weighted by the covered box's
-  /// silhouette seen from them.
+  /// The sky's directions: an image's texels weighted by the covered box's
+  /// silhouette seen from them; a uniform sky's hemisphere.
   SkySampler skySampler;
   Bounds3 bounds;
   Bounds3 region;       ///< photons stored only inside (empty: everywhere)
@@ -169,12 +169,13 @@ inline float boxSilhouette(const Bounds3& box, const Vec3& d) {
   return std::fabs(d.x) * e.y * e.z + std::fabs(d.y) * e.x * e.z + std::fabs(d.z) * e.x * e.y;
 }
 
-/// A sky image's photon: a direction from Context::skySampler (texels by
-/// radiance times the covered box's silhouette and solid angle), a start
-/// through the box; the path carries L A(d) / pdf(d) of the sky's power
-/// (Sky::power sums the same over the texels' centres).
-inline bool emitFromSkyImage(const Context& ctx, const Emitter& e, Rng& rng, EmittedRay& out) {
-  const double u0 = uniform53(rng);
+/// A sky photon: a direction from Context::skySampler (an image's texels by
+/// radiance times the covered box's silhouette and solid angle; a uniform
+/// sky's hemisphere), a start through the box; the path carries
+/// L A(d) / pdf(d) of the sky's power (Sky::power: pi L S / 2, or the same
+/// sum over an image's texel centres).
+inline bool emitFromSky(const Context& ctx, const Emitter& e, Rng& rng, EmittedRay& out) {
+  const double u0 = ctx.scene->sky.image ? uniform53(rng) : 0.0;  // no texel to pick
   const float u1 = rng.uniform(), u2 = rng.uniform();
   Vec3 towards;
   float pdf = 0;
@@ -246,25 +247,8 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
       out.direction = d;
       return true;
     }
-    case Emitter::Kind::Sky: {
-      if (scene.sky.image) return emitFromSkyImage(ctx, e, rng, out);
-      // A sky direction uniform over the upper hemisphere (pdf 1 / 2 pi),
-      // then a start through the covered box's silhouette seen from it: the
-      // path carries L A(d) 2 pi where Sky::power counts pi L S / 2 on
-      // average (S the box's surface area).
-      const float u1 = rng.uniform(), u2 = rng.uniform();
-      const float y = u1, r = std::sqrt(std::max(0.0f, 1.0f - y * y)), phi = 2.0f * kPi * u2;
-      const Vec3 towards{r * std::cos(phi), y, r * std::sin(phi)};
-      const Vec3 d = -towards;
-      float area = 0;
-      out.origin = startThroughBox(ctx, d, rng, area);
-      out.direction = d;
-      const Vec3 ext = ctx.emitBounds.extent();
-      const float surface = 2.0f * (ext.x * ext.y + ext.y * ext.z + ext.z * ext.x);
-      out.power *= 4.0f * area / surface;
-      out.storeFirstHit = true;
-      return !(y <= 0);
-    }
+    case Emitter::Kind::Sky:
+      return emitFromSky(ctx, e, rng, out);
     case Emitter::Kind::Triangle: {
       size_t tri = e.index;
       const Vec3& p0 = scene.positions[scene.indices[3 * tri]];
@@ -427,11 +411,9 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
       throw InputError("the sky has non-finite power " + e.power.ToString());
     }
     if (average(e.power) > 0) ctx.emitters.push_back(e);
-    if (scene.sky.image) {
-      const Bounds3 box = ctx.emitBounds;
-      ctx.skySampler =
-          SkySampler(scene.sky, [box](const Vec3& d) { return boxSilhouette(box, d); });
-    }
+    const Bounds3 box = ctx.emitBounds;
+    ctx.skySampler =
+        SkySampler(scene.sky, [box](const Vec3& d) { return boxSilhouette(box, d); });
   }
   const EmitterSampler triangles = buildEmitterSampler(scene);
   for (size_t k = 0; k < triangles.size(); ++k) {

@@ -497,12 +497,7 @@ TEST(Photons, SkyImageLightsAnOpenFloorWithItsCosineIntegral) {
   Scene scene;
   int floor = addMaterial(scene, {0, 0, 0});
   addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, floor);
-  auto image = std::make_shared<Texture>();
-  image->width = image->height = 8;
-  for (int y = 0; y < 8; ++y) {
-    for (int x = 0; x < 8; ++x) image->texels.push_back(Vec3(y < 2 ? 4.0f : y < 4 ? 1.0f : 7.0f));
-  }
-  scene.sky.image = image;
+  scene.sky.image = test::twoBandSkyImage();
   scene.sky.radiance = {1.0f, 0.5f, 0.25f};  // scales the image
   PhotonParams params;
   params.storedPhotons = 60000;

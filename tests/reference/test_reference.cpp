@@ -136,12 +136,7 @@ TEST(Reference, SkyImageOverAnOpenFloorGivesAlbedoTimesItsIrradiance) {
   Scene scene;
   const int floor = addMaterial(scene, Vec3(0.5f));
   addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, 1, 0}, floor);
-  auto image = std::make_shared<Texture>();
-  image->width = image->height = 8;
-  for (int y = 0; y < 8; ++y) {
-    for (int x = 0; x < 8; ++x) image->texels.push_back(Vec3(y < 2 ? 4.0f : y < 4 ? 1.0f : 7.0f));
-  }
-  scene.sky.image = image;
+  scene.sky.image = test::twoBandSkyImage();
   scene.sky.radiance = {1, 1, 1};
   ReferenceParams params;
   params.width = params.height = 8;
