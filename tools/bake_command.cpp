@@ -55,13 +55,16 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
   if (opt.bounds.empty() && !scene.region.empty() && !opt.quiet) {
+    Bounds3 world;  // the file's coordinates
+    world.extend(scene.toWorld(scene.region.lower).toVec3());
+    world.extend(scene.toWorld(scene.region.upper).toVec3());
     std::printf("region of interest marked in the scene: %s (--bounds overrides it)\n",
-                scene.region.ToString().c_str());
+                world.ToString().c_str());
   }
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.lights.size()) + " punctual lights");
 
-  const BakeParams params = opt.bakeParams();
+  const BakeParams params = opt.bakeParams(scene);
   DistributedStats distributed;
   TileParams tiles;
   tiles.tilesPerAxis = opt.tiles == "auto" ? 0 : std::stoi(opt.tiles);
@@ -80,7 +83,8 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
 
   if (!opt.photonMap.empty()) {
     StageTimer pointsTimer(rows, "write photon map");
-    writePhotonPoints(opt.photonMap, baked.photons.photons, baked.grid.frame.voxelSize);
+    writePhotonPoints(opt.photonMap, baked.photons.photons, baked.grid.frame.voxelSize,
+                      scene.origin);
     pointsTimer.finish(opt.photonMap);
   }
 

@@ -7,7 +7,7 @@
 
 namespace lo::tool {
 
-BakeParams BakeOptions::bakeParams() const {
+BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   BakeParams params;
   params.depth = depth;
   params.photons = photons;
@@ -24,8 +24,8 @@ BakeParams BakeOptions::bakeParams() const {
   params.autoThreshold = autoThreshold;
   parseRepresentation(representation, &params.representation);  // checked by the flag
   if (!bounds.empty()) {
-    params.region.extend(Vec3{float(bounds[0]), float(bounds[1]), float(bounds[2])});
-    params.region.extend(Vec3{float(bounds[3]), float(bounds[4]), float(bounds[5])});
+    params.region.extend(scene.toLocal(Vec3d{bounds[0], bounds[1], bounds[2]}));
+    params.region.extend(scene.toLocal(Vec3d{bounds[3], bounds[4], bounds[5]}));
   }
   params.keepPhotons = !photonMap.empty();
   return params;

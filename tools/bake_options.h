@@ -42,7 +42,9 @@ struct BakeOptions {
   bool quiet = false;
 
   /// The bake's settings from the flags (keepPhotons: --photon-map given).
-  BakeParams bakeParams() const;
+  /// The bake's parameters; --bounds (the file's world coordinates) taken
+  /// to the scene's (Scene::origin).
+  BakeParams bakeParams(const Scene& scene) const;
 };
 
 /// Registers the flags of `bake` on `cmd`.

@@ -1,6 +1,7 @@
 #include "camera_options.h"
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <sstream>
 
 #include "core/error.h"
@@ -16,16 +17,19 @@ void addCameraOptions(CLI::App* cmd, CameraOptions& opt) {
       ->check(CLI::Range(1.0f, 179.0f));
 }
 
-Vec3 parseVec3(const std::string& text, const char* flag) {
-  Vec3 v;
+Vec3d parseVec3d(const std::string& text, const char* flag) {
+  Vec3d v;
   char c1 = 0, c2 = 0;
   std::istringstream is(text);
   if (!(is >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !is.eof() ||
-      !isFinite(v)) {
+      !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) ||
+      !isFinite(v.toVec3())) {
     throw InputError(std::string(flag) + ": expected three numbers x,y,z, got '" + text + "'");
   }
   return v;
 }
+
+Vec3 parseVec3(const std::string& text, const char* flag) { return parseVec3d(text, flag).toVec3(); }
 
 void checkCameraOptions(const CameraOptions& opt) {
   if (!opt.eye.empty() != !opt.target.empty()) {
@@ -55,7 +59,9 @@ PinholeCamera chooseCamera(const CameraOptions& opt, const Scene& scene,
                            const std::string& scenePath) {
   const float fov = (opt.fovDegrees > 0 ? opt.fovDegrees : 45.0f) * kPi / 180.0f;
   if (!opt.eye.empty()) {
-    const Vec3 eye = parseVec3(opt.eye, "--eye"), target = parseVec3(opt.target, "--target");
+    // The file's world coordinates, taken to the scene's (Scene::origin).
+    const Vec3 eye = scene.toLocal(parseVec3d(opt.eye, "--eye"));
+    const Vec3 target = scene.toLocal(parseVec3d(opt.target, "--target"));
     if (eye == target) throw InputError("--eye and --target: the same point");
     return PinholeCamera::lookAt(eye, target, fov);
   }

@@ -31,6 +31,8 @@ void checkCameraOptions(const CameraOptions& opt);
 
 /// "x,y,z" -> Vec3. @throws InputError naming `flag`.
 Vec3 parseVec3(const std::string& text, const char* flag);
+/// The same in double (world positions, before Scene::toLocal).
+Vec3d parseVec3d(const std::string& text, const char* flag);
 
 /// The chosen scene camera: null for --eye/--target or a scene without
 /// cameras. @throws InputError naming --camera and the scene's cameras.

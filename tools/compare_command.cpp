@@ -95,6 +95,7 @@ int runCompare(const CompareOptions& opt) {
     j["non_finite_pixels"] = result.nonFinitePixels;
     j["max_error_pixel"] = {result.maxErrorX, result.maxErrorY};
     j["mean_reference_luminance"] = result.meanReferenceLuminance;
+    j["mean_test_luminance"] = result.meanTestLuminance;
     writeTextAtomically(opt.json, j.dump(2) + "\n");
     if (!opt.quiet) std::printf("wrote %s\n", opt.json.c_str());
   }

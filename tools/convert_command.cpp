@@ -69,13 +69,19 @@ int runConvert(const ConvertOptions& opt) {
     StageTimer loadTimer(rows, "load scene");
     scene = loadScene(opt.scene);
     printSceneWarnings(scene);
+    const Vec3d& a = scene.origin;
+    const Vec3d& b = in.grid.frame.offset;
+    if (a.x != b.x || a.y != b.y || a.z != b.z) {
+      throw InputError(opt.scene + " is stored relative to another origin than " + opt.input +
+                       " was baked in (its scene_origin): convert with the scene it was baked from");
+    }
     params.scene = &scene;
     loadTimer.finish(formatCount(scene.triangleCount()) + " triangles");
   }
   std::vector<Photon> photons;
   if (!opt.photonMap.empty()) {
     StageTimer readTimer(rows, "read photon map");
-    photons = readPhotonPoints(opt.photonMap);
+    photons = readPhotonPoints(opt.photonMap, in.grid.frame.offset);
     params.photons = &photons;
     readTimer.finish(formatCount(photons.size()) + " photons");
   }

@@ -29,10 +29,14 @@ What is matched (docs/scene.md defines the project's units):
 Materials, --material:
   * principled: as Blender's importer makes them (Principled BSDF: Burley
     diffuse, GGX specular; not glTF's BRDF exactly);
-  * gltf: glTF's BRDF built from nodes: Lambert diffuse and a GGX layer mixed
-    by a Fresnel node (ior from KHR_materials_ior, 1.5 by default), GGX metal
-    tinted by the base colour, mixed by metallic; Cycles' Fresnel node uses the
-    exact dielectric Fresnel of n.v, where glTF uses Schlick's of v.h;
+  * gltf: glTF's BRDF built from nodes: Lambert diffuse times 1 - w F0 plus w
+    times a GGX layer weighted by the Fresnel of each microfacet (a Principled
+    BSDF with a black base: Cycles' dielectric Fresnel of l.h, F0 from
+    KHR_materials_ior, w = KHR_materials_specular's specularFactor), and a GGX
+    metal with F0 = the base colour (Principled, metallic 1), mixed by
+    metallic. Not exact: glTF weights the diffuse lobe by 1 - w F(v.h), which
+    no node sees (the constant is within 0.025 w of its mean), and Cycles'
+    Smith shadowing is separable where glTF's is height-correlated;
   * lambert: the diffuse part alone (to judge the light transport apart from
     the material model).
 """
@@ -97,6 +101,50 @@ def read_gltf_json(path):
         length = int.from_bytes(data[12:16], "little")
         return json.loads(data[20:20 + length])
     return {}
+
+
+def material_info(ior=1.5, weight=1.0, roughness=None, transmission=0.0, cutoff=None):
+    """What the rebuilt material needs beyond Blender's import: the specular
+    layer's F0 and weight, a roughness that overrides the import's (None:
+    keep it), the transmission factor, and the alpha cutoff of MASK."""
+    return {"ior": ior, "f0": ((ior - 1.0) / (ior + 1.0)) ** 2, "weight": weight,
+            "roughness": roughness, "transmission": transmission, "cutoff": cutoff}
+
+
+def read_obj_layers(path):
+    """{material: material_info} as the project's OBJ loader
+    maps the .mtl (docs/scene.md): Ks -> the layer's weight (its largest
+    channel; none or 0: Lambertian, roughness 1), Ns -> roughness
+    sqrt(2 / (Ns + 2)), Ni -> F0. Blender's importer maps them otherwise
+    (roughness 1 - sqrt(Ns / 1000)), so they are set from here."""
+    layers = {}
+    folder = os.path.dirname(path)
+    with open(path, errors="replace") as f:
+        libs = [line.split(None, 1)[1].strip() for line in f if line.startswith("mtllib ")]
+    for lib in libs:
+        name, ks, ns, ni = None, 0.0, 0.0, 1.5
+
+        def flush():
+            if name is not None:
+                weight = min(ks, 1.0)
+                rough = math.sqrt(2.0 / (max(ns, 0.0) + 2.0)) if weight > 0 else 1.0
+                layers[name] = material_info(ni, weight, rough)
+        with open(os.path.join(folder, lib), errors="replace") as f:
+            for line in f:
+                words = line.split()
+                if not words:
+                    continue
+                if words[0] == "newmtl":
+                    flush()
+                    name, ks, ns, ni = " ".join(words[1:]), 0.0, 0.0, 1.5
+                elif words[0] == "Ks":
+                    ks = max(float(w) for w in words[1:4])
+                elif words[0] == "Ns":
+                    ns = float(words[1])
+                elif words[0] == "Ni" and float(words[1]) > 0:
+                    ni = float(words[1])
+        flush()
+    return layers
 
 
 def import_scene(path):
@@ -199,7 +247,26 @@ def connect(tree, source, default, target):
             target.default_value = default[0] if hasattr(default, "__len__") else default
 
 
-def rebuild_material(mat, mode, ior_of):
+def principled_lobe(tree, base, metallic, specular, rough_src, rough_val):
+    """A Principled BSDF reduced to its GGX specular lobe: Cycles 3.4 weights
+    it by the Fresnel of each microfacet, interpolated from F0 (0.08 x
+    specular, or the base colour when metallic) to 1 as glTF's Schlick term is."""
+    node = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    node.distribution = "GGX"
+    if base is not None:
+        node.inputs["Base Color"].default_value = base
+    node.inputs["Metallic"].default_value = metallic
+    node.inputs["Specular"].default_value = specular
+    node.inputs["Specular Tint"].default_value = 0.0
+    node.inputs["Sheen"].default_value = 0.0
+    node.inputs["Clearcoat"].default_value = 0.0
+    node.inputs["Subsurface"].default_value = 0.0
+    node.inputs["Transmission"].default_value = 0.0
+    connect(tree, rough_src, rough_val, node.inputs["Roughness"])
+    return node
+
+
+def rebuild_material(mat, mode, layer_of):
     """Replaces the material's Principled BSDF by glTF's BRDF from nodes (gltf)
     or its diffuse part (lambert); in every mode, emission from the front face
     only."""
@@ -226,23 +293,57 @@ def rebuild_material(mat, mode, ior_of):
         if normal_src is not None:
             tree.links.new(normal_src, diffuse.inputs["Normal"])
         surface = diffuse.outputs["BSDF"]
+    info = layer_of(mat)
+    f0, weight = info["f0"], info["weight"]
+    if info["roughness"] is not None:
+        rough_src, rough_val = None, info["roughness"]
+    alpha_src, alpha_val = socket_value(principled.inputs["Alpha"])
     if mode == "gltf":
-        layer = tree.nodes.new("ShaderNodeBsdfGlossy")
-        layer.distribution = "GGX"
-        layer.inputs["Color"].default_value = (1, 1, 1, 1)
-        connect(tree, rough_src, rough_val, layer.inputs["Roughness"])
-        fresnel = tree.nodes.new("ShaderNodeFresnel")
-        fresnel.inputs["IOR"].default_value = ior_of(mat)
-        dielectric = tree.nodes.new("ShaderNodeMixShader")
-        tree.links.new(fresnel.outputs["Fac"], dielectric.inputs[0])
-        tree.links.new(diffuse.outputs["BSDF"], dielectric.inputs[1])
-        tree.links.new(layer.outputs["BSDF"], dielectric.inputs[2])
-        metal = tree.nodes.new("ShaderNodeBsdfGlossy")
-        metal.distribution = "GGX"
-        connect(tree, base_src, base_val, metal.inputs["Color"])
-        connect(tree, rough_src, rough_val, metal.inputs["Roughness"])
+        # Diffuse weight 1 - w F(v.h): constant 1 - w F0 here (no node sees
+        # v.h for a diffuse lobe); the cosine-weighted mean of F(v.h) exceeds
+        # F0 by at most 0.025 w, at grazing view. A Fresnel node on n.v would
+        # give 1 - F(n.v), 0.22 at grazing where glTF's mean is 0.94.
+        darken = tree.nodes.new("ShaderNodeMixRGB")
+        darken.blend_type = "MULTIPLY"
+        darken.inputs["Fac"].default_value = 1.0
+        connect(tree, base_src, base_val, darken.inputs["Color1"])
+        keep = 1.0 - weight * f0
+        darken.inputs["Color2"].default_value = (keep, keep, keep, 1.0)
+        tree.links.new(darken.outputs["Color"], diffuse.inputs["Color"])
+        # The layer w F(v.h) GGX: a Principled BSDF with a black base is its
+        # GGX lobe alone, with the Fresnel of each microfacet (l.h = v.h),
+        # F0 = 0.08 specular, untinted.
+        layer = principled_lobe(tree, (0.0, 0.0, 0.0, 1.0), 0.0, f0 / 0.08, rough_src, rough_val)
+        scaled = tree.nodes.new("ShaderNodeMixShader")  # w x layer
+        scaled.inputs[0].default_value = weight
+        nothing = tree.nodes.new("ShaderNodeBsdfDiffuse")
+        nothing.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        tree.links.new(nothing.outputs["BSDF"], scaled.inputs[1])
+        tree.links.new(layer.outputs["BSDF"], scaled.inputs[2])
+        dielectric = tree.nodes.new("ShaderNodeAddShader")
+        tree.links.new(diffuse.outputs["BSDF"], dielectric.inputs[0])
+        tree.links.new(scaled.outputs["Shader"], dielectric.inputs[1])
+        if info["transmission"] > 0:
+            # KHR_materials_transmission: the diffuse base gives way to a
+            # GGX BTDF under the same Fresnel layer: a Glass BSDF (its exact
+            # Fresnel splits reflection and refraction), tinted by the base.
+            glass = tree.nodes.new("ShaderNodeBsdfGlass")
+            glass.distribution = "GGX"
+            glass.inputs["IOR"].default_value = info["ior"]
+            connect(tree, base_src, base_val, glass.inputs["Color"])
+            connect(tree, rough_src, rough_val, glass.inputs["Roughness"])
+            if normal_src is not None:
+                tree.links.new(normal_src, glass.inputs["Normal"])
+            transmits = tree.nodes.new("ShaderNodeMixShader")
+            transmits.inputs[0].default_value = info["transmission"]
+            tree.links.new(dielectric.outputs["Shader"], transmits.inputs[1])
+            tree.links.new(glass.outputs["BSDF"], transmits.inputs[2])
+            dielectric = transmits
+        # The metal: the same lobe with F0 = the base colour (metallic 1).
+        metal = principled_lobe(tree, None, 1.0, 0.5, rough_src, rough_val)
+        connect(tree, base_src, base_val, metal.inputs["Base Color"])
         if normal_src is not None:
-            for n in (layer, fresnel, metal):
+            for n in (layer, metal):
                 tree.links.new(normal_src, n.inputs["Normal"])
         mix = tree.nodes.new("ShaderNodeMixShader")
         connect(tree, metal_src, metal_val, mix.inputs[0])
@@ -266,6 +367,22 @@ def rebuild_material(mat, mode, ior_of):
         tree.links.new(surface, add.inputs[0])
         tree.links.new(front.outputs["Shader"], add.inputs[1])
         surface = add.outputs["Shader"]
+    if alpha_src is not None or (alpha_val is not None and alpha_val < 1.0):
+        # Coverage: alpha (BLEND) or alpha < cutoff cut away (MASK), as the
+        # tracers read glTF's alphaMode.
+        coverage_src = alpha_src
+        if info["cutoff"] is not None:
+            opaque = tree.nodes.new("ShaderNodeMath")
+            opaque.operation = "GREATER_THAN"
+            connect(tree, alpha_src, alpha_val, opaque.inputs[0])
+            opaque.inputs[1].default_value = info["cutoff"] - 1e-6
+            coverage_src = opaque.outputs["Value"]
+        transparent = tree.nodes.new("ShaderNodeBsdfTransparent")
+        covered = tree.nodes.new("ShaderNodeMixShader")
+        connect(tree, coverage_src, alpha_val if coverage_src is None else None, covered.inputs[0])
+        tree.links.new(transparent.outputs["BSDF"], covered.inputs[1])
+        tree.links.new(surface, covered.inputs[2])
+        surface = covered.outputs["Shader"]
     tree.links.new(surface, output.inputs["Surface"])
 
 
@@ -332,11 +449,19 @@ def main():
     gltf = read_gltf_json(scene_path)
     import_scene(scene_path)
     set_lights(gltf)
-    iors = {}
+    layers = {}
     for m in gltf.get("materials", []):
-        iors[m.get("name", "")] = m.get("extensions", {}).get("KHR_materials_ior", {}).get("ior", 1.5)
+        ext = m.get("extensions", {})
+        layers[m.get("name", "")] = material_info(
+            ior=ext.get("KHR_materials_ior", {}).get("ior", 1.5),
+            weight=ext.get("KHR_materials_specular", {}).get("specularFactor", 1.0),
+            transmission=ext.get("KHR_materials_transmission", {}).get("transmissionFactor", 0.0),
+            cutoff=m.get("alphaCutoff", 0.5) if m.get("alphaMode") == "MASK" else None)
+    if scene_path.lower().endswith(".obj"):
+        layers = read_obj_layers(scene_path)
     for mat in bpy.data.materials:
-        rebuild_material(mat, args.material, lambda m: iors.get(m.name.split(".")[0], 1.5))
+        rebuild_material(mat, args.material,
+                         lambda m: layers.get(m.name.split(".")[0], material_info()))
     set_world(gltf)
     set_camera(args, gltf)
 

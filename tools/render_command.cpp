@@ -83,7 +83,7 @@ int runRender(const RenderOptions& opt) {
   if (opt.mode == "irradiance") {
     Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
     printSceneWarnings(scene);
-    return renderIrradiance(opt, scene, readVdlGrid(opt.lights));
+    return renderIrradiance(opt, scene, readVdlGrid(opt.lights, scene.origin));
   }
   RenderParams params = opt.shading.renderParams(parseRenderMode(opt.mode));
   params.width = opt.width;
@@ -91,7 +91,7 @@ int runRender(const RenderOptions& opt) {
 
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
-  LoadedVdl baked = readVdlGrid(opt.lights);
+  LoadedVdl baked = readVdlGrid(opt.lights, scene.origin);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   if (baked.meta.includeDirect == 1 &&
       (params.mode == RenderMode::Full || params.mode == RenderMode::Direct)) {

@@ -65,6 +65,13 @@ void printSummary(std::FILE* out, const std::vector<StageReport>& rows) {
 
 void printSceneWarnings(const Scene& scene) {
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (scene.rebased()) {
+    std::fprintf(stderr,
+                 "note: %s lies far from the origin; it is kept relative to its centre "
+                 "(%.17g, %.17g, %.17g) so that float keeps its precision (--eye, --target, "
+                 "--bounds and the .vdb stay in the file's coordinates)\n",
+                 scene.sourcePath.c_str(), scene.origin.x, scene.origin.y, scene.origin.z);
+  }
 }
 
 }  // namespace lo::tool

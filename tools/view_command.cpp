@@ -73,7 +73,14 @@ int runView(const ViewOptions& opt) {
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
   std::optional<LoadedVdl> baked;
-  if (!opt.progressive) baked = readVdlGrid(opt.lights);
+  if (!opt.progressive) baked = readVdlGrid(opt.lights, scene.origin);
+  view.worldOrigin = scene.origin;
+  if (view.path) {
+    for (CameraKey& key : view.path->keys) {  // the file's world coordinates
+      key.eye = scene.toLocal(Vec3d(key.eye));
+      key.target = scene.toLocal(Vec3d(key.target));
+    }
+  }
 
   PinholeCamera startCamera = chooseCamera(opt.camera, scene, opt.scene);
   view.defaultFovDegrees = opt.camera.fovDegrees > 0 ? opt.camera.fovDegrees : 45.0f;

@@ -232,7 +232,9 @@ LightmapExportResult exportLightmap(const Scene& scene, const std::string& light
                                     const LightmapExportParams& params) {
   return lightmap_export_internal::exportWith(
       scene,
-      [&lightsPath] { return buildGpuOctree(readVdlGrid(lightsPath).grid, GpuOctreeParams{}); },
+      [&lightsPath, &scene] {
+        return buildGpuOctree(readVdlGrid(lightsPath, scene.origin).grid, GpuOctreeParams{});
+      },
       params);
 }
 

@@ -266,6 +266,7 @@ SurfaceGrid buildSurfaceGrid(const Scene& scene, const GridParams& params, Progr
   SurfaceGrid grid;
   grid.frame = makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth,
                              params.padding);
+  grid.frame.offset = scene.origin;  // the grid in the scene's (rebased) coordinates
   const FrameD frame(grid.frame);
 
   tbb::enumerable_thread_specific<std::vector<Contribution>> perThread;

@@ -115,7 +115,7 @@ CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
   checkSizes(test, reference, params);
   CompareResult r;
   Accumulator acc[4];
-  double maxLum = -1, sumLum = 0;
+  double maxLum = -1, sumLum = 0, sumTestLum = 0;
   for (size_t i = 0; i < reference.pixelCount(); ++i) {
     PixelUse use = pixelUse(test, reference, params, i);
     if (use == PixelUse::Ignore) {
@@ -132,6 +132,7 @@ CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
     double ya = luminance(a), yb = luminance(b);
     acc[3].add(ya, yb);
     sumLum += yb;
+    sumTestLum += ya;
     if (std::fabs(ya - yb) > maxLum) {
       maxLum = std::fabs(ya - yb);
       r.maxErrorX = int(i % size_t(reference.width));
@@ -141,6 +142,7 @@ CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
   for (int c = 0; c < 3; ++c) r.channel[c] = acc[c].result();
   r.luminance = acc[3].result();
   r.meanReferenceLuminance = r.comparedPixels ? sumLum / double(r.comparedPixels) : 0.0;
+  r.meanTestLuminance = r.comparedPixels ? sumTestLum / double(r.comparedPixels) : 0.0;
   return r;
 }
 
@@ -157,7 +159,12 @@ std::string CompareResult::ToString() const {
   }
   os << "pixels: " << comparedPixels << " compared, " << ignoredPixels << " ignored, "
      << nonFinitePixels << " non-finite; largest Y error at (" << maxErrorX << ", " << maxErrorY
-     << "); mean reference Y " << meanReferenceLuminance;
+     << "); mean Y: reference " << meanReferenceLuminance << ", test " << meanTestLuminance;
+  if (meanReferenceLuminance > 0) {
+    std::snprintf(line, sizeof line, " (%.4f of the reference)",
+                  meanTestLuminance / meanReferenceLuminance);
+    os << line;
+  }
   return os.str();
 }
 

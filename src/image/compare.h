@@ -42,6 +42,7 @@ struct CompareResult {
   size_t nonFinitePixels = 0;          ///< NaN/inf in either image: left out and counted
   int maxErrorX = -1, maxErrorY = -1;  ///< pixel of the largest luminance error
   double meanReferenceLuminance = 0;   ///< over the compared pixels
+  double meanTestLuminance = 0;        ///< over the same pixels
   std::string ToString() const;        ///< a small table
 };
 

@@ -44,8 +44,11 @@ Coord GridFrame::coordOf(const Vec3& p) const {
 std::string GridFrame::ToString() const {
   std::ostringstream os;
   os.precision(9);
-  os << "GridFrame{origin " << origin.ToString() << ", voxel " << voxelSize << ", depth " << depth
-     << "}";
+  os << "GridFrame{origin " << origin.ToString() << ", voxel " << voxelSize << ", depth " << depth;
+  if (offset.x != 0 || offset.y != 0 || offset.z != 0) {
+    os << ", offset (" << offset.x << ", " << offset.y << ", " << offset.z << ")";
+  }
+  os << "}";
   return os.str();
 }
 

@@ -18,6 +18,10 @@ struct GridFrame {
   Vec3 origin{0, 0, 0};   ///< world position of the lower corner of voxel (0,0,0)
   float voxelSize = 1.0f; ///< world units (edge length of the cube / 2^depth)
   int depth = 0;          ///< 2^depth voxels per axis
+  /// The origin of the scene's coordinates in the file's world (Scene::origin):
+  /// `origin` and every position above are relative to it; the .vdb's
+  /// transform adds it back (0 unless the scene was rebased).
+  Vec3d offset;
 
   int resolution() const { return 1 << depth; }
   Vec3 voxelCenter(const Coord& c) const;

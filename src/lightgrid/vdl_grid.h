@@ -189,7 +189,13 @@ struct BakeMetadata {
   /// version 3 hold VDLs.
   std::string representation = "vdl";
   int64_t seed = 0;
+  /// The scene's bounds and (below) the region, in the scene's coordinates:
+  /// relative to `sceneOrigin`.
   Bounds3 sceneBounds;
+  /// Scene::origin of the baked scene in the file's world coordinates
+  /// ("scene_origin", written from the grid's frame.offset when it is not 0;
+  /// the grids' transform is in world coordinates, this offset included).
+  Vec3d sceneOrigin;
   std::string units = "length: scene units (glTF metres); irradiance: W/m^2 (scene light units)";
   /// Written as kVdlFormatVersion for SH files, kVdlFormatVersionVdl for
   /// VDL files; on reading, the file's value (1 when absent).

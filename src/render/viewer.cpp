@@ -44,7 +44,7 @@ CameraKey keyOf(const PinholeCamera& camera, float time) {
 /// file's last keyframe (plus one second) when the file already has some.
 class PathRecorder {
  public:
-  explicit PathRecorder(std::string path) : path_(std::move(path)) {}
+  PathRecorder(std::string path, const Vec3d& origin) : path_(std::move(path)), origin_(origin) {}
   void append(const PinholeCamera& camera) {
     if (!started_) {
       base_ = 0;
@@ -55,13 +55,27 @@ class PathRecorder {
     }
     float t = base_ + float(last_ == -INFINITY ? 0.0 : clock_.seconds());
     t = std::max(t, last_ + 0.001f);  // strictly increasing, even for two presses in a frame
-    appendCameraKey(path_, keyOf(camera, t));
+    const CameraKey key = inWorld(keyOf(camera, t), camera);
+    appendCameraKey(path_, key);
     last_ = t;
-    std::printf("appended keyframe %s to %s\n", keyOf(camera, t).ToString().c_str(), path_.c_str());
+    std::printf("appended keyframe %s to %s\n", key.ToString().c_str(), path_.c_str());
   }
 
  private:
+  /// The key in the file's world coordinates; far from the origin the target
+  /// is put farther along the view than 1 unit, so that rounding the world
+  /// positions to float leaves the direction precise.
+  CameraKey inWorld(CameraKey key, const PinholeCamera& camera) const {
+    if (origin_.x == 0 && origin_.y == 0 && origin_.z == 0) return key;
+    const double reach =
+        std::max(1.0, 1e-3 * std::max({std::fabs(origin_.x), std::fabs(origin_.y), std::fabs(origin_.z)}));
+    key.eye = (Vec3d(camera.eye) + origin_).toVec3();
+    key.target = (Vec3d(camera.eye) + Vec3d(camera.forward) * reach + origin_).toVec3();
+    return key;
+  }
+
   std::string path_;
+  Vec3d origin_;
   bool started_ = false;
   float base_ = 0, last_ = 0;
   Stopwatch clock_;
@@ -256,7 +270,7 @@ ViewerStats Viewer::Impl::run() {
   using namespace viewer_internal;
   const std::optional<CameraPath>& path = params.path;
   window.setInputHandler(this);
-  PathRecorder recorder(params.record);
+  PathRecorder recorder(params.record, params.worldOrigin);
   Stopwatch clock;
   ViewerStats stats;
   double lastTime = 0, titleTime = 0, pathStart = 0;

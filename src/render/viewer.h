@@ -34,6 +34,9 @@ struct ViewerParams {
   std::string saveFrames;    ///< folder: every frame drawn as frame_00000.png, ...; "" = none
   int frames = 0;            ///< exit after this many frames (at the target depth); 0 = no limit
   std::string record = "camera-path.txt";  ///< the file P appends keyframes to
+  /// Scene::origin: keyframes are recorded in the file's world coordinates
+  /// (the camera's position plus this), as --eye and camera paths take them.
+  Vec3d worldOrigin;
   bool continuous = false;   ///< redraw every iteration even when nothing changed
   int shownDepth = 0;        ///< depth of the octree the renderer starts with (0 = none)
   int firstDepth = 0;        ///< the level source's first depth (progressive)

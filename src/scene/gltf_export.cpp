@@ -237,6 +237,14 @@ class Exporter {
     addCameras(nodes, doc);
     json sceneNodes = json::array();
     for (size_t i = 0; i < nodes.size(); ++i) sceneNodes.push_back(i);
+    if (scene_.rebased()) {
+      // A scene the loader rebased (Scene::origin): everything under one node
+      // that puts it back where the file had it, in double.
+      nodes.push_back({{"name", "scene origin"},
+                       {"translation", {scene_.origin.x, scene_.origin.y, scene_.origin.z}},
+                       {"children", sceneNodes}});
+      sceneNodes = json::array({nodes.size() - 1});
+    }
     doc["scene"] = 0;
     doc["scenes"] = json::array({{{"nodes", sceneNodes}}});
     doc["nodes"] = std::move(nodes);

@@ -28,11 +28,12 @@ struct Mat4 {
       }
     return r;
   }
-  Vec3 point(const Vec3& p) const {
-    double x = at(0, 0) * p.x + at(0, 1) * p.y + at(0, 2) * p.z + at(0, 3);
-    double y = at(1, 0) * p.x + at(1, 1) * p.y + at(1, 2) * p.z + at(1, 3);
-    double z = at(2, 0) * p.x + at(2, 1) * p.y + at(2, 2) * p.z + at(2, 3);
-    return {float(x), float(y), float(z)};
+  Vec3 point(const Vec3& p) const { return pointInDouble(p).toVec3(); }
+  /// The transformed point before rounding to float (the loader rebases it).
+  Vec3d pointInDouble(const Vec3& p) const {
+    return {at(0, 0) * p.x + at(0, 1) * p.y + at(0, 2) * p.z + at(0, 3),
+            at(1, 0) * p.x + at(1, 1) * p.y + at(1, 2) * p.z + at(1, 3),
+            at(2, 0) * p.x + at(2, 1) * p.y + at(2, 2) * p.z + at(2, 3)};
   }
   Vec3 vector(const Vec3& v) const {
     double x = at(0, 0) * v.x + at(0, 1) * v.y + at(0, 2) * v.z;

@@ -319,6 +319,7 @@ class SceneBuilder {
     traverse();
     readSky();
     finishVertexAttributes();
+    rebase();
     return std::move(scene_);
   }
 
@@ -682,6 +683,9 @@ class SceneBuilder {
                  materials = sc.triangleMaterial.size();
     addMesh(node.mesh, world);
     for (size_t i = positions; i < sc.positions.size(); ++i) sc.region.extend(sc.positions[i]);
+    world_.region.insert(world_.region.end(), world_.vertices.begin() + ptrdiff_t(positions),
+                         world_.vertices.end());
+    world_.vertices.resize(positions);
     sc.positions.resize(positions);
     sc.normals.resize(normals);
     sc.texcoords0.resize(uv0);
@@ -701,6 +705,7 @@ class SceneBuilder {
     c.name = !node.name.empty() ? node.name
                                 : (!g.name.empty() ? g.name : "camera" + std::to_string(nodeIndex));
     c.position = world.point({0, 0, 0});
+    world_.cameras.push_back(world.pointInDouble({0, 0, 0}));
     c.forward = normalize(world.vector({0, 0, -1}));
     Vec3 up = world.vector({0, 1, 0});
     c.up = normalize(up - c.forward * dot(up, c.forward));
@@ -744,6 +749,7 @@ class SceneBuilder {
       fail(path_, "light " + std::to_string(lightIndex) + " has a non-finite value or transform");
     }
     scene_.lights.push_back(l);
+    world_.lights.push_back(world.pointInDouble({0, 0, 0}));
   }
 
   void addMesh(int meshIndex, const Mat4& world) {
@@ -812,11 +818,14 @@ class SceneBuilder {
         fail(path_, "too many vertices for 32-bit indices");
       }
       for (size_t v = 0; v < nverts; ++v) {
-        Vec3 pw = world.point({float(pos[3 * v]), float(pos[3 * v + 1]), float(pos[3 * v + 2])});
+        const Vec3d pd =
+            world.pointInDouble({float(pos[3 * v]), float(pos[3 * v + 1]), float(pos[3 * v + 2])});
+        const Vec3 pw = pd.toVec3();
         if (!isFinite(pw)) {
           fail(path_, what + ": non-finite vertex position (vertex " + std::to_string(v) + ")");
         }
         scene_.positions.push_back(pw);
+        world_.vertices.push_back(pd);
       }
       // Normals / UV sets present on some primitives only: fill the others.
       appendNormals(nrm, normalMatrix, nverts, base, tris, flip);
@@ -936,6 +945,34 @@ class SceneBuilder {
     }
   }
 
+  /// Positions were gathered in double (world_): a scene far from the
+  /// origin is stored relative to its centre (Scene::origin), the rest as
+  /// the file places it.
+  void rebase() {
+    const double inf = std::numeric_limits<double>::infinity();
+    Vec3d lower{inf, inf, inf}, upper{-inf, -inf, -inf};
+    for (const Vec3d& p : world_.vertices) {
+      for (int a = 0; a < 3; ++a) {
+        lower[a] = std::min(lower[a], p[a]);
+        upper[a] = std::max(upper[a], p[a]);
+      }
+    }
+    const Vec3d origin = scene_internal::rebaseOrigin(lower, upper);
+    if (origin.x == 0 && origin.y == 0 && origin.z == 0) return;
+    scene_.origin = origin;
+    for (size_t i = 0; i < scene_.positions.size(); ++i) {
+      scene_.positions[i] = scene_.toLocal(world_.vertices[i]);
+    }
+    for (size_t i = 0; i < scene_.lights.size(); ++i) {
+      scene_.lights[i].position = scene_.toLocal(world_.lights[i]);
+    }
+    for (size_t i = 0; i < scene_.cameras.size(); ++i) {
+      scene_.cameras[i].position = scene_.toLocal(world_.cameras[i]);
+    }
+    scene_.region = Bounds3();
+    for (const Vec3d& p : world_.region) scene_.region.extend(scene_.toLocal(p));
+  }
+
   void finishVertexAttributes() {
     LO_CHECK(!hasNormals_ || scene_.normals.size() == scene_.positions.size());
   }
@@ -944,6 +981,11 @@ class SceneBuilder {
   const tinygltf::Model& model_;
   GltfReader reader_;
   Scene scene_;
+  /// World positions in double, parallel to scene_'s vertices, lights and
+  /// cameras, and the region marker's vertices: what rebase() starts from.
+  struct {
+    std::vector<Vec3d> vertices, lights, cameras, region;
+  } world_;
   /// A decoded texture: its image, whether as sRGB colour, its sampler.
   struct TextureKey {
     int image;

@@ -8,10 +8,13 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -72,6 +75,44 @@ struct VertexKey {
 
 Vec3 rgb(const tinyobj::real_t c[3]) { return {float(c[0]), float(c[1]), float(c[2])}; }
 
+/// The `v` lines of an OBJ in double (tinyobjloader parses them as float,
+/// 2^-7 m apart at 1e5 m): x, y, z per vertex in file order.
+std::vector<double> readVerticesInDouble(const std::string& path) {
+  std::vector<double> out;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    size_t i = line.find_first_not_of(" \t");
+    if (i == std::string::npos || line[i] != 'v' || i + 1 >= line.size() ||
+        (line[i + 1] != ' ' && line[i + 1] != '\t')) {
+      continue;
+    }
+    const char* c = line.c_str() + i + 1;
+    for (int k = 0; k < 3; ++k) {
+      char* end = nullptr;
+      const double x = std::strtod(c, &end);
+      if (end == c) return {};  // not what tinyobjloader read: keep its floats
+      out.push_back(x);
+      c = end;
+    }
+  }
+  return out;
+}
+
+/// rebaseOrigin of x, y, z triples.
+template <typename T>
+Vec3d originOf(const std::vector<T>& xyz) {
+  const double inf = std::numeric_limits<double>::infinity();
+  Vec3d lower{inf, inf, inf}, upper{-inf, -inf, -inf};
+  for (size_t i = 0; i + 2 < xyz.size(); i += 3) {
+    for (int a = 0; a < 3; ++a) {
+      lower[a] = std::min(lower[a], double(xyz[i + size_t(a)]));
+      upper[a] = std::max(upper[a], double(xyz[i + size_t(a)]));
+    }
+  }
+  return rebaseOrigin(lower, upper);
+}
+
 }  // namespace
 
 Scene loadObj(const std::string& path) {
@@ -117,6 +158,18 @@ Scene loadObj(const std::string& path) {
     }
   }
   const std::vector<tinyobj::real_t>& v = attrib.vertices;
+  // A scene far from the origin is stored relative to its centre
+  // (Scene::origin), its vertices read again in double for it.
+  std::vector<double> far;
+  scene.origin = originOf(v);
+  if (scene.rebased()) {
+    far = readVerticesInDouble(path);
+    if (far.size() == v.size()) {
+      scene.origin = originOf(far);
+    } else {
+      far.clear();
+    }
+  }
   const std::vector<tinyobj::real_t>& vn = attrib.normals;
   const std::vector<tinyobj::real_t>& vt = attrib.texcoords;
   size_t nv = v.size() / 3, nn = vn.size() / 3, nt = vt.size() / 2;
@@ -130,9 +183,12 @@ Scene loadObj(const std::string& path) {
     m.baseColor = rgb(o.diffuse);
     m.emission = rgb(o.emission);
     m.metallic = float(o.metallic);
-    // Phong exponent -> roughness (docs/scene.md). A material without a
-    // specular colour (Ks 0 0 0) has no glossy lobe at all: keep it diffuse.
-    bool hasSpecular = maxComponent(rgb(o.specular)) > 0;
+    // Phong exponent -> roughness, Ks -> the specular layer's weight
+    // (docs/scene.md). A material without a specular colour (Ks 0 0 0, or no
+    // Ks) has no glossy lobe at all: Lambertian.
+    const float ks = maxComponent(rgb(o.specular));
+    const bool hasSpecular = ks > 0;
+    m.specular = hasSpecular ? std::min(ks, 1.0f) : 0.0f;
     m.roughness =
         hasSpecular ? std::sqrt(2.0f / (std::max(float(o.shininess), 0.0f) + 2.0f)) : 1.0f;
     if (o.dissolve < 1) m.transmission = 1.0f - std::max(float(o.dissolve), 0.0f);
@@ -211,7 +267,9 @@ Scene loadObj(const std::string& path) {
     if (it != vertexOf.end()) return it->second;
     uint32_t id = uint32_t(scene.positions.size());
     size_t p = size_t(ix.vertex_index);
-    Vec3 pos{float(v[3 * p]), float(v[3 * p + 1]), float(v[3 * p + 2])};
+    const Vec3d world = far.empty() ? Vec3d(v[3 * p], v[3 * p + 1], v[3 * p + 2])
+                                    : Vec3d(far[3 * p], far[3 * p + 1], far[3 * p + 2]);
+    const Vec3 pos = scene.toLocal(world);
     if (!isFinite(pos)) {
       fail(path, "non-finite vertex position (v " + std::to_string(p + 1) + ")");
     }

@@ -581,13 +581,20 @@ void checkLightAndMaterialValues(Scene& scene) {
                                  ", outside [0, " + formatLimit(kMaxLightIntensity) +
                                  "] (cd or lx, as W/sr or W/m^2)");
     }
-    const float reach = std::max({std::fabs(light.position.x), std::fabs(light.position.y),
-                                  std::fabs(light.position.z)});
-    if (!std::isfinite(reach) || reach > kMaxCoordinate) {
-      fail(scene.sourcePath, name + " lies at " + light.position.ToString() + ", beyond " +
+    const Vec3d world = scene.toWorld(light.position);
+    const double reach = std::max({std::fabs(world.x), std::fabs(world.y), std::fabs(world.z)});
+    if (!std::isfinite(reach) || reach > double(kMaxCoordinate)) {
+      fail(scene.sourcePath, name + " lies at " + world.toVec3().ToString() + ", beyond " +
                                  formatLimit(kMaxCoordinate) + " scene units from the origin");
     }
   }
+}
+
+Vec3d rebaseOrigin(const Vec3d& lower, const Vec3d& upper) {
+  if (!(lower.x <= upper.x && lower.y <= upper.y && lower.z <= upper.z)) return {};
+  const Vec3d centre = (lower + upper) * 0.5;
+  const double distance = std::max({std::fabs(centre.x), std::fabs(centre.y), std::fabs(centre.z)});
+  return distance > kRebaseDistance * length(upper - lower) ? centre : Vec3d{};
 }
 
 void validateScene(Scene& scene) {
@@ -596,10 +603,15 @@ void validateScene(Scene& scene) {
   // Coordinates the tracers can hold: Embree and the bake work in single
   // precision, in a frame centred on the scene; beyond kMaxCoordinate a
   // float has not a millimetre left (docs/scene.md, "Limits").
+  const double originReach =
+      std::max({std::fabs(scene.origin.x), std::fabs(scene.origin.y), std::fabs(scene.origin.z)});
   for (size_t i = 0; i < scene.positions.size(); ++i) {
     const Vec3& p = scene.positions[i];
-    if (std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) > kMaxCoordinate) {
-      fail(scene.sourcePath, "vertex " + std::to_string(i) + " lies at " + p.ToString() +
+    if (std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}) + originReach >
+        double(kMaxCoordinate)) {
+      const Vec3d w = scene.toWorld(p);
+      fail(scene.sourcePath, "vertex " + std::to_string(i) + " lies at " +
+                                 Vec3{float(w.x), float(w.y), float(w.z)}.ToString() +
                                  ", beyond " + formatLimit(kMaxCoordinate) +
                                  " scene units from the origin (a node transform or unit "
                                  "scale out of range?)");

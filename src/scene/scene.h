@@ -208,9 +208,24 @@ struct Camera {
   float zfar = 0;  ///< 0 = infinite
 };
 
-/// Triangle soup in world space, one material index per triangle.
+/// Triangle soup in world space, one material index per triangle. Every
+/// position (vertices, lights, cameras, the region) is stored relative to
+/// `origin`, which is (0, 0, 0) unless the loader rebased a scene far from
+/// the world's origin.
 struct Scene {
   std::string sourcePath;
+  /// Where the stored positions are measured from, in the file's world
+  /// coordinates (world = stored + origin). loadScene keeps (0, 0, 0) unless
+  /// the scene's centre lies farther from the world origin than 128x its size
+  /// (a building in projected coordinates, 1e5-1e6 m): then the centre of its
+  /// geometry, the positions taken to it in double before they are rounded to
+  /// float, so that the scene bakes and renders as it would at the origin.
+  /// World-space inputs (--eye, --target, --bounds, camera paths) go through
+  /// toLocal; outputs (the .vdb's transform, glTF exports) carry it back.
+  Vec3d origin;
+  Vec3 toLocal(const Vec3d& world) const { return (world - origin).toVec3(); }
+  Vec3d toWorld(const Vec3& local) const { return Vec3d(local) + origin; }
+  bool rebased() const { return origin.x != 0 || origin.y != 0 || origin.z != 0; }
   /// What loading corrected and a user should hear of (e.g. a base colour
   /// above 1 clamped): one sentence each, naming the file and the thing.
   std::vector<std::string> warnings;

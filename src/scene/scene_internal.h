@@ -36,6 +36,17 @@ std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std
 Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
                     const std::string& what, bool srgb = true);
 
+/// How far a scene may lie from the origin, in multiples of its size, before
+/// its loader rebases it: there float spacing reaches 2^-16 (1.5e-5) of its
+/// size.
+constexpr double kRebaseDistance = 128.0;
+
+/// The origin a loader rebases its scene to (Scene::origin), from the
+/// world-space bounds of its vertices: their centre when it lies farther from
+/// (0, 0, 0) than kRebaseDistance times the bounds' diagonal, else (0, 0, 0),
+/// so that a scene near the origin keeps its coordinates exactly.
+Vec3d rebaseOrigin(const Vec3d& lower, const Vec3d& upper);
+
 Scene loadGltf(const std::string& path);
 Scene loadObj(const std::string& path);
 

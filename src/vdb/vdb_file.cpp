@@ -179,6 +179,10 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   m.insertMeta("scene_bounds_min", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.lower)));
   m.insertMeta("scene_bounds_max", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.upper)));
   m.insertMeta("units", openvdb::StringMetadata(meta.units));
+  const Vec3d& o = grid.frame.offset;
+  if (o.x != 0 || o.y != 0 || o.z != 0) {
+    m.insertMeta("scene_origin", openvdb::Vec3DMetadata(openvdb::Vec3d(o.x, o.y, o.z)));
+  }
   m.insertMeta(kMetaMaxVdls, openvdb::Int32Metadata(grid.maxVdls));
   // The lowest version that holds the file (lightgrid/vdl_grid.h).
   m.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(grid.shTerms > 0 ? kVdlFormatVersion
@@ -262,6 +266,10 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.sceneBounds.upper = fromVdb(
       metaValue<openvdb::Vec3s>(path, m, "scene_bounds_max", false, openvdb::Vec3s(-INFINITY)));
   meta.units = metaValue<std::string>(path, m, "units", false, "");
+  const openvdb::Vec3d origin =
+      metaValue<openvdb::Vec3d>(path, m, "scene_origin", false, openvdb::Vec3d(0.0));
+  if (!origin.isFinite()) throw InputError(path + ": file metadata 'scene_origin' is not finite");
+  meta.sceneOrigin = Vec3d(origin.x(), origin.y(), origin.z());
   meta.formatVersion = metaValue<int32_t>(path, m, kMetaFormatVersion, false, 0);
   meta.convertedFrom = metaValue<std::string>(path, m, "converted_from", false, "");
   meta.surfaceLayers = metaValue<int32_t>(path, m, "surface_layers", false, -1);

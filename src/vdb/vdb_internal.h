@@ -4,6 +4,7 @@
 /// broken files and inspect point files, so that tests need no OpenVDB headers.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,9 @@ void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const Bak
 /// readVdlGrid without checkLightGridValues: the grid as the file holds it,
 /// for `inspect` to report every check. @throws InputError as readVdlGrid
 /// for what makes a file unreadable (contract, transforms, counts, NaN).
-LoadedVdl readVdlStructure(const std::string& path);
+/// `origin`: as readVdlGrid's.
+LoadedVdl readVdlStructure(const std::string& path,
+                           const std::optional<Vec3d>& origin = std::nullopt);
 
 /// What a photon point file holds, read back through OpenVDB.
 struct PointFileInfo {

@@ -5,6 +5,7 @@
 /// src/grid and src/vdb. See docs/vdb-contract.md.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -84,16 +85,25 @@ std::vector<VdbCheck> checkLightGridValues(const VdlGrid& grid, bool halfFloat);
 /// the missing grid / mismatched transform / unreadable content, or the first
 /// check of checkLightGridValues it fails (the check `inspect` names).
 /// Files with a format_version above kVdlFormatVersion are refused.
-LoadedVdl readVdlGrid(const std::string& path);
+/// `origin`: the coordinates the grid is wanted in (Scene::origin of the
+/// scene it lights; by default the baked scene's, file metadata
+/// scene_origin): the frame comes back relative to it (frame.offset =
+/// origin), computed in double from the file's world transform.
+LoadedVdl readVdlGrid(const std::string& path,
+                      const std::optional<Vec3d>& origin = std::nullopt);
 
 /// Writes photons as a PointDataGrid named "photons" with attributes P,
 /// Cd (RGB power, W), direction (wi), normal, bounce. Temp name + rename.
-void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize);
+/// `offset`: Scene::origin of the photons' scene; the file's positions are
+/// world positions (offset + position, in double).
+void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
+                       const Vec3d& offset = Vec3d());
 
 /// Reads a photon file written by writePhotonPoints. Photons come back in the
 /// file's (leaf) order, which is deterministic but not the order written.
 /// @throws InputError naming the file when it cannot be read, holds no
 /// "photons" point grid or lacks one of the attributes.
-std::vector<Photon> readPhotonPoints(const std::string& path);
+/// Positions come back relative to `origin` (computed in double).
+std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origin = Vec3d());
 
 }  // namespace lo

@@ -24,7 +24,8 @@ namespace {
 
 using openvdb::math::Transform;
 
-void writePoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize) {
+void writePoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
+                 const Vec3d& offset) {
   if (!(voxelSize > 0) || !std::isfinite(voxelSize)) {
     throw InputError(path + ": photon point voxel size must be positive, got " +
                      std::to_string(voxelSize));
@@ -37,7 +38,8 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   std::vector<int32_t> bounce(n);
   for (size_t i = 0; i < n; ++i) {
     const Photon& p = photons[i];
-    positions[i] = openvdb::Vec3R(p.position.x, p.position.y, p.position.z);
+    positions[i] = openvdb::Vec3R(offset.x + double(p.position.x), offset.y + double(p.position.y),
+                                  offset.z + double(p.position.z));
     power[i] = toVdb(p.power);
     direction[i] = toVdb(p.direction);
     normal[i] = toVdb(p.normal);
@@ -75,7 +77,7 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   writeVdbFile(path, {{"photons", [&grid] { return openvdb::GridBase::Ptr(grid); }}}, meta);
 }
 
-std::vector<Photon> readPoints(const std::string& path) {
+std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin) {
   namespace pts = openvdb::points;
   OpenedFile f = openFile(path);
   if (!findGrid(f, "photons") && findGrid(f, gridNameOf(&VdlGrid::irradiance))) {
@@ -110,7 +112,8 @@ std::vector<Photon> readPoints(const std::string& path) {
         const openvdb::Vec3d world =
             xform.indexToWorld(pHandle.get(*idx) + idx.getCoord().asVec3d());
         Photon p;
-        p.position = Vec3(float(world.x()), float(world.y()), float(world.z()));
+        p.position = Vec3(float(world.x() - origin.x), float(world.y() - origin.y),
+                          float(world.z() - origin.z));
         p.power = fromVdb(cdHandle.get(*idx));
         p.direction = fromVdb(dHandle.get(*idx));
         p.normal = fromVdb(nHandle.get(*idx));
@@ -160,13 +163,13 @@ PointFileInfo inspectPointFile(const std::string& path) {
 
 }  // namespace vdb_internal
 
-std::vector<Photon> readPhotonPoints(const std::string& path) {
-  return vdb_internal::readPoints(path);
+std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origin) {
+  return vdb_internal::readPoints(path, origin);
 }
 
-void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons,
-                       float voxelSize) {
-  vdb_internal::writePoints(path, photons, voxelSize);
+void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
+                       const Vec3d& offset) {
+  vdb_internal::writePoints(path, photons, voxelSize, offset);
 }
 
 }  // namespace lo

@@ -33,7 +33,8 @@ bool canonicalLess(const Coord& a, const Coord& b) {
   return oa < ob;
 }
 
-GridFrame readFrame(const std::string& path, const Transform& xform, int depth) {
+GridFrame readFrame(const std::string& path, const Transform& xform, int depth,
+                    const Vec3d& offset) {
   const openvdb::math::MapBase::ConstPtr map = xform.baseMap();
   const bool axisAligned = map->isType<openvdb::math::UniformScaleTranslateMap>() ||
                            map->isType<openvdb::math::UniformScaleMap>();
@@ -45,8 +46,9 @@ GridFrame readFrame(const std::string& path, const Transform& xform, int depth) 
   const openvdb::Vec3d centre0 = xform.indexToWorld(openvdb::Vec3d(0.0));
   GridFrame frame;
   frame.voxelSize = float(h);
-  frame.origin = Vec3(float(centre0.x() - 0.5 * h), float(centre0.y() - 0.5 * h),
-                      float(centre0.z() - 0.5 * h));
+  frame.origin = Vec3(float(centre0.x() - 0.5 * h - offset.x), float(centre0.y() - 0.5 * h - offset.y),
+                      float(centre0.z() - 0.5 * h - offset.z));
+  frame.offset = offset;
   frame.depth = depth;
   return frame;
 }
@@ -198,7 +200,7 @@ void readLayers(const std::string& path, const OpenedFile& f, const Transform& x
 
 }  // namespace
 
-LoadedVdl readVdlStructure(const std::string& path) {
+LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& origin) {
   OpenedFile f = openFile(path);
   LoadedVdl out;
   out.meta = readMetadata(path, *f.meta);
@@ -276,7 +278,7 @@ LoadedVdl readVdlStructure(const std::string& path) {
   }
 
   VdlGrid& g = out.grid;
-  g.frame = readFrame(path, xform, out.meta.depth);
+  g.frame = readFrame(path, xform, out.meta.depth, origin.value_or(out.meta.sceneOrigin));
   g.maxVdls = maxVdls;
   g.shTerms = shTerms;
   g.coords.reserve(size_t(active));
@@ -303,8 +305,8 @@ LoadedVdl readVdlStructure(const std::string& path) {
 
 }  // namespace vdb_internal
 
-LoadedVdl readVdlGrid(const std::string& path) {
-  LoadedVdl loaded = vdb_internal::readVdlStructure(path);
+LoadedVdl readVdlGrid(const std::string& path, const std::optional<Vec3d>& origin) {
+  LoadedVdl loaded = vdb_internal::readVdlStructure(path, origin);
   for (const VdbCheck& c : checkLightGridValues(loaded.grid, loaded.halfFloat)) {
     if (!c.passed) {
       throw InputError(path + ": check " + c.name + " fails: " + c.detail +

@@ -32,9 +32,9 @@ using openvdb::math::Transform;
 Transform::Ptr frameTransform(const GridFrame& frame) {
   const double h = frame.voxelSize;
   Transform::Ptr xform = Transform::createLinearTransform(h);
-  xform->postTranslate(openvdb::Vec3d(double(frame.origin.x) + 0.5 * h,
-                                      double(frame.origin.y) + 0.5 * h,
-                                      double(frame.origin.z) + 0.5 * h));
+  xform->postTranslate(openvdb::Vec3d(frame.offset.x + double(frame.origin.x) + 0.5 * h,
+                                      frame.offset.y + double(frame.origin.y) + 0.5 * h,
+                                      frame.offset.z + double(frame.origin.z) + 0.5 * h));
   return xform;
 }
 

@@ -37,6 +37,7 @@ TEST(Compare, ScaledImageHasKnownErrors) {
     EXPECT_NEAR(r.channel[c].maxAbs, 0.1 * maxRef, 1e-5);
   }
   EXPECT_EQ(r.comparedPixels, size_t(35));
+  EXPECT_NEAR(r.meanTestLuminance / r.meanReferenceLuminance, 1.1, 1e-5);
   EXPECT_EQ(compareImages(ref, ref).luminance.relRmse, 0.0);
 }
 

@@ -21,9 +21,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
+#include "bake/bake.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "render/context.h"
@@ -204,6 +207,69 @@ TEST(Golden, CornellBoxFarFromTheOriginIsTheSamePicture) {
       EXPECT_LE(m.maxAbsDiff, kMaxAbsDiff) << name << "; images in " << dir;
     }
   }
+}
+
+/// data/cornell-box.gltf with its nodes under one node at `t` (glTF JSON
+/// numbers: exact in double), as a scene in projected coordinates holds them.
+std::string cornellBoxUnderNode(const std::string& t, const std::string& path) {
+  std::ifstream in(test::dataDir() + "/cornell-box.gltf");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string g = text.str();
+  const size_t scenes = g.find("\"scenes\"");
+  const size_t list = g.find('[', g.find("\"nodes\"", scenes));
+  g.replace(list, g.find(']', list) - list + 1, "[0]");
+  const std::string top = "\n \"nodes\": [";
+  std::string root = "\n  {\"name\": \"projected\", \"translation\": [" + t + "], \"children\": [";
+  for (int i = 1; i <= 9; ++i) root += std::to_string(i) + (i < 9 ? ", " : "]},");
+  g.insert(g.find(top) + top.size(), root);
+  std::ofstream(path) << g;
+  return path;
+}
+
+// A scene in projected coordinates, millions of metres from the origin
+// (float spacing 0.25-0.5 m there): the loader keeps it relative to its
+// centre in double (Scene::origin), the light grid is read in the same
+// coordinates, the bake writes its frame there, and the picture is the one
+// at the origin.
+TEST(Golden, CornellBoxInProjectedCoordinatesIsTheSamePicture) {
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
+  if (updating()) GTEST_SKIP() << "updating the references";
+  const std::string dir = test::outputDir("golden_cornell_projected");
+  GoldenScene far = setup();
+  far.scene = loadScene(cornellBoxUnderNode("2500000.5, 300, -5400000.25", dir + "/far.gltf"));
+  ASSERT_TRUE(far.scene.rebased());
+  // The golden bake (of the box at the origin), read relative to where the
+  // far scene keeps its own centre: the box's centre at the origin.
+  const Vec3d centre = far.scene.origin - Vec3d(2500000.5, 300, -5400000.25);
+  far.octree = buildGpuOctree(readVdlGrid(goldenDir() + "/cornell-box-d4.vdb", centre).grid,
+                              test::paperCosine());
+  far.camera = PinholeCamera::fromScene(far.scene.cameras.at(0));
+  for (RenderMode mode : {RenderMode::Full, RenderMode::Indirect}) {
+    RenderParams p;
+    p.width = p.height = kSize;
+    p.mode = mode;
+    Renderer atOrigin(setup().scene, setup().octree), moved(far.scene, far.octree);
+    const std::string name = toString(mode);
+    const RgbImage expected = asPng(atOrigin.render(setup().camera, p), exposureOf(mode),
+                                    dir + "/at-origin-" + name + ".png");
+    const RgbImage got =
+        asPng(moved.render(far.camera, p), exposureOf(mode), dir + "/far-" + name + ".png");
+    RgbImage diff;
+    const Mismatch m = compare(got, expected, &diff);
+    if (m.failed()) writePng(dir + "/difference-" + name + ".png", diff);
+    EXPECT_LE(m.failingFraction, kMaxFailingFraction)
+        << name << " (max abs diff " << m.maxAbsDiff << "); images in " << dir;
+    EXPECT_LE(m.maxAbsDiff, kMaxAbsDiff) << name << "; images in " << dir;
+  }
+  // A bake of the far scene stores its frame in the scene's coordinates.
+  BakeParams params;
+  params.depth = 3;
+  params.photons = 2000;
+  const BakeResult baked = bake(far.scene, params);
+  EXPECT_EQ(baked.grid.frame.offset.x, far.scene.origin.x);
+  EXPECT_EQ(baked.grid.frame.offset.z, far.scene.origin.z);
+  EXPECT_LT(std::fabs(baked.grid.frame.origin.x), 1.0f);
 }
 
 }  // namespace

@@ -314,6 +314,7 @@ TEST(SceneShared, CornellBoxObj) {
     if (m.name == "leftWall") {
       expectNear(m.baseColor, {0.63f, 0.065f, 0.05f}, 1e-6f, "Kd");
       EXPECT_FLOAT_EQ(m.roughness, 1.0f);  // Ks 0 0 0: diffuse
+      EXPECT_FLOAT_EQ(m.specular, 0.0f);   // and no specular layer
       EXPECT_FLOAT_EQ(m.ior, 1.5f);        // Ni 1.5
       EXPECT_FLOAT_EQ(m.transmission, 0.0f);
     }
@@ -736,6 +737,73 @@ TEST(SceneReject, UnreadableImage) {
   expectInputError(path, "garbage.png");
 }
 
+/// A 0.3 x 0.2 quad in z = 0, a camera and a point light, under a node at
+/// `t` (glTF JSON numbers, so the translation is exact in double).
+MiniGltf quadUnderNode(const std::string& t) {
+  MiniGltf g;
+  g.positions = {0, 0, 0, 0.3f, 0, 0, 0.3f, 0.2f, 0, 0, 0.2f, 0};
+  g.normals = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+  g.indices = {0, 1, 2, 0, 2, 3};
+  g.nodes = R"([{"translation": [)" + t + R"(], "children": [1, 2, 3]}, {"mesh": 0},
+      {"camera": 0, "translation": [0.1, 0.1, 2]},
+      {"translation": [0.5, 0.25, 1], "extensions": {"KHR_lights_punctual": {"light": 0}}}])";
+  g.extraTop =
+      R"("cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
+      "extensionsUsed": ["KHR_lights_punctual"],
+      "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1}]}},)";
+  return g;
+}
+
+TEST(SceneGltf, ASceneFarFromTheOriginKeepsItsPrecision) {
+  // Projected coordinates (1e6-1e7 m): floats there are 0.06-0.5 m apart, so
+  // the loader keeps the scene relative to its centre, computed in double
+  // (Scene::origin), and every position keeps float's precision near 0.
+  const std::string dir = test::outputDir("SceneGltf_Far");
+  const Vec3d t(1234567.25, 89.5, -7654321.0625);
+  const Scene far = loadScene(writeGltf(dir, "far.gltf", quadUnderNode("1234567.25, 89.5, -7654321.0625")));
+  ASSERT_TRUE(far.rebased());
+  const Vec3d corners[4] = {{0, 0, 0}, {0.3f, 0, 0}, {0.3f, 0.2f, 0}, {0, 0.2f, 0}};
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_DOUBLE_EQ(far.origin[a], t[a] + 0.5 * corners[2][a]);  // the quad's centre
+  }
+  ASSERT_EQ(far.positions.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    const Vec3d world = far.toWorld(far.positions[i]);
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(world[a], t[a] + corners[i][a], 1e-7) << i << a;
+  }
+  EXPECT_NEAR(far.triangleArea(0) + far.triangleArea(1), 0.06, 1e-7);
+  ASSERT_EQ(far.lights.size(), 1u);
+  ASSERT_EQ(far.cameras.size(), 1u);
+  const Vec3d light = far.toWorld(far.lights[0].position);
+  const Vec3d camera = far.toWorld(far.cameras[0].position);
+  const Vec3d lightAt(0.5, 0.25, 1), cameraAt(0.1, 0.1, 2);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(light[a], t[a] + lightAt[a], 1e-6) << a;
+    EXPECT_NEAR(camera[a], t[a] + cameraAt[a], 1e-6) << a;
+  }
+  // Near the origin nothing moves: the file's coordinates exactly.
+  const Scene near = loadScene(writeGltf(dir, "near.gltf", quadUnderNode("1, 2, 3")));
+  EXPECT_FALSE(near.rebased());
+  EXPECT_EQ(near.positions[2], Vec3(1.3f, 2.2f, 3.0f));
+  EXPECT_EQ(near.lights[0].position, Vec3(1.5f, 2.25f, 4.0f));
+}
+
+TEST(SceneObj, ASceneFarFromTheOriginKeepsItsPrecision) {
+  // The OBJ's own numbers, read again in double (its parser reads float).
+  const std::string dir = test::outputDir("SceneObj_Far");
+  writeFile(dir + "/far.obj",
+            "v 1234567.25 89.5 -7654321.0625\nv 1234567.55 89.5 -7654321.0625\n"
+            "v 1234567.55 89.7 -7654321.0625\nv 1234567.25 89.7 -7654321.0625\nf 1 2 3 4\n");
+  const Scene far = loadScene(dir + "/far.obj");
+  ASSERT_TRUE(far.rebased());
+  EXPECT_DOUBLE_EQ(far.origin.x, (1234567.25 + 1234567.55) / 2);
+  const Vec3d p2 = far.toWorld(far.positions[2]);
+  EXPECT_NEAR(p2.x, 1234567.55, 1e-7);
+  EXPECT_NEAR(p2.y, 89.7, 1e-7);
+  EXPECT_NEAR(p2.z, -7654321.0625, 1e-7);
+  EXPECT_NEAR(far.triangleArea(0) + far.triangleArea(1), 0.06, 1e-7);
+}
+
 TEST(SceneGltf, LightAndMaterialValuesStayInTheirRanges) {
   // glTF's [0, 1] factors are clamped with a warning naming them; a negative
   // emission is taken as 0, warned; intensities and positions beyond what
@@ -845,7 +913,7 @@ TEST(SceneReject, NodeCycle) {
 TEST(SceneObj, MaterialMappingAndGrouping) {
   std::string dir = test::outputDir("SceneObj_Materials");
   writeFile(dir + "/m.mtl",
-            "newmtl shiny\nKd 0.5 0.25 0.125\nKs 1 1 1\nNs 98\nd 0.25\nNi 1.4\n"
+            "newmtl shiny\nKd 0.5 0.25 0.125\nKs 0.5 0.625 0.25\nNs 98\nd 0.25\nNi 1.4\n"
             "newmtl lamp\nKd 0 0 0\nKe 2 3 4\n");
   writeFile(
       dir + "/scene.obj",
@@ -858,6 +926,8 @@ TEST(SceneObj, MaterialMappingAndGrouping) {
   EXPECT_EQ(shiny.name, "shiny");
   expectNear(shiny.baseColor, {0.5f, 0.25f, 0.125f}, 1e-6f);
   EXPECT_NEAR(shiny.roughness, std::sqrt(2.0f / 100.0f), 1e-6f);
+  EXPECT_FLOAT_EQ(shiny.specular, 0.625f);  // the largest channel of Ks
+  EXPECT_FLOAT_EQ(s.materials[1].specular, 0.0f);  // no Ks: Lambertian
   EXPECT_NEAR(shiny.transmission, 0.75f, 1e-6f);
   EXPECT_NEAR(shiny.ior, 1.4f, 1e-6f);
   expectNear(s.materials[1].emission, {2, 3, 4}, 1e-6f);

@@ -352,6 +352,47 @@ namespace lo {
 namespace {
 
 /// A small bake of a room (its edges have surface layers) for the tests below.
+TEST(VdbIo, AGridOfARebasedSceneIsStoredInWorldCoordinates) {
+  // A scene the loader rebased (Scene::origin 1e6 away): the grid's frame is
+  // relative to it, the file's transform is in world coordinates, and
+  // reading gives back the frame exactly, by default or for the scene's
+  // origin; for another origin, the same world positions.
+  const std::string folder = test::outputDir("VdbIo.Rebased");
+  const std::string path = folder + "/far.vdb";
+  VdlGrid g = makeGrid(200, 2, 7);
+  g.frame.offset = Vec3d(1234567.25, -89.5, -7654321.0625);
+  writeVdlGrid(path, g, makeMeta());
+  for (const LoadedVdl& back : {readVdlGrid(path), readVdlGrid(path, g.frame.offset)}) {
+    EXPECT_EQ(back.grid.frame.origin, g.frame.origin);
+    EXPECT_EQ(back.grid.frame.voxelSize, g.frame.voxelSize);
+    EXPECT_EQ(back.grid.frame.offset.x, g.frame.offset.x);
+    EXPECT_EQ(back.grid.frame.offset.y, g.frame.offset.y);
+    EXPECT_EQ(back.grid.frame.offset.z, g.frame.offset.z);
+    EXPECT_EQ(back.meta.sceneOrigin.z, g.frame.offset.z);
+  }
+  const Vec3d near(1234560.0, -80.0, -7654320.0);
+  const LoadedVdl moved = readVdlGrid(path, near);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(double(moved.grid.frame.origin[a]) + near[a],
+                double(g.frame.origin[a]) + g.frame.offset[a], 1e-5)
+        << a;
+  }
+  // Photons likewise: world positions in the file, relative ones back.
+  std::vector<Photon> photons = makePhotons(100);
+  writePhotonPoints(folder + "/photons.vdb", photons, 0.05f, g.frame.offset);
+  const std::vector<Photon> world = readPhotonPoints(folder + "/photons.vdb");
+  const std::vector<Photon> local = readPhotonPoints(folder + "/photons.vdb", g.frame.offset);
+  Bounds3 a, b, c;
+  for (const Photon& p : photons) a.extend(p.position);
+  for (const Photon& p : world) b.extend(p.position);
+  for (const Photon& p : local) c.extend(p.position);
+  EXPECT_NEAR(b.lower.z, a.lower.z + g.frame.offset.z, 1.0);  // float at 7.6e6: 0.5 apart
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(c.lower[k], a.lower[k], 1e-5f) << k;
+    EXPECT_NEAR(c.upper[k], a.upper[k], 1e-5f) << k;
+  }
+}
+
 BakeResult smallRoomBake() {
   BakeParams p;
   p.depth = 4;
