@@ -18,6 +18,11 @@ void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
                   "Light the scene with an equirectangular radiance map (.exr or .hdr, linear; "
                   "its upper half, row 0 at the zenith), scaled by --sky (default 1,1,1)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--sky-mesh", opt.skyMesh,
+                  "Take the triangles of this material (a sky box or dome around the scene) out "
+                  "of the geometry and light the scene with them as its sky: their emission, or "
+                  "their base colour (texture included) as radiance, scaled by --sky")
+      ->excludes("--sky-image");
 }
 
 Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
@@ -40,6 +45,15 @@ Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
     }
   }
   Scene scene = loadScene(path);
+  if (!opt.skyMesh.empty()) {
+    try {
+      skyFromMaterial(scene, opt.skyMesh);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--sky-mesh: ") + e.what());
+    }
+    if (!opt.sky.empty()) scene.sky.radiance = sky;
+    return scene;
+  }
   if (image) {
     scene.sky.image = std::move(image);
     scene.sky.radiance = opt.sky.empty() ? Vec3{1, 1, 1} : sky;

@@ -19,9 +19,10 @@ namespace lo::tool {
 struct SceneOptions {
   std::string sky;       ///< "r,g,b" radiance W/(m^2 sr); empty = the file's
   std::string skyImage;  ///< .exr or .hdr equirectangular map; empty = the file's
+  std::string skyMesh;   ///< material of a sky box to take as the sky; empty = none
 };
 
-/// Registers --sky and --sky-image on `cmd`.
+/// Registers --sky, --sky-image and --sky-mesh on `cmd`.
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt);
 
 /// loadScene(path) with the flags applied. @throws InputError naming the flag

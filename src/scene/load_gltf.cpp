@@ -320,6 +320,13 @@ class SceneBuilder {
     readSky();
     finishVertexAttributes();
     rebase();
+    if (!skyMesh_.empty()) {
+      // extras.lightoctree_sky, when given, scales the sky mesh's image.
+      const Vec3 scale = skyScale_ ? scene_.sky.radiance : Vec3{1, 1, 1};
+      scene_.sourcePath = path_;  // for its messages
+      skyFromMaterial(scene_, skyMesh_);
+      scene_.sky.radiance = scale;
+    }
     return std::move(scene_);
   }
 
@@ -562,6 +569,19 @@ class SceneBuilder {
     if (s < 0 || size_t(s) >= scenes.size()) return;
     const tinygltf::Value& extras = scenes[size_t(s)].extras;
     if (!extras.IsObject()) return;
+    if (extras.Has("lightoctree_sky_mesh")) {
+      // The material of a sky box to take as the sky (skyFromMaterial).
+      const tinygltf::Value& name = extras.Get("lightoctree_sky_mesh");
+      const std::string what = "scene " + std::to_string(s) + ": extras.lightoctree_sky_mesh";
+      if (!name.IsString() || name.Get<std::string>().empty()) {
+        fail(path_, what + " must be the name of the sky box's material");
+      }
+      if (extras.Has("lightoctree_sky_image")) {
+        fail(path_, what + " and extras.lightoctree_sky_image: give one sky");
+      }
+      skyMesh_ = name.Get<std::string>();
+    }
+    skyScale_ = extras.Has("lightoctree_sky");
     if (extras.Has("lightoctree_sky_image")) {
       // An equirectangular radiance map beside the file (.exr or .hdr).
       const tinygltf::Value& uri = extras.Get("lightoctree_sky_image");
@@ -998,6 +1018,8 @@ class SceneBuilder {
     }
   };
   std::map<TextureKey, int> imageToTexture_;
+  std::string skyMesh_;    ///< extras.lightoctree_sky_mesh: a material to take as the sky
+  bool skyScale_ = false;  ///< extras.lightoctree_sky was given
   std::set<int> missingImages_;  ///< images whose file is missing, warned once
   int defaultMaterial_ = -1;
   bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false;

@@ -295,6 +295,19 @@ struct Scene {
   Scene translated(const Vec3& offset) const;
 };
 
+/// Takes the triangles of material `material` (a sky box or dome: a closed
+/// mesh around the scene) out of the geometry and makes them the scene's
+/// sky: an equirectangular image `width` x `width`/2 of what the centre of
+/// the remaining geometry sees of them along each texel's centre direction
+/// (nearest triangle, either face), their emission as radiance, or their
+/// base colour (texture included) when the material does not emit (a plain
+/// textured sky box, shown unlit as glTF viewers show it); multiplier 1.
+/// Like every sky, only its upper hemisphere lights the scene. Vertices no
+/// other triangle uses go too. @throws InputError naming the scene when no
+/// material has that name (listing those it has), it covers no triangle, or
+/// it covers them all.
+void skyFromMaterial(Scene& scene, const std::string& material, int width = 1024);
+
 /// Largest |coordinate| a scene may have, scene units (glTF metres): 1e12
 /// (a million km). The tracers work in single precision in a frame centred
 /// on the scene; loadScene refuses vertices beyond this, naming the vertex.

@@ -804,6 +804,94 @@ TEST(SceneObj, ASceneFarFromTheOriginKeepsItsPrecision) {
   EXPECT_NEAR(far.triangleArea(0) + far.triangleArea(1), 0.06, 1e-7);
 }
 
+// --- a sky box taken as the sky ---------------------------------------------
+
+TEST(SkyMesh, ASkyBoxBecomesTheSkyItShows) {
+  // A floor under a 100 m sky box whose top is blue and whose sides are
+  // orange (one material, a two-texel texture): the box leaves the geometry
+  // and its colours go where the floor's centre sees them.
+  Scene scene;
+  scene.sourcePath = "sky-box scene";
+  scene.materials.resize(2);
+  scene.materials[0].name = "floor";
+  scene.materials[1].name = "sky";
+  scene.materials[1].baseColor = {1, 1, 1};
+  scene.materials[1].baseColorTexture = 0;
+  Texture colours;
+  colours.width = 2;
+  colours.height = 1;
+  const Vec3 blue{0.2f, 0.4f, 0.8f}, orange{0.9f, 0.5f, 0.2f};
+  colours.texels = {blue, orange};
+  scene.textures.push_back(colours);
+  auto quad = [&](const Vec3& corner, const Vec3& eu, const Vec3& ev, int material, float u) {
+    const uint32_t base = uint32_t(scene.positions.size());
+    for (const Vec3& p : {corner, corner + eu, corner + eu + ev, corner + ev}) {
+      scene.positions.push_back(p);
+      scene.texcoords0.insert(scene.texcoords0.end(), {u, 0.5f});
+    }
+    for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) scene.indices.push_back(base + i);
+    scene.triangleMaterial.insert(scene.triangleMaterial.end(), {material, material});
+  };
+  quad({-1, 0, -1}, {0, 0, 2}, {2, 0, 0}, 0, 0.25f);
+  const float r = 50;
+  quad({-r, r, -r}, {2 * r, 0, 0}, {0, 0, 2 * r}, 1, 0.25f);  // top: blue
+  for (int side = 0; side < 4; ++side) {                        // sides: orange
+    const Vec3 corner = side == 0 ? Vec3{-r, -r, -r} : side == 1 ? Vec3{r, -r, -r}
+                      : side == 2 ? Vec3{r, -r, r} : Vec3{-r, -r, r};
+    const Vec3 along = side == 0 ? Vec3{2 * r, 0, 0} : side == 1 ? Vec3{0, 0, 2 * r}
+                     : side == 2 ? Vec3{-2 * r, 0, 0} : Vec3{0, 0, -2 * r};
+    quad(corner, along, {0, 2 * r, 0}, 1, 0.75f);
+  }
+  skyFromMaterial(scene, "sky", 64);
+  ASSERT_EQ(scene.triangleCount(), 2u);
+  EXPECT_EQ(scene.positions.size(), 4u);
+  EXPECT_EQ(scene.texcoords0.size(), 8u);
+  EXPECT_EQ(scene.bounds().upper, Vec3(1, 0, 1));
+  ASSERT_TRUE(scene.sky.image);
+  const Texture& sky = *scene.sky.image;
+  ASSERT_EQ(sky.width, 64);
+  ASSERT_EQ(sky.height, 32);
+  EXPECT_EQ(scene.sky.radiance, Vec3(1, 1, 1));
+  // Rows 0-7 look within 45 degrees of the zenith: the top everywhere; rows
+  // 10-15 lower than 54.7 degrees (the top's corners): the sides; the lower
+  // half is not used (black).
+  for (int x = 0; x < 64; ++x) {
+    for (int y = 0; y < 32; ++y) {
+      const Vec3 texel = sky.texels[size_t(y) * 64 + size_t(x)];
+      const Vec3 expected = y < 8 ? blue : (y >= 10 && y < 16) ? orange : y >= 16 ? Vec3{} : texel;
+      const Vec3 d = texel - expected;
+      ASSERT_LT(std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}), 1e-6f)
+          << x << ", " << y << ": " << texel.ToString() << " vs " << expected.ToString();
+    }
+  }
+  expectNear(scene.sky.radianceFrom({0, 1, 0}), blue, 1e-6f, "zenith");
+  expectNear(scene.sky.radianceFrom(normalize(Vec3{1, 0.05f, 0})), orange, 1e-6f, "horizon");
+}
+
+TEST(SkyMesh, NamesWhatIsWrong) {
+  Scene scene = test::boxWithTwoBlocks(Bounds3{{0.1f, 0, 0.1f}, {0.3f, 0.2f, 0.3f}},
+                                       Bounds3{{0.6f, 0, 0.6f}, {0.8f, 0.5f, 0.8f}});
+  scene.sourcePath = "box";
+  try {
+    skyFromMaterial(scene, "heaven");
+    ADD_FAILURE() << "no error for an unknown material";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no material named 'heaven'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(scene.materials[0].name), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(skyFromMaterial(scene, scene.materials[0].name), InputError);  // all of it
+  // The scene file's extras name it: a glTF whose only mesh is the sky.
+  const std::string dir = test::outputDir("SkyMesh_Gltf");
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"name": "dome"}])";
+  g.extraTop = R"("scenes": [{"nodes": [0], "extras": {"lightoctree_sky_mesh": "dome"}}], )";
+  std::string json = g.json();
+  json.replace(json.find("\"scenes\": [{\"nodes\": [0]}], "), 28, "");
+  writeFile(dir + "/dome.gltf", json);
+  expectInputError(dir + "/dome.gltf", "nothing is left under the sky");
+}
+
 TEST(SceneGltf, LightAndMaterialValuesStayInTheirRanges) {
   // glTF's [0, 1] factors are clamped with a warning naming them; a negative
   // emission is taken as 0, warned; intensities and positions beyond what
