@@ -23,6 +23,14 @@ void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
                   "of the geometry and light the scene with them as its sky: their emission, or "
                   "their base colour (texture included) as radiance, scaled by --sky")
       ->excludes("--sky-image");
+  cmd->add_option("--physical-sky", opt.physicalSky,
+                  "Light the scene with the daylight sky of its sun (its first directional "
+                  "light), an atmosphere of this turbidity (2: very clear, 3: clear, 6: hazy; "
+                  "Preetham et al. 1999), as bright beside the sun as that sky is beside the "
+                  "sun through it; scaled by --sky")
+      ->check(CLI::Range(double(kMinTurbidity), double(kMaxTurbidity)))
+      ->excludes("--sky-image")
+      ->excludes("--sky-mesh");
 }
 
 Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
@@ -45,11 +53,16 @@ Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
     }
   }
   Scene scene = loadScene(path);
-  if (!opt.skyMesh.empty()) {
+  if (!opt.skyMesh.empty() || opt.physicalSky > 0) {
+    const char* flag = opt.skyMesh.empty() ? "--physical-sky: " : "--sky-mesh: ";
     try {
-      skyFromMaterial(scene, opt.skyMesh);
+      if (!opt.skyMesh.empty()) {
+        skyFromMaterial(scene, opt.skyMesh);
+      } else {
+        physicalSky(scene, opt.physicalSky);
+      }
     } catch (const InputError& e) {
-      throw InputError(std::string("--sky-mesh: ") + e.what());
+      throw InputError(flag + std::string(e.what()));
     }
     if (!opt.sky.empty()) scene.sky.radiance = sky;
     return scene;

@@ -20,9 +20,10 @@ struct SceneOptions {
   std::string sky;       ///< "r,g,b" radiance W/(m^2 sr); empty = the file's
   std::string skyImage;  ///< .exr or .hdr equirectangular map; empty = the file's
   std::string skyMesh;   ///< material of a sky box to take as the sky; empty = none
+  float physicalSky = 0; ///< turbidity of a daylight sky for the scene's sun; 0 = none
 };
 
-/// Registers --sky, --sky-image and --sky-mesh on `cmd`.
+/// Registers --sky, --sky-image, --sky-mesh and --physical-sky on `cmd`.
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt);
 
 /// loadScene(path) with the flags applied. @throws InputError naming the flag

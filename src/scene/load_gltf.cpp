@@ -320,11 +320,15 @@ class SceneBuilder {
     readSky();
     finishVertexAttributes();
     rebase();
-    if (!skyMesh_.empty()) {
-      // extras.lightoctree_sky, when given, scales the sky mesh's image.
+    if (!skyMesh_.empty() || turbidity_ > 0) {
+      // extras.lightoctree_sky, when given, scales the sky's image.
       const Vec3 scale = skyScale_ ? scene_.sky.radiance : Vec3{1, 1, 1};
-      scene_.sourcePath = path_;  // for its messages
-      skyFromMaterial(scene_, skyMesh_);
+      scene_.sourcePath = path_;  // for their messages
+      if (!skyMesh_.empty()) {
+        skyFromMaterial(scene_, skyMesh_);
+      } else {
+        physicalSky(scene_, turbidity_);
+      }
       scene_.sky.radiance = scale;
     }
     return std::move(scene_);
@@ -580,6 +584,18 @@ class SceneBuilder {
         fail(path_, what + " and extras.lightoctree_sky_image: give one sky");
       }
       skyMesh_ = name.Get<std::string>();
+    }
+    if (extras.Has("lightoctree_physical_sky")) {
+      // The daylight sky of the scene's sun, at this turbidity (physicalSky).
+      const tinygltf::Value& t = extras.Get("lightoctree_physical_sky");
+      const std::string what = "scene " + std::to_string(s) + ": extras.lightoctree_physical_sky";
+      if (!t.IsNumber() || !(t.GetNumberAsDouble() > 0)) {
+        fail(path_, what + " must be the atmosphere's turbidity (a number, 2 to 10)");
+      }
+      if (extras.Has("lightoctree_sky_image") || extras.Has("lightoctree_sky_mesh")) {
+        fail(path_, what + " and another sky (lightoctree_sky_image or _mesh): give one sky");
+      }
+      turbidity_ = float(t.GetNumberAsDouble());
     }
     skyScale_ = extras.Has("lightoctree_sky");
     if (extras.Has("lightoctree_sky_image")) {
@@ -1020,6 +1036,7 @@ class SceneBuilder {
   std::map<TextureKey, int> imageToTexture_;
   std::string skyMesh_;    ///< extras.lightoctree_sky_mesh: a material to take as the sky
   bool skyScale_ = false;  ///< extras.lightoctree_sky was given
+  float turbidity_ = 0;    ///< extras.lightoctree_physical_sky; 0 = none
   std::set<int> missingImages_;  ///< images whose file is missing, warned once
   int defaultMaterial_ = -1;
   bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false;

@@ -308,6 +308,37 @@ struct Scene {
 /// it covers them all.
 void skyFromMaterial(Scene& scene, const std::string& material, int width = 1024);
 
+/// A daylight sky for the scene's sun (its first directional light):
+/// Preetham, Shirley and Smits' analytic model ("A Practical Analytic Model
+/// for Daylight", 1999) at `turbidity` (2: very clear, 3: clear, 6: hazy),
+/// drawn into a `width` x `width`/2 equirectangular image (upper half; the
+/// luminance in cd/m^2 = W/(m^2 sr) in the project's units, the model's
+/// chromaticity, to linear Rec. 709), scaled so that the sky stands to the
+/// scene's sun as the model's sky to the sun that reaches the ground through
+/// the same air: sky x E_scene / directSunIlluminance, E_scene the
+/// luminance of the sun's colour x intensity (lx). The sun itself stays the
+/// scene's light. @throws InputError naming the scene when it has no
+/// directional light, the sun is not above the horizon, or the turbidity
+/// lies outside [kMinTurbidity, kMaxTurbidity].
+void physicalSky(Scene& scene, float turbidity, int width = 512);
+
+constexpr float kMinTurbidity = 1.7f;  ///< below it the model's sky turns negative
+constexpr float kMaxTurbidity = 10.0f;
+/// The sun's illuminance above the atmosphere, lx (its mean distance).
+constexpr double kSolarIlluminance = 128000.0;
+
+/// The model's zenith: luminance (cd/m^2) and chromaticity (x, y), for the
+/// sun `sunZenith` radians from the zenith (Preetham et al. 1999, A.2).
+struct DaylightZenith {
+  double luminance = 0, x = 0, y = 0;
+};
+DaylightZenith daylightZenith(double sunZenith, double turbidity);
+
+/// The sun's direct normal illuminance at the ground, lx: kSolarIlluminance
+/// through Kasten and Young's air mass with Kasten's Rayleigh optical depth
+/// and `turbidity` taken as Linke's (the ESRA clear-sky formula).
+double directSunIlluminance(double sunZenith, double turbidity);
+
 /// Largest |coordinate| a scene may have, scene units (glTF metres): 1e12
 /// (a million km). The tracers work in single precision in a frame centred
 /// on the scene; loadScene refuses vertices beyond this, naming the vertex.
