@@ -86,30 +86,95 @@ vec3 indirectLight(vec3 n, vec3 v, vec3 ng, vec3 baseColor, float metallic, floa
   return indirect;
 }
 
-// Light through a transmissive surface (KHR_materials_transmission).
-vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
-  // Thin-walled transmission (glTF without KHR_materials_volume): the
-  // surface replaces that share of its diffuse lobe by the scene behind
-  // it, seen straight through, tinted by the base colour and weighted by
-  // the Fresnel transmittance at the viewing angle (Schlick, F0 = 0.04).
-  // Thin-walled: seen straight through. With a volume: screen-space
-  // refraction, the image read where the refracted ray leaves a slab of the
-  // material's thickness (an approximation: the real exit depends on the
-  // shape behind the surface).
-  vec3 behind;
-  if (uThickness > 0.0) {
-    vec3 t = refract(-v, n, 1.0 / max(uIor, 1.0));
-    if (dot(t, t) == 0.0) t = -v;
-    vec4 clip = uViewProj * vec4(vPosition + t * uThickness, 1.0);
-    vec2 uv = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
-    behind = textureLod(uBehind, uv, 0.0).rgb;
-  } else {
-    behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0).rgb;
+// The opaque scene's radiance behind a transmissive surface along the ray
+// from q in direction d: the ray is taken to the scene's bounds (the walls
+// of a room, the probe's parallax box) and that point read from the opaque
+// image drawn before the transmissive surfaces; from the reflection probe
+// when it falls off the screen or behind the camera.
+vec3 behindAlong(vec3 q, vec3 d) {
+  vec3 dd = mix(d, vec3(1e-6), equal(d, vec3(0.0)));  // no 0/0 below
+  vec3 tf = max((uProbeBoxMax - q) / dd, (uProbeBoxMin - q) / dd);
+  float tBox = max(min(min(tf.x, tf.y), tf.z), 0.0);
+#ifdef LO_DIRECT_LIGHT
+  // An emitter drawn as an area light (the probe leaves those out): its
+  // radiance where the ray meets the nearest one's front face.
+  if (uMode == LO_MODE_FULL || uMode == LO_MODE_DIRECT) {
+    float nearest = tBox;
+    vec3 emitted = vec3(-1.0);
+    for (int i = uLightCount.x - uLightCount.y; i < uLightCount.x; ++i) {
+      vec3 a = uLights[i].corner0.xyz, e1 = uLights[i].corner1.xyz - a,
+           e2 = uLights[i].corner2.xyz - a;
+      if (dot(d, uLights[i].directionRange.xyz) >= 0.0) continue;  // its back
+      vec3 pv = cross(d, e2);
+      float det = dot(e1, pv);
+      if (abs(det) < 1e-12) continue;
+      vec3 s = q - a;
+      float b1 = dot(s, pv) / det;
+      vec3 qv = cross(s, e1);
+      float b2 = dot(d, qv) / det;
+      float t = dot(e2, qv) / det;
+      if (b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 && t > 0.0 && t <= nearest) {
+        nearest = t;
+        emitted = uLights[i].colorFar.rgb;
+      }
+    }
+    if (emitted.x >= 0.0) return emitted;
   }
+#endif
+  vec3 hit = q + d * tBox;
+  vec4 clip = uViewProj * vec4(hit, 1.0);
+  vec2 uv = clip.xy / max(clip.w, 1e-9) * 0.5 + 0.5;
+  bool onScreen = clip.w > 0.0 && all(greaterThanEqual(uv, vec2(0.0))) &&
+                  all(lessThanEqual(uv, vec2(1.0)));
+  if (!onScreen && uHasProbe) return textureLod(uProbe, hit, 0.0).rgb;
+  vec3 behind = textureLod(uBehind, clamp(uv, vec2(0.0), vec2(1.0)), 0.0).rgb;
   if (uEncodeSrgb) behind = srgbDecode(behind);
-  behind /= uExposureScale;
-  float fresnel = 0.04 + 0.96 * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);
-  return uTransmission * (1.0 - fresnel) * baseColor * behind;
+  return behind / uExposureScale;
+}
+
+// Light through a transmissive surface (KHR_materials_transmission), tinted
+// by the base colour and weighted by the Fresnel transmittance of each
+// interface it crosses (Schlick, F0 from the ior).
+vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
+  float ior = max(uIor, 1.0);
+  float f0 = (ior - 1.0) / (ior + 1.0);
+  f0 *= f0;
+  float fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);
+  if (uThickness <= 0.0) {
+    // Thin-walled (glTF without KHR_materials_volume): the scene behind,
+    // seen straight through.
+    vec3 behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0).rgb;
+    if (uEncodeSrgb) behind = srgbDecode(behind);
+    return uTransmission * (1.0 - fresnel) * baseColor * behind / uExposureScale;
+  }
+  // A volume (KHR_materials_volume): the surface taken as a ball whose
+  // diameter is the material's thickness, touching the surface here (exact
+  // for a sphere given its diameter, as exporters give it); the ray refracts
+  // in, crosses the ball along its chord and leaves it there (the share the
+  // far side lets through) or after one reflection inside it (the rest: a
+  // light above a glass ball shows in its lower half), on to the scene
+  // behind.
+  vec3 t = refract(-v, n, 1.0 / ior);
+  if (dot(t, t) == 0.0) t = -v;
+  float radius = 0.5 * uThickness;
+  vec3 centre = vPosition - n * radius;
+  vec3 light = vec3(0.0);
+  float carried = 1.0 - fresnel;  // what entered
+  vec3 p = vPosition;
+  for (int bounce = 0; bounce < 2; ++bounce) {
+    vec3 exitPoint = p + t * max(2.0 * radius * dot(t, normalize(centre - p)), 0.0);
+    vec3 m = normalize(exitPoint - centre);  // outward at the exit
+    vec3 out_ = refract(t, -m, ior);
+    float through = 0.0;
+    if (dot(out_, out_) > 0.0) {
+      through = 1.0 - (f0 + (1.0 - f0) * pow(1.0 - clamp(dot(out_, m), 0.0, 1.0), 5.0));
+      light += carried * through * behindAlong(exitPoint, out_);
+    }
+    carried *= 1.0 - through;
+    t = reflect(t, -m);
+    p = exitPoint;
+  }
+  return uTransmission * baseColor * light;
 }
 
 void main() {

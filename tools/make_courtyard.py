@@ -85,31 +85,9 @@ def cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
-        os.path.dirname(__file__), "..", "data", "courtyard.gltf")
-    materials = [
-        ("ground", (0.3, 0.3, 0.3)),
-        ("white", (0.75, 0.73, 0.7)),
-        ("brick", (0.6, 0.3, 0.22)),
-        ("blue", (0.35, 0.45, 0.6)),
-        ("sand", (0.7, 0.6, 0.42)),
-    ]
-    # (material, lower corner, upper corner)
-    blocks = [
-        (1, (-12, 0, -12), (4, 10, -6)),   # north: long, tall
-        (2, (6, 0, -12), (12, 12, 4)),     # east: the tallest
-        (3, (-12, 0, -4), (-6, 6, 12)),    # west: low
-        (4, (-2, 0, 6), (12, 8, 12)),      # south
-        (1, (-5, 0, 8), (-3, 1.5, 10)),    # a low wall in the south-west gap
-    ]
-    quads = [(0, ((-20, 0, -20), (0, 0, 40), (40, 0, 0)))]
-    for material, lo, hi in blocks:
-        for face in box_faces(lo, hi):
-            if face[0][1] == 0 and face[1][1] == 0 and face[2][1] == 0:
-                continue  # the bottom face lies on the ground: never seen
-            quads.append((material, face))
-
+def mesh_nodes(materials, quads):
+    """One mesh and node per material from (material, (corner, u, v)) quads:
+    (buffer bytes, bufferViews, accessors, meshes, nodes)."""
     data = bytearray()
     views, accessors, meshes, nodes = [], [], [], []
     for material in range(len(materials)):
@@ -148,10 +126,14 @@ def main():
         meshes.append({"name": materials[material][0], "primitives": [
             {"attributes": attributes, "indices": len(accessors) - 1, "material": material}]})
         nodes.append({"name": materials[material][0], "mesh": len(meshes) - 1})
+    return data, views, accessors, meshes, nodes
 
-    # The sun: its -Z axis is the way the light travels; 40 degrees above the
-    # horizon, from the south-west.
-    elevation, azimuth = math.radians(40), math.radians(225)
+
+def sun_rotation(elevation_degrees, azimuth_degrees):
+    """The quaternion turning a light's -Z (the way it travels) to the light
+    of a sun `elevation_degrees` above the horizon, travelling towards the
+    azimuth `azimuth_degrees`, measured from -Z towards -X (0: due -Z)."""
+    elevation, azimuth = math.radians(elevation_degrees), math.radians(azimuth_degrees)
     travel = (-math.cos(elevation) * math.sin(azimuth), -math.sin(elevation),
               -math.cos(elevation) * math.cos(azimuth))
     # Rotation taking -Z to `travel`: about the axis (-Z) x travel.
@@ -159,17 +141,55 @@ def main():
     axis = cross(z, travel)
     s = math.sqrt(sum(c * c for c in axis))
     angle = math.atan2(s, sum(z[i] * travel[i] for i in range(3)))
-    q = [c / s * math.sin(angle / 2) for c in axis] + [math.cos(angle / 2)]
-    nodes.append({"name": "sun", "rotation": q, "extensions": {"KHR_lights_punctual": {"light": 0}}})
-    # The camera above the south-west corner, looking at the courtyard's centre.
-    eye, target = (-16.0, 14.0, 18.0), (2.0, 0.0, -1.0)
+    return [c / s * math.sin(angle / 2) for c in axis] + [math.cos(angle / 2)]
+
+
+def camera_rotation(eye, target):
+    """The quaternion of a camera at `eye` looking at `target`, +Y up."""
     forward = [target[i] - eye[i] for i in range(3)]
     yaw = math.atan2(-forward[0], -forward[2])
     pitch = math.atan2(forward[1], math.hypot(forward[0], forward[2]))
     qy = (0.0, math.sin(yaw / 2), 0.0, math.cos(yaw / 2))
     qx = (math.sin(pitch / 2), 0.0, 0.0, math.cos(pitch / 2))
-    cam_q = (qy[3] * qx[0], qy[1] * qx[3], -qy[1] * qx[0], qy[3] * qx[3])
-    nodes.append({"name": "camera", "camera": 0, "translation": list(eye), "rotation": list(cam_q)})
+    return [qy[3] * qx[0], qy[1] * qx[3], -qy[1] * qx[0], qy[3] * qx[3]]
+
+
+def embedded_buffer(data):
+    return {"byteLength": len(data),
+            "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
+        os.path.dirname(__file__), "..", "data", "courtyard.gltf")
+    materials = [
+        ("ground", (0.3, 0.3, 0.3)),
+        ("white", (0.75, 0.73, 0.7)),
+        ("brick", (0.6, 0.3, 0.22)),
+        ("blue", (0.35, 0.45, 0.6)),
+        ("sand", (0.7, 0.6, 0.42)),
+    ]
+    # (material, lower corner, upper corner)
+    blocks = [
+        (1, (-12, 0, -12), (4, 10, -6)),   # north: long, tall
+        (2, (6, 0, -12), (12, 12, 4)),     # east: the tallest
+        (3, (-12, 0, -4), (-6, 6, 12)),    # west: low
+        (4, (-2, 0, 6), (12, 8, 12)),      # south
+        (1, (-5, 0, 8), (-3, 1.5, 10)),    # a low wall in the south-west gap
+    ]
+    quads = [(0, ((-20, 0, -20), (0, 0, 40), (40, 0, 0)))]
+    for material, lo, hi in blocks:
+        for face in box_faces(lo, hi):
+            if face[0][1] == 0 and face[1][1] == 0 and face[2][1] == 0:
+                continue  # the bottom face lies on the ground: never seen
+            quads.append((material, face))
+
+    data, views, accessors, meshes, nodes = mesh_nodes(materials, quads)
+    nodes.append({"name": "sun", "rotation": sun_rotation(40, 225),
+                  "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    # The camera above the south-west corner, looking at the courtyard's centre.
+    nodes.append({"name": "camera", "camera": 0, "translation": [-16.0, 14.0, 18.0],
+                  "rotation": camera_rotation((-16.0, 14.0, 18.0), (2.0, 0.0, -1.0))})
 
     gltf = {
         "asset": {"version": "2.0", "generator": "tools/make_courtyard.py"},
@@ -185,8 +205,7 @@ def main():
             "baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}
             for name, color in materials],
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1}}],
-        "buffers": [{"byteLength": len(data),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "buffers": [embedded_buffer(data)],
         "bufferViews": views,
         "accessors": accessors,
     }

@@ -36,6 +36,7 @@ struct ReferenceOptions {
   uint64_t seed = 1;
   int threads = 0;
   int maxBounces = 256;
+  float exposure = 0;  // PNG only, as `render --exposure`
   double edgeDistance = 0;  // 0 = one voxel of a depth-6 bake
   bool quiet = false;
 };
@@ -89,7 +90,7 @@ int runReference(const ReferenceOptions& opt) {
 
   ConsoleProgress progress(opt.quiet);
   ReferenceImage result = renderReference(scene, camera, params, &progress);
-  writeImage(opt.output, result.image);
+  writeImage(opt.output, result.image, opt.exposure);
   if (!opt.stdErrorOutput.empty()) writeImage(opt.stdErrorOutput, result.stdError);
 
   if (!opt.quiet) {
@@ -134,6 +135,9 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--height", opt->height, "Image height in pixels")
       ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--exposure", opt->exposure, "PNG exposure in EV (radiance * 2^EV), as render's")
+      ->check(CLI::Range(-30.0f, 30.0f))
       ->capture_default_str();
   auto* spp = cmd->add_option("--spp", opt->spp, "Samples per pixel")
                   ->check(CLI::Range(1, 1000000))
