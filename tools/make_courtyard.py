@@ -159,6 +159,38 @@ def embedded_buffer(data):
             "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}
 
 
+def write_sunlit_scene(out, generator, materials, quads, sun, camera, scene_extras):
+    """Writes a glTF of the quads (one mesh per material, buffer embedded),
+    a 3 W/m^2 directional sun at (elevation, azimuth) degrees (sun_rotation),
+    a camera (eye, target, yfov, znear) and the scene's extras."""
+    data, views, accessors, meshes, nodes = mesh_nodes(materials, quads)
+    nodes.append({"name": "sun", "rotation": sun_rotation(*sun),
+                  "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    eye, target, yfov, znear = camera
+    nodes.append({"name": "camera", "camera": 0, "translation": list(eye),
+                  "rotation": camera_rotation(eye, target)})
+    gltf = {
+        "asset": {"version": "2.0", "generator": generator},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "directional", "name": "sun", "color": [1.0, 0.95, 0.85], "intensity": 3.0}]}},
+        "scene": 0,
+        "scenes": [{"nodes": list(range(len(nodes))), "extras": scene_extras}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": [{"name": name, "pbrMetallicRoughness": {
+            "baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}
+            for name, color in materials],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": yfov, "znear": znear}}],
+        "buffers": [embedded_buffer(data)],
+        "bufferViews": views,
+        "accessors": accessors,
+    }
+    with open(out, "w") as f:
+        json.dump(gltf, f, indent=1)
+        f.write("\n")
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
         os.path.dirname(__file__), "..", "data", "courtyard.gltf")
@@ -184,34 +216,11 @@ def main():
                 continue  # the bottom face lies on the ground: never seen
             quads.append((material, face))
 
-    data, views, accessors, meshes, nodes = mesh_nodes(materials, quads)
-    nodes.append({"name": "sun", "rotation": sun_rotation(40, 225),
-                  "extensions": {"KHR_lights_punctual": {"light": 0}}})
-    # The camera above the south-west corner, looking at the courtyard's centre.
-    nodes.append({"name": "camera", "camera": 0, "translation": [-16.0, 14.0, 18.0],
-                  "rotation": camera_rotation((-16.0, 14.0, 18.0), (2.0, 0.0, -1.0))})
-
-    gltf = {
-        "asset": {"version": "2.0", "generator": "tools/make_courtyard.py"},
-        "extensionsUsed": ["KHR_lights_punctual"],
-        "extensions": {"KHR_lights_punctual": {"lights": [
-            {"type": "directional", "name": "sun", "color": [1.0, 0.95, 0.85], "intensity": 3.0}]}},
-        "scene": 0,
-        "scenes": [{"nodes": list(range(len(nodes))),
-                    "extras": {"lightoctree_sky": [0.12, 0.16, 0.22]}}],
-        "nodes": nodes,
-        "meshes": meshes,
-        "materials": [{"name": name, "pbrMetallicRoughness": {
-            "baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}
-            for name, color in materials],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1}}],
-        "buffers": [embedded_buffer(data)],
-        "bufferViews": views,
-        "accessors": accessors,
-    }
-    with open(out, "w") as f:
-        json.dump(gltf, f, indent=1)
-        f.write("\n")
+    # The sun 40 degrees high from the south-west; the camera above the
+    # south-west corner, looking at the courtyard's centre.
+    write_sunlit_scene(out, "tools/make_courtyard.py", materials, quads, sun=(40, 225),
+                       camera=((-16.0, 14.0, 18.0), (2.0, 0.0, -1.0), 0.9, 0.1),
+                       scene_extras={"lightoctree_sky": [0.12, 0.16, 0.22]})
     write_sky_hdr(os.path.join(os.path.dirname(out), "courtyard-sky.hdr"))
 
 

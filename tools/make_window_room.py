@@ -21,11 +21,10 @@ alone (the buffer is a base64 data: URI); stdlib only.
 Usage: python3 tools/make_window_room.py [output.gltf]
 """
 
-import json
 import os
 import sys
 
-from make_courtyard import box_faces, camera_rotation, embedded_buffer, mesh_nodes, sun_rotation
+from make_courtyard import box_faces, write_sunlit_scene
 
 
 def slabs():
@@ -56,33 +55,11 @@ def main():
             if face[0][1] == 0 and face[1][1] == 0 and face[2][1] == 0:
                 continue  # on the ground: never seen
             quads.append((material, face))
-    data, views, accessors, meshes, nodes = mesh_nodes(materials, quads)
-    nodes.append({"name": "sun", "rotation": sun_rotation(30, 20),
-                  "extensions": {"KHR_lights_punctual": {"light": 0}}})
-    eye, target = (2.6, 1.7, -2.1), (-0.6, 0.9, 2.5)
-    nodes.append({"name": "camera", "camera": 0, "translation": list(eye),
-                  "rotation": camera_rotation(eye, target)})
-    gltf = {
-        "asset": {"version": "2.0", "generator": "tools/make_window_room.py"},
-        "extensionsUsed": ["KHR_lights_punctual"],
-        "extensions": {"KHR_lights_punctual": {"lights": [
-            {"type": "directional", "name": "sun", "color": [1.0, 0.95, 0.85], "intensity": 3.0}]}},
-        "scene": 0,
-        "scenes": [{"nodes": list(range(len(nodes))),
-                    "extras": {"lightoctree_physical_sky": 3}}],
-        "nodes": nodes,
-        "meshes": meshes,
-        "materials": [{"name": name, "pbrMetallicRoughness": {
-            "baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}
-            for name, color in materials],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 1.1, "znear": 0.05}}],
-        "buffers": [embedded_buffer(data)],
-        "bufferViews": views,
-        "accessors": accessors,
-    }
-    with open(out, "w") as f:
-        json.dump(gltf, f, indent=1)
-        f.write("\n")
+    # The sun 30 degrees high, shining in through the window; the camera in
+    # the north-east corner, looking at the window.
+    write_sunlit_scene(out, "tools/make_window_room.py", materials, quads, sun=(30, 20),
+                       camera=((2.6, 1.7, -2.1), (-0.6, 0.9, 2.5), 1.1, 0.05),
+                       scene_extras={"lightoctree_physical_sky": 3})
 
 
 if __name__ == "__main__":
