@@ -140,14 +140,22 @@ vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
   float f0 = (ior - 1.0) / (ior + 1.0);
   f0 *= f0;
   float fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 5.0);
-  if (uThickness <= 0.0) {
-    // Thin-walled (glTF without KHR_materials_volume): the scene behind,
-    // seen straight through.
+  // How curved the surface is here: the normal's turn per unit of surface
+  // across the pixel (a sphere: 1 / its radius; a pane: 0).
+  float curvature = max(length(dFdx(n)) / max(length(dFdx(vPosition)), 1e-9),
+                        length(dFdy(n)) / max(length(dFdy(vPosition)), 1e-9));
+  if (uThickness <= 0.0 || curvature * uThickness < 0.25) {
+    // Thin-walled (glTF without KHR_materials_volume), or a volume whose
+    // surface is flat on the scale of its thickness (a pane, a table top):
+    // the scene behind, seen straight through (a slab shifts the view
+    // sideways by at most its thickness, and bends nothing), through one
+    // interface or two.
     vec3 behind = texelFetch(uBehind, ivec2(gl_FragCoord.xy), 0).rgb;
     if (uEncodeSrgb) behind = srgbDecode(behind);
-    return uTransmission * (1.0 - fresnel) * baseColor * behind / uExposureScale;
+    float through = uThickness > 0.0 ? (1.0 - fresnel) * (1.0 - fresnel) : 1.0 - fresnel;
+    return uTransmission * through * baseColor * behind / uExposureScale;
   }
-  // A volume (KHR_materials_volume): the surface taken as a ball whose
+  // A curved volume (KHR_materials_volume): the surface taken as a ball whose
   // diameter is the material's thickness, touching the surface here (exact
   // for a sphere given its diameter, as exporters give it); the ray refracts
   // in, crosses the ball along its chord and leaves it there (the share the
@@ -225,6 +233,10 @@ void main() {
   }
 
   vec3 radiance = vec3(0.0);
+  if (uUnlit) {
+    // Seen by the camera alone, as its base colour (Material::unlit).
+    if (uMode == LO_MODE_FULL || uMode == LO_MODE_DIRECT) radiance = baseColor;
+  } else
 #ifndef LO_ATLAS_LIGHTING
   if (uMode == LO_MODE_VOXELS) {
     uvec4 leaf;

@@ -52,6 +52,7 @@ uniform int uAlphaMode;      // LO_ALPHA_OPAQUE, LO_ALPHA_MASK or LO_ALPHA_BLEND
 uniform float uBaseAlpha;    // baseColorFactor's alpha
 uniform float uAlphaCutoff;  // glTF alphaCutoff (mask)
 uniform float uTransmission;  // KHR_materials_transmission of this draw; 0 = opaque
+uniform bool uUnlit;          // KHR_materials_unlit: the base colour, unshaded (Material::unlit)
 uniform vec2 uDielectric;     // the dielectric's specular layer: F0 (from the ior), weight (specular)
 uniform vec3 uViewForward;     // the camera's unit view direction (render space)
 uniform vec4 uCascadeFar;      // view depth where each sun cascade ends

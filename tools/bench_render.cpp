@@ -83,7 +83,7 @@ Baked load(const std::string& scenePath, const std::string& vdbPath) {
   }
   Baked b;
   b.scene = lo::loadScene(scenePath);
-  lo::LoadedVdl vdl = lo::readVdlGrid(vdbPath);
+  lo::LoadedVdl vdl = lo::readVdlGrid(vdbPath, b.scene.origin);
   b.meta = vdl.meta;
   b.octree = lo::buildGpuOctree(vdl.grid);
   lo::GpuOctreeParams half;

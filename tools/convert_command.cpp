@@ -69,12 +69,11 @@ int runConvert(const ConvertOptions& opt) {
     StageTimer loadTimer(rows, "load scene");
     scene = loadScene(opt.scene);
     printSceneWarnings(scene);
+    // The grid in the scene's coordinates (its origin may differ from the
+    // one the file was baked in: a file from before rebasing, say).
     const Vec3d& a = scene.origin;
     const Vec3d& b = in.grid.frame.offset;
-    if (a.x != b.x || a.y != b.y || a.z != b.z) {
-      throw InputError(opt.scene + " is stored relative to another origin than " + opt.input +
-                       " was baked in (its scene_origin): convert with the scene it was baked from");
-    }
+    if (a.x != b.x || a.y != b.y || a.z != b.z) in = readVdlGrid(opt.input, scene.origin);
     params.scene = &scene;
     loadTimer.finish(formatCount(scene.triangleCount()) + " triangles");
   }

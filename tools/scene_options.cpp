@@ -28,7 +28,7 @@ void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
                   "light), an atmosphere of this turbidity (2: very clear, 3: clear, 6: hazy; "
                   "Preetham et al. 1999), as bright beside the sun as that sky is beside the "
                   "sun through it; scaled by --sky")
-      ->check(CLI::Range(double(kMinTurbidity), double(kMaxTurbidity)))
+      ->check(CLI::Range(1.7, 10.0))  // kMinTurbidity, kMaxTurbidity
       ->excludes("--sky-image")
       ->excludes("--sky-mesh");
 }
@@ -52,17 +52,24 @@ Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
       throw InputError(std::string("--sky-image: ") + e.what());
     }
   }
-  Scene scene = loadScene(path);
+  Scene scene;
+  try {
+    scene = loadScene(path, opt.skyMesh);
+  } catch (const InputError& e) {
+    // A sky-mesh name the scene lacks is the flag's problem.
+    const std::string what = e.what();
+    if (!opt.skyMesh.empty() && what.find("sky mesh") != std::string::npos) {
+      throw InputError("--sky-mesh: " + what);
+    }
+    throw;
+  }
   if (!opt.skyMesh.empty() || opt.physicalSky > 0) {
-    const char* flag = opt.skyMesh.empty() ? "--physical-sky: " : "--sky-mesh: ";
-    try {
-      if (!opt.skyMesh.empty()) {
-        skyFromMaterial(scene, opt.skyMesh);
-      } else {
+    if (opt.physicalSky > 0) {
+      try {
         physicalSky(scene, opt.physicalSky);
+      } catch (const InputError& e) {
+        throw InputError(std::string("--physical-sky: ") + e.what());
       }
-    } catch (const InputError& e) {
-      throw InputError(flag + std::string(e.what()));
     }
     if (!opt.sky.empty()) scene.sky.radiance = sky;
     return scene;

@@ -57,16 +57,30 @@ float rayHash(uint32_t prim, const float org[3], const float dir[3]) {
   return float(h >> 40) * 0x1p-24f;
 }
 
+/// An intersection context that says whether the ray comes from the camera
+/// (the only rays that see unlit surfaces, Material::unlit).
+struct TracingContext {
+  RTCIntersectContext embree;  // first: Embree hands the filter its address
+  bool fromCamera = false;
+};
+
 /// Embree filter (intersection and occlusion): a hit where the material's
 /// coverage (Scene::coverage: alpha against the cutoff for Mask, alpha for
-/// Blend) says there is no surface is rejected, and the ray goes on.
+/// Blend) says there is no surface is rejected, and the ray goes on; so is
+/// a hit on an unlit surface by a ray that does not come from the camera.
 void alphaFilter(const RTCFilterFunctionNArguments* args) {
   const Scene& scene = *static_cast<const Scene*>(args->geometryUserPtr);
+  const bool fromCamera = reinterpret_cast<const TracingContext*>(args->context)->fromCamera;
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
     const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
     const float b1 = RTCHitN_u(args->hit, args->N, i), b2 = RTCHitN_v(args->hit, args->N, i);
-    if (!scene.materials[size_t(scene.triangleMaterial[prim])].hasAlpha()) continue;
+    const Material& m = scene.materials[size_t(scene.triangleMaterial[prim])];
+    if (m.unlit && !fromCamera) {
+      args->valid[i] = 0;
+      continue;
+    }
+    if (!m.hasAlpha()) continue;
     const float coverage = scene.coverage(prim, b1, b2);
     if (coverage >= 1.0f) continue;
     bool keep = false;
@@ -118,7 +132,7 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     }
     std::copy(scene.indices.begin(), scene.indices.begin() + 3 * scene.triangleCount(), indices);
     bool alpha = false;
-    for (const Material& m : scene.materials) alpha = alpha || m.hasAlpha();
+    for (const Material& m : scene.materials) alpha = alpha || m.hasAlpha() || m.unlit;
     if (alpha) {
       impl_->alphaScene = std::make_unique<Scene>(scene);
       rtcSetGeometryUserData(geom, impl_->alphaScene.get());
@@ -137,8 +151,18 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
 RayTracer::~RayTracer() = default;
 
 bool RayTracer::intersect(const Vec3& org, const Vec3& dir, Hit& hit, float tmax) const {
-  RTCIntersectContext ictx;
-  rtcInitIntersectContext(&ictx);
+  return trace(org, dir, hit, tmax, false);
+}
+
+bool RayTracer::intersectFromCamera(const Vec3& org, const Vec3& dir, Hit& hit) const {
+  return trace(org, dir, hit, std::numeric_limits<float>::infinity(), true);
+}
+
+bool RayTracer::trace(const Vec3& org, const Vec3& dir, Hit& hit, float tmax,
+                      bool fromCamera) const {
+  TracingContext context;
+  rtcInitIntersectContext(&context.embree);
+  context.fromCamera = fromCamera;
   RTCRayHit rh;
   rh.ray.org_x = org.x;
   rh.ray.org_y = org.y;
@@ -154,7 +178,7 @@ bool RayTracer::intersect(const Vec3& org, const Vec3& dir, Hit& hit, float tmax
   rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->scene, &ictx, &rh);
+  rtcIntersect1(impl_->scene, &context.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.t = rh.ray.tfar;
   hit.triangle = rh.hit.primID;
@@ -165,8 +189,8 @@ bool RayTracer::intersect(const Vec3& org, const Vec3& dir, Hit& hit, float tmax
 }
 
 bool RayTracer::occluded(const Vec3& org, const Vec3& dir, float tmax) const {
-  RTCIntersectContext ictx;
-  rtcInitIntersectContext(&ictx);
+  TracingContext context;
+  rtcInitIntersectContext(&context.embree);
   RTCRay ray;
   ray.org_x = org.x;
   ray.org_y = org.y;
@@ -180,7 +204,7 @@ bool RayTracer::occluded(const Vec3& org, const Vec3& dir, float tmax) const {
   ray.mask = 0xFFFFFFFFu;
   ray.id = 0;
   ray.flags = 0;
-  rtcOccluded1(impl_->scene, &ictx, &ray);
+  rtcOccluded1(impl_->scene, &context.embree, &ray);
   // Embree sets tfar to -inf when the ray is occluded.
   return ray.tfar < 0;
 }

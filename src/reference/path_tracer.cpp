@@ -68,6 +68,7 @@ struct Context {
   float epsilon = 0;
   int maxBounces = 0;
   int rouletteStart = 0;
+  bool unlit = false;  ///< the scene has unlit materials: camera rays look for them first
 };
 
 /// One path's radiance, split by where the light was last emitted relative
@@ -278,6 +279,18 @@ inline Vec3 samplePixel(const Context& ctx, const PinholeCamera& cam, const Vec3
   float sx = (2.0f * (float(x) + u) / float(width) - 1.0f) * tanHalf * aspect;
   float sy = (1.0f - 2.0f * (float(y) + v) / float(height)) * tanHalf;
   Vec3 dir = normalize(cam.forward + right * sx + cam.up * sy);
+  if (ctx.unlit) {
+    // An unlit surface in front: its base colour, seen by the camera alone.
+    Hit seen;
+    ++rays;
+    if (ctx.tracer->intersectFromCamera(cam.eye, dir, seen)) {
+      const Material& m = ctx.scene->materials[size_t(ctx.scene->triangleMaterial[seen.triangle])];
+      if (m.unlit) {
+        const bool shown = part == ReferencePart::Full || part == ReferencePart::Direct;
+        return shown ? ctx.scene->albedo(seen.triangle, seen.b1, seen.b2) : Vec3{0, 0, 0};
+      }
+    }
+  }
   if (part != ReferencePart::Irradiance) {
     PathRadiance r = tracePath(ctx, cam.eye, dir, rng);
     rays += r.rays;
@@ -313,6 +326,7 @@ void buildContext(const Scene& scene, const ReferenceParams& params, Context& ct
   ctx.maxBounces = params.maxBounces;
   ctx.rouletteStart = params.rouletteStart;
   ctx.lobes.resize(scene.materials.size());
+  for (const Material& m : scene.materials) ctx.unlit = ctx.unlit || m.unlit;
   for (size_t i = 0; i < scene.materials.size(); ++i) ctx.lobes[i] = bsdfLobes(scene.materials[i]);
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
     int32_t m = scene.triangleMaterial[t];

@@ -68,6 +68,7 @@ struct DrawRange {
   float ior = 1.5f;
   float dielectricF0 = 0.04f;  ///< the dielectric's specular layer (Material::dielectricF0)
   float specular = 1;          ///< its weight (KHR_materials_specular)
+  bool unlit = false;          ///< Material::unlit: unshaded, no shadow
 };
 
 /// The scene's triangles on the GPU, grouped by material in DrawCategory

@@ -29,7 +29,9 @@ int alphaModeOf(const Material& m) {
 DrawCategory categoryOf(const Material& m) {
   if (m.transmission > 0) return kTransmissive;
   if (m.alphaMode == AlphaMode::Blend) return kBlended;
-  if (m.alphaMode == AlphaMode::Mask) return kMasked;
+  // Unlit surfaces are drawn range by range in depth passes, as masked
+  // ones are: the camera's pre-pass has them, the shadow maps do not.
+  if (m.alphaMode == AlphaMode::Mask || m.unlit) return kMasked;
   return kSolid;
 }
 
@@ -156,6 +158,7 @@ DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat) {
   range.baseAlpha = mat.baseAlpha;
   range.alphaCutoff = mat.alphaCutoff;
   range.doubleSided = mat.doubleSided;
+  range.unlit = mat.unlit;
   if (usable(scene, mat.emissiveTexture, mat.emissiveTexCoord) && mat.isEmissive()) {
     range.emissiveTexture = useTexture(scene, mat.emissiveTexture);
   }
@@ -264,10 +267,13 @@ void SceneGeometry::drawDepthOnly(GLuint program, bool shadows) const {
   for (size_t i = 0; i < ranges.size(); ++i) {
     const DrawRange& range = ranges[i];
     if (rangeCategory[i] != kMasked && !(shadows && rangeCategory[i] == kBlended)) continue;
+    if (shadows && range.unlit) continue;  // light passes unlit surfaces
     glUniform1i(alphaTest, 1);
     glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
     glUniform1f(baseAlpha, range.baseAlpha);
-    glUniform1f(cutoff, rangeCategory[i] == kMasked ? range.alphaCutoff : 0.5f);
+    // An unlit opaque range keeps every fragment (cutoff 0).
+    const bool masked = range.alphaMode == shader::LO_ALPHA_MASK;
+    glUniform1f(cutoff, rangeCategory[i] == kMasked ? (masked ? range.alphaCutoff : 0.0f) : 0.5f);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D, texture(range.texture));
     glDrawArrays(GL_TRIANGLES, range.first, range.count);

@@ -198,6 +198,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
   const GLint thickness = loc("uThickness");
   const GLint ior = loc("uIor");
   const GLint dielectric = loc("uDielectric");
+  const GLint unlit = loc("uUnlit");
   // glTF: single-sided materials are culled from behind (counter-clockwise
   // winding in front, as the loader keeps it).
   glFrontFace(GL_CCW);
@@ -246,6 +247,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
     glUniform1f(thickness, range.thickness);
     glUniform1f(ior, range.ior);
     glUniform2f(dielectric, range.dielectricF0, range.specular);
+    glUniform1i(unlit, range.unlit ? 1 : 0);
     bind(GL_TEXTURE10, range.emissiveTexture);
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(hasEmissive, range.emissiveTexture >= 0 ? 1 : 0);

@@ -311,13 +311,19 @@ Vec3 vec3From(const std::vector<double>& v, const Vec3& fallback) {
 
 class SceneBuilder {
  public:
-  SceneBuilder(const std::string& path, const tinygltf::Model& model)
-      : path_(path), model_(model), reader_(path, model) {}
+  SceneBuilder(const std::string& path, const tinygltf::Model& model, const std::string& skyMesh)
+      : path_(path), model_(model), reader_(path, model), skyMeshFlag_(skyMesh) {}
 
   Scene build() {
     convertMaterials();
     traverse();
     readSky();
+    if (!skyMeshFlag_.empty()) {  // the command line's sky mesh replaces the file's sky
+      skyMesh_ = skyMeshFlag_;
+      turbidity_ = 0;
+      scene_.sky = Sky();
+      skyScale_ = false;
+    }
     finishVertexAttributes();
     rebase();
     if (!skyMesh_.empty() || turbidity_ > 0) {
@@ -390,6 +396,7 @@ class SceneBuilder {
                         ": KHR_materials_volume thicknessFactor must be finite and >= 0");
       }
       m.doubleSided = g.doubleSided;
+      m.unlit = g.extensions.count("KHR_materials_unlit") > 0;
       if (!isFinite(m.baseColor) || !isFinite(m.emission) || !std::isfinite(m.metallic) ||
           !std::isfinite(m.roughness) || !std::isfinite(m.transmission) || !std::isfinite(m.ior)) {
         fail(path_, "material " + std::to_string(i) + " has a non-finite factor");
@@ -448,6 +455,13 @@ class SceneBuilder {
       m.occlusionStrength = float(g.occlusionTexture.strength);
       if (!std::isfinite(m.normalScale) || !std::isfinite(m.occlusionStrength)) {
         fail(path_, "material " + std::to_string(i) + ": a texture scale or strength is not finite");
+      }
+      if (m.unlit) {
+        // Unlit: the base colour is all there is (the extension's rule);
+        // it casts and emits nothing (Material::unlit).
+        m.emission = Vec3{0, 0, 0};
+        m.emissiveTexture = -1;
+        m.transmission = 0;
       }
       scene_.materials.push_back(std::move(m));
     }
@@ -985,12 +999,25 @@ class SceneBuilder {
   /// origin is stored relative to its centre (Scene::origin), the rest as
   /// the file places it.
   void rebase() {
+    // The sky mesh's vertices do not count: it is about to leave the scene,
+    // and a sky box much larger than the site would hide how far out it lies.
+    int sky = -1;
+    for (size_t m = 0; m < scene_.materials.size() && !skyMesh_.empty(); ++m) {
+      if (scene_.materials[m].name == skyMesh_) {
+        sky = int(m);
+        break;
+      }
+    }
     const double inf = std::numeric_limits<double>::infinity();
     Vec3d lower{inf, inf, inf}, upper{-inf, -inf, -inf};
-    for (const Vec3d& p : world_.vertices) {
-      for (int a = 0; a < 3; ++a) {
-        lower[a] = std::min(lower[a], p[a]);
-        upper[a] = std::max(upper[a], p[a]);
+    for (size_t t = 0; t < scene_.triangleCount(); ++t) {
+      if (scene_.triangleMaterial[t] == sky) continue;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3d& p = world_.vertices[scene_.indices[3 * t + size_t(k)]];
+        for (int a = 0; a < 3; ++a) {
+          lower[a] = std::min(lower[a], p[a]);
+          upper[a] = std::max(upper[a], p[a]);
+        }
       }
     }
     const Vec3d origin = scene_internal::rebaseOrigin(lower, upper);
@@ -1034,7 +1061,8 @@ class SceneBuilder {
     }
   };
   std::map<TextureKey, int> imageToTexture_;
-  std::string skyMesh_;    ///< extras.lightoctree_sky_mesh: a material to take as the sky
+  std::string skyMeshFlag_;  ///< the command line's sky mesh (loadScene's skyMesh)
+  std::string skyMesh_;    ///< extras.lightoctree_sky_mesh, or the flag's: a material to take as the sky
   bool skyScale_ = false;  ///< extras.lightoctree_sky was given
   float turbidity_ = 0;    ///< extras.lightoctree_physical_sky; 0 = none
   std::set<int> missingImages_;  ///< images whose file is missing, warned once
@@ -1044,7 +1072,7 @@ class SceneBuilder {
 
 }  // namespace
 
-Scene loadGltf(const std::string& path) {
+Scene loadGltf(const std::string& path, const std::string& skyMesh) {
   fs::path p(path);
   std::string baseDir = p.parent_path().string();
   if (baseDir.empty()) baseDir = ".";
@@ -1088,7 +1116,7 @@ Scene loadGltf(const std::string& path) {
   }
   bytes.clear();
   jsonText.clear();
-  return SceneBuilder(path, model).build();
+  return SceneBuilder(path, model, skyMesh).build();
 }
 
 }  // namespace lo::scene_internal

@@ -76,9 +76,9 @@ double directSunIlluminance(double sunZenith, double turbidity) {
   // the turbidity as Linke's (ESRA: B_n = E0 exp(-0.8662 T_L m dR(m))).
   const double elevation = 90.0 - sunZenith * 180.0 / kPi;
   const double m = 1.0 / (std::cos(sunZenith) + 0.50572 * std::pow(elevation + 6.07995, -1.6364));
-  const double mm = std::min(m, 20.0);
   const double rayleigh =
-      1.0 / (6.6296 + mm * (1.7513 + mm * (-0.1202 + mm * (0.0065 - mm * 0.00013))));
+      m > 20.0 ? 1.0 / (10.4 + 0.718 * m)
+               : 1.0 / (6.6296 + m * (1.7513 + m * (-0.1202 + m * (0.0065 - m * 0.00013))));
   return kSolarIlluminance * std::exp(-0.8662 * turbidity * m * rayleigh);
 }
 

@@ -391,7 +391,7 @@ std::string Scene::ToString() const {
   return os.str();
 }
 
-Scene loadScene(const std::string& path) {
+Scene loadScene(const std::string& path, const std::string& skyMesh) {
   namespace fs = std::filesystem;
   const std::string ext = lowerExtension(path);
   bool gltf = ext == ".gltf" || ext == ".glb";
@@ -402,7 +402,13 @@ Scene loadScene(const std::string& path) {
   if (!fs::is_regular_file(path, ec)) scene_internal::fail(path, "missing file (not found)");
   Scene scene;
   try {
-    scene = gltf ? scene_internal::loadGltf(path) : scene_internal::loadObj(path);
+    if (gltf) {
+      scene = scene_internal::loadGltf(path, skyMesh);
+    } else {
+      scene = scene_internal::loadObj(path);
+      scene.sourcePath = path;
+      if (!skyMesh.empty()) skyFromMaterial(scene, skyMesh);
+    }
   } catch (const std::bad_alloc&) {
     scene_internal::fail(path, "out of memory while loading (corrupt sizes?)");
   }

@@ -122,6 +122,12 @@ struct Material {
   /// specular layer (its F0 comes from `ior`). 0: a pure Lambert base, in
   /// every renderer (scenes whose answers are analytic only for Lambert).
   float specular = 1.0f;
+  /// KHR_materials_unlit, read the way Blender imports it: the camera sees
+  /// the base colour (texture and alpha included) as radiance, and every
+  /// other ray passes through (no light, no shadow, no emission into the
+  /// scene): photons, shadow and path-tracer rays go on, the GL renderer
+  /// draws it unshaded and leaves it out of its shadow maps.
+  bool unlit = false;
 
   /// The dielectric's F0 at normal incidence, ((ior - 1) / (ior + 1))^2
   /// (0.04 at glTF's default ior 1.5).
@@ -376,7 +382,10 @@ void checkSceneIndices(const Scene& scene);
 /// .mtl files) resolve only inside the scene file's own folder.
 /// @throws InputError naming the file and the problem (missing buffer, index
 /// out of range, non-finite vertex, unsupported primitive mode, unreadable
-/// image, unknown extension).
-Scene loadScene(const std::string& path);
+/// image, unknown extension). `skyMesh`: a material to take as the scene's
+/// sky (skyFromMaterial), replacing the file's sky; in a glTF its vertices
+/// do not count when the loader decides whether to rebase (Scene::origin),
+/// in an OBJ they do (its v lines are rebased before faces are read).
+Scene loadScene(const std::string& path, const std::string& skyMesh = "");
 
 }  // namespace lo

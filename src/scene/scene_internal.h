@@ -47,7 +47,8 @@ constexpr double kRebaseDistance = 128.0;
 /// so that a scene near the origin keeps its coordinates exactly.
 Vec3d rebaseOrigin(const Vec3d& lower, const Vec3d& upper);
 
-Scene loadGltf(const std::string& path);
+/// `skyMesh`: loadScene's.
+Scene loadGltf(const std::string& path, const std::string& skyMesh);
 Scene loadObj(const std::string& path);
 
 /// The light and material numbers within their documented ranges

@@ -142,7 +142,7 @@ void skyFromMaterial(Scene& scene, const std::string& material, int width) {
   }
   if (rest.empty()) {
     throw InputError(where + ": every triangle is of material '" + material +
-                     "': nothing is left under the sky");
+                     "': nothing would be left beside the sky mesh");
   }
 
   // The sky as the scene's centre sees it: per texel, the nearest sky

@@ -45,8 +45,10 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
     normal[i] = toVdb(p.normal);
     bounce[i] = int32_t(p.bounce);
   }
-  // Points are world space; the grid only buckets them (no translation).
+  // Points are world space; the grid only buckets them, from the scene's
+  // origin (voxel indices stay small far from the world's).
   Transform::Ptr xform = Transform::createLinearTransform(double(voxelSize));
+  xform->postTranslate(openvdb::Vec3d(offset.x, offset.y, offset.z));
   pts::PointAttributeVector<openvdb::Vec3R> positionWrapper(positions);
   auto indexGrid =
       openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positionWrapper, *xform);

@@ -279,6 +279,18 @@ LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& 
 
   VdlGrid& g = out.grid;
   g.frame = readFrame(path, xform, out.meta.depth, origin.value_or(out.meta.sceneOrigin));
+  if (origin) {
+    // The metadata's bounds too, from the baked scene's origin to `origin`.
+    const Vec3d from = out.meta.sceneOrigin;
+    const Vec3 shift((from - *origin).toVec3());
+    for (Bounds3* b : {&out.meta.sceneBounds, &out.meta.region}) {
+      if (!b->empty()) {
+        b->lower += shift;
+        b->upper += shift;
+      }
+    }
+    out.meta.sceneOrigin = *origin;
+  }
   g.maxVdls = maxVdls;
   g.shTerms = shTerms;
   g.coords.reserve(size_t(active));

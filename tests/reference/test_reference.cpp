@@ -409,5 +409,38 @@ TEST(DirectIrradiance, EmitterLightsAPlaneAtEveryAngle) {
   }
 }
 
+TEST(Reference, UnlitIsSeenByTheCameraAloneAsItsColour) {
+  // KHR_materials_unlit as Blender imports it: camera rays see the base
+  // colour, every other ray passes through (no shadow, no light).
+  Scene with, without;
+  for (Scene* s : {&with, &without}) {
+    s->materials.resize(1);
+    test::addQuad(*s, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 0);
+    Light point;
+    point.position = {0, 0, 1};
+    point.intensity = 2.0f;
+    s->lights.push_back(point);
+  }
+  Material card;
+  card.baseColor = {0.2f, 0.6f, 0.9f};
+  card.unlit = true;
+  with.materials.push_back(card);
+  test::addQuad(with, {-0.3f, -0.3f, 0.5f}, {0.3f, 0, 0}, {0, 0.6f, 0}, {0, 0, 1}, 1);
+  ReferenceParams params;
+  params.width = params.height = 16;
+  params.samplesPerPixel = 64;
+  params.part = ReferencePart::Direct;
+  const PinholeCamera camera = PinholeCamera::lookAt({0, 0, 2}, {0, 0, 0}, 0.9f);
+  const ReferenceImage a = renderReference(with, camera, params);
+  const ReferenceImage b = renderReference(without, camera, params);
+  // Left of centre: the card, exactly its colour in every sample.
+  const Vec3 seen = a.image.at(8 * 16 + 5);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(seen[c], card.baseColor[c], 1e-5f) << c;
+  // Right of centre: the quad, where the card would shadow it, lit as without it.
+  const float lit = b.image.at(8 * 16 + 11).x;
+  EXPECT_GT(lit, 0.1f);
+  EXPECT_NEAR(a.image.at(8 * 16 + 11).x, lit, 0.02f * lit);
+}
+
 }  // namespace
 }  // namespace lo

@@ -458,6 +458,45 @@ TEST(RenderImage, SpotPoolFollowsTheGltfConeFalloff) {
   EXPECT_GT(inPenumbra, 3);
 }
 
+TEST(RenderImage, UnlitIsSeenAsItsColourAndCastsNoShadow) {
+  // KHR_materials_unlit as Blender imports it: a small unlit card between a
+  // point light and the quad shows its base colour exactly and leaves the
+  // quad's direct light where its shadow would fall untouched.
+  REQUIRE_OSMESA();
+  QuadSetup with, without;
+  Light point;
+  point.position = {0.1f, -0.05f, 1};
+  point.intensity = 2.0f;
+  with.scene.lights.push_back(point);
+  without.scene.lights.push_back(point);
+  Material card;
+  card.baseColor = {0.2f, 0.6f, 0.9f};
+  card.unlit = true;
+  with.scene.materials.push_back(card);
+  test::addQuad(with.scene, {0.2f, -0.2f, 0.5f}, {0.2f, 0, 0}, {0, 0.4f, 0}, {0, 0, 1}, 1);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const RgbImage a = Renderer(with.scene, octree).render(with.camera, p);
+  const RgbImage b = Renderer(without.scene, octree).render(without.camera, p);
+  // Pixel of a point at depth `distance` from the camera, (x, y) from the view's centre.
+  const float perPixel = 2.0f * std::tan(0.5f * with.camera.yfov) / float(p.height);
+  auto pixel = [&](float x, float y, float distance, int& px, int& py) {
+    px = int(x / (perPixel * distance) + 0.5f * float(p.width));
+    py = int(0.5f * float(p.height) - y / (perPixel * distance));
+  };
+  int px = 0, py = 0;
+  pixel(0.2f, 0.05f, 1.5f, px, py);  // the card's centre (0.3, 0, 0.5)
+  const Vec3 seen = a.at(size_t(py) * size_t(p.width) + size_t(px));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(seen[c], card.baseColor[c], 1e-3f) << c;
+  // The quad at (0.6, 0, 0): behind the card as the light sees it, beside
+  // it as the camera does.
+  pixel(0.5f, 0.05f, 2.0f, px, py);
+  EXPECT_GT(b.pixel(px, py)[0], 0.05f);
+  EXPECT_NEAR(a.pixel(px, py)[0], b.pixel(px, py)[0], 1e-3f * b.pixel(px, py)[0]);
+}
+
 /// Renders QuadSetup's quad with a red/blue checker (16x16 texels, cells of
 /// 4x4) repeated twice across it under a point light, and checks that the
 /// centres of two neighbouring cells show the colours the bake's own lookup
@@ -843,6 +882,38 @@ TEST(RenderImage, GlassShowsWhatIsBehindAndCastsNoShadow) {
   ASSERT_GT(a[0], 0.01f);
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(b[c] / a[c], 0.96f, 0.01f) << "channel " << c << ": " << b[c] << " vs " << a[c];
+  }
+}
+
+TEST(RenderImage, AFlatGlassVolumeIsSeenStraightThroughTwoInterfaces) {
+  // A pane with KHR_materials_volume (thickness 0.05, as exporters give
+  // panes) is flat on the scale of its thickness: the view goes straight
+  // through (not bent as through a ball of that diameter), losing the
+  // Fresnel reflectance at both faces, 1 - 0.04 each at normal incidence.
+  REQUIRE_OSMESA();
+  QuadSetup s;
+  Light light;
+  light.position = {0.6f, 0.5f, 0.5f};  // under the pane: it casts no shadow here
+  light.intensity = 1.0f;
+  s.scene.lights.push_back(light);
+  GpuOctree octree =
+      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+  RenderParams p = QuadSetup::params(false);
+  p.mode = RenderMode::Direct;
+  const RgbImage open = Renderer(s.scene, octree).render(s.camera, p);
+  Material glass;
+  glass.baseColor = {1, 1, 1};
+  glass.roughness = 0.05f;
+  glass.transmission = 1.0f;
+  glass.thickness = 0.05f;
+  s.scene.materials.push_back(glass);
+  test::addQuad(s.scene, {-1, -1, 0.8f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
+  const RgbImage through = Renderer(s.scene, octree).render(s.camera, p);
+  for (int px : {p.width / 2, p.width / 2 + 12}) {  // the centre, and 7 degrees off it
+    const float* a = open.pixel(px, p.height / 2);
+    const float* b = through.pixel(px, p.height / 2);
+    ASSERT_GT(a[0], 0.01f);
+    EXPECT_NEAR(b[0] / a[0], 0.96f * 0.96f, 0.01f) << "pixel " << px;
   }
 }
 

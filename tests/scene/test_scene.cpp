@@ -889,7 +889,7 @@ TEST(SkyMesh, NamesWhatIsWrong) {
   std::string json = g.json();
   json.replace(json.find("\"scenes\": [{\"nodes\": [0]}], "), 28, "");
   writeFile(dir + "/dome.gltf", json);
-  expectInputError(dir + "/dome.gltf", "nothing is left under the sky");
+  expectInputError(dir + "/dome.gltf", "nothing would be left beside the sky mesh");
 }
 
 // --- the daylight sky of the scene's sun ---------------------------------------
