@@ -107,6 +107,16 @@ std::string notReplaceable(const std::string& path) {
 
 }  // namespace file_internal
 
+void requireRegularFile(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) throw InputError(path + ": " + what + " not found");
+  if (!fs::is_regular_file(status)) {
+    throw InputError(path + ": " + what + " is " + file_internal::describe(status) +
+                     " (only regular files are read)");
+  }
+}
+
 std::string readFile(const std::string& path) {
   // A FIFO or a device would block or never end: only regular files are read.
   std::error_code ec;

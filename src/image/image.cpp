@@ -183,6 +183,7 @@ void writeImage(const std::string& path, const RgbImage& image, float exposureEv
 }
 
 RgbImage readImage(const std::string& path, bool linear8Bit) {
+  requireRegularFile(path, "the image");
   std::string ext = lowerExtension(path);
   if (ext == ".exr") return readExr(path);
   if (ext == ".hdr") {

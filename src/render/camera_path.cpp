@@ -140,6 +140,7 @@ CameraPath parseCameraPath(std::istream& in, const std::string& name) {
 }
 
 CameraPath readCameraPath(const std::string& path) {
+  requireRegularFile(path, "the camera path");
   std::ifstream f(path);
   if (!f) throw InputError(path + ": cannot open the camera path");
   return parseCameraPath(f, path);
@@ -149,6 +150,7 @@ void appendCameraKey(const std::string& path, const CameraKey& key) {
   std::string old;
   bool exists = std::filesystem::exists(path);
   if (exists) {
+    requireRegularFile(path, "the camera path to append to");
     std::ifstream f(path, std::ios::binary);
     if (!f) throw IoError(path + ": cannot read the camera path to append to it");
     std::ostringstream os;

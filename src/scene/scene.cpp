@@ -399,7 +399,8 @@ Scene loadScene(const std::string& path, const std::string& skyMesh) {
     scene_internal::fail(path, "unknown extension '" + ext + "' (expected .gltf, .glb or .obj)");
   }
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) scene_internal::fail(path, "missing file (not found)");
+  if (!fs::exists(path, ec)) scene_internal::fail(path, "missing file (not found)");
+  requireRegularFile(path, "the scene");
   Scene scene;
   try {
     if (gltf) {

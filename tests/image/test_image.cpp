@@ -2,6 +2,7 @@
 // masks, EXR round trips.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -136,6 +137,21 @@ TEST(Compare, BinningAveragesBlocksAndMasksKeepWholeBlocks) {
   test.set(1, Vec3(1));
   EXPECT_GT(compareImages(test, ref).luminance.relRmse, 0.4);
   EXPECT_NEAR(compareImages(binImage(test, 2), binImage(ref, 2)).luminance.relRmse, 0.0, 1e-7);
+}
+
+
+TEST(ReadImage, APipeIsRefusedNotWaitedOn) {
+  // One rule for every input (core/file.h requireRegularFile): a FIFO named
+  // as an image would block the reader forever.
+  const std::string fifo = test::outputDir("ReadImage_Pipe") + "/image.png";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    readImage(fifo);
+    ADD_FAILURE() << "a pipe was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a pipe"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(readImage(test::outputDir("ReadImage_Pipe") + "/absent.exr"), InputError);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // appending, and the fly camera's frame against PinholeCamera::lookAt.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
@@ -261,6 +262,13 @@ TEST(FlyCamera, TurnWrapsYawAndKeyRoundTripsThroughAPath) {
   expectNear(c.eye, fly.position, 1e-6f);
   expectNear(c.forward, fly.forward(), 1e-5f);
   EXPECT_NEAR(c.yfov, 0.9f, 1e-5f);
+}
+
+TEST(CameraPath, APipeIsRefusedNotWaitedOn) {
+  const std::string fifo = test::outputDir("CameraPath_Pipe") + "/path.txt";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_THROW(readCameraPath(fifo), InputError);
+  EXPECT_THROW(appendCameraKey(fifo, CameraKey{}), InputError);
 }
 
 }  // namespace

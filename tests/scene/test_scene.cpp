@@ -2,6 +2,7 @@
 // transforms, punctual lights, and one malformed file per rejected input.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <cstring>
@@ -644,6 +645,8 @@ TEST(SceneReject, MissingFile) {
   std::string dir = test::outputDir("SceneReject_Missing");
   expectInputError(dir + "/nope.gltf", "missing");
   expectInputError(dir + "/nope.obj", "missing");
+  ASSERT_EQ(mkfifo((dir + "/pipe.gltf").c_str(), 0600), 0);  // would block a reader
+  expectInputError(dir + "/pipe.gltf", "is a pipe");
 }
 
 TEST(SceneReject, UnknownExtension) {
