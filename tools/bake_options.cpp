@@ -2,7 +2,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
 #include "cli_checks.h"
+#include "core/error.h"
 #include "core/resources.h"
 
 namespace lo::tool {
@@ -24,6 +29,18 @@ BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   params.autoThreshold = autoThreshold;
   parseRepresentation(representation, &params.representation);  // checked by the flag
   if (!bounds.empty()) {
+    // Finite, of some extent, within the coordinates a scene may have: a NaN
+    // would make an empty grid, 1e20 an Embree abort. Corners in any order.
+    for (int a = 0; a < 3; ++a) {
+      const double lo = bounds[size_t(a)], hi = bounds[size_t(a) + 3];
+      if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo != hi) ||
+          std::max(std::fabs(lo), std::fabs(hi)) > double(kMaxCoordinate)) {
+        char what[160];
+        std::snprintf(what, sizeof what, "axis %c: %g, %g", char('x' + a), lo, hi);
+        throw InputError("--bounds: each axis needs two different finite corners within " +
+                         formatNumber(double(kMaxCoordinate)) + " scene units (" + what + ")");
+      }
+    }
     params.region.extend(scene.toLocal(Vec3d{bounds[0], bounds[1], bounds[2]}));
     params.region.extend(scene.toLocal(Vec3d{bounds[3], bounds[4], bounds[5]}));
   }

@@ -26,6 +26,10 @@ Vec3d parseVec3d(const std::string& text, const char* flag) {
       !isFinite(v.toVec3())) {
     throw InputError(std::string(flag) + ": expected three numbers x,y,z, got '" + text + "'");
   }
+  if (std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > double(kMaxCoordinate)) {
+    throw InputError(std::string(flag) + ": '" + text + "' lies beyond 1e12 scene units from "
+                     "the origin (kMaxCoordinate), where no scene reaches");
+  }
   return v;
 }
 

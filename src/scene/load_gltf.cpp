@@ -758,11 +758,21 @@ class SceneBuilder {
     world_.cameras.push_back(world.pointInDouble({0, 0, 0}));
     c.forward = normalize(world.vector({0, 0, -1}));
     Vec3 up = world.vector({0, 1, 0});
-    c.up = normalize(up - c.forward * dot(up, c.forward));
+    const Vec3 across = up - c.forward * dot(up, c.forward);
+    if (!(lengthSquared(across) > 1e-12f * lengthSquared(up))) {
+      fail(path_, "camera on node " + std::to_string(nodeIndex) +
+                      " has a degenerate transform: its up is parallel to its view");
+    }
+    c.up = normalize(across);
     c.yfov = float(g.perspective.yfov);
     c.aspectRatio = float(g.perspective.aspectRatio);
     c.znear = float(g.perspective.znear);
     c.zfar = float(g.perspective.zfar);
+    if (!(c.znear >= 0) || !std::isfinite(c.zfar) || (c.zfar > 0 && !(c.zfar > c.znear))) {
+      fail(path_, "camera on node " + std::to_string(nodeIndex) + ": znear " +
+                      std::to_string(c.znear) + " and zfar " + std::to_string(c.zfar) +
+                      " (glTF: zfar > znear > 0, or no zfar)");
+    }
     if (!(c.yfov > 0 && c.yfov < kPi) || lengthSquared(c.forward) == 0) {
       fail(path_,
            "camera on node " + std::to_string(nodeIndex) + " has an invalid yfov or transform");

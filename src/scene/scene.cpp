@@ -604,6 +604,20 @@ Vec3d rebaseOrigin(const Vec3d& lower, const Vec3d& upper) {
   return distance > kRebaseDistance * length(upper - lower) ? centre : Vec3d{};
 }
 
+/// Cameras within the coordinates a scene may have (kMaxCoordinate), as
+/// lights are: a camera at 1e19 would abort the tracers.
+void checkCameras(const Scene& scene) {
+  for (const Camera& c : scene.cameras) {
+    const Vec3d w = scene.toWorld(c.position);
+    const double reach = std::max({std::fabs(w.x), std::fabs(w.y), std::fabs(w.z)});
+    if (!std::isfinite(reach) || reach > double(kMaxCoordinate)) {
+      fail(scene.sourcePath, "camera '" + c.name + "' lies at " + w.toVec3().ToString() +
+                                 ", beyond " + formatLimit(kMaxCoordinate) +
+                                 " scene units from the origin");
+    }
+  }
+}
+
 void validateScene(Scene& scene) {
   if (scene.triangleCount() == 0) fail(scene.sourcePath, "no triangles in the scene");
   checkSceneIndices(scene);
@@ -637,6 +651,7 @@ void validateScene(Scene& scene) {
     }
   }
   checkLightAndMaterialValues(scene);
+  checkCameras(scene);
   LO_CHECK(scene.normals.empty() || scene.normals.size() == scene.positions.size());
   LO_CHECK(scene.texcoords0.empty() || scene.texcoords0.size() == 2 * scene.positions.size());
   LO_CHECK(scene.texcoords1.empty() || scene.texcoords1.size() == 2 * scene.positions.size());

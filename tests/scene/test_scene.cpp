@@ -974,6 +974,30 @@ TEST(PhysicalSky, NeedsASunAboveTheHorizon) {
   EXPECT_THROW(physicalSky(haze, 40), InputError);
 }
 
+TEST(SceneGltf, CamerasThatCannotShowAnythingAreRefused) {
+  // A camera whose up is parallel to its view (here: squashed to nothing
+  // along its up), whose far plane is nearer than its near one, or that
+  // lies beyond kMaxCoordinate: refused by name instead of a black image.
+  const std::string dir = test::outputDir("SceneGltf_Cameras");
+  auto withCamera = [&](const std::string& name, const std::string& node,
+                        const std::string& perspective) {
+    MiniGltf g = oneTriangle();
+    g.nodes = R"([{"mesh": 0}, )" + node + "]";
+    g.sceneNodes = "[0, 1]";
+    g.extraTop = R"("cameras": [{"type": "perspective", "perspective": )" + perspective + "}], ";
+    return writeGltf(dir, name, g);
+  };
+  const std::string fine = R"({"yfov": 0.8, "znear": 0.1})";
+  EXPECT_NO_THROW(loadScene(withCamera("ok.gltf", R"({"camera": 0, "translation": [0, 0, 3]})", fine)));
+  expectInputError(withCamera("flat.gltf", R"({"camera": 0, "scale": [1, 0, 1]})", fine),
+                   "its up is parallel to its view");
+  expectInputError(withCamera("far.gltf", R"({"camera": 0})",
+                              R"({"yfov": 0.8, "znear": 1.0, "zfar": 0.5})"),
+                   "zfar > znear");
+  expectInputError(withCamera("away.gltf", R"({"camera": 0, "translation": [0, 0, 1e19]})", fine),
+                   "beyond");
+}
+
 TEST(SceneGltf, LightAndMaterialValuesStayInTheirRanges) {
   // glTF's [0, 1] factors are clamped with a warning naming them; a negative
   // emission is taken as 0, warned; intensities and positions beyond what
