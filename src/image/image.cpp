@@ -16,6 +16,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/resources.h"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
@@ -38,6 +39,12 @@ RgbImage readExr(const std::string& path) {
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i& dw = file.header().dataWindow();
+    // The header's size before any pixel: the image and a float frame buffer.
+    try {
+      checkImageSize(int64_t(dw.max.x) - dw.min.x + 1, int64_t(dw.max.y) - dw.min.y + 1, 2 * 12);
+    } catch (const InputError& e) {
+      throw InputError(path + ": " + e.what());
+    }
     RgbImage image(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1);
     const Imf::ChannelList& channels = file.header().channels();
     const char* names[3] = {"R", "G", "B"};
@@ -185,6 +192,17 @@ void writeImage(const std::string& path, const RgbImage& image, float exposureEv
 RgbImage readImage(const std::string& path, bool linear8Bit) {
   requireRegularFile(path, "the image");
   std::string ext = lowerExtension(path);
+  if (ext != ".exr") {
+    // The header's size before decoding (stb's buffer and the image's floats).
+    int w = 0, h = 0, n = 0;
+    if (stbi_info(path.c_str(), &w, &h, &n)) {
+      try {
+        checkImageSize(w, h, 4 * 4 + 12);
+      } catch (const InputError& e) {
+        throw InputError(path + ": " + e.what());
+      }
+    }
+  }
   if (ext == ".exr") return readExr(path);
   if (ext == ".hdr") {
     // Radiance RGBE: linear floats (stb applies no transfer curve to them).
@@ -215,12 +233,30 @@ float srgbToLinear(float s) {
   return s <= 0.04045f ? s / 12.92f : std::pow((s + 0.055f) / 1.055f, 2.4f);
 }
 
+void checkImageSize(int64_t width, int64_t height, double bytesPerPixel) {
+  const std::string size = std::to_string(width) + " x " + std::to_string(height);
+  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide) {
+    throw InputError("image of " + size + " pixels: its sides must lie from 1 to " +
+                     std::to_string(kMaxImageSide));
+  }
+  const double needed = double(width) * double(height) * bytesPerPixel;
+  const size_t available = availableMemoryBytes();
+  if (available > 0 && needed > 0.5 * double(available)) {
+    throw InputError("image of " + size + " pixels would take " + formatBytes(size_t(needed)) +
+                     " to read, more than half the " + formatBytes(available) +
+                     " of memory available");
+  }
+}
+
 DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
   if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
     throw InputError("empty or too large");
   }
   const int n = int(size);
   int w = 0, h = 0, comp = 0;
+  // The header's size first: stb, its floats and the caller's texture
+  // (16 bytes per texel) per pixel, at most 4 channels of 16 bits.
+  if (stbi_info_from_memory(bytes, n, &w, &h, &comp)) checkImageSize(w, h, 4 * (2 + 4) + 16);
   DecodedImage out;
   auto finish = [&](auto* data, float scale) {
     out.width = w;

@@ -41,8 +41,19 @@ struct DecodedImage {
   int channels = 0;           ///< 1..4
   std::vector<float> values;  ///< width * height * channels, row 0 at the top
 };
-/// @throws InputError with the decoder's reason (the caller names the file).
+/// @throws InputError with the decoder's reason (the caller names the file),
+/// or, before any decoding, when the header's size breaks checkImageSize.
 DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size);
+
+/// Largest width or height of an image any stage reads (the largest 2D
+/// texture GL contexts give, 16384).
+constexpr int kMaxImageSide = 16384;
+/// Refuses an image whose header says `width` x `height` before it is
+/// decoded: a side above kMaxImageSide, or `bytesPerPixel` (what the reader
+/// and its caller keep per pixel) x the pixels above half the memory
+/// available. A few hundred bytes of JPEG can claim gigabytes.
+/// @throws InputError "image of W x H ... " (the caller names the file).
+void checkImageSize(int64_t width, int64_t height, double bytesPerPixel);
 
 /// sRGB transfer function (IEC 61966-2-1) to linear, for one channel in [0, 1].
 float srgbToLinear(float s);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "core/error.h"
 #include "image/compare.h"
@@ -152,6 +153,35 @@ TEST(ReadImage, APipeIsRefusedNotWaitedOn) {
     EXPECT_NE(std::string(e.what()).find("is a pipe"), std::string::npos) << e.what();
   }
   EXPECT_THROW(readImage(test::outputDir("ReadImage_Pipe") + "/absent.exr"), InputError);
+}
+
+
+TEST(ReadImage, AHeaderClaimingAHugeImageIsRefusedBeforeDecoding) {
+  // A PNG of a few dozen bytes whose header says 16385 x 4096: refused from
+  // the header (kMaxImageSide), in memory and on disk, before decoding.
+  auto be32 = [](uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+  };
+  std::string png = "\x89PNG\r\n\x1a\n";
+  png += be32(13) + "IHDR" + be32(16385) + be32(4096) + std::string("\x08\x02\x00\x00\x00", 5);
+  png += be32(0);  // CRC: the size is read before anything checks it
+  png += be32(0) + "IDAT" + be32(0) + be32(0) + "IEND" + be32(0);
+  try {
+    decodeImageBytes(reinterpret_cast<const unsigned char*>(png.data()), png.size());
+    ADD_FAILURE() << "the bomb was decoded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("16385 x 4096"), std::string::npos) << e.what();
+  }
+  const std::string path = test::outputDir("ReadImage_Bomb") + "/bomb.png";
+  std::ofstream(path, std::ios::binary) << png;
+  try {
+    readImage(path);
+    ADD_FAILURE() << "the bomb was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("16385 x 4096"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(checkImageSize(kMaxImageSide, 1, 16));
+  EXPECT_THROW(checkImageSize(kMaxImageSide + 1, 1, 16), InputError);
 }
 
 }  // namespace

@@ -114,7 +114,7 @@ TEST(CameraPath, MissingFileIsNamed) {
     readCameraPath(missing);
     FAIL() << "no exception";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), missing + ": cannot open the camera path");
+    EXPECT_EQ(std::string(e.what()), missing + ": the camera path not found");
   }
 }
 
