@@ -110,7 +110,7 @@ std::string notReplaceable(const std::string& path) {
 void requireRegularFile(const std::string& path, const std::string& what) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (ec || !fs::exists(status)) throw InputError(path + ": " + what + " not found");
+  if (ec || !fs::exists(status)) throw InputError(path + ": " + what + " does not exist");
   if (!fs::is_regular_file(status)) {
     throw InputError(path + ": " + what + " is " + file_internal::describe(status) +
                      " (only regular files are read)");

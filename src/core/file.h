@@ -16,7 +16,7 @@ namespace lo {
 /// @brief The one rule for every input file: it exists and is a regular
 /// file (or a link to one). A pipe, a device or a socket would block or never
 /// end, a folder cannot be read. @throws InputError "<path>: <what> is a
-/// pipe (only regular files are read)", or "... not found".
+/// pipe (only regular files are read)", or "... does not exist".
 void requireRegularFile(const std::string& path, const std::string& what);
 
 /// @brief The whole content of the file at `path`, as bytes.

@@ -114,7 +114,7 @@ TEST(CameraPath, MissingFileIsNamed) {
     readCameraPath(missing);
     FAIL() << "no exception";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), missing + ": the camera path not found");
+    EXPECT_EQ(std::string(e.what()), missing + ": the camera path does not exist");
   }
 }
 
