@@ -92,6 +92,15 @@ void prevalidateJson(const std::string& path, const std::string& baseDir, const 
       if (!fs::is_regular_file(file, ec)) {
         fail(path, "missing buffer file '" + u + "' (" + what + ", not found)");
       }
+      // Its size against byteLength before anything reads it: the parser
+      // reads a buffer file whole and then wants exactly byteLength bytes, so
+      // a 16 GiB file behind byteLength 2,496 was read whole to be refused.
+      const uintmax_t size = fs::file_size(file, ec);
+      if (!ec && size != uintmax_t(bufferLengths.back())) {
+        fail(path, what + ": file '" + u + "' holds " + std::to_string(size) +
+                       " bytes where its byteLength says " +
+                       std::to_string(bufferLengths.back()) + " (they must be equal)");
+      }
     }
   }
   std::vector<char> viewOk;

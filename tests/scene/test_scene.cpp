@@ -665,6 +665,10 @@ TEST(SceneReject, MissingExternalBuffer) {
   // With the .bin present it loads.
   writeFile(dir + "/mesh.bin", g.blob());
   EXPECT_EQ(loadScene(path).triangleCount(), 1u);
+  // A .bin far larger than its byteLength is refused from its size, unread
+  // (a sparse 64 MiB file: nothing is written to the disk).
+  fs::resize_file(dir + "/mesh.bin", uintmax_t(64) << 20);
+  expectInputError(path, "holds 67108864 bytes where its byteLength says");
 }
 
 TEST(SceneReject, BufferUriEscapingTheFolder) {
