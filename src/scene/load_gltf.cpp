@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "core/file.h"
+#include "core/resources.h"
 #include "image/image.h"
 #include "scene/gltf_prevalidate.h"
 #include "scene/gltf_transform.h"
@@ -662,7 +663,52 @@ class SceneBuilder {
     return roots;
   }
 
+  /// The triangles the node tree will make, from the accessors' counts, and
+  /// the memory they will take, before any is built: ten thousand nodes
+  /// instancing a 200k-triangle mesh are 2e9 triangles, built only to be
+  /// refused (32-bit indices) after minutes and gigabytes.
+  void checkTriangleBudget() {
+    std::vector<uint64_t> perMesh(model_.meshes.size(), 0);
+    for (size_t m = 0; m < model_.meshes.size(); ++m) {
+      for (const tinygltf::Primitive& prim : model_.meshes[m].primitives) {
+        int accessor = prim.indices;
+        if (accessor < 0) {
+          auto pos = prim.attributes.find("POSITION");
+          accessor = pos == prim.attributes.end() ? -1 : pos->second;
+        }
+        if (accessor < 0 || size_t(accessor) >= model_.accessors.size()) continue;
+        const uint64_t count = uint64_t(model_.accessors[size_t(accessor)].count);
+        const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+        perMesh[m] += mode == TINYGLTF_MODE_TRIANGLES ? count / 3 : (count >= 2 ? count - 2 : 0);
+      }
+    }
+    uint64_t triangles = 0;
+    std::vector<int> stack = sceneRoots();
+    size_t visits = 0;
+    while (!stack.empty()) {
+      const int n = stack.back();
+      stack.pop_back();
+      // Out-of-range nodes and cycles are traverse()'s to name.
+      if (n < 0 || size_t(n) >= model_.nodes.size() || ++visits > model_.nodes.size()) return;
+      const tinygltf::Node& node = model_.nodes[size_t(n)];
+      if (node.mesh >= 0 && size_t(node.mesh) < perMesh.size()) triangles += perMesh[size_t(node.mesh)];
+      for (int c : node.children) stack.push_back(c);
+    }
+    // Per triangle, at most three vertices of their own (position, normal,
+    // two UV sets, tangent: 56 bytes; the double position kept for the
+    // rebase: 24), its indices and material (16).
+    const double bytes = double(triangles) * (3.0 * (56 + 24) + 16);
+    const size_t available = availableMemoryBytes();
+    if (triangles > (uint64_t(1) << 32) / 3 || (available > 0 && bytes > 0.5 * double(available))) {
+      fail(path_, "the node tree makes " + std::to_string(triangles) + " triangles (" +
+                      formatBytes(size_t(std::min(bytes, 1e18))) + " to hold), beyond " +
+                      (available > 0 ? "half the " + formatBytes(available) + " of memory available"
+                                     : std::string("32-bit indices")));
+    }
+  }
+
   void traverse() {
+    checkTriangleBudget();
     struct Item {
       int node;
       Mat4 parent;

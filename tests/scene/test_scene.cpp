@@ -671,6 +671,25 @@ TEST(SceneReject, MissingExternalBuffer) {
   expectInputError(path, "holds 67108864 bytes where its byteLength says");
 }
 
+TEST(SceneReject, TrianglesBeyondMemoryAreCountedBeforeBuilt) {
+  // Twenty nodes instancing a mesh of 1e8 triangles (an accessor without a
+  // buffer view: zeros, as glTF allows): 2e9 triangles, refused from the
+  // accessors' counts before any is built.
+  std::string nodes, roots;
+  for (int i = 0; i < 20; ++i) {
+    nodes += std::string(i ? ", " : "") + R"({"mesh": 0})";
+    roots += std::string(i ? ", " : "") + std::to_string(i);
+  }
+  const std::string dir = test::outputDir("SceneReject_Instances");
+  writeFile(dir + "/many.gltf",
+            R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [)" + roots +
+                R"(]}], "nodes": [)" + nodes +
+                R"(], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+                "accessors": [{"componentType": 5126, "count": 300000000, "type": "VEC3",
+                "min": [0, 0, 0], "max": [0, 0, 0]}]})");
+  expectInputError(dir + "/many.gltf", "the node tree makes 2000000000 triangles");
+}
+
 TEST(SceneReject, BufferUriEscapingTheFolder) {
   std::string dir = test::outputDir("SceneReject_Escape");
   fs::create_directories(dir + "/inner");
