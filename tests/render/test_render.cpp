@@ -855,30 +855,43 @@ TEST(RenderImage, MetallicRoughnessAndOcclusionMaps) {
 // lit quad shows the quad through it, dimmed only by the Fresnel reflectance
 // at normal incidence (4%), where it used to be drawn as an opaque white
 // surface; and it casts no shadow on the quad under it.
-TEST(RenderImage, GlassShowsWhatIsBehindAndCastsNoShadow) {
-  REQUIRE_OSMESA();
+/// QuadSetup's quad under a point light, drawn (Direct) without and with a
+/// clear glass pane at z = 0.8 covering the view (`thickness` > 0: a
+/// KHR_materials_volume pane).
+struct PaneRenders {
+  RenderParams params = QuadSetup::params(false);
+  RgbImage open, through;
+};
+PaneRenders renderWithAndWithoutAPane(const Vec3& lightAt, float intensity, float thickness) {
+  PaneRenders r;
   QuadSetup s;
   Light light;
-  light.type = Light::Type::Point;
-  light.position = {0.6f, 0.5f, 1.5f};  // off to the side: no highlight on the pane at the centre
-  light.intensity = 4.0f;
+  light.position = lightAt;
+  light.intensity = intensity;
   s.scene.lights.push_back(light);
   GpuOctree octree =
       makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
-  RenderParams p = QuadSetup::params(false);
-  p.mode = RenderMode::Direct;
-  const RgbImage open = Renderer(s.scene, octree).render(s.camera, p);
+  r.params.mode = RenderMode::Direct;
+  r.open = Renderer(s.scene, octree).render(s.camera, r.params);
   Material glass;
   glass.baseColor = {1, 1, 1};
   glass.roughness = 0.05f;
   glass.transmission = 1.0f;
+  glass.thickness = thickness;
   s.scene.materials.push_back(glass);
-  // The pane at z = 0.8 covers the view and lies between the light and the
-  // centre of the quad.
   test::addQuad(s.scene, {-1, -1, 0.8f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
-  const RgbImage through = Renderer(s.scene, octree).render(s.camera, p);
-  const float* a = open.pixel(p.width / 2, p.height / 2);
-  const float* b = through.pixel(p.width / 2, p.height / 2);
+  r.through = Renderer(s.scene, octree).render(s.camera, r.params);
+  return r;
+}
+
+TEST(RenderImage, GlassShowsWhatIsBehindAndCastsNoShadow) {
+  // The thin pane lies between the light (off to the side: no highlight on
+  // the pane at the centre) and the centre of the quad.
+  REQUIRE_OSMESA();
+  const PaneRenders r = renderWithAndWithoutAPane({0.6f, 0.5f, 1.5f}, 4.0f, 0.0f);
+  const RenderParams& p = r.params;
+  const float* a = r.open.pixel(p.width / 2, p.height / 2);
+  const float* b = r.through.pixel(p.width / 2, p.height / 2);
   ASSERT_GT(a[0], 0.01f);
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(b[c] / a[c], 0.96f, 0.01f) << "channel " << c << ": " << b[c] << " vs " << a[c];
@@ -890,28 +903,13 @@ TEST(RenderImage, AFlatGlassVolumeIsSeenStraightThroughTwoInterfaces) {
   // panes) is flat on the scale of its thickness: the view goes straight
   // through (not bent as through a ball of that diameter), losing the
   // Fresnel reflectance at both faces, 1 - 0.04 each at normal incidence.
+  // The light is under the pane: it casts no shadow here.
   REQUIRE_OSMESA();
-  QuadSetup s;
-  Light light;
-  light.position = {0.6f, 0.5f, 0.5f};  // under the pane: it casts no shadow here
-  light.intensity = 1.0f;
-  s.scene.lights.push_back(light);
-  GpuOctree octree =
-      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
-  RenderParams p = QuadSetup::params(false);
-  p.mode = RenderMode::Direct;
-  const RgbImage open = Renderer(s.scene, octree).render(s.camera, p);
-  Material glass;
-  glass.baseColor = {1, 1, 1};
-  glass.roughness = 0.05f;
-  glass.transmission = 1.0f;
-  glass.thickness = 0.05f;
-  s.scene.materials.push_back(glass);
-  test::addQuad(s.scene, {-1, -1, 0.8f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
-  const RgbImage through = Renderer(s.scene, octree).render(s.camera, p);
+  const PaneRenders r = renderWithAndWithoutAPane({0.6f, 0.5f, 0.5f}, 1.0f, 0.05f);
+  const RenderParams& p = r.params;
   for (int px : {p.width / 2, p.width / 2 + 12}) {  // the centre, and 7 degrees off it
-    const float* a = open.pixel(px, p.height / 2);
-    const float* b = through.pixel(px, p.height / 2);
+    const float* a = r.open.pixel(px, p.height / 2);
+    const float* b = r.through.pixel(px, p.height / 2);
     ASSERT_GT(a[0], 0.01f);
     EXPECT_NEAR(b[0] / a[0], 0.96f * 0.96f, 0.01f) << "pixel " << px;
   }
