@@ -4,11 +4,16 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
+#include <string>
 #include <utility>
+
+#include "core/error.h"
 
 namespace lo {
 
@@ -111,14 +116,30 @@ size_t availableMemoryBytes() {
       break;
     }
   }
-  // LIGHTOCTREE_MEMORY_LIMIT (bytes): a budget of one's own, or a smaller
-  // machine's in tests.
+  // LIGHTOCTREE_MEMORY_LIMIT: a budget of one's own, or a smaller machine's
+  // in tests: bytes, or a number with K, M, G or T (binary: 2G = 2 GiB, an
+  // optional "iB" or "B" after it). Anything else is refused, not ignored.
   if (const char* limit = std::getenv("LIGHTOCTREE_MEMORY_LIMIT")) {
     char* end = nullptr;
-    const unsigned long long bytes = std::strtoull(limit, &end, 10);
-    if (end != limit && *end == '\0' && bytes > 0) {
-      available = available ? std::min(available, size_t(bytes)) : size_t(bytes);
+    const double number = std::strtod(limit, &end);
+    double scale = 1;
+    std::string unit = end ? end : "";
+    if (!unit.empty()) {
+      const char prefix = char(std::toupper(static_cast<unsigned char>(unit[0])));
+      const std::string rest = unit.substr(1);
+      const size_t power = std::string("KMGT").find(prefix);
+      if (power != std::string::npos && (rest.empty() || rest == "B" || rest == "iB")) {
+        scale = std::ldexp(1.0, 10 * int(power + 1));
+      } else if (unit != "B") {
+        scale = 0;
+      }
     }
+    const double bytes = number * scale;
+    if (end == limit || !(bytes >= 1) || !std::isfinite(bytes) || bytes > 1e18) {
+      throw InputError(std::string("LIGHTOCTREE_MEMORY_LIMIT='") + limit +
+                       "': expected a size in bytes, or a number with K, M, G or T (2G: 2 GiB)");
+    }
+    available = available ? std::min(available, size_t(bytes)) : size_t(bytes);
   }
   return available;
 }

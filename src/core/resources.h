@@ -37,8 +37,9 @@ size_t peakRssSinceResetBytes();
 
 /// Memory the kernel says a new allocation can get without swapping
 /// (MemAvailable of /proc/meminfo, capped by the cgroup's limit when one is
-/// set, and by the environment variable LIGHTOCTREE_MEMORY_LIMIT in bytes when
-/// set), bytes; 0 if unknown.
+/// set, and by the environment variable LIGHTOCTREE_MEMORY_LIMIT when set:
+/// bytes, or a number with K, M, G or T, binary: 2G = 2 GiB), bytes; 0 if
+/// unknown. @throws InputError when LIGHTOCTREE_MEMORY_LIMIT is not a size.
 size_t availableMemoryBytes();
 
 /// One stage's row in a report.

@@ -1,11 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <set>
 #include <vector>
 
 #include "core/error.h"
 #include "core/math.h"
 #include "core/progress.h"
+#include "core/resources.h"
 #include "core/rng.h"
 
 namespace lo {
@@ -105,6 +109,27 @@ TEST(Progress, ReportsMonotonicallyAndFinishesAtTotal) {
   EXPECT_EQ(sink.last, 10000u);
   // Throttled to about one report per percent.
   EXPECT_LE(sink.updates, 102);
+}
+
+
+TEST(Resources, MemoryLimitTakesUnitsAndRefusesWhatItCannotRead) {
+  // LIGHTOCTREE_MEMORY_LIMIT=2G used to be ignored without a word.
+  const size_t unlimited = availableMemoryBytes();
+  auto limited = [](const char* value) {
+    setenv("LIGHTOCTREE_MEMORY_LIMIT", value, 1);
+    const size_t bytes = availableMemoryBytes();
+    unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+    return bytes;
+  };
+  EXPECT_EQ(limited("1048576"), std::min<size_t>(unlimited ? unlimited : SIZE_MAX, 1048576));
+  EXPECT_EQ(limited("3M"), size_t(3) << 20);
+  EXPECT_EQ(limited("1.5MiB"), size_t(3) << 19);
+  EXPECT_EQ(limited("2k"), size_t(2048));
+  for (const char* bad : {"2X", "lots", "-5", "0", "2GB and more"}) {
+    setenv("LIGHTOCTREE_MEMORY_LIMIT", bad, 1);
+    EXPECT_THROW(availableMemoryBytes(), InputError) << bad;
+    unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+  }
 }
 
 }  // namespace
