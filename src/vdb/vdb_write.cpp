@@ -237,6 +237,19 @@ void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const Bak
 
 void writeVdlGrid(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
                   const VdlWriteOptions& options) {
+  // What every reader will check, checked before anything is written: a file
+  // the commands would refuse never replaces a good one (bake, convert).
+  try {
+    vdb_internal::checkReadableValues(path, grid);
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) + "; not written, the file there is left as it was");
+  }
+  for (const VdbCheck& c : checkLightGridValues(grid, options.halfFloat)) {
+    if (!c.passed) {
+      throw InputError(path + ": not written: the light grid fails check " + c.name + " (" +
+                       c.detail + "); the file there is left as it was");
+    }
+  }
   vdb_internal::writeVdl(path, grid, meta, options, nullptr);
 }
 

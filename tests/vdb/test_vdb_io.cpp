@@ -154,6 +154,27 @@ TEST(VdbIo, RoundTripIsBitExact) {
   }
 }
 
+TEST(VdbIo, AGridTheReadersWouldRefuseIsNotWritten) {
+  // The readers' value checks run before the write: a negative or a NaN
+  // irradiance (what a bad light once baked) leaves the old file as it was.
+  const std::string path = test::outputDir("VdbIo.RefusedWrite") + "/grid.vdb";
+  const VdlGrid good = makeGrid(50, 2, 3);
+  writeVdlGrid(path, good, makeMeta());
+  const std::string before = readFile(path);
+  for (float bad : {-1.0f, std::nanf("")}) {
+    VdlGrid g = good;
+    g.irradiance[7].y = bad;
+    try {
+      writeVdlGrid(path, g, makeMeta());
+      ADD_FAILURE() << "written with irradiance " << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("not written"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(readFile(path), before) << "irradiance " << bad;
+    EXPECT_TRUE(leftoverTemporaries(path).empty());
+  }
+}
+
 TEST(VdbIo, EmptyGridRoundTrips) {
   std::string path = test::outputDir("VdbIo.Empty") + "/empty.vdb";
   VdlGrid g = makeGrid(0, 4, 1);
@@ -173,7 +194,7 @@ TEST(VdbIo, SameInputGivesSameBytes) {
   EXPECT_GT(a.size(), 1000u);
   EXPECT_TRUE(a == readFile(dir + "/b.vdb"));
   // A different grid gets a different (content-derived) file UUID.
-  g.irradiance[0].x += 1.0f;
+  g.photonCount[0] += 1.0f;
   writeVdlGrid(dir + "/c.vdb", g, makeMeta());
   EXPECT_NE(a.substr(21, 36), readFile(dir + "/c.vdb").substr(21, 36));
 }
@@ -464,7 +485,9 @@ TEST(VdbIo, NonFiniteValuesAreRefusedAtReading) {
   const std::string dir = test::outputDir("VdbIo.NonFinite");
   VdlGrid g = makeGrid(30, 2, 7);
   g.irradiance[11].y = std::nanf("");
-  writeVdlGrid(dir + "/nan.vdb", g, makeMeta());
+  // Written past writeVdlGrid's own checks (which refuse it), as a damaged
+  // or foreign file would arrive.
+  vdb_internal::writeVdlGridDamaged(dir + "/nan.vdb", g, makeMeta(), vdb_internal::Damage{});
   try {
     readVdlGrid(dir + "/nan.vdb");
     FAIL() << "expected an InputError";
@@ -475,7 +498,7 @@ TEST(VdbIo, NonFiniteValuesAreRefusedAtReading) {
   }
   g.irradiance[11].y = 0.5f;
   g.vdls[3].direction.x = INFINITY;
-  writeVdlGrid(dir + "/inf.vdb", g, makeMeta());
+  vdb_internal::writeVdlGridDamaged(dir + "/inf.vdb", g, makeMeta(), vdb_internal::Damage{});
   EXPECT_THROW(readVdlGrid(dir + "/inf.vdb"), InputError);
 }
 
