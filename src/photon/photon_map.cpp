@@ -81,9 +81,9 @@ struct Context {
   SkySampler skySampler;
   Bounds3 bounds;
   Bounds3 region;       ///< photons stored only inside (empty: everywhere)
-  /// emitBounds: what the sun and the sky cover: the bounds, or the region
-  /// with a margin (emitBoxOfRegion)
-  Bounds3 emitBounds;   ///< what directional lights cover: the region, else the bounds
+  /// What the sun and the sky cover: the bounds, or the region with a
+  /// margin (emitBoxOfRegion).
+  Bounds3 emitBounds;
   float epsilon = 0;
   int maxBounces = 0;
   bool includeDirect = false;

@@ -1064,19 +1064,12 @@ class SceneBuilder {
         break;
       }
     }
-    const double inf = std::numeric_limits<double>::infinity();
-    Vec3d lower{inf, inf, inf}, upper{-inf, -inf, -inf};
+    scene_internal::RebaseBounds bounds;
     for (size_t t = 0; t < scene_.triangleCount(); ++t) {
       if (scene_.triangleMaterial[t] == sky) continue;
-      for (int k = 0; k < 3; ++k) {
-        const Vec3d& p = world_.vertices[scene_.indices[3 * t + size_t(k)]];
-        for (int a = 0; a < 3; ++a) {
-          lower[a] = std::min(lower[a], p[a]);
-          upper[a] = std::max(upper[a], p[a]);
-        }
-      }
+      for (int k = 0; k < 3; ++k) bounds.extend(world_.vertices[scene_.indices[3 * t + size_t(k)]]);
     }
-    const Vec3d origin = scene_internal::rebaseOrigin(lower, upper);
+    const Vec3d origin = bounds.origin();
     if (origin.x == 0 && origin.y == 0 && origin.z == 0) return;
     scene_.origin = origin;
     for (size_t i = 0; i < scene_.positions.size(); ++i) {

@@ -99,18 +99,12 @@ std::vector<double> readVerticesInDouble(const std::string& path) {
   return out;
 }
 
-/// rebaseOrigin of x, y, z triples.
+/// The rebase origin (RebaseBounds) of x, y, z triples.
 template <typename T>
 Vec3d originOf(const std::vector<T>& xyz) {
-  const double inf = std::numeric_limits<double>::infinity();
-  Vec3d lower{inf, inf, inf}, upper{-inf, -inf, -inf};
-  for (size_t i = 0; i + 2 < xyz.size(); i += 3) {
-    for (int a = 0; a < 3; ++a) {
-      lower[a] = std::min(lower[a], double(xyz[i + size_t(a)]));
-      upper[a] = std::max(upper[a], double(xyz[i + size_t(a)]));
-    }
-  }
-  return rebaseOrigin(lower, upper);
+  RebaseBounds bounds;
+  for (size_t i = 0; i + 2 < xyz.size(); i += 3) bounds.extend(Vec3d(xyz[i], xyz[i + 1], xyz[i + 2]));
+  return bounds.origin();
 }
 
 }  // namespace

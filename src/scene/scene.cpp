@@ -597,7 +597,7 @@ void checkLightAndMaterialValues(Scene& scene) {
   }
 }
 
-Vec3d rebaseOrigin(const Vec3d& lower, const Vec3d& upper) {
+Vec3d RebaseBounds::origin() const {
   if (!(lower.x <= upper.x && lower.y <= upper.y && lower.z <= upper.z)) return {};
   const Vec3d centre = (lower + upper) * 0.5;
   const double distance = std::max({std::fabs(centre.x), std::fabs(centre.y), std::fabs(centre.z)});

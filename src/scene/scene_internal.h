@@ -3,7 +3,9 @@
 /// @brief Helpers shared by the glTF and OBJ loaders. Not part of the public
 /// API: nothing outside src/scene includes this header.
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -41,11 +43,23 @@ Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, si
 /// size.
 constexpr double kRebaseDistance = 128.0;
 
-/// The origin a loader rebases its scene to (Scene::origin), from the
-/// world-space bounds of its vertices: their centre when it lies farther from
-/// (0, 0, 0) than kRebaseDistance times the bounds' diagonal, else (0, 0, 0),
-/// so that a scene near the origin keeps its coordinates exactly.
-Vec3d rebaseOrigin(const Vec3d& lower, const Vec3d& upper);
+/// World-space bounds of a loader's vertices, in double, and the origin it
+/// rebases its scene to (Scene::origin): their centre when it lies farther
+/// from (0, 0, 0) than kRebaseDistance times the bounds' diagonal, else
+/// (0, 0, 0), so that a scene near the origin keeps its coordinates exactly.
+struct RebaseBounds {
+  Vec3d lower{kInfinity, kInfinity, kInfinity}, upper{-kInfinity, -kInfinity, -kInfinity};
+  void extend(const Vec3d& p) {
+    for (int a = 0; a < 3; ++a) {
+      lower[a] = std::min(lower[a], p[a]);
+      upper[a] = std::max(upper[a], p[a]);
+    }
+  }
+  Vec3d origin() const;
+
+ private:
+  static constexpr double kInfinity = std::numeric_limits<double>::infinity();
+};
 
 /// `skyMesh`: loadScene's.
 Scene loadGltf(const std::string& path, const std::string& skyMesh);
