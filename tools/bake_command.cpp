@@ -64,7 +64,18 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.lights.size()) + " punctual lights");
 
-  const BakeParams params = opt.bakeParams(scene);
+  BakeParams params = opt.bakeParams(scene);
+  if (comm && opt.photons == 0 && opt.targetError == 0) {
+    // A target bake runs in one process: under mpirun the default is the
+    // paper's fixed budget.
+    params.targetError = 0;
+    params.photons = BakeParams{}.photons;
+    if (!opt.quiet) {
+      std::printf("under mpirun the bake stores a fixed %s photons (--photons); "
+                  "--target-error needs one process\n",
+                  formatCount(params.photons).c_str());
+    }
+  }
   DistributedStats distributed;
   TileParams tiles;
   tiles.tilesPerAxis = opt.tiles == "auto" ? 0 : std::stoi(opt.tiles);
@@ -88,7 +99,29 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
     pointsTimer.finish(opt.photonMap);
   }
 
-  if (!opt.quiet) printSummary(stdout, rows);
+  if (!opt.quiet) {
+    printSummary(stdout, rows);
+    const BakeStats& st = baked.stats;
+    for (size_t i = 0; i < st.passes.size(); ++i) {
+      std::printf("pass %zu: %s photons, %s\n", i + 1, formatCount(st.passes[i].photons).c_str(),
+                  st.passes[i].noise.ToString().c_str());
+    }
+    if (!st.passes.empty()) {
+      std::printf("target error %s: %s after %zu pass%s, %s photons\n",
+                  formatNumber(params.targetError).c_str(), st.targetStop.c_str(),
+                  st.passes.size(), st.passes.size() == 1 ? "" : "es",
+                  formatCount(st.storedPhotons).c_str());
+    } else {
+      std::printf("%s\n", st.noise.ToString().c_str());
+    }
+  }
+  if (!baked.stats.passes.empty() && baked.stats.targetStop != "target reached") {
+    std::fprintf(stderr,
+                 "warning: the noise target %s was not reached (%s): the grid's %s; raise "
+                 "--max-photons, bake at a smaller --depth or ask for a larger --target-error\n",
+                 formatNumber(params.targetError).c_str(), baked.stats.targetStop.c_str(),
+                 baked.stats.noise.ToString().c_str());
+  }
   if (!opt.quiet && comm) std::printf("%s", ranksTable(distributed, baked.stats.storedPhotons).c_str());
 
   if (!opt.statsJson.empty()) {

@@ -15,7 +15,17 @@ namespace lo::tool {
 BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   BakeParams params;
   params.depth = depth;
-  params.photons = photons;
+  if (photons > 0 && targetError > 0) {
+    throw InputError("give --photons (a fixed budget) or --target-error (photons until the noise "
+                     "reaches it), not both");
+  }
+  if (photons > 0) {
+    params.photons = photons;
+  } else {
+    params.targetError = targetError > 0 ? targetError : kDefaultTargetError;
+    params.maxPhotons = maxPhotons;
+    params.maxSeconds = maxSeconds;
+  }
   params.knn = knn;
   params.radius = radius;
   params.vdls = parseVdlCount(vdls);
@@ -58,10 +68,30 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
                   "Octree depth: 2^depth voxels across the scene's bounding cube")
       ->check(depthValidator())
       ->capture_default_str();
-  cmd->add_option("--photons", opt.photons, "Photons to store in the photon map")
+  cmd->add_option("--photons", opt.photons,
+                  "A fixed photon budget: store this many photons (the paper's 600000) instead "
+                  "of tracing until --target-error is reached")
+      ->check(CLI::Range(size_t(1), size_t(200000000)));
+  cmd->add_option("--target-error", opt.targetError,
+                  "Trace photons in passes until the bake's noise figure is at most this (default " +
+                      formatNumber(kDefaultTargetError) +
+                      "): the estimated relative standard error of the irradiance that 90% of the "
+                      "lit area is below (docs/accuracy.md, \"How good is a bake\"). A deeper "
+                      "grid gets the photons it needs")
+      ->check(CLI::Range(1e-3, 1.0));
+  cmd->add_option("--max-photons", opt.maxPhotons,
+                  "With --target-error: store at most this many photons (fewer when memory "
+                  "holds fewer); the report says when the cap stopped the bake")
       ->check(CLI::Range(size_t(1), size_t(200000000)))
       ->capture_default_str();
-  cmd->add_option("--knn", opt.knn, "Nearest photons gathered per voxel (paper: 300)")
+  cmd->add_option("--max-seconds", opt.maxSeconds,
+                  "With --target-error: start no new pass after this many seconds (0: no limit). "
+                  "The one setting that makes the result depend on the machine's speed")
+      ->check(CLI::Range(0.0, 1e7))
+      ->capture_default_str();
+  cmd->add_option("--knn", opt.knn,
+                  "Nearest photons gathered per voxel (paper: 300); a target bake raises it to "
+                  "2/E^2 so that it does not hold the noise up")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--radius", opt.radius,

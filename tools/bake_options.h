@@ -21,7 +21,10 @@ struct BakeOptions {
   SceneOptions sceneOptions;  // --sky
   std::string output;
   int depth = 6;
-  size_t photons = 600000;
+  size_t photons = 0;        // 0: not given (a target bake)
+  double targetError = 0;    // 0: not given (kDefaultTargetError unless --photons)
+  size_t maxPhotons = kDefaultMaxPhotons;
+  double maxSeconds = 0;
   int knn = 300;
   float radius = 0;  // 0 = auto
   std::string vdls = "4";

@@ -60,6 +60,13 @@ nlohmann::json toJson(const VdbReport& r) {
     for (const auto& [k, v] : g.metadata) gj["metadata"][k] = v;
     j["grids"].push_back(gj);
   }
+  if (r.noise.recorded) {
+    j["noise"] = {{"quantile", r.noise.quantile}, {"median", r.noise.median},
+                  {"lit", r.noise.lit}, {"unlit", r.noise.unlit},
+                  {"mean_irradiance", r.noise.meanLuminance}};
+  } else {
+    j["noise"] = nullptr;
+  }
   j["checks"] = nlohmann::json::array();
   for (const VdbCheck& c : r.checks) {
     j["checks"].push_back({{"name", c.name}, {"passed", c.passed}, {"detail", c.detail}});
@@ -89,6 +96,10 @@ void printText(const VdbReport& r) {
         "%.6g)\n",
         r.grids.size(), formatBytes(size_t(memory)).c_str(), g.voxelSize[0], g.origin[0],
         g.origin[1], g.origin[2]);
+  }
+  if (r.noise.recorded) {
+    std::printf("\n%s over %s lit voxels and layers (%s unlit)\n", r.noise.ToString().c_str(),
+                formatCount(r.noise.lit).c_str(), formatCount(r.noise.unlit).c_str());
   }
   std::printf("\nchecks\n");
   for (const VdbCheck& c : r.checks) {

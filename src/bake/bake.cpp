@@ -4,6 +4,7 @@
 #include "bake/bake.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -56,9 +57,18 @@ GridParams BakeParams::gridParams() const {
   return p;
 }
 
+int targetKnn(double targetError) {
+  if (!(targetError > 0)) return 0;
+  return int(std::min(1e5, std::ceil(2.0 / (targetError * targetError))));
+}
+
+int BakeParams::effectiveKnn() const {
+  return targetError > 0 ? std::max(knn, targetKnn(targetError)) : knn;
+}
+
 GatherParams BakeParams::gatherParams() const {
   GatherParams p;
-  p.k = knn;
+  p.k = effectiveKnn();
   p.radius = radius;
   p.edgeCorrection = edgeCorrection;
   return p;
@@ -75,8 +85,12 @@ ClusterParams BakeParams::clusterParams() const {
 }
 
 std::string BakeParams::ToString() const {
-  return "BakeParams{depth " + std::to_string(depth) + ", photons " + std::to_string(photons) +
-         ", knn " + std::to_string(knn) + ", radius " + std::to_string(radius) + ", vdls " +
+  const std::string budget =
+      targetError > 0 ? "target error " + std::to_string(targetError) + ", max photons " +
+                            std::to_string(maxPhotons)
+                      : "photons " + std::to_string(photons);
+  return "BakeParams{depth " + std::to_string(depth) + ", " + budget +
+         ", knn " + std::to_string(effectiveKnn()) + ", radius " + std::to_string(radius) + ", vdls " +
          vdls.ToString() + ", representation " + representationName(representation) +
          ", seed " + std::to_string(seed) +
          (includeDirect ? ", include direct" : "") + (layers ? "" : ", no layers") +
@@ -102,35 +116,51 @@ SegmentBlocked GatherOcclusion::test() const {
   };
 }
 
-SurfaceGrid voxelizeAndSplat(const Scene& scene, const std::vector<Photon>& photons,
-                             const GridParams& params, ProgressSink* progress, LevelStats* stats,
-                             std::vector<StageReport>* stages) {
-  std::vector<StageReport> ignored;
-  std::vector<StageReport>& rows = stages ? *stages : ignored;
-  LevelStats s;
+namespace {
 
+SurfaceGrid voxelize(const Scene& scene, const GridParams& params, ProgressSink* progress,
+                     LevelStats& s, std::vector<StageReport>& rows) {
   StageTimer voxelize(rows, "voxelize");
   SurfaceGrid grid = buildSurfaceGrid(scene, params, progress);
   s.activeVoxels = grid.size();
   const size_t dense = size_t(1) << (3 * params.depth);
   s.voxelizeSeconds =
       voxelize.finish(formatCount(grid.size()) + " of " + formatCount(dense) + " voxels active");
+  return grid;
+}
 
+void splat(SurfaceGrid& grid, const std::vector<Photon>& photons, LevelStats& s,
+           std::vector<StageReport>& rows) {
   StageTimer splat(rows, "splat photons");
   s.droppedPhotons = splatPhotons(grid, photons);
   s.splatSeconds =
       splat.finish(s.droppedPhotons ? formatCount(s.droppedPhotons) + " photons outside the grid"
                                     : "");
+}
+
+}  // namespace
+
+SurfaceGrid voxelizeAndSplat(const Scene& scene, const std::vector<Photon>& photons,
+                             const GridParams& params, ProgressSink* progress, LevelStats* stats,
+                             std::vector<StageReport>* stages) {
+  std::vector<StageReport> ignored;
+  std::vector<StageReport>& rows = stages ? *stages : ignored;
+  LevelStats s;
+  SurfaceGrid grid = voxelize(scene, params, progress, s, rows);
+  splat(grid, photons, s, rows);
   if (stats) *stats = s;
   return grid;
 }
 
-VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const LevelParams& params,
-                  ProgressSink* progress, LevelStats* stats, std::vector<StageReport>* stages) {
+VdlGrid gatherLevel(const Scene& scene, SurfaceGrid& grid, const std::vector<Photon>& photons,
+                    const LevelParams& params, ProgressSink* progress, LevelStats* stats,
+                    std::vector<StageReport>* stages) {
   std::vector<StageReport> ignored;
   std::vector<StageReport>& rows = stages ? *stages : ignored;
   LevelStats s;
-  SurfaceGrid grid = voxelizeAndSplat(scene, photons, params.grid, progress, &s, &rows);
+  if (stats) s = *stats;  // keeps the voxelize figures
+  s.activeVoxels = grid.size();
+  splat(grid, photons, s, rows);
 
   StageTimer cluster(rows, "gather + cluster");
   GatherParams gather = params.gather;
@@ -158,6 +188,17 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
   return vdls;
 }
 
+VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const LevelParams& params,
+                  ProgressSink* progress, LevelStats* stats, std::vector<StageReport>* stages) {
+  std::vector<StageReport> ignored;
+  std::vector<StageReport>& rows = stages ? *stages : ignored;
+  LevelStats s;
+  SurfaceGrid grid = voxelize(scene, params.grid, progress, s, rows);
+  VdlGrid vdls = gatherLevel(scene, grid, photons, params, progress, &s, &rows);
+  if (stats) *stats = s;
+  return vdls;
+}
+
 void checkDepth(int depth, const std::string& what) {
   if (depth < 1 || depth > kMaxGridDepth) {
     throw InputError(what + " " + std::to_string(depth) + " is outside [1, " +
@@ -170,6 +211,14 @@ namespace {
 void checkParams(const BakeParams& p, int processes) {
   checkDepth(p.depth);
   if (p.photons < 1) throw InputError("--photons must be at least 1");
+  if (!(p.targetError >= 0) || !(p.targetError <= 1)) {
+    throw InputError("--target-error " + formatNumber(p.targetError) +
+                     " is outside (0, 1] (a relative error: 0.05 is 5%)");
+  }
+  if (p.targetError > 0 && p.maxPhotons < 1) throw InputError("--max-photons must be at least 1");
+  if (!(p.maxSeconds >= 0) || !std::isfinite(p.maxSeconds)) {
+    throw InputError("--max-seconds " + formatNumber(p.maxSeconds) + " must be a finite time >= 0");
+  }
   if (!p.region.empty() &&
       (!isFinite(p.region.lower) || !isFinite(p.region.upper) ||
        !(maxComponent(p.region.extent()) > 0))) {
@@ -179,7 +228,7 @@ void checkParams(const BakeParams& p, int processes) {
   // at depths 6 to 8, docs/scale.md): refuse before tracing what cannot fit.
   const size_t available = availableMemoryBytes();
   const double needed = double(p.photons) * double(kBakeBytesPerPhoton) / double(processes);
-  if (available > 0 && needed > double(available)) {
+  if (p.targetError == 0 && available > 0 && needed > double(available)) {
     throw InputError("--photons " + std::to_string(p.photons) + " needs about " +
                      formatBytes(size_t(needed)) + " (" + std::to_string(kBakeBytesPerPhoton) +
                      " bytes per stored photon), more than the " + formatBytes(available) +
@@ -228,8 +277,10 @@ void checkBakeMemory(const Scene& scene, const BakeParams& params, int processes
   const GridFrame frame =
       makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth);
   const double voxels = estimateActiveVoxels(scene, frame, params.region);
+  // A target bake fits its photons to what memory is left (targetPhotonCap).
+  const double photons = params.targetError > 0 ? double(kMinPilotPhotons) : double(params.photons);
   const double needed =
-      (voxels * double(kBakeBytesPerVoxel) + double(params.photons) * double(kBakeBytesPerPhoton)) /
+      (voxels * double(kBakeBytesPerVoxel) + photons * double(kBakeBytesPerPhoton)) /
       double(std::max(processes, 1));
   if (needed > double(available)) {
     throw InputError("--depth " + std::to_string(params.depth) + ": the scene's surfaces cross " +
@@ -304,7 +355,7 @@ BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t 
   meta.depth = params.depth;
   meta.photons = photons;
   meta.emittedPaths = emittedPaths;
-  meta.knn = params.knn;
+  meta.knn = params.effectiveKnn();
   meta.radius = radius;
   meta.vdls = params.vdls.ToString();
   meta.representation = representationName(params.representation);
@@ -329,8 +380,122 @@ LevelParams BakeParams::levelParams() const {
   return level;
 }
 
+namespace bake_internal {
+
+/// The photons a target bake may store: maxPhotons, or fewer when the
+/// memory left beside the voxels (kBakeBytesPerVoxel) does not hold them at
+/// kBakeBytesPerPhoton plus the unscaled copy the passes keep.
+size_t targetPhotonCap(const BakeParams& params, size_t activeVoxels) {
+  size_t cap = params.maxPhotons;
+  const size_t available = availableMemoryBytes();
+  if (available > 0) {
+    const double left = double(available) - double(activeVoxels) * double(kBakeBytesPerVoxel);
+    const double fits = left / double(kBakeBytesPerPhoton + sizeof(Photon));
+    cap = size_t(std::clamp(fits, 0.0, double(cap)));
+  }
+  return std::max<size_t>(cap, 1);
+}
+
+/// Photons the next pass stores: the noise falls as 1/sqrt(photons) while
+/// the gather reads every photon within its radius, so the count that
+/// reaches `target` from `noise` with `photons`, with a 10% margin, at
+/// least 1.5x and at most 16x the current count, and within `cap`.
+size_t nextPassPhotons(size_t photons, double noise, double target, size_t cap) {
+  const double ratio = noise / target;
+  const double grow = std::clamp(ratio * ratio * 1.1, 1.5, 16.0);
+  return std::min(cap, size_t(std::ceil(double(photons) * grow)));
+}
+
+/// bake() with params.targetError > 0: passes of more photons over one
+/// voxelization until the noise figure reaches the target.
+BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink* progress) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  BakeResult r;
+  BakeStats& s = r.stats;
+  s.triangles = scene.triangleCount();
+  s.denseVoxels = size_t(1) << (3 * params.depth);
+
+  const LevelParams level = params.levelParams();
+  SurfaceGrid grid = voxelize(scene, level.grid, progress, s.level, s.stages);
+  const size_t cap = targetPhotonCap(params, grid.size());
+  PhotonParams photonParams = params.photonParams();
+  photonParams.storedPhotons = cap;
+  const PhotonTracer tracer(scene, photonParams);
+  const size_t maxEmitted = maxEmittedPaths(photonParams);
+  const double target = params.targetError;
+
+  std::vector<Photon> raw;  // photons of paths 0 .. emitted-1, powers not yet scaled
+  size_t emitted = 0, empty = 0, missed = 0;
+  size_t goal = std::min(cap, std::max(kMinPilotPhotons, kPilotPhotonsPerVoxel * grid.size()));
+  std::vector<Photon> scaled;
+  for (int pass = 1;; ++pass) {
+    const double passStart = elapsed();
+    StageTimer trace(s.stages, "trace photons");
+    {
+      Progress bar(progress, "Tracing photons, pass " + std::to_string(pass), goal);
+      bar.advance(std::min(raw.size(), goal));
+      const PhotonTracer::PathSink take = [&](const Photon* photons, uint32_t n, uint32_t,
+                                              bool pathMissed) {
+        raw.insert(raw.end(), photons, photons + n);
+        ++emitted;
+        empty += n == 0;
+        missed += pathMissed;
+        return raw.size() < goal;
+      };
+      while (tracer.canStore() && raw.size() < goal) {
+        const size_t batch = photonBatchPaths(goal, raw.size(), emitted, maxEmitted);
+        if (batch == 0) break;
+        const size_t before = raw.size();
+        tracer.trace(uint64_t(emitted), batch, take);
+        bar.advance(std::min(raw.size(), goal) - std::min(before, goal));
+      }
+    }
+    s.storedPhotons = raw.size();
+    s.emittedPaths = emitted;
+    s.emptyPaths = empty;
+    s.missedPaths = missed;
+    checkPhotonsStored(params, s);
+    s.traceSeconds += trace.finish(formatCount(raw.size()) + " photons from " +
+                                   formatCount(emitted) + " paths (pass " +
+                                   std::to_string(pass) + ")");
+
+    scaled = raw;
+    scalePhotonPower(scaled, emitted);
+    r.grid = gatherLevel(scene, grid, scaled, level, progress, &s.level, &s.stages);
+    s.noise = summarizeNoise(r.grid);
+    s.passes.push_back({raw.size(), emitted, s.noise, elapsed() - passStart});
+    if (s.noise.quantile <= target) {
+      s.targetStop = "target reached";
+    } else if (raw.size() >= cap) {
+      s.targetStop = "photon cap";
+    } else if (emitted >= maxEmitted || raw.size() < goal) {
+      s.targetStop = "no more paths";
+    } else if (params.maxSeconds > 0 && elapsed() >= params.maxSeconds) {
+      s.targetStop = "time cap";
+    } else if (pass >= kMaxTargetPasses) {
+      s.targetStop = "pass cap";
+    }
+    if (!s.targetStop.empty()) break;
+    goal = nextPassPhotons(raw.size(), s.noise.quantile, target, cap);
+  }
+  r.metadata = bakeMetadata(scene, params, int64_t(raw.size()), int64_t(emitted), s.level.radius);
+  if (params.keepPhotons) {
+    r.photons.photons = std::move(scaled);
+    r.photons.emittedPaths = emitted;
+    r.photons.emptyPaths = empty;
+    r.photons.missedPaths = missed;
+    r.photons.emittedPower = tracer.emittedPower();
+  }
+  return r;
+}
+
+}  // namespace bake_internal
+
 BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* progress) {
   const BakeParams params = checkedBakeParams(scene, requested);
+  if (params.targetError > 0) return bake_internal::targetBake(scene, params, progress);
   BakeResult r;
   BakeStats& s = r.stats;
   s.triangles = scene.triangleCount();
@@ -347,6 +512,7 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
                                 formatCount(photons.emittedPaths) + " paths");
 
   r.grid = bakeLevel(scene, photons.photons, params.levelParams(), progress, &s.level, &s.stages);
+  s.noise = summarizeNoise(r.grid);
   r.metadata = bakeMetadata(scene, params, int64_t(photons.photons.size()),
                             int64_t(photons.emittedPaths), s.level.radius);
   if (params.keepPhotons) r.photons = std::move(photons);

@@ -16,6 +16,7 @@
 #include "core/progress.h"
 #include "core/resources.h"
 #include "gather/gather.h"
+#include "lightgrid/grid_noise.h"
 #include "grid/surface_grid.h"
 #include "lightgrid/vdl_grid.h"
 #include "photon/photon_map.h"
@@ -55,10 +56,37 @@ constexpr double kMinStorableVoxel = 1.5e-5;
 
 struct LevelParams;
 
+/// `lightoctree bake`'s default noise target (`--target-error`): the bake's
+/// noise figure (NoiseSummary::quantile) it traces photons until it reaches.
+/// Chosen so that the Cornell box at the default depth costs about what the
+/// paper's 600,000 photons did (docs/accuracy.md, "How good is a bake").
+constexpr double kDefaultTargetError = 0.05;
+/// A target bake stores at most this many photons unless told otherwise
+/// (`--max-photons`), nor more than the memory available holds.
+constexpr size_t kDefaultMaxPhotons = 20000000;
+/// A target bake's first pass stores this many photons per active voxel
+/// (at least kMinPilotPhotons): enough for each voxel's noise to say how
+/// many the target needs.
+constexpr size_t kPilotPhotonsPerVoxel = 8;
+constexpr size_t kMinPilotPhotons = 20000;
+/// Passes of a target bake at most (the pilot included).
+constexpr int kMaxTargetPasses = 6;
+
 /// Every setting of a bake, with the defaults of `lightoctree bake`.
 struct BakeParams {
   int depth = 6;            ///< 2^depth voxels across the padded bounding cube (paper's delta)
-  size_t photons = 600000;  ///< photons stored in the photon map (paper: 600k)
+  /// Photons stored in the photon map (paper: 600k), when targetError is 0.
+  size_t photons = 600000;
+  /// > 0: trace photons in passes until the bake's noise figure
+  /// (NoiseSummary::quantile of the smoothed grid) is at most this, or
+  /// maxPhotons or maxSeconds stops it (BakeStats::targetStop says which).
+  /// The gather then reads photons within its radius up to k =
+  /// max(knn, targetKnn(targetError)), so that k does not hold the noise up.
+  double targetError = 0;
+  size_t maxPhotons = kDefaultMaxPhotons;  ///< target bakes: photon cap
+  /// Target bakes: no new pass starts after this many seconds (0: no limit).
+  /// The only setting whose result depends on the machine's speed.
+  double maxSeconds = 0;
   int knn = 300;            ///< nearest photons gathered per voxel (paper: 300)
   /// Gathering radius, world units; 0 = kDefaultRadiusVoxels voxel sizes.
   float radius = 0.0f;
@@ -92,6 +120,8 @@ struct BakeParams {
   Bounds3 region;
 
   PhotonParams photonParams() const;
+  /// The gather's k: knn, raised for a target bake (targetKnn).
+  int effectiveKnn() const;
   LevelParams levelParams() const;  ///< the grid, gather and cluster settings together
   GridParams gridParams() const;
   GatherParams gatherParams() const;
@@ -158,6 +188,24 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
                   ProgressSink* progress = nullptr, LevelStats* stats = nullptr,
                   std::vector<StageReport>* stages = nullptr);
 
+/// bakeLevel on a grid already voxelized (buildSurfaceGrid at
+/// params.grid): splats `photons` into its bins (replacing earlier ones),
+/// gathers, clusters and smooths. Fills the splat and gather fields of `stats`.
+VdlGrid gatherLevel(const Scene& scene, SurfaceGrid& grid, const std::vector<Photon>& photons,
+                    const LevelParams& params, ProgressSink* progress = nullptr,
+                    LevelStats* stats = nullptr, std::vector<StageReport>* stages = nullptr);
+
+/// The k a target bake gathers with: 2 / E^2 photons, so that a disc
+/// holding k equal photons is at noise E / sqrt(2) before smoothing.
+int targetKnn(double targetError);
+
+/// One pass of a target bake.
+struct TargetPass {
+  size_t photons = 0, paths = 0;
+  NoiseSummary noise;
+  double seconds = 0;  ///< the pass's tracing and gathering, wall
+};
+
 /// Figures of a whole bake.
 struct BakeStats {
   size_t triangles = 0;
@@ -168,7 +216,12 @@ struct BakeStats {
   size_t missedPaths = 0;
   size_t denseVoxels = 0;  ///< 8^depth
   double traceSeconds = 0;
-  LevelStats level;        ///< voxelize / splat / gather + cluster
+  LevelStats level;        ///< voxelize / splat / gather + cluster (the last pass)
+  NoiseSummary noise;      ///< the grid's noise figure (summarizeNoise)
+  /// Target bakes: every pass, and why the last one was the last:
+  /// "target reached", "photon cap", "time cap", "pass cap", "no more paths".
+  std::vector<TargetPass> passes;
+  std::string targetStop;
   /// One row per stage ("trace photons", "voxelize", "splat photons",
   /// "gather + cluster"), with the process's memory after each.
   std::vector<StageReport> stages;

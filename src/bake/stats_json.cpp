@@ -14,8 +14,10 @@ std::string bakeStatsJson(const BakeStats& stats, const BakeStatsRecord& record)
   j["scene"] = record.scene;
   j["output"] = record.output;
   j["parameters"] = {{"depth", p.depth},
-                     {"photons", p.photons},
-                     {"knn", p.knn},
+                     {"photons", p.targetError > 0 ? json(nullptr) : json(p.photons)},
+                     {"target_error", p.targetError > 0 ? json(p.targetError) : json(nullptr)},
+                     {"max_photons", p.targetError > 0 ? json(p.maxPhotons) : json(nullptr)},
+                     {"knn", p.effectiveKnn()},
                      {"radius", record.radius},
                      {"vdls", p.vdls.ToString()},
                      {"representation", representationName(p.representation)},
@@ -34,6 +36,22 @@ std::string bakeStatsJson(const BakeStats& stats, const BakeStatsRecord& record)
                  {"dense_voxels", stats.denseVoxels},
                  {"photons_outside_grid", stats.level.droppedPhotons},
                  {"vdb_bytes", record.vdbBytes}};
+  auto noiseJson = [](const NoiseSummary& n) -> json {
+    if (!n.recorded) return nullptr;
+    return {{"quantile", n.quantile}, {"median", n.median}, {"lit", n.lit}, {"unlit", n.unlit},
+            {"mean_irradiance", n.meanLuminance}};
+  };
+  j["noise"] = noiseJson(stats.noise);
+  if (!stats.passes.empty()) {
+    json passes = json::array();
+    for (const TargetPass& pass : stats.passes) {
+      passes.push_back({{"photons", pass.photons},
+                        {"paths", pass.paths},
+                        {"noise", noiseJson(pass.noise)},
+                        {"seconds", pass.seconds}});
+    }
+    j["target"] = {{"passes", passes}, {"stop", stats.targetStop}};
+  }
   j["thread_seconds"] = {{"gather", stats.level.threadSeconds.gatherSeconds},
                          {"cluster", stats.level.threadSeconds.clusterSeconds}};
   json stages = json::array();

@@ -54,6 +54,10 @@ struct Mixer {
   std::vector<DirectionSample> samples;
   double irr[3] = {0, 0, 0};
   double photonCount = 0, radius = 0;
+  // Variance of the weighted sum's luminance from the inputs' noise, taken
+  // as independent (neighbouring gathers share some photons, so this
+  // rather underestimates a coarse voxel's noise).
+  double noiseVariance = 0;
   // Weighted variance of the input voxels' angular errors, weight = the
   // power (average irradiance) each brings, like the K-means weights.
   double varianceSum = 0, varianceWeight = 0;
@@ -61,7 +65,7 @@ struct Mixer {
   void reset() {
     samples.clear();
     irr[0] = irr[1] = irr[2] = 0;
-    photonCount = radius = varianceSum = varianceWeight = 0;
+    photonCount = radius = varianceSum = varianceWeight = noiseVariance = 0;
   }
 
   void add(const VdlGrid& g, size_t v, double w) {
@@ -71,6 +75,10 @@ struct Mixer {
     irr[2] += w * e.z;
     photonCount += w * g.photonCount[v];
     radius += w * g.radius[v];
+    if (!g.noise.empty()) {
+      const double sigma = w * double(g.noise[v]) * double(luminance(e));
+      noiseVariance += sigma * sigma;
+    }
     const double power = w * std::max(0.0f, average(e));
     varianceSum += power * double(g.angularError[v]) * g.angularError[v];
     varianceWeight += power;
@@ -86,6 +94,8 @@ struct Mixer {
     out.irradiance[o] = Vec3(float(irr[0]), float(irr[1]), float(irr[2]));
     out.photonCount[o] = float(photonCount);
     out.radius[o] = float(radius);
+    const double y = double(luminance(out.irradiance[o]));
+    out.noise[o] = y > 0 ? float(std::sqrt(noiseVariance) / y) : 0.0f;
     ClusterResult c = clusterDirections(samples.data(), samples.size(), params.vdls, params, o);
     // Law of total variance, approximately (chord lengths are not additive):
     // the spread of the photons around their old VDLs plus the spread of the
@@ -218,6 +228,7 @@ struct ReclusterBody {
       // exact for weight 1, but say so in code rather than rely on it.
       out.irradiance[v] = in.irradiance[v];
       out.photonCount[v] = in.photonCount[v];
+      out.noise[v] = in.noise.empty() ? 0.0f : in.noise[v];
       out.radius[v] = in.radius[v];
     }
   }

@@ -71,7 +71,7 @@ struct Worker {
     uint32_t voxel;
     int layer;
     Vec3 normal, point, irradiance;
-    float photonCount, radius;
+    float photonCount, noise, radius;
     ClusterResult vdls;
     std::array<Vec3, layout::LO_SH_MAX_TERMS> sh;
   };
@@ -156,6 +156,7 @@ struct BakeBody {
       out.points[v] = layered ? found[0].point : grid.centroids[v];
       out.irradiance[v] = g.irradiance;
       out.photonCount[v] = float(g.photons.size());
+      out.noise[v] = g.noise;
       out.radius[v] = g.radius;
       out.angularError[v] = c.angularError;
       out.vdlCount[v] = uint8_t(c.count);
@@ -168,7 +169,7 @@ struct BakeBody {
         Clock::time_point t4 = Clock::now();
         Worker::Layer layer{uint32_t(v), l, w.gathered.normal, found[l].point,
                             w.gathered.irradiance, float(w.gathered.photons.size()),
-                            w.gathered.radius, ClusterResult{}, {}};
+                            w.gathered.noise, w.gathered.radius, ClusterResult{}, {}};
         layer.vdls = clusterGathered(w, stream + (uint64_t(l) << kCanonicalKeyBits), layer.sh.data());
         w.layers.push_back(layer);
         gatherSeconds += secondsBetween(t3, t4);
@@ -204,6 +205,7 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
   out.normals.assign(n, Vec3{});
   out.irradiance.assign(n, Vec3{});
   out.photonCount.assign(n, 0.0f);
+  out.noise.assign(n, 0.0f);
   out.radius.assign(n, 0.0f);
   out.angularError.assign(n, 0.0f);
   out.vdlCount.assign(n, 0);
@@ -252,6 +254,7 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
     L.points.push_back(e.point);
     L.irradiance.push_back(e.irradiance);
     L.photonCount.push_back(e.photonCount);
+    L.noise.push_back(e.noise);
     L.radius.push_back(e.radius);
     L.angularError.push_back(e.vdls.angularError);
     L.vdlCount.push_back(uint8_t(e.vdls.count));
@@ -269,6 +272,20 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
   return out;
 }
 
+namespace vdl_grid_internal {
+
+/// Correlation of two gather estimates whose discs of radius r lie d apart
+/// on one plane: the share of photons they have in common, the lens area of
+/// the two discs over one disc's area (a Poisson process shares exactly
+/// those photons).
+double discOverlap(double d, double r) {
+  if (!(r > 0) || d >= 2 * r) return 0.0;
+  const double a = 2 * r * r * std::acos(d / (2 * r)) - 0.5 * d * std::sqrt(4 * r * r - d * d);
+  return std::clamp(a / (kPi * r * r), 0.0, 1.0);
+}
+
+}  // namespace vdl_grid_internal
+
 size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& params) {
   const size_t n = out.size();
   LO_CHECK_EQ(grid.size(), n);
@@ -276,9 +293,23 @@ size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& 
   for (uint32_t v : out.layers.voxel) layered[v] = 1;
   const float h = out.frame.voxelSize;
   const float inv2s2 = 1.0f / (2.0f * params.sigmaVoxels * params.sigmaVoxels * h * h);
+  const bool hasNoise = out.noise.size() == n;
+  // A voxel's photon noise as a standard deviation of luminance: the
+  // recorded relative noise, else 1/sqrt(photons gathered).
+  auto sigmaOf = [&](size_t v, float y) {
+    if (hasNoise && out.noise[v] > 0) return out.noise[v] * y;
+    return out.photonCount[v] > 0 ? y / std::sqrt(out.photonCount[v]) : 0.0f;
+  };
   std::vector<Vec3> smoothed(out.irradiance);
+  std::vector<float> smoothedNoise(hasNoise ? out.noise : std::vector<float>());
   std::vector<char> changed(n, 0);
+  struct Member {
+    size_t voxel;
+    Vec3 point;
+    double weight, sigma;
+  };
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<Member> members;
     for (size_t v = r.begin(); v != r.end(); ++v) {
       if (layered[v] || !out.lit(v)) continue;
       const Vec3 nv = out.normals[v];
@@ -286,9 +317,11 @@ size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& 
       const Vec3 pv = out.points.empty() ? grid.centroids[v] : out.points[v];
       const float yv = luminance(out.irradiance[v]);
       if (!(yv > 0) || !(out.photonCount[v] > 0)) continue;
-      const float noise = params.rangeSigmas * yv / std::sqrt(out.photonCount[v]);
+      const float noise = params.rangeSigmas * sigmaOf(v, yv);
+      if (!(noise > 0)) continue;
       const float invNoise2 = 1.0f / (2.0f * noise * noise);
       double sum[3] = {0, 0, 0}, weight = 0;
+      members.clear();
       const Coord c = out.coords[v];
       for (int dz = -1; dz <= 1; ++dz) {
         for (int dy = -1; dy <= 1; ++dy) {
@@ -299,18 +332,38 @@ size_t smoothVdlGrid(const SurfaceGrid& grid, VdlGrid& out, const SmoothParams& 
             if (!(dot(out.normals[k], nv) > params.minCosine)) continue;
             const Vec3 pw = out.points.empty() ? grid.centroids[k] : out.points[k];
             if (std::fabs(dot(pw - pv, nv)) > params.planeVoxels * h) continue;
-            const float dy2 = luminance(out.irradiance[k]) - yv;
+            const float yk = luminance(out.irradiance[k]);
+            const float dy2 = yk - yv;
             const float wk = std::exp(-lengthSquared(pw - pv) * inv2s2 - dy2 * dy2 * invNoise2);
             for (int a = 0; a < 3; ++a) sum[a] += double(wk) * double(out.irradiance[k][a]);
             weight += double(wk);
+            members.push_back({k, pw, double(wk), double(sigmaOf(k, yk))});
           }
         }
       }
       if (!(weight > 0)) continue;
       smoothed[v] = Vec3{float(sum[0] / weight), float(sum[1] / weight), float(sum[2] / weight)};
       changed[v] = 1;
+      if (!hasNoise) continue;
+      // The weighted mean's variance: neighbouring gathers share photons,
+      // so each pair of estimates correlates by their discs' overlap.
+      double variance = 0;
+      for (const Member& a : members) {
+        for (const Member& b : members) {
+          const double rho =
+              a.voxel == b.voxel
+                  ? 1.0
+                  : vdl_grid_internal::discOverlap(
+                        double(length(a.point - b.point)),
+                        0.5 * (double(out.radius[a.voxel]) + double(out.radius[b.voxel])));
+          variance += a.weight * b.weight * a.sigma * b.sigma * rho;
+        }
+      }
+      const double y = double(luminance(smoothed[v]));
+      smoothedNoise[v] = y > 0 ? float(std::sqrt(variance) / weight / y) : 0.0f;
     }
   });
+  if (hasNoise) out.noise = std::move(smoothedNoise);
   size_t count = 0;
   for (size_t v = 0; v < n; ++v) {
     if (!changed[v]) continue;

@@ -584,6 +584,10 @@ class RankBake {
 
 BakeResult distributedBake(const Scene& scene, const BakeParams& requested, const TileParams& tiles,
                            Communicator& comm, ProgressSink* progress, DistributedStats* stats) {
+  if (requested.targetError > 0) {
+    throw InputError("--target-error: the distributed bake (mpirun) traces a fixed photon "
+                     "budget; give --photons");
+  }
   const BakeParams params = checkedBakeParams(scene, requested, comm.size());
   if (params.keepPhotons) {
     throw InputError(

@@ -303,14 +303,18 @@ void gatherWith(const SurfaceGrid& grid, const std::vector<Photon>& photons,
   if (!(rk > 0)) rk = radius;
 
   out.photons.resize(keys.size());
-  double power[3] = {0, 0, 0};
+  double power[3] = {0, 0, 0}, y = 0, y2 = 0;
   for (size_t i = 0; i < keys.size(); ++i) {
     const uint32_t p = uint32_t(keys[i]);
     out.photons[i] = p;
     power[0] += photons[p].power.x;
     power[1] += photons[p].power.y;
     power[2] += photons[p].power.z;
+    const double yp = double(luminance(photons[p].power));
+    y += yp;
+    y2 += yp * yp;
   }
+  out.noise = relativeNoise(y, y2);
   // Edge correction: the disc's share on the surface (at least a quarter,
   // so that a stray estimate cannot blow up).
   const double coverage =

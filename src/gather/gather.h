@@ -3,6 +3,7 @@
 /// @brief KNN filtering per voxel (paper §3.1.1): the k nearest photons within
 /// radius r, distances measured in an ellipsoid aligned with the voxel normal.
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -96,7 +97,18 @@ struct GatherResult {
   Vec3 irradiance{0, 0, 0};  ///< sum(power) / (pi r_k^2 coverage), W/m^2
   /// Share of the disc pi r_k^2 on the surface (GatherParams::edgeCorrection), else 1.
   float coverage = 1.0f;
+  /// The estimate's relative standard error, sqrt(sum y_i^2) / sum y_i over
+  /// the gathered photons' luminances y_i: photons arriving as a Poisson
+  /// process whose powers vary (1/sqrt(n) for equal powers). 0 without
+  /// photons. What it leaves out: the blur of the disc (bias) and the
+  /// correlation of photons from one path.
+  float noise = 0.0f;
 };
+
+/// GatherResult::noise of photon luminances summed as `sum` and their squares as `sumSquares`.
+inline float relativeNoise(double sum, double sumSquares) {
+  return sum > 0 ? float(std::sqrt(sumSquares) / sum) : 0.0f;
+}
 
 /// The photons of a surface grid's bins, copied contiguously in bin order
 /// (grid.binPhotons order: bin v is entries[grid.binStart[v] ..

@@ -41,6 +41,12 @@ struct LightGridVoxels {
   std::vector<float> areas;         ///< geometry area in the voxel, world units^2
   std::vector<Vec3> irradiance;     ///< total RGB irradiance, W/m^2
   std::vector<float> photonCount;   ///< photons gathered for the estimate
+  /// The estimate's photon noise: its relative standard error (standard
+  /// deviation / luminance of `irradiance`), from the gathered photons'
+  /// powers and carried through smoothing and resampling
+  /// (docs/accuracy.md, "How good is a bake"); 0 where nothing was gathered
+  /// or the file does not record it.
+  std::vector<float> noise;
   std::vector<float> radius;        ///< r_k reached, world units
 
   size_t size() const { return coords.size(); }
@@ -63,6 +69,7 @@ struct VdlLayers {
   std::vector<Vec3> points;       ///< a point of the layer's surface, world space
   std::vector<Vec3> irradiance;   ///< W/m^2, the sum of the layer's VDLs
   std::vector<float> photonCount;
+  std::vector<float> noise;
   std::vector<float> radius;
   std::vector<float> angularError;
   std::vector<uint8_t> vdlCount;

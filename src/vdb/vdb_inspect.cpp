@@ -372,6 +372,10 @@ class VdlChecker {
     }
     add("readable", true, "render, convert and the sweep read it");
     for (const VdbCheck& c : checkLightGridValues(loaded.grid, loaded.halfFloat)) r_.checks.push_back(c);
+    const std::vector<std::string>& absent = loaded.absentGrids;
+    if (std::find(absent.begin(), absent.end(), "noise") == absent.end()) {
+      r_.noise = summarizeNoise(loaded.grid);
+    }
   }
 
   const OpenedFile& f_;

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "lightgrid/grid_noise.h"
 #include "vdb/vdb_io.h"
 
 namespace lo {
@@ -38,6 +39,9 @@ struct VdbReport {
   std::vector<std::pair<std::string, std::string>> metadata;  ///< file metadata as text
   std::vector<GridSummary> grids;
   std::vector<VdbCheck> checks;
+  /// The bake's noise figure (summarizeNoise) of a readable VDL file with
+  /// a `noise` grid; not recorded otherwise.
+  NoiseSummary noise;
 
   bool ok() const {
     for (const VdbCheck& c : checks) {

@@ -6,6 +6,7 @@
 
 #include "test_util.h"
 #include "cluster/vdl_cluster.h"
+#include "lightgrid/light_grid_schema.h"
 #include "core/error.h"
 #include "core/rng.h"
 
@@ -119,6 +120,56 @@ TEST(VdlGrid, RejectsBadVdlCount) {
 namespace lo {
 namespace {
 
+// Smoothing averages a voxel with its neighbours, whose gathers share
+// photons where their discs overlap: with discs too small to overlap the
+// noise falls as for independent estimates (sqrt(sum w^2) / sum w, at most
+// that of the 3x3 in-plane neighbourhood: 0.354), with discs far larger
+// than the voxels (every photon shared) it does not fall at all.
+TEST(Smoothing, NoiseFallsByWhatTheNeighboursDoNotShare) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0.01f, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  GridParams gp;
+  gp.depth = 4;
+  const SurfaceGrid grid = buildSurfaceGrid(scene, gp);
+  const size_t n = grid.size();
+  VdlGrid g;
+  g.frame = grid.frame;
+  g.maxVdls = 1;
+  g.coords = grid.coords;
+  resizeVoxelArrays(g);
+  g.normals = grid.normals;
+  g.points = grid.centroids;
+  g.areas = grid.areas;
+  for (size_t v = 0; v < n; ++v) {
+    g.irradiance[v] = Vec3(1.0f);
+    g.vdls[v] = Vdl{Vec3(1.0f), {0, 1, 0}};
+    g.vdlCount[v] = 1;
+    g.photonCount[v] = 100;
+    g.noise[v] = 0.1f;
+  }
+  // An interior voxel of the plane.
+  size_t middle = n;
+  for (size_t v = 0; v < n; ++v) {
+    const Vec3 c = grid.centroids[v];
+    if (std::fabs(c.x - 0.5f) < 0.07f && std::fabs(c.z - 0.5f) < 0.07f) middle = v;
+  }
+  ASSERT_LT(middle, n);
+  const float h = grid.frame.voxelSize;
+  VdlGrid apart = g, shared = g;
+  std::fill(apart.radius.begin(), apart.radius.end(), 1e-3f * h);
+  std::fill(shared.radius.begin(), shared.radius.end(), 1e4f * h);
+  smoothVdlGrid(grid, apart);
+  smoothVdlGrid(grid, shared);
+  const double w1 = std::exp(-0.5), w2 = std::exp(-1.0);
+  const double independent9 =
+      0.1 * std::sqrt(1 + 4 * w1 * w1 + 4 * w2 * w2) / (1 + 4 * w1 + 4 * w2);
+  EXPECT_LE(apart.noise[middle], independent9 * 1.001);
+  EXPECT_GT(apart.noise[middle], 0.1 / std::sqrt(27.0));
+  EXPECT_NEAR(shared.noise[middle], 0.1, 1e-3);
+  EXPECT_EQ(apart.irradiance[middle], Vec3(1.0f));
+}
+
 // Layer-aware smoothing (smoothVdlGrid) on a floor and a wall meeting at an
 // edge, with made-up estimates: on the floor a uniform light with 8% noise
 // around a shadow step of 5x; the wall a different level. Smoothing shrinks
@@ -173,6 +224,7 @@ TEST(Smoothing, ShrinksNoiseKeepsStepsAndSurfaces) {
     g.layers.irradiance.push_back(Vec3(3.0f));
     g.layers.photonCount.push_back(150);
     g.layers.radius.push_back(0.05f);
+    g.layers.noise.push_back(0.08f);
     g.layers.angularError.push_back(0);
     g.layers.vdlCount.push_back(0);
     g.layers.vdls.resize(g.layers.vdls.size() + 2);

@@ -296,6 +296,8 @@ TEST(Gather, UniformPlaneIrradiance) {
     g.gather(v, res);
     ASSERT_EQ(res.photons.size(), size_t(params.k));
     ASSERT_LT(res.radius, r);
+    // Equal powers: the relative standard error is 1/sqrt(photons).
+    EXPECT_NEAR(res.noise, 1.0f / std::sqrt(float(params.k)), 1e-5f);
     for (int ch = 0; ch < 3; ++ch) {
       EXPECT_NEAR(res.irradiance[ch] / expected[ch], 1.0f, tol) << grid.coords[v].ToString();
     }
@@ -345,6 +347,14 @@ TEST(Gather, FewerThanKUsesTheSearchRadius) {
     }
     EXPECT_NEAR(res.irradiance.x, power / (kPi * r * r * res.coverage),
                 1e-4 * power / (r * r) + 1e-9);
+    // The noise from the gathered photons' luminances, sqrt(sum y^2) / sum y.
+    double y = 0, y2 = 0;
+    for (uint32_t i : res.photons) {
+      const double yi = luminance(photons[i].power);
+      y += yi;
+      y2 += yi * yi;
+    }
+    EXPECT_NEAR(res.noise, within > 0 ? std::sqrt(y2) / y : 0.0, 1e-5);
   }
 }
 

@@ -165,7 +165,7 @@ TEST(LightgridSchema, TheTableIsConsistent) {
     }
   });
   EXPECT_EQ(optionalVdlGridNames(),
-            (std::vector<std::string>{"photon_count", "angular_error", "radius", "area"}));
+            (std::vector<std::string>{"photon_count", "noise", "angular_error", "radius", "area"}));
 }
 
 TEST(LightgridSchema, ResizingSatisfiesTheArrayChecks) {

@@ -39,6 +39,7 @@ VdlGrid floorGrid(int depth, const Vec3& direction, LightFn light) {
       g.irradiance.push_back(e);
       g.photonCount.push_back(300);
       g.radius.push_back(kVoxel);
+      g.noise.push_back(0.05f);
       g.angularError.push_back(0);
       g.vdlCount.push_back(e.x > 0 ? 1 : 0);
       for (int i = 0; i < g.maxVdls; ++i) {
@@ -147,6 +148,7 @@ TEST(AdaptiveLeaves, LayersAndDarkVoxelsAreNeverCovered) {
   L.irradiance.push_back({1, 1, 1});
   L.photonCount.push_back(100);
   L.radius.push_back(kVoxel);
+  L.noise.push_back(0.05f);
   L.angularError.push_back(0);
   L.vdlCount.push_back(1);
   for (int i = 0; i < g.maxVdls; ++i) L.vdls.push_back(i == 0 ? Vdl{{1, 1, 1}, {0, 0, -1}} : Vdl{});

@@ -350,6 +350,7 @@ TEST(OctreeLayers, EachSurfaceOfAVoxelGetsItsOwnLayer) {
   g.layers.irradiance = {b.irradiance};
   g.layers.photonCount = {10};
   g.layers.radius = {0.1f};
+  g.layers.noise = {0.1f};
   g.layers.angularError = {0};
   g.layers.vdlCount = {1};
   g.layers.vdls = {b, Vdl{}};

@@ -137,6 +137,7 @@ VdlGrid shSlab(int terms, float power) {
       g.irradiance.push_back(sample.value);
       g.photonCount.push_back(1);
       g.radius.push_back(0.3f);
+      g.noise.push_back(0.05f);
       g.angularError.push_back(0);
       g.vdlCount.push_back(0);
       for (int i = 0; i < g.maxVdls; ++i) g.vdls.push_back(Vdl{});

@@ -44,6 +44,7 @@ VdlGrid floorGrid(int maxVdls = 3) {
       g.areas.push_back(0.0625f * 0.0625f * (0.5f + rng.uniform()));
       g.photonCount.push_back(float(100 + rng.uniformInt(200)));
       g.radius.push_back(0.2f);
+      g.noise.push_back(0.04f);
       g.angularError.push_back(0.2f * rng.uniform());
       const uint8_t count = uint8_t(1 + rng.uniformInt(uint32_t(maxVdls)));
       g.vdlCount.push_back(count);
@@ -136,10 +137,10 @@ TEST(OptionalGrids, DroppedGridsReadAsZero) {
   std::string dir = test::outputDir("Convert.Drop");
   VdlGrid g = floorGrid();
   VdlWriteOptions opt;
-  opt.drop = {"angular_error", "photon_count", "radius", "area"};
+  opt.drop = {"angular_error", "photon_count", "noise", "radius", "area"};
   writeVdlGrid(dir + "/d.vdb", g, meta(), opt);
   LoadedVdl d = readVdlGrid(dir + "/d.vdb");
-  EXPECT_EQ(d.absentGrids.size(), 4u);
+  EXPECT_EQ(d.absentGrids.size(), 5u);
   EXPECT_EQ(d.grid.irradiance, g.irradiance);
   EXPECT_EQ(d.grid.coords, g.coords);
   for (size_t v = 0; v < g.size(); ++v) {
@@ -201,7 +202,7 @@ TEST(Inspect, GoodFileReportsGridsAndPasses) {
   VdbReport r = inspectVdb(dir + "/g.vdb");
   EXPECT_EQ(r.kind, "vdl");
   EXPECT_TRUE(r.ok());
-  ASSERT_EQ(r.grids.size(), 7u + 2u * 2u);
+  ASSERT_EQ(r.grids.size(), 8u + 2u * 2u);
   // VDL grids are active where the voxel has that VDL (sparse).
   size_t withTwo = 0;
   for (size_t v = 0; v < g.size(); ++v) withTwo += g.vdlCount[v] > 1;

@@ -57,6 +57,7 @@ VdlGrid makeGrid(size_t voxels, int maxVdls, uint64_t seed) {
     g.areas.push_back(rng.uniform() * 0.01f);
     g.photonCount.push_back(float(rng.uniformInt(301)));
     g.radius.push_back(rng.uniform() * 0.1f);
+    g.noise.push_back(rng.uniform() * 0.2f);
     g.angularError.push_back(rng.uniform() * 0.5f);
     uint8_t count = uint8_t(rng.uniformInt(uint32_t(maxVdls) + 1));
     g.vdlCount.push_back(count);
