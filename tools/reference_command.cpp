@@ -28,6 +28,7 @@ struct ReferenceOptions {
   SceneOptions sceneOptions;  // --sky
   std::string output;
   std::string stdErrorOutput;
+  std::string emitterMaskOutput;
   CameraOptions camera;
   int width = 800, height = 600;  // as `render`, so that the images compare pixel for pixel
   int spp = 64;
@@ -51,7 +52,10 @@ void checkImageOutput(const std::string& path, const char* flag) {
 int runReference(const ReferenceOptions& opt) {
   checkImageOutput(opt.output, "--output");
   if (!opt.stdErrorOutput.empty()) checkImageOutput(opt.stdErrorOutput, "--std-error");
-  checkDistinctFiles({{"--output", opt.output}, {"--std-error", opt.stdErrorOutput}},
+  if (!opt.emitterMaskOutput.empty()) checkImageOutput(opt.emitterMaskOutput, "--emitter-mask");
+  checkDistinctFiles({{"--output", opt.output},
+                      {"--std-error", opt.stdErrorOutput},
+                      {"--emitter-mask", opt.emitterMaskOutput}},
                      {{"SCENE", opt.scene}});
   checkCameraOptions(opt.camera);
   ThreadLimit threadLimit(opt.threads);
@@ -92,6 +96,7 @@ int runReference(const ReferenceOptions& opt) {
   ReferenceImage result = renderReference(scene, camera, params, &progress);
   writeImage(opt.output, result.image, opt.exposure);
   if (!opt.stdErrorOutput.empty()) writeImage(opt.stdErrorOutput, result.stdError);
+  if (!opt.emitterMaskOutput.empty()) writeImage(opt.emitterMaskOutput, result.emitterMask);
 
   if (!opt.quiet) {
     // The mean standard error relative to the mean value: how far the
@@ -171,6 +176,11 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--std-error", opt->stdErrorOutput,
                   "Also write the per-pixel standard error of the mean (.exr or .png)");
+  cmd->add_option("--emitter-mask", opt->emitterMaskOutput,
+                  "Also write a mask for `compare --mask` (.png or .exr): white where the "
+                  "pixel's centre sees no emissive surface, black on the light fixtures, whose "
+                  "own pixels the octree and the path tracer define differently")
+      ->check(CLI::NonexistentPath | CLI::ExistingFile);
   cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runReference(*opt) : -1; };
 }

@@ -502,6 +502,21 @@ ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
       result.stdError.rgb[3 * i + c] = float(std::sqrt(var / n));
     }
   }
+  result.emitterMask = RgbImage(params.width, params.height);
+  for (int y = 0; y < params.height; ++y) {
+    for (int x = 0; x < params.width; ++x) {
+      const float sx = (2.0f * (float(x) + 0.5f) / float(params.width) - 1.0f) * body.tanHalf *
+                       body.aspect;
+      const float sy = (1.0f - 2.0f * (float(y) + 0.5f) / float(params.height)) * body.tanHalf;
+      const Vec3 dir = normalize(camera.forward + body.right * sx + camera.up * sy);
+      Hit seen;
+      const bool emitter =
+          tracer.intersectFromCamera(camera.eye, dir, seen) &&
+          scene.materials[size_t(scene.triangleMaterial[seen.triangle])].isEmissive();
+      const size_t i = size_t(y) * size_t(params.width) + size_t(x);
+      for (int c = 0; c < 3; ++c) result.emitterMask.rgb[3 * i + c] = emitter ? 0.0f : 1.0f;
+    }
+  }
   result.raysTraced = rays.load();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

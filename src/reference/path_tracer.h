@@ -60,6 +60,11 @@ struct ReferenceParams {
 struct ReferenceImage {
   RgbImage image;     ///< the mean over samples
   RgbImage stdError;  ///< per pixel and channel: standard error of that mean
+  /// 1 where the ray through the pixel's centre meets no emissive surface,
+  /// 0 where it does (`reference --emitter-mask`, for `compare --mask`: the
+  /// octree and the path tracer define irradiance differently on a light
+  /// fixture's own pixels, docs/accuracy.md).
+  RgbImage emitterMask;
   int samplesPerPixel = 0;
   double seconds = 0;      ///< wall-clock rendering time
   uint64_t raysTraced = 0; ///< closest-hit plus shadow rays

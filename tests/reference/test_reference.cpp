@@ -180,6 +180,56 @@ TEST(Reference, FurnaceParts) {
   expectMean(renderFurnace(ReferencePart::Irradiance), kPi, "irradiance");
 }
 
+// The emitter mask is 0 exactly on the light fixture's pixels: there the
+// direct part (the emission seen) is far brighter than anywhere the mask
+// keeps, and the mask keeps most of the picture.
+TEST(Reference, EmitterMaskMarksTheLightFixture) {
+  Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
+  ReferenceParams params;
+  params.width = 64;
+  params.height = 48;
+  params.samplesPerPixel = 2;
+  params.part = ReferencePart::Direct;
+  const ReferenceImage direct =
+      renderReference(scene, PinholeCamera::fromScene(scene.cameras.at(0)), params);
+  const RgbImage& mask = direct.emitterMask;
+  ASSERT_EQ(mask.width, params.width);
+  ASSERT_EQ(mask.height, params.height);
+  // Pixels at the fixture's border are partly on it (the mask asks the
+  // pixel's centre, the image averages jittered samples): compared are the
+  // masked pixels and the kept ones with no masked neighbour.
+  auto maskAt = [&](int x, int y) {
+    x = std::clamp(x, 0, mask.width - 1);
+    y = std::clamp(y, 0, mask.height - 1);
+    return mask.rgb[3 * (size_t(y) * size_t(mask.width) + size_t(x))];
+  };
+  size_t masked = 0;
+  float sumMasked = 0, brightestKept = 0;
+  for (int y = 0; y < mask.height; ++y) {
+    for (int x = 0; x < mask.width; ++x) {
+      const size_t i = size_t(y) * size_t(mask.width) + size_t(x);
+      const float m = mask.rgb[3 * i];
+      ASSERT_TRUE(m == 0.0f || m == 1.0f);
+      const float lum = luminance(Vec3{direct.image.rgb[3 * i], direct.image.rgb[3 * i + 1],
+                                       direct.image.rgb[3 * i + 2]});
+      bool nearMasked = false;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) nearMasked = nearMasked || maskAt(x + dx, y + dy) == 0;
+      }
+      if (m == 0.0f) {
+        ++masked;
+        sumMasked += lum;
+      } else if (!nearMasked) {
+        brightestKept = std::max(brightestKept, lum);
+      }
+    }
+  }
+  const float meanMasked = masked > 0 ? sumMasked / float(masked) : 0.0f;
+  EXPECT_GT(masked, 4u);
+  EXPECT_LT(masked, size_t(mask.width) * size_t(mask.height) / 10);
+  EXPECT_GT(meanMasked, brightestKept);
+}
+
 TEST(Reference, DirectPlusIndirectIsFull) {
   Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
   ReferenceParams params;
