@@ -19,6 +19,7 @@ struct CompareOptions {
   std::string test;
   std::string reference;
   std::string mask;
+  std::string referenceError;
   bool ignoreBackground = false;
   int bin = 1;
   std::string diff;
@@ -40,7 +41,10 @@ int runCompare(const CompareOptions& opt) {
   }
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
   checkDistinctFiles({{"--diff", opt.diff}, {"--json", opt.json}},
-                     {{"TEST", opt.test}, {"REFERENCE", opt.reference}, {"--mask", opt.mask}});
+                     {{"TEST", opt.test},
+                      {"REFERENCE", opt.reference},
+                      {"--mask", opt.mask},
+                      {"--reference-error", opt.referenceError}});
   RgbImage test = readImage(opt.test);
   RgbImage reference = readImage(opt.reference);
   RgbImage mask;
@@ -61,18 +65,41 @@ int runCompare(const CompareOptions& opt) {
                      std::to_string(mask.height) + ", the images are " +
                      std::to_string(reference.width) + " x " + std::to_string(reference.height));
   }
+  RgbImage stdError;
+  if (!opt.referenceError.empty()) {
+    stdError = readImage(opt.referenceError);
+    if (stdError.width != reference.width || stdError.height != reference.height) {
+      throw InputError("--reference-error: " + opt.referenceError + " is " +
+                       std::to_string(stdError.width) + " x " + std::to_string(stdError.height) +
+                       ", the images are " + std::to_string(reference.width) + " x " +
+                       std::to_string(reference.height));
+    }
+  }
   if (opt.bin > 1) {
     test = binImage(test, opt.bin);
     reference = binImage(reference, opt.bin);
     if (params.mask) mask = binMask(mask, opt.bin);
+    if (!stdError.rgb.empty()) stdError = binStdError(stdError, opt.bin);
   }
   CompareResult result = compareImages(test, reference, params);
+  const double noise = stdError.rgb.empty() ? -1.0 : referenceNoise(reference, stdError, params);
   if (!opt.quiet) {
     std::printf("%s against %s%s\n%s\n", opt.test.c_str(), opt.reference.c_str(),
                 opt.bin > 1 ? (", binned " + std::to_string(opt.bin) + "x" +
                                std::to_string(opt.bin)).c_str()
                             : "",
                 result.ToString().c_str());
+    if (noise >= 0) {
+      std::printf("reference noise: %.3g relative RMS standard error of Y over the same pixels%s\n",
+                  noise, opt.bin > 1 ? " and bins" : "");
+    }
+  }
+  if (noise >= 0 && noise >= result.luminance.relRmse) {
+    std::fprintf(stderr,
+                 "warning: the reference's own noise (%.3g) is at or above the difference "
+                 "measured (Y rel. RMSE %.3g): the reference cannot tell the images apart; "
+                 "render it with more samples or compare over larger --bin blocks\n",
+                 noise, result.luminance.relRmse);
   }
   if (!opt.diff.empty()) {
     // Linear float values in an EXR; PNG keeps the false colour as it is.
@@ -96,6 +123,7 @@ int runCompare(const CompareOptions& opt) {
     j["max_error_pixel"] = {result.maxErrorX, result.maxErrorY};
     j["mean_reference_luminance"] = result.meanReferenceLuminance;
     j["mean_test_luminance"] = result.meanTestLuminance;
+    j["reference_noise"] = noise >= 0 ? nlohmann::json(noise) : nlohmann::json(nullptr);
     writeTextAtomically(opt.json, j.dump(2) + "\n");
     if (!opt.quiet) std::printf("wrote %s\n", opt.json.c_str());
   }
@@ -118,6 +146,11 @@ std::function<int()> addCompareCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--mask", opt->mask,
                   "Image of the same size; pixels that are 0 in every channel are left out")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--reference-error", opt->referenceError,
+                  "The reference's per-pixel standard error (`reference --std-error`): prints "
+                  "its noise over the compared pixels (binned with --bin), the floor under the "
+                  "error, and warns when the error measured is not above it")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--ignore-background", opt->ignoreBackground,
                 "Leave out pixels where the reference is exactly black");

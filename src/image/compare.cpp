@@ -110,6 +110,38 @@ RgbImage binMask(const RgbImage& mask, int bin) {
   return binWith(selection, bin, 1.0f, [](double a, double v) { return std::min(a, v); }, false);
 }
 
+RgbImage binStdError(const RgbImage& stdError, int bin) {
+  RgbImage squared = stdError;
+  for (float& v : squared.rgb) v *= v;
+  // Sums of squares per block, then sqrt(sum) / n.
+  RgbImage out = binWith(squared, bin, 0.0f, [](double a, double v) { return a + v; }, false);
+  for (int by = 0; by < out.height; ++by) {
+    for (int bx = 0; bx < out.width; ++bx) {
+      const int nx = std::min(stdError.width, (bx + 1) * bin) - bx * bin;
+      const int ny = std::min(stdError.height, (by + 1) * bin) - by * bin;
+      const float n = float(nx * ny);
+      float* p = out.rgb.data() + (size_t(by) * size_t(out.width) + size_t(bx)) * 3;
+      for (int c = 0; c < 3; ++c) p[c] = std::sqrt(p[c]) / n;
+    }
+  }
+  return out;
+}
+
+double referenceNoise(const RgbImage& reference, const RgbImage& stdError,
+                      const CompareParams& params) {
+  checkSizes(stdError, reference, params);
+  double se2 = 0, y2 = 0;
+  for (size_t i = 0; i < reference.pixelCount(); ++i) {
+    if (pixelUse(stdError, reference, params, i) != PixelUse::Compare) continue;
+    const Vec3 s = stdError.at(i);
+    const double se = 0.2126 * s.x + 0.7152 * s.y + 0.0722 * s.z;
+    const double y = luminance(reference.at(i));
+    se2 += se * se;
+    y2 += y * y;
+  }
+  return y2 > 0 ? std::sqrt(se2 / y2) : 0.0;
+}
+
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
                             const CompareParams& params) {
   checkSizes(test, reference, params);

@@ -55,6 +55,21 @@ RgbImage binImage(const RgbImage& image, int bin);
 /// A mask binned like binImage: a block is selected when every pixel of it is.
 RgbImage binMask(const RgbImage& mask, int bin);
 
+/// Per-pixel standard errors binned as binImage bins values: the standard
+/// error of each block's mean, sqrt(sum se^2) / n (pixels independent).
+RgbImage binStdError(const RgbImage& stdError, int bin);
+
+/// The reference's own noise as compareImages' luminance relative RMSE
+/// counts an error: sqrt(sum_P se_Y^2 / sum_P Y^2) over the pixels P that
+/// `params` compares, se_Y = 0.2126 se_R + 0.7152 se_G + 0.0722 se_B (the
+/// channels of one path correlate, so this bounds the luminance's error).
+/// `stdError` is the reference's per-pixel standard error (`reference
+/// --std-error`), binned alike when the images are. A measured error at or
+/// below it says nothing the reference can tell apart from its own noise.
+/// @throws InputError if the sizes differ.
+double referenceNoise(const RgbImage& reference, const RgbImage& stdError,
+                      const CompareParams& params = {});
+
 /// @throws InputError if the sizes (or the mask's) differ or an image is empty.
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
                             const CompareParams& params = {});

@@ -33,20 +33,13 @@ namespace lo {
 namespace sweep_internal {
 namespace {
 
-/// Luminance standard error relative to the reference's RMS luminance: the
-/// noise floor of any relative RMSE measured against it. Channels of one
-/// path are correlated, so the luminance error is bounded by the weighted sum.
-double relativeNoise(const ReferenceImage& ref) {
-  double se2 = 0, y2 = 0;
-  for (size_t i = 0; i < ref.image.pixelCount(); ++i) {
-    const Vec3 v = ref.image.at(i), s = ref.stdError.at(i);
-    const double y = 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
-    const double se = 0.2126 * s.x + 0.7152 * s.y + 0.0722 * s.z;
-    if (v.x == 0 && v.y == 0 && v.z == 0) continue;  // background, left out as in compare
-    se2 += se * se;
-    y2 += y * y;
-  }
-  return y2 > 0 ? std::sqrt(se2 / y2) : 0.0;
+/// What every error of the sweep compares: the pixels that see the scene
+/// and no light fixture.
+CompareParams sweepCompareParams(const RgbImage& emitterMask) {
+  CompareParams p;
+  p.ignoreBackground = true;
+  p.mask = &emitterMask;
+  return p;
 }
 
 /// Path-traced references, cached in cacheDir with the settings they were
@@ -67,22 +60,29 @@ References loadOrRenderReferences(const SweepParams& params, const Scene& scene,
   rp.part = ReferencePart::Irradiance;
   ReferenceImage irr = renderReference(scene, camera, rp, params.progress);
   refs.irradiance = irr.image;
-  refs.irradianceNoise = relativeNoise(irr);
+  refs.emitterMask = irr.emitterMask;
+  const CompareParams compared = sweepCompareParams(refs.emitterMask);
+  refs.irradianceNoise = referenceNoise(irr.image, irr.stdError, compared);
+  const RgbImage binnedMask = binMask(refs.emitterMask, kSweepBin);
+  refs.irradianceBinnedNoise =
+      referenceNoise(binImage(irr.image, kSweepBin), binStdError(irr.stdError, kSweepBin),
+                     sweepCompareParams(binnedMask));
   refs.seconds = irr.seconds;
   if (params.frames > 0) {
     rp.part = ReferencePart::Indirect;
     ReferenceImage ind = renderReference(scene, camera, rp, params.progress);
     refs.indirect = ind.image;
-    refs.indirectNoise = relativeNoise(ind);
+    refs.indirectNoise = referenceNoise(ind.image, ind.stdError, compared);
     refs.seconds += ind.seconds;
   }
   cache.storeReferences(refs);
   if (log) {
     std::fprintf(log,
                  "reference: %d x %d, %d spp, %.1f s; noise (rel. RMS std. error) "
-                 "irradiance %.2f%%, indirect %.2f%%\n",
+                 "irradiance %.2f%% (%.2f%% over %dx%d bins), indirect %.2f%%\n",
                  params.width, params.height, params.referenceSpp, refs.seconds,
-                 100 * refs.irradianceNoise, 100 * refs.indirectNoise);
+                 100 * refs.irradianceNoise, 100 * refs.irradianceBinnedNoise, kSweepBin,
+                 kSweepBin, 100 * refs.indirectNoise);
   }
   return refs;
 }
@@ -92,6 +92,7 @@ BakeParams bakeParamsOf(const SweepPoint& point, const Scene& scene, uint64_t se
   BakeParams b;
   b.depth = point.depth;
   b.photons = point.photons;
+  b.targetError = point.targetError;
   b.knn = point.knn;
   b.vdls = parseVdlCount(point.vdls, "sweep point --vdls");
   b.seed = seed;
@@ -132,6 +133,8 @@ BakeFigures bakeAndWrite(const Scene& scene, const std::string& scenePath, const
   f.vdbBytes = double(fs::file_size(vdb));
   f.activeVoxels = double(st.level.activeVoxels);
   f.denseVoxels = double(st.denseVoxels);
+  f.storedPhotons = double(st.storedPhotons);
+  f.noiseFigure = st.noise.recorded ? st.noise.quantile : -1.0;
   return f;
 }
 
@@ -181,8 +184,10 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
                                      ? PinholeCamera::framing(scene.bounds(), kPi / 4)
                                      : PinholeCamera::fromScene(scene.cameras.front());
   const References refs = loadOrRenderReferences(params, scene, camera, cache, log);
-  CompareParams compareParams;
-  compareParams.ignoreBackground = true;
+  const CompareParams compareParams = sweepCompareParams(refs.emitterMask);
+  const RgbImage binnedMask = binMask(refs.emitterMask, kSweepBin);
+  const RgbImage binnedReference = binImage(refs.irradiance, kSweepBin);
+  const CompareParams binnedParams = sweepCompareParams(binnedMask);
 
   const std::vector<SweepPoint> points =
       params.points.empty() ? sweepPoints(params.scale) : params.points;
@@ -220,6 +225,8 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     r.vdbBytes = figures.vdbBytes;
     r.activeVoxels = figures.activeVoxels;
     r.denseVoxels = figures.denseVoxels;
+    r.storedPhotons = figures.storedPhotons;
+    r.noiseFigure = figures.noiseFigure;
     // The octree's irradiance at the reference's first hits.
     const LoadedVdl baked = readVdlGrid(vdb);
     GpuOctreeParams octreeParams;
@@ -251,6 +258,9 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     const CompareResult irrError = compareImages(irradiance, refs.irradiance, compareParams);
     r.irradianceRelRmse = irrError.luminance.relRmse;
     r.irradianceRelMae = irrError.luminance.relMae;
+    r.irradianceBinnedRelRmse =
+        compareImages(binImage(irradiance, kSweepBin), binnedReference, binnedParams)
+            .luminance.relRmse;
     // The indirect image through the GL renderer, and its frame time.
     if (params.frames > 0) {
       const RgbImage indirect =
@@ -271,10 +281,11 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
   for (SweepResult& r : results) {
     r.referenceIrradianceNoise = refs.irradianceNoise;
     r.referenceIndirectNoise = refs.indirectNoise;
+    r.referenceIrradianceBinnedNoise = refs.irradianceBinnedNoise;
   }
   markParetoFronts(results);
 
-  writeSweepPictures(params, results, refs.irradiance, cache);
+  writeSweepPictures(params, results, refs.irradiance, refs.emitterMask, cache);
   return results;
 }
 

@@ -39,6 +39,9 @@ struct SweepPoint {
   bool smoothing = BakeParams{}.smoothing;  ///< BakeParams::smoothing
   std::string representation = "vdl";     ///< BakeParams::representation: "vdl", "sh1", "sh2"
   float tolerance = 0.0f;  ///< GpuOctreeParams::tolerance (adaptive leaves; 0 = uniform tree)
+  /// BakeParams::targetError: > 0 bakes to this noise figure (photons and
+  /// knn then follow from it; `photons` is ignored).
+  double targetError = 0;
 
   /// Short human label, e.g. "d6 600k k300 r1.5 v4" (+ " no-interp", " half",
   /// " paper-cosine", " no-layers", " no-occlusion", " no-edge", " smooth",
@@ -76,15 +79,20 @@ struct SweepResult {
   double vdbBytes = 0;      ///< the .vdb file
   double gpuBytes = 0;      ///< octree pool + VDL texture as uploaded
   double activeVoxels = 0, denseVoxels = 0;
+  double storedPhotons = 0;  ///< photons the bake stored (a target bake's last pass)
+  double noiseFigure = -1;   ///< the bake's noise figure (NoiseSummary::quantile); < 0: none
   double vdlTexels = 0;  ///< VDLs stored in the GPU texture
   double gpuLeaves = -1;  ///< leaves of the GPU octree (< 0: not recorded)
   double frameMs = -1;   ///< OSMesa frame time, indirect mode; < 0: not measured
   // Errors against the references (luminance; relative RMSE and MAE).
   double irradianceRelRmse = 0, irradianceRelMae = 0;
+  /// The same over kSweepBin x kSweepBin bins (the fronts' error).
+  double irradianceBinnedRelRmse = 0;
   double indirectRelRmse = -1;  ///< < 0: not measured
   /// The references' own noise (relative RMS standard error of luminance):
   /// the floor under the two errors above.
   double referenceIrradianceNoise = 0, referenceIndirectNoise = 0;
+  double referenceIrradianceBinnedNoise = 0;  ///< over the bins
   bool paretoTime = false;    ///< on the front of irradiance error vs bake time
   bool paretoMemory = false;  ///< on the front of irradiance error vs GPU bytes
 };

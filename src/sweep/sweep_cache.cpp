@@ -45,10 +45,13 @@ nlohmann::json resultJson(const SweepResult& r) {
           {"active_voxels", r.activeVoxels},
           {"dense_voxels", r.denseVoxels},
           {"vdl_texels", r.vdlTexels},
+          {"stored_photons", r.storedPhotons},
+          {"noise_figure", r.noiseFigure},
           {"gpu_leaves", r.gpuLeaves},
           {"frame_ms", r.frameMs},
           {"irradiance_rel_rmse", r.irradianceRelRmse},
           {"irradiance_rel_mae", r.irradianceRelMae},
+          {"irradiance_binned_rel_rmse", r.irradianceBinnedRelRmse},
           {"indirect_rel_rmse", r.indirectRelRmse}};
 }
 
@@ -66,10 +69,13 @@ SweepResult resultFromJson(const nlohmann::json& j, const SweepPoint& point) {
   r.activeVoxels = j.at("active_voxels");
   r.denseVoxels = j.at("dense_voxels");
   r.vdlTexels = j.at("vdl_texels");
+  r.storedPhotons = j.at("stored_photons");
+  r.noiseFigure = j.at("noise_figure");
   r.gpuLeaves = j.value("gpu_leaves", -1.0);
   r.frameMs = j.at("frame_ms");
   r.irradianceRelRmse = j.at("irradiance_rel_rmse");
   r.irradianceRelMae = j.at("irradiance_rel_mae");
+  r.irradianceBinnedRelRmse = j.at("irradiance_binned_rel_rmse");
   r.indirectRelRmse = j.at("indirect_rel_rmse");
   return r;
 }
@@ -79,7 +85,8 @@ nlohmann::json toJson(const BakeFigures& f) {
           {"splat_seconds", f.splatSeconds},   {"cluster_seconds", f.clusterSeconds},
           {"bake_seconds", f.bakeSeconds},     {"peak_rss_bytes", f.peakRssBytes},
           {"vdb_bytes", f.vdbBytes},           {"active_voxels", f.activeVoxels},
-          {"dense_voxels", f.denseVoxels}};
+          {"dense_voxels", f.denseVoxels},     {"stored_photons", f.storedPhotons},
+          {"noise_figure", f.noiseFigure}};
 }
 
 BakeFigures bakeFiguresFromJson(const nlohmann::json& j) {
@@ -93,6 +100,8 @@ BakeFigures bakeFiguresFromJson(const nlohmann::json& j) {
   f.vdbBytes = j.at("vdb_bytes");
   f.activeVoxels = j.at("active_voxels");
   f.denseVoxels = j.at("dense_voxels");
+  f.storedPhotons = j.at("stored_photons");
+  f.noiseFigure = j.at("noise_figure");
   return f;
 }
 
@@ -139,11 +148,16 @@ bool SweepCache::loadReferences(References& refs) const {
   const std::string keyFile = dir_ + "/reference.json";
   const std::string irrFile = dir_ + "/reference-irradiance.exr";
   const std::string indFile = dir_ + "/reference-indirect.exr";
-  if (!fs::exists(keyFile) || !fs::exists(irrFile) || (params_.frames > 0 && !fs::exists(indFile)))
+  const std::string maskFile = dir_ + "/reference-emitters.exr";
+  if (!fs::exists(keyFile) || !fs::exists(irrFile) || !fs::exists(maskFile) ||
+      (params_.frames > 0 && !fs::exists(indFile)))
     return false;
   const nlohmann::json cached = readJson(keyFile);
   if (cached["key"] != referenceKey(params_)) return false;
+  if (!cached.contains("irradiance_binned_noise")) return false;  // before the emitter mask
   refs.irradiance = readImage(irrFile);
+  refs.emitterMask = readImage(maskFile);
+  refs.irradianceBinnedNoise = cached.value("irradiance_binned_noise", 0.0);
   if (params_.frames > 0) refs.indirect = readImage(indFile);
   refs.irradianceNoise = cached.value("irradiance_noise", 0.0);
   refs.indirectNoise = cached.value("indirect_noise", 0.0);
@@ -153,10 +167,12 @@ bool SweepCache::loadReferences(References& refs) const {
 
 void SweepCache::storeReferences(const References& refs) const {
   writeExr(dir_ + "/reference-irradiance.exr", refs.irradiance);
+  writeExr(dir_ + "/reference-emitters.exr", refs.emitterMask);
   if (params_.frames > 0) writeExr(dir_ + "/reference-indirect.exr", refs.indirect);
   const nlohmann::json j = {{"key", referenceKey(params_)},
                             {"irradiance_noise", refs.irradianceNoise},
                             {"indirect_noise", refs.indirectNoise},
+                            {"irradiance_binned_noise", refs.irradianceBinnedNoise},
                             {"seconds", refs.seconds}};
   writeTextAtomically(dir_ + "/reference.json", j.dump(2) + "\n");
 }
@@ -166,6 +182,7 @@ bool SweepCache::loadBake(const SweepPoint& point, BakeFigures& figures) const {
   if (!fs::exists(stats) || !fs::exists(vdbPath(point))) return false;
   const nlohmann::json cached = readJson(stats);
   if (cached.value("context", nlohmann::json()) != nlohmann::json::parse(context_)) return false;
+  if (!cached.at("bake").contains("noise_figure")) return false;  // before the noise figure
   figures = bakeFiguresFromJson(cached.at("bake"));
   return true;
 }
@@ -183,6 +200,8 @@ bool SweepCache::loadResult(const SweepPoint& point, SweepResult& result) const 
   if (!fs::exists(file)) return false;
   const nlohmann::json cached = readJson(file);
   if (cached["context"] != nlohmann::json::parse(context_)) return false;
+  // Results from before the binned error and the noise figure: stale.
+  if (!cached["result"].contains("irradiance_binned_rel_rmse")) return false;
   result = resultFromJson(cached["result"], point);
   return true;
 }

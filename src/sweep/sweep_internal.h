@@ -21,9 +21,19 @@ std::string photonsText(size_t n);
 /// A fraction as a percentage rounded to 2 decimals.
 double percent2(double fraction);
 
+/// Bins of kSweepBin x kSweepBin pixels: the binned irradiance error, at
+/// the scale of a few pixels without the reference's per-pixel noise.
+constexpr int kSweepBin = 4;
+
 struct References {
   RgbImage irradiance, indirect;
-  double irradianceNoise = 0, indirectNoise = 0;
+  /// reference --emitter-mask: the light fixtures' pixels are left out of
+  /// every error (there the octree and the path tracer define irradiance
+  /// differently).
+  RgbImage emitterMask;
+  /// The references' noise (referenceNoise) over the compared pixels,
+  /// per pixel and over kSweepBin bins.
+  double irradianceNoise = 0, indirectNoise = 0, irradianceBinnedNoise = 0;
   double seconds = 0;
 };
 
@@ -31,6 +41,8 @@ struct References {
 struct BakeFigures {
   double traceSeconds = 0, voxelizeSeconds = 0, splatSeconds = 0, clusterSeconds = 0;
   double bakeSeconds = 0, peakRssBytes = 0, vdbBytes = 0, activeVoxels = 0, denseVoxels = 0;
+  double storedPhotons = 0;
+  double noiseFigure = -1;  ///< NoiseSummary::quantile; < 0: not recorded
 };
 
 /// The sweep's cache folder (SweepParams::outDir/cache): each bake's .vdb
@@ -64,7 +76,8 @@ class SweepCache {
 /// Pictures of the paper's point and of the most accurate point on the time
 /// front: reference | light octree | difference, as PNGs in params.outDir.
 void writeSweepPictures(const SweepParams& params, const std::vector<SweepResult>& results,
-                        const RgbImage& referenceIrradiance, const SweepCache& cache);
+                        const RgbImage& referenceIrradiance, const RgbImage& emitterMask,
+                        const SweepCache& cache);
 
 }  // namespace sweep_internal
 }  // namespace lo

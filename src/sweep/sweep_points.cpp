@@ -28,8 +28,11 @@ double percent2(double fraction) { return std::round(10000.0 * fraction) / 100.0
 
 std::string SweepPoint::label() const {
   using namespace sweep_internal;
-  std::string s = "d" + std::to_string(depth) + " " + photonsText(photons) + " k" +
-                  std::to_string(knn) + " r" + formatNumber(radiusVoxels) + " v" + vdls;
+  // A target bake's photons and k follow from its target.
+  std::string s = "d" + std::to_string(depth) + " " +
+                  (targetError > 0 ? "t" + formatNumber(targetError)
+                                   : photonsText(photons) + " k" + std::to_string(knn)) +
+                  " r" + formatNumber(radiusVoxels) + " v" + vdls;
   if (!interpolation) s += " no-interp";
   if (halfFloat) s += " half";
   if (!cosineCorrection) s += " paper-cosine";
@@ -44,7 +47,9 @@ std::string SweepPoint::label() const {
 
 std::string SweepPoint::bakeKey() const {
   using namespace sweep_internal;
-  return "d" + std::to_string(depth) + "-p" + std::to_string(photons) + "-k" + std::to_string(knn) +
+  return "d" + std::to_string(depth) +
+         (targetError > 0 ? "-t" + formatNumber(targetError) : "") + "-p" +
+         std::to_string(photons) + "-k" + std::to_string(knn) +
          "-r" + formatNumber(radiusVoxels) + "-v" + vdls + (layers ? "" : "-l0") +
          (occlusion ? "" : "-o0") + (edgeCorrection ? "" : "-e0") +
          (smoothing == BakeParams{}.smoothing ? "" : (smoothing ? "-s1" : "-s0")) +
@@ -122,6 +127,19 @@ std::vector<SweepPoint> sweepPoints(SweepScale scale) {
   vary("representation", [](SweepPoint& p) { p.representation = representationName(LightRepresentation::Sh2); });
   // Adaptive leaves (docs/octree.md): the same bake, coarser leaves where the light agrees.
   for (float t : {0.05f, 0.1f, 0.2f, 0.4f}) vary("tolerance", [t](SweepPoint& p) { p.tolerance = t; });
+  // Noise targets (bake --target-error): tighter targets at the default
+  // depth, and every depth at the command's default target.
+  const std::vector<double> targets =
+      full ? std::vector<double>{0.2, 0.1, kDefaultTargetError, 0.05, 0.03}
+           : std::vector<double>{0.1, kDefaultTargetError};
+  for (double t : targets) vary("target", [t](SweepPoint& p) { p.targetError = t; });
+  const std::vector<int> targetDepths = full ? std::vector<int>{5, 7, 8} : std::vector<int>{5};
+  for (int d : targetDepths) {
+    vary("target", [d](SweepPoint& p) {
+      p.targetError = kDefaultTargetError;
+      p.depth = d;
+    });
+  }
   vary("tolerance", [](SweepPoint& p) {
     p.representation = representationName(LightRepresentation::Sh1);
     p.tolerance = 0.1f;
@@ -176,7 +194,7 @@ void markParetoFronts(std::vector<SweepResult>& results) {
   for (const SweepResult& r : results) {
     time.push_back(r.bakeSeconds);
     memory.push_back(r.gpuBytes);
-    error.push_back(r.irradianceRelRmse);
+    error.push_back(r.irradianceBinnedRelRmse);
   }
   std::vector<bool> t = paretoFront(time, error), m = paretoFront(memory, error);
   for (size_t i = 0; i < results.size(); ++i) {

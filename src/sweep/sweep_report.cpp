@@ -87,22 +87,29 @@ std::string markdownTable(const std::vector<SweepResult>& results) {
   std::ostringstream os;
   os << "| setting | varies | trace s | voxelize s | splat s | gather+cluster s | bake s | "
         "peak RSS MiB | .vdb KiB | GPU KiB | active voxels | GPU leaves | frame ms | "
-        "irradiance rel. RMSE | rel. MAE | indirect image rel. RMSE | front |\n"
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+        "photons | noise figure | irradiance rel. RMSE, 4x4 bins | per pixel | rel. MAE | "
+        "indirect image rel. RMSE | front |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "---:|---|\n";
   for (const SweepResult& r : results) {
     const bool paper = r.point.sameSettings(paperPoint());
     char line[1024];
     std::string front = std::string(r.paretoTime ? "T" : "") + (r.paretoMemory ? "M" : "");
     std::snprintf(line, sizeof line,
                   "| %s%s%s | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %.0f | %.0f | %.0f "
-                  "| %s | %s | %.1f%% | %.1f%% | %s | %s |\n",
+                  "| %s | %s | %s | %s | %.1f%% | %.1f%% | %.1f%% | %s | %s |\n",
                   paper ? "**" : "", r.point.label().c_str(), paper ? "** (paper)" : "",
                   r.point.group.c_str(), r.traceSeconds, r.voxelizeSeconds, r.splatSeconds,
                   r.clusterSeconds, r.bakeSeconds, r.peakRssBytes / 1048576.0, r.vdbBytes / 1024.0,
                   r.gpuBytes / 1024.0, r.activeVoxels,
                   r.gpuLeaves >= 0 ? formatNumber(r.gpuLeaves).c_str() : "-",
                   r.frameMs >= 0 ? formatNumber(std::round(r.frameMs * 10) / 10).c_str() : "-",
-                  100 * r.irradianceRelRmse, 100 * r.irradianceRelMae,
+                  formatCount(size_t(r.storedPhotons)).c_str(),
+                  r.noiseFigure >= 0
+                      ? (formatNumber(std::round(1000 * r.noiseFigure) / 10) + "%").c_str()
+                      : "-",
+                  100 * r.irradianceBinnedRelRmse, 100 * r.irradianceRelRmse,
+                  100 * r.irradianceRelMae,
                   r.indirectRelRmse >= 0
                       ? (formatNumber(std::round(1000 * r.indirectRelRmse) / 10) + "%").c_str()
                       : "-",
@@ -124,9 +131,11 @@ std::string plotData(std::vector<std::pair<double, std::pair<double, std::string
 }  // namespace
 
 void writeSweepPictures(const SweepParams& params, const std::vector<SweepResult>& results,
-                        const RgbImage& referenceIrradiance, const SweepCache& cache) {
+                        const RgbImage& referenceIrradiance, const RgbImage& emitterMask,
+                        const SweepCache& cache) {
   CompareParams compareParams;
   compareParams.ignoreBackground = true;
+  compareParams.mask = &emitterMask;
   const float ev = exposureFor(referenceIrradiance);
   auto picture = [&](const SweepResult& r, const std::string& name) {
     const RgbImage octreeImage = readImage(cache.imagePath(r.point, "irradiance"));
@@ -142,7 +151,7 @@ void writeSweepPictures(const SweepParams& params, const std::vector<SweepResult
   }
   const SweepResult* best = nullptr;
   for (const SweepResult& r : results)
-    if (r.paretoTime && (!best || r.irradianceRelRmse < best->irradianceRelRmse)) best = &r;
+    if (r.paretoTime && (!best || r.irradianceBinnedRelRmse < best->irradianceBinnedRelRmse)) best = &r;
   if (best) picture(*best, "irradiance-best.png");
 }
 
@@ -154,20 +163,22 @@ std::string sweepCsv(const std::vector<SweepResult>& results) {
         "cosine_correction,trace_s,voxelize_s,splat_s,gather_cluster_s,bake_s,peak_rss_mib,vdb_kib,"
         "gpu_kib,"
         "active_voxels,dense_voxels,vdl_texels,frame_ms,irradiance_rel_rmse,"
-        "irradiance_rel_mae,indirect_rel_rmse,pareto_time,pareto_memory,paper\n";
+        "irradiance_rel_mae,irradiance_binned_rel_rmse,indirect_rel_rmse,stored_photons,"
+        "noise_figure,target_error,pareto_time,pareto_memory,paper\n";
   for (const SweepResult& r : results) {
     const SweepPoint& p = r.point;
     char line[1024];
     std::snprintf(
         line, sizeof line,
         "\"%s\",%s,%d,%zu,%d,%g,%s,%d,%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.1f,%.0f,%.0f,"
-        "%.0f,%.2f,%.5f,%.5f,%.5f,%d,%d,%d\n",
+        "%.0f,%.2f,%.5f,%.5f,%.5f,%.5f,%.0f,%.5f,%g,%d,%d,%d\n",
         p.label().c_str(), p.group.c_str(), p.depth, p.photons, p.knn, double(p.radiusVoxels),
         p.vdls.c_str(), int(p.interpolation), int(p.halfFloat), int(p.cosineCorrection),
         r.traceSeconds, r.voxelizeSeconds, r.splatSeconds, r.clusterSeconds, r.bakeSeconds,
         r.peakRssBytes / 1048576.0, r.vdbBytes / 1024.0, r.gpuBytes / 1024.0, r.activeVoxels,
         r.denseVoxels, r.vdlTexels, r.frameMs, r.irradianceRelRmse, r.irradianceRelMae,
-        r.indirectRelRmse, int(r.paretoTime), int(r.paretoMemory),
+        r.irradianceBinnedRelRmse, r.indirectRelRmse, r.storedPhotons, r.noiseFigure,
+        p.targetError, int(r.paretoTime), int(r.paretoMemory),
         int(p.sameSettings(paperPoint())));
     os << line;
   }
@@ -184,7 +195,7 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
   using Rows = std::vector<std::pair<double, std::pair<double, std::string>>>;
   Rows allTime, allMem, frontTime, frontMem, paperTime, paperMem, toleranceMem;
   for (const SweepResult& r : results) {
-    const double e = 100 * r.irradianceRelRmse, t = r.bakeSeconds, m = r.gpuBytes / 1024.0;
+    const double e = 100 * r.irradianceBinnedRelRmse, t = r.bakeSeconds, m = r.gpuBytes / 1024.0;
     const std::string l = r.point.label();
     allTime.push_back({t, {e, l}});
     allMem.push_back({m, {e, l}});
@@ -217,7 +228,7 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
   gp << "# Redraw with: cd " << dir << " && gnuplot sweep.gp\n"
      << "set terminal pngcairo size 1000,700 font 'sans,10'\n"
      << "set logscale x\nset grid\nset key top right\n"
-     << "set ylabel 'indirect irradiance: relative RMSE vs reference (%)'\n";
+     << "set ylabel 'indirect irradiance: relative RMSE vs reference, 4x4 bins (%)'\n";
   auto plot = [&](const char* png, const char* xlabel, const char* which) {
     const bool memory = std::string(which) == "memory";
     gp << "set output '" << png << "'\n"
@@ -253,16 +264,23 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
      << " x " << params.height << " from the scene camera, references path-traced at "
      << params.referenceSpp
      << " spp. Errors are luminance relative RMSE / MAE over the pixels that see the scene "
+        "and no light fixture (`reference --emitter-mask`: there the octree and the path "
+        "tracer define irradiance differently), over 4x4-pixel bins and per pixel "
         "(docs/accuracy.md). "
-        "*front*: T = on the Pareto front of irradiance error vs bake "
-        "time, M = vs GPU bytes. Frame times: OSMesa (software GL), "
+        "*front*: T = on the Pareto front of the binned irradiance error vs bake "
+        "time, M = vs GPU bytes. *t0.07*: a target bake (`--target-error 0.07`), whose "
+        "photons and k follow from the target; *noise figure*: the bake's own estimate "
+        "(docs/accuracy.md, \"How good is a bake\"). Frame times: OSMesa (software GL), "
      << params.frames
      << " frames, indirect mode. Times are wall-clock on this machine "
         "and include every bake stage.\n\n"
      << "The references' own noise, the floor under these errors (relative RMS standard "
-        "error of luminance): irradiance "
+        "error of luminance, over the same pixels): irradiance "
      << formatNumber(results.empty() ? 0.0 : percent2(results.front().referenceIrradianceNoise))
-     << "%, indirect image "
+     << "% per pixel, "
+     << formatNumber(results.empty() ? 0.0
+                                     : percent2(results.front().referenceIrradianceBinnedNoise))
+     << "% over the bins; indirect image "
      << formatNumber(results.empty() ? 0.0 : percent2(results.front().referenceIndirectNoise))
      << "%.\n\n"
      << markdownTable(results) << "\n";

@@ -113,6 +113,32 @@ namespace {
 
 // binImage averages blocks (partial ones at the edges over what they hold);
 // binMask keeps a block only when all its pixels are selected.
+// The standard error of a block's mean: sqrt(sum se^2) / n; the noise of a
+// reference as the relative RMSE counts it, over the compared pixels only.
+TEST(Compare, ReferenceNoiseBinsAsAMeanOfIndependentPixels) {
+  RgbImage se(3, 2);
+  for (size_t i = 0; i < se.pixelCount(); ++i) se.set(i, Vec3(0.2f));
+  const RgbImage binned = binStdError(se, 2);
+  ASSERT_EQ(binned.width, 2);
+  EXPECT_FLOAT_EQ(binned.at(0).x, 0.2f / 2.0f);                  // 4 pixels: 1/sqrt(4)
+  EXPECT_FLOAT_EQ(binned.at(1).x, 0.2f / std::sqrt(2.0f));       // the right column, 2 pixels
+  RgbImage ref(3, 2);
+  for (size_t i = 0; i < ref.pixelCount(); ++i) ref.set(i, Vec3(2.0f));
+  EXPECT_NEAR(referenceNoise(ref, se), 0.1, 1e-6);  // 0.2 / 2 for a grey image
+  // A pixel left out by the mask, another as background, do not count.
+  se.set(0, Vec3(100.0f));
+  se.set(1, Vec3(100.0f));
+  ref.set(1, Vec3(0.0f));
+  RgbImage mask(3, 2);
+  for (size_t i = 0; i < mask.pixelCount(); ++i) mask.set(i, Vec3(1));
+  mask.set(0, Vec3(0));
+  CompareParams params;
+  params.mask = &mask;
+  params.ignoreBackground = true;
+  EXPECT_NEAR(referenceNoise(ref, se, params), 0.1, 1e-6);
+  EXPECT_THROW(referenceNoise(ref, RgbImage(2, 2)), InputError);
+}
+
 TEST(Compare, BinningAveragesBlocksAndMasksKeepWholeBlocks) {
   RgbImage image(3, 2);
   for (size_t i = 0; i < image.pixelCount(); ++i) image.set(i, Vec3(float(i)));
