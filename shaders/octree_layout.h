@@ -82,8 +82,14 @@ const uint LO_MAX_LAYERS = 3u;
  * its own (60 degrees: layers are that far apart, lightgrid/vdl_grid.h)... */
 const float LO_LAYER_MIN_COSINE = 0.5;
 /* ...and that lies on the same side as the layer's surface of every other
- * layer's plane, within this many voxels. */
+ * layer's plane, within this many voxels: a plane parallel to the layer's
+ * own (the other face of a thin wall, where a fragment lies on the plane
+ * itself)... */
 const float LO_LAYER_SIDE_TOLERANCE = 0.1;
+/* ...or within this many, of a plane across the layer's (a wall standing on
+ * a floor layer): a floor fragment at the wall's foot is on one side, the
+ * side its light belongs to. */
+const float LO_LAYER_JOINT_TOLERANCE = 0.001;
 const uint LO_VDL_TEXTURE_WIDTH = 4096u;
 const uint LO_ADDRESS_BITS = 24u;
 const uint LO_MAX_ADDRESS = 16777215u; /* 2^24 - 1 */

@@ -143,8 +143,10 @@ LO_LOOKUP_FN vec3 loVdlDirection(float code) {
  * (octree voxel units) whose surface faces ng: all of a plain leaf's; of a
  * layered leaf (octree_layout.h), the layer whose normal lies closest to ng,
  * within LO_LAYER_MIN_COSINE, and whose surface lies on q's side of every
- * other layer's plane (LO_LAYER_SIDE_TOLERANCE): a floor layer lit from one
- * side of a thin wall does not light the floor on its other side. False when
+ * other layer's plane (LO_LAYER_SIDE_TOLERANCE for a parallel plane,
+ * LO_LAYER_JOINT_TOLERANCE for one across it): a floor layer lit from one
+ * side of a thin wall does not light the floor on its other side, not even
+ * at the wall's foot. False when
  * no layer serves the point: the voxel then lends it no light. */
 LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
                              LO_OUT(uint) first, LO_OUT(int) count) {
@@ -178,8 +180,10 @@ LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
       if (m == l) continue;
       float sq = dot(normals[m], q - points[m]);
       float sl = dot(normals[m], points[l] - points[m]);
-      if ((sq > LO_LAYER_SIDE_TOLERANCE && sl < -LO_LAYER_SIDE_TOLERANCE) ||
-          (sq < -LO_LAYER_SIDE_TOLERANCE && sl > LO_LAYER_SIDE_TOLERANCE)) {
+      float tolerance = abs(dot(normals[l], normals[m])) > LO_LAYER_MIN_COSINE
+                            ? LO_LAYER_SIDE_TOLERANCE
+                            : LO_LAYER_JOINT_TOLERANCE;
+      if ((sq > tolerance && sl < -tolerance) || (sq < -tolerance && sl > tolerance)) {
         sameSide = false;
       }
     }

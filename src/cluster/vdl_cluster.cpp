@@ -153,7 +153,7 @@ struct BakeBody {
       clusterSeconds += secondsBetween(t1, t2);
 
       out.normals[v] = g.normal;
-      out.points[v] = layered ? found[0].point : grid.centroids[v];
+      out.points[v] = layered ? found[0].lit : grid.centroids[v];
       out.irradiance[v] = g.irradiance;
       out.photonCount[v] = float(g.photons.size());
       out.noise[v] = g.noise;
@@ -167,7 +167,7 @@ struct BakeBody {
         Clock::time_point t3 = Clock::now();
         w.gatherer.gatherLayer(v, found[l].point, found[l].normal, w.gathered);
         Clock::time_point t4 = Clock::now();
-        Worker::Layer layer{uint32_t(v), l, w.gathered.normal, found[l].point,
+        Worker::Layer layer{uint32_t(v), l, w.gathered.normal, found[l].lit,
                             w.gathered.irradiance, float(w.gathered.photons.size()),
                             w.gathered.noise, w.gathered.radius, ClusterResult{}, {}};
         layer.vdls = clusterGathered(w, stream + (uint64_t(l) << kCanonicalKeyBits), layer.sh.data());

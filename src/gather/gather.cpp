@@ -623,6 +623,7 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
   struct Candidate {
     Vec3 normal, point;
     float area;
+    bool twoSided;  ///< a thin wall: faces of the voxel's geometry look both ways
   };
   Candidate candidates[SurfaceGrid::kMaxOrientations];
   int count = 0;
@@ -633,19 +634,25 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
       // which side (or both) is lit.
       bool opposite = false;
       for (int c = 0; c < count; ++c) {
-        opposite = opposite || -dot(candidates[c].normal, g.normal) > params.splitCosine;
+        if (-dot(candidates[c].normal, g.normal) > params.splitCosine) {
+          opposite = true;
+          candidates[c].twoSided = true;
+        }
       }
-      if (!opposite) candidates[count++] = {g.normal, g.centroid, g.area};
+      if (!opposite) candidates[count++] = {g.normal, g.centroid, g.area, false};
     }
   }
   if (count == 0) {
     if (!(lengthSquared(grid_.normals[voxel]) > 0.5f)) return 0;
-    candidates[count++] = {grid_.normals[voxel], grid_.centroids[voxel], grid_.areas[voxel]};
+    candidates[count++] = {grid_.normals[voxel], grid_.centroids[voxel], grid_.areas[voxel], false};
   }
   // Which side of each surface its photons arrived on: the photons of the
   // voxel's own bin within params.splitCosine of the front or the back.
   const BinnedPhotons::Entry* entries = binned_->entries.data();
   double front[SurfaceGrid::kMaxOrientations] = {}, back[SurfaceGrid::kMaxOrientations] = {};
+  // Power-weighted sums of those photons' positions.
+  double frontAt[SurfaceGrid::kMaxOrientations][3] = {},
+         backAt[SurfaceGrid::kMaxOrientations][3] = {};
   uint32_t frontCount[SurfaceGrid::kMaxOrientations] = {},
            backCount[SurfaceGrid::kMaxOrientations] = {};
   double total = 0;
@@ -655,27 +662,41 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
     total += double(e.weight);
     for (int c = 0; c < count; ++c) {
       const float d = dot(e.normal, candidates[c].normal);
+      const double w = double(e.weight);
       if (d > params.splitCosine) {
-        front[c] += double(e.weight);
+        front[c] += w;
         ++frontCount[c];
+        for (int a = 0; a < 3; ++a) frontAt[c][a] += w * double(e.position[a]);
       } else if (-d > params.splitCosine) {
-        back[c] += double(e.weight);
+        back[c] += w;
         ++backCount[c];
+        for (int a = 0; a < 3; ++a) backAt[c][a] += w * double(e.position[a]);
       }
     }
   }
   // A surface lit on one side is a layer facing that side (its winding's when
   // no photon landed on it: a dark layer still claims its fragments); lit on
-  // both, two layers facing away from each other.
+  // both, two layers facing away from each other. A thin wall (faces both
+  // ways) always has both: its dark face's layer claims the fragments of
+  // that side, and the fragments of a floor meeting it there find no layer
+  // of the wall facing their way, so the lit face's light stays on its side.
   auto significant = [&](double w, uint32_t n) {
     return n >= params.minPhotons && w >= double(params.minShare) * total && w > 0;
   };
   int layers = 0;
   for (int c = 0; c < count && layers < params.maxLayers; ++c) {
     const Candidate& k = candidates[c];
-    const bool f = significant(front[c], frontCount[c]), b = significant(back[c], backCount[c]);
-    if (f || !b) out[layers++] = {k.normal, k.point, front[c], frontCount[c]};
-    if (b && layers < params.maxLayers) out[layers++] = {-k.normal, k.point, back[c], backCount[c]};
+    const bool f = significant(front[c], frontCount[c]),
+               b = significant(back[c], backCount[c]) || (k.twoSided && f);
+    auto mean = [&](const double* at, double w) {
+      return w > 0 ? Vec3{float(at[0] / w), float(at[1] / w), float(at[2] / w)} : k.point;
+    };
+    if (f || !b) {
+      out[layers++] = {k.normal, k.point, front[c], frontCount[c], mean(frontAt[c], front[c])};
+    }
+    if (b && layers < params.maxLayers) {
+      out[layers++] = {-k.normal, k.point, back[c], backCount[c], mean(backAt[c], back[c])};
+    }
   }
   return layers;
 }

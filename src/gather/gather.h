@@ -52,6 +52,12 @@ struct SurfaceLayer {
   Vec3 point{0, 0, 0};   ///< a point of the surface (its centroid in the voxel), world space
   double weight = 0;     ///< summed average(power) of the voxel's photons on that side
   uint32_t photons = 0;
+  /// Where the layer's light landed: the power-weighted mean position of
+  /// the voxel's own photons facing its way (`point` when none did). What
+  /// the renderer's side test measures (VdlGrid::points): a floor cut by a
+  /// thin wall and lit on one side has its light on that side, wherever
+  /// the floor's centroid in the voxel falls.
+  Vec3 lit{0, 0, 0};
 };
 
 /// Criteria of findSurfaceLayers.

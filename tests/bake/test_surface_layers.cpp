@@ -144,6 +144,46 @@ TEST(SurfaceLayers, NoLightThroughAThinWall) {
   }
 }
 
+/// The joint of the same scene: the dark side's floor right at the wall
+/// (closer than the layers' side tolerance) and the wall's dark face right
+/// above the floor. The layer a fragment there takes must be its own
+/// side's: a lit floor layer whose point lay on the wall served both sides,
+/// and drew a bright line along the joint's dark side.
+TEST(SurfaceLayers, NoBrightLineWhereAThinWallMeetsTheFloor) {
+  Scene scene = blackScene();
+  Material white;
+  white.baseColor = {0.8f, 0.8f, 0.8f};
+  scene.materials.push_back(white);
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 1);        // floor
+  test::addQuad(scene, {0.5f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 1);     // wall, +x side
+  test::addQuad(scene, {0.5f, 0, 0}, {0, 0, 1}, {0, 1, 0}, {-1, 0, 0}, 1);    // wall, -x side
+  test::addQuad(scene, {0, 1, 0}, {0, 0, 1}, {0.5f, 0, 0}, {0, 1, 0}, 0);     // black roof over x < 0.5
+  test::addQuad(scene, {0, 1, 0}, {0.5f, 0, 0}, {0, 0, 1}, {0, -1, 0}, 0);
+  scene.lights.push_back(sun({0, -1, 0}, 1.0f));
+  BakeParams p;
+  p.depth = 5;
+  p.photons = 300000;
+  const BakeResult baked = bake(scene, p);
+  const GpuOctree octree = buildGpuOctree(baked.grid);
+  double darkestLit = 1e30, brightestDark = 0;
+  for (int i = 0; i < 40; ++i) {
+    const float z = 0.1f + 0.8f * float(i) / 39.0f;
+    for (float gap : {1e-4f, 5e-4f, 1e-3f, 2e-3f, 3e-3f}) {
+      // The dark side's floor next to the wall, and the wall's dark face next to the floor.
+      brightestDark = std::max(brightestDark, double(luminance(octreeIrradiance(
+                                                  octree, {0.5f - gap, 0, z}, {0, 1, 0}))));
+      brightestDark = std::max(brightestDark, double(luminance(octreeIrradiance(
+                                                  octree, {0.5f, gap, z}, {-1, 0, 0}))));
+      darkestLit = std::min(darkestLit, double(luminance(octreeIrradiance(
+                                            octree, {0.5f + gap, 0, z}, {0, 1, 0}))));
+    }
+  }
+  std::printf("thin wall joint: brightest dark-side point %.4g, darkest lit-side point %.4g W/m^2\n",
+              brightestDark, darkestLit);
+  EXPECT_GT(darkestLit, 0.0);
+  EXPECT_EQ(brightestDark, 0.0) << "light across the joint";
+}
+
 }  // namespace
 }  // namespace lo
 
