@@ -34,6 +34,7 @@ BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   params.layers = layers == "on";
   params.occlusion = occlusion == "on";
   params.edgeCorrection = edgeCorrection == "on";
+  params.separateCaustics = separateCaustics == "on";
   params.smoothing = smoothing == "on";
   params.autoCap = autoCap;
   params.autoThreshold = autoThreshold;
@@ -137,6 +138,13 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
   cmd->add_option("--edge-correction", opt.edgeCorrection,
                   "Divide the gathered power by the part of the gather disc that lies on the "
                   "surface, not the whole disc: next to an edge the plain estimate is too dark")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--separate-caustics", opt.separateCaustics,
+                  "Gather the photons that reached a surface through mirrors and glass alone (a "
+                  "caustic) apart from the smooth light, within " +
+                      formatNumber(kDefaultCausticRadiusVoxels) +
+                      " voxels: a caustic stays sharp and does not blot the light around it")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   cmd->add_option("--smoothing", opt.smoothing,

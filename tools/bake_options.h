@@ -35,6 +35,7 @@ struct BakeOptions {
   std::string layers = "on";
   std::string occlusion = "on";
   std::string edgeCorrection = "on";
+  std::string separateCaustics = "on";
   std::string smoothing = "on";
   int autoCap = BakeParams{}.autoCap;
   float autoThreshold = BakeParams{}.autoThreshold;

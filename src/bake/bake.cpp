@@ -71,6 +71,7 @@ GatherParams BakeParams::gatherParams() const {
   p.k = effectiveKnn();
   p.radius = radius;
   p.edgeCorrection = edgeCorrection;
+  p.separateCaustics = separateCaustics;
   return p;
 }
 
@@ -95,6 +96,7 @@ std::string BakeParams::ToString() const {
          ", seed " + std::to_string(seed) +
          (includeDirect ? ", include direct" : "") + (layers ? "" : ", no layers") +
          (occlusion ? "" : ", no occlusion") + (edgeCorrection ? "" : ", no edge correction") +
+         (separateCaustics ? "" : ", caustics merged") +
          (smoothing ? ", smoothing" : "") +
          "}";
 }

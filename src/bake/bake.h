@@ -114,6 +114,8 @@ struct BakeParams {
   bool occlusion = true;
   /// Edge correction (`--edge-correction`): GatherParams::edgeCorrection.
   bool edgeCorrection = true;
+  /// Caustics apart (`--separate-caustics`): GatherParams::separateCaustics.
+  bool separateCaustics = true;
   /// Layer-aware smoothing of the estimates (`--smoothing`): smoothVdlGrid.
   bool smoothing = true;
   /// A region of interest (`--bounds`; empty = the whole scene): the grid

@@ -62,6 +62,7 @@ struct Worker {
       : gatherer(grid, photons, std::move(binned), params) {}
   Gatherer gatherer;
   GatherResult gathered;
+  GatherResult caustic;  ///< the caustic photons of the same point (Gatherer::gatherCaustics)
   std::vector<DirectionSample> samples;
   double gatherSeconds = 0;
   double clusterSeconds = 0;
@@ -107,10 +108,13 @@ struct BakeBody {
   ClusterResult clusterGathered(Worker& w, uint64_t stream, Vec3* sh) const {
     const GatherResult& g = w.gathered;
     w.samples.clear();
-    const float r = g.radius;
-    if (r > 0) {
-      const float invArea = 1.0f / (kPi * r * r * g.coverage);
-      for (uint32_t p : g.photons) {
+    // The smooth light's photons, then the caustic ones, each share of its
+    // own estimate: the VDLs sum to their total.
+    for (const GatherResult* part : {&w.gathered, &w.caustic}) {
+      const float r = part->radius;
+      if (!(r > 0) || part->photons.empty()) continue;
+      const float invArea = 1.0f / (kPi * r * r * part->coverage);
+      for (uint32_t p : part->photons) {
         const Photon& ph = photons[p];
         w.samples.push_back({ph.direction, ph.power * invArea});
       }
@@ -121,6 +125,36 @@ struct BakeBody {
       return ClusterResult{};
     }
     return clusterDirections(w.samples.data(), w.samples.size(), cluster.vdls, cluster, stream);
+  }
+
+  /// The caustic photons of the point the smooth gather just read, on the
+  /// side it found (w.caustic; empty without caustic photons).
+  static void gatherCaustics(Worker& w, size_t v, const Vec3& point) {
+    if (w.gatherer.hasCaustics()) {
+      w.gatherer.gatherCaustics(v, point, w.gathered.normal, w.caustic);
+    } else {
+      w.caustic.photons.clear();
+      w.caustic.irradiance = Vec3{0, 0, 0};
+      w.caustic.noise = 0;
+    }
+  }
+
+  /// The smooth and the caustic estimates together: their sum, photons,
+  /// and noise (independent photons: the standard deviations add in squares).
+  struct Totals {
+    Vec3 irradiance;
+    float photons, noise;
+  };
+  static Totals totals(const Worker& w) {
+    const GatherResult &g = w.gathered, &c = w.caustic;
+    Totals t{g.irradiance + c.irradiance, float(g.photons.size() + c.photons.size()), g.noise};
+    if (!c.photons.empty()) {
+      const double sg = double(g.noise) * double(luminance(g.irradiance)),
+                   sc = double(c.noise) * double(luminance(c.irradiance));
+      const double y = double(luminance(t.irradiance));
+      t.noise = y > 0 ? float(std::sqrt(sg * sg + sc * sc) / y) : 0.0f;
+    }
+    return t;
   }
 
   void operator()(const tbb::blocked_range<size_t>& range) const {
@@ -144,7 +178,9 @@ struct BakeBody {
       } else {
         w.gatherer.gather(v, w.gathered);
       }
+      gatherCaustics(w, v, layered ? found[0].point : grid.centroids[v]);
       const GatherResult& g = w.gathered;
+      const Totals total = totals(w);
       Clock::time_point t1 = Clock::now();
       const size_t terms = size_t(out.shTerms);
       ClusterResult c = clusterGathered(w, stream, out.sh.data() + v * terms);
@@ -154,9 +190,9 @@ struct BakeBody {
 
       out.normals[v] = g.normal;
       out.points[v] = layered ? found[0].lit : grid.centroids[v];
-      out.irradiance[v] = g.irradiance;
-      out.photonCount[v] = float(g.photons.size());
-      out.noise[v] = g.noise;
+      out.irradiance[v] = total.irradiance;
+      out.photonCount[v] = total.photons;
+      out.noise[v] = total.noise;
       out.radius[v] = g.radius;
       out.angularError[v] = c.angularError;
       out.vdlCount[v] = uint8_t(c.count);
@@ -166,10 +202,12 @@ struct BakeBody {
       for (int l = 1; l < layers; ++l) {
         Clock::time_point t3 = Clock::now();
         w.gatherer.gatherLayer(v, found[l].point, found[l].normal, w.gathered);
+        gatherCaustics(w, v, found[l].point);
+        const Totals layerTotal = totals(w);
         Clock::time_point t4 = Clock::now();
         Worker::Layer layer{uint32_t(v), l, w.gathered.normal, found[l].lit,
-                            w.gathered.irradiance, float(w.gathered.photons.size()),
-                            w.gathered.noise, w.gathered.radius, ClusterResult{}, {}};
+                            layerTotal.irradiance, layerTotal.photons,
+                            layerTotal.noise, w.gathered.radius, ClusterResult{}, {}};
         layer.vdls = clusterGathered(w, stream + (uint64_t(l) << kCanonicalKeyBits), layer.sh.data());
         w.layers.push_back(layer);
         gatherSeconds += secondsBetween(t3, t4);

@@ -361,7 +361,9 @@ std::shared_ptr<const BinnedPhotons> binPhotonsForGather(const SurfaceGrid& grid
     const uint32_t i = grid.binPhotons[j];
     LO_CHECK_LT(size_t(i), photons.size());
     const Photon& p = photons[i];
-    binned->entries[j] = {p.position, p.normal, average(p.power), i, BinnedPhotons::kNoGroup};
+    binned->entries[j] = {p.position, p.normal, average(p.power), i, BinnedPhotons::kNoGroup,
+                          p.caustic};
+    binned->causticPhotons += p.caustic != 0;
   }
   binned->bins.resize(grid.size());
   for (size_t v = 0; v < grid.size(); ++v) {
@@ -399,7 +401,7 @@ std::shared_ptr<const BinnedPhotons> binPhotonsForGather(const SurfaceGrid& grid
       int g = 0;
       if (bin.groups > 0) {
         while (!(bin.normal[g] == entry.normal)) ++g;
-        entry.group = uint32_t(g);
+        entry.group = uint16_t(g);
       } else {
         bin.normalSum += entry.normal;
       }
@@ -440,6 +442,9 @@ Gatherer::Gatherer(const SurfaceGrid& grid, const std::vector<Photon>& photons,
   if (!binned_) binned_ = binPhotonsForGather(grid, photons);
   LO_CHECK_EQ(binned_->entries.size(), grid.binPhotons.size());
   radius_ = resolveRadius(params, grid.frame);
+  causticRadius_ = std::min(radius_, params.causticRadius > 0
+                                         ? params.causticRadius
+                                         : kDefaultCausticRadiusVoxels * grid.frame.voxelSize);
   // Photons in a voxel's bin lie inside its box grown by binMargin, and the
   // query point (the centroid) lies in its own voxel's closed box: +1 covers a
   // centroid on the upper face.
@@ -528,17 +533,30 @@ void Gatherer::markBlocked(size_t ownVoxel, const Vec3& point, const Vec3& norma
 
 void Gatherer::gather(size_t voxel, GatherResult& out) {
   LO_CHECK_LT(voxel, grid_.size());
-  gatherAt(voxel, grid_.centroids[voxel], grid_.normals[voxel], false, 0.0f, out);
+  gatherAt(voxel, grid_.centroids[voxel], grid_.normals[voxel], false, 0.0f,
+           hasCaustics() ? 0 : -1, radius_, out);
 }
 
 void Gatherer::gatherLayer(size_t voxel, const Vec3& point, const Vec3& normal,
                            GatherResult& out) {
   LO_CHECK_LT(voxel, grid_.size());
-  gatherAt(voxel, point, normal, true, params_.layerCosine, out);
+  gatherAt(voxel, point, normal, true, params_.layerCosine, hasCaustics() ? 0 : -1, radius_, out);
+}
+
+void Gatherer::gatherCaustics(size_t voxel, const Vec3& point, const Vec3& normal,
+                              GatherResult& out) {
+  LO_CHECK_LT(voxel, grid_.size());
+  if (!hasCaustics()) {
+    out = GatherResult{};
+    out.normal = normal;
+    out.radius = causticRadius_;
+    return;
+  }
+  gatherAt(voxel, point, normal, true, params_.layerCosine, 1, causticRadius_, out);
 }
 
 void Gatherer::gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, bool fixedNormal,
-                        float sideCosine, GatherResult& out) {
+                        float sideCosine, int caustic, float radius, GatherResult& out) {
   using namespace gather_internal;
   updateBlock(grid_.coords[voxel]);
   findNear(point);
@@ -595,12 +613,14 @@ void Gatherer::gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, boo
       const Neighbour& nb = blockNeighbours_[nr.neighbour];
       if (nr.blocked == 0) {
         for (uint32_t j = nb.begin; j != nb.end; ++j) {
+          if (caustic >= 0 && entries[j].caustic != caustic) continue;
           selectPhoton(entries[j].position, entries[j].normal, entries[j].index, query, side,
                        selection);
         }
       } else if (binned_->bins[nb.voxel].groups > 0) {
         for (uint32_t j = nb.begin; j != nb.end; ++j) {
           if (nr.blocked & (1u << entries[j].group)) continue;
+          if (caustic >= 0 && entries[j].caustic != caustic) continue;
           selectPhoton(entries[j].position, entries[j].normal, entries[j].index, query, side,
                        selection);
         }
@@ -612,7 +632,7 @@ void Gatherer::gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, boo
   spec.normal = normal;
   spec.fixedNormal = fixedNormal;
   spec.sideCosine = sideCosine;
-  gatherWith(grid_, photons_, spec, params_, radius_, keys_, out, vote, prepare, select);
+  gatherWith(grid_, photons_, spec, params_, radius, keys_, out, vote, prepare, select);
 }
 
 int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
@@ -712,8 +732,12 @@ GatherResult bruteForce(const SurfaceGrid& grid, const std::vector<Photon>& phot
   auto vote = [&](const Query& query, Scan& scan) {
     for (const Photon& p : photons) votePhoton(p.position, p.normal, average(p.power), query, scan);
   };
+  // Caustic photons apart, as Gatherer::gather leaves them.
+  bool apart = false;
+  for (const Photon& p : photons) apart = apart || (params.separateCaustics && p.caustic != 0);
   auto select = [&](const Query& query, Side side, KnnSelection& selection) {
     for (size_t i = 0; i < photons.size(); ++i) {
+      if (apart && photons[i].caustic != 0) continue;
       selectPhoton(photons[i].position, photons[i].normal, uint32_t(i), query, side, selection);
     }
   };

@@ -44,7 +44,19 @@ struct GatherParams {
   /// the whole disc: next to an edge, where the disc reaches past the
   /// surface, the plain estimate is too dark by up to half.
   bool edgeCorrection = true;
+  /// Caustics apart (the classic caustic map): photons that reached their
+  /// surface through mirrors and glass alone (Photon::caustic) are not
+  /// gathered with the smooth light but by Gatherer::gatherCaustics, within
+  /// causticRadius, so that a caustic stays sharp and its few bright photons
+  /// do not blot the smooth light around it.
+  bool separateCaustics = true;
+  /// The caustic gather's radius, world units; 0 = kDefaultCausticRadiusVoxels voxel sizes.
+  float causticRadius = 0.0f;
 };
+
+/// Default caustic gather radius in voxels: a caustic is kept to about its
+/// own voxel, where the smooth light's 1.5-voxel disc spreads it over three.
+constexpr float kDefaultCausticRadiusVoxels = 0.75f;
 
 /// One surface of a voxel facing one way (Gatherer::findSurfaceLayers).
 struct SurfaceLayer {
@@ -126,10 +138,12 @@ struct BinnedPhotons {
     Vec3 normal;     ///< the photon's normal (facing its arrival side)
     float weight;    ///< average(power), W: the orientation vote's weight
     uint32_t index;  ///< into the photon array
-    uint32_t group;  ///< its bin's group of equal normals, kNoGroup when the bin has none
+    uint16_t group;  ///< its bin's group of equal normals, kNoGroup when the bin has none
+    uint16_t caustic;  ///< Photon::caustic
   };
-  static constexpr uint32_t kNoGroup = 0xffffffffu;
+  static constexpr uint16_t kNoGroup = 0xffffu;
   std::vector<Entry> entries;
+  size_t causticPhotons = 0;  ///< entries with caustic set
   /// Per bin (grid voxel): the bounds of its photons' positions and, when its
   /// photons carry at most kMaxGroups distinct normals, their summed weight
   /// per normal. A bin whose bounds lie wholly within the gather radius then
@@ -169,6 +183,13 @@ class Gatherer {
   /// to `point` whose normals lie within GatherParams::layerCosine of
   /// `normal` (unit, already oriented: no vote), in the ellipsoid along it.
   void gatherLayer(size_t voxel, const Vec3& point, const Vec3& normal, GatherResult& out);
+  /// The caustic photons (Photon::caustic) near `point` on the side of
+  /// `normal` (unit, oriented: the smooth gather's), within the caustic
+  /// radius: what separateCaustics leaves out of gather and gatherLayer.
+  /// Empty (irradiance 0) when the map holds no caustic photon.
+  void gatherCaustics(size_t voxel, const Vec3& point, const Vec3& normal, GatherResult& out);
+  /// Whether the photon map holds caustic photons to gather apart.
+  bool hasCaustics() const { return params_.separateCaustics && binned_->causticPhotons > 0; }
   /// The surface layers of `voxel`: its geometric orientations
   /// (SurfaceGrid::orientations, the largest first), else its one normal,
   /// each facing the side its photons arrived on (the photons of the voxel's
@@ -214,8 +235,11 @@ class Gatherer {
   void markBlocked(size_t ownVoxel, const Vec3& point, const Vec3& normal, float sideCosine);
   /// gather and gatherLayer: `fixedNormal` skips the orientation vote;
   /// photons are kept when dot(photon normal, n) > sideCosine.
+  /// `caustic`: -1 every photon, 0 all but caustic ones, 1 caustic ones
+  /// alone, within `radius`.
   void gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, bool fixedNormal,
-                float sideCosine, GatherResult& out);
+                float sideCosine, int caustic, float radius, GatherResult& out);
+  float causticRadius_ = 0;
   Coord blockCoord_{};
   bool blockValid_ = false;
   std::vector<Neighbour> blockNeighbours_;

@@ -16,7 +16,11 @@ struct Photon {
   Vec3 direction;  ///< unit, world space, from the hit point TOWARDS where the photon came from (wi)
   Vec3 power;      ///< RGB flux carried, W
   Vec3 normal;     ///< unit geometric normal at the hit, facing the side the photon arrived from
-  uint32_t bounce = 0;  ///< 0 = direct from a light, 1 = after one diffuse/glossy bounce, ...
+  uint16_t bounce = 0;  ///< 0 = direct from a light, 1 = after one diffuse/glossy bounce, ...
+  /// 1: a caustic photon, which reached this hit from the light through
+  /// mirrors, glass or smooth metal alone (L S+ D): the gather reads it with
+  /// its own, smaller reach (GatherParams::separateCaustics).
+  uint16_t caustic = 0;
 };
 
 }  // namespace lo

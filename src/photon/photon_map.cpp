@@ -325,6 +325,9 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
   Vec3 org = start.origin, dir = start.direction, power = start.power;
 
   Hit hit;
+  // Every scattering event so far was specular (a mirror, glass or a metal
+  // too smooth to store photons): the next stored photon is a caustic's.
+  bool specularChain = true;
   for (uint32_t bounce = 0;; ++bounce) {
     ++rayCount;
     if (!ctx.tracer->intersect(org, dir, hit)) {
@@ -357,7 +360,8 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
       ph.direction = wo;
       ph.power = power;
       ph.normal = n;
-      ph.bounce = bounce;
+      ph.bounce = uint16_t(std::min<uint32_t>(bounce, 0xffffu));
+      ph.caustic = bounce > 0 && specularChain ? 1 : 0;
       out.push_back(ph);
       ++photonCount;
     }
@@ -384,7 +388,11 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     // Through a thin wall the light is still direct light: the renderer
     // draws it so (thin-walled glass casts no shadow), so the photon keeps
     // its bounce count (--include-direct decides whether it is stored).
-    if (sample.passThrough) --bounce;
+    if (sample.passThrough) {
+      --bounce;
+    } else {
+      specularChain = specularChain && (sample.delta || !mat.storesPhotons);
+    }
   }
 }
 

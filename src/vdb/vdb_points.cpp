@@ -119,7 +119,7 @@ std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin) {
         p.power = fromVdb(cdHandle.get(*idx));
         p.direction = fromVdb(dHandle.get(*idx));
         p.normal = fromVdb(nHandle.get(*idx));
-        p.bounce = uint32_t(std::max(0, bHandle.get(*idx)));
+        p.bounce = uint16_t(std::clamp(bHandle.get(*idx), 0, 0xffff));
         out.push_back(p);
       }
     }

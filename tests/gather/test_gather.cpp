@@ -310,6 +310,126 @@ TEST(Gather, UniformPlaneIrradiance) {
   EXPECT_NEAR(sum / double(count), 1.0, 0.03);
 }
 
+// Caustics apart: on a uniformly lit plane whose photons are half caustic,
+// the smooth gather reads the other half and gatherCaustics the caustic
+// half within its smaller radius; together they make the plane's
+// irradiance, and with separateCaustics off the smooth gather reads all.
+TEST(Gather, CausticPhotonsAreGatheredApartWithinTheirOwnRadius) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  const size_t n = 200000;
+  std::vector<Photon> photons = uniformPhotons(scene, n, 23);
+  for (size_t i = 0; i < photons.size(); ++i) {
+    photons[i].power = Vec3(1e-5f);
+    photons[i].caustic = i % 2;
+  }
+  const float expected = 1e-5f * float(n);  // A = 1 m^2
+  SurfaceGrid grid = gridFor(scene, 5, photons);
+  GatherParams params;
+  params.k = 100000;  // every photon within the radius
+  Gatherer apart(grid, photons, params);
+  ASSERT_TRUE(apart.hasCaustics());
+  params.separateCaustics = false;
+  Gatherer together(grid, photons, params);
+  ASSERT_FALSE(together.hasCaustics());
+  const float r = resolveRadius(params, grid.frame);
+  GatherResult smooth, caustic, all;
+  double sum = 0;
+  size_t count = 0;
+  for (size_t v = 0; v < grid.size(); ++v) {
+    const Vec3 c = grid.centroids[v];
+    if (std::min({c.x, c.z, 1 - c.x, 1 - c.z}) < r) continue;
+    apart.gather(v, smooth);
+    apart.gatherCaustics(v, c, smooth.normal, caustic);
+    together.gather(v, all);
+    for (uint32_t i : smooth.photons) ASSERT_EQ(photons[i].caustic, 0u);
+    for (uint32_t i : caustic.photons) {
+      ASSERT_EQ(photons[i].caustic, 1u);
+      ASSERT_LE(length(photons[i].position - c),
+                kDefaultCausticRadiusVoxels * grid.frame.voxelSize * 1.0001f);
+    }
+    EXPECT_NEAR(double(all.photons.size()) / double(smooth.photons.size()), 2.0, 0.3);
+    EXPECT_LT(caustic.photons.size(), smooth.photons.size() / 2) << "a smaller disc";
+    EXPECT_NEAR(smooth.irradiance.x / expected, 0.5f, 0.1f);
+    EXPECT_NEAR(caustic.irradiance.x / expected, 0.5f, 0.2f);
+    sum += (smooth.irradiance.x + caustic.irradiance.x) / all.irradiance.x;
+    ++count;
+  }
+  ASSERT_GT(count, 100u);
+  EXPECT_NEAR(sum / double(count), 1.0, 0.03) << "the two halves make the whole";
+}
+
+// A caustic stays sharp: a spot of caustic photons (ten times the smooth
+// light, 2 voxels across its radius) on a uniformly lit plane. Just outside
+// the spot the truth is the smooth light alone; gathered with the smooth
+// light's 1.5-voxel disc the spot bleeds into it, gathered apart within
+// 0.75 voxels it does not, and inside the spot both hold its light.
+TEST(Gather, ACausticGatheredApartDoesNotBleedIntoTheLightAroundIt) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  std::vector<Photon> photons = uniformPhotons(scene, 100000, 29);
+  for (Photon& p : photons) p.power = Vec3(1e-5f);
+  const float smooth = 1e-5f * 100000.0f;  // W/m^2 over the 1 m^2 plane
+  GridParams gp;
+  gp.depth = 5;
+  const float h = makeGridFrame(scene.bounds(), gp.depth).voxelSize;
+  const Vec3 centre{0.5f, 0, 0.5f};
+  const float spotRadius = 2 * h;
+  // Caustic photons uniform over the spot at 10x the smooth density.
+  const size_t spotCount = size_t(10 * 100000 * kPi * spotRadius * spotRadius);
+  Rng rng(31, 0);
+  for (size_t i = 0; i < spotCount; ++i) {
+    const float rr = spotRadius * std::sqrt(rng.uniform()), phi = 2 * kPi * rng.uniform();
+    Photon p = photons.front();
+    p.position = centre + Vec3{rr * std::cos(phi), 0, rr * std::sin(phi)};
+    p.caustic = 1;
+    p.bounce = 1;
+    photons.push_back(p);
+  }
+  SurfaceGrid grid = gridFor(scene, gp.depth, photons);
+  GatherParams params;
+  params.k = 100000;
+  Gatherer apart(grid, photons, params);
+  params.separateCaustics = false;
+  Gatherer merged(grid, photons, params);
+  GatherResult g, c, m;
+  double bleedApart = 0, bleedMerged = 0, insideApart = 0, insideMerged = 0;
+  int outside = 0, inside = 0;
+  for (size_t v = 0; v < grid.size(); ++v) {
+    const Vec3 q = grid.centroids[v];
+    const float d = length(q - centre);
+    const bool ring = d > spotRadius + 0.8f * h && d < spotRadius + 1.4f * h;
+    const bool core = d < spotRadius - 1.0f * h;
+    if (!ring && !core) continue;
+    apart.gather(v, g);
+    apart.gatherCaustics(v, q, g.normal, c);
+    merged.gather(v, m);
+    const double a = (g.irradiance.x + c.irradiance.x) / smooth, b = m.irradiance.x / smooth;
+    if (ring) {
+      bleedApart += a - 1;
+      bleedMerged += b - 1;
+      ++outside;
+    } else {
+      insideApart += a;
+      insideMerged += b;
+      ++inside;
+    }
+  }
+  ASSERT_GT(outside, 8);
+  ASSERT_GT(inside, 2);
+  bleedApart /= outside;
+  bleedMerged /= outside;
+  std::printf("[ caustic ] just outside the spot: the smooth light + %.1f%% apart, + %.1f%% merged; "
+              "inside: %.2f and %.2f x the smooth light (truth 11)\n",
+              100 * bleedApart, 100 * bleedMerged, insideApart / inside, insideMerged / inside);
+  EXPECT_LT(std::fabs(bleedApart), 0.05) << "no caustic photon within 0.75 voxel there";
+  EXPECT_GT(bleedMerged, 0.1) << "the 1.5-voxel disc reaches into the spot";
+  EXPECT_NEAR(insideApart / inside, 11.0, 1.0);
+  EXPECT_NEAR(insideMerged / inside, 11.0, 1.5);
+}
+
 // Fewer than k photons within r: all of them are kept and r_k = r.
 TEST(Gather, FewerThanKUsesTheSearchRadius) {
   Scene scene;
