@@ -46,7 +46,15 @@ void projectSh(const DirectionSample* samples, size_t n, const Vec3& normal, int
       atNormal[a] += sum[i][a] * y;
     }
   }
+  const double y0 = double(layout::loShBasis(0u, 0.0f, 0.0f, 1.0f));  // the constant term's basis
   for (int a = 0; a < 3; ++a) {
+    if (oriented && total[a] > 0 && !(atNormal[a] > 0)) {
+      // The truncated series is not positive at the normal (a few photons
+      // from grazing directions ring below zero there): keep the estimate
+      // as a constant, E(n) = the samples' sum in every direction.
+      for (int i = 0; i < terms; ++i) out[i][a] = i == 0 ? float(total[a] / y0) : 0.0f;
+      continue;
+    }
     const double scale = oriented && atNormal[a] > 0 && total[a] > 0 ? total[a] / atNormal[a] : 1.0;
     for (int i = 0; i < terms; ++i) out[i][a] = float(sum[i][a] * scale);
   }

@@ -62,7 +62,9 @@ constexpr float kShMinCosine = 0.25f;
 /// scaled so that E(n) = sum_i E_i Y_i(n) equals the samples' sum, the
 /// gathered estimate, where both are positive: the truncated series keeps
 /// the voxel's own irradiance and adds the change with the normal (a normal
-/// map's). `normal` zero: no division, no scaling.
+/// map's). Where the series is not positive at the normal (a few photons
+/// from grazing directions ring below zero there) the channel is kept as a
+/// constant equal to the estimate. `normal` zero: no division, no scaling.
 void projectSh(const DirectionSample* samples, size_t n, const Vec3& normal, int terms, Vec3* out);
 
 struct BakeTimings {

@@ -119,6 +119,24 @@ TEST(SphericalHarmonics, ScalingKeepsTheVoxelsOwnIrradiance) {
   for (const Vec3& t : sh) EXPECT_EQ(luminance(t), 0.0f);
 }
 
+// One photon from behind the layer's surface (a thin wall's dark layer may
+// gather one whose own normal faced its way): the series is negative at the
+// normal, so the channel is kept as a constant that still equals the
+// estimate there, as the file's check (E(n) = irradiance) demands.
+TEST(Sh, ASeriesNotPositiveAtTheNormalKeepsTheEstimateAsAConstant) {
+  const Vec3 up{0, 0, 1};
+  const DirectionSample grazing{normalize(Vec3{0.1f, 0, -1}), Vec3(0.5f)};
+  // Order 1 from straight behind: E(n) ~ 1/4 - 1/2 of the light, negative.
+  Vec3 sh[9];
+  projectSh(&grazing, 1, up, 4, sh);
+  EXPECT_NEAR(evaluate(sh, 4, up).x, 0.5f, 1e-6f);
+  EXPECT_NEAR(evaluate(sh, 4, Vec3{1, 0, 0}).x, 0.5f, 1e-6f) << "a constant";
+  EXPECT_NEAR(evaluate(sh, 4, Vec3{0, 0, -1}).x, 0.5f, 1e-6f) << "a constant";
+  // Order 2 rings positive there: scaled as usual, the estimate kept.
+  projectSh(&grazing, 1, up, 9, sh);
+  EXPECT_NEAR(evaluate(sh, 9, up).x, 0.5f, 1e-5f);
+}
+
 /// A slab of depth-3 voxels at z = 0 whose SH hold one projected direction.
 VdlGrid shSlab(int terms, float power) {
   VdlGrid g;
