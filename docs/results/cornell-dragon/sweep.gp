@@ -3,7 +3,7 @@ set terminal pngcairo size 1000,700 font 'sans,10'
 set logscale x
 set grid
 set key top right
-set ylabel 'indirect irradiance: relative RMSE vs reference (%)'
+set ylabel 'indirect irradiance: relative RMSE vs reference, 4x4 bins (%)'
 set output 'error-vs-bake-time.png'
 set title 'cornell-dragon: error against bake time, s'
 set xlabel 'bake time, s (log scale)'
