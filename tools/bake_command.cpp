@@ -115,7 +115,9 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
       std::printf("%s\n", st.noise.ToString().c_str());
     }
   }
-  if (!baked.stats.passes.empty() && baked.stats.targetStop != "target reached") {
+  // Running out of paths is photonBudgetWarning's, with its advice.
+  if (!baked.stats.passes.empty() && baked.stats.targetStop != "target reached" &&
+      baked.stats.targetStop != "no more paths") {
     std::fprintf(stderr,
                  "warning: the noise target %s was not reached (%s): the grid's %s; raise "
                  "--max-photons, bake at a smaller --depth or ask for a larger --target-error\n",

@@ -304,10 +304,18 @@ std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
                              " photon paths missed every surface" +
                              (params.region.empty() ? "" : " in --bounds") +
                              ": bake the part that matters with --bounds";
-  if (st.storedPhotons < params.photons) {
-    const std::string head = "only " + formatCount(st.storedPhotons) + " of " +
-                             formatCount(params.photons) + " photons were stored from " +
-                             formatCount(st.emittedPaths) + " paths (the most a bake traces); ";
+  // A fixed budget falls short when fewer photons than asked were stored; a
+  // target bake when its passes ran out of paths (its other stops are
+  // reported by the bake's own summary).
+  const bool target = params.targetError > 0;
+  if (target ? st.targetStop == "no more paths" : st.storedPhotons < params.photons) {
+    const std::string head =
+        target ? "the noise target was not reached: " + formatCount(st.storedPhotons) +
+                     " photons were stored from " + formatCount(st.emittedPaths) +
+                     " paths (the most a bake traces); "
+               : "only " + formatCount(st.storedPhotons) + " of " + formatCount(params.photons) +
+                     " photons were stored from " + formatCount(st.emittedPaths) +
+                     " paths (the most a bake traces); ";
     if (mostlyMissed) return head + missed;
     return head + formatCount(st.emptyPaths) +
            " paths reached a surface but stored nothing (their first hit is direct light, "

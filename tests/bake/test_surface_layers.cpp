@@ -238,6 +238,17 @@ TEST(BakeRegion, BudgetWarningSaysWhatHappenedAndWhatHelps) {
   EXPECT_NE(w.find("--bounds"), std::string::npos) << w;
   st.storedPhotons = 1000;
   EXPECT_NE(photonBudgetWarning(p, st).find("--bounds"), std::string::npos);
+  // A target bake stores what its noise asks, fewer than BakeParams::photons
+  // or more: short only when its passes ran out of paths.
+  p.targetError = 0.07;
+  st.missedPaths = 100;
+  st.storedPhotons = 400;
+  st.targetStop = "target reached";
+  EXPECT_EQ(photonBudgetWarning(p, st), "");
+  st.targetStop = "no more paths";
+  w = photonBudgetWarning(p, st);
+  EXPECT_NE(w.find("the noise target was not reached: 400 photons"), std::string::npos) << w;
+  EXPECT_NE(w.find("--include-direct"), std::string::npos) << w;
 }
 
 // A small room on a 50 m ground plane under a sun: without a region of
