@@ -20,7 +20,7 @@ struct InspectOptions {
   bool json = false;
 };
 
-constexpr int kChecksFailed = 2;
+constexpr int kChecksFailed = 3;  // 1: an error, 2: a usage error (lightoctree.cpp)
 
 std::string range(const GridSummary& g) {
   if (g.min.empty()) return g.valueType == "float" || g.valueType == "vec3s" ? "(none)" : "";
@@ -127,7 +127,7 @@ std::function<int()> addInspectCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "inspect",
       "List a .vdb file's grids, metadata, value ranges and memory, and check the VDL contract "
-      "(exit 0: checks pass, 2: a check failed, 1: unreadable file).");
+      "(exit 0: checks pass, 3: a check failed, 1: unreadable file, 2: bad command line).");
   cmd->add_option("input", opt->input, ".vdb file")->required()->check(CLI::ExistingFile);
   cmd->add_flag("--json", opt->json, "Print the report as JSON");
   return [cmd, opt]() -> int { return cmd->parsed() ? runInspect(*opt) : -1; };

@@ -8,6 +8,9 @@
 
 namespace {
 
+/// Exit status of a command line the parser refuses (docs: README, "Exit status").
+constexpr int kUsageError = 2;
+
 int run(int argc, char** argv) {
   CLI::App app{
       "Light Octree " LO_VERSION
@@ -29,7 +32,9 @@ int run(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; a usage error exits 2, as command-line
+    // tools do (the parser's own codes, 105-109, say nothing to a script).
+    return app.exit(e) == 0 ? 0 : kUsageError;
   }
   for (auto& command : commands) {
     int rc = command();
