@@ -37,8 +37,10 @@ struct LightmapOptions {
 /// The export's parameters from the flags, checked before any work.
 LightmapExportParams exportParams(const LightmapOptions& opt) {
   checkOutputFolder(opt.output, "--output");
-  checkDistinctFiles({{"--output", opt.output}}, {{"SCENE", opt.scene}, {"LIGHTS", opt.lights}});
   checkLightmapExportPath(opt.output, "--output");
+  NamedPaths inputs = sceneInputs(opt.scene);
+  inputs.push_back({"LIGHTS", opt.lights});
+  checkLightmapOutputs(opt.output, opt.image == "png", opt.previewUnlit, opt.chartImage, inputs);
   LightmapExportParams p;
   p.output = opt.output;
   p.content = parseAtlasContent(opt.content);

@@ -56,7 +56,7 @@ int runReference(const ReferenceOptions& opt) {
   checkDistinctFiles({{"--output", opt.output},
                       {"--std-error", opt.stdErrorOutput},
                       {"--emitter-mask", opt.emitterMaskOutput}},
-                     {{"SCENE", opt.scene}});
+                     sceneInputs(opt.scene));
   checkCameraOptions(opt.camera);
   ThreadLimit threadLimit(opt.threads);
 

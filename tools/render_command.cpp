@@ -75,7 +75,9 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
 int runRender(const RenderOptions& opt) {
   // Everything that can be checked before the work is checked first.
   checkOutputFolder(opt.output, "--output");
-  checkDistinctFiles({{"--output", opt.output}}, {{"SCENE", opt.scene}, {"LIGHTS", opt.lights}});
+  NamedPaths inputs = sceneInputs(opt.scene);
+  inputs.push_back({"LIGHTS", opt.lights});
+  checkDistinctFiles({{"--output", opt.output}}, inputs);
   if (!hasExtension(opt.output, ".png") && !hasExtension(opt.output, ".exr")) {
     throw InputError("--output: '" + opt.output + "' must end in .png or .exr");
   }

@@ -3,9 +3,11 @@
 #include <CLI/CLI.hpp>
 
 #include <cmath>
+#include <filesystem>
 
 #include "camera_options.h"
 #include "core/error.h"
+#include "scene/scene_files.h"
 
 namespace lo::tool {
 
@@ -31,6 +33,22 @@ void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
       ->check(CLI::Range(1.7, 10.0))  // kMinTurbidity, kMaxTurbidity
       ->excludes("--sky-image")
       ->excludes("--sky-mesh");
+}
+
+NamedPaths sceneInputs(const std::string& scene) {
+  NamedPaths inputs;
+  const std::string folder = std::filesystem::path(scene).parent_path().string();
+  for (const std::string& file : sceneFiles(scene)) {
+    if (inputs.empty()) {
+      inputs.push_back({"SCENE", file});
+      continue;
+    }
+    std::error_code ec;
+    const std::string name =
+        std::filesystem::relative(file, folder.empty() ? "." : folder, ec).generic_string();
+    inputs.push_back({"SCENE's file '" + (ec || name.empty() ? file : name) + "'", file});
+  }
+  return inputs;
 }
 
 Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {

@@ -8,6 +8,7 @@
 
 #include <string>
 
+#include "core/file.h"
 #include "scene/scene.h"
 
 namespace CLI {
@@ -25,6 +26,11 @@ struct SceneOptions {
 
 /// Registers --sky, --sky-image, --sky-mesh and --physical-sky on `cmd`.
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt);
+
+/// The files loading `scene` reads, named for checkDistinctFiles ("SCENE",
+/// then "SCENE's file 'tex.png'", ...; scene/scene_files.h): what no
+/// output of a command may replace.
+NamedPaths sceneInputs(const std::string& scene);
 
 /// loadScene(path) with the flags applied. @throws InputError naming the flag
 /// (a radiance that is negative or not a number) or the file.

@@ -214,6 +214,43 @@ void checkLightmapExportPath(const std::string& output, const char* flag) {
   }
 }
 
+void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bool charts,
+                          const NamedPaths& inputs) {
+  using lightmap_export_internal::besideOutput;
+  NamedPaths outputs{{"--output", output}};
+  if (hasExtension(output, ".gltf")) outputs.push_back({"--output's buffer", besideOutput(output, ".bin")});
+  if (preview) outputs.push_back({"--preview-unlit", besideOutput(output, "-preview.glb")});
+  checkDistinctFiles(outputs, inputs);
+  // The pages and chart images: OUT-lightmap<k>.exr|png, OUT-charts<k>.png.
+  std::error_code ec;
+  const fs::path folder = fs::weakly_canonical(fs::absolute(fs::path(output).parent_path(), ec), ec);
+  const std::string stem = fs::path(output).stem().string();
+  auto numbered = [](const std::string& name, const std::string& head, const std::string& tail) {
+    if (name.size() <= head.size() + tail.size() || name.compare(0, head.size(), head) != 0 ||
+        name.compare(name.size() - tail.size(), tail.size(), tail) != 0) {
+      return false;
+    }
+    for (size_t i = head.size(); i < name.size() - tail.size(); ++i) {
+      if (name[i] < '0' || name[i] > '9') return false;
+    }
+    return true;
+  };
+  for (const auto& [what, path] : inputs) {
+    if (path.empty()) continue;
+    std::error_code e;
+    const fs::path in = fs::weakly_canonical(fs::absolute(path, e), e);
+    if (e || in.parent_path() != folder) continue;
+    const std::string name = in.filename().string();
+    const bool page = numbered(name, stem + "-lightmap", rgbm ? ".png" : ".exr");
+    const bool chart = charts && numbered(name, stem + "-charts", ".png");
+    if (page || chart) {
+      throw InputError("--output: the " + std::string(page ? "lightmap pages" : "chart images") +
+                       " of '" + output + "' would replace the input " + what + " ('" + path +
+                       "'); write to another name");
+    }
+  }
+}
+
 std::string lightmapPagePath(const std::string& output, int page, bool rgbm) {
   return lightmap_export_internal::besideOutput(
       output, "-lightmap" + std::to_string(page) + (rgbm ? ".png" : ".exr"));

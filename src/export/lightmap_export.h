@@ -22,6 +22,8 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+
+#include "core/file.h"
 #include <vector>
 
 #include "core/resources.h"
@@ -88,6 +90,14 @@ void checkLightmapExportPath(const std::string& output, const char* flag = "--ou
 
 /// D/OUT-lightmapN.exr (or .png with rgbm) for `output` D/OUT.glb or .gltf.
 std::string lightmapPagePath(const std::string& output, int page, bool rgbm);
+
+/// Refuses, before any work, an export some file of which would replace one
+/// of `inputs` (the scene, its buffers and images, the grid: checkDistinctFiles'
+/// pairs): the glTF, its .bin (a .gltf output), the preview, and the pages
+/// and chart images whatever their count (any input named like one of them
+/// beside the output). @throws InputError naming both.
+void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bool charts,
+                          const NamedPaths& inputs);
 
 /// @brief The export described in the file comment of `grid` over `scene`.
 /// @throws InputError for a bad output path, unusable TEXCOORD_1 (see

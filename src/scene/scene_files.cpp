@@ -1,0 +1,134 @@
+#include "scene/scene_files.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/file.h"
+#include "scene/gltf_prevalidate.h"
+#include "scene/scene_internal.h"
+
+namespace lo {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace scene_internal;
+
+/// The uris of `key` (buffers or images) that name files.
+void addUris(const std::string& path, const std::string& baseDir, const nlohmann::json& j,
+             const char* key, std::vector<std::string>& out) {
+  auto list = j.find(key);
+  if (list == j.end() || !list->is_array()) return;
+  for (const nlohmann::json& item : *list) {
+    if (!item.is_object()) continue;
+    auto uri = item.find("uri");
+    if (uri == item.end() || !uri->is_string()) continue;
+    const std::string u = uri->get<std::string>();
+    if (u.rfind("data:", 0) == 0) continue;
+    try {
+      out.push_back(resolveInsideFolder(path, baseDir, percentDecode(u), key));
+    } catch (const InputError&) {
+      // Outside the folder: the load refuses the scene.
+    }
+  }
+}
+
+/// The JSON of a .gltf, or of a .glb's first chunk (read alone: the
+/// binary chunk after it may be large). Empty when the file is not one.
+std::string gltfJson(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!hasExtension(path, ".glb")) {
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+  unsigned char header[20];
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return "";
+  const uint32_t jsonLength = uint32_t(header[12]) | uint32_t(header[13]) << 8 |
+                              uint32_t(header[14]) << 16 | uint32_t(header[15]) << 24;
+  std::error_code ec;
+  const uintmax_t size = fs::file_size(path, ec);
+  if (ec || std::memcmp(header, "glTF", 4) != 0 || 20 + uintmax_t(jsonLength) > size) return "";
+  std::string text(jsonLength, '\0');
+  if (!in.read(text.data(), std::streamsize(jsonLength))) return "";
+  return text;
+}
+
+void gltfFiles(const std::string& path, const std::string& baseDir,
+               std::vector<std::string>& out) {
+  const std::string text = gltfJson(path);
+  checkJsonNesting(path, text);
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object()) return;
+  addUris(path, baseDir, j, "buffers", out);
+  addUris(path, baseDir, j, "images", out);
+}
+
+/// The whitespace-separated words of `line` after its first.
+std::vector<std::string> wordsAfterFirst(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> words;
+  std::string w;
+  in >> w;
+  while (in >> w) words.push_back(w);
+  return words;
+}
+
+void objFiles(const std::string& path, const std::string& baseDir, std::vector<std::string>& out) {
+  std::ifstream obj(path);
+  std::string line;
+  std::vector<std::string> libraries;
+  while (std::getline(obj, line)) {
+    if (line.rfind("mtllib", 0) != 0) continue;
+    for (const std::string& name : wordsAfterFirst(line)) {
+      try {
+        libraries.push_back(resolveInsideFolder(path, baseDir, name, "mtllib"));
+      } catch (const InputError&) {
+      }
+    }
+  }
+  for (const std::string& library : libraries) {
+    out.push_back(library);
+    std::ifstream mtl(library);
+    while (std::getline(mtl, line)) {
+      const size_t start = line.find_first_not_of(" \t");
+      if (start == std::string::npos || line.compare(start, 6, "map_Kd") != 0) continue;
+      const std::vector<std::string> words = wordsAfterFirst(line.substr(start));
+      if (words.empty()) continue;
+      try {
+        out.push_back(resolveInsideFolder(path, baseDir, words.back(), "map_Kd"));
+      } catch (const InputError&) {
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> sceneFiles(const std::string& path) {
+  std::vector<std::string> files{path};
+  std::string baseDir = fs::path(path).parent_path().string();
+  if (baseDir.empty()) baseDir = ".";
+  try {
+    requireRegularFile(path, "scene");  // a FIFO would hang the reads below
+    if (hasExtension(path, ".obj")) {
+      objFiles(path, baseDir, files);
+    } else {
+      gltfFiles(path, baseDir, files);
+    }
+  } catch (const InputError&) {
+    // The load says what is wrong with the file.
+  }
+  std::vector<std::string> unique;
+  for (const std::string& f : files) {
+    if (std::find(unique.begin(), unique.end(), f) == unique.end()) unique.push_back(f);
+  }
+  return unique;
+}
+
+}  // namespace lo

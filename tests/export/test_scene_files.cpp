@@ -1,0 +1,90 @@
+// sceneFiles: every file loading a scene reads, so that no command's output
+// replaces one of them (an output that is an input).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "core/error.h"
+#include "core/file.h"
+#include "export/lightmap_export.h"
+#include "scene/scene_files.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> names(const std::vector<std::string>& files) {
+  std::vector<std::string> out;
+  for (const std::string& f : files) out.push_back(fs::path(f).filename().string());
+  return out;
+}
+
+TEST(SceneFiles, AGltfListsItsBuffersAndImages) {
+  const std::string truck = test::sharedScenesDir() + "/real/milk-truck-spots/truck-under-spots.gltf";
+  const std::vector<std::string> files = sceneFiles(truck);
+  EXPECT_EQ(names(files), (std::vector<std::string>{"truck-under-spots.gltf",
+                                                    "CesiumMilkTruck0.bin", "CesiumMilkTruck.png"}));
+  for (const std::string& f : files) EXPECT_TRUE(fs::is_regular_file(f)) << f;
+}
+
+TEST(SceneFiles, AGlbListsItselfAndAnObjItsLibrariesAndTextures) {
+  EXPECT_EQ(names(sceneFiles(test::sharedScenesDir() + "/composed/cornell-box.glb")),
+            std::vector<std::string>{"cornell-box.glb"});
+  const std::vector<std::string> files =
+      sceneFiles(test::sharedScenesDir() + "/real/viking-room/viking_room_lit.obj");
+  EXPECT_EQ(names(files), (std::vector<std::string>{"viking_room_lit.obj", "viking_room_lit.mtl",
+                                                    "viking_room.png"}));
+}
+
+TEST(SceneFiles, WhatCannotBeReadListsTheSceneAlone) {
+  const std::string dir = test::outputDir("SceneFiles.Bad");
+  {
+    std::ofstream(dir + "/broken.gltf") << "{ not json";
+  }
+  EXPECT_EQ(sceneFiles(dir + "/broken.gltf"), std::vector<std::string>{dir + "/broken.gltf"});
+  EXPECT_EQ(sceneFiles(dir + "/missing.gltf"), std::vector<std::string>{dir + "/missing.gltf"});
+  {
+    // A uri outside the folder is the loader's to refuse, not listed.
+    std::ofstream(dir + "/outside.gltf")
+        << R"({"asset":{"version":"2.0"},"images":[{"uri":"../x.png"}],)"
+        << R"("buffers":[{"uri":"a%20b.bin","byteLength":4}]})";
+  }
+  EXPECT_EQ(names(sceneFiles(dir + "/outside.gltf")),
+            (std::vector<std::string>{"outside.gltf", "a b.bin"}));
+}
+
+// A lightmap export refuses outputs that would replace the scene's files:
+// its glTF, its .bin, its preview, and its numbered pages and chart images.
+TEST(SceneFiles, ALightmapExportWouldNotReplaceTheScenesFiles) {
+  const std::string dir = test::outputDir("SceneFiles.Lightmap");
+  const NamedPaths inputs{{"SCENE", dir + "/room.gltf"},
+                          {"SCENE's file 'room.bin'", dir + "/room.bin"},
+                          {"SCENE's file 'out-lightmap3.exr'", dir + "/out-lightmap3.exr"},
+                          {"SCENE's file 'out-charts0.png'", dir + "/out-charts0.png"},
+                          {"SCENE's file 'y-preview.glb'", dir + "/y-preview.glb"}};
+  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/lit.gltf", false, true, true, inputs));
+  EXPECT_THROW(checkLightmapOutputs(dir + "/room.gltf", false, false, false, inputs), InputError);
+  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/room.glb", false, false, false, {inputs[1]}))
+      << "no .bin beside a .glb: only a .gltf output writes room.bin";
+  EXPECT_THROW(checkLightmapOutputs(dir + "/out.glb", false, false, false, inputs), InputError);
+  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/out.glb", true, false, false, {inputs[2]}))
+      << "PNG pages are named .png";
+  EXPECT_THROW(checkLightmapOutputs(dir + "/out.glb", true, false, true, {inputs[3]}), InputError);
+  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/out.glb", true, false, false, {inputs[3]}));
+  EXPECT_THROW(checkLightmapOutputs(dir + "/y.glb", false, true, false, inputs), InputError);
+  try {
+    checkLightmapOutputs(dir + "/lit.gltf", false, false, false,
+                         {{"SCENE's file 'lit.bin'", dir + "/lit.bin"}});
+    FAIL() << "lit.gltf writes lit.bin";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("SCENE's file 'lit.bin'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace lo
