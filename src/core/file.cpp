@@ -1,4 +1,5 @@
 #include "core/file.h"
+#include "core/file_set.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -105,6 +106,36 @@ std::string notReplaceable(const std::string& path) {
   return describe(s);
 }
 
+/// @throws IoError unless `path` may be replaced (absent or a regular file).
+void requireReplaceable(const std::string& path) {
+  const std::string refused = notReplaceable(path);
+  if (!refused.empty()) {
+    throw IoError(path + ": will not write: it is " + refused + " (write to a new name)");
+  }
+}
+
+/// A new temporary name of `path`, its file created exclusively and without
+/// following links: a name that exists (whoever put it there) is an error,
+/// never something to write through.
+std::string createTemporary(const std::string& path) {
+  const std::string tmp = temporaryPathFor(path);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    throw IoError(path + ": cannot create the temporary file '" + tmp + "' (" +
+                  std::strerror(errno) + ")");
+  }
+  ::close(fd);
+  return tmp;
+}
+
+/// Fills the temporary file `tmp` of `path` with `text`.
+void writeBytes(const std::string& path, const std::string& tmp, const std::string& text) {
+  std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+  if (!f) throw IoError(path + ": cannot open '" + tmp + "' for writing");
+  f.write(text.data(), std::streamsize(text.size()));
+  if (!f.flush()) throw IoError(path + ": write failed");
+}
+
 }  // namespace file_internal
 
 void requireRegularFile(const std::string& path, const std::string& what) {
@@ -169,19 +200,8 @@ std::vector<std::string> leftoverTemporaries(const std::string& path) {
 void writeAtomically(const std::string& path,
                      const std::function<void(const std::string& tmp)>& write) {
   using namespace file_internal;
-  const std::string refused = notReplaceable(path);
-  if (!refused.empty()) {
-    throw IoError(path + ": will not write: it is " + refused + " (write to a new name)");
-  }
-  const std::string tmp = temporaryPathFor(path);
-  // Created exclusively and without following links: a name that exists
-  // (whoever put it there) is an error, never something to write through.
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    throw IoError(path + ": cannot create the temporary file '" + tmp + "' (" +
-                  std::strerror(errno) + ")");
-  }
-  ::close(fd);
+  requireReplaceable(path);
+  const std::string tmp = createTemporary(path);
   const int slot = track(tmp);
   auto removeTmp = [&] {
     std::error_code ignored;
@@ -216,13 +236,62 @@ void writeAtomically(const std::string& path,
   untrack(slot);
 }
 
+AtomicFileSet::~AtomicFileSet() {
+  for (const Entry& e : entries_) {
+    std::error_code ignored;
+    fs::remove(e.tmp, ignored);
+    file_internal::untrack(e.slot);
+  }
+}
+
+void AtomicFileSet::add(const std::string& path,
+                        const std::function<void(const std::string& tmp)>& write) {
+  using namespace file_internal;
+  requireReplaceable(path);
+  for (const Entry& e : entries_) {
+    if (e.path == path) throw IoError(path + ": named twice in one set of output files");
+  }
+  const std::string tmp = createTemporary(path);
+  // From here the destructor removes it, whatever fails.
+  entries_.push_back({path, tmp, track(tmp)});
+  try {
+    write(tmp);
+  } catch (const IoError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw IoError(path + ": cannot write (" + e.what() + ")");
+  }
+  if (fs::symlink_status(tmp).type() != fs::file_type::regular) {
+    throw IoError(path + ": the temporary file '" + tmp + "' was replaced while writing");
+  }
+}
+
+void AtomicFileSet::addText(const std::string& path, const std::string& text) {
+  add(path, [&](const std::string& tmp) { file_internal::writeBytes(path, tmp, text); });
+}
+
+void AtomicFileSet::commit() {
+  using namespace file_internal;
+  for (const Entry& e : entries_) requireReplaceable(e.path);
+  while (!entries_.empty()) {
+    const Entry e = entries_.front();
+    std::error_code ec;
+    fs::rename(e.tmp, e.path, ec);
+    if (ec) throw IoError(e.path + ": cannot rename '" + e.tmp + "' (" + ec.message() + ")");
+    untrack(e.slot);
+    entries_.erase(entries_.begin());
+  }
+}
+
+std::vector<std::string> AtomicFileSet::paths() const {
+  std::vector<std::string> out;
+  for (const Entry& e : entries_) out.push_back(e.path);
+  return out;
+}
+
 void writeTextAtomically(const std::string& path, const std::string& text) {
-  writeAtomically(path, [&](const std::string& tmp) {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw IoError(path + ": cannot open '" + tmp + "' for writing");
-    f.write(text.data(), std::streamsize(text.size()));
-    if (!f.flush()) throw IoError(path + ": write failed");
-  });
+  writeAtomically(path,
+                  [&](const std::string& tmp) { file_internal::writeBytes(path, tmp, text); });
 }
 
 void checkOutputFolder(const std::string& path, const char* flag) {

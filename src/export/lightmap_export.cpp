@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "core/error.h"
+#include "core/file_set.h"
 #include "core/file.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
@@ -36,23 +37,6 @@ std::string besideOutput(const std::string& output, const std::string& suffix) {
   const fs::path out(output);
   return (out.parent_path() / (out.stem().string() + suffix)).string();
 }
-
-/// Files this export has written, removed again if a later one fails, so
-/// that a failed export leaves nothing behind.
-class WrittenFiles {
- public:
-  void add(const std::string& path) { paths_.push_back(path); }
-  void keep() { paths_.clear(); }
-  ~WrittenFiles() {
-    for (const std::string& p : paths_) {
-      std::error_code ignored;
-      fs::remove(p, ignored);
-    }
-  }
-
- private:
-  std::vector<std::string> paths_;
-};
 
 void addRow(std::vector<StageReport>& rows, const std::string& name, double seconds,
             const std::string& detail) {
@@ -166,30 +150,39 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
   encodeTimer.finish(ex.encoding + (params.preview ? " + unlit preview" : ""));
 
   StageTimer writeTimer(rows, "write");
-  WrittenFiles written;
+  // The whole set appears at once, or nothing does: every file goes to its
+  // temporary name first, and a failure (a link planted at the preview's
+  // name, a full disk, a signal) leaves an earlier run's set as it was.
+  AtomicFileSet set;
   for (int p = 0; p < atlas.pageCount; ++p) {
     const std::string& path = result.pagePaths[size_t(p)];
     if (params.rgbm) {
-      writeTextAtomically(path, rgbmPages[size_t(p)]);
+      set.addText(path, rgbmPages[size_t(p)]);
     } else {
-      writeExr(path, atlas.irradiance[size_t(p)]);
+      const RgbImage& page = atlas.irradiance[size_t(p)];
+      set.add(path, [&page](const std::string& tmp) { writeExr(tmp, page); });
     }
-    written.add(path);
-    result.pageFileBytes += size_t(fs::file_size(path));
+    result.pageFileBytes += params.rgbm ? rgbmPages[size_t(p)].size() : 0;
   }
-  for (const std::string& path : writeGltfFiles(lit, params.output)) written.add(path);
-  if (params.preview) {
-    for (const std::string& path : writeGltfFiles(unlit, result.previewPath)) written.add(path);
-  }
+  auto addGltf = [&set](const GltfFiles& files, const std::string& path) {
+    if (!files.binUri.empty()) {
+      set.addText((fs::path(path).parent_path() / files.binUri).string(), files.bin);
+    }
+    set.addText(path, files.gltf);
+  };
+  addGltf(lit, params.output);
+  if (params.preview) addGltf(unlit, result.previewPath);
   if (params.chartImages) {
     for (int p = 0; p < uvs.pageCount; ++p) {
       result.chartPaths.push_back(besideOutput(params.output, "-charts" + std::to_string(p) + ".png"));
       const std::vector<uint8_t> png = encodePng(chartLayoutImage(uvs, p));
-      writeTextAtomically(result.chartPaths.back(), std::string(png.begin(), png.end()));
-      written.add(result.chartPaths.back());
+      set.addText(result.chartPaths.back(), std::string(png.begin(), png.end()));
     }
   }
-  written.keep();
+  set.commit();
+  if (!params.rgbm) {
+    for (const std::string& path : result.pagePaths) result.pageFileBytes += size_t(fs::file_size(path));
+  }
   writeTimer.finish(formatCount(size_t(atlas.pageCount) + 1 + (params.preview ? 1 : 0) +
                                 result.chartPaths.size()) +
                     " files");

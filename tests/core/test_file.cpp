@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "test_util.h"
 
 namespace lo {
@@ -71,6 +72,54 @@ TEST(OutputFiles, NeverWritesThroughALinkOrOverWhatIsNotARegularFile) {
   EXPECT_THROW(checkOutputFolder("/dev/null", "--output"), InputError);
   EXPECT_THROW(checkOutputFolder(dir + "/no-such-folder/x.vdb", "--output"), InputError);
   EXPECT_TRUE(leftoverTemporaries(link).empty());
+}
+
+// A set of output files appears whole or not at all: a failure at its last
+// file (a link planted at its name) leaves an earlier run's files as they
+// were and no temporary; a committed set replaces them all.
+TEST(OutputFiles, ASetAppearsWholeOrNotAtAll) {
+  const std::string dir = test::outputDir("OutputFiles.Set");
+  const std::string a = dir + "/a.gltf", b = dir + "/a.bin", c = dir + "/a-preview.glb";
+  for (const std::string& f : {a, b, c}) std::filesystem::remove(f);
+  writeTextAtomically(a, "old a");
+  writeTextAtomically(b, "old b");
+  std::filesystem::create_symlink(dir + "/elsewhere.txt", c);
+  {
+    AtomicFileSet set;
+    set.addText(a, "new a");
+    set.addText(b, "new b");
+    EXPECT_THROW(set.addText(c, "new c"), IoError);
+  }
+  EXPECT_EQ(readFile(a), "old a");
+  EXPECT_EQ(readFile(b), "old b");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/elsewhere.txt")) << "nothing through the link";
+  for (const std::string& f : {a, b, c}) EXPECT_TRUE(leftoverTemporaries(f).empty()) << f;
+  // Destroyed uncommitted: nothing changes either.
+  {
+    AtomicFileSet set;
+    set.addText(a, "new a");
+    EXPECT_THROW(set.addText(a, "twice"), IoError);
+  }
+  EXPECT_EQ(readFile(a), "old a");
+  std::filesystem::remove(c);
+  {
+    AtomicFileSet set;
+    set.addText(a, "new a");
+    set.addText(b, "new b");
+    set.add(c, [](const std::string& tmp) { std::ofstream(tmp) << "new c"; });
+    EXPECT_EQ(readFile(a), "old a") << "nothing renamed before commit";
+    // A link planted at a name after its write: commit refuses, renames nothing.
+    std::filesystem::create_symlink(dir + "/elsewhere.txt", c);
+    EXPECT_THROW(set.commit(), IoError);
+    EXPECT_EQ(readFile(a), "old a");
+    std::filesystem::remove(c);
+    set.commit();
+    EXPECT_TRUE(set.paths().empty());
+  }
+  EXPECT_EQ(readFile(a), "new a");
+  EXPECT_EQ(readFile(b), "new b");
+  EXPECT_EQ(readFile(c), "new c");
+  for (const std::string& f : {a, b, c}) EXPECT_TRUE(leftoverTemporaries(f).empty()) << f;
 }
 
 TEST(OutputFiles, AnOutputThatIsAnInputIsRefused) {

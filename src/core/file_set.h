@@ -1,0 +1,44 @@
+#pragma once
+/// @file core/file_set.h
+/// @brief Several output files that appear together or not at all (a
+/// lightmap's glTF, buffer, pages and preview): each is written under its
+/// temporary name with writeAtomically's rules (created exclusively, no link
+/// followed, a link or device at the final name refused), and commit()
+/// renames them all at the end. A set that fails, or is destroyed without
+/// commit(), removes its temporaries (on SIGINT, SIGTERM and SIGHUP too):
+/// files left by an earlier run under the final names stay as they were.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace lo {
+
+class AtomicFileSet {
+ public:
+  AtomicFileSet() = default;
+  ~AtomicFileSet();
+  AtomicFileSet(const AtomicFileSet&) = delete;
+  AtomicFileSet& operator=(const AtomicFileSet&) = delete;
+
+  /// Writes `path`'s content to its temporary file through `write(tmp)`.
+  /// @throws IoError naming `path` (refused final name, a name given twice,
+  /// a failed write); the set's other files are then still uncommitted.
+  void add(const std::string& path, const std::function<void(const std::string& tmp)>& write);
+  void addText(const std::string& path, const std::string& text);
+  /// Checks every final name once more, then renames every temporary over it.
+  /// @throws IoError when a name became a link or a device meanwhile (nothing
+  /// renamed) or a rename fails (the files renamed before it stay).
+  void commit();
+  /// The final names, in the order added.
+  std::vector<std::string> paths() const;
+
+ private:
+  struct Entry {
+    std::string path, tmp;
+    int slot;
+  };
+  std::vector<Entry> entries_;
+};
+
+}  // namespace lo
