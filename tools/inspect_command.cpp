@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "bake/stats_json.h"
 #include "commands.h"
 #include "report.h"
 #include "vdb/vdb_inspect.h"
@@ -60,13 +61,7 @@ nlohmann::json toJson(const VdbReport& r) {
     for (const auto& [k, v] : g.metadata) gj["metadata"][k] = v;
     j["grids"].push_back(gj);
   }
-  if (r.noise.recorded) {
-    j["noise"] = {{"quantile", r.noise.quantile}, {"median", r.noise.median},
-                  {"lit", r.noise.lit}, {"unlit", r.noise.unlit},
-                  {"mean_irradiance", r.noise.meanLuminance}};
-  } else {
-    j["noise"] = nullptr;
-  }
+  j["noise"] = nlohmann::json::parse(noiseSummaryJson(r.noise));
   j["checks"] = nlohmann::json::array();
   for (const VdbCheck& c : r.checks) {
     j["checks"].push_back({{"name", c.name}, {"passed", c.passed}, {"detail", c.detail}});

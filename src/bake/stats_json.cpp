@@ -6,6 +6,16 @@
 
 namespace lo {
 
+std::string noiseSummaryJson(const NoiseSummary& n) {
+  if (!n.recorded) return "null";
+  const nlohmann::json j = {{"quantile", n.quantile},
+                            {"median", n.median},
+                            {"lit", n.lit},
+                            {"unlit", n.unlit},
+                            {"mean_irradiance", n.meanLuminance}};
+  return j.dump();
+}
+
 std::string bakeStatsJson(const BakeStats& stats, const BakeStatsRecord& record) {
   using nlohmann::json;
   const BakeParams& p = record.params;
@@ -36,11 +46,7 @@ std::string bakeStatsJson(const BakeStats& stats, const BakeStatsRecord& record)
                  {"dense_voxels", stats.denseVoxels},
                  {"photons_outside_grid", stats.level.droppedPhotons},
                  {"vdb_bytes", record.vdbBytes}};
-  auto noiseJson = [](const NoiseSummary& n) -> json {
-    if (!n.recorded) return nullptr;
-    return {{"quantile", n.quantile}, {"median", n.median}, {"lit", n.lit}, {"unlit", n.unlit},
-            {"mean_irradiance", n.meanLuminance}};
-  };
+  auto noiseJson = [](const NoiseSummary& n) { return json::parse(noiseSummaryJson(n)); };
   j["noise"] = noiseJson(stats.noise);
   if (!stats.passes.empty()) {
     json passes = json::array();

@@ -5,8 +5,10 @@
 ///
 /// The document, keys in alphabetical order (as nlohmann-json writes them):
 ///   scene, output            the files as the command named them
-///   parameters               depth, photons, knn, radius (the gathering radius
-///                            used, world units), vdls ("4" or "auto"),
+///   parameters               depth, photons (null for a target bake),
+///                            target_error, max_photons (null for a fixed
+///                            budget), knn (the one gathered with), radius (the
+///                            gathering radius used, world units), vdls ("4" or "auto"),
 ///                            representation, seed, threads, include_direct,
 ///                            layers, gather_occlusion, edge_correction,
 ///                            smoothing ("on" / "off")
@@ -14,6 +16,9 @@
 ///                            empty_paths (paths that stored no photon),
 ///                            active_voxels, dense_voxels,
 ///                            photons_outside_grid, vdb_bytes
+///   noise                    the grid's noise figure (noiseSummaryJson), or null
+///   target                   a target bake's passes (photons, paths, noise,
+///                            seconds each) and why it stopped; absent otherwise
 ///   thread_seconds           gather, cluster: summed over threads
 ///   stages                   per row: name, seconds, rss_bytes, peak_rss_bytes
 ///   total_seconds            the rows' seconds summed
@@ -52,5 +57,10 @@ struct BakeStatsRecord {
 /// by 2 spaces, ending in a newline. Deterministic (the same values give the
 /// same bytes).
 std::string bakeStatsJson(const BakeStats& stats, const BakeStatsRecord& record);
+
+/// A noise figure as JSON text: quantile, median, lit, unlit,
+/// mean_irradiance; "null" when not recorded. The one spelling of it
+/// (`bake --stats-json` and `inspect --json`).
+std::string noiseSummaryJson(const NoiseSummary& noise);
 
 }  // namespace lo

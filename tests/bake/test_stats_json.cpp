@@ -114,3 +114,31 @@ TEST(BakeStatsJson, SectionsOfLaterStagesGoInAsGiven) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+TEST(BakeStatsJson, TheNoiseFigureIsSpelledOnce) {
+  EXPECT_EQ(noiseSummaryJson(NoiseSummary{}), "null");
+  NoiseSummary n;
+  n.recorded = true;
+  n.lit = 900;
+  n.unlit = 12;
+  n.meanLuminance = 0.5;
+  n.median = 0.03;
+  n.quantile = 0.0625;
+  const nlohmann::json j = nlohmann::json::parse(noiseSummaryJson(n));
+  EXPECT_EQ(j.size(), 5u);
+  EXPECT_EQ(j["quantile"].get<double>(), 0.0625);
+  EXPECT_EQ(j["median"].get<double>(), 0.03);
+  EXPECT_EQ(j["lit"], 900);
+  EXPECT_EQ(j["unlit"], 12);
+  EXPECT_EQ(j["mean_irradiance"].get<double>(), 0.5);
+  BakeStats stats;
+  stats.noise = n;
+  const nlohmann::json doc = nlohmann::json::parse(bakeStatsJson(stats, BakeStatsRecord{}));
+  EXPECT_EQ(doc["noise"], j);
+}
+
+}  // namespace
+}  // namespace lo

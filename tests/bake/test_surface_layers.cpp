@@ -104,7 +104,7 @@ TEST(SurfaceLayers, EachFaceOfAnEdgeKeepsItsOwnLightAsSphericalHarmonics) {
 /// A 1 x 1 floor split at x = 0.5 by a thin wall (both sides facing out,
 /// up to y = 1), lit from above on the +x side only (a sun whose light
 /// reaches x < 0.5 is blocked by a roof there).
-TEST(SurfaceLayers, NoLightThroughAThinWall) {
+Scene thinWallScene() {
   Scene scene = blackScene();
   Material white;
   white.baseColor = {0.8f, 0.8f, 0.8f};
@@ -115,6 +115,11 @@ TEST(SurfaceLayers, NoLightThroughAThinWall) {
   test::addQuad(scene, {0, 1, 0}, {0, 0, 1}, {0.5f, 0, 0}, {0, 1, 0}, 0);     // black roof over x < 0.5
   test::addQuad(scene, {0, 1, 0}, {0.5f, 0, 0}, {0, 0, 1}, {0, -1, 0}, 0);
   scene.lights.push_back(sun({0, -1, 0}, 1.0f));
+  return scene;
+}
+
+TEST(SurfaceLayers, NoLightThroughAThinWall) {
+  const Scene scene = thinWallScene();
   for (int on = 0; on < 2; ++on) {
     BakeParams p;
     p.depth = 5;
@@ -150,16 +155,7 @@ TEST(SurfaceLayers, NoLightThroughAThinWall) {
 /// side's: a lit floor layer whose point lay on the wall served both sides,
 /// and drew a bright line along the joint's dark side.
 TEST(SurfaceLayers, NoBrightLineWhereAThinWallMeetsTheFloor) {
-  Scene scene = blackScene();
-  Material white;
-  white.baseColor = {0.8f, 0.8f, 0.8f};
-  scene.materials.push_back(white);
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 1);        // floor
-  test::addQuad(scene, {0.5f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 1);     // wall, +x side
-  test::addQuad(scene, {0.5f, 0, 0}, {0, 0, 1}, {0, 1, 0}, {-1, 0, 0}, 1);    // wall, -x side
-  test::addQuad(scene, {0, 1, 0}, {0, 0, 1}, {0.5f, 0, 0}, {0, 1, 0}, 0);     // black roof over x < 0.5
-  test::addQuad(scene, {0, 1, 0}, {0.5f, 0, 0}, {0, 0, 1}, {0, -1, 0}, 0);
-  scene.lights.push_back(sun({0, -1, 0}, 1.0f));
+  const Scene scene = thinWallScene();
   BakeParams p;
   p.depth = 5;
   p.photons = 300000;
