@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "core/error.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "core/threads.h"
 #include "distributed/mpi_session.h"
 #include "distributed/distributed_stats.h"
@@ -87,15 +88,18 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   if (!missed.empty()) std::fprintf(stderr, "warning: %s\n", missed.c_str());
   baked.metadata.sourceScene = std::filesystem::path(opt.scene).filename().string();
 
+  // The .vdb, the photon map and the stats appear together or not at all: a
+  // side file that fails (a full disk, a name refused) leaves the old .vdb.
+  AtomicFileSet outputs;
   StageTimer writeTimer(rows, "write .vdb");
-  writeVdlGrid(opt.output, baked.grid, baked.metadata);
-  size_t fileBytes = size_t(std::filesystem::file_size(opt.output));
+  writeVdlGrid(opt.output, baked.grid, baked.metadata, {}, &outputs);
+  const size_t fileBytes = size_t(outputs.bytesOf(opt.output));
   writeTimer.finish(opt.output + " (" + formatBytes(fileBytes) + ")");
 
   if (!opt.photonMap.empty()) {
     StageTimer pointsTimer(rows, "write photon map");
     writePhotonPoints(opt.photonMap, baked.photons.photons, baked.grid.frame.voxelSize,
-                      scene.origin);
+                      scene.origin, &outputs);
     pointsTimer.finish(opt.photonMap);
   }
 
@@ -140,8 +144,9 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
       record.sections.emplace_back(
           "distributed", distributedStatsJson(distributed, comm->size(), baked.stats.storedPhotons));
     }
-    writeTextAtomically(opt.statsJson, bakeStatsJson(baked.stats, record));
+    outputs.addText(opt.statsJson, bakeStatsJson(baked.stats, record));
   }
+  outputs.commit();
   if (!opt.quiet) std::printf("\nwrote %s\n", opt.output.c_str());
   return 0;
 }

@@ -124,7 +124,7 @@ int runCompare(const CompareOptions& opt) {
     j["mean_reference_luminance"] = result.meanReferenceLuminance;
     j["mean_test_luminance"] = result.meanTestLuminance;
     j["reference_noise"] = noise >= 0 ? nlohmann::json(noise) : nlohmann::json(nullptr);
-    writeTextAtomically(opt.json, j.dump(2) + "\n");
+    writeTextAtomically(opt.json, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
     if (!opt.quiet) std::printf("wrote %s\n", opt.json.c_str());
   }
   return 0;

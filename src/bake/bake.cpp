@@ -273,27 +273,31 @@ double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bo
   return h > 0 ? area / (h * h) : 0.0;
 }
 
-void checkBakeMemory(const Scene& scene, const BakeParams& params, int processes) {
+void checkVoxelMemory(const Scene& scene, const GridFrame& frame, const Bounds3& region,
+                      double otherBytes, int processes) {
   const size_t available = availableMemoryBytes();
   if (available == 0 || scene.triangleCount() == 0) return;
+  const double voxels = estimateActiveVoxels(scene, frame, region);
+  const double needed =
+      (voxels * double(kBakeBytesPerVoxel) + otherBytes) / double(std::max(processes, 1));
+  if (needed > double(available)) {
+    throw InputError("--depth " + std::to_string(frame.depth) + ": the scene's surfaces cross " +
+                     "about " + formatCount(size_t(voxels)) + " voxels of " +
+                     formatNumber(frame.voxelSize) + " scene units, which " +
+                     (otherBytes > 0 ? "with the photons " : "") + "need about " +
+                     formatBytes(size_t(needed)) + " (" + std::to_string(kBakeBytesPerVoxel) +
+                     " bytes per voxel), more than the " + formatBytes(available) +
+                     " of memory available: use a smaller --depth, or only the part "
+                     "that matters (bake --bounds)");
+  }
+}
+
+void checkBakeMemory(const Scene& scene, const BakeParams& params, int processes) {
   const GridFrame frame =
       makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth);
-  const double voxels = estimateActiveVoxels(scene, frame, params.region);
   // A target bake fits its photons to what memory is left (targetPhotonCap).
   const double photons = params.targetError > 0 ? double(kMinPilotPhotons) : double(params.photons);
-  const double needed =
-      (voxels * double(kBakeBytesPerVoxel) + photons * double(kBakeBytesPerPhoton)) /
-      double(std::max(processes, 1));
-  if (needed > double(available)) {
-    throw InputError("--depth " + std::to_string(params.depth) + ": the scene's surfaces cross " +
-                     "about " + formatCount(size_t(voxels)) + " voxels of " +
-                     formatNumber(frame.voxelSize) + " scene units, which with the photons " +
-                     "need about " + formatBytes(size_t(needed)) + " (" +
-                     std::to_string(kBakeBytesPerVoxel) + " bytes per voxel), more than the " +
-                     formatBytes(available) +
-                     " of memory available: bake at a smaller --depth, or only the part "
-                     "that matters (--bounds)");
-  }
+  checkVoxelMemory(scene, frame, params.region, photons * double(kBakeBytesPerPhoton), processes);
 }
 
 std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {

@@ -261,6 +261,13 @@ void checkPhotonsStored(const BakeParams& params, const BakeStats& stats);
 /// slanted surfaces cross up to sqrt(3)x more, so this rather underestimates).
 double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bounds3& region);
 
+/// Refuses, before any work, a grid at `frame` whose voxels
+/// (estimateActiveVoxels x kBakeBytesPerVoxel) and `otherBytes` need more
+/// memory than is available, naming --depth and the figures (bake, convert
+/// to a finer depth). @throws InputError.
+void checkVoxelMemory(const Scene& scene, const GridFrame& frame, const Bounds3& region,
+                      double otherBytes, int processes = 1);
+
 /// Refuses, before any work, a bake whose voxels (estimateActiveVoxels x
 /// kBakeBytesPerVoxel) and photons (kBakeBytesPerPhoton) need more memory
 /// than is available (availableMemoryBytes), naming --depth and the figures.

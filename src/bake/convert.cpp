@@ -56,6 +56,14 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
   std::vector<StageReport>& rows = r.stages;
 
   if (params.scene && (depth != inDepth || params.photons)) {
+    if (depth > inDepth) {
+      // The finer grid's voxels against the memory, before voxelizing (as bake).
+      GridFrame finer = in.frame;
+      finer.depth = depth;
+      finer.voxelSize = in.frame.voxelSize / float(1 << (depth - inDepth));
+      const double photonBytes = params.photons ? double(params.photons->size()) * double(kBakeBytesPerPhoton) : 0.0;
+      checkVoxelMemory(*params.scene, finer, inMeta.region, photonBytes);
+    }
     StageTimer voxelize(rows, "voxelize scene");
     GridParams gridParams;
     gridParams.depth = depth;

@@ -13,7 +13,7 @@ std::string noiseSummaryJson(const NoiseSummary& n) {
                             {"lit", n.lit},
                             {"unlit", n.unlit},
                             {"mean_irradiance", n.meanLuminance}};
-  return j.dump();
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string bakeStatsJson(const BakeStats& stats, const BakeStatsRecord& record) {
@@ -84,7 +84,7 @@ std::string bakeStatsJson(const BakeStats& stats, const BakeStatsRecord& record)
     }
     j[key] = std::move(section);
   }
-  return j.dump(2) + "\n";
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace lo

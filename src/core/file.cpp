@@ -2,6 +2,7 @@
 #include "core/file_set.h"
 
 #include <fcntl.h>
+#include <climits>
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -10,6 +11,8 @@
 #include <array>
 #include <atomic>
 #include <cctype>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -38,7 +41,17 @@ Slot slots[kSlots];
 struct sigaction previous[3];
 constexpr int kSignals[3] = {SIGINT, SIGTERM, SIGHUP};
 
+// A set's commit in progress: a signal then waits for the renames to finish
+// (raised again at the end of commit), so that a set is never left half
+// renamed by SIGINT, SIGTERM or SIGHUP.
+std::atomic<int> committing{0};
+volatile sig_atomic_t deferredSignal = 0;
+
 void onSignal(int sig) {
+  if (committing.load() != 0) {
+    deferredSignal = sig;
+    return;
+  }
   for (Slot& s : slots) {
     if (s.state.load() == 2) ::unlink(s.path);
   }
@@ -161,6 +174,38 @@ std::string readFile(const std::string& path) {
   return bytes;
 }
 
+namespace {
+
+/// The longest file name the folder of `path` takes (NAME_MAX where pathconf
+/// cannot tell).
+size_t nameMaxFor(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  const long n = ::pathconf(parent.empty() ? "." : parent.c_str(), _PC_NAME_MAX);
+  return n > 0 ? size_t(n) : size_t(NAME_MAX);
+}
+
+/// The bytes a temporary name adds to its prefix: ".PID-16HEX.tmp" with a
+/// PID of up to 10 digits.
+constexpr size_t kTemporaryTagBytes = 1 + 10 + 1 + 16 + 4;
+
+/// The fixed head of every temporary name of `path`: ".NAME" or, when NAME
+/// is too long to carry the tag within the file system's name limit, its
+/// first bytes, "~" and a hash of the whole name, so that the temporary name
+/// of a name the OS takes always fits too.
+std::string temporaryHeadFor(const std::string& path) {
+  const std::string name = fs::path(path).filename().string();
+  const size_t limit = nameMaxFor(path);
+  if (1 + name.size() + kTemporaryTagBytes <= limit) return "." + name;
+  uint64_t hash = 1469598103934665603ull;  // FNV-1a
+  for (unsigned char c : name) hash = (hash ^ c) * 1099511628211ull;
+  char tail[24];
+  std::snprintf(tail, sizeof tail, "~%016llx", static_cast<unsigned long long>(hash));
+  const size_t keep = limit > 1 + 17 + kTemporaryTagBytes + 8 ? limit - 1 - 17 - kTemporaryTagBytes : 8;
+  return "." + name.substr(0, std::min(keep, name.size())) + tail;
+}
+
+}  // namespace
+
 std::string temporaryPathFor(const std::string& path) {
   static std::atomic<uint64_t> counter{0};
   static const uint64_t seed = [] {
@@ -170,18 +215,34 @@ std::string temporaryPathFor(const std::string& path) {
   const uint64_t n = counter.fetch_add(1);
   std::mt19937_64 mix(seed ^ (n * 0x9e3779b97f4a7c15ull));
   char tag[64];
-  std::snprintf(tag, sizeof tag, "%ld-%016llx", long(::getpid()),
+  std::snprintf(tag, sizeof tag, ".%ld-%016llx.tmp", long(::getpid()),
                 static_cast<unsigned long long>(mix()));
-  const fs::path p(path);
-  return (p.parent_path() / ("." + p.filename().string() + "." + tag + ".tmp")).string();
+  return (fs::path(path).parent_path() / (temporaryHeadFor(path) + tag)).string();
 }
 
 bool isTemporaryPathFor(const std::string& candidate, const std::string& path) {
   const std::string name = fs::path(candidate).filename().string();
-  const std::string prefix = "." + fs::path(path).filename().string() + ".";
+  const std::string prefix = temporaryHeadFor(path) + ".";
   return fs::path(candidate).parent_path() == fs::path(path).parent_path() &&
          name.size() > prefix.size() + 4 && name.compare(0, prefix.size(), prefix) == 0 &&
          name.compare(name.size() - 4, 4, ".tmp") == 0;
+}
+
+void checkOutputName(const std::string& path, const char* flag) {
+  const std::string name = fs::path(path).filename().string();
+  const size_t limit = nameMaxFor(path);
+  if (name.size() > limit) {
+    throw InputError(std::string(flag) + ": the file name '" + name.substr(0, 40) + "...' is " +
+                     std::to_string(name.size()) + " bytes long; the folder's file system takes " +
+                     std::to_string(limit) + " (name the output shorter)");
+  }
+  std::error_code ec;
+  const std::string absolute = fs::absolute(path, ec).string();
+  if (!ec && absolute.size() + 1 > size_t(PATH_MAX)) {
+    throw InputError(std::string(flag) + ": the path is " + std::to_string(absolute.size()) +
+                     " bytes long; the system takes " + std::to_string(PATH_MAX - 1) +
+                     " (write it to a shorter folder)");
+  }
 }
 
 std::vector<std::string> leftoverTemporaries(const std::string& path) {
@@ -236,8 +297,31 @@ void writeAtomically(const std::string& path,
   untrack(slot);
 }
 
+namespace {
+
+/// The test hook of the kill tests (tests/kill_lightmap.sh):
+/// LIGHTOCTREE_PAUSE_SET=add:N pauses a set after writing its N-th file,
+/// =commit after its first rename, saying so on stderr, so that a signal
+/// lands at that moment every time.
+void pauseForTest(const char* moment, size_t n) {
+  static const std::string wanted = [] {
+    const char* v = std::getenv("LIGHTOCTREE_PAUSE_SET");
+    return std::string(v ? v : "");
+  }();
+  if (wanted.empty()) return;
+  const std::string here = n ? std::string(moment) + ":" + std::to_string(n) : std::string(moment);
+  if (wanted != here) return;
+  std::fprintf(stderr, "lightoctree: paused at %s (LIGHTOCTREE_PAUSE_SET)\n", here.c_str());
+  std::fflush(stderr);
+  // Up to a minute, or until a signal arrives that commit defers.
+  for (int i = 0; i < 1200 && file_internal::deferredSignal == 0; ++i) ::usleep(50000);
+}
+
+}  // namespace
+
 AtomicFileSet::~AtomicFileSet() {
   for (const Entry& e : entries_) {
+    if (e.committed) continue;
     std::error_code ignored;
     fs::remove(e.tmp, ignored);
     file_internal::untrack(e.slot);
@@ -253,7 +337,7 @@ void AtomicFileSet::add(const std::string& path,
   }
   const std::string tmp = createTemporary(path);
   // From here the destructor removes it, whatever fails.
-  entries_.push_back({path, tmp, track(tmp)});
+  entries_.push_back({path, tmp, track(tmp), 0, false});
   try {
     write(tmp);
   } catch (const IoError&) {
@@ -264,6 +348,9 @@ void AtomicFileSet::add(const std::string& path,
   if (fs::symlink_status(tmp).type() != fs::file_type::regular) {
     throw IoError(path + ": the temporary file '" + tmp + "' was replaced while writing");
   }
+  std::error_code ec;
+  entries_.back().bytes = uint64_t(fs::file_size(tmp, ec));
+  pauseForTest("add", entries_.size());
 }
 
 void AtomicFileSet::addText(const std::string& path, const std::string& text) {
@@ -272,15 +359,36 @@ void AtomicFileSet::addText(const std::string& path, const std::string& text) {
 
 void AtomicFileSet::commit() {
   using namespace file_internal;
-  for (const Entry& e : entries_) requireReplaceable(e.path);
-  while (!entries_.empty()) {
-    const Entry e = entries_.front();
+  for (const Entry& e : entries_) {
+    if (!e.committed) requireReplaceable(e.path);
+  }
+  // The renames are a few system calls; a signal waits for them to end.
+  struct Deferral {
+    Deferral() { committing.fetch_add(1); }
+    ~Deferral() {
+      if (committing.fetch_sub(1) == 1 && deferredSignal != 0) {
+        const int sig = deferredSignal;
+        deferredSignal = 0;
+        ::raise(sig);
+      }
+    }
+  } deferral;
+  for (Entry& e : entries_) {
+    if (e.committed) continue;
     std::error_code ec;
     fs::rename(e.tmp, e.path, ec);
     if (ec) throw IoError(e.path + ": cannot rename '" + e.tmp + "' (" + ec.message() + ")");
     untrack(e.slot);
-    entries_.erase(entries_.begin());
+    e.committed = true;
+    if (&e == &entries_.front()) pauseForTest("commit", 0);
   }
+}
+
+uint64_t AtomicFileSet::bytesOf(const std::string& path) const {
+  for (const Entry& e : entries_) {
+    if (e.path == path) return e.bytes;
+  }
+  return 0;
 }
 
 std::vector<std::string> AtomicFileSet::paths() const {
@@ -295,6 +403,7 @@ void writeTextAtomically(const std::string& path, const std::string& text) {
 }
 
 void checkOutputFolder(const std::string& path, const char* flag) {
+  checkOutputName(path, flag);
   const fs::path parent = fs::path(path).parent_path();
   const fs::path folder = parent.empty() ? fs::path(".") : parent;
   if (!fs::is_directory(folder)) {

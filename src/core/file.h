@@ -37,7 +37,10 @@ void writeAtomically(const std::string& path, const std::function<void(const std
 void writeTextAtomically(const std::string& path, const std::string& text);
 
 /// @brief A new temporary name for `path`: ".NAME.PID-RANDOM.tmp" in the same
-/// folder (hidden, unpredictable, distinct for every call and process).
+/// folder (hidden, unpredictable, distinct for every call and process). A NAME
+/// too long to carry the tag within the file system's limit on names (255
+/// bytes) is cut and ends in "~" and a hash of the whole name, so a name the
+/// OS takes always has a temporary name too.
 std::string temporaryPathFor(const std::string& path);
 
 /// @brief Whether `candidate` is a name temporaryPathFor(path) can return
@@ -47,7 +50,13 @@ bool isTemporaryPathFor(const std::string& candidate, const std::string& path);
 /// @brief The temporary files of `path` present in its folder.
 std::vector<std::string> leftoverTemporaries(const std::string& path);
 
-/// @throws InputError naming `flag` when `path` cannot be written: its folder
+/// @throws InputError naming `flag` when `path`'s file name is longer than its
+/// folder's file system takes (NAME_MAX, 255 bytes) or the whole path longer
+/// than PATH_MAX: found before the work, not when the file is written.
+void checkOutputName(const std::string& path, const char* flag);
+
+/// @throws InputError naming `flag` when `path` cannot be written: its name is
+/// too long (checkOutputName), its folder
 /// does not exist or is not writable, or `path` names a folder, a link or
 /// anything but a regular file. Called by commands before any long work.
 void checkOutputFolder(const std::string& path, const char* flag);

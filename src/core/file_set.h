@@ -8,6 +8,7 @@
 /// commit(), removes its temporaries (on SIGINT, SIGTERM and SIGHUP too):
 /// files left by an earlier run under the final names stay as they were.
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -30,13 +31,17 @@ class AtomicFileSet {
   /// @throws IoError when a name became a link or a device meanwhile (nothing
   /// renamed) or a rename fails (the files renamed before it stay).
   void commit();
-  /// The final names, in the order added.
+  /// The final names, in the order added (committed or not).
   std::vector<std::string> paths() const;
+  /// The bytes written for `path` (0 when it is not in the set).
+  uint64_t bytesOf(const std::string& path) const;
 
  private:
   struct Entry {
     std::string path, tmp;
     int slot;
+    uint64_t bytes;
+    bool committed;
   };
   std::vector<Entry> entries_;
 };

@@ -78,7 +78,7 @@ std::string distributedStatsJson(const DistributedStats& d, int ranks, size_t st
       // Tile (x * T + y) * T + z: its rank and estimated work (docs/scale.md).
       {"tile_owner", d.tileOwner},
       {"tile_work", d.tileWork}};
-  return j.dump();
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace lo

@@ -214,6 +214,9 @@ void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bo
   if (hasExtension(output, ".gltf")) outputs.push_back({"--output's buffer", besideOutput(output, ".bin")});
   if (preview) outputs.push_back({"--preview-unlit", besideOutput(output, "-preview.glb")});
   checkDistinctFiles(outputs, inputs);
+  // The longest name the set writes (up to 1,000 pages) must fit the file
+  // system's limit, found now and not after the bake.
+  checkOutputName(besideOutput(output, "-lightmap999.exr"), "--output");
   // The pages and chart images: OUT-lightmap<k>.exr|png, OUT-charts<k>.png.
   std::error_code ec;
   const fs::path folder = fs::weakly_canonical(fs::absolute(fs::path(output).parent_path(), ec), ec);

@@ -64,6 +64,21 @@ class AtlasPageEvaluator {
   virtual AtlasPageTexels evaluatePage(int page, const std::vector<int32_t>& triangles) = 0;
 };
 
+/// Peak memory per page texel of a lightmap bake and its export, measured
+/// (`lightmap` on the Cornell box, one 4096^2 page: 634 MB peak without the
+/// preview, 1.19 GB with it): the pages, coverage, the triangle and surface
+/// point per texel, the images written. checkAtlasMemory refuses a bake
+/// beyond the memory available with these before any page is allocated.
+constexpr size_t kAtlasBytesPerTexel = 40;
+/// What AtlasBakeParams::radiance (the preview) adds per texel.
+constexpr size_t kAtlasRadianceBytesPerTexel = 36;
+
+/// @throws InputError, before any page exists, when `uvs`' pages need more
+/// memory than is available (kAtlasBytesPerTexel, plus
+/// kAtlasRadianceBytesPerTexel with `radiance`), naming --texel-size and the
+/// figures.
+void checkAtlasMemory(const LightmapUvs& uvs, bool radiance);
+
 struct AtlasBakeParams {
   /// The lookup's settings (interpolation, VDLs used, normal offset): pass
   /// the renderer's, so that the atlas holds what it would compute.

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 namespace lo {
 
@@ -28,6 +29,22 @@ std::string LightmapBake::ToString() const {
      << atlas.dilatedTexels << " dilated; UVs " << uvSeconds << " s, atlas " << atlasSeconds
      << " s";
   return os.str();
+}
+
+void checkAtlasMemory(const LightmapUvs& uvs, bool radiance) {
+  const size_t available = availableMemoryBytes();
+  const double texels = double(uvs.pageCount) * double(uvs.width) * double(uvs.height);
+  const double perTexel = double(kAtlasBytesPerTexel + (radiance ? kAtlasRadianceBytesPerTexel : 0));
+  const double needed = texels * perTexel;
+  if (available == 0 || needed <= double(available)) return;
+  std::ostringstream os;
+  os << "--texel-size " << uvs.texelSize << ": the atlas is " << uvs.pageCount << " page(s) of "
+     << uvs.width << " x " << uvs.height << " texels, which need about " << formatBytes(size_t(needed))
+     << " (" << perTexel << " bytes per texel" << (radiance ? ", with the preview" : "")
+     << "), more than the " << formatBytes(available)
+     << " of memory available: use a larger --texel-size (or a smaller --atlas, when the charts "
+        "leave a page mostly empty)";
+  throw InputError(os.str());
 }
 
 float defaultLightmapTexel(const GpuOctree& octree) {
@@ -73,6 +90,7 @@ LightmapBake bakeLightmap(const Scene& scene, const GpuOctree& octree,
     }
   }
   const auto uvDone = Clock::now();
+  checkAtlasMemory(out.uvs, params.atlas.radiance);
   out.atlas = bakeLightmapAtlas(scene, out.uvs, octree, params.atlas);
   out.uvSeconds = std::chrono::duration<double>(uvDone - start).count();
   out.atlasSeconds = std::chrono::duration<double>(Clock::now() - uvDone).count();

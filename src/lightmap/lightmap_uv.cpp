@@ -48,7 +48,8 @@ void checkParams(const LightmapUvParams& p) {
 // extent plus a margin on both sides, so that float rounding of the UVs
 // (2^-24 of the page) never pushes a corner into the next texel column.
 int chartTexels(double extent, double t, double margin) {
-  return std::max(1, int(std::ceil(extent / t + 2 * margin)));
+  // Saturated: a texel size of 1e-15 must not overflow the int (it did).
+  return int(std::clamp(std::ceil(extent / t + 2 * margin), 1.0, double(1 << 30)));
 }
 
 std::vector<RectSize> rectSizes(const std::vector<FlatChart>& charts, double t, int gutter,

@@ -119,7 +119,7 @@ SweepCache::SweepCache(const SweepParams& params, const std::string& dir)
                              {"threads", params.threads},
                              {"seed", params.seed},
                              {"version", LO_VERSION}})
-                 .dump();
+                 .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string SweepCache::vdbPath(const SweepPoint& point) const {
@@ -174,7 +174,7 @@ void SweepCache::storeReferences(const References& refs) const {
                             {"indirect_noise", refs.indirectNoise},
                             {"irradiance_binned_noise", refs.irradianceBinnedNoise},
                             {"seconds", refs.seconds}};
-  writeTextAtomically(dir_ + "/reference.json", j.dump(2) + "\n");
+  writeTextAtomically(dir_ + "/reference.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 bool SweepCache::loadBake(const SweepPoint& point, BakeFigures& figures) const {
@@ -191,7 +191,7 @@ void SweepCache::storeBake(const SweepPoint& point, const BakeFigures& figures) 
   writeTextAtomically(
       dir_ + "/" + point.bakeKey() + "-bake.json",
       nlohmann::json({{"context", nlohmann::json::parse(context_)}, {"bake", toJson(figures)}})
-              .dump(2) +
+              .dump(2, ' ', false, nlohmann::json::error_handler_t::replace) +
           "\n");
 }
 
@@ -210,7 +210,7 @@ void SweepCache::storeResult(const SweepResult& result) const {
   writeTextAtomically(dir_ + "/" + result.point.key() + ".json",
                       nlohmann::json({{"context", nlohmann::json::parse(context_)},
                                       {"result", resultJson(result)}})
-                              .dump(2) +
+                              .dump(2, ' ', false, nlohmann::json::error_handler_t::replace) +
                           "\n");
 }
 

@@ -6,7 +6,9 @@
 #include <openvdb/io/GridDescriptor.h>
 #include <openvdb/openvdb.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -18,6 +20,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "core/isolate.h"
 #include "vdb/vdb_contract.h"
 #include "vdb/vdb_file.h"
@@ -143,21 +146,26 @@ class GridByGridArchive : public openvdb::io::Archive {
 // Writes through a temporary file (core/file.h), grid by grid: a reader
 // never sees a half file.
 void writeVdbFile(const std::string& path, const std::vector<GridSource>& sources,
-                  const openvdb::MetaMap& meta) {
+                  const openvdb::MetaMap& meta, AtomicFileSet* into) {
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty() && !fs::is_directory(parent)) {
     throw IoError(path + ": cannot write: folder '" + parent.string() + "' does not exist");
   }
-  writeAtomically(path, [&](const std::string& tmp) {
+  const auto write = [&](const std::string& tmp) {
     {
       std::ofstream file(tmp, std::ios_base::out | std::ios_base::binary);
       if (!file) throw std::runtime_error("cannot open the file");
       GridByGridArchive().writeGrids(file, sources, meta);
       file.close();
-      if (file.fail()) throw std::runtime_error("cannot write the file");
+      if (file.fail()) throw std::runtime_error(std::string("cannot write the file: ") + std::strerror(errno));
     }
     makeUuidDeterministic(tmp);
-  });
+  };
+  if (into) {
+    into->add(path, write);
+  } else {
+    writeAtomically(path, write);
+  }
 }
 
 // ---------------------------------------------------------------------------

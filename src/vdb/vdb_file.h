@@ -52,9 +52,11 @@ struct GridSource {
 
 /// Writes the grids `sources` make, in order, with the file metadata `meta`
 /// to `path` through a temporary file (core/file.h), then gives the file
-/// its deterministic UUID (vdb_contract.h). @throws IoError.
+/// its deterministic UUID (vdb_contract.h). With `into`, the file joins that
+/// set (written under its temporary name, renamed by the set's commit).
+/// @throws IoError.
 void writeVdbFile(const std::string& path, const std::vector<GridSource>& sources,
-                  const openvdb::MetaMap& meta);
+                  const openvdb::MetaMap& meta, AtomicFileSet* into = nullptr);
 
 /// The file metadata of a light grid (docs/vdb-contract.md).
 openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid);

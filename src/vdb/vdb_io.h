@@ -14,6 +14,8 @@
 
 namespace lo {
 
+class AtomicFileSet;  // core/file_set.h
+
 /// Grids of the contract a file may leave out (`convert --drop`): readVdlGrid
 /// fills them with 0. The others (irradiance, normal, vdl_count, vdl<i>_*) are
 /// required.
@@ -34,10 +36,14 @@ struct VdlWriteOptions {
 
 /// Writes every grid of the contract (irradiance, normal, photon_count,
 /// angular_error, vdl_count, vdl<i>_irradiance, vdl<i>_direction) on one
-/// transform, to `path` + ".tmp" and then renames, so an interrupted write
-/// never leaves a broken file. @throws IoError.
+/// transform, through a temporary name renamed at the end (core/file.h), so an
+/// interrupted write never leaves a broken file. With `into`, the file joins
+/// that set of outputs instead (core/file_set.h: renamed with the others by
+/// its commit, so a side file that fails later leaves the old file in
+/// place). @throws IoError; InputError when the grid fails the readers'
+/// checks (nothing written).
 void writeVdlGrid(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
-                  const VdlWriteOptions& options = {});
+                  const VdlWriteOptions& options = {}, AtomicFileSet* into = nullptr);
 
 struct LoadedVdl {
   VdlGrid grid;
@@ -97,7 +103,7 @@ LoadedVdl readVdlGrid(const std::string& path,
 /// `offset`: Scene::origin of the photons' scene; the file's positions are
 /// world positions (offset + position, in double).
 void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
-                       const Vec3d& offset = Vec3d());
+                       const Vec3d& offset = Vec3d(), AtomicFileSet* into = nullptr);
 
 /// Reads a photon file written by writePhotonPoints. Photons come back in the
 /// file's (leaf) order, which is deterministic but not the order written.

@@ -25,7 +25,7 @@ namespace {
 using openvdb::math::Transform;
 
 void writePoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
-                 const Vec3d& offset) {
+                 const Vec3d& offset, AtomicFileSet* into) {
   if (!(voxelSize > 0) || !std::isfinite(voxelSize)) {
     throw InputError(path + ": photon point voxel size must be positive, got " +
                      std::to_string(voxelSize));
@@ -76,7 +76,7 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   meta.insertMeta("generator", openvdb::StringMetadata("lightoctree"));
   meta.insertMeta("version", openvdb::StringMetadata(LO_VERSION));
   meta.insertMeta("photons", openvdb::Int64Metadata(int64_t(n)));
-  writeVdbFile(path, {{"photons", [&grid] { return openvdb::GridBase::Ptr(grid); }}}, meta);
+  writeVdbFile(path, {{"photons", [&grid] { return openvdb::GridBase::Ptr(grid); }}}, meta, into);
 }
 
 std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin) {
@@ -170,8 +170,8 @@ std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origi
 }
 
 void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
-                       const Vec3d& offset) {
-  vdb_internal::writePoints(path, photons, voxelSize, offset);
+                       const Vec3d& offset, AtomicFileSet* into) {
+  vdb_internal::writePoints(path, photons, voxelSize, offset, into);
 }
 
 }  // namespace lo

@@ -175,7 +175,7 @@ bool isOptionalGrid(const std::string& name) {
 }
 
 void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
-              const VdlWriteOptions& options, const Damage* damage) {
+              const VdlWriteOptions& options, const Damage* damage, AtomicFileSet* into) {
   initOpenVdb();
   for (const std::string& name : options.drop) {
     if (!isOptionalGrid(name)) {
@@ -223,20 +223,20 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
       fileMeta.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(damage->formatVersion));
     }
   }
-  writeVdbFile(path, sources, fileMeta);
+  writeVdbFile(path, sources, fileMeta, into);
 }
 
 }  // namespace
 
 void writeVdlGridDamaged(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
                          const Damage& damage) {
-  writeVdl(path, grid, meta, damage.options, &damage);
+  writeVdl(path, grid, meta, damage.options, &damage, nullptr);
 }
 
 }  // namespace vdb_internal
 
 void writeVdlGrid(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
-                  const VdlWriteOptions& options) {
+                  const VdlWriteOptions& options, AtomicFileSet* into) {
   // What every reader will check, checked before anything is written: a file
   // the commands would refuse never replaces a good one (bake, convert).
   try {
@@ -250,7 +250,7 @@ void writeVdlGrid(const std::string& path, const VdlGrid& grid, const BakeMetada
                        c.detail + "); the file there is left as it was");
     }
   }
-  vdb_internal::writeVdl(path, grid, meta, options, nullptr);
+  vdb_internal::writeVdl(path, grid, meta, options, nullptr, into);
 }
 
 }  // namespace lo

@@ -36,6 +36,33 @@ TEST(OutputFiles, TemporaryNamesAreFreshHiddenAndBesideTheTarget) {
   EXPECT_FALSE(isTemporaryPathFor(dir + "/out.vdb.tmp", dir + "/out.vdb"));
 }
 
+TEST(OutputFiles, EveryNameTheFileSystemTakesHasATemporaryName) {
+  // Names of 200-255 bytes are legal (NAME_MAX); their temporary names are
+  // cut and end in a hash, so the write works and nothing is left behind.
+  const std::string dir = test::outputDir("OutputFiles.LongNames");
+  for (size_t length : {200u, 227u, 250u, 255u}) {
+    const std::string path = dir + "/" + std::string(length - 4, 'n') + ".vdb";
+    const std::string t = temporaryPathFor(path);
+    EXPECT_LE(fs::path(t).filename().string().size(), 255u) << length;
+    EXPECT_TRUE(isTemporaryPathFor(t, path)) << length;
+    writeTextAtomically(path, "x");
+    EXPECT_EQ(readFile(path), "x") << length;
+    EXPECT_TRUE(leftoverTemporaries(path).empty()) << length;
+    checkOutputName(path, "--output");
+  }
+  // Two long names that share their first 230 bytes keep distinct temporaries.
+  const std::string a = dir + "/" + std::string(240, 'm') + "a", b = dir + "/" + std::string(240, 'm') + "b";
+  EXPECT_FALSE(isTemporaryPathFor(temporaryPathFor(a), b));
+  // One byte past the limit is refused before any work, naming the flag.
+  try {
+    checkOutputFolder(dir + "/" + std::string(256, 'n'), "--output");
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--output: the file name"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("256 bytes"), std::string::npos) << e.what();
+  }
+}
+
 TEST(OutputFiles, ReplacesARegularFileAndLeavesNothingBehind) {
   const std::string dir = test::outputDir("OutputFiles.Replace");
   const std::string path = dir + "/a.txt";
@@ -114,7 +141,9 @@ TEST(OutputFiles, ASetAppearsWholeOrNotAtAll) {
     EXPECT_EQ(readFile(a), "old a");
     std::filesystem::remove(c);
     set.commit();
-    EXPECT_TRUE(set.paths().empty());
+    EXPECT_EQ(set.paths(), (std::vector<std::string>{a, b, c}));
+    EXPECT_EQ(set.bytesOf(b), 5u);
+    EXPECT_EQ(set.bytesOf(dir + "/absent.txt"), 0u);
   }
   EXPECT_EQ(readFile(a), "new a");
   EXPECT_EQ(readFile(b), "new b");
