@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes the readers of untrusted input with libFuzzer (clang, AddressSanitizer and
-# UndefinedBehaviorSanitizer): the glTF loader, the OBJ loader and the .vdb reader
-# (tests/fuzz/). Builds the targets into build-fuzz/, makes the seed corpus
+# UndefinedBehaviorSanitizer): the glTF loader, the OBJ loader, the .vdb reader and
+# the image decoders (tests/fuzz/). Builds the targets into build-fuzz/, makes the seed corpus
 # (tests/fuzz/seeds/, the scenes of data/, small bakes made with build/tools/lightoctree)
 # and runs each target for SECONDS (default 60). A finding (crash, sanitizer report,
 # an exception other than InputError, timeout, out of memory) fails the script and
@@ -15,18 +15,20 @@ out=out/fuzz
 
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DLO_FUZZ=ON -DLO_BUILD_TESTS=OFF -DLO_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_gltf fuzz_obj fuzz_vdb
+cmake --build build-fuzz --parallel "$(nproc)" --target fuzz_gltf fuzz_obj fuzz_vdb fuzz_image
 
 rm -rf "$out/seeds" "$out/findings"
 mkdir -p "$out/findings"
-for t in gltf obj vdb; do mkdir -p "$out/seeds/$t" "$out/corpus/$t" "$out/tmp/$t"; done
+for t in gltf obj vdb image; do mkdir -p "$out/seeds/$t" "$out/corpus/$t" "$out/tmp/$t"; done
 cp tests/fuzz/seeds/gltf/* data/*.gltf "$out/seeds/gltf/"
 cp tests/fuzz/seeds/obj/* "$out/seeds/obj/"
+cp tests/fuzz/seeds/image/* data/*.hdr "$out/seeds/image/"
 L=build/tools/lightoctree
 "$L" bake data/cornell-box.gltf -o "$out/seeds/vdb/d2.vdb" --depth 2 --photons 2000 --knn 20 \
   --photon-map "$out/seeds/vdb/photons.vdb" --quiet
 "$L" bake data/cornell-box.gltf -o "$out/seeds/vdb/d2-sh1.vdb" --depth 2 --photons 2000 --knn 20 \
   --representation sh1 --quiet
+"$L" reference data/cornell-box.gltf -o "$out/seeds/image/cornell.exr" --width 8 --height 6 --spp 1 --quiet
 "$L" convert "$out/seeds/vdb/d2.vdb" -o "$out/seeds/vdb/d2-half.vdb" --half --quiet 2>/dev/null ||
   "$L" convert "$out/seeds/vdb/d2.vdb" -o "$out/seeds/vdb/d2-half.vdb" --half >/dev/null
 
@@ -36,8 +38,8 @@ summary="$out/summary.md"
   echo "|---|---:|---:|---:|---:|---:|"
 } > "$summary"
 status=0
-for t in gltf obj vdb; do
-  case $t in gltf) maxlen=16384 ;; obj) maxlen=4096 ;; vdb) maxlen=65536 ;; esac
+for t in gltf obj vdb image; do
+  case $t in gltf) maxlen=16384 ;; obj) maxlen=4096 ;; vdb) maxlen=65536 ;; image) maxlen=16384 ;; esac
   log="$out/$t.log"
   echo "== fuzz_$t for ${seconds} s"
   set +e

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 
@@ -18,12 +19,9 @@
 #include "core/file.h"
 #include "core/resources.h"
 
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#include <stb_image_write.h>
-// The project's one copy of stb_image: scene textures decode through
-// decodeImageBytes too.
-#define STB_IMAGE_IMPLEMENTATION
+// stb's implementation is compiled once, in stb_image_impl.cpp.
 #include <stb_image.h>
+#include <stb_image_write.h>
 
 namespace lo {
 namespace {
@@ -35,6 +33,47 @@ void checkImage(const std::string& path, const RgbImage& image) {
 }
 
 
+/// The largest ratio of raw pixel bytes to stored bytes an EXR compression
+/// reaches, 0 where none is bounded (the DCT of DWAA/DWAB under zlib).
+double largestExrRatio(Imf::Compression c) {
+  switch (c) {
+    case Imf::NO_COMPRESSION: return 1;
+    case Imf::RLE_COMPRESSION: return 64;  // a run of up to 128 bytes in 2
+    case Imf::ZIPS_COMPRESSION:
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION: return 1032;  // deflate
+    case Imf::PIZ_COMPRESSION: return 1024;    // Huffman codes with runs of up to 255 values
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION: return 11;  // a flat 4 x 4 block of halves in 3 bytes
+    default: return 0;
+  }
+}
+
+/// Refuses an EXR whose file is too small for the pixels its header claims
+/// under its compression's largest ratio (OpenEXR fills what a chunk lacks
+/// without a word: an 8 KB file claiming 16000 x 16000 cost 3 GB).
+void checkExrHoldsItsPixels(const std::string& path, const Imf::Header& header, int64_t width,
+                            int64_t height) {
+  const double ratio = largestExrRatio(header.compression());
+  if (ratio <= 0) return;
+  double bytesPerPixel = 0;
+  for (auto c = header.channels().begin(); c != header.channels().end(); ++c) {
+    const double size = c.channel().type == Imf::HALF ? 2.0 : 4.0;
+    const double samples = double(std::max(1, c.channel().xSampling)) * std::max(1, c.channel().ySampling);
+    bytesPerPixel += size / samples;
+  }
+  const double least = double(width) * double(height) * bytesPerPixel / ratio;
+  std::error_code ec;
+  const double held = double(std::filesystem::file_size(path, ec));
+  if (!ec && held < least) {
+    throw InputError(path + ": a " + std::to_string(width) + " x " + std::to_string(height) +
+                     " EXR of " + std::to_string(int(bytesPerPixel)) +
+                     " bytes per pixel compressed at most " + std::to_string(int(ratio)) +
+                     ":1 needs at least " + formatBytes(size_t(least)) + "; the file holds " +
+                     formatBytes(size_t(held)) + ": truncated, or a header that lies");
+  }
+}
+
 RgbImage readExr(const std::string& path) {
   try {
     Imf::InputFile file(path.c_str());
@@ -45,26 +84,42 @@ RgbImage readExr(const std::string& path) {
     } catch (const InputError& e) {
       throw InputError(path + ": " + e.what());
     }
-    RgbImage image(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1);
+    const int width = dw.max.x - dw.min.x + 1, height = dw.max.y - dw.min.y + 1;
+    checkExrHoldsItsPixels(path, file.header(), width, height);
     const Imf::ChannelList& channels = file.header().channels();
     const char* names[3] = {"R", "G", "B"};
     const char* first =
         channels.findChannel("R") ? "R" : (channels.findChannel("Y") ? "Y" : nullptr);
     if (!first) throw InputError(path + ": no R or Y channel");
-    Imf::FrameBuffer fb;
-    // Slices are addressed from the data window's origin, which may not be (0, 0).
-    char* base =
-        reinterpret_cast<char*>(image.rgb.data()) -
-        (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * image.width) * 3 * ptrdiff_t(sizeof(float));
-    size_t yStride = size_t(image.width) * 3 * sizeof(float);
-    fb.insert(first, Imf::Slice(Imf::FLOAT, base, 3 * sizeof(float), yStride));
-    for (int c = 1; c < 3; ++c) {
-      if (channels.findChannel(names[c]))
-        fb.insert(names[c],
-                  Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float), yStride));
+    // Read in bands of rows, the image growing by what each band decoded: a
+    // file that ends before its last chunk fails at the first missing band,
+    // having allocated only what it held.
+    constexpr int kBandRows = 64;
+    std::vector<float> band;
+    RgbImage image;
+    image.width = width;
+    image.height = height;
+    const size_t rowFloats = size_t(width) * 3;
+    for (int y0 = dw.min.y; y0 <= dw.max.y; y0 += kBandRows) {
+      const int y1 = std::min(dw.max.y, y0 + kBandRows - 1);
+      band.assign(rowFloats * size_t(y1 - y0 + 1), 0.0f);
+      // Slices are addressed from the data window's origin (x) and this
+      // band's first row (y).
+      char* base = reinterpret_cast<char*>(band.data()) -
+                   (ptrdiff_t(dw.min.x) + ptrdiff_t(y0) * width) * 3 * ptrdiff_t(sizeof(float));
+      const size_t yStride = rowFloats * sizeof(float);
+      Imf::FrameBuffer fb;
+      fb.insert(first, Imf::Slice(Imf::FLOAT, base, 3 * sizeof(float), yStride));
+      for (int c = 1; c < 3; ++c) {
+        if (channels.findChannel(names[c])) {
+          fb.insert(names[c],
+                    Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float), yStride));
+        }
+      }
+      file.setFrameBuffer(fb);
+      file.readPixels(y0, y1);
+      image.rgb.insert(image.rgb.end(), band.begin(), band.end());
     }
-    file.setFrameBuffer(fb);
-    file.readPixels(dw.min.y, dw.max.y);
     // Single-channel files (masks): G and B copy the first channel.
     for (int c = 1; c < 3; ++c) {
       if (channels.findChannel(names[c])) continue;
@@ -191,34 +246,36 @@ void writeImage(const std::string& path, const RgbImage& image, float exposureEv
 
 RgbImage readImage(const std::string& path, bool linear8Bit) {
   requireRegularFile(path, "the image");
-  std::string ext = lowerExtension(path);
-  if (ext != ".exr") {
-    // The header's size before decoding (stb's buffer and the image's floats).
-    int w = 0, h = 0, n = 0;
-    if (stbi_info(path.c_str(), &w, &h, &n)) {
-      try {
-        checkImageSize(w, h, 4 * 4 + 12);
-      } catch (const InputError& e) {
-        throw InputError(path + ": " + e.what());
-      }
-    }
-  }
+  const std::string ext = lowerExtension(path);
   if (ext == ".exr") return readExr(path);
+  if (ext != ".hdr" && ext != ".png" && ext != ".jpg" && ext != ".jpeg") {
+    throw InputError(path + ": unsupported image extension '" + ext +
+                     "' (expected .exr, .hdr, .png or .jpg)");
+  }
+  const std::string file = readFile(path);
+  const auto* bytes = reinterpret_cast<const unsigned char*>(file.data());
+  if (file.empty() || file.size() > size_t(std::numeric_limits<int>::max())) {
+    throw InputError(path + ": cannot read image (empty or larger than 2 GiB)");
+  }
+  const int size = int(file.size());
+  // The header's size, and whether the bytes can hold it, before decoding
+  // (stb's buffer and the image's floats).
+  try {
+    checkEncodedImage(bytes, file.size(), 4 * 4 + 12);
+  } catch (const InputError& e) {
+    throw InputError(path + ": " + e.what());
+  }
+  int w = 0, h = 0, n = 0;
   if (ext == ".hdr") {
     // Radiance RGBE: linear floats (stb applies no transfer curve to them).
-    int w = 0, h = 0, n = 0;
-    float* data = stbi_loadf(path.c_str(), &w, &h, &n, 3);
+    float* data = stbi_loadf_from_memory(bytes, size, &w, &h, &n, 3);
     if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
     RgbImage image(w, h);
     std::copy(data, data + image.rgb.size(), image.rgb.begin());
     stbi_image_free(data);
     return image;
   }
-  if (ext != ".png" && ext != ".jpg" && ext != ".jpeg")
-    throw InputError(path + ": unsupported image extension '" + ext +
-                     "' (expected .exr, .hdr, .png or .jpg)");
-  int w = 0, h = 0, n = 0;
-  unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 3);
+  unsigned char* data = stbi_load_from_memory(bytes, size, &w, &h, &n, 3);
   if (!data) throw InputError(path + ": cannot read image (" + stbi_failure_reason() + ")");
   RgbImage image(w, h);
   for (size_t i = 0; i < image.rgb.size(); ++i) {
@@ -248,6 +305,109 @@ void checkImageSize(int64_t width, int64_t height, double bytesPerPixel) {
   }
 }
 
+namespace {
+
+/// Where a JPEG's segments start (after SOI, which stb, like the standard's
+/// decoders, finds after any number of 0xff fill bytes); 0 when `bytes` is
+/// not a JPEG.
+size_t jpegBody(const unsigned char* bytes, size_t size) {
+  size_t at = 0;
+  while (at < size && bytes[at] == 0xff) ++at;
+  return at >= 1 && at < size && bytes[at] == 0xd8 ? at + 1 : 0;
+}
+
+}  // namespace
+
+void checkImageHoldsItsPixels(const unsigned char* bytes, size_t size, int64_t width,
+                              int64_t height) {
+  auto starts = [&](const char* magic, size_t n) {
+    return size >= n && std::memcmp(bytes, magic, n) == 0;
+  };
+  const double pixels = double(width) * double(height);
+  double least = 0;
+  const char* why = "";
+  if (starts("\x89PNG\r\n\x1a\n", 8)) {
+    // One bit per pixel at the least (1-bit grey) and a filter byte per row,
+    // through deflate, which compresses at most 1032:1.
+    least = (double(height) * (1.0 + std::ceil(double(width) / 8.0))) / 1032.0;
+    why = "PNG (deflate compresses at most 1032:1)";
+  } else if (jpegBody(bytes, size) != 0) {
+    // At least one bit per 8 x 8 block of the first component's DC scan
+    // (pixels / 512 bytes); eight times below that to be safe.
+    least = pixels / 4096.0;
+    why = "JPEG (at least a bit per 8 x 8 block)";
+  } else if (starts("#?", 2)) {
+    // Radiance RLE: a run of up to 127 bytes in 2, four streams per pixel.
+    least = pixels * 4.0 * 2.0 / 127.0 / 2.0;
+    why = "Radiance HDR (runs of at most 127)";
+  }
+  if (double(size) < least) {
+    throw InputError("a " + std::to_string(width) + " x " + std::to_string(height) + " " + why +
+                     " needs at least " + formatBytes(size_t(least)) + "; the file holds " +
+                     formatBytes(size) + ": truncated, or a header that lies");
+  }
+}
+
+namespace {
+
+/// The Huffman tables of a JPEG (every DHT segment, before and between the
+/// scans) hold at most 256 codes each. stb_image as Debian 12 ships it
+/// writes past its 257-entry tables when the 16 counts sum to more (a
+/// finding of the image fuzz target; upstream stb issues 1289 and 1291), so
+/// the segments are checked before stb sees the bytes. @throws InputError.
+void checkJpegHuffmanTables(const unsigned char* bytes, size_t size, size_t at) {
+  auto bad = [](const std::string& what) {
+    throw InputError("not a valid JPEG: " + what);
+  };
+  while (at + 1 < size) {
+    if (bytes[at] != 0xff) {
+      // Entropy-coded data of a scan: the next marker is 0xff followed by
+      // neither 0x00 (a stuffed byte) nor a restart marker.
+      while (at + 1 < size &&
+             !(bytes[at] == 0xff && bytes[at + 1] != 0x00 && bytes[at + 1] != 0xff &&
+               (bytes[at + 1] < 0xd0 || bytes[at + 1] > 0xd7))) {
+        ++at;
+      }
+      continue;
+    }
+    const unsigned marker = bytes[at + 1];
+    if (marker == 0xff) {  // fill byte
+      ++at;
+      continue;
+    }
+    at += 2;
+    if (marker == 0xd9) return;                                         // EOI
+    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd7)) continue;  // no length
+    if (at + 2 > size) return;  // truncated: the decoder says so
+    const size_t length = size_t(bytes[at]) << 8 | bytes[at + 1];
+    if (length < 2) bad("a segment of length " + std::to_string(length));
+    const size_t end = std::min(size, at + length);
+    if (marker == 0xc4) {
+      for (size_t p = at + 2; p < end;) {
+        if (p + 17 > end) bad("a Huffman table cut short");
+        size_t codes = 0;
+        for (size_t i = 1; i <= 16; ++i) codes += bytes[p + i];
+        if (codes > 256) bad("a Huffman table of " + std::to_string(codes) + " codes (at most 256)");
+        p += 17 + codes;
+      }
+    }
+    at += length;
+  }
+}
+
+}  // namespace
+
+void checkEncodedImage(const unsigned char* bytes, size_t size, double bytesPerPixel) {
+  if (const size_t body = jpegBody(bytes, size)) checkJpegHuffmanTables(bytes, size, body);
+  int w = 0, h = 0, comp = 0;
+  if (size > size_t(std::numeric_limits<int>::max()) ||
+      !stbi_info_from_memory(bytes, int(size), &w, &h, &comp)) {
+    return;  // the decoder says why
+  }
+  checkImageSize(w, h, bytesPerPixel);
+  checkImageHoldsItsPixels(bytes, size, w, h);
+}
+
 DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
   if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
     throw InputError("empty or too large");
@@ -256,7 +416,7 @@ DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
   int w = 0, h = 0, comp = 0;
   // The header's size first: stb, its floats and the caller's texture
   // (16 bytes per texel) per pixel, at most 4 channels of 16 bits.
-  if (stbi_info_from_memory(bytes, n, &w, &h, &comp)) checkImageSize(w, h, 4 * (2 + 4) + 16);
+  checkEncodedImage(bytes, size, 4 * (2 + 4) + 16);
   DecodedImage out;
   auto finish = [&](auto* data, float scale) {
     out.width = w;

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "image/compare.h"
 #include "image/image.h"
 #include "core/file.h"
+#include "core/isolate.h"
 #include "test_util.h"
 
 namespace lo {
@@ -208,6 +210,116 @@ TEST(ReadImage, AHeaderClaimingAHugeImageIsRefusedBeforeDecoding) {
   }
   EXPECT_NO_THROW(checkImageSize(kMaxImageSide, 1, 16));
   EXPECT_THROW(checkImageSize(kMaxImageSide + 1, 1, 16), InputError);
+}
+
+// The fuzz seeds of the image decoders (tests/fuzz/seeds/image/).
+std::string seedImage(const char* name) {
+  return readFile(test::dataDir() + "/../tests/fuzz/seeds/image/" + name);
+}
+
+TEST(ReadImage, BytesThatCannotHoldTheHeadersPixelsAreRefused) {
+  // A PNG and a JPEG of 16 x 16 whose headers are changed to 4000 x 4000:
+  // within every size limit, but 149 and 677 bytes cannot hold that many
+  // pixels (a 156-byte JPEG claiming 12000^2 decoded for 52 s and 3.3 GB).
+  const std::string png = seedImage("tiny.png"), jpg = seedImage("tiny.jpg");
+  auto decodes = [](const std::string& bytes) {
+    return decodeImageBytes(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+  };
+  EXPECT_EQ(decodes(png).width, 16);
+  EXPECT_EQ(decodes(jpg).height, 16);
+  std::string forgedPng = png;
+  for (int k : {16, 20}) {  // IHDR width and height, big-endian
+    forgedPng[size_t(k) + 2] = char(4000 >> 8);
+    forgedPng[size_t(k) + 3] = char(4000 & 0xff);
+  }
+  std::string forgedJpg = jpg;
+  const size_t sof = forgedJpg.find("\xff\xc0");
+  ASSERT_NE(sof, std::string::npos);
+  for (size_t k : {sof + 5, sof + 7}) {  // SOF0 height and width, big-endian
+    forgedJpg[k] = char(4000 >> 8);
+    forgedJpg[k + 1] = char(4000 & 0xff);
+  }
+  for (const auto& [bytes, what] : {std::pair{forgedPng, "PNG"}, std::pair{forgedJpg, "JPEG"}}) {
+    try {
+      decodes(bytes);
+      ADD_FAILURE() << what << " decoded";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("a 4000 x 4000 ") + what), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("truncated, or a header that lies"), std::string::npos)
+          << e.what();
+    }
+  }
+  // A JPEG whose Huffman table counts more than 256 codes: stb (Debian 12's)
+  // wrote past its tables (the image fuzz target's finding); refused first.
+  const std::string overflow = seedImage("huffman-table-overflow.jpg");
+  try {
+    decodes(overflow);
+    ADD_FAILURE() << "the Huffman table overflow was decoded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a valid JPEG: a Huffman table of"), std::string::npos)
+        << e.what();
+  }
+  // The same on disk, through readImage (compare, --mask).
+  const std::string path = test::outputDir("ReadImage_Forged") + "/forged.jpg";
+  std::ofstream(path, std::ios::binary) << forgedJpg;
+  EXPECT_THROW(readImage(path), InputError);
+}
+
+// The image fuzz target's seeds and findings (tests/fuzz/seeds/image/) as an
+// ordinary test, under the sanitizers in CI: each decodes or is refused.
+TEST(ReadImage, FuzzSeedsDecodeOrAreRefusedCleanly) {
+  int decoded = 0, refused = 0;
+  for (const auto& e : std::filesystem::directory_iterator(test::dataDir() + "/../tests/fuzz/seeds/image")) {
+    const std::string bytes = readFile(e.path().string());
+    try {
+      decodeImageBytes(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+      ++decoded;
+    } catch (const InputError&) {
+      ++refused;
+    }
+  }
+  EXPECT_GE(decoded, 2);  // tiny.png, tiny.jpg
+  EXPECT_GE(refused, 1);  // huffman-table-overflow.jpg
+}
+
+TEST(ReadImage, AnExrThatHoldsLessThanItsHeaderIsRefusedUnread) {
+  // An EXR of 16 x 8000 (ZIP) whose header says 8000 x 8000: OpenEXR would
+  // fill what the chunks lack without a word, into a 768 MB frame. Its 313
+  // KB cannot hold 768 MB at deflate's 1032:1: refused before any pixel is
+  // read, under a 512 MiB limit.
+  const std::string dir = test::outputDir("ReadImage_ExrBands");
+  writeExr(dir + "/small.exr", ramp(16, 8000));
+  std::string bytes = readFile(dir + "/small.exr");
+  const size_t at = bytes.find(std::string("dataWindow\0box2i\0", 17));
+  ASSERT_NE(at, std::string::npos);
+  const size_t xmax = at + 17 + 4 + 8;  // after the size, xmin and ymin
+  const int32_t wide = 7999;
+  std::memcpy(&bytes[xmax], &wide, 4);
+  const std::string forged = dir + "/forged.exr";
+  std::ofstream(forged, std::ios::binary) << bytes;
+  IsolationLimits limits;
+  limits.memoryBytes = size_t(512) << 20;
+  limits.seconds = 60;
+  const IsolatedRun run = runIsolated(
+      [&](std::string& message) {
+        try {
+          readImage(forged);
+        } catch (const InputError& e) {
+          message = e.what();
+          return 1;
+        }
+        return 0;
+      },
+      limits);
+  if (run.outcome == IsolatedRun::Outcome::NotIsolated) GTEST_SKIP() << "no fork";
+  ASSERT_EQ(int(run.outcome), int(IsolatedRun::Outcome::Finished)) << run.ToString(limits);
+  EXPECT_EQ(run.exitCode, 1) << run.message;
+  EXPECT_NE(run.message.find("forged.exr"), std::string::npos) << run.message;
+  EXPECT_NE(run.message.find("a 8000 x 8000 EXR of 12 bytes per pixel compressed at most 1032:1"),
+            std::string::npos) << run.message;
+  // A whole file still reads.
+  EXPECT_EQ(readImage(dir + "/small.exr").rgb, ramp(16, 8000).rgb);
 }
 
 }  // namespace
