@@ -4,7 +4,12 @@
 
 #include <openvdb/io/File.h>
 #include <openvdb/io/GridDescriptor.h>
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
+
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
@@ -14,6 +19,7 @@
 #include <limits>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -46,6 +52,20 @@ IsolationLimits readLimits(uintmax_t fileBytes) {
   return limits;
 }
 
+namespace {
+
+/// An anonymous file in memory that a forked child writes and its parent
+/// reads (closed with the object), both through its /proc/self/fd name.
+struct MemoryFile {
+  int fd = ::memfd_create("lightoctree-vdb", MFD_CLOEXEC);
+  ~MemoryFile() {
+    if (fd >= 0) ::close(fd);
+  }
+  std::string name() const { return "/proc/self/fd/" + std::to_string(fd); }
+};
+
+}  // namespace
+
 OpenedFile openFile(const std::string& path) {
   initOpenVdb();
   std::error_code ec;
@@ -53,19 +73,31 @@ OpenedFile openFile(const std::string& path) {
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
   // OpenVDB trusts the sizes a file states: a damaged file can make it
   // allocate gigabytes, loop for minutes or corrupt the heap. A child
-  // process reads it first under limits; only a file it read whole is read
-  // here (docs/robustness.md, "Reading untrusted files").
+  // process reads it under limits and hands back the grids it built,
+  // written anew by OpenVDB's own writer (every size and offset derived
+  // from the trees in memory): the parent never reads the file's own bytes
+  // (docs/robustness.md, "Reading untrusted files").
   const uintmax_t bytes = std::filesystem::file_size(path, ec);
   const IsolationLimits limits = readLimits(ec ? 0 : bytes);
-  auto trialRead = [&](std::string&) {
+  const MemoryFile handover;
+  auto trialRead = [&](std::string& message) {
     openvdb::io::File file(path);
     file.open(false);
-    file.getMetadata();
-    file.getGrids();
+    openvdb::MetaMap::Ptr meta = file.getMetadata();
+    openvdb::GridPtrVecPtr grids = file.getGrids();
     file.close();
+    std::ofstream os(handover.name(), std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
+    openvdb::io::Stream out(os);
+    out.setCompression(openvdb::io::COMPRESS_ACTIVE_MASK);  // no zip: it only crosses memory
+    out.write(*grids, *meta);
+    os.close();
+    if (os.fail()) {
+      message = std::string("cannot hand the grids back: ") + std::strerror(errno);
+      return 1;
+    }
     return 0;
   };
-  IsolatedRun trial = runIsolated(trialRead, limits);
+  IsolatedRun trial = handover.fd >= 0 ? runIsolated(trialRead, limits) : IsolatedRun{};
   // A child forked from a process with other threads can, rarely, wait
   // forever on a lock one of them held at the fork: a wait past the time
   // limit, or a crash, is tried once more before the file is refused (a
@@ -85,13 +117,22 @@ OpenedFile openFile(const std::string& path) {
   }
   OpenedFile f;
   try {
-    openvdb::io::File file(path);
-    // No delayed loading: every read error surfaces here, inside the try,
-    // rather than on first access to a leaf.
-    file.open(false);
-    f.meta = file.getMetadata();
-    f.grids = file.getGrids();
-    file.close();
+    if (trial.outcome == IsolatedRun::Outcome::Finished) {
+      // The child's grids, as OpenVDB's writer wrote them.
+      std::ifstream is(handover.name(), std::ios_base::in | std::ios_base::binary);
+      openvdb::io::Stream stream(is, /*delayLoad=*/false);
+      f.meta = stream.getMetadata();
+      f.grids = stream.getGrids();
+    } else {
+      // No child could be started (fork failed): read here, as before.
+      openvdb::io::File file(path);
+      // No delayed loading: every read error surfaces here, inside the try,
+      // rather than on first access to a leaf.
+      file.open(false);
+      f.meta = file.getMetadata();
+      f.grids = file.getGrids();
+      file.close();
+    }
   } catch (const std::exception& e) {
     throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(e.what()));
   }

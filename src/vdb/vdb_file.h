@@ -29,7 +29,10 @@ void initOpenVdb();
 /// and kReadSecondsBase + kReadSecondsPerByte x its size of time
 /// (core/isolate.h); a file it cannot read within them, or that crashes it
 /// (twice: a time-out or crash is tried again once), is refused without
-/// being read here.
+/// being read here. What the child read it hands back through memory,
+/// written anew by OpenVDB's writer: the parent never reads the file's own
+/// bytes, so a file that corrupts the child's heap without crashing it
+/// cannot reach the parent.
 constexpr size_t kReadMemoryBaseBytes = size_t(512) << 20;
 constexpr double kReadMemoryPerFileByte = 64;
 constexpr double kReadSecondsBase = 10;
