@@ -36,13 +36,15 @@ PACKAGES=(
 # What only the test suite needs (tools/test.sh sets LO_SETUP_TESTS=1): Blender,
 # whose Cycles judges the path tracer (tools/cycles_reference.py, test
 # cycles.lights_in_project_units), and NumPy for its glTF importer.
+# Chromium draws the three.js module's pictures (tests/web/, test web.three_lightmap).
 if [ "${LO_SETUP_TESTS:-0}" = "1" ]; then
-  PACKAGES+=(blender python3-numpy)
+  PACKAGES+=(blender python3-numpy chromium)
 fi
 
-# The Khronos glTF validator (npm package gltf-validator, pinned), installed
-# into the project-local folder the tests read (git ignores .cache/).
-GLTF_VALIDATOR_VERSION="2.0.0-dev.3.10"
+# npm packages, pinned, installed into the project-local folder the tests
+# read (git ignores .cache/): the Khronos glTF validator (the lightmap
+# exports), three.js and puppeteer-core (the three.js module in Chromium).
+NPM_PACKAGES=(gltf-validator@2.0.0-dev.3.10 three@0.187.0 puppeteer-core@25.16.0)
 NPM_PREFIX="$(cd "$(dirname "$0")/.." && pwd)/.cache/npm"
 
 SUDO=""
@@ -78,14 +80,20 @@ if ! command -v npm >/dev/null 2>&1; then
   apt_install npm
 fi
 
-installed="$(sed -n 's/.*"version": *"\([^"]*\)".*/\1/p' \
-  "$NPM_PREFIX/node_modules/gltf-validator/package.json" 2>/dev/null || true)"
-if [ "$installed" = "$GLTF_VALIDATOR_VERSION" ]; then
-  echo "setup: gltf-validator $installed present in .cache/npm"
+npm_missing=()
+for spec in "${NPM_PACKAGES[@]}"; do
+  name="${spec%@*}" version="${spec##*@}"
+  installed="$(sed -n 's/^ *"version": *"\([^"]*\)".*/\1/p' \
+    "$NPM_PREFIX/node_modules/$name/package.json" 2>/dev/null | head -1 || true)"
+  [ "$installed" = "$version" ] || npm_missing+=("$spec")
+done
+if [ ${#npm_missing[@]} -eq 0 ]; then
+  echo "setup: npm packages present in .cache/npm (${NPM_PACKAGES[*]})"
 else
-  echo "setup: installing gltf-validator $GLTF_VALIDATOR_VERSION into .cache/npm"
+  echo "setup: installing ${NPM_PACKAGES[*]} into .cache/npm"
   mkdir -p "$NPM_PREFIX"
+  # All at once: npm removes what a --no-save install does not name.
   npm install --prefix "$NPM_PREFIX" --no-audit --no-fund --no-save --loglevel=error \
-    "gltf-validator@$GLTF_VALIDATOR_VERSION" >/dev/null
+    "${NPM_PACKAGES[@]}" >/dev/null
 fi
 echo "setup: done"
