@@ -160,7 +160,7 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->delimiter(',');
   cmd->add_option("--photon-map", opt.photonMap,
                   "Also write the photons as an OpenVDB point grid for inspection");
-  cmd->add_option("--stats-json", opt.statsJson,
+  cmd->add_option("--stats-json,--json", opt.statsJson,
                   "Write the per-stage figures as JSON (under mpirun, per rank too: time, "
                   "bytes sent, peak memory)");
   cmd->add_option("--tiles", opt.tiles,

@@ -15,7 +15,9 @@
 #include "commands.h"
 #include "core/error.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "core/threads.h"
+#include "json_report.h"
 #include "report.h"
 #include "scene/scene.h"
 #include "vdb/vdb_io.h"
@@ -34,13 +36,15 @@ struct ConvertOptions {
   std::string photonMap;
   uint64_t seed = 1;
   int threads = 0;
+  std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
 
 int runConvert(const ConvertOptions& opt) {
   checkOutputFolder(opt.output, "--output");
-  checkDistinctFiles({{"--output", opt.output}},
-                     {{"IN", opt.input}, {"--scene", opt.scene}, {"--photon-map", opt.photonMap}});
+  if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
+  const NamedPaths inputs{{"IN", opt.input}, {"--scene", opt.scene}, {"--photon-map", opt.photonMap}};
+  checkDistinctFiles({{"--output", opt.output}, {"--json", opt.json}}, inputs);
   const auto& optional = optionalVdlGridNames();
   for (const std::string& name : opt.drop) {
     if (std::find(optional.begin(), optional.end(), name) == optional.end()) {
@@ -95,9 +99,19 @@ int runConvert(const ConvertOptions& opt) {
   VdlWriteOptions write;
   write.halfFloat = opt.half;
   write.drop = opt.drop;
-  writeVdlGrid(opt.output, out.grid, out.metadata, write);
-  writeTimer.finish(opt.output + " (" +
-                    formatBytes(size_t(std::filesystem::file_size(opt.output))) + ")");
+  AtomicFileSet outputs;
+  writeVdlGrid(opt.output, out.grid, out.metadata, write, &outputs);
+  writeTimer.finish(opt.output + " (" + formatBytes(size_t(outputs.bytesOf(opt.output))) + ")");
+  if (!opt.json.empty()) {
+    JsonReport report{"convert", inputs,
+                      {{"depth", {{"in", inDepth}, {"out", out.metadata.depth}}},
+                       {"voxels", {{"in", in.grid.size()}, {"out", out.grid.size()}}},
+                       {"vdls", out.vdls},
+                       {"method", out.method},
+                       {"energy", {{"in", lightGridEnergy(in.grid)}, {"out", lightGridEnergy(out.grid)}}}}};
+    report.addTo(outputs, opt.json, rows);
+  }
+  outputs.commit();
   if (!opt.quiet) {
     printSummary(stdout, rows);
     std::printf("\n%s: depth %d -> %d, %s -> %s voxels, %s VDLs; %s\n", opt.input.c_str(), inDepth,
@@ -141,6 +155,9 @@ std::function<int()> addConvertCommand(CLI::App& app) {
       ->check(seedValidator())->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
+  cmd->add_option("--json", opt->json,
+                  "Also write a JSON report: the files read and written, depths, voxels, method, "
+                  "energy in and out (README.md, \"Scripting\")");
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress or summary, only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runConvert(*opt) : -1; };
 }

@@ -10,6 +10,7 @@
 #include "scene_options.h"
 #include "core/file.h"
 #include "export/lightmap_export.h"
+#include "json_report.h"
 #include "report.h"
 #include "scene/scene.h"
 
@@ -31,6 +32,7 @@ struct LightmapOptions {
   float exposure = 0;
   std::string atlasOn = "cpu";  // cpu | osmesa | egl
   bool chartImage = false;
+  std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
 
@@ -41,6 +43,10 @@ LightmapExportParams exportParams(const LightmapOptions& opt) {
   NamedPaths inputs = sceneInputs(opt.scene);
   inputs.push_back({"LIGHTS", opt.lights});
   checkLightmapOutputs(opt.output, opt.image == "png", opt.previewUnlit, opt.chartImage, inputs);
+  if (!opt.json.empty()) {
+    checkOutputFolder(opt.json, "--json");
+    checkDistinctFiles({{"--output", opt.output}, {"--json", opt.json}}, inputs);
+  }
   LightmapExportParams p;
   p.output = opt.output;
   p.content = parseAtlasContent(opt.content);
@@ -56,9 +62,44 @@ LightmapExportParams exportParams(const LightmapOptions& opt) {
   return p;
 }
 
+/// The figures `lightmap --json` reports (README.md, "Scripting").
+nlohmann::json lightmapFigures(const LightmapExportResult& r, const LightmapExportParams& params) {
+  const LightmapUvs& uvs = r.lightmap.uvs;
+  const LightmapAtlas& atlas = r.lightmap.atlas;
+  nlohmann::json pages = nlohmann::json::array();
+  for (const std::string& path : r.pagePaths) pages.push_back(path);
+  return {{"uvs", r.lightmap.fromTexcoord1 ? "texcoord1" : "charts"},
+          {"charts", uvs.chartCount},
+          {"pages", atlas.pageCount},
+          {"page_size", {atlas.width, atlas.height}},
+          {"texel_size", uvs.texelSize},
+          {"utilisation", uvs.utilisation},
+          {"covered_texels", atlas.coveredTexels},
+          {"dilated_texels", atlas.dilatedTexels},
+          {"seam_mismatch", {{"before", atlas.seamMismatchBefore}, {"after", atlas.seamMismatchAfter}}},
+          {"content", toString(params.content)},
+          {"encoding", params.rgbm ? "rgbm-png" : "linear-exr"},
+          {"rgbm_range", params.rgbm ? nlohmann::json(r.rgbmRange) : nlohmann::json(nullptr)},
+          {"page_files", pages},
+          {"gltf", r.output},
+          {"preview", r.previewPath.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.previewPath)},
+          {"octree_bytes", r.octreePoolBytes + r.octreeVdlBytes}};
+}
+
 int runLightmap(const LightmapOptions& opt) {
-  const LightmapExportParams params = exportParams(opt);
+  LightmapExportParams params = exportParams(opt);
   std::vector<StageReport> rows;
+  NamedPaths inputs = sceneInputs(opt.scene);
+  inputs.push_back({"LIGHTS", opt.lights});
+  if (!opt.json.empty()) {
+    // The report goes into the export's set: it appears with the files or not at all.
+    params.beforeCommit = [&](const LightmapExportResult& r, AtomicFileSet& set) {
+      std::vector<StageReport> all = rows;
+      all.insert(all.end(), r.stages.begin(), r.stages.end());
+      JsonReport report{"lightmap", inputs, lightmapFigures(r, params)};
+      report.addTo(set, opt.json, all);
+    };
+  }
   StageTimer loadTimer(rows, "load scene");
   const Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
@@ -166,6 +207,10 @@ std::function<int()> addLightmapCommand(CLI::App& app) {
   cmd->add_flag("--chart-image", opt->chartImage,
                 "Also write OUT-chartsN.png: each page's UV layout, one colour per chart, chart "
                 "borders darker (v = 0 is the top row)");
+  cmd->add_option("--json", opt->json,
+                  "Also write a JSON report: the files read and written (pages, glTF, preview), the "
+                  "RGBM range, page count and size, time and memory per stage (README.md, "
+                  "\"Scripting\"); written with the other files, as one set");
   cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runLightmap(*opt) : -1; };
 }

@@ -12,11 +12,13 @@
 #include "scene_options.h"
 #include "core/error.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "core/threads.h"
 #include "image/image.h"
 #include "lightgrid/grid_frame.h"
 #include "reference/first_hit.h"
 #include "reference/path_tracer.h"
+#include "json_report.h"
 #include "report.h"
 #include "scene/scene.h"
 
@@ -39,6 +41,7 @@ struct ReferenceOptions {
   int maxBounces = 256;
   float exposure = 0;  // PNG only, as `render --exposure`
   double edgeDistance = 0;  // 0 = one voxel of a depth-6 bake
+  std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
 
@@ -53,10 +56,15 @@ int runReference(const ReferenceOptions& opt) {
   checkImageOutput(opt.output, "--output");
   if (!opt.stdErrorOutput.empty()) checkImageOutput(opt.stdErrorOutput, "--std-error");
   if (!opt.emitterMaskOutput.empty()) checkImageOutput(opt.emitterMaskOutput, "--emitter-mask");
+  if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
+  const NamedPaths inputs = sceneInputs(opt.scene);
   checkDistinctFiles({{"--output", opt.output},
                       {"--std-error", opt.stdErrorOutput},
-                      {"--emitter-mask", opt.emitterMaskOutput}},
-                     sceneInputs(opt.scene));
+                      {"--emitter-mask", opt.emitterMaskOutput},
+                      {"--json", opt.json}},
+                     inputs);
+  JsonReport report{"reference", inputs, {{"part", opt.part}, {"width", opt.width}, {"height", opt.height}}};
+  std::vector<StageReport> rows;
   checkCameraOptions(opt.camera);
   ThreadLimit threadLimit(opt.threads);
 
@@ -73,7 +81,13 @@ int runReference(const ReferenceOptions& opt) {
                                                 : makeGridFrame(scene.bounds(), 6).voxelSize;
     ConsoleProgress progress(opt.quiet);
     const RgbImage mask = renderEdgeMask(scene, camera, fp, distance, &progress);
-    writeImage(opt.output, mask);
+    AtomicFileSet outputs;
+    writeImage(opt.output, mask, 0.0f, &outputs);
+    if (!opt.json.empty()) {
+      report.figures["edge_distance"] = distance;
+      report.addTo(outputs, opt.json, rows);
+    }
+    outputs.commit();
     if (!opt.quiet) {
       double covered = 0;
       for (size_t i = 0; i < mask.pixelCount(); ++i) covered += mask.at(i).x > 0 ? 1 : 0;
@@ -93,10 +107,23 @@ int runReference(const ReferenceOptions& opt) {
   params.seed = opt.seed;
 
   ConsoleProgress progress(opt.quiet);
+  StageTimer traceTimer(rows, "path trace");
   ReferenceImage result = renderReference(scene, camera, params, &progress);
-  writeImage(opt.output, result.image, opt.exposure);
-  if (!opt.stdErrorOutput.empty()) writeImage(opt.stdErrorOutput, result.stdError);
-  if (!opt.emitterMaskOutput.empty()) writeImage(opt.emitterMaskOutput, result.emitterMask);
+  traceTimer.finish(std::to_string(result.samplesPerPixel) + " spp");
+  // The image and its side images (and the report) appear together.
+  AtomicFileSet outputs;
+  writeImage(opt.output, result.image, opt.exposure, &outputs);
+  if (!opt.stdErrorOutput.empty()) writeImage(opt.stdErrorOutput, result.stdError, 0.0f, &outputs);
+  if (!opt.emitterMaskOutput.empty()) {
+    writeImage(opt.emitterMaskOutput, result.emitterMask, 0.0f, &outputs);
+  }
+  if (!opt.json.empty()) {
+    report.figures["samples_per_pixel"] = result.samplesPerPixel;
+    report.figures["rays"] = result.raysTraced;
+    report.figures["seconds"] = result.seconds;
+    report.addTo(outputs, opt.json, rows);
+  }
+  outputs.commit();
 
   if (!opt.quiet) {
     // The mean standard error relative to the mean value: how far the
@@ -181,6 +208,9 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
                   "pixel's centre sees no emissive surface, black on the light fixtures, whose "
                   "own pixels the octree and the path tracer define differently")
       ->check(CLI::NonexistentPath | CLI::ExistingFile);
+  cmd->add_option("--json", opt->json,
+                  "Also write a JSON report: the files read and written, samples, rays and time "
+                  "(README.md, \"Scripting\")");
   cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runReference(*opt) : -1; };
 }

@@ -12,11 +12,13 @@
 #include "scene_options.h"
 #include "commands.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
 #include "reference/first_hit.h"
 #include "render/context.h"
+#include "json_report.h"
 #include "report.h"
 #include "image/image.h"
 #include "render/renderer.h"
@@ -38,8 +40,33 @@ struct RenderOptions {
   std::string backend = "osmesa";
   int frames = 0;
   int irradianceSpp = 64;
+  std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
+
+/// Mean Rec. 709 luminance of a linear image (the report's figure).
+double meanLuminance(const RgbImage& image) {
+  double sum = 0;
+  for (size_t i = 0; i < image.pixelCount(); ++i) {
+    sum += 0.2126 * image.rgb[3 * i] + 0.7152 * image.rgb[3 * i + 1] + 0.0722 * image.rgb[3 * i + 2];
+  }
+  return image.pixelCount() ? sum / double(image.pixelCount()) : 0.0;
+}
+
+/// Writes the image and, with --json, the report, as one set.
+void writeRenderOutputs(const RenderOptions& opt, const RgbImage& image, JsonReport& report,
+                        const std::vector<StageReport>& rows) {
+  AtomicFileSet outputs;
+  writeImage(opt.output, image, opt.shading.exposure, &outputs);
+  if (!opt.json.empty()) {
+    report.figures["image"] = {{"width", image.width},
+                               {"height", image.height},
+                               {"mean_luminance", meanLuminance(image)},
+                               {"exposure_ev", opt.shading.exposure}};
+    report.addTo(outputs, opt.json, rows);
+  }
+  outputs.commit();
+}
 
 /// `--mode irradiance`: the octree's indirect irradiance at the first hit,
 /// evaluated on the CPU (octree/octree_irradiance.h: the shader's lookup and
@@ -50,7 +77,8 @@ struct RenderOptions {
 /// pixel across an edge mixes its two surfaces in steps of a quarter, an
 /// error of up to a quarter of their difference that is the sampling's,
 /// not the octree's.
-int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedVdl& baked) {
+int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedVdl& baked,
+                     JsonReport& report, std::vector<StageReport>& rows) {
   if (opt.frames > 0) throw InputError("--frames: not with --mode irradiance (no GL frame)");
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   // No GL context to ask: the limits of the GL 3.3 contexts we render with.
@@ -64,10 +92,12 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
   params.width = opt.width;
   params.height = opt.height;
   params.samplesPerPixel = opt.irradianceSpp;
+  StageTimer renderTimer(rows, "render");
   RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {
     return octreeIrradiance(octree, hit.position, hit.normal, shade);
   });
-  writeImage(opt.output, image, opt.shading.exposure);
+  renderTimer.finish(std::to_string(opt.irradianceSpp) + " rays per pixel");
+  writeRenderOutputs(opt, image, report, rows);
   if (!opt.quiet) std::printf("wrote %s\n", opt.output.c_str());
   return 0;
 }
@@ -75,25 +105,29 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
 int runRender(const RenderOptions& opt) {
   // Everything that can be checked before the work is checked first.
   checkOutputFolder(opt.output, "--output");
+  if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
   NamedPaths inputs = sceneInputs(opt.scene);
   inputs.push_back({"LIGHTS", opt.lights});
-  checkDistinctFiles({{"--output", opt.output}}, inputs);
+  checkDistinctFiles({{"--output", opt.output}, {"--json", opt.json}}, inputs);
+  JsonReport report{"render", inputs, {{"mode", opt.mode}, {"width", opt.width}, {"height", opt.height}}};
+  std::vector<StageReport> rows;
   if (!hasExtension(opt.output, ".png") && !hasExtension(opt.output, ".exr")) {
     throw InputError("--output: '" + opt.output + "' must end in .png or .exr");
   }
   checkCameraOptions(opt.camera);
-  if (opt.mode == "irradiance") {
-    Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
-    printSceneWarnings(scene);
-    return renderIrradiance(opt, scene, readVdlGrid(opt.lights, scene.origin));
-  }
+  StageTimer loadTimer(rows, "load scene");
+  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
+  printSceneWarnings(scene);
+  loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
+                   std::to_string(scene.textures.size()) + " textures");
+  StageTimer readTimer(rows, "read grid");
+  LoadedVdl baked = readVdlGrid(opt.lights, scene.origin);
+  readTimer.finish(formatCount(baked.grid.size()) + " voxels");
+  if (opt.mode == "irradiance") return renderIrradiance(opt, scene, baked, report, rows);
   RenderParams params = opt.shading.renderParams(parseRenderMode(opt.mode));
   params.width = opt.width;
   params.height = opt.height;
 
-  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
-  printSceneWarnings(scene);
-  LoadedVdl baked = readVdlGrid(opt.lights, scene.origin);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   if (baked.meta.includeDirect == 1 &&
       (params.mode == RenderMode::Full || params.mode == RenderMode::Direct)) {
@@ -103,24 +137,36 @@ int runRender(const RenderOptions& opt) {
                  opt.lights.c_str(), opt.mode.c_str());
   }
 
+  StageTimer contextTimer(rows, "GL context");
   GlContextParams contextParams;
   contextParams.backend = parseGlBackend(opt.backend);
   std::unique_ptr<GlContext> context = createGlContext(contextParams);
+  contextTimer.finish(opt.backend);
   if (!opt.quiet) std::printf("%s: %s\n", opt.backend.c_str(), context->info().ToString().c_str());
+  report.figures["gl"] = context->info().ToString();
 
+  StageTimer octreeTimer(rows, "octree");
   GpuOctree octree = buildGpuOctree(baked.grid, opt.shading.octreeParams(&context->info()));
+  octreeTimer.finish("");
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
+  report.figures["octree"] = octree.ToString();
 
+  StageTimer uploadTimer(rows, "upload and prepare");
   Renderer renderer(scene, octree, opt.shading.rendererParams());
   opt.shading.prepareLighting(renderer, scene, octree, opt.quiet);
+  uploadTimer.finish("");
+  StageTimer frameTimer(rows, "first frame");
   RgbImage image = renderer.render(camera, params);
-  writeImage(opt.output, image, opt.shading.exposure);
+  frameTimer.finish(std::to_string(opt.width) + " x " + std::to_string(opt.height));
 
   if (opt.frames > 0) {
     double seconds = renderer.timeFrames(camera, params, opt.frames);
     std::printf("frame time: %.2f ms (%d x %d, mode %s, mean of %d frames, glFinish each)\n",
                 1000.0 * seconds / opt.frames, opt.width, opt.height, opt.mode.c_str(), opt.frames);
+    report.figures["frame_ms"] = 1000.0 * seconds / opt.frames;
+    report.figures["frames_timed"] = opt.frames;
   }
+  writeRenderOutputs(opt, image, report, rows);
   if (!opt.quiet) std::printf("wrote %s\n", opt.output.c_str());
   return 0;
 }
@@ -160,6 +206,9 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   cmd->add_option("--backend", opt->backend, "Headless OpenGL: osmesa (software) or egl")
       ->check(CLI::IsMember({"osmesa", "egl"}))
       ->capture_default_str();
+  cmd->add_option("--json", opt->json,
+                  "Also write a JSON report: the files read and written, the figures printed, "
+                  "time and memory per stage (README.md, \"Scripting\")");
   cmd->add_option("--frames", opt->frames,
                   "Also time this many frames (no read-back) and print the mean frame time")
       ->check(CLI::Range(0, 100000));

@@ -179,10 +179,11 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
       set.addText(result.chartPaths.back(), std::string(png.begin(), png.end()));
     }
   }
-  set.commit();
   if (!params.rgbm) {
-    for (const std::string& path : result.pagePaths) result.pageFileBytes += size_t(fs::file_size(path));
+    for (const std::string& path : result.pagePaths) result.pageFileBytes += size_t(set.bytesOf(path));
   }
+  if (params.beforeCommit) params.beforeCommit(result, set);
+  set.commit();
   writeTimer.finish(formatCount(size_t(atlas.pageCount) + 1 + (params.preview ? 1 : 0) +
                                 result.chartPaths.size()) +
                     " files");

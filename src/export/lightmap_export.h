@@ -20,10 +20,12 @@
 /// one cannot be written, those written before it are removed again.
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 
 #include "core/file.h"
+#include "core/file_set.h"
 #include <vector>
 
 #include "core/resources.h"
@@ -42,6 +44,8 @@ enum class AtlasContent {
 /// "indirect" | "full". @throws InputError naming --content and the value.
 AtlasContent parseAtlasContent(const std::string& name);
 const char* toString(AtlasContent content);  ///< "indirect" | "full"
+
+struct LightmapExportResult;
 
 struct LightmapExportParams {
   std::string output;  ///< the lit glTF: .glb (one file) or .gltf (+ .bin)
@@ -65,6 +69,10 @@ struct LightmapExportParams {
   /// of this kind (OSMesa or EGL). Unset: on the CPU (the same bytes on every
   /// machine).
   std::optional<GlBackend> atlasGl;
+  /// Called with the result and the export's set of files just before the
+  /// set is renamed into place: a command adds its side files (its `--json`
+  /// report) there, so that they appear with the set or not at all.
+  std::function<void(const LightmapExportResult&, AtomicFileSet&)> beforeCommit;
 };
 
 struct LightmapExportResult {

@@ -17,6 +17,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "core/resources.h"
 
 // stb's implementation is compiled once, in stb_image_impl.cpp.
@@ -144,9 +145,9 @@ unsigned char encodeSrgb8(float linear) {
   return static_cast<unsigned char>(std::lround(linearToSrgb(linear) * 255.0f));
 }
 
-void writeExr(const std::string& path, const RgbImage& image) {
+void writeExr(const std::string& path, const RgbImage& image, AtomicFileSet* into) {
   checkImage(path, image);
-  writeAtomically(path, [&](const std::string& tmp) {
+  const auto write = [&](const std::string& tmp) {
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
     const char* names[3] = {"R", "G", "B"};
@@ -160,13 +161,23 @@ void writeExr(const std::string& path, const RgbImage& image) {
     }
     file.setFrameBuffer(fb);
     file.writePixels(image.height);
-  });
+  };
+  if (into) {
+    into->add(path, write);
+  } else {
+    writeAtomically(path, write);
+  }
 }
 
-void writePng(const std::string& path, const RgbImage& image, float exposureEv) {
+void writePng(const std::string& path, const RgbImage& image, float exposureEv,
+              AtomicFileSet* into) {
   checkImage(path, image);
   const std::vector<unsigned char> png = encodePng(image, exposureEv);
-  writeTextAtomically(path, std::string(png.begin(), png.end()));
+  if (into) {
+    into->addText(path, std::string(png.begin(), png.end()));
+  } else {
+    writeTextAtomically(path, std::string(png.begin(), png.end()));
+  }
 }
 
 std::vector<unsigned char> encodePng8(int width, int height, int channels,
@@ -237,10 +248,11 @@ RgbImage decodeRgbm(const DecodedImage& image, float range) {
   return out;
 }
 
-void writeImage(const std::string& path, const RgbImage& image, float exposureEv) {
+void writeImage(const std::string& path, const RgbImage& image, float exposureEv,
+                AtomicFileSet* into) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".exr") return writeExr(path, image);
-  if (ext == ".png") return writePng(path, image, exposureEv);
+  if (ext == ".exr") return writeExr(path, image, into);
+  if (ext == ".png") return writePng(path, image, exposureEv, into);
   throw InputError(path + ": unsupported image extension '" + ext + "' (expected .exr or .png)");
 }
 

@@ -14,6 +14,8 @@
 
 namespace lo {
 
+class AtomicFileSet;  // core/file_set.h
+
 /// Linear RGB, row-major, row 0 at the top: the one image type of the
 /// project (GL frames, path-traced references, masks, differences).
 struct RgbImage {
@@ -74,18 +76,22 @@ float linearToSrgb(float linear);
 
 /// Writes 32-bit float channels R, G, B (ZIP, lossless) to
 /// `path` through `path.tmp` and a rename. @throws IoError naming the file.
-void writeExr(const std::string& path, const RgbImage& image);
+void writeExr(const std::string& path, const RgbImage& image, AtomicFileSet* into = nullptr);
 /// Writes radiance * 2^exposureEv, clamped, sRGB-encoded, 8-bit RGB.
-void writePng(const std::string& path, const RgbImage& image, float exposureEv = 0.0f);
+void writePng(const std::string& path, const RgbImage& image, float exposureEv = 0.0f,
+              AtomicFileSet* into = nullptr);
 /// Reads an EXR's R, G, B channels (missing G/B copy R: single-channel masks
 /// written as Y or R work too), a Radiance .hdr (linear) or a PNG/JPEG
 /// (8-bit, sRGB decoded to linear unless `linear8Bit`, in which case v/255).
 /// Dispatch by extension.
 /// @throws InputError naming the file for an unknown extension or a failed read.
 RgbImage readImage(const std::string& path, bool linear8Bit = false);
-/// Dispatch by extension: .exr (linear, `exposureEv` ignored) or .png.
+/// Dispatch by extension: .exr (linear, `exposureEv` ignored) or .png. The
+/// writers take `into`: the file joins that set of outputs (core/file_set.h,
+/// renamed with the others by its commit) instead of being renamed at once.
 /// @throws InputError naming the file for another extension.
-void writeImage(const std::string& path, const RgbImage& image, float exposureEv = 0.0f);
+void writeImage(const std::string& path, const RgbImage& image, float exposureEv = 0.0f,
+                AtomicFileSet* into = nullptr);
 
 /// The 8-bit sRGB encoding PNG output uses, for one linear value (clamped;
 /// NaN and Inf encode as 0).
