@@ -28,6 +28,8 @@ PACKAGES=(
   gnuplot-nox
   # a virtual display for the `lightoctree view` window tests (xvfb-run)
   xvfb xauth
+  # `import lightoctree` (python/): pybind11 and Python's headers; pytest runs its tests
+  pybind11-dev python3-dev python3-numpy python3-pytest
   # Node.js runs the Khronos glTF validator on the `lightoctree lightmap`
   # exports (tests gltf.validate_*); npm, which installs the validator, is
   # handled below
@@ -38,7 +40,7 @@ PACKAGES=(
 # cycles.lights_in_project_units), and NumPy for its glTF importer.
 # Chromium draws the three.js module's pictures (tests/web/, test web.three_lightmap).
 if [ "${LO_SETUP_TESTS:-0}" = "1" ]; then
-  PACKAGES+=(blender python3-numpy chromium)
+  PACKAGES+=(blender chromium)
 fi
 
 # npm packages, pinned, installed into the project-local folder the tests
