@@ -206,6 +206,32 @@ std::vector<unsigned char> encodePng(const RgbImage& image, float exposureEv) {
   return encodePng8(image.width, image.height, 3, rgb.data());
 }
 
+namespace {
+
+uint32_t crc32(const unsigned char* bytes, size_t size, uint32_t crc = 0) {
+  crc = ~crc;
+  for (size_t i = 0; i < size; ++i) {
+    crc ^= bytes[i];
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+/// A PNG chunk: length, type, data, CRC of type and data (big-endian).
+std::string pngChunk(const char type[4], const std::string& data) {
+  std::string chunk;
+  auto be32 = [&chunk](uint32_t v) {
+    for (int shift = 24; shift >= 0; shift -= 8) chunk.push_back(char((v >> shift) & 0xff));
+  };
+  be32(uint32_t(data.size()));
+  const std::string body = std::string(type, 4) + data;
+  chunk += body;
+  be32(crc32(reinterpret_cast<const unsigned char*>(body.data()), body.size()));
+  return chunk;
+}
+
+}  // namespace
+
 std::vector<unsigned char> encodeRgbmPng(const RgbImage& image, float range) {
   checkImage("encodeRgbmPng", image);
   if (!(std::isfinite(range) && range > 0)) {
@@ -228,7 +254,21 @@ std::vector<unsigned char> encodeRgbmPng(const RgbImage& image, float range) {
     }
     rgba[4 * i + 3] = (unsigned char)a;
   }
-  return encodePng8(image.width, image.height, 4, rgba.data());
+  std::vector<unsigned char> png = encodePng8(image.width, image.height, 4, rgba.data());
+  // Marked as data after IHDR (8 + 25 bytes): gAMA 1.0 (linear values, no sRGB
+  // curve to undo) and text chunks naming the encoding and its range, so the
+  // file says how to read it without the glTF beside it.
+  char rangeText[32];
+  std::snprintf(rangeText, sizeof rangeText, "%.9g", double(range));
+  const std::string gamma{'\0', '\x01', '\x86', '\xa0'};  // 100000: gamma 1.0
+  const std::string chunks =
+      pngChunk("gAMA", gamma) +
+      pngChunk("tEXt", std::string("Software") + '\0' + "lightoctree") +
+      pngChunk("tEXt", std::string("lightoctree:encoding") + '\0' +
+                           "rgbm: E = RGB/255 * A/255 * rgbmRange, W/m^2; not a colour image") +
+      pngChunk("tEXt", std::string("lightoctree:rgbmRange") + '\0' + rangeText);
+  png.insert(png.begin() + 33, chunks.begin(), chunks.end());
+  return png;
 }
 
 RgbImage decodeRgbm(const DecodedImage& image, float range) {

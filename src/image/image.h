@@ -114,7 +114,9 @@ std::vector<unsigned char> encodePng(const RgbImage& image, float exposureEv = 0
 /// decoded as c' = (RGB / 255) * (A / 255) * range (decodeRgbm). No sRGB curve
 /// on any channel: the PNG holds data, not a picture. A is rounded up, so the
 /// channel never exceeds 255, and |c' - c| <= 0.5 / 255 * M * range
-/// <= (0.5 / 255) * (max(c) + range / 255) per channel.
+/// <= (0.5 / 255) * (max(c) + range / 255) per channel. The PNG says what it
+/// holds: a gAMA chunk of 1.0 (linear data) and tEXt chunks
+/// "lightoctree:encoding" and "lightoctree:rgbmRange" (the range, as text).
 /// @throws InputError for an empty image or a range that is not finite and > 0.
 std::vector<unsigned char> encodeRgbmPng(const RgbImage& image, float range);
 /// @brief The inverse of encodeRgbmPng for a decoded RGBA image

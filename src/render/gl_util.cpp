@@ -124,7 +124,8 @@ std::vector<std::vector<std::string>> allPrograms() {
           {"render_fullscreen.vert", "render_layout_probe.frag"},
           {"render_fullscreen.vert", "render_brdf_probe.frag"},
           {"render_fullscreen.vert", "render_sky.frag"},
-          {"atlas_bake.vert", "atlas_bake.geom", "atlas_bake.frag"}};
+          {"atlas_bake.vert", "atlas_bake.geom", "atlas_bake.frag"},
+          {"hud.vert", "hud.frag"}};
 }
 
 void checkGl(const char* what) {

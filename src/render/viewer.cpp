@@ -2,6 +2,8 @@
 
 #include "render/viewer.h"
 
+#include "render/hud.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -102,7 +104,8 @@ const char* viewerKeyHelp() {
          "  [ / ]             fewer / more VDLs used per voxel (1..8)\n"
          "  , / .             exposure -0.5 / +0.5 EV;  0: back to --exposure\n"
          "  P                 append the current camera to the --record path file\n"
-         "  R                 back to the start camera;  H: print these keys and the camera\n"
+         "  R                 back to the start camera\n"
+         "  H                 these keys on the screen (and printed, with the camera); H again hides them\n"
          "  Esc               quit\n";
 }
 
@@ -122,7 +125,9 @@ struct Viewer::Impl final : InputHandler {
   float pendingYaw = 0, pendingPitch = 0;  // radians, from the mouse since the last frame
   bool appendKey = false;                  // P pressed: handled in the frame loop
   bool printHelp = false;
+  bool showKeys = false;  // H: the keys on the HUD too
   bool damaged = false;  // the window needs a redraw (exposed, resized)
+  std::unique_ptr<HudOverlay> hud;  // made in run(), with the window's context current
 
   Impl(GlContext& w, Renderer& r, const ViewerParams& p, OctreeLevelSource* l)
       : window(w), renderer(r), params(p), levels(l), fly(p.start), render(p.render),
@@ -189,7 +194,10 @@ struct Viewer::Impl final : InputHandler {
         if (press) appendKey = true;
         break;
       case Key::H:
-        if (press) printHelp = true;
+        if (press) {
+          printHelp = true;
+          showKeys = !showKeys;
+        }
         break;
       default:
         break;
@@ -263,6 +271,31 @@ struct Viewer::Impl final : InputHandler {
     return buf;
   }
 
+  /// The HUD's lines: what is on screen, then `H` for the keys (or the keys).
+  std::vector<std::string> hudLines(double frameMs, const std::string& octreeText,
+                                    const std::string& pathText) const {
+    char line[256];
+    std::snprintf(line, sizeof line, "%.1f ms  %.0f fps   %s, interp %s, %d VDL%s, EV %+.1f", frameMs,
+                  frameMs > 0 ? 1000.0 / frameMs : 0.0, toString(render.mode).c_str(),
+                  render.interpolation ? "on" : "off", render.maxVdls, render.maxVdls == 1 ? "" : "s",
+                  double(exposure));
+    std::vector<std::string> lines{line, "octree: " + octreeText};
+    if (!pathText.empty()) lines.push_back(pathText.substr(3));  // without " | "
+    if (!showKeys) {
+      lines.push_back("H: keys");
+      return lines;
+    }
+    const std::string keys = viewerKeyHelp();
+    for (size_t start = 0; start < keys.size();) {
+      const size_t end = keys.find('\n', start);
+      const std::string k = keys.substr(start, end == std::string::npos ? std::string::npos : end - start);
+      if (!k.empty()) lines.push_back(k);
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+    return lines;
+  }
+
   ViewerStats run();
 };
 
@@ -281,6 +314,7 @@ ViewerStats Viewer::Impl::run() {
       params.continuous || path || params.frames > 0 || !params.saveFrames.empty();
   PinholeCamera lastCamera;
   RenderParams lastParams;
+  std::string lastHudState;
   float lastExposure = 0;
   bool justShown = false;  // a new level went on screen: reported once its first frame is drawn
   bool pathDone = false;
@@ -325,6 +359,16 @@ ViewerStats Viewer::Impl::run() {
     }
     camera.znear = params.znear;
 
+    std::string octreeText = "depth " + std::to_string(shownDepth);
+    if (levels) {
+      if (shownDepth == 0) {
+        octreeText = "no octree yet (" + levels->status() + ")";
+      } else if (refining) {
+        octreeText = "depth " + std::to_string(shownDepth) + ", refining to " +
+                     std::to_string(params.targetDepth) + " (" + levels->status() + ")";
+      }
+    }
+
     int width = 0, height = 0;
     window.framebufferSize(width, height);
     if (width <= 0 || height <= 0) {  // minimized
@@ -338,12 +382,22 @@ ViewerStats Viewer::Impl::run() {
     // (camera, settings, window, a new level), so that a still view leaves
     // the cores to the bake; paths, --frames and --save-frames draw every
     // iteration, as does --continuous.
-    const bool draw = alwaysDraw || stats.framesDrawn == 0 || damaged || justShown ||
-                      !sameView(camera, lastCamera) || !sameParams(render, lastParams) ||
-                      exposure != lastExposure;
+    const bool drawScene = alwaysDraw || stats.framesDrawn == 0 || damaged || justShown ||
+                           !sameView(camera, lastCamera) || !sameParams(render, lastParams) ||
+                           exposure != lastExposure;
+    // The HUD's text but for its frame time: a change (the bake's progress,
+    // the keys shown) redraws a still view too.
+    const std::string hudState = octreeText + pathText + (showKeys ? "k" : "");
+    const bool hudChanged = params.hud && hudState != lastHudState;
+    const bool draw = drawScene || hudChanged;
     if (draw) {
       Stopwatch frameClock;
       renderer.drawToScreen(camera, render, exposure);
+      if (params.hud) {
+        if (!hud) hud = std::make_unique<HudOverlay>();
+        hud->draw(hudLines(titleMs, octreeText, pathText), width, height);
+        lastHudState = hudState;
+      }
       if (!params.saveFrames.empty()) {
         writeImage(framePath(params.saveFrames, stats.framesSaved++),
                    renderer.render(camera, render), exposure);
@@ -389,15 +443,6 @@ ViewerStats Viewer::Impl::run() {
       titleTime = frameEnd;
       titleFrames = 0;
       titleDrawSeconds = 0;
-      std::string octreeText = "depth " + std::to_string(shownDepth);
-      if (levels) {
-        if (shownDepth == 0) {
-          octreeText = "no octree yet (" + levels->status() + ")";
-        } else if (refining) {
-          octreeText = "depth " + std::to_string(shownDepth) + ", refining to " +
-                       std::to_string(params.targetDepth) + " (" + levels->status() + ")";
-        }
-      }
       window.setTitle(title(titleMs, octreeText, pathText));
     }
     if (params.frames > 0 && framesCounted >= params.frames) break;

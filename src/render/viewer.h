@@ -42,6 +42,10 @@ struct ViewerParams {
   int firstDepth = 0;        ///< the level source's first depth (progressive)
   int targetDepth = 0;       ///< the level source's last depth (progressive)
   bool quiet = false;        ///< no terminal output
+  /// The HUD in the window (render/hud.h): frame time, mode, octree level,
+  /// the progressive bake's progress, `H` for the keys. Saved frames
+  /// (--save-frames) never hold it.
+  bool hud = true;
 };
 
 struct ViewerStats {

@@ -217,6 +217,11 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   m.insertMeta("generator", openvdb::StringMetadata(meta.generator));
   m.insertMeta("version", openvdb::StringMetadata(meta.version));
   m.insertMeta("source_scene", openvdb::StringMetadata(meta.sourceScene));
+  // The frame the coordinates are in, for tools that would guess (Blender is
+  // Z up): the scene file's, and a glTF's is Y up, right-handed, metres.
+  m.insertMeta("up_axis", openvdb::StringMetadata("+Y"));
+  m.insertMeta("handedness", openvdb::StringMetadata("right"));
+  m.insertMeta("units", openvdb::StringMetadata("the scene file's (glTF: metres)"));
   // The grid's own frame is the truth for depth; see the check in writeVdlGrid.
   m.insertMeta(kMetaDepth, openvdb::Int32Metadata(grid.frame.depth));
   m.insertMeta("photons", openvdb::Int64Metadata(meta.photons));

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 #include "core/error.h"
 #include "core/rng.h"
@@ -74,6 +75,12 @@ TEST(Rgbm, RoundTripStaysWithinTheStatedBound) {
   EXPECT_NEAR(back.at(1).x, kRange, 1e-5f);
   EXPECT_NEAR(back.at(2).x, kRange, 1e-5f);
   EXPECT_EQ(back.at(2).z, 0.0f);
+
+  // The file says what it holds: linear data, RGBM, and its range.
+  const std::string bytes(png.begin(), png.end());
+  EXPECT_EQ(bytes.find("gAMA"), 37u) << "right after IHDR";
+  EXPECT_NE(bytes.find(std::string("lightoctree:rgbmRange") + '\0' + "8"), std::string::npos);
+  EXPECT_NE(bytes.find(std::string("lightoctree:encoding") + '\0' + "rgbm"), std::string::npos);
 
   EXPECT_THROW(encodeRgbmPng(img, 0.0f), InputError);
   EXPECT_THROW(encodeRgbmPng(img, NAN), InputError);
