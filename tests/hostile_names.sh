@@ -30,12 +30,12 @@ for length in 250 255; do
   [ -f "$name" ] || fail "no file of $length bytes"
 done
 name=$(printf 'n%.0s' $(seq 1 252)).vdb
-start=$(date +%s%N)
 msg=$("$cli" bake "$scene" -o "$name" --depth 7 --photons 2000000 2>&1)
-rc=$? ms=$((($(date +%s%N) - start) / 1000000))
+rc=$?
 [ "$rc" -eq 2 ] || [ "$rc" -eq 1 ] || fail "a 256-byte name: exit $rc"
 echo "$msg" | grep -q "is 256 bytes long" || fail "a 256-byte name: '$msg'"
-[ "$ms" -lt 3000 ] || fail "a 256-byte name was refused after ${ms} ms, not before the bake"
+# Refused before any work: the error is all the command said (no stage, no progress).
+[ "$(echo "$msg" | wc -l)" -eq 1 ] || fail "a 256-byte name: work was done before the refusal: '$msg'"
 ls -A | grep -q '\.tmp$' && fail "temporary files left: $(ls -A | grep '\.tmp$')"
 
 # 3. A side file that cannot be written (the file size limit lets the .vdb

@@ -5,7 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 LO_SETUP_TESTS=1 bash tools/build.sh
-(cd build && ctest --output-on-failure --timeout 600)
+# Tests in parallel, one per core (they write to their own folders).
+(cd build && ctest --output-on-failure --timeout 600 --parallel "$(nproc)")
 
 # The whole suite again under the sanitizers, in its own build folder; any
 # report fails its test. Leak checking is off: OpenVDB, Mesa and TBB keep
@@ -17,7 +18,7 @@ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLO_SANITIZ
   -DLO_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build build-asan --parallel "$(nproc)"
 (cd build-asan && ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --output-on-failure --timeout 900)
+  ctest --output-on-failure --timeout 900 --parallel "$(nproc)")
 
 # Fuzzing: each libFuzzer target for 60 s; a finding fails the run.
 bash tools/fuzz.sh 60
