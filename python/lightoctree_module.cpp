@@ -83,14 +83,7 @@ GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, doubl
   Scene scene = loadScene(scenePath);
   BakeParams params;
   params.depth = depth;
-  if (photons > 0 && targetError > 0) {
-    throw InputError("give photons (a fixed budget) or target_error, not both");
-  }
-  if (photons > 0) {
-    params.photons = photons;
-  } else {
-    params.targetError = targetError > 0 ? targetError : kDefaultTargetError;
-  }
+  setPhotonBudget(params, photons, targetError);
   params.seed = seed;
   params.knn = knn;
   params.vdls = parseVdlCount(vdls);

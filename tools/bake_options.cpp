@@ -15,14 +15,8 @@ namespace lo::tool {
 BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   BakeParams params;
   params.depth = depth;
-  if (photons > 0 && targetError > 0) {
-    throw InputError("give --photons (a fixed budget) or --target-error (photons until the noise "
-                     "reaches it), not both");
-  }
-  if (photons > 0) {
-    params.photons = photons;
-  } else {
-    params.targetError = targetError > 0 ? targetError : kDefaultTargetError;
+  setPhotonBudget(params, photons, targetError);
+  if (params.targetError > 0) {
     params.maxPhotons = maxPhotons;
     params.maxSeconds = maxSeconds;
   }

@@ -273,6 +273,19 @@ double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bo
   return h > 0 ? area / (h * h) : 0.0;
 }
 
+void setPhotonBudget(BakeParams& params, size_t photons, double targetError) {
+  if (photons > 0 && targetError > 0) {
+    throw InputError("give photons (a fixed budget, --photons) or a target error (photons until "
+                     "the noise reaches it, --target-error), not both");
+  }
+  if (photons > 0) {
+    params.photons = photons;
+    params.targetError = 0;
+  } else {
+    params.targetError = targetError > 0 ? targetError : kDefaultTargetError;
+  }
+}
+
 void checkVoxelMemory(const Scene& scene, const GridFrame& frame, const Bounds3& region,
                       double otherBytes, int processes) {
   const size_t available = availableMemoryBytes();

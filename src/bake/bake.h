@@ -261,6 +261,12 @@ void checkPhotonsStored(const BakeParams& params, const BakeStats& stats);
 /// slanted surfaces cross up to sqrt(3)x more, so this rather underestimates).
 double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bounds3& region);
 
+/// The photon budget from the two ways of asking for one: `photons` > 0 a
+/// fixed budget, else photons until the noise figure reaches `targetError`
+/// (0: kDefaultTargetError). The command line and the Python module both ask
+/// through it. @throws InputError when both are given.
+void setPhotonBudget(BakeParams& params, size_t photons, double targetError);
+
 /// Refuses, before any work, a grid at `frame` whose voxels
 /// (estimateActiveVoxels x kBakeBytesPerVoxel) and `otherBytes` need more
 /// memory than is available, naming --depth and the figures (bake, convert
