@@ -45,12 +45,12 @@ int runConvert(const ConvertOptions& opt) {
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
   const NamedPaths inputs{{"IN", opt.input}, {"--scene", opt.scene}, {"--photon-map", opt.photonMap}};
   checkDistinctFiles({{"--output", opt.output}, {"--json", opt.json}}, inputs);
-  const auto& optional = optionalVdlGridNames();
+  const auto& optional = droppableVdlGridNames();
   for (const std::string& name : opt.drop) {
     if (std::find(optional.begin(), optional.end(), name) == optional.end()) {
       std::string list;
       for (const auto& o : optional) list += (list.empty() ? "" : ", ") + o;
-      throw InputError("--drop: '" + name + "' is not an optional grid; only " + list +
+      throw InputError("--drop: '" + name + "' is not a grid that may be left out; only " + list +
                        " can be dropped (the others are required by the VDL file contract)");
     }
   }
@@ -143,7 +143,8 @@ std::function<int()> addConvertCommand(CLI::App& app) {
   cmd->add_flag("--half", opt->half,
                 "Store irradiance, normal, VDL, angular_error and radius grids as half floats");
   cmd->add_option("--drop", opt->drop,
-                  "Optional grids to leave out: photon_count, angular_error, radius, area")
+                  "Grids to leave out: the optional photon_count, noise, angular_error, radius, "
+                  "area, and the display grid density")
       ->delimiter(',');
   cmd->add_option("--scene", opt->scene,
                   "The baked scene: needed for a finer --depth and for --photon-map")

@@ -89,4 +89,13 @@ const std::vector<std::string>& optionalVdlGridNames() {
   return names;
 }
 
+const std::vector<std::string>& droppableVdlGridNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out = optionalVdlGridNames();
+    out.push_back(vdb_internal::kDensityGrid);
+    return out;
+  }();
+  return names;
+}
+
 }  // namespace lo

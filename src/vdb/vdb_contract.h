@@ -13,6 +13,10 @@
 
 namespace lo::vdb_internal {
 
+/// The display grid written beside the contract's (vdb_write.cpp,
+/// droppableVdlGridNames): not part of the contract, ignored by the readers.
+constexpr const char* kDensityGrid = "density";
+
 /// "layer<l>_": the prefix of surface layer l's grids (l = 1, 2).
 std::string layerPrefix(int layer);
 

@@ -21,6 +21,11 @@ class AtomicFileSet;  // core/file_set.h
 /// required.
 const std::vector<std::string>& optionalVdlGridNames();
 
+/// What `convert --drop` may leave out: the optional grids and the display
+/// grid `density` (the irradiance luminance over the brightest voxel's, in
+/// [0, 1], written for viewers' default volume import; the readers ignore it).
+const std::vector<std::string>& droppableVdlGridNames();
+
 /// How writeVdlGrid stores the grids.
 struct VdlWriteOptions {
   /// Store irradiance, normal, VDL, angular_error and radius grids as 16-bit
@@ -29,7 +34,7 @@ struct VdlWriteOptions {
   /// vdl_count, photon_count and area stay 32-bit: counts above 2048 and the
   /// small areas the coarsener weights by would not survive half precision.
   bool halfFloat = false;
-  /// Optional grids (optionalVdlGridNames) to leave out. @throws InputError
+  /// Grids (droppableVdlGridNames) to leave out. @throws InputError
   /// from writeVdlGrid for a required or unknown name.
   std::vector<std::string> drop;
 };

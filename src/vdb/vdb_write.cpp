@@ -169,18 +169,33 @@ std::vector<GridSource> vdlGridSources(const VdlGrid& g, const Transform::Ptr& x
   return grids;
 }
 
-bool isOptionalGrid(const std::string& name) {
-  const auto& names = optionalVdlGridNames();
-  return std::find(names.begin(), names.end(), name) != names.end();
+/// The display grid viewers read by default (Blender's and Houdini's volume
+/// import show a `density` fog): each voxel's irradiance luminance over the
+/// brightest voxel's, in [0, 1], on every voxel. Not part of the contract:
+/// the readers ignore it.
+FloatGrid::Ptr densityGrid(const VdlGrid& g, const Transform::Ptr& xform) {
+  auto luminance = [&g](size_t v) {
+    const Vec3& e = g.irradiance[v];
+    return 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z;
+  };
+  float brightest = 0;
+  for (size_t v = 0; v < g.size(); ++v) brightest = std::max(brightest, luminance(v));
+  FloatGrid::Ptr grid = floatGrid(kDensityGrid, "irradiance luminance / the brightest voxel's", xform,
+                                  g.coords, [&](size_t v) {
+                                    return brightest > 0 ? std::clamp(luminance(v) / brightest, 0.0f, 1.0f) : 0.0f;
+                                  });
+  grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+  return grid;
 }
 
 void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
               const VdlWriteOptions& options, const Damage* damage, AtomicFileSet* into) {
   initOpenVdb();
   for (const std::string& name : options.drop) {
-    if (!isOptionalGrid(name)) {
+    const auto& droppable = droppableVdlGridNames();
+    if (std::find(droppable.begin(), droppable.end(), name) == droppable.end()) {
       std::string list;
-      for (const auto& o : optionalVdlGridNames()) list += (list.empty() ? "" : ", ") + o;
+      for (const auto& o : droppable) list += (list.empty() ? "" : ", ") + o;
       throw InputError("--drop: grid '" + name + "' " +
                        (isRequiredVoxelGrid(name) ? "is required by the VDL file contract"
                                                   : "is not a grid of the VDL file contract") +
@@ -213,6 +228,13 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
                            shifted->postTranslate(openvdb::Vec3d(grid.frame.voxelSize, 0, 0));
                            g->setTransform(shifted);
                          }
+                         return g;
+                       }});
+  }
+  if (std::find(options.drop.begin(), options.drop.end(), kDensityGrid) == options.drop.end()) {
+    sources.push_back({kDensityGrid, [&grid, xform, half = options.halfFloat] {
+                         openvdb::GridBase::Ptr g = densityGrid(grid, xform);
+                         if (half) g->setSaveFloatAsHalf(true);
                          return g;
                        }});
   }

@@ -149,7 +149,7 @@ TEST(OptionalGrids, DroppedGridsReadAsZero) {
   }
   VdbReport r = inspectVdb(dir + "/d.vdb");
   EXPECT_TRUE(r.ok());
-  EXPECT_EQ(r.grids.size(), 3u + 2u * 3u);
+  EXPECT_EQ(r.grids.size(), 3u + 2u * 3u + 1u);  // + the display grid density
 
   for (const char* bad : {"irradiance", "vdl0_direction", "vdl_count", "bogus"}) {
     VdlWriteOptions o;
@@ -202,7 +202,7 @@ TEST(Inspect, GoodFileReportsGridsAndPasses) {
   VdbReport r = inspectVdb(dir + "/g.vdb");
   EXPECT_EQ(r.kind, "vdl");
   EXPECT_TRUE(r.ok());
-  ASSERT_EQ(r.grids.size(), 8u + 2u * 2u);
+  ASSERT_EQ(r.grids.size(), 8u + 2u * 2u + 1u);  // + the display grid density
   // VDL grids are active where the voxel has that VDL (sparse).
   size_t withTwo = 0;
   for (size_t v = 0; v < g.size(); ++v) withTwo += g.vdlCount[v] > 1;

@@ -224,6 +224,42 @@ TEST(VdbIo, VdbPrintListsTheContractGrids) {
   EXPECT_EQ(out.rfind("photons ", 0), 0u) << out;
 }
 
+// The display grid `density` (viewers' default volume import shows it): the
+// irradiance luminance over the brightest voxel's, on every voxel, in [0, 1];
+// readers ignore it, `--drop density` leaves it out, and it is the only
+// grid the contract does not name.
+TEST(VdbIo, ADensityGridShowsTheLightToViewers) {
+  std::string dir = test::outputDir("VdbIo.Density");
+  VdlGrid g = makeGrid(100, 2, 5);
+  writeVdlGrid(dir + "/g.vdb", g, makeMeta());
+  const VdbReport report = inspectVdb(dir + "/g.vdb");
+  const GridSummary* density = nullptr;
+  for (const GridSummary& s : report.grids) {
+    if (s.name == "density") density = &s;
+  }
+  ASSERT_NE(density, nullptr);
+  EXPECT_EQ(density->activeVoxels, g.size());
+  ASSERT_EQ(density->min.size(), 1u);
+  EXPECT_GE(density->min[0], 0.0);
+  EXPECT_DOUBLE_EQ(density->max[0], 1.0);  // the brightest voxel
+  // Reading ignores it: the grid comes back as written.
+  EXPECT_EQ(readVdlGrid(dir + "/g.vdb").grid.irradiance, g.irradiance);
+  VdlWriteOptions drop;
+  drop.drop = {"density"};
+  writeVdlGrid(dir + "/nodensity.vdb", g, makeMeta(), drop);
+  const VdbReport without = inspectVdb(dir + "/nodensity.vdb");
+  for (const GridSummary& s : without.grids) EXPECT_NE(s.name, "density");
+  // The grid changes no check's verdict (this grid's coordinates are not a
+  // bake's, so voxel_bounds fails in both).
+  ASSERT_EQ(without.checks.size(), report.checks.size());
+  for (size_t i = 0; i < report.checks.size(); ++i) {
+    EXPECT_EQ(report.checks[i].name, without.checks[i].name);
+    EXPECT_EQ(report.checks[i].passed, without.checks[i].passed) << report.checks[i].name;
+  }
+  drop.drop = {"irradiance"};
+  EXPECT_THROW(writeVdlGrid(dir + "/bad.vdb", g, makeMeta(), drop), InputError);
+}
+
 TEST(VdbIo, MissingGridIsAnInputError) {
   std::string dir = test::outputDir("VdbIo.MissingGrid");
   VdlGrid g = makeGrid(50, 2, 7);
