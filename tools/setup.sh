@@ -46,7 +46,7 @@ fi
 # npm packages, pinned, installed into the project-local folder the tests
 # read (git ignores .cache/): the Khronos glTF validator (the lightmap
 # exports), three.js and puppeteer-core (the three.js module in Chromium).
-NPM_PACKAGES=(gltf-validator@2.0.0-dev.3.10 three@0.187.0 puppeteer-core@25.16.0)
+NPM_PACKAGES=(gltf-validator@2.0.0-dev.3.10 three@0.187.0 puppeteer-core@24.43.1)
 NPM_PREFIX="$(cd "$(dirname "$0")/.." && pwd)/.cache/npm"
 
 SUDO=""
