@@ -38,22 +38,27 @@ struct Grid {
   VdlGrid grid;
   BakeMetadata meta;
   py::dict stats;  ///< the bake's figures (empty for a grid read from a file)
+  /// The lookup's octree, built on the first lookup (a grid never changes).
+  std::shared_ptr<const GpuOctree> octree;
+  const GpuOctree& lookupOctree() {
+    if (!octree) octree = std::make_shared<const GpuOctree>(buildGpuOctree(grid, GpuOctreeParams{}));
+    return *octree;
+  }
 };
 using GridPtr = std::shared_ptr<Grid>;
 
-/// A read-only view of `count` rows of `columns` floats (or ints) starting at
-/// `data`, rows `rowBytes` apart, kept alive by `owner`.
+/// A read-only array of `shape` and byte `strides` over `data`, kept alive
+/// by `owner`.
 template <typename T>
-py::array view(const py::object& owner, const T* data, size_t count, std::vector<size_t> shape,
+py::array view(const py::object& owner, const T* data, std::vector<size_t> shape,
                std::vector<size_t> strides) {
-  (void)count;
   py::array a(py::dtype::of<T>(), shape, strides, data, owner);
   py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   return a;
 }
 
 py::array vec3s(const py::object& owner, const std::vector<Vec3>& v) {
-  return view<float>(owner, &v.data()->x, v.size(), {v.size(), 3}, {sizeof(Vec3), sizeof(float)});
+  return view<float>(owner, &v.data()->x, {v.size(), 3}, {sizeof(Vec3), sizeof(float)});
 }
 
 /// The bake's progress to a Python callable (task, done, total), called with
@@ -153,14 +158,14 @@ GridPtr convertGrid(const Grid& in, int depth, const std::string& vdls, const st
 }
 
 /// E(p, n) through the CPU copy of the renderer's octree lookup.
-py::array_t<float> lookup(const Grid& g, py::array_t<float, py::array::c_style | py::array::forcecast> points,
+py::array_t<float> lookup(Grid& g, py::array_t<float, py::array::c_style | py::array::forcecast> points,
                           py::array_t<float, py::array::c_style | py::array::forcecast> normals) {
   if (points.ndim() != 2 || points.shape(1) != 3 || normals.ndim() != 2 || normals.shape(1) != 3 ||
       normals.shape(0) != points.shape(0)) {
     throw InputError("lookup: points and normals must both be arrays of shape (N, 3)");
   }
   const size_t n = size_t(points.shape(0));
-  const GpuOctree octree = buildGpuOctree(g.grid, GpuOctreeParams{});
+  const GpuOctree& octree = g.lookupOctree();
   py::array_t<float> out({n, size_t(3)});
   const float* p = points.data();
   const float* nn = normals.data();
@@ -234,7 +239,7 @@ PYBIND11_MODULE(lightoctree, m) {
       .def_property_readonly("sh_terms", [](const Grid& g) { return g.grid.shTerms; })
       .def_property_readonly("coords", [](py::object self) {
         const auto& c = self.cast<const Grid&>().grid.coords;
-        return view<int32_t>(self, &c.data()->x, c.size(), {c.size(), 3}, {sizeof(Coord), sizeof(int32_t)});
+        return view<int32_t>(self, &c.data()->x, {c.size(), 3}, {sizeof(Coord), sizeof(int32_t)});
       }, "(N, 3) int32 voxel coordinates")
       .def_property_readonly("positions", [](const Grid& g) {
         py::array_t<double> out({g.grid.size(), size_t(3)});
@@ -253,22 +258,22 @@ PYBIND11_MODULE(lightoctree, m) {
                              "(N, 3) RGB irradiance, W/m^2")
       .def_property_readonly("noise", [](py::object self) {
         const auto& n = self.cast<const Grid&>().grid.noise;
-        return view<float>(self, n.data(), n.size(), {n.size()}, {sizeof(float)});
+        return view<float>(self, n.data(), {n.size()}, {sizeof(float)});
       }, "(N,) relative standard error of each voxel's estimate")
       .def_property_readonly("vdl_count", [](py::object self) {
         const auto& c = self.cast<const Grid&>().grid.vdlCount;
-        return view<uint8_t>(self, c.data(), c.size(), {c.size()}, {sizeof(uint8_t)});
+        return view<uint8_t>(self, c.data(), {c.size()}, {sizeof(uint8_t)});
       }, "(N,) VDLs used per voxel")
       .def_property_readonly("vdl_irradiance", [](py::object self) {
         const VdlGrid& g = self.cast<const Grid&>().grid;
         const size_t k = size_t(g.maxVdls);
-        return view<float>(self, &g.vdls.data()->irradiance.x, g.vdls.size(), {g.size(), k, 3},
+        return view<float>(self, &g.vdls.data()->irradiance.x, {g.size(), k, 3},
                            {k * sizeof(Vdl), sizeof(Vdl), sizeof(float)});
       }, "(N, max_vdls, 3) RGB irradiance of each VDL, strongest first")
       .def_property_readonly("vdl_direction", [](py::object self) {
         const VdlGrid& g = self.cast<const Grid&>().grid;
         const size_t k = size_t(g.maxVdls);
-        return view<float>(self, &g.vdls.data()->direction.x, g.vdls.size(), {g.size(), k, 3},
+        return view<float>(self, &g.vdls.data()->direction.x, {g.size(), k, 3},
                            {k * sizeof(Vdl), sizeof(Vdl), sizeof(float)});
       }, "(N, max_vdls, 3) unit direction of each VDL, towards the light")
       .def_property_readonly("stats", [](const Grid& g) { return g.stats; },

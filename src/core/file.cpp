@@ -260,41 +260,10 @@ std::vector<std::string> leftoverTemporaries(const std::string& path) {
 
 void writeAtomically(const std::string& path,
                      const std::function<void(const std::string& tmp)>& write) {
-  using namespace file_internal;
-  requireReplaceable(path);
-  const std::string tmp = createTemporary(path);
-  const int slot = track(tmp);
-  auto removeTmp = [&] {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    untrack(slot);
-  };
-  try {
-    write(tmp);
-  } catch (const IoError&) {
-    removeTmp();
-    throw;
-  } catch (const std::exception& e) {
-    removeTmp();
-    throw IoError(path + ": cannot write (" + e.what() + ")");
-  }
-  // The writer opened the name itself: it must still be our regular file.
-  if (fs::symlink_status(tmp).type() != fs::file_type::regular) {
-    removeTmp();
-    throw IoError(path + ": the temporary file '" + tmp + "' was replaced while writing");
-  }
-  const std::string refusedNow = notReplaceable(path);
-  if (!refusedNow.empty()) {
-    removeTmp();
-    throw IoError(path + ": will not write: it is " + refusedNow + " (write to a new name)");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    removeTmp();
-    throw IoError(path + ": cannot rename '" + tmp + "' (" + ec.message() + ")");
-  }
-  untrack(slot);
+  // One file is a set of one: the same temporary name, checks and rename.
+  AtomicFileSet set;
+  set.add(path, write);
+  set.commit();
 }
 
 namespace {
@@ -354,7 +323,7 @@ void AtomicFileSet::add(const std::string& path,
 }
 
 void AtomicFileSet::addText(const std::string& path, const std::string& text) {
-  add(path, [&](const std::string& tmp) { file_internal::writeBytes(path, tmp, text); });
+  writeOutputText(this, path, text);
 }
 
 void AtomicFileSet::commit() {
@@ -398,8 +367,20 @@ std::vector<std::string> AtomicFileSet::paths() const {
 }
 
 void writeTextAtomically(const std::string& path, const std::string& text) {
-  writeAtomically(path,
-                  [&](const std::string& tmp) { file_internal::writeBytes(path, tmp, text); });
+  writeOutputText(nullptr, path, text);
+}
+
+void writeOutput(AtomicFileSet* set, const std::string& path,
+                 const std::function<void(const std::string& tmp)>& write) {
+  if (set) {
+    set->add(path, write);
+  } else {
+    writeAtomically(path, write);
+  }
+}
+
+void writeOutputText(AtomicFileSet* set, const std::string& path, const std::string& text) {
+  writeOutput(set, path, [&](const std::string& tmp) { file_internal::writeBytes(path, tmp, text); });
 }
 
 void checkOutputFolder(const std::string& path, const char* flag) {

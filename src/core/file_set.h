@@ -46,4 +46,12 @@ class AtomicFileSet {
   std::vector<Entry> entries_;
 };
 
+/// Writes `path` through `write(tmp)`: into `set` when one is given (renamed
+/// with the others by its commit), else on its own (writeAtomically). The
+/// writers that may be part of a set (images, .vdb files) take this path.
+void writeOutput(AtomicFileSet* set, const std::string& path,
+                 const std::function<void(const std::string& tmp)>& write);
+/// writeOutput of a byte string.
+void writeOutputText(AtomicFileSet* set, const std::string& path, const std::string& text);
+
 }  // namespace lo

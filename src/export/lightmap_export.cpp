@@ -159,28 +159,18 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
     if (params.rgbm) {
       set.addText(path, rgbmPages[size_t(p)]);
     } else {
-      const RgbImage& page = atlas.irradiance[size_t(p)];
-      set.add(path, [&page](const std::string& tmp) { writeExr(tmp, page); });
+      writeExr(path, atlas.irradiance[size_t(p)], &set);
     }
-    result.pageFileBytes += params.rgbm ? rgbmPages[size_t(p)].size() : 0;
+    result.pageFileBytes += size_t(set.bytesOf(path));
   }
-  auto addGltf = [&set](const GltfFiles& files, const std::string& path) {
-    if (!files.binUri.empty()) {
-      set.addText((fs::path(path).parent_path() / files.binUri).string(), files.bin);
-    }
-    set.addText(path, files.gltf);
-  };
-  addGltf(lit, params.output);
-  if (params.preview) addGltf(unlit, result.previewPath);
+  writeGltfFiles(lit, params.output, &set);
+  if (params.preview) writeGltfFiles(unlit, result.previewPath, &set);
   if (params.chartImages) {
     for (int p = 0; p < uvs.pageCount; ++p) {
       result.chartPaths.push_back(besideOutput(params.output, "-charts" + std::to_string(p) + ".png"));
       const std::vector<uint8_t> png = encodePng(chartLayoutImage(uvs, p));
       set.addText(result.chartPaths.back(), std::string(png.begin(), png.end()));
     }
-  }
-  if (!params.rgbm) {
-    for (const std::string& path : result.pagePaths) result.pageFileBytes += size_t(set.bytesOf(path));
   }
   if (params.beforeCommit) params.beforeCommit(result, set);
   set.commit();

@@ -162,22 +162,14 @@ void writeExr(const std::string& path, const RgbImage& image, AtomicFileSet* int
     file.setFrameBuffer(fb);
     file.writePixels(image.height);
   };
-  if (into) {
-    into->add(path, write);
-  } else {
-    writeAtomically(path, write);
-  }
+  writeOutput(into, path, write);
 }
 
 void writePng(const std::string& path, const RgbImage& image, float exposureEv,
               AtomicFileSet* into) {
   checkImage(path, image);
   const std::vector<unsigned char> png = encodePng(image, exposureEv);
-  if (into) {
-    into->addText(path, std::string(png.begin(), png.end()));
-  } else {
-    writeTextAtomically(path, std::string(png.begin(), png.end()));
-  }
+  writeOutputText(into, path, std::string(png.begin(), png.end()));
 }
 
 std::vector<unsigned char> encodePng8(int width, int height, int channels,
@@ -296,6 +288,111 @@ void writeImage(const std::string& path, const RgbImage& image, float exposureEv
   throw InputError(path + ": unsupported image extension '" + ext + "' (expected .exr or .png)");
 }
 
+namespace {
+
+/// Where a JPEG's segments start (after SOI, which stb, like the standard's
+/// decoders, finds after any number of 0xff fill bytes); 0 when `bytes` is
+/// not a JPEG.
+size_t jpegBody(const unsigned char* bytes, size_t size) {
+  size_t at = 0;
+  while (at < size && bytes[at] == 0xff) ++at;
+  return at >= 1 && at < size && bytes[at] == 0xd8 ? at + 1 : 0;
+}
+
+/// Refuses an encoded image whose bytes cannot hold the pixels its header
+/// claims, before it is decoded: a PNG below its raw size / 1032 (deflate's
+/// largest ratio, at one bit per pixel), a JPEG below pixels / 4096 bytes, a
+/// Radiance HDR below pixels / 32. Other formats pass.
+void checkImageHoldsItsPixels(const unsigned char* bytes, size_t size, int64_t width,
+                              int64_t height) {
+  auto starts = [&](const char* magic, size_t n) {
+    return size >= n && std::memcmp(bytes, magic, n) == 0;
+  };
+  const double pixels = double(width) * double(height);
+  double least = 0;
+  const char* why = "";
+  if (starts("\x89PNG\r\n\x1a\n", 8)) {
+    // One bit per pixel at the least (1-bit grey) and a filter byte per row,
+    // through deflate, which compresses at most 1032:1.
+    least = (double(height) * (1.0 + std::ceil(double(width) / 8.0))) / 1032.0;
+    why = "PNG (deflate compresses at most 1032:1)";
+  } else if (jpegBody(bytes, size) != 0) {
+    // At least one bit per 8 x 8 block of the first component's DC scan
+    // (pixels / 512 bytes); eight times below that to be safe.
+    least = pixels / 4096.0;
+    why = "JPEG (at least a bit per 8 x 8 block)";
+  } else if (starts("#?", 2)) {
+    // Radiance RLE: a run of up to 127 bytes in 2, four streams per pixel.
+    least = pixels * 4.0 * 2.0 / 127.0 / 2.0;
+    why = "Radiance HDR (runs of at most 127)";
+  }
+  if (double(size) < least) {
+    throw InputError("a " + std::to_string(width) + " x " + std::to_string(height) + " " + why +
+                     " needs at least " + formatBytes(size_t(least)) + "; the file holds " +
+                     formatBytes(size) + ": truncated, or a header that lies");
+  }
+}
+
+/// The Huffman tables of a JPEG (every DHT segment, before and between the
+/// scans) hold at most 256 codes each. stb_image as Debian 12 ships it
+/// writes past its 257-entry tables when the 16 counts sum to more (a
+/// finding of the image fuzz target; upstream stb issues 1289 and 1291), so
+/// the segments are checked before stb sees the bytes. @throws InputError.
+void checkJpegHuffmanTables(const unsigned char* bytes, size_t size, size_t at) {
+  auto bad = [](const std::string& what) {
+    throw InputError("not a valid JPEG: " + what);
+  };
+  while (at + 1 < size) {
+    if (bytes[at] != 0xff) {
+      // Entropy-coded data of a scan: the next marker is 0xff followed by
+      // neither 0x00 (a stuffed byte) nor a restart marker.
+      while (at + 1 < size &&
+             !(bytes[at] == 0xff && bytes[at + 1] != 0x00 && bytes[at + 1] != 0xff &&
+               (bytes[at + 1] < 0xd0 || bytes[at + 1] > 0xd7))) {
+        ++at;
+      }
+      continue;
+    }
+    const unsigned marker = bytes[at + 1];
+    if (marker == 0xff) {  // fill byte
+      ++at;
+      continue;
+    }
+    at += 2;
+    if (marker == 0xd9) return;                                         // EOI
+    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd7)) continue;  // no length
+    if (at + 2 > size) return;  // truncated: the decoder says so
+    const size_t length = size_t(bytes[at]) << 8 | bytes[at + 1];
+    if (length < 2) bad("a segment of length " + std::to_string(length));
+    const size_t end = std::min(size, at + length);
+    if (marker == 0xc4) {
+      for (size_t p = at + 2; p < end;) {
+        if (p + 17 > end) bad("a Huffman table cut short");
+        size_t codes = 0;
+        for (size_t i = 1; i <= 16; ++i) codes += bytes[p + i];
+        if (codes > 256) bad("a Huffman table of " + std::to_string(codes) + " codes (at most 256)");
+        p += 17 + codes;
+      }
+    }
+    at += length;
+  }
+}
+
+/// checkImageSize and checkImageHoldsItsPixels on what stb's header reader
+/// finds (nothing when it finds no image: the decoder then says why).
+void checkEncodedImage(const unsigned char* bytes, size_t size, double bytesPerPixel) {
+  if (const size_t body = jpegBody(bytes, size)) checkJpegHuffmanTables(bytes, size, body);
+  int w = 0, h = 0, comp = 0;
+  if (size > size_t(std::numeric_limits<int>::max()) ||
+      !stbi_info_from_memory(bytes, int(size), &w, &h, &comp)) {
+    return;  // the decoder says why
+  }
+  checkImageSize(w, h, bytesPerPixel);
+  checkImageHoldsItsPixels(bytes, size, w, h);
+}
+
+}  // namespace
+
 RgbImage readImage(const std::string& path, bool linear8Bit) {
   requireRegularFile(path, "the image");
   const std::string ext = lowerExtension(path);
@@ -357,108 +454,6 @@ void checkImageSize(int64_t width, int64_t height, double bytesPerPixel) {
   }
 }
 
-namespace {
-
-/// Where a JPEG's segments start (after SOI, which stb, like the standard's
-/// decoders, finds after any number of 0xff fill bytes); 0 when `bytes` is
-/// not a JPEG.
-size_t jpegBody(const unsigned char* bytes, size_t size) {
-  size_t at = 0;
-  while (at < size && bytes[at] == 0xff) ++at;
-  return at >= 1 && at < size && bytes[at] == 0xd8 ? at + 1 : 0;
-}
-
-}  // namespace
-
-void checkImageHoldsItsPixels(const unsigned char* bytes, size_t size, int64_t width,
-                              int64_t height) {
-  auto starts = [&](const char* magic, size_t n) {
-    return size >= n && std::memcmp(bytes, magic, n) == 0;
-  };
-  const double pixels = double(width) * double(height);
-  double least = 0;
-  const char* why = "";
-  if (starts("\x89PNG\r\n\x1a\n", 8)) {
-    // One bit per pixel at the least (1-bit grey) and a filter byte per row,
-    // through deflate, which compresses at most 1032:1.
-    least = (double(height) * (1.0 + std::ceil(double(width) / 8.0))) / 1032.0;
-    why = "PNG (deflate compresses at most 1032:1)";
-  } else if (jpegBody(bytes, size) != 0) {
-    // At least one bit per 8 x 8 block of the first component's DC scan
-    // (pixels / 512 bytes); eight times below that to be safe.
-    least = pixels / 4096.0;
-    why = "JPEG (at least a bit per 8 x 8 block)";
-  } else if (starts("#?", 2)) {
-    // Radiance RLE: a run of up to 127 bytes in 2, four streams per pixel.
-    least = pixels * 4.0 * 2.0 / 127.0 / 2.0;
-    why = "Radiance HDR (runs of at most 127)";
-  }
-  if (double(size) < least) {
-    throw InputError("a " + std::to_string(width) + " x " + std::to_string(height) + " " + why +
-                     " needs at least " + formatBytes(size_t(least)) + "; the file holds " +
-                     formatBytes(size) + ": truncated, or a header that lies");
-  }
-}
-
-namespace {
-
-/// The Huffman tables of a JPEG (every DHT segment, before and between the
-/// scans) hold at most 256 codes each. stb_image as Debian 12 ships it
-/// writes past its 257-entry tables when the 16 counts sum to more (a
-/// finding of the image fuzz target; upstream stb issues 1289 and 1291), so
-/// the segments are checked before stb sees the bytes. @throws InputError.
-void checkJpegHuffmanTables(const unsigned char* bytes, size_t size, size_t at) {
-  auto bad = [](const std::string& what) {
-    throw InputError("not a valid JPEG: " + what);
-  };
-  while (at + 1 < size) {
-    if (bytes[at] != 0xff) {
-      // Entropy-coded data of a scan: the next marker is 0xff followed by
-      // neither 0x00 (a stuffed byte) nor a restart marker.
-      while (at + 1 < size &&
-             !(bytes[at] == 0xff && bytes[at + 1] != 0x00 && bytes[at + 1] != 0xff &&
-               (bytes[at + 1] < 0xd0 || bytes[at + 1] > 0xd7))) {
-        ++at;
-      }
-      continue;
-    }
-    const unsigned marker = bytes[at + 1];
-    if (marker == 0xff) {  // fill byte
-      ++at;
-      continue;
-    }
-    at += 2;
-    if (marker == 0xd9) return;                                         // EOI
-    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd7)) continue;  // no length
-    if (at + 2 > size) return;  // truncated: the decoder says so
-    const size_t length = size_t(bytes[at]) << 8 | bytes[at + 1];
-    if (length < 2) bad("a segment of length " + std::to_string(length));
-    const size_t end = std::min(size, at + length);
-    if (marker == 0xc4) {
-      for (size_t p = at + 2; p < end;) {
-        if (p + 17 > end) bad("a Huffman table cut short");
-        size_t codes = 0;
-        for (size_t i = 1; i <= 16; ++i) codes += bytes[p + i];
-        if (codes > 256) bad("a Huffman table of " + std::to_string(codes) + " codes (at most 256)");
-        p += 17 + codes;
-      }
-    }
-    at += length;
-  }
-}
-
-}  // namespace
-
-void checkEncodedImage(const unsigned char* bytes, size_t size, double bytesPerPixel) {
-  if (const size_t body = jpegBody(bytes, size)) checkJpegHuffmanTables(bytes, size, body);
-  int w = 0, h = 0, comp = 0;
-  if (size > size_t(std::numeric_limits<int>::max()) ||
-      !stbi_info_from_memory(bytes, int(size), &w, &h, &comp)) {
-    return;  // the decoder says why
-  }
-  checkImageSize(w, h, bytesPerPixel);
-  checkImageHoldsItsPixels(bytes, size, w, h);
-}
 
 DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
   if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {

@@ -57,18 +57,6 @@ constexpr int kMaxImageSide = 16384;
 /// @throws InputError "image of W x H ... " (the caller names the file).
 void checkImageSize(int64_t width, int64_t height, double bytesPerPixel);
 
-/// Refuses an encoded image whose bytes cannot hold the pixels its header
-/// claims, before it is decoded: a PNG below its raw size / 1032 (deflate's
-/// largest ratio, at one bit per pixel), a JPEG below pixels / 4096 bytes, a
-/// Radiance HDR below pixels / 32. Other formats pass. @throws InputError
-/// "a W x H PNG ... needs at least ...; the file holds ..." (the caller names
-/// the file).
-void checkImageHoldsItsPixels(const unsigned char* bytes, size_t size, int64_t width,
-                              int64_t height);
-/// checkImageSize and checkImageHoldsItsPixels on what stb's header reader
-/// finds (nothing when it finds no image: the decoder then says why).
-void checkEncodedImage(const unsigned char* bytes, size_t size, double bytesPerPixel);
-
 /// sRGB transfer function (IEC 61966-2-1) to linear, for one channel in [0, 1].
 float srgbToLinear(float s);
 /// Its inverse: linear (clamped to [0, 1]; not finite: 0) to sRGB, in [0, 1].

@@ -25,6 +25,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "image/image.h"
 
 namespace lo {
@@ -750,21 +751,14 @@ GltfFiles encodeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,
   return files;
 }
 
-std::vector<std::string> writeGltfFiles(const GltfFiles& files, const std::string& path) {
-  if (files.binUri.empty()) {
-    writeTextAtomically(path, files.gltf);
-    return {path};
+void writeGltfFiles(const GltfFiles& files, const std::string& path, AtomicFileSet* set) {
+  AtomicFileSet own;
+  AtomicFileSet& into = set ? *set : own;
+  if (!files.binUri.empty()) {
+    into.addText((std::filesystem::path(path).parent_path() / files.binUri).string(), files.bin);
   }
-  const std::string binPath = (std::filesystem::path(path).parent_path() / files.binUri).string();
-  writeTextAtomically(binPath, files.bin);
-  try {
-    writeTextAtomically(path, files.gltf);
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(binPath, ignored);
-    throw;
-  }
-  return {binPath, path};
+  into.addText(path, files.gltf);
+  if (!set) own.commit();
 }
 
 void writeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,

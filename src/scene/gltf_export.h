@@ -33,6 +33,10 @@
 #include "scene/scene.h"
 
 namespace lo {
+class AtomicFileSet;  // core/file_set.h
+}
+
+namespace lo {
 
 /// @brief A lightmap for writeLightmapGltf, as plain data.
 struct LightmapExport {
@@ -80,11 +84,11 @@ struct GltfFiles {
 GltfFiles encodeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,
                              const std::string& path);
 
-/// @brief Writes `files`, encodeLightmapGltf's for `path`, atomically
-/// (core/file.h): a .gltf's .bin first, removed again if the .gltf cannot be
-/// written. Returns the paths written, the .bin first.
+/// @brief Writes `files`, encodeLightmapGltf's for `path` (a .gltf's .bin,
+/// then the .gltf), as one set of outputs (core/file_set.h): into `set` when
+/// given (renamed by its commit), else committed here.
 /// @throws IoError naming the file.
-std::vector<std::string> writeGltfFiles(const GltfFiles& files, const std::string& path);
+void writeGltfFiles(const GltfFiles& files, const std::string& path, AtomicFileSet* set = nullptr);
 
 /// @brief encodeLightmapGltf, then writeGltfFiles.
 /// @throws InputError as encodeLightmapGltf; IoError naming the file.

@@ -202,11 +202,7 @@ void writeVdbFile(const std::string& path, const std::vector<GridSource>& source
     }
     makeUuidDeterministic(tmp);
   };
-  if (into) {
-    into->add(path, write);
-  } else {
-    writeAtomically(path, write);
-  }
+  writeOutput(into, path, write);
 }
 
 // ---------------------------------------------------------------------------
