@@ -47,9 +47,7 @@ struct RenderOptions {
 /// Mean Rec. 709 luminance of a linear image (the report's figure).
 double meanLuminance(const RgbImage& image) {
   double sum = 0;
-  for (size_t i = 0; i < image.pixelCount(); ++i) {
-    sum += 0.2126 * image.rgb[3 * i] + 0.7152 * image.rgb[3 * i + 1] + 0.0722 * image.rgb[3 * i + 2];
-  }
+  for (size_t i = 0; i < image.pixelCount(); ++i) sum += double(luminance(image.at(i)));
   return image.pixelCount() ? sum / double(image.pixelCount()) : 0.0;
 }
 

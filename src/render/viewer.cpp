@@ -258,28 +258,34 @@ struct Viewer::Impl final : InputHandler {
     pendingYaw = pendingPitch = 0;
   }
 
+  /// "full, interp on, 4 VDLs, EV +0.0": the settings on screen.
+  std::string settingsText() const {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "%s, interp %s, %d VDL%s, EV %+.1f", toString(render.mode).c_str(),
+                  render.interpolation ? "on" : "off", render.maxVdls, render.maxVdls == 1 ? "" : "s",
+                  double(exposure));
+    return buf;
+  }
+
+  /// "12.3 ms, 81.3 fps".
+  static std::string frameText(double frameMs) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.1f ms, %.1f fps", frameMs, frameMs > 0 ? 1000.0 / frameMs : 0.0);
+    return buf;
+  }
+
   std::string title(double frameMs, const std::string& octreeText,
                     const std::string& pathText) const {
-    char buf[512];
-    std::snprintf(buf, sizeof buf,
-                  "Light Octree | %s, interp %s, %d VDL%s, EV %+.1f, speed %.3g/s | %.1f ms, "
-                  "%.1f fps | %s%s",
-                  toString(render.mode).c_str(), render.interpolation ? "on" : "off",
-                  render.maxVdls, render.maxVdls == 1 ? "" : "s", double(exposure),
-                  double(fly.speed), frameMs, frameMs > 0 ? 1000.0 / frameMs : 0.0,
-                  octreeText.c_str(), pathText.c_str());
-    return buf;
+    char speed[32];
+    std::snprintf(speed, sizeof speed, "%.3g", double(fly.speed));
+    return "Light Octree | " + settingsText() + ", speed " + speed + "/s | " + frameText(frameMs) +
+           " | " + octreeText + pathText;
   }
 
   /// The HUD's lines: what is on screen, then `H` for the keys (or the keys).
   std::vector<std::string> hudLines(double frameMs, const std::string& octreeText,
                                     const std::string& pathText) const {
-    char line[256];
-    std::snprintf(line, sizeof line, "%.1f ms  %.0f fps   %s, interp %s, %d VDL%s, EV %+.1f", frameMs,
-                  frameMs > 0 ? 1000.0 / frameMs : 0.0, toString(render.mode).c_str(),
-                  render.interpolation ? "on" : "off", render.maxVdls, render.maxVdls == 1 ? "" : "s",
-                  double(exposure));
-    std::vector<std::string> lines{line, "octree: " + octreeText};
+    std::vector<std::string> lines{frameText(frameMs) + "   " + settingsText(), "octree: " + octreeText};
     if (!pathText.empty()) lines.push_back(pathText.substr(3));  // without " | "
     if (!showKeys) {
       lines.push_back("H: keys");

@@ -174,15 +174,11 @@ std::vector<GridSource> vdlGridSources(const VdlGrid& g, const Transform::Ptr& x
 /// brightest voxel's, in [0, 1], on every voxel. Not part of the contract:
 /// the readers ignore it.
 FloatGrid::Ptr densityGrid(const VdlGrid& g, const Transform::Ptr& xform) {
-  auto luminance = [&g](size_t v) {
-    const Vec3& e = g.irradiance[v];
-    return 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z;
-  };
   float brightest = 0;
-  for (size_t v = 0; v < g.size(); ++v) brightest = std::max(brightest, luminance(v));
+  for (const Vec3& e : g.irradiance) brightest = std::max(brightest, luminance(e));
   FloatGrid::Ptr grid = floatGrid(kDensityGrid, "irradiance luminance / the brightest voxel's", xform,
                                   g.coords, [&](size_t v) {
-                                    return brightest > 0 ? std::clamp(luminance(v) / brightest, 0.0f, 1.0f) : 0.0f;
+                                    return brightest > 0 ? std::clamp(luminance(g.irradiance[v]) / brightest, 0.0f, 1.0f) : 0.0f;
                                   });
   grid->setGridClass(openvdb::GRID_FOG_VOLUME);
   return grid;
