@@ -199,7 +199,7 @@ std::function<int()> addViewCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--seed", opt->bake.photons.seed, "Progressive: random seed")
       ->check(seedValidator())->capture_default_str();
-  cmd->add_flag("--no-hud{false}", opt->view.hud,
+  cmd->add_flag_callback("--no-hud", [opt] { opt->view.hud = false; },
                 "No heads-up display in the window (frame time, mode, octree level, the "
                 "progressive bake's progress; H shows the keys there)");
   cmd->add_flag("-q,--quiet", opt->view.quiet, "Only errors");
