@@ -101,7 +101,7 @@ GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, doubl
     BakeResult r = bake(scene, params, sink.get());
     out->grid = std::move(r.grid);
     out->meta = std::move(r.metadata);
-    out->meta.sourceScene = scenePath;
+    recordSourceScene(out->meta, scenePath);
     py::gil_scoped_acquire lock;
     out->stats["stored_photons"] = r.stats.storedPhotons;
     out->stats["emitted_paths"] = r.stats.emittedPaths;

@@ -22,9 +22,10 @@ bake = load("bake.json")
 assert bake["output"] == "grid.vdb" and bake["counts"]["vdb_bytes"] == os.path.getsize("grid.vdb"), bake["counts"]
 checks = {
     "render": (["render.png"], lambda f: f["image"]["width"] == 64 and f["image"]["mean_luminance"] > 0),
-    "lightmap": (["lm-lightmap0.png", "lm.bin", "lm.gltf", "lm-preview.glb"],
+    "lightmap": (["lm-lightmap0.png", "lm-direction0.png", "lm.bin", "lm.gltf", "lm-preview.glb"],
                  lambda f: f["pages"] == 1 and f["rgbm_range"] > 0 and f["encoding"] == "rgbm-png"
-                 and f["page_files"] == ["lm-lightmap0.png"]),
+                 and f["page_files"] == ["lm-lightmap0.png"]
+                 and f["direction_files"] == ["lm-direction0.png"]),
     "convert": (["coarse.vdb"], lambda f: f["depth"] == {"in": 4, "out": 3} and f["voxels"]["out"] > 0),
     "reference": (["ref.exr", "mask.png"], lambda f: f["samples_per_pixel"] == 2 and f["rays"] > 0),
 }

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "commands.h"
+#include "bake/bake.h"
 #include "scene_options.h"
 #include "core/file.h"
 #include "export/lightmap_export.h"
@@ -32,6 +33,7 @@ struct LightmapOptions {
   float exposure = 0;
   std::string atlasOn = "cpu";  // cpu | osmesa | egl
   bool chartImage = false;
+  std::string directions = "on";
   std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
@@ -58,6 +60,7 @@ LightmapExportParams exportParams(const LightmapOptions& opt) {
   p.preview = opt.previewUnlit;
   p.previewExposureEv = opt.exposure;
   p.chartImages = opt.chartImage;
+  p.directionPages = opt.directions == "on";
   if (opt.atlasOn != "cpu") p.atlasGl = parseGlBackend(opt.atlasOn);
   return p;
 }
@@ -68,6 +71,8 @@ nlohmann::json lightmapFigures(const LightmapExportResult& r, const LightmapExpo
   const LightmapAtlas& atlas = r.lightmap.atlas;
   nlohmann::json pages = nlohmann::json::array();
   for (const std::string& path : r.pagePaths) pages.push_back(path);
+  nlohmann::json directions = nlohmann::json::array();
+  for (const std::string& path : r.directionPaths) directions.push_back(path);
   return {{"uvs", r.lightmap.fromTexcoord1 ? "texcoord1" : "charts"},
           {"charts", uvs.chartCount},
           {"pages", atlas.pageCount},
@@ -81,6 +86,7 @@ nlohmann::json lightmapFigures(const LightmapExportResult& r, const LightmapExpo
           {"encoding", params.rgbm ? "rgbm-png" : "linear-exr"},
           {"rgbm_range", params.rgbm ? nlohmann::json(r.rgbmRange) : nlohmann::json(nullptr)},
           {"page_files", pages},
+          {"direction_files", directions},
           {"gltf", r.output},
           {"preview", r.previewPath.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.previewPath)},
           {"octree_bytes", r.octreePoolBytes + r.octreeVdlBytes}};
@@ -107,6 +113,8 @@ int runLightmap(const LightmapOptions& opt) {
                    std::to_string(scene.materials.size()) + " materials");
 
   const LightmapExportResult r = exportLightmap(scene, opt.lights, params);
+  const std::string stale = staleBakeWarning(r.gridMetadata, opt.scene);
+  if (!stale.empty()) std::fprintf(stderr, "warning: %s: %s\n", opt.lights.c_str(), stale.c_str());
   if (opt.quiet) return 0;
   if (params.atlasGl) std::printf("%s: %s\n", opt.atlasOn.c_str(), r.glInfo.c_str());
   rows.insert(rows.end(), r.stages.begin(), r.stages.end());
@@ -133,6 +141,7 @@ int runLightmap(const LightmapOptions& opt) {
       formatBytes(r.octreePoolBytes).c_str(), formatBytes(r.octreeVdlBytes).c_str());
   if (params.rgbm) std::printf("RGBM range: %s W/m^2\n", formatNumber(r.rgbmRange).c_str());
   for (const std::string& path : r.pagePaths) std::printf("wrote %s\n", path.c_str());
+  for (const std::string& path : r.directionPaths) std::printf("wrote %s (directions)\n", path.c_str());
   std::printf("wrote %s (%s)\n", r.output.c_str(), formatBytes(r.outputBytes).c_str());
   if (params.preview) {
     std::printf("wrote %s (%s, unlit preview)\n", r.previewPath.c_str(),
@@ -203,6 +212,12 @@ std::function<int()> addLightmapCommand(CLI::App& app) {
                   "bytes on every machine), osmesa (OpenGL in software) or egl (a GPU, "
                   "headless): the scene shader's lookup run per texel (paper 4.2.3)")
       ->check(CLI::IsMember({"cpu", "osmesa", "egl"}))
+      ->capture_default_str();
+  cmd->add_option("--directions", opt->directions,
+                  "Also write OUT-directionN.png beside each page: the mean direction the light "
+                  "comes from per texel (world space, 8-bit unit vectors, extras.lightmap.direction), "
+                  "so viewers shade normal maps and gloss from the lightmap (on) or not (off)")
+      ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   cmd->add_flag("--chart-image", opt->chartImage,
                 "Also write OUT-chartsN.png: each page's UV layout, one colour per chart, chart "

@@ -11,6 +11,7 @@
 #include "render_options.h"
 #include "scene_options.h"
 #include "commands.h"
+#include "bake/bake.h"
 #include "core/file.h"
 #include "core/file_set.h"
 #include "core/error.h"
@@ -121,6 +122,8 @@ int runRender(const RenderOptions& opt) {
   StageTimer readTimer(rows, "read grid");
   LoadedVdl baked = readVdlGrid(opt.lights, scene.origin);
   readTimer.finish(formatCount(baked.grid.size()) + " voxels");
+  const std::string stale = staleBakeWarning(baked.meta, opt.scene);
+  if (!stale.empty()) std::fprintf(stderr, "warning: %s: %s\n", opt.lights.c_str(), stale.c_str());
   if (opt.mode == "irradiance") return renderIrradiance(opt, scene, baked, report, rows);
   RenderParams params = opt.shading.renderParams(parseRenderMode(opt.mode));
   params.width = opt.width;

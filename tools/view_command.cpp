@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "bake/bake.h"
 #include "bake/progressive_bake.h"
 #include "camera_options.h"
 #include "cli_checks.h"
@@ -73,7 +74,11 @@ int runView(const ViewOptions& opt) {
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   printSceneWarnings(scene);
   std::optional<LoadedVdl> baked;
-  if (!opt.progressive) baked = readVdlGrid(opt.lights, scene.origin);
+  if (!opt.progressive) {
+    baked = readVdlGrid(opt.lights, scene.origin);
+    const std::string stale = staleBakeWarning(baked->meta, opt.scene);
+    if (!stale.empty()) std::fprintf(stderr, "warning: %s: %s\n", opt.lights.c_str(), stale.c_str());
+  }
   view.worldOrigin = scene.origin;
   if (view.path) {
     for (CameraKey& key : view.path->keys) {  // the file's world coordinates

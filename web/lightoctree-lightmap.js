@@ -16,6 +16,16 @@
 // diffuse BRDF (baseColor / pi) multiplies, the shading the extras name, so
 // the intensity is 1 with physically based lights (the default since r155;
 // pass `intensity: 1 / Math.PI` for `renderer.useLegacyLights = true`).
+// Direction pages (`extras.lightmap.direction`, written by default): the
+// mean direction the light of each texel comes from. With them the light map
+// is not added as flat irradiance; each fragment gets one directional light
+// of colour E / max(n_vertex . d, 0.05) from d, as `lightoctree render
+// --lighting atlas` does: its diffuse part baseColor / pi times that light's
+// irradiance (the page's contract; at the vertex normal exactly
+// baseColor / pi * E), plus three's GGX reflection of it, so normal maps show
+// their relief and glossy surfaces a highlight (needs r187's
+// MeshStandardMaterial shader chunks; other materials take three's RE_Direct).
+// Pass `directions: false` to use the irradiance alone.
 // Materials of the unlit preview (`extras.lightmapPreview`) already show the
 // bake and are left alone. A `content: "full"` map holds the direct light
 // too: remove the scene's lights then (`result.userData.lightOctree.content`
@@ -41,18 +51,50 @@ void main() {
   gl_FragColor = vec4(rgbm.rgb * rgbm.a * range, 1.0);
 }`;
 
+// three's light-map chunk with the irradiance turned into one light from the
+// texel's direction (shared by every material that has direction pages).
+const directionalLightMap = /* glsl */ `
+#if defined( RE_IndirectDiffuse ) && defined( USE_LIGHTMAP )
+	{
+		vec3 loE = texture2D( lightMap, vLightMapUv ).rgb * lightMapIntensity;
+		vec2 loUv = vec2( vLightMapUv.x, mix( vLightMapUv.y, 1.0 - vLightMapUv.y, loDirectionFlip ) );
+		vec3 loD = texture2D( loDirectionMap, loUv ).rgb * ( 255.0 / 127.0 ) - 128.0 / 127.0;
+		float loLength = length( loD );
+		if ( loLength > 1e-3 ) {
+			IncidentLight loLight;
+			loLight.direction = normalize( ( viewMatrix * vec4( loD / loLength, 0.0 ) ).xyz );
+			loLight.color = loE / max( dot( nonPerturbedNormal, loLight.direction ), 0.05 );
+			loLight.visible = true;
+			#ifdef STANDARD
+				// The page's contract (extras.lightmap.shading): the diffuse part is
+				// baseColor / pi * E, no Fresnel share taken from it; the light's
+				// specular reflection is added.
+				vec3 loIrradiance = loLight.color * saturate( dot( geometryNormal, loLight.direction ) );
+				reflectedLight.directDiffuse += loIrradiance * BRDF_Lambert( material.diffuseContribution );
+				reflectedLight.directSpecular += loIrradiance * material.multiScatteringCompensation *
+					BRDF_GGX( loLight.direction, geometryViewDir, geometryNormal, material );
+			#else
+				RE_Direct( loLight, geometryPosition, geometryNormal, geometryViewDir, geometryClearcoatNormal, material, reflectedLight );
+			#endif
+		}
+	}
+#endif
+`;
+
 export class LightOctreeLightmaps {
   /**
    * @param parser the GLTFParser GLTFLoader passes to its plugins
    * @param options.renderer the WebGLRenderer (needed for RGBM pages)
    * @param options.intensity the light maps' intensity (1: physical lights)
    */
-  constructor(parser, { renderer = null, intensity = 1 } = {}) {
+  constructor(parser, { renderer = null, intensity = 1, directions = true } = {}) {
     this.name = 'LIGHTOCTREE_lightmap';  // reads extras, not a glTF extension
     this.parser = parser;
     this.renderer = renderer;
     this.intensity = intensity;
+    this.directions = directions;
     this.pages = new Map();  // uri -> Promise<THREE.Texture>
+    this.directionPages = new Map();  // uri -> Promise<THREE.Texture>
   }
 
   async afterRoot(result) {
@@ -71,11 +113,16 @@ export class LightOctreeLightmaps {
     await Promise.all(uses.map(async ([material, lightmap]) => {
       material.lightMap = await this.page(lightmap);
       material.lightMapIntensity = this.intensity;
+      if (this.directions && lightmap.direction) {
+        this.useDirections(material, await this.directionPage(lightmap.direction),
+                           lightmap.encoding === 'linear-exr');
+      }
       material.needsUpdate = true;
     }));
     result.userData.lightOctree = {
       materials: uses.length,
       pages: this.pages.size,
+      directionPages: this.directionPages.size,
       content: contents.size === 1 ? [...contents][0] : [...contents].join(','),
     };
   }
@@ -99,6 +146,49 @@ export class LightOctreeLightmaps {
     return this.pages.get(lightmap.uri);
   }
 
+  // The light map as one light per fragment from the texel's direction
+  // (directionalLightMap). `flipped`: the page texture flips v (EXR), the
+  // direction page does not.
+  useDirections(material, directionMap, flipped) {
+    material.onBeforeCompile = (shader) => {
+      shader.uniforms.loDirectionMap = { value: directionMap };
+      shader.uniforms.loDirectionFlip = { value: flipped ? 1 : 0 };
+      shader.fragmentShader = shader.fragmentShader
+        .replace('#include <common>', '#include <common>\nuniform sampler2D loDirectionMap;\nuniform float loDirectionFlip;')
+        .replace('#include <lights_fragment_maps>',
+                 THREE.ShaderChunk.lights_fragment_maps.replace(
+                   /#ifdef USE_LIGHTMAP[\s\S]*?#endif/, '') + directionalLightMap);
+    };
+    material.customProgramCacheKey = () => 'lightoctree-direction';
+  }
+
+  directionPage(direction) {
+    if (!this.directionPages.has(direction.uri)) {
+      const url = THREE.LoaderUtils.resolveURL(direction.uri, this.parser.options.path);
+      this.directionPages.set(direction.uri, direction.encoding !== 'unit-vector-png'
+        ? Promise.reject(new Error(`lightmap direction ${direction.uri}: unknown encoding '${direction.encoding}'`))
+        : this.dataPng(url, THREE.LinearFilter));
+    }
+    return this.directionPages.get(direction.uri);
+  }
+
+  // A PNG that holds data: read as stored (no colour conversion, no
+  // premultiplication), row 0 at v = 0 as glTF has it, no mipmaps.
+  async dataPng(url, filter) {
+    const bitmap = await new THREE.ImageBitmapLoader()
+      .setOptions({ imageOrientation: 'none', premultiplyAlpha: 'none', colorSpaceConversion: 'none' })
+      .loadAsync(url);
+    const texture = new THREE.Texture(bitmap);
+    texture.flipY = false;
+    texture.premultiplyAlpha = false;
+    texture.colorSpace = THREE.NoColorSpace;
+    texture.minFilter = texture.magFilter = filter;
+    texture.generateMipmaps = false;
+    texture.channel = 1;
+    texture.needsUpdate = true;
+    return texture;
+  }
+
   async exrPage(url) {
     const texture = await new EXRLoader().setDataType(THREE.HalfFloatType).loadAsync(url);
     texture.generateMipmaps = false;  // the dilated gutter is one ring wide
@@ -114,16 +204,8 @@ export class LightOctreeLightmaps {
   async rgbmPage(url, range) {
     if (!this.renderer) throw new Error(`lightmap ${url}: RGBM pages need the renderer (options.renderer)`);
     if (!(range > 0)) throw new Error(`lightmap ${url}: rgbmRange ${range} is not a positive range`);
-    const bitmap = await new THREE.ImageBitmapLoader()
-      .setOptions({ imageOrientation: 'none', premultiplyAlpha: 'none', colorSpaceConversion: 'none' })
-      .loadAsync(url);
-    const source = new THREE.Texture(bitmap);
-    source.flipY = false;  // glTF: row 0 is v = 0
-    source.premultiplyAlpha = false;
-    source.colorSpace = THREE.NoColorSpace;
-    source.minFilter = source.magFilter = THREE.NearestFilter;
-    source.generateMipmaps = false;
-    source.needsUpdate = true;
+    const source = await this.dataPng(url, THREE.NearestFilter);
+    const bitmap = source.image;
     const target = new THREE.WebGLRenderTarget(bitmap.width, bitmap.height, {
       type: THREE.HalfFloatType, depthBuffer: false, generateMipmaps: false,
       minFilter: THREE.LinearFilter, magFilter: THREE.LinearFilter,

@@ -1,7 +1,8 @@
 # Light Octree for Blender (3.4 or later; Python only): File > Import >
 #   "Light Octree bake (.vdb)": the grid as a Volume object in the scene's
 #     frame (glTF's Y up turned to Blender's Z up) with a material that shows
-#     the baked irradiance as emission;
+#     the baked irradiance as emission, and optionally each voxel's strongest
+#     VDL as an arrow (geometry nodes on a point per voxel);
 #   "Lightmapped glTF (Light Octree)": Blender's glTF importer (with the
 #     numpy fix Blender 3.4 on numpy 1.24 needs), then every material that
 #     names a lightmap page in its extras gets the page wired in: the outgoing
@@ -20,7 +21,7 @@ bl_info = {
 }
 
 import bpy
-from bpy.props import EnumProperty, FloatProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
 from . import lightmap, volume
@@ -38,10 +39,21 @@ class LIGHTOCTREE_OT_import_vdb(bpy.types.Operator, ImportHelper):
         name="Emission strength",
         description="Scale of the irradiance shown as the volume's emission (W/m^2 per unit)",
         default=1.0, min=0.0)
+    arrows: BoolProperty(
+        name="VDL arrows",
+        description="Also draw each voxel's strongest virtual directional light as an arrow "
+                    "towards its light, coloured by its irradiance (needs the lightoctree Python "
+                    "module)",
+        default=False)
+    max_arrows: IntProperty(
+        name="Most arrows",
+        description="Draw at most this many arrows, from voxels picked evenly through the grid",
+        default=20000, min=1)
 
     def execute(self, context):
         try:
-            obj = volume.import_bake(context, self.filepath, self.strength)
+            obj = volume.import_bake(context, self.filepath, self.strength, self.arrows,
+                                     self.max_arrows)
         except (OSError, RuntimeError, ValueError) as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}

@@ -44,6 +44,51 @@ def _uv_name(mat):
     return "UVMap.001"
 
 
+def _directional(n, principled, direction, folder, uv, irradiance):
+    """E scaled by how the shading normal (normal map included) faces the
+    texel's light direction d against how the vertex normal does, as
+    `lightoctree render --lighting atlas` shades its diffuse part:
+    E * max(n . d, 0) / max(n_vertex . d, 0.05)."""
+    path = os.path.join(folder, direction["uri"])
+    if direction.get("encoding") != "unit-vector-png" or not os.path.isfile(path):
+        return irradiance  # the irradiance alone, as without direction pages
+    image = bpy.data.images.load(path, check_existing=True)
+    image.colorspace_settings.name = "Non-Color"
+    tex = n.new("ShaderNodeTexImage", image=image, interpolation="Linear", extension="EXTEND")
+    n.link(uv.outputs["UV"], tex.inputs["Vector"])
+    # d = (byte - 128) / 127 per channel, in glTF's frame (Y up); Blender's
+    # importer turns (x, y, z) into (x, -z, y).
+    decode = n.new("ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+    n.link(tex.outputs["Color"], decode.inputs[0])
+    decode.inputs[1].default_value = (255 / 127,) * 3
+    decode.inputs[2].default_value = (-128 / 127,) * 3
+    xyz = n.new("ShaderNodeSeparateXYZ")
+    n.link(decode.outputs["Vector"], xyz.inputs[0])
+    flip = n.math("MULTIPLY", xyz.outputs["Z"], -1.0)
+    frame = n.new("ShaderNodeCombineXYZ")
+    n.link(xyz.outputs["X"], frame.inputs["X"])
+    n.link(flip, frame.inputs["Y"])
+    n.link(xyz.outputs["Y"], frame.inputs["Z"])
+    d = n.new("ShaderNodeVectorMath", operation="NORMALIZE")
+    n.link(frame.outputs["Vector"], d.inputs[0])
+    geometry = n.new("ShaderNodeNewGeometry")
+    normal = principled.inputs["Normal"]
+    shading = normal.links[0].from_socket if normal.is_linked else geometry.outputs["Normal"]
+
+    def facing(vector):
+        dot = n.new("ShaderNodeVectorMath", operation="DOT_PRODUCT")
+        n.link(vector, dot.inputs[0])
+        n.link(d.outputs["Vector"], dot.inputs[1])
+        return dot.outputs["Value"]
+
+    factor = n.math("DIVIDE", n.math("MAXIMUM", facing(shading), 0.0),
+                    n.math("MAXIMUM", facing(geometry.outputs["Normal"]), 0.05))
+    scaled = n.new("ShaderNodeVectorMath", operation="SCALE")
+    n.link(irradiance, scaled.inputs[0])
+    n.link(factor, scaled.inputs["Scale"])
+    return scaled.outputs["Vector"]
+
+
 class _Nodes:
     """Adds nodes to a material's tree, laid out in a column left of x0."""
 
@@ -106,6 +151,8 @@ def _wire(mat, lightmap, folder, uv_name, mode):
         n.link(irradiance, decode.inputs[0])
         n.link(scale, decode.inputs["Scale"])
         irradiance = decode.outputs["Vector"]
+    if lightmap.get("direction"):
+        irradiance = _directional(n, principled, lightmap["direction"], folder, uv, irradiance)
     # radiance = baseColor / pi * E, on the diffuse part of the material only:
     # (1 - metallic) (1 - transmission), times alpha.
     times_base = n.new("ShaderNodeVectorMath", operation="MULTIPLY")

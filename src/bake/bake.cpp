@@ -7,9 +7,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "core/error.h"
+#include "scene/scene_files.h"
 #include "raytrace/ray_tracer.h"
 
 namespace lo {
@@ -394,6 +396,24 @@ BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t 
   meta.includeDirect = params.includeDirect ? 1 : 0;
   meta.region = params.region;
   return meta;
+}
+
+void recordSourceScene(BakeMetadata& meta, const std::string& scenePath) {
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(scenePath, ec);
+  meta.sourceScene = std::filesystem::path(scenePath).filename().string();
+  meta.sourceScenePath = ec ? scenePath : absolute.lexically_normal().string();
+  meta.sourceSceneHash = sceneContentHash(scenePath);
+}
+
+std::string staleBakeWarning(const BakeMetadata& meta, const std::string& scenePath) {
+  if (meta.sourceSceneHash.empty()) return "";
+  const std::string now = sceneContentHash(scenePath);
+  if (now == meta.sourceSceneHash) return "";
+  return "the light was baked from " +
+         (meta.sourceScenePath.empty() ? meta.sourceScene : meta.sourceScenePath) + " (" +
+         meta.sourceSceneHash + "); '" + scenePath + "' and the files it reads differ (" + now +
+         "): bake again if the scene changed";
 }
 
 LevelParams BakeParams::levelParams() const {

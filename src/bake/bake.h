@@ -234,8 +234,8 @@ struct BakeStats {
 
 struct BakeResult {
   VdlGrid grid;
-  /// Everything the file metadata records (sourceScene is left to the caller,
-  /// which knows the file name).
+  /// Everything the file metadata records (the source scene is left to the caller:
+  /// recordSourceScene).
   BakeMetadata metadata;
   BakeStats stats;
   PhotonMap photons;  ///< filled when BakeParams::keepPhotons
@@ -287,11 +287,20 @@ void checkBakeMemory(const Scene& scene, const BakeParams& params, int processes
 /// bake runs with. @throws InputError naming the flag.
 BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, int processes = 1);
 
-/// The file metadata of a bake of `scene` with `params` (sourceScene left to
-/// the caller) that stored `photons` from `emittedPaths` paths and gathered
+/// The file metadata of a bake of `scene` with `params` (the source scene
+/// left to the caller: recordSourceScene) that stored `photons` from `emittedPaths` paths and gathered
 /// within `radius` (world units).
 BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t photons,
                           int64_t emittedPaths, float radius);
+
+/// Records the scene file a bake read, `scenePath`, in `meta`: its name, its
+/// absolute path and its content hash (scene/scene_files.h sceneContentHash).
+void recordSourceScene(BakeMetadata& meta, const std::string& scenePath);
+
+/// "" when `meta` records no content hash or `scenePath`'s files still have
+/// it; else a sentence for a warning: the grid was baked from a scene whose
+/// files have changed since (its light may no longer fit the scene).
+std::string staleBakeWarning(const BakeMetadata& meta, const std::string& scenePath);
 
 
 /// @brief Bakes `scene` with `params` (paper §3.1). Deterministic. Without

@@ -134,6 +134,14 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
     result.pagePaths.push_back(lightmapPagePath(params.output, p, params.rgbm));
     ex.pageUris.push_back(fs::path(result.pagePaths.back()).filename().string());
   }
+  std::vector<std::vector<unsigned char>> directionPngs;
+  if (params.directionPages) {
+    for (int p = 0; p < atlas.pageCount; ++p) {
+      result.directionPaths.push_back(lightmapDirectionPath(params.output, p));
+      ex.directionUris.push_back(fs::path(result.directionPaths.back()).filename().string());
+      directionPngs.push_back(encodeUnitVectorPng(atlas.direction[size_t(p)]));
+    }
+  }
   const GltfFiles lit = encodeLightmapGltf(scene, ex, params.output);
   GltfFiles unlit;
   if (params.preview) {
@@ -163,6 +171,11 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
     }
     result.pageFileBytes += size_t(set.bytesOf(path));
   }
+  for (size_t p = 0; p < directionPngs.size(); ++p) {
+    const std::string& path = result.directionPaths[p];
+    set.addText(path, std::string(directionPngs[p].begin(), directionPngs[p].end()));
+    result.pageFileBytes += size_t(set.bytesOf(path));
+  }
   writeGltfFiles(lit, params.output, &set);
   if (params.preview) writeGltfFiles(unlit, result.previewPath, &set);
   if (params.chartImages) {
@@ -174,8 +187,8 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
   }
   if (params.beforeCommit) params.beforeCommit(result, set);
   set.commit();
-  writeTimer.finish(formatCount(size_t(atlas.pageCount) + 1 + (params.preview ? 1 : 0) +
-                                result.chartPaths.size()) +
+  writeTimer.finish(formatCount(size_t(atlas.pageCount) + result.directionPaths.size() + 1 +
+                                (params.preview ? 1 : 0) + result.chartPaths.size()) +
                     " files");
   return result;
 }
@@ -207,7 +220,7 @@ void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bo
   checkDistinctFiles(outputs, inputs);
   // The longest name the set writes (up to 1,000 pages) must fit the file
   // system's limit, found now and not after the bake.
-  checkOutputName(besideOutput(output, "-lightmap999.exr"), "--output");
+  checkOutputName(besideOutput(output, "-direction999.png"), "--output");
   // The pages and chart images: OUT-lightmap<k>.exr|png, OUT-charts<k>.png.
   std::error_code ec;
   const fs::path folder = fs::weakly_canonical(fs::absolute(fs::path(output).parent_path(), ec), ec);
@@ -230,8 +243,10 @@ void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bo
     const std::string name = in.filename().string();
     const bool page = numbered(name, stem + "-lightmap", rgbm ? ".png" : ".exr");
     const bool chart = charts && numbered(name, stem + "-charts", ".png");
-    if (page || chart) {
-      throw InputError("--output: the " + std::string(page ? "lightmap pages" : "chart images") +
+    const bool direction = numbered(name, stem + "-direction", ".png");
+    if (page || chart || direction) {
+      throw InputError("--output: the " +
+                       std::string(page ? "lightmap pages" : chart ? "chart images" : "direction pages") +
                        " of '" + output + "' would replace the input " + what + " ('" + path +
                        "'); write to another name");
     }
@@ -241,6 +256,10 @@ void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bo
 std::string lightmapPagePath(const std::string& output, int page, bool rgbm) {
   return lightmap_export_internal::besideOutput(
       output, "-lightmap" + std::to_string(page) + (rgbm ? ".png" : ".exr"));
+}
+
+std::string lightmapDirectionPath(const std::string& output, int page) {
+  return lightmap_export_internal::besideOutput(output, "-direction" + std::to_string(page) + ".png");
 }
 
 LightmapExportResult exportLightmap(const Scene& scene, const VdlGrid& grid,
@@ -254,12 +273,17 @@ LightmapExportResult exportLightmap(const Scene& scene, const VdlGrid& grid,
 
 LightmapExportResult exportLightmap(const Scene& scene, const std::string& lightsPath,
                                     const LightmapExportParams& params) {
-  return lightmap_export_internal::exportWith(
+  BakeMetadata meta;
+  LightmapExportResult result = lightmap_export_internal::exportWith(
       scene,
-      [&lightsPath, &scene] {
-        return buildGpuOctree(readVdlGrid(lightsPath, scene.origin).grid, GpuOctreeParams{});
+      [&lightsPath, &scene, &meta] {
+        LoadedVdl loaded = readVdlGrid(lightsPath, scene.origin);
+        meta = std::move(loaded.meta);
+        return buildGpuOctree(loaded.grid, GpuOctreeParams{});
       },
       params);
+  result.gridMetadata = std::move(meta);
+  return result;
 }
 
 }  // namespace lo

@@ -13,6 +13,7 @@
 ///
 /// Files, for params.output D/OUT.glb or D/OUT.gltf, in the order written:
 ///   D/OUT-lightmapN.exr | .png   one per atlas page
+///   D/OUT-directionN.png         directionPages, one per atlas page
 ///   D/OUT.bin, D/OUT.gltf | D/OUT.glb
 ///   D/OUT-preview.glb            preview
 ///   D/OUT-chartsN.png            chartImages, one per page
@@ -65,6 +66,11 @@ struct LightmapExportParams {
   bool preview = false;
   float previewExposureEv = 0;  ///< the preview's exposure, EV (radiance * 2^EV)
   bool chartImages = false;     ///< also OUT-chartsN.png, each page's UV layout
+  /// Also OUT-directionN.png beside each page: the atlas's per-texel mean
+  /// light direction (LightmapAtlas::direction, world space,
+  /// encodeUnitVectorPng), named in extras.lightmap.direction, so a viewer
+  /// can shade normal maps and glossy surfaces from the lightmap.
+  bool directionPages = true;
   /// Set: the octree is rendered into the atlas by GL in a headless context
   /// of this kind (OSMesa or EGL). Unset: on the CPU (the same bytes on every
   /// machine).
@@ -84,12 +90,15 @@ struct LightmapExportResult {
   std::vector<StageReport> stages;
   float rgbmRange = 0;                 ///< rgbm: the pages' range, W/m^2
   std::vector<std::string> pagePaths;  ///< per page, as written
+  std::vector<std::string> directionPaths;  ///< directionPages: per page, else empty
   std::string output;                  ///< params.output
   std::string previewPath;             ///< preview: OUT-preview.glb, else ""
   std::vector<std::string> chartPaths;  ///< chartImages: per page
   size_t pageFileBytes = 0;             ///< the page files' sizes together
   size_t outputBytes = 0;               ///< the lit glTF's (and its .bin's) bytes
   size_t previewBytes = 0;              ///< the preview's bytes
+  /// The grid file's metadata (exportLightmap of a .vdb path; else default).
+  BakeMetadata gridMetadata;
 };
 
 /// @throws InputError naming `flag` when `output` ends in neither .glb nor
@@ -98,6 +107,8 @@ void checkLightmapExportPath(const std::string& output, const char* flag = "--ou
 
 /// D/OUT-lightmapN.exr (or .png with rgbm) for `output` D/OUT.glb or .gltf.
 std::string lightmapPagePath(const std::string& output, int page, bool rgbm);
+/// D/OUT-directionN.png, the direction image of page N.
+std::string lightmapDirectionPath(const std::string& output, int page);
 
 /// Refuses, before any work, an export some file of which would replace one
 /// of `inputs` (the scene, its buffers and images, the grid: checkDistinctFiles'

@@ -222,6 +222,20 @@ std::string pngChunk(const char type[4], const std::string& data) {
   return chunk;
 }
 
+/// `png` (encodePng8's) marked as data after IHDR (8 + 25 bytes): gAMA 1.0
+/// (linear values, no sRGB curve to undo) and text chunks naming the
+/// encoding (and what `moreChunks` adds), so the file says how to read it
+/// without the glTF beside it.
+std::vector<unsigned char> dataPng(std::vector<unsigned char> png, const std::string& encoding,
+                                   const std::string& moreChunks = "") {
+  const std::string gamma{'\0', '\x01', '\x86', '\xa0'};  // 100000: gamma 1.0
+  const std::string chunks =
+      pngChunk("gAMA", gamma) + pngChunk("tEXt", std::string("Software") + '\0' + "lightoctree") +
+      pngChunk("tEXt", std::string("lightoctree:encoding") + '\0' + encoding) + moreChunks;
+  png.insert(png.begin() + 33, chunks.begin(), chunks.end());
+  return png;
+}
+
 }  // namespace
 
 std::vector<unsigned char> encodeRgbmPng(const RgbImage& image, float range) {
@@ -246,21 +260,11 @@ std::vector<unsigned char> encodeRgbmPng(const RgbImage& image, float range) {
     }
     rgba[4 * i + 3] = (unsigned char)a;
   }
-  std::vector<unsigned char> png = encodePng8(image.width, image.height, 4, rgba.data());
-  // Marked as data after IHDR (8 + 25 bytes): gAMA 1.0 (linear values, no sRGB
-  // curve to undo) and text chunks naming the encoding and its range, so the
-  // file says how to read it without the glTF beside it.
   char rangeText[32];
   std::snprintf(rangeText, sizeof rangeText, "%.9g", double(range));
-  const std::string gamma{'\0', '\x01', '\x86', '\xa0'};  // 100000: gamma 1.0
-  const std::string chunks =
-      pngChunk("gAMA", gamma) +
-      pngChunk("tEXt", std::string("Software") + '\0' + "lightoctree") +
-      pngChunk("tEXt", std::string("lightoctree:encoding") + '\0' +
-                           "rgbm: E = RGB/255 * A/255 * rgbmRange, W/m^2; not a colour image") +
-      pngChunk("tEXt", std::string("lightoctree:rgbmRange") + '\0' + rangeText);
-  png.insert(png.begin() + 33, chunks.begin(), chunks.end());
-  return png;
+  return dataPng(encodePng8(image.width, image.height, 4, rgba.data()),
+                 "rgbm: E = RGB/255 * A/255 * rgbmRange, W/m^2; not a colour image",
+                 pngChunk("tEXt", std::string("lightoctree:rgbmRange") + '\0' + rangeText));
 }
 
 RgbImage decodeRgbm(const DecodedImage& image, float range) {
@@ -276,6 +280,34 @@ RgbImage decodeRgbm(const DecodedImage& image, float range) {
   for (size_t i = 0; i < out.pixelCount(); ++i) {
     const float m = image.values[4 * i + 3] * range;
     for (int k = 0; k < 3; ++k) out.rgb[3 * i + size_t(k)] = image.values[4 * i + size_t(k)] * m;
+  }
+  return out;
+}
+
+std::vector<unsigned char> encodeUnitVectorPng(const RgbImage& vectors) {
+  checkImage("encodeUnitVectorPng", vectors);
+  std::vector<unsigned char> rgb(vectors.rgb.size());
+  for (size_t i = 0; i < rgb.size(); ++i) {
+    const float c = vectors.rgb[i];
+    rgb[i] = (unsigned char)(128 + (std::isfinite(c) ? std::lround(127.0f * std::clamp(c, -1.0f, 1.0f)) : 0));
+  }
+  return dataPng(encodePng8(vectors.width, vectors.height, 3, rgb.data()),
+                 "unit vectors: c = (byte - 128) / 127 per channel, (128, 128, 128) = none; "
+                 "not a colour image");
+}
+
+RgbImage decodeUnitVectors(const DecodedImage& image) {
+  if (image.channels < 3 || image.width < 1 || image.height < 1 ||
+      image.values.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels)) {
+    throw InputError("decodeUnitVectors: needs an RGB image, got " +
+                     std::to_string(image.channels) + " channel(s)");
+  }
+  RgbImage out(image.width, image.height);
+  const size_t n = size_t(image.channels);
+  for (size_t i = 0; i < out.pixelCount(); ++i) {
+    for (size_t k = 0; k < 3; ++k) {
+      out.rgb[3 * i + k] = (std::round(image.values[n * i + k] * 255.0f) - 128.0f) / 127.0f;
+    }
   }
   return out;
 }

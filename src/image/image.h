@@ -112,4 +112,16 @@ std::vector<unsigned char> encodeRgbmPng(const RgbImage& image, float range);
 /// the image has 4 channels and range is finite and > 0.
 RgbImage decodeRgbm(const DecodedImage& image, float range);
 
+/// @brief Unit vectors (a directional lightmap's directions) in an 8-bit RGB
+/// PNG, each component c in [-1, 1] as round(127 * c) + 128 (NaN as 0), so
+/// that 128 is exactly 0 (a texel without a direction: (128, 128, 128)) and
+/// decodeUnitVectors gives c' = (byte - 128) / 127, |c' - c| <= 0.5 / 127.
+/// Like encodeRgbmPng's, the PNG is marked as data: gAMA 1.0 and a tEXt
+/// chunk "lightoctree:encoding". @throws InputError for an empty image.
+std::vector<unsigned char> encodeUnitVectorPng(const RgbImage& vectors);
+/// @brief The inverse of encodeUnitVectorPng for a decoded RGB or RGBA image
+/// (decodeImageBytes: channels scaled to [0, 1]). @throws InputError for
+/// fewer than 3 channels.
+RgbImage decodeUnitVectors(const DecodedImage& image);
+
 }  // namespace lo

@@ -185,7 +185,12 @@ constexpr int kVdlFormatVersionVdl = 2;
 struct BakeMetadata {
   std::string generator = "lightoctree";
   std::string version = LO_VERSION;
-  std::string sourceScene;
+  std::string sourceScene;  ///< the scene file's name ("source_scene")
+  /// The scene file as the bake was given it, made absolute
+  /// ("source_scene_path"), and sceneContentHash of it and of every file it
+  /// reads ("source_scene_hash"), so a reader can tell whether the scene has
+  /// changed since (bake.h recordSourceScene); "" when not recorded.
+  std::string sourceScenePath, sourceSceneHash;
   int depth = 0;
   int64_t photons = 0;       ///< stored photons
   int64_t emittedPaths = 0;

@@ -157,12 +157,18 @@ void checkExport(const Scene& scene, const LightmapExport& lm) {
   if (lm.uv.size() != 6 * nt) sizeError("uv", lm.uv.size(), 6 * nt);
   if (lm.trianglePage.size() != nt) sizeError("trianglePage", lm.trianglePage.size(), nt);
   if (pages == 0) fail("LightmapExport.pageUris is empty (one file name per page)");
-  for (size_t p = 0; p < pages; ++p) {
-    const std::string& uri = lm.pageUris[p];
-    if (uri.empty() || uri.front() == '/' || uri.find("..") != std::string::npos ||
-        uri.find(':') != std::string::npos) {
-      fail("LightmapExport.pageUris[" + std::to_string(p) + "] '" + uri +
-           "' is not a file name relative to the glTF's folder");
+  if (!lm.directionUris.empty() && lm.directionUris.size() != pages) {
+    fail("LightmapExport.directionUris has " + std::to_string(lm.directionUris.size()) +
+         " names for " + std::to_string(pages) + " pages");
+  }
+  for (const auto* uris : {&lm.pageUris, &lm.directionUris}) {
+    for (size_t p = 0; p < uris->size(); ++p) {
+      const std::string& uri = (*uris)[p];
+      if (uri.empty() || uri.front() == '/' || uri.find("..") != std::string::npos ||
+          uri.find(':') != std::string::npos) {
+        fail(std::string("LightmapExport.") + (uris == &lm.pageUris ? "pageUris[" : "directionUris[") +
+             std::to_string(p) + "] '" + uri + "' is not a file name relative to the glTF's folder");
+      }
     }
   }
   if (lm.width < 1 || lm.height < 1) {
@@ -525,6 +531,14 @@ class Exporter {
               {"width", lm_.width},
               {"height", lm_.height}};
     if (lm_.encoding == "rgbm-png") l["rgbmRange"] = double(lm_.rgbmRange);
+    if (!lm_.directionUris.empty()) {
+      l["direction"] = {{"uri", uriEncode(lm_.directionUris[size_t(page)])},
+                        {"encoding", "unit-vector-png"},
+                        {"decode", "d = (byte - 128) / 127 per channel"},
+                        {"space", "world"},
+                        {"quantity", "mean direction towards the light"},
+                        {"shading", "one light of colour E / max(dot(n_vertex, d), 0.05) from d"}};
+    }
     return l;
   }
 

@@ -51,6 +51,10 @@ struct LightmapExport {
   /// Per page: the page image's file name relative to the glTF's folder
   /// (written there by the caller), percent-encoded on output as glTF uris are.
   std::vector<std::string> pageUris;
+  /// Per page, or empty: the page's direction image (a directional lightmap,
+  /// image/image.h encodeUnitVectorPng of LightmapAtlas::direction), named
+  /// like pageUris; recorded as extras.lightmap.direction.
+  std::vector<std::string> directionUris;
   /// How the page images hold E: "linear-exr" (32-bit float RGB, W/m^2 as is)
   /// or "rgbm-png" (image/image.h encodeRgbmPng with rgbmRange).
   std::string encoding = "linear-exr";

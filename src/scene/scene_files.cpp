@@ -3,6 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -129,6 +131,43 @@ std::vector<std::string> sceneFiles(const std::string& path) {
     if (std::find(unique.begin(), unique.end(), f) == unique.end()) unique.push_back(f);
   }
   return unique;
+}
+
+std::string sceneContentHash(const std::string& path) {
+  uint64_t hash = 1469598103934665603ull;
+  auto add = [&hash](const void* data, size_t size) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < size; ++i) hash = (hash ^ p[i]) * 1099511628211ull;
+  };
+  const fs::path folder = fs::path(path).parent_path();
+  std::vector<char> buffer(1 << 16);
+  bool first = true;
+  for (const std::string& file : sceneFiles(path)) {
+    // The files it reads by name, but not the scene's own name: a renamed
+    // copy is the same scene.
+    std::error_code ec;
+    std::string name = fs::relative(file, folder.empty() ? fs::path(".") : folder, ec).generic_string();
+    if (ec || name.empty()) name = fs::path(file).filename().string();
+    if (first) name.clear();
+    first = false;
+    add(name.data(), name.size() + 1);  // with its terminating zero
+    std::ifstream in(file, std::ios::binary);
+    if (!in) {
+      add("missing", 7);
+      continue;
+    }
+    uint64_t size = 0;
+    while (in) {
+      in.read(buffer.data(), std::streamsize(buffer.size()));
+      const size_t got = size_t(in.gcount());
+      add(buffer.data(), got);
+      size += got;
+    }
+    add(&size, sizeof size);
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, "fnv1a64:%016llx", static_cast<unsigned long long>(hash));
+  return text;
 }
 
 }  // namespace lo

@@ -17,4 +17,12 @@ namespace lo {
 /// are listed too (an output must not appear in their place either).
 std::vector<std::string> sceneFiles(const std::string& path);
 
+/// A hash of the scene's content: FNV-1a (64 bits) over every file of
+/// sceneFiles(path) in order, each as its name relative to the scene's
+/// folder (none for the scene file itself: a renamed copy is the same
+/// scene), its size and its bytes (a missing file as its name and "missing"),
+/// written "fnv1a64:" and 16 hex digits. The same files give the same hash
+/// wherever they lie; a change to any byte the load reads changes it.
+std::string sceneContentHash(const std::string& path);
+
 }  // namespace lo

@@ -119,7 +119,7 @@ BakeFigures bakeAndWrite(const Scene& scene, const std::string& scenePath, const
   const bool reset = resetPeakRss();
   Stopwatch clock;
   BakeResult baked = bake(scene, b);
-  baked.metadata.sourceScene = fs::path(scenePath).filename().string();
+  recordSourceScene(baked.metadata, scenePath);
   writeVdlGrid(vdb, baked.grid, baked.metadata);
   BakeFigures f;
   f.bakeSeconds = clock.seconds();

@@ -213,6 +213,10 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   m.insertMeta("generator", openvdb::StringMetadata(meta.generator));
   m.insertMeta("version", openvdb::StringMetadata(meta.version));
   m.insertMeta("source_scene", openvdb::StringMetadata(meta.sourceScene));
+  if (!meta.sourceScenePath.empty())
+    m.insertMeta("source_scene_path", openvdb::StringMetadata(meta.sourceScenePath));
+  if (!meta.sourceSceneHash.empty())
+    m.insertMeta("source_scene_hash", openvdb::StringMetadata(meta.sourceSceneHash));
   // The frame the coordinates are in, for tools that would guess (Blender is
   // Z up): the scene file's, and a glTF's is Y up, right-handed, metres.
   m.insertMeta("up_axis", openvdb::StringMetadata("+Y"));
@@ -302,6 +306,8 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.generator = metaValue<std::string>(path, m, "generator", false, "");
   meta.version = metaValue<std::string>(path, m, "version", false, "");
   meta.sourceScene = metaValue<std::string>(path, m, "source_scene", false, "");
+  meta.sourceScenePath = metaValue<std::string>(path, m, "source_scene_path", false, "");
+  meta.sourceSceneHash = metaValue<std::string>(path, m, "source_scene_hash", false, "");
   meta.depth = metaValue<int32_t>(path, m, kMetaDepth, true, 0);
   meta.photons = metaValue<int64_t>(path, m, "photons", false, 0);
   meta.emittedPaths = metaValue<int64_t>(path, m, "emitted_paths", false, 0);

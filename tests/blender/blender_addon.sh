@@ -6,9 +6,11 @@
 # the project's `render --lighting atlas --mode indirect` (the light fixture's
 # pixels left out); the bake imported as a Volume (test_addon.py checks it).
 # The pictures stay in WORKDIR (blender-exr.png, blender-rgbm.png, ours.png).
-# Usage: blender_addon.sh LIGHTOCTREE SCENE ADDON_ZIP WORKDIR
+# With MODULE_DIR (where `import lightoctree` is built) the Volume comes with
+# its VDL arrows, checked and drawn (blender-arrows.png).
+# Usage: blender_addon.sh LIGHTOCTREE SCENE ADDON_ZIP WORKDIR [MODULE_DIR]
 set -u
-cli=$1 scene=$2 zip=$3 dir=$4
+cli=$1 scene=$2 zip=$3 dir=$4 modules=${5:-}
 here=$(cd "$(dirname "$0")" && pwd)
 size=128
 rm -rf "$dir" && mkdir -p "$dir/addon" || exit 1
@@ -26,14 +28,15 @@ failures=0
 for pages in exr rgbm; do
   mkdir -p "$dir/$pages"
   if ! blender -b --factory-startup --python "$here/test_addon.py" -- "$dir/addon" "$dir/cornell-$pages.glb" \
-      "$dir/grid.vdb" "$dir/$pages" $size > "$dir/blender-$pages.log" 2>&1; then
+      "$dir/grid.vdb" "$dir/$pages" $size "$modules" > "$dir/blender-$pages.log" 2>&1; then
     grep -E "FAILED|Error|Traceback" "$dir/blender-$pages.log" | head -5
     echo "FAILED: Blender with the $pages pages (log: $dir/blender-$pages.log)"
     failures=$((failures + 1))
     continue
   fi
-  grep -E "lightmapped materials|volume " "$dir/blender-$pages.log"
+  grep -E "lightmapped materials|volume |VDL arrows" "$dir/blender-$pages.log"
   cp "$dir/$pages/blender-bake.png" "$dir/blender-$pages.png"
+  [ -f "$dir/$pages/blender-arrows.png" ] && cp "$dir/$pages/blender-arrows.png" "$dir/blender-arrows.png"
   "$cli" compare "$dir/blender-$pages.png" "$dir/ours.png" --mask "$dir/emitter-mask.png" \
     --json "$dir/compare-$pages.json" > /dev/null || { echo "FAILED: compare"; failures=$((failures + 1)); continue; }
   verdict=$(python3 - "$dir/compare-$pages.json" "$pages" <<'PY'

@@ -1,10 +1,13 @@
 # The Blender add-on (blender/lightoctree_blender) in Blender, headless:
 #   blender -b --factory-startup --python tests/blender/test_addon.py -- \
-#       ADDON_PARENT SCENE.glb GRID.vdb OUT_DIR SIZE
+#       ADDON_PARENT SCENE.glb GRID.vdb OUT_DIR SIZE [MODULE_DIR]
 # Imports the lightmapped glTF in "baked light only" mode and renders it with
 # Cycles from the file's camera (OUT_DIR/blender-bake.png, sRGB, Standard view,
 # no tone mapping), and imports the .vdb as a Volume (checks its grids, frame
-# and material). tests/blender/blender_addon.sh compares the picture with the
+# and material) and, with MODULE_DIR (where `import lightoctree` is built),
+# with its VDL arrows (a point per voxel, cones by geometry nodes; checked on
+# the evaluated mesh and drawn to OUT_DIR/blender-arrows.png).
+# tests/blender/blender_addon.sh compares the picture with the
 # project's own render. Prints "FAILED: ..." for what is wrong.
 import math
 import os
@@ -12,9 +15,13 @@ import sys
 
 import bpy
 
-addon_parent, glb, vdb, out, size = sys.argv[sys.argv.index("--") + 1:]
+args = sys.argv[sys.argv.index("--") + 1:]
+addon_parent, glb, vdb, out, size = args[:5]
+module_dir = args[5] if len(args) > 5 and args[5] else None
 size = int(size)
 sys.path.insert(0, addon_parent)
+if module_dir:
+    sys.path.insert(0, module_dir)
 import lightoctree_blender  # noqa: E402
 
 failures = []
@@ -57,7 +64,7 @@ scene.render.filepath = os.path.join(out, "blender-bake.png")
 bpy.ops.render.render(write_still=True)
 print(f"wrote {scene.render.filepath}")
 
-result = bpy.ops.lightoctree.import_vdb(filepath=vdb)
+result = bpy.ops.lightoctree.import_vdb(filepath=vdb, arrows=bool(module_dir), max_arrows=1500)
 volumes = [o for o in bpy.data.objects if o.type == "VOLUME"]
 if "FINISHED" not in result or not volumes:
     failures.append(f"import_vdb returned {result}")
@@ -71,6 +78,30 @@ else:
         failures.append("the volume is not turned from Y up to Z up")
     if not v.data.materials or v.data.materials[0].node_tree.nodes.get("Attribute") is None:
         failures.append("the volume has no irradiance material")
+
+if module_dir:
+    arrows = [o for o in bpy.data.objects if o.get("lightoctree") and o.type == "MESH"]
+    if not arrows:
+        failures.append("no VDL arrows object")
+    else:
+        a = arrows[0]
+        points = len(a.data.vertices)
+        evaluated = a.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+        print(f"VDL arrows: {points} points ({a['lightoctree']['voxels']} voxels), "
+              f"{len(evaluated.vertices)} vertices after geometry nodes, "
+              f"attributes {sorted(k.name for k in evaluated.attributes if not k.name.startswith('.'))}")
+        if points != min(1500, a["lightoctree"]["voxels"]) or len(evaluated.vertices) < 2 * points:
+            failures.append("the arrows' geometry nodes made no cones")
+        if "irradiance" not in evaluated.attributes:
+            failures.append("the arrows lost their irradiance attribute")
+        # A picture of the volume's arrows from the file's camera.
+        for o in bpy.data.objects:
+            if o.type == "MESH" and o is not a:
+                o.hide_render = True
+        scene.render.resolution_x = scene.render.resolution_y = 2 * size
+        scene.render.filepath = os.path.join(out, "blender-arrows.png")
+        bpy.ops.render.render(write_still=True)
+        print(f"wrote {scene.render.filepath}")
 
 for f in failures:
     print(f"FAILED: {f}")

@@ -1,18 +1,25 @@
 // The lightmap export (export/lightmap_export.h): every file it names is
-// written and nothing else; the RGBM range is the power of two above the
+// written and nothing else, the direction pages holding the atlas's
+// directions; the RGBM range is the power of two above the
 // brightest texel; the glTF reads back with its lightmap UVs; a file that
 // cannot be written takes the others with it; --content full adds the
 // path tracer's direct light; a bad output name is refused before any work.
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <string>
 
 #include "core/error.h"
 #include "export/lightmap_export.h"
+#include "image/image.h"
 #include "lightgrid/vdl_grid.h"
 #include "scene/scene.h"
 #include "test_util.h"
@@ -79,8 +86,31 @@ TEST(LightmapExport, WritesEveryFileItNamesAndNothingElse) {
   for (int i = 0; i < pages; ++i) {
     expected.insert("room-lightmap" + std::to_string(i) + ".png");
     expected.insert("room-charts" + std::to_string(i) + ".png");
+    expected.insert("room-direction" + std::to_string(i) + ".png");
   }
   EXPECT_EQ(filesIn(dir), expected);
+  ASSERT_EQ(r.directionPaths.size(), size_t(pages));
+  EXPECT_EQ(r.directionPaths[1], lightmapDirectionPath(p.output, 1));
+  // The direction pages hold the atlas's directions (to 0.5 / 127), and the
+  // glTF names them.
+  for (int i = 0; i < pages; ++i) {
+    const RgbImage& want = r.lightmap.atlas.direction[size_t(i)];
+    std::ifstream file(r.directionPaths[size_t(i)], std::ios::binary);
+    const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)), {});
+    const RgbImage got = decodeUnitVectors(decodeImageBytes(bytes.data(), bytes.size()));
+    ASSERT_EQ(got.rgb.size(), want.rgb.size());
+    for (size_t k = 0; k < got.rgb.size(); ++k) {
+      ASSERT_NEAR(got.rgb[k], std::clamp(want.rgb[k], -1.0f, 1.0f), 0.5f / 127 + 1e-6f) << i << " " << k;
+    }
+  }
+  {
+    std::ifstream in(p.output);
+    const nlohmann::json gltf = nlohmann::json::parse(in);
+    const nlohmann::json& direction = gltf["materials"][0]["extras"]["lightmap"]["direction"];
+    EXPECT_EQ(direction["encoding"], "unit-vector-png");
+    EXPECT_EQ(direction["space"], "world");
+    EXPECT_EQ(direction["uri"].get<std::string>().rfind("room-direction", 0), 0u);
+  }
   ASSERT_EQ(r.pagePaths.size(), size_t(pages));
   EXPECT_EQ(r.pagePaths[1], lightmapPagePath(p.output, 1, true));
   EXPECT_EQ(r.chartPaths.size(), size_t(pages));
@@ -89,6 +119,7 @@ TEST(LightmapExport, WritesEveryFileItNamesAndNothingElse) {
   EXPECT_EQ(r.previewBytes, size_t(fs::file_size(r.previewPath)));
   size_t pageBytes = 0;
   for (const std::string& page : r.pagePaths) pageBytes += size_t(fs::file_size(page));
+  for (const std::string& page : r.directionPaths) pageBytes += size_t(fs::file_size(page));
   EXPECT_EQ(r.pageFileBytes, pageBytes);
   EXPECT_GT(r.octreeLeaves, 0u);
   EXPECT_TRUE(r.glInfo.empty());

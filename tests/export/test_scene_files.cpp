@@ -86,5 +86,28 @@ TEST(SceneFiles, ALightmapExportWouldNotReplaceTheScenesFiles) {
   }
 }
 
+// The content hash: the same bytes give the same hash wherever they lie and
+// whatever the scene file is called; a byte changed in a file it reads (an
+// image) changes it.
+TEST(SceneFiles, TheContentHashFollowsTheBytesNotTheNames) {
+  const std::string dir = test::outputDir("SceneFiles.Hash");
+  fs::create_directories(dir + "/a");
+  fs::create_directories(dir + "/b");
+  const std::string gltf =
+      R"({"asset":{"version":"2.0"},"images":[{"uri":"t.png"}]})";
+  for (const char* sub : {"/a/", "/b/"}) {
+    std::ofstream(dir + sub + (sub[1] == 'a' ? "scene.gltf" : "renamed.gltf")) << gltf;
+    std::ofstream(dir + sub + "t.png") << "not really a png";
+  }
+  const std::string a = sceneContentHash(dir + "/a/scene.gltf");
+  EXPECT_EQ(a.rfind("fnv1a64:", 0), 0u) << a;
+  EXPECT_EQ(a.size(), 8u + 16u);
+  EXPECT_EQ(a, sceneContentHash(dir + "/b/renamed.gltf"));
+  std::ofstream(dir + "/b/t.png") << "not really a pnG";
+  EXPECT_NE(a, sceneContentHash(dir + "/b/renamed.gltf"));
+  fs::remove(dir + "/b/t.png");  // a missing image counts too
+  EXPECT_NE(a, sceneContentHash(dir + "/b/renamed.gltf"));
+}
+
 }  // namespace
 }  // namespace lo

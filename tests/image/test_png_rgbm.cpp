@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/math.h"
 #include "core/rng.h"
 #include "image/image.h"
 
@@ -87,6 +88,39 @@ TEST(Rgbm, RoundTripStaysWithinTheStatedBound) {
   const std::vector<unsigned char> plain = encodePng(img);
   const DecodedImage rgb = decodeImageBytes(plain.data(), plain.size());
   EXPECT_THROW(decodeRgbm(rgb, kRange), InputError);
+}
+
+// Unit vectors round trip within 0.5 / 127 per component; (0, 0, 0) is
+// exactly 128 and back to 0; the PNG says it holds data.
+TEST(UnitVectorPng, RoundTripsWithinHalfAStep) {
+  RgbImage img(16, 9);
+  Rng rng(3, 0);
+  for (size_t i = 0; i < img.pixelCount(); ++i) {
+    Vec3 d{rng.uniform() * 2 - 1, rng.uniform() * 2 - 1, rng.uniform() * 2 - 1};
+    d = i % 5 == 0 ? Vec3{0, 0, 0} : normalize(d);
+    for (int k = 0; k < 3; ++k) img.rgb[3 * i + size_t(k)] = d[k];
+  }
+  img.rgb[3] = NAN;  // encodes as 0
+  const std::vector<unsigned char> png = encodeUnitVectorPng(img);
+  const std::string text(png.begin(), png.end());
+  EXPECT_NE(text.find("gAMA"), std::string::npos);
+  EXPECT_NE(text.find("lightoctree:encoding"), std::string::npos);
+  const DecodedImage d = decodeImageBytes(png.data(), png.size());
+  ASSERT_EQ(d.channels, 3);
+  const RgbImage back = decodeUnitVectors(d);
+  ASSERT_EQ(back.width, 16);
+  ASSERT_EQ(back.height, 9);
+  for (size_t i = 0; i < img.rgb.size(); ++i) {
+    const float want = std::isfinite(img.rgb[i]) ? img.rgb[i] : 0.0f;
+    ASSERT_LE(std::fabs(back.rgb[i] - want), 0.5f / 127.0f + 1e-6f) << i;
+    if (want == 0.0f) {
+      ASSERT_EQ(back.rgb[i], 0.0f) << i;
+    }
+  }
+  EXPECT_THROW(encodeUnitVectorPng(RgbImage()), InputError);
+  DecodedImage grey = d;
+  grey.channels = 1;
+  EXPECT_THROW(decodeUnitVectors(grey), InputError);
 }
 
 }  // namespace
