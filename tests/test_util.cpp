@@ -83,12 +83,11 @@ void addBlock(Scene& scene, const Vec3& lo, const Vec3& hi, int material) {
 }
 
 std::shared_ptr<const Texture> twoBandSkyImage() {
-  auto image = std::make_shared<Texture>();
-  image->width = image->height = 8;
+  std::vector<Vec3> rows;
   for (int y = 0; y < 8; ++y) {
-    for (int x = 0; x < 8; ++x) image->texels.push_back(Vec3(y < 2 ? 4.0f : y < 4 ? 1.0f : 7.0f));
+    for (int x = 0; x < 8; ++x) rows.push_back(Vec3(y < 2 ? 4.0f : y < 4 ? 1.0f : 7.0f));
   }
-  return image;
+  return std::make_shared<Texture>(Texture::fromLinear(8, 8, rows));
 }
 
 Scene pointLitRoom() {

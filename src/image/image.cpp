@@ -487,28 +487,29 @@ void checkImageSize(int64_t width, int64_t height, double bytesPerPixel) {
 }
 
 
-DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
+StoredImage decodeStoredImage(const unsigned char* bytes, size_t size) {
   if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
     throw InputError("empty or too large");
   }
   const int n = int(size);
   int w = 0, h = 0, comp = 0;
-  // The header's size first: stb, its floats and the caller's texture
-  // (16 bytes per texel) per pixel, at most 4 channels of 16 bits.
-  checkEncodedImage(bytes, size, 4 * (2 + 4) + 16);
-  DecodedImage out;
-  auto finish = [&](auto* data, float scale) {
+  // The header's size first: stb's pixels and the caller's copy, at most 4
+  // channels of 16 bits each.
+  checkEncodedImage(bytes, size, 2 * 4 * 2);
+  StoredImage out;
+  if (size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0) out.mimeType = "image/png";
+  if (jpegBody(bytes, size) != 0) out.mimeType = "image/jpeg";
+  auto finish = [&](auto* data, auto& values) {
     out.width = w;
     out.height = h;
     out.channels = comp;
-    out.values.resize(size_t(w) * size_t(h) * size_t(comp));
-    for (size_t i = 0; i < out.values.size(); ++i) out.values[i] = float(data[i]) * scale;
+    values.assign(data, data + size_t(w) * size_t(h) * size_t(comp));
     stbi_image_free(data);
   };
   if (stbi_is_16_bit_from_memory(bytes, n)) {
     stbi_us* data = stbi_load_16_from_memory(bytes, n, &w, &h, &comp, 0);
     if (data && w > 0 && h > 0 && comp >= 1 && comp <= 4) {
-      finish(data, 1.0f / 65535.0f);
+      finish(data, out.unorm16);
       return out;
     }
     if (data) stbi_image_free(data);
@@ -519,7 +520,25 @@ DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
     const char* reason = stbi_failure_reason();
     throw InputError(reason ? reason : "cannot decode");
   }
-  finish(data, 1.0f / 255.0f);
+  finish(data, out.unorm8);
+  return out;
+}
+
+DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
+  // The stored pixels and their floats (4 channels of 4 bytes) per pixel.
+  checkEncodedImage(bytes, size, 2 * 4 * 2 + 4 * 4);
+  const StoredImage stored = decodeStoredImage(bytes, size);
+  DecodedImage out;
+  out.width = stored.width;
+  out.height = stored.height;
+  out.channels = stored.channels;
+  if (!stored.unorm16.empty()) {
+    out.values.resize(stored.unorm16.size());
+    for (size_t i = 0; i < out.values.size(); ++i) out.values[i] = float(stored.unorm16[i]) / 65535.0f;
+  } else {
+    out.values.resize(stored.unorm8.size());
+    for (size_t i = 0; i < out.values.size(); ++i) out.values[i] = float(stored.unorm8[i]) / 255.0f;
+  }
   return out;
 }
 

@@ -47,6 +47,19 @@ struct DecodedImage {
 /// or, before any decoding, when the header's size breaks checkImageSize.
 DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size);
 
+/// An image file's pixels as the file stores them: 8 or 16 bits per channel
+/// (what a texture keeps: a fourth of floats' memory or less).
+struct StoredImage {
+  int width = 0, height = 0;
+  int channels = 0;                ///< 1..4
+  std::vector<uint8_t> unorm8;     ///< 8-bit files: width * height * channels
+  std::vector<uint16_t> unorm16;   ///< 16-bit files (PNG): the same, 16 bits each
+  std::string mimeType;            ///< "image/png", "image/jpeg", or "" for other formats
+};
+/// @brief decodeImageBytes without the conversion to floats.
+/// @throws as decodeImageBytes.
+StoredImage decodeStoredImage(const unsigned char* bytes, size_t size);
+
 /// Largest width or height of an image any stage reads (the largest 2D
 /// texture GL contexts give, 16384).
 constexpr int kMaxImageSide = 16384;

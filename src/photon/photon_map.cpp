@@ -54,6 +54,7 @@ struct Emitter {
   enum class Kind { Point, Spot, Directional, Triangle, Sky };
   Kind kind = Kind::Point;
   uint32_t index = 0;  ///< into Scene::lights or triangle index
+  uint32_t entry = 0;  ///< Triangle: its entry in Context::triangleEmitters
   Vec3 power;          ///< W, RGB, what this emitter actually emits
   /// W, RGB, the power of the distribution sampled before any rejection (a
   /// spot's full outer cone); also the selection weight (its average).
@@ -75,6 +76,7 @@ struct Context {
   std::vector<BsdfLobes> materials;
   std::vector<Emitter> emitters;
   std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
+  EmitterSampler triangleEmitters;  ///< the emissive triangles (where on them light starts)
   std::vector<LightFootprint> footprints;  ///< of the directional lights
   /// The sky's directions: an image's texels weighted by the covered box's
   /// silhouette seen from them; a uniform sky's hemisphere.
@@ -276,16 +278,22 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
       const Vec3& p0 = scene.positions[scene.indices[3 * tri]];
       const Vec3& p1 = scene.positions[scene.indices[3 * tri + 1]];
       const Vec3& p2 = scene.positions[scene.indices[3 * tri + 2]];
-      float s = std::sqrt(rng.uniform());
-      float b1 = 1.0f - s, b2 = rng.uniform() * s;
+      // An emissive texture: the triangle was picked by its mean radiance
+      // and the point by its cells' (EmitterSampler::samplePoint); the
+      // photon carries the ratio of the radiance where it starts to the
+      // mean, times how much less likely than uniform its point was.
+      // (Untextured: two numbers drawn, a uniform point, as always.)
+      const bool textured = scene.materials[ctx.triangles[tri].material].emissiveTexture >= 0;
+      float b1 = 0, b2 = 0, weight = 1;
+      const float cell = textured ? rng.uniform() : 0.0f;
+      const float a1 = rng.uniform(), a2 = rng.uniform();
+      ctx.triangleEmitters.samplePoint(e.entry, cell, a1, a2, b1, b2, weight);
       Vec3 p = p0 + (p1 - p0) * b1 + (p2 - p0) * b2;
       Vec3 n = ctx.triangles[tri].normal;
-      // An emissive texture: the triangle was picked by its mean radiance;
-      // the photon carries the ratio of the radiance where it starts.
-      if (scene.materials[ctx.triangles[tri].material].emissiveTexture >= 0) {
-        const Vec3 mean = scene.triangleEmission(tri);
+      if (textured) {
+        const Vec3& mean = ctx.triangleEmitters.emission[e.entry];
         const Vec3 here = scene.emission(tri, b1, b2);
-        for (int c = 0; c < 3; ++c) out.power[c] *= mean[c] > 0 ? here[c] / mean[c] : 0.0f;
+        for (int c = 0; c < 3; ++c) out.power[c] *= mean[c] > 0 ? weight * here[c] / mean[c] : 0.0f;
       }
       // One-sided emitters emit on the side of the winding normal;
       // double-sided ones pick a side (their power counts both).
@@ -323,6 +331,8 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
   EmittedRay start;
   if (!emit(ctx, rng, start)) return;
   Vec3 org = start.origin, dir = start.direction, power = start.power;
+  // A black texel of an emissive texture: a path, but nothing to carry.
+  if (!(maxComponent(power) > 0)) return;
 
   Hit hit;
   // Every scattering event so far was specular (a mirror, glass or a metal
@@ -445,11 +455,13 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
     ctx.skySampler =
         SkySampler(scene.sky, [box](const Vec3& d) { return boxSilhouette(box, d); });
   }
-  const EmitterSampler triangles = buildEmitterSampler(scene);
+  ctx.triangleEmitters = buildEmitterSampler(scene);
+  const EmitterSampler& triangles = ctx.triangleEmitters;
   for (size_t k = 0; k < triangles.size(); ++k) {
     Emitter e;
     e.kind = Emitter::Kind::Triangle;
     e.index = triangles.triangles[k];
+    e.entry = uint32_t(k);
     e.power = triangles.power[k];
     e.samplePower = e.power;
     ctx.emitters.push_back(e);

@@ -19,6 +19,8 @@ namespace {
 
 constexpr int kMaxLights = shader::LO_MAX_LIGHTS;
 constexpr int kMaxShadowLayers = shader::LO_MAX_SHADOW_LAYERS;
+/// The most bytes the shadow maps take (4 per texel: 24-bit depth as stored).
+constexpr double kShadowMapBudget = 96.0 * 1024 * 1024;
 constexpr int kCascades = shader::LO_SUN_CASCADES;
 
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
@@ -124,12 +126,19 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
     }
     layers += need;
   }
+  // The maps within a memory budget: a scene of many shadowed lights (an
+  // emissive texture's VPLs take 6 layers each) gets smaller maps, halved
+  // until they fit, but not below 256 texels.
+  while (shadowMapSize > 256 &&
+         double(shadowMapSize) * double(shadowMapSize) * 4.0 * double(layers) > kShadowMapBudget) {
+    shadowMapSize /= 2;
+  }
   std::copy(lights.begin(), lights.end(), block.uLights);
   block.uLightCount[0] = int32_t(lights.size());
   block.uLightCount[1] = int32_t(areaLightCount);  // appended last
   // Depth bias as a fraction of the far plane and a normal offset, both
   // about one shadow texel at the scene's scale.
-  const float texel = 2.0f * sceneSize / float(params.shadowMapSize);
+  const float texel = 2.0f * sceneSize / float(shadowMapSize);
   block.uShadowParams[0] = 0.5f * texel / std::max(sceneSize, 1e-6f);
   block.uShadowParams[1] = 1.5f * texel;
 

@@ -65,7 +65,11 @@ struct RenderParams {
 
 /// Set once: resources built for the scene.
 struct RendererParams {
-  int shadowMapSize = 1024;  ///< texels per side of every shadow map layer
+  /// Texels per side of every shadow map layer, at most: with many shadowed
+  /// lights (a VPL takes 6 layers) the maps are halved until they fit in
+  /// 96 MiB (not below 256), so an emissive-textured asset's VPLs do not
+  /// take hundreds of megabytes.
+  int shadowMapSize = 1024;
   /// Emissive triangles are drawn as area lights (exact unshadowed irradiance
   /// of each triangle, soft shadows by its size) when the scene has at most
   /// LO_MAX_AREA_LIGHTS (shaders/render_constants.h) of them; else, or when

@@ -37,23 +37,45 @@ DrawCategory categoryOf(const Material& m) {
 
 }  // namespace
 
-/// Uploads a texture (linear RGB, and its alpha where it has one) with its
+/// Uploads a texture (its colour, and its alpha where it has one) with its
 /// glTF sampler's filters and wrap modes; mipmaps and anisotropic filtering
-/// where the minification filter uses mipmaps (glTF's default).
+/// where the minification filter uses mipmaps (glTF's default). 8-bit
+/// texels go up as they are stored, 4 bytes per texel: sRGB colour maps as
+/// GL_SRGB8_ALPHA8, whose fetches the GPU decodes to linear before it
+/// filters (as Texture::lookup does), data maps as GL_RGBA8. 16-bit and
+/// float texels go up as linear half floats.
 GlTexture SceneGeometry::uploadTexture(const Texture& t) const {
   GlTexture id = GlTexture::create();
   glBindTexture(GL_TEXTURE_2D, id.get());
-  std::vector<float> rgba(t.texels.size() * 4);
-  for (size_t i = 0; i < t.texels.size(); ++i) {
-    rgba[4 * i] = t.texels[i].x;
-    rgba[4 * i + 1] = t.texels[i].y;
-    rgba[4 * i + 2] = t.texels[i].z;
-    rgba[4 * i + 3] = t.alpha.empty() ? 1.0f : t.alpha[i];
-  }
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  // Half floats: linear colour with 11 bits of precision, filterable and
-  // mipmappable on every GL 3.3 context.
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT, rgba.data());
+  const size_t n = t.texelCount(), c = size_t(t.channels);
+  if (t.format == TexelFormat::Unorm8) {
+    // Grey (and grey + alpha) spread to RGBA: one layout for every image.
+    std::vector<uint8_t> rgba(n * 4);
+    for (size_t i = 0; i < n; ++i) {
+      const uint8_t* p = t.unorm8.data() + i * c;
+      rgba[4 * i] = p[0];
+      rgba[4 * i + 1] = c >= 3 ? p[1] : p[0];
+      rgba[4 * i + 2] = c >= 3 ? p[2] : p[0];
+      rgba[4 * i + 3] = t.hasAlpha() ? p[c - 1] : 255;
+    }
+    glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0,
+                 GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  } else {
+    // Half floats: linear colour with 11 bits of precision, filterable and
+    // mipmappable on every GL 3.3 context.
+    std::vector<float> rgba(n * 4);
+    for (size_t i = 0; i < n; ++i) {
+      const int x = int(i % size_t(t.width)), y = int(i / size_t(t.width));
+      const Vec3 v = t.texel(x, y);
+      rgba[4 * i] = v.x;
+      rgba[4 * i + 1] = v.y;
+      rgba[4 * i + 2] = v.z;
+      rgba[4 * i + 3] = t.texelAlpha(x, y);
+    }
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT,
+                 rgba.data());
+  }
   // The glTF sampler (its codes are OpenGL's); an undefined minFilter is
   // trilinear, as glTF viewers draw it.
   const TextureSampler& sampler = t.sampler;

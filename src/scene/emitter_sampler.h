@@ -25,6 +25,8 @@ struct EmitterSampler {
   std::vector<uint32_t> triangles;
   /// Per entry: emitted power pi L A * sides, W (RGB).
   std::vector<Vec3> power;
+  /// Per entry: its mean radiance L (Scene::triangleEmission), W/(m^2 sr).
+  std::vector<Vec3> emission;
   /// Per entry: the cumulative sum of average(power) up to and including it;
   /// back() is the total. Summed in double in triangle order.
   std::vector<double> cdf;
@@ -41,7 +43,26 @@ struct EmitterSampler {
   /// of a point drawn uniformly on the picked triangle), 0 for triangles that
   /// do not emit. size() = the scene's triangle count.
   std::vector<float> areaPdfs(const Scene& scene) const;
+
+  /// Emissive textures: where on a triangle its light comes from. The
+  /// triangle is cut into kEmitterCells equal sub-triangles (8 x 8 along
+  /// its edges) whose centroid emissions are the 64 points its mean
+  /// (Scene::triangleEmission) averages; a point is drawn in a cell picked by
+  /// that emission half the time and evenly the other half (no emitting
+  /// texel is missed and no photon weighs more than twice its share), then
+  /// uniformly in it. Per entry: -1 (no texture: uniform points), or
+  /// where its kEmitterCells cumulative weights start in cellCdf.
+  std::vector<int32_t> cellTable;
+  std::vector<float> cellCdf;
+  /// A point on entry k's triangle for u0, u1, u2 in [0, 1): barycentrics
+  /// (b1, b2) of Scene::emission, and the factor (1 / area) / pdf of the
+  /// point, by which a photon's power is multiplied (1 without a texture).
+  void samplePoint(size_t k, float u0, float u1, float u2, float& b1, float& b2,
+                   float& weight) const;
 };
+
+/// Sub-triangles per emitting triangle for EmitterSampler::samplePoint.
+constexpr int kEmitterCells = 64;
 
 /// @throws InputError naming the material and triangle when an emitter's
 /// power is not finite (an emission so large that pi L A overflows).

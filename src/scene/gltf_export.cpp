@@ -261,6 +261,7 @@ class Exporter {
     if (!images_.empty()) {
       doc["images"] = std::move(images_);
       doc["textures"] = std::move(textures_);
+      if (!samplers_.empty()) doc["samplers"] = std::move(samplers_);
     }
     if (!lights_.empty()) {
       doc["extensions"]["KHR_lights_punctual"] = {{"lights", std::move(lights_)}};
@@ -456,38 +457,71 @@ class Exporter {
         {{"attributes", attributes}, {"indices", indexAccessor}, {"material", material}});
   }
 
-  /// The glTF texture of Scene texture `index` (encoded once per decoding).
+  /// The glTF texture of Scene texture `index`: the image file's own bytes
+  /// when the texture was read from a PNG or JPEG and is read here with the
+  /// encoding it was decoded with (each file embedded once); else its texels
+  /// encoded as an 8-bit PNG (once per texture and encoding).
   int texture(int index, bool srgb) {
     auto it = textureOf_.find({index, srgb});
     if (it != textureOf_.end()) return it->second;
     const Texture& tex = scene_.textures[size_t(index)];
-    const size_t n = size_t(tex.width) * size_t(tex.height);
-    const int channels = tex.alpha.size() == n ? 4 : 3;
-    std::vector<unsigned char> pixels(n * size_t(channels));
-    auto data8 = [](float v) {
-      return (unsigned char)std::lround(255.0f *
-                                        (std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f));
-    };
-    for (size_t i = 0; i < n; ++i) {
-      const Vec3& c = tex.texels[i];
-      for (int k = 0; k < 3; ++k)
-        pixels[i * size_t(channels) + size_t(k)] = srgb ? encodeSrgb8(c[k]) : data8(c[k]);
-      if (channels == 4) pixels[i * 4 + 3] = data8(tex.alpha[i]);
+    int result = -1;
+    if (tex.encoded && !tex.encoded->empty() && tex.srgb == srgb) {
+      auto image = imageOfFile_.find(tex.encoded.get());
+      const int source = image != imageOfFile_.end()
+                             ? image->second
+                             : addImage(*tex.encoded, tex.mimeType, tex.name);
+      imageOfFile_[tex.encoded.get()] = source;
+      textures_.push_back({{"source", source}});
+      result = int(textures_.size()) - 1;
+      addSampler(textures_.back(), tex.sampler);
+    } else {
+      const size_t n = tex.texelCount();
+      const int channels = tex.hasAlpha() ? 4 : 3;
+      std::vector<unsigned char> pixels(n * size_t(channels));
+      auto data8 = [](float v) {
+        return (unsigned char)std::lround(255.0f *
+                                          (std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f));
+      };
+      for (size_t i = 0; i < n; ++i) {
+        const int x = int(i % size_t(tex.width)), y = int(i / size_t(tex.width));
+        const Vec3 c = tex.texel(x, y);
+        for (int k = 0; k < 3; ++k)
+          pixels[i * size_t(channels) + size_t(k)] = srgb ? encodeSrgb8(c[k]) : data8(c[k]);
+        if (channels == 4) pixels[i * 4 + 3] = data8(tex.texelAlpha(x, y));
+      }
+      const std::vector<unsigned char> png =
+          encodePng8(tex.width, tex.height, channels, pixels.data());
+      textures_.push_back({{"source", addImage(png, "image/png", tex.name)}});
+      result = int(textures_.size()) - 1;
+      addSampler(textures_.back(), tex.sampler);
     }
-    const std::vector<unsigned char> png =
-        encodePng8(tex.width, tex.height, channels, pixels.data());
-    const int result = addImage(png, tex.name);
     textureOf_[{index, srgb}] = result;
     return result;
   }
 
-  int addImage(const std::vector<unsigned char>& png, const std::string& name) {
-    const int view = buffer_.addView(png.data(), png.size(), 0);
-    json image = {{"bufferView", view}, {"mimeType", "image/png"}};
+  /// `texture`'s sampler when it is not glTF's default (one per distinct sampler).
+  void addSampler(json& texture, const TextureSampler& sampler) {
+    const TextureSampler defaults;
+    if (!(sampler < defaults) && !(defaults < sampler)) return;
+    auto it = samplerOf_.find(sampler);
+    if (it == samplerOf_.end()) {
+      json s = {{"magFilter", sampler.magFilter}, {"wrapS", sampler.wrapS}, {"wrapT", sampler.wrapT}};
+      if (sampler.minFilter != 0) s["minFilter"] = sampler.minFilter;
+      samplers_.push_back(std::move(s));
+      it = samplerOf_.emplace(sampler, int(samplers_.size()) - 1).first;
+    }
+    texture["sampler"] = it->second;
+  }
+
+  /// An image in the buffer; returns its index.
+  int addImage(const std::vector<unsigned char>& bytes, const std::string& mimeType,
+               const std::string& name) {
+    const int view = buffer_.addView(bytes.data(), bytes.size(), 0);
+    json image = {{"bufferView", view}, {"mimeType", mimeType}};
     if (!name.empty()) image["name"] = name;
     images_.push_back(std::move(image));
-    textures_.push_back({{"source", int(images_.size()) - 1}});
-    return int(textures_.size()) - 1;
+    return int(images_.size()) - 1;
   }
 
   /// Whether a map is written: a decoded texture on a UV set the scene has
@@ -495,9 +529,7 @@ class Exporter {
   bool mapExported(int index, int texCoord) const {
     if (index < 0 || size_t(index) >= scene_.textures.size()) return false;
     const Texture& tex = scene_.textures[size_t(index)];
-    return tex.width >= 1 && tex.height >= 1 &&
-           tex.texels.size() == size_t(tex.width) * size_t(tex.height) &&
-           hasUvSet(scene_, texCoord);
+    return !tex.empty() && tex.byteSize() > 0 && hasUvSet(scene_, texCoord);
   }
 
   /// A texture reference, or null when the map is dropped (mapExported).
@@ -629,8 +661,9 @@ class Exporter {
   int previewTexture(int page) {
     auto it = previewOf_.find(page);
     if (it != previewOf_.end()) return it->second;
-    const int t =
-        addImage(lm_.previewPng[size_t(page)], "lightmap preview " + std::to_string(page));
+    textures_.push_back({{"source", addImage(lm_.previewPng[size_t(page)], "image/png",
+                                             "lightmap preview " + std::to_string(page))}});
+    const int t = int(textures_.size()) - 1;
     previewOf_[page] = t;
     return t;
   }
@@ -709,7 +742,10 @@ class Exporter {
   BufferBuilder buffer_;
   json accessors_ = json::array(), primitives_ = json::array(), materials_ = json::array();
   json images_ = json::array(), textures_ = json::array(), lights_ = json::array();
+  json samplers_ = json::array();
   std::map<std::pair<int, bool>, int> textureOf_;
+  std::map<const std::vector<uint8_t>*, int> imageOfFile_;  ///< embedded image files
+  std::map<TextureSampler, int> samplerOf_;
   std::map<int, int> previewOf_;
   std::set<std::string> extensionsUsed_;
 };

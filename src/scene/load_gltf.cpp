@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <set>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -558,7 +559,10 @@ class SceneBuilder {
       }
     }
     if (im.image.empty()) fail(path_, "unreadable image: no data " + what);
-    Texture t = decodeImage(path_, im.image.data(), im.image.size(), what, srgb);
+    // The file's bytes, shared by every texture decoding this image.
+    std::shared_ptr<const std::vector<uint8_t>>& bytes = imageBytes_[source];
+    if (!bytes) bytes = std::make_shared<const std::vector<uint8_t>>(im.image);
+    Texture t = decodeImage(path_, bytes, what, srgb);
     t.sampler = key.sampler;
     t.name =
         im.name.empty() ? (im.uri.empty() ? "image" + std::to_string(source) : im.uri) : im.name;
@@ -1115,6 +1119,8 @@ class SceneBuilder {
   bool skyScale_ = false;  ///< extras.lightoctree_sky was given
   float turbidity_ = 0;    ///< extras.lightoctree_physical_sky; 0 = none
   std::set<int> missingImages_;  ///< images whose file is missing, warned once
+  /// Each image's file bytes, kept by the textures that decode it (Texture::encoded).
+  std::map<int, std::shared_ptr<const std::vector<uint8_t>>> imageBytes_;
   int defaultMaterial_ = -1;
   bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false;
 };

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
@@ -207,8 +208,9 @@ Scene loadObj(const std::string& path) {
           scene.materials.push_back(std::move(m));
           continue;
         }
-        std::vector<unsigned char> bytes = readFileBytes(path, file, "texture");
-        Texture t = decodeImage(path, bytes.data(), bytes.size(), "(" + what + ")");
+        auto bytes = std::make_shared<const std::vector<unsigned char>>(
+            readFileBytes(path, file, "texture"));
+        Texture t = decodeImage(path, bytes, "(" + what + ")");
         t.name = o.diffuse_texname;
         m.baseColorTexture = int(scene.textures.size());
         textureByFile[o.diffuse_texname] = m.baseColorTexture;

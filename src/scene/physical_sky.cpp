@@ -121,11 +121,7 @@ void physicalSky(Scene& scene, float turbidity, int width) {
   const double scale = sunLux / directSunIlluminance(sunZenith, t);
 
   const int w = width, h = width / 2;
-  auto image = std::make_shared<Texture>();
-  image->name = "physical sky (turbidity " + std::to_string(turbidity).substr(0, 4) + ")";
-  image->width = w;
-  image->height = h;
-  image->texels.assign(size_t(w) * size_t(h), Vec3{0, 0, 0});
+  std::vector<Vec3> radiance(size_t(w) * size_t(h), Vec3{0, 0, 0});
   for (int y = 0; y < h / 2; ++y) {
     for (int x = 0; x < w; ++x) {
       const Vec3 d = skyPixelDirection(float(x) + 0.5f, float(y) + 0.5f, w, h);
@@ -134,9 +130,11 @@ void physicalSky(Scene& scene, float turbidity, int width) {
       const double Y = zenith.luminance * fY(cosTheta, gamma) / gY;
       const double cx = zenith.x * fx(cosTheta, gamma) / gx;
       const double cy = zenith.y * fy(cosTheta, gamma) / gy;
-      image->texels[size_t(y) * size_t(w) + size_t(x)] = rgbOfxyY(cx, cy, std::max(Y, 0.0) * scale);
+      radiance[size_t(y) * size_t(w) + size_t(x)] = rgbOfxyY(cx, cy, std::max(Y, 0.0) * scale);
     }
   }
+  auto image = std::make_shared<Texture>(Texture::fromLinear(w, h, radiance));
+  image->name = "physical sky (turbidity " + std::to_string(turbidity).substr(0, 4) + ")";
   scene.sky.image = std::move(image);
   scene.sky.radiance = Vec3{1, 1, 1};
 }

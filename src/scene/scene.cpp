@@ -1,6 +1,7 @@
 #include "scene/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <cmath>
@@ -61,18 +62,87 @@ T sampleTexels(const TextureSampler& sampler, int width, int height, float u, fl
 
 }  // namespace
 
+Texture Texture::fromLinear(int width, int height, const std::vector<Vec3>& rgb,
+                            const std::vector<float>& alpha) {
+  Texture t;
+  t.width = width;
+  t.height = height;
+  t.format = TexelFormat::Float32;
+  t.channels = alpha.empty() ? 3 : 4;
+  t.floats.resize(rgb.size() * size_t(t.channels));
+  for (size_t i = 0; i < rgb.size(); ++i) {
+    float* out = t.floats.data() + i * size_t(t.channels);
+    out[0] = rgb[i].x;
+    out[1] = rgb[i].y;
+    out[2] = rgb[i].z;
+    if (t.channels == 4) out[3] = i < alpha.size() ? alpha[i] : 1.0f;
+  }
+  return t;
+}
+
+namespace {
+
+/// 8-bit sRGB to linear, every value once.
+const std::array<float, 256>& srgb8ToLinear() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[size_t(i)] = srgbToLinear(float(i) / 255.0f);
+    return t;
+  }();
+  return table;
+}
+
+}  // namespace
+
+Vec3 Texture::texelAt(size_t i) const {
+  const size_t c = size_t(channels);
+  const size_t at = i * c;
+  const size_t g = c >= 3 ? 1 : 0, b = c >= 3 ? 2 : 0;  // grey: R = G = B
+  switch (format) {
+    case TexelFormat::Unorm8: {
+      const uint8_t* p = unorm8.data() + at;
+      if (srgb) {
+        const std::array<float, 256>& lut = srgb8ToLinear();
+        return {lut[p[0]], lut[p[g]], lut[p[b]]};
+      }
+      constexpr float k = 1.0f / 255.0f;
+      return {float(p[0]) * k, float(p[g]) * k, float(p[b]) * k};
+    }
+    case TexelFormat::Unorm16: {
+      const uint16_t* p = unorm16.data() + at;
+      constexpr float k = 1.0f / 65535.0f;
+      const Vec3 v{float(p[0]) * k, float(p[g]) * k, float(p[b]) * k};
+      return srgb ? Vec3{srgbToLinear(v.x), srgbToLinear(v.y), srgbToLinear(v.z)} : v;
+    }
+    case TexelFormat::Float32:
+    default: {
+      const float* p = floats.data() + at;
+      return {p[0], p[g], p[b]};
+    }
+  }
+}
+
+float Texture::alphaAt(size_t i) const {
+  if (!hasAlpha()) return 1.0f;
+  const size_t at = i * size_t(channels) + size_t(channels) - 1;
+  switch (format) {
+    case TexelFormat::Unorm8: return float(unorm8[at]) * (1.0f / 255.0f);
+    case TexelFormat::Unorm16: return float(unorm16[at]) * (1.0f / 65535.0f);
+    case TexelFormat::Float32:
+    default: return floats[at];
+  }
+}
+
 Vec3 Texture::lookup(float u, float v) const {
-  if (width <= 0 || height <= 0) return Vec3{1, 1, 1};
-  return sampleTexels<Vec3>(sampler, width, height, u, v, [this](int x, int y) {
-    return texels[size_t(y) * size_t(width) + size_t(x)];
-  });
+  if (empty()) return Vec3{1, 1, 1};
+  return sampleTexels<Vec3>(sampler, width, height, u, v,
+                            [this](int x, int y) { return texel(x, y); });
 }
 
 float Texture::lookupAlpha(float u, float v) const {
-  if (width <= 0 || height <= 0 || alpha.empty()) return 1.0f;
-  return sampleTexels<float>(sampler, width, height, u, v, [this](int x, int y) {
-    return alpha[size_t(y) * size_t(width) + size_t(x)];
-  });
+  if (empty() || !hasAlpha()) return 1.0f;
+  return sampleTexels<float>(sampler, width, height, u, v,
+                             [this](int x, int y) { return texelAlpha(x, y); });
 }
 
 void TextureTransform::apply(float& u, float& v) const {
@@ -145,20 +215,22 @@ std::shared_ptr<const Texture> loadSkyImage(const std::string& path) {
     throw InputError(path + ": a sky image must be 2 x 2 to 16384 x 8192 texels, not " +
                      std::to_string(image.width) + " x " + std::to_string(image.height));
   }
-  auto texture = std::make_shared<Texture>();
-  texture->name = path;
-  texture->width = image.width;
-  texture->height = image.height;
-  texture->texels.resize(size_t(image.width) * size_t(image.height));
-  for (size_t i = 0; i < texture->texels.size(); ++i) {
+  for (size_t i = 0; i < image.pixelCount(); ++i) {
     const Vec3 v{image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]};
     if (!isFinite(v) || v.x < 0 || v.y < 0 || v.z < 0) {
       throw InputError(path + ": texel " + std::to_string(i % size_t(image.width)) + ", " +
                        std::to_string(i / size_t(image.width)) + " is " + v.ToString() +
                        ": a radiance is finite and not negative");
     }
-    texture->texels[i] = v;
   }
+  // Floats, 3 channels (RGB32F on the GPU): a sun's radiance needs them.
+  auto texture = std::make_shared<Texture>();
+  texture->name = path;
+  texture->width = image.width;
+  texture->height = image.height;
+  texture->channels = 3;
+  texture->format = TexelFormat::Float32;
+  texture->floats = image.rgb;
   return texture;
 }
 
@@ -167,7 +239,7 @@ Vec3 Sky::radianceFrom(const Vec3& towards) const {
   if (!image) return radiance;
   int x = 0, y = 0;
   skyPixelOf(towards, image->width, image->height, x, y);
-  return radiance * image->texels[size_t(y) * size_t(image->width) + size_t(x)];
+  return radiance * image->texel(x, y);
 }
 
 Vec3 Sky::power(const Bounds3& box) const {
@@ -188,7 +260,7 @@ Vec3 Sky::power(const Bounds3& box) const {
       const Vec3 d = skyPixelDirection(float(x) + 0.5f, float(y) + 0.5f, w, h);
       const float area = std::fabs(d.x) * e.y * e.z + std::fabs(d.y) * e.x * e.z +
                          std::fabs(d.z) * e.x * e.y;
-      sum = sum + Vec3d(image->texels[size_t(y) * size_t(w) + size_t(x)] * (area * omega));
+      sum = sum + Vec3d(image->texel(x, y) * (area * omega));
     }
   }
   return radiance * Vec3{float(sum.x), float(sum.y), float(sum.z)};
@@ -496,31 +568,32 @@ std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std
   return bytes;
 }
 
-Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
+Texture decodeImage(const std::string& scenePath,
+                    const std::shared_ptr<const std::vector<uint8_t>>& bytes,
                     const std::string& what, bool srgb) {
-  DecodedImage d;
+  StoredImage d;
   try {
-    d = decodeImageBytes(bytes, size);
+    d = decodeStoredImage(bytes->data(), bytes->size());
   } catch (const InputError& e) {
     fail(scenePath, "unreadable image " + what + ": " + e.what());
   }
   Texture t;
   t.width = d.width;
   t.height = d.height;
-  t.texels.resize(size_t(d.width) * size_t(d.height));
-  const size_t comp = size_t(d.channels);
-  for (size_t i = 0; i < t.texels.size(); ++i) {
-    const float* px = d.values.data() + i * comp;
-    const float r = px[0];
-    const float g = comp >= 3 ? px[1] : r;
-    const float b = comp >= 3 ? px[2] : r;
-    t.texels[i] = srgb ? Vec3{srgbToLinear(r), srgbToLinear(g), srgbToLinear(b)} : Vec3{r, g, b};
+  t.channels = d.channels;
+  // Alpha is linear in glTF whatever the colour encoding (Texture::srgb
+  // leaves it alone).
+  t.srgb = srgb;
+  if (!d.unorm16.empty()) {
+    t.format = TexelFormat::Unorm16;
+    t.unorm16 = std::move(d.unorm16);
+  } else {
+    t.format = TexelFormat::Unorm8;
+    t.unorm8 = std::move(d.unorm8);
   }
-  // Alpha is linear in glTF whatever the colour encoding; kept only where
-  // the image has it (grey + alpha or RGBA).
-  if (comp == 2 || comp == 4) {
-    t.alpha.resize(t.texels.size());
-    for (size_t i = 0; i < t.alpha.size(); ++i) t.alpha[i] = d.values[i * comp + comp - 1];
+  if (!d.mimeType.empty()) {
+    t.encoded = bytes;
+    t.mimeType = d.mimeType;
   }
   return t;
 }

@@ -42,15 +42,61 @@ struct TextureSampler {
   }
 };
 
+/// How a Texture keeps its texels: as the image file gives them.
+enum class TexelFormat : uint8_t {
+  Unorm8,   ///< 8 bits per channel (Texture::unorm8), value / 255
+  Unorm16,  ///< 16 bits per channel (Texture::unorm16), value / 65535
+  Float32,  ///< floats as they are (Texture::floats): HDR images, textures made in code
+};
+
+/// An image as a texture. Texels stay as the file stores them (one byte per
+/// channel for the usual 8-bit PNG or JPEG, not 16 bytes of linear floats
+/// per texel), and are decoded at each fetch: sRGB colour maps through a
+/// 256-entry table (8-bit) or the transfer function (16-bit), so the
+/// tracers, the bake and the GL renderer (which uploads 8-bit sRGB texels to
+/// an sRGB texture format) read the same linear values.
 struct Texture {
   std::string name;
   TextureSampler sampler;
   int width = 0, height = 0;
-  std::vector<Vec3> texels;             ///< width * height: colour maps converted from sRGB to
-                                        ///< linear, data maps (normal maps) as stored, in [0, 1]
-  /// width * height alpha values in [0, 1] (linear, as glTF defines alpha),
-  /// or empty when the image has no alpha channel (alpha 1 everywhere).
-  std::vector<float> alpha;
+  /// Channels per texel as stored: 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA.
+  /// A grey value is its texel's R, G and B.
+  int channels = 0;
+  TexelFormat format = TexelFormat::Float32;
+  /// The colour channels hold sRGB-encoded values (colour maps of 8- and
+  /// 16-bit images): fetches return them linear. Alpha is always linear, as
+  /// glTF defines it; data maps (normal, metallic-roughness) are not sRGB.
+  bool srgb = false;
+  /// width * height * channels values, row 0 first; only the vector of
+  /// `format` is filled.
+  std::vector<uint8_t> unorm8;
+  std::vector<uint16_t> unorm16;
+  std::vector<float> floats;
+  /// The image file's own bytes and MIME type ("image/png", "image/jpeg"),
+  /// when the texture was decoded from a file: what an export embeds again
+  /// instead of encoding the texels anew. Shared, as several textures (two
+  /// samplers, colour and data) may decode one image.
+  std::shared_ptr<const std::vector<uint8_t>> encoded;
+  std::string mimeType;
+
+  /// A Float32 texture of linear RGB (width * height values) and, when not
+  /// empty, alpha: what code that makes textures (tests, the sky) holds.
+  static Texture fromLinear(int width, int height, const std::vector<Vec3>& rgb,
+                            const std::vector<float>& alpha = {});
+
+  bool empty() const { return width <= 0 || height <= 0 || channels <= 0; }
+  bool hasAlpha() const { return channels == 2 || channels == 4; }
+  size_t texelCount() const { return size_t(width) * size_t(height); }
+  /// The bytes the texels take in memory.
+  size_t byteSize() const {
+    return unorm8.size() + 2 * unorm16.size() + 4 * floats.size();
+  }
+  /// Texel i = y * width + x (in range), linear RGB; the same for its alpha
+  /// (1 when none).
+  Vec3 texelAt(size_t i) const;
+  float alphaAt(size_t i) const;
+  Vec3 texel(int x, int y) const { return texelAt(size_t(y) * size_t(width) + size_t(x)); }
+  float texelAlpha(int x, int y) const { return alphaAt(size_t(y) * size_t(width) + size_t(x)); }
   /// The texture at (u, v) through its sampler: bilinear (or the nearest
   /// texel), wrapped as the sampler says; white when empty.
   Vec3 lookup(float u, float v) const;

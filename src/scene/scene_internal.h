@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,9 +34,11 @@ std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std
                                          const std::string& what);
 
 /// Decodes a PNG/JPEG/... image (stb_image; 1-4 channels, 8 or 16 bit) into a
-/// linear-RGB Texture (sRGB transfer function removed; alpha ignored; grey
-/// replicated). Throws InputError "<scenePath>: unreadable image <what>".
-Texture decodeImage(const std::string& scenePath, const unsigned char* bytes, size_t size,
+/// Texture that keeps its texels as stored (`srgb`: its colour channels are
+/// sRGB-encoded) and, for PNG and JPEG, the file's bytes (Texture::encoded).
+/// Throws InputError "<scenePath>: unreadable image <what>".
+Texture decodeImage(const std::string& scenePath,
+                    const std::shared_ptr<const std::vector<uint8_t>>& bytes,
                     const std::string& what, bool srgb = true);
 
 /// How far a scene may lie from the origin, in multiples of its size, before

@@ -150,12 +150,8 @@ void skyFromMaterial(Scene& scene, const std::string& material, int width) {
   // plain textured sky box, its base colour) as radiance.
   const int w = width, h = width / 2;
   const Vec3d centre = Vec3d(rest.center());
-  auto texture = std::make_shared<Texture>();
-  texture->name = "sky mesh '" + material + "'";
-  texture->width = w;
-  texture->height = h;
-  texture->texels.assign(size_t(w) * size_t(h), Vec3{0, 0, 0});
-  std::vector<double> nearest(texture->texels.size(), std::numeric_limits<double>::infinity());
+  std::vector<Vec3> radiance(size_t(w) * size_t(h), Vec3{0, 0, 0});
+  std::vector<double> nearest(radiance.size(), std::numeric_limits<double>::infinity());
   const bool emissive = scene.materials[size_t(id)].isEmissive();
   for (size_t t : sky) {
     Vec3d v[3], dirs[3];
@@ -175,11 +171,13 @@ void skyFromMaterial(Scene& scene, const std::string& material, int width) {
           continue;
         }
         nearest[texel] = distance;
-        texture->texels[texel] = emissive ? scene.emission(t, float(b1), float(b2))
-                                          : scene.albedo(t, float(b1), float(b2));
+        radiance[texel] = emissive ? scene.emission(t, float(b1), float(b2))
+                                   : scene.albedo(t, float(b1), float(b2));
       }
     }
   }
+  auto texture = std::make_shared<Texture>(Texture::fromLinear(w, h, radiance));
+  texture->name = "sky mesh '" + material + "'";
   removeTriangles(scene, [&](size_t t) { return scene.triangleMaterial[t] == id; });
   scene.sky.image = std::move(texture);
   scene.sky.radiance = Vec3{1, 1, 1};

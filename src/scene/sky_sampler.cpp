@@ -23,7 +23,7 @@ SkySampler::SkySampler(const Sky& sky, const std::function<float(const Vec3&)>& 
     if (!(omega > 0)) break;
     for (int x = 0; x < width_; ++x) {
       const Vec3 d = skyPixelDirection(float(x) + 0.5f, float(y) + 0.5f, width_, height_);
-      const Vec3 l = sky.radiance * image.texels[size_t(y) * size_t(width_) + size_t(x)];
+      const Vec3 l = sky.radiance * image.texel(x, y);
       const double w = weight ? double(weight(d)) : 1.0;
       total += std::max(0.0, double(average(l)) * double(omega) * w);
       cdf_.push_back(total);

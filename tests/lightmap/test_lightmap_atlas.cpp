@@ -399,12 +399,11 @@ TEST(LightmapAtlas, RadianceIsAlbedoOverPiTimesIrradiancePlusEmission) {
       plane.scene.texcoords0.push_back(float(i) / kGrid);
       plane.scene.texcoords0.push_back(float(j) / kGrid);
     }
-  Texture tex;
-  tex.width = tex.height = kTex;
-  tex.sampler.magFilter = TextureSampler::kNearest;  // the expected albedo below is per texel
+  std::vector<Vec3> ramps;
   for (int y = 0; y < kTex; ++y)
-    for (int x = 0; x < kTex; ++x)
-      tex.texels.push_back({0.1f + 0.2f * float(x), 0.9f - 0.2f * float(y), 0.5f});
+    for (int x = 0; x < kTex; ++x) ramps.push_back({0.1f + 0.2f * float(x), 0.9f - 0.2f * float(y), 0.5f});
+  Texture tex = Texture::fromLinear(kTex, kTex, ramps);
+  tex.sampler.magFilter = TextureSampler::kNearest;  // the expected albedo below is per texel
   plane.scene.textures.push_back(tex);
   Material& m = plane.scene.materials[0];
   m.baseColor = {0.9f, 0.8f, 0.7f};
@@ -452,7 +451,7 @@ TEST(LightmapAtlas, RadianceIsAlbedoOverPiTimesIrradiancePlusEmission) {
       if (std::fabs(tu - std::round(tu)) < 1e-3 || std::fabs(tv - std::round(tv)) < 1e-3) continue;
       const int tx = std::clamp(int(std::floor(tu)), 0, kTex - 1);
       const int ty = std::clamp(int(std::floor(tv)), 0, kTex - 1);
-      const Vec3 albedo = m.baseColor * tex.texels[size_t(ty * kTex + tx)];
+      const Vec3 albedo = m.baseColor * tex.texel(tx, ty);
       const Vec3 e = atlas.irradiance[0].at(i);
       const Vec3 expected = albedo * e / kPi + m.emission;
       const Vec3 fromAnalytic = albedo * analytic / kPi + m.emission;

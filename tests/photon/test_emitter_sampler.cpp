@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
+#include "core/rng.h"
 #include "photon/photon_map.h"
 #include "test_util.h"
 
@@ -98,6 +100,73 @@ TEST(EmitterSampler, NoEmitterIsEmpty) {
   EXPECT_TRUE(s.empty());
   EXPECT_EQ(s.total(), 0.0);
   EXPECT_EQ(s.areaPdfs(scene), std::vector<float>(1 * 2, 0.0f));
+}
+
+// Points on an emissive-textured triangle: inside it, drawn mostly where the
+// texture is bright (no point in the black half but for the even share),
+// and unbiased: the mean of weight x emission over the draws is the
+// triangle's mean emission (a brute-force average over a fine grid of
+// barycentrics), for a texture the 64 cells' centroids see only in part.
+TEST(EmitterSampler, TexturedPointsFollowTheTextureWithoutBias) {
+  Scene scene;
+  Material lamp;
+  lamp.emission = {1, 1, 1};
+  lamp.emissiveTexture = 0;
+  scene.materials.push_back(lamp);
+  // u < 0.5 black, u >= 0.5 a ramp of 32 texels (nearest: sharp steps).
+  std::vector<Vec3> texels;
+  for (int x = 0; x < 64; ++x) texels.push_back(Vec3(x < 32 ? 0.0f : float(x - 31) / 32.0f));
+  Texture tex = Texture::fromLinear(64, 1, texels);
+  tex.sampler.magFilter = TextureSampler::kNearest;
+  scene.textures.push_back(tex);
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+  for (size_t v = 0; v < scene.positions.size(); ++v) {
+    scene.texcoords0.push_back(scene.positions[v].x);
+    scene.texcoords0.push_back(scene.positions[v].z);
+  }
+  const EmitterSampler s = buildEmitterSampler(scene);
+  ASSERT_EQ(s.size(), 2u);
+  for (size_t k = 0; k < s.size(); ++k) {
+    SCOPED_TRACE(k);
+    ASSERT_GE(s.cellTable[k], 0);
+    const uint32_t t = s.triangles[k];
+    // The brute-force mean over the triangle (barycentric grid, 400 x 400).
+    double exact = 0, blackArea = 0;
+    int count = 0;
+    for (int i = 0; i < 400; ++i)
+      for (int j = 0; i + j < 400; ++j) {
+        const float e = scene.emission(t, (float(i) + 0.33f) / 400, (float(j) + 0.33f) / 400).x;
+        exact += double(e);
+        blackArea += e == 0 ? 1.0 : 0.0;
+        ++count;
+      }
+    exact /= count;
+    blackArea /= count;
+    Rng rng(7, k);
+    double sum = 0;
+    int dark = 0;
+    constexpr int kDraws = 400000;
+    for (int n = 0; n < kDraws; ++n) {
+      float b1 = 0, b2 = 0, w = 0;
+      s.samplePoint(k, rng.uniform(), rng.uniform(), rng.uniform(), b1, b2, w);
+      ASSERT_GE(b1, -1e-6f);
+      ASSERT_GE(b2, -1e-6f);
+      ASSERT_LE(b1 + b2, 1.0f + 1e-5f);
+      ASSERT_LE(w, 2.0f + 1e-5f);
+      const float e = scene.emission(t, b1, b2).x;
+      if (e == 0) ++dark;
+      sum += double(w) * double(e);
+    }
+    const double mean = sum / kDraws;
+    std::printf("triangle %zu: mean emission %.5f by the sampler, %.5f brute force; %.1f%% of "
+                "points on black texels, %.1f%% of its area\n",
+                k, mean, exact, 100.0 * dark / kDraws, 100.0 * blackArea);
+    EXPECT_NEAR(mean, exact, 0.01 * exact);
+    // Uniform points would land on black texels as often as they cover the
+    // triangle; half the draws are even, the other half find the light (but
+    // in the few cells the texture's edge crosses).
+    EXPECT_LT(double(dark) / kDraws, 0.5 * blackArea + 0.05);
+  }
 }
 
 }  // namespace

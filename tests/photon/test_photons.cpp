@@ -601,9 +601,8 @@ double wallPowerFromATiltedFloor(int tilt) {
       scene.texcoords0[2 * v] = 0.5f * (scene.positions[v].x + 1.0f);
       scene.texcoords0[2 * v + 1] = 0.5f * (scene.positions[v].z + 1.0f);
     }
-    Texture map;
-    map.width = map.height = 1;
-    map.texels = {Vec3{0.5f * (std::sin(angle) + 1.0f), 0.5f, 0.5f * (std::cos(angle) + 1.0f)}};
+    Texture map = Texture::fromLinear(
+        1, 1, {Vec3{0.5f * (std::sin(angle) + 1.0f), 0.5f, 0.5f * (std::cos(angle) + 1.0f)}});
     scene.textures.push_back(map);
     scene.materials[size_t(floor)].normalTexture = 0;
   }
@@ -673,11 +672,9 @@ TEST(Photons, EmissiveTextureWeightsThePhotons) {
   addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
   int lamp = addMaterial(scene, {0.5f, 0.5f, 0.5f});
   scene.materials[size_t(lamp)].emission = {2, 2, 2};
-  Texture half;
+  // x < 0 emits, x > 0 is dark
+  Texture half = Texture::fromLinear(2, 1, {Vec3{1, 1, 1}, Vec3{0, 0, 0}});
   half.sampler.magFilter = TextureSampler::kNearest;  // two halves, not a ramp
-  half.width = 2;
-  half.height = 1;
-  half.texels = {Vec3{1, 1, 1}, Vec3{0, 0, 0}};  // x < 0 emits, x > 0 is dark
   scene.textures.push_back(half);
   scene.materials[size_t(lamp)].emissiveTexture = 0;
   const size_t firstVertex = scene.positions.size();
@@ -722,9 +719,7 @@ TEST(Photons, MetallicRoughnessMapMakesAMirrorDiffuse) {
     scene.materials[size_t(mirror)].metallic = 1.0f;
     scene.materials[size_t(mirror)].roughness = 0.05f;
     if (withMap) {
-      Texture map;
-      map.width = map.height = 1;
-      map.texels = {Vec3{0, 1, 0}};  // G roughness x1, B metallic x0
+      Texture map = Texture::fromLinear(1, 1, {Vec3{0, 1, 0}});  // G roughness x1, B metallic x0
       scene.textures.push_back(map);
       scene.materials[size_t(mirror)].metallicRoughnessTexture = 0;
     }

@@ -32,11 +32,8 @@ Scene alphaQuad(const Material& material, const Texture* texture) {
 // Alpha MASK in the tracer: a ray through the cut-out half passes, one
 // through the opaque half hits; the same for shadow rays.
 TEST(RayTracerAlpha, MaskCutsRaysThroughTransparentTexels) {
-  Texture half;
-  half.width = 2;
-  half.height = 1;
-  half.texels = {Vec3{1, 1, 1}, Vec3{1, 1, 1}};
-  half.alpha = {0.0f, 1.0f};  // u < 0.5 cut out
+  Texture half = Texture::fromLinear(2, 1, {Vec3{1, 1, 1}, Vec3{1, 1, 1}},
+                                     {0.0f, 1.0f});  // u < 0.5 cut out
   Material m;
   m.alphaMode = AlphaMode::Mask;
   const Scene scene = alphaQuad(m, &half);

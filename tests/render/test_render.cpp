@@ -503,13 +503,12 @@ TEST(RenderImage, UnlitIsSeenAsItsColourAndCastsNoShadow) {
 /// (Scene::albedo) gives there. Returns which of the two was red.
 std::vector<bool> checkCheckerQuad(const TextureTransform& transform, const std::string& name) {
   QuadSetup s;
-  Texture checker;
-  checker.width = checker.height = 16;
   const Vec3 red{0.8f, 0.1f, 0.1f}, blue{0.1f, 0.1f, 0.8f};
+  std::vector<Vec3> squares;
   for (int y = 0; y < 16; ++y) {
-    for (int x = 0; x < 16; ++x) checker.texels.push_back((x / 4 + y / 4) % 2 ? blue : red);
+    for (int x = 0; x < 16; ++x) squares.push_back((x / 4 + y / 4) % 2 ? blue : red);
   }
-  s.scene.textures.push_back(checker);
+  s.scene.textures.push_back(Texture::fromLinear(16, 16, squares));
   s.scene.materials[0].baseColor = {1, 1, 1};
   s.scene.materials[0].baseColorTexture = 0;
   s.scene.materials[0].baseColorTransform = transform;
@@ -579,10 +578,8 @@ TEST(RenderImage, GltfSamplerFiltersTheTexture) {
   REQUIRE_OSMESA();
   for (int filter : {TextureSampler::kNearest, TextureSampler::kLinear}) {
     QuadSetup s;
-    Texture halves;  // red | blue along u
-    halves.width = 2;
-    halves.height = 1;
-    halves.texels = {Vec3{0.8f, 0.1f, 0.1f}, Vec3{0.1f, 0.1f, 0.8f}};
+    // red | blue along u
+    Texture halves = Texture::fromLinear(2, 1, {Vec3{0.8f, 0.1f, 0.1f}, Vec3{0.1f, 0.1f, 0.8f}});
     halves.sampler.magFilter = filter;
     halves.sampler.wrapS = halves.sampler.wrapT = TextureSampler::kClampToEdge;
     s.scene.textures.push_back(halves);
@@ -738,9 +735,8 @@ TEST(RenderImage, NormalMapTiltsTheShadingNormal) {
   float brightness[2];
   for (int side = 0; side < 2; ++side) {
     QuadSetup s;
-    Texture map;
-    map.width = map.height = 1;
-    map.texels = {Vec3{0.5f * (std::sin(theta) + 1.0f), 0.5f, 0.5f * (std::cos(theta) + 1.0f)}};
+    Texture map = Texture::fromLinear(
+        1, 1, {Vec3{0.5f * (std::sin(theta) + 1.0f), 0.5f, 0.5f * (std::cos(theta) + 1.0f)}});
     s.scene.textures.push_back(map);
     s.scene.materials[0].normalTexture = 0;
     s.scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};  // u along +x
@@ -769,9 +765,8 @@ TEST(RenderImage, FileTangentsOrientTheNormalMap) {
   REQUIRE_OSMESA();
   const float theta = 0.4f;
   QuadSetup s;
-  Texture map;
-  map.width = map.height = 1;
-  map.texels = {Vec3{0.5f * (std::sin(theta) + 1.0f), 0.5f, 0.5f * (std::cos(theta) + 1.0f)}};
+  Texture map = Texture::fromLinear(
+      1, 1, {Vec3{0.5f * (std::sin(theta) + 1.0f), 0.5f, 0.5f * (std::cos(theta) + 1.0f)}});
   s.scene.textures.push_back(map);
   s.scene.materials[0].normalTexture = 0;
   s.scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};  // u along +x
@@ -811,16 +806,12 @@ TEST(RenderImage, MetallicRoughnessAndOcclusionMaps) {
     m.metallic = metalWithMap ? 1.0f : 0.0f;
     s.scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};
     if (metalWithMap) {
-      Texture mr;
-      mr.width = mr.height = 1;
-      mr.texels = {Vec3{0.0f, 1.0f, 0.0f}};  // roughness x1, metallic x0
+      Texture mr = Texture::fromLinear(1, 1, {Vec3{0.0f, 1.0f, 0.0f}});  // roughness x1, metallic x0
       s.scene.textures.push_back(mr);
       m.metallicRoughnessTexture = int(s.scene.textures.size()) - 1;
     }
     if (occlusion < 1.0f) {
-      Texture ao;
-      ao.width = ao.height = 1;
-      ao.texels = {Vec3{occlusion, 0.0f, 0.0f}};
+      Texture ao = Texture::fromLinear(1, 1, {Vec3{occlusion, 0.0f, 0.0f}});
       s.scene.textures.push_back(ao);
       m.occlusionTexture = int(s.scene.textures.size()) - 1;
     }
@@ -1049,11 +1040,8 @@ TEST(RenderImage, MaskedCardCutsOutTheViewAndTheShadow) {
   light.position = {0.1f, -0.05f, 1.0f};
   light.intensity = 2.0f;
   s.scene.lights.push_back(light);
-  Texture half;
-  half.width = 2;
-  half.height = 1;
-  half.texels = {Vec3{1, 1, 1}, Vec3{1, 1, 1}};
-  half.alpha = {0.0f, 1.0f};  // u < 0.5 (x < 0) cut out
+  Texture half = Texture::fromLinear(2, 1, {Vec3{1, 1, 1}, Vec3{1, 1, 1}},
+                                     {0.0f, 1.0f});  // u < 0.5 (x < 0) cut out
   s.scene.textures.push_back(half);
   Material card;
   card.baseColor = {1, 1, 1};
@@ -1126,11 +1114,9 @@ TEST(RenderImage, EmissiveTextureMultipliesTheEmission) {
   QuadSetup s;
   // 16 texels: red on the left half, green on the right (bilinear filtering
   // reads one colour away from the middle).
-  Texture two;
-  two.width = 16;
-  two.height = 1;
-  for (int x = 0; x < 16; ++x) two.texels.push_back(x < 8 ? Vec3{1, 0, 0} : Vec3{0, 0.5f, 0});
-  s.scene.textures.push_back(two);
+  std::vector<Vec3> halves;
+  for (int x = 0; x < 16; ++x) halves.push_back(x < 8 ? Vec3{1, 0, 0} : Vec3{0, 0.5f, 0});
+  s.scene.textures.push_back(Texture::fromLinear(16, 1, halves));
   s.scene.materials[0].emission = {2, 2, 2};
   s.scene.materials[0].emissiveTexture = 0;
   for (const Vec3& v : s.scene.positions) {

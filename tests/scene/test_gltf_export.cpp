@@ -7,9 +7,12 @@
 // gltf.validate_*).
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -27,15 +30,14 @@ namespace {
 namespace fs = std::filesystem;
 
 Texture smallTexture(int w, int h, bool alpha, float offset) {
-  Texture t;
-  t.name = "tex";
-  t.width = w;
-  t.height = h;
+  std::vector<Vec3> rgb;
+  std::vector<float> a;
   for (int i = 0; i < w * h; ++i) {
-    t.texels.push_back(
-        {offset + 0.1f * float(i % 7), 0.05f * float(i), 0.9f - 0.1f * float(i % 5)});
-    if (alpha) t.alpha.push_back(float(i) / float(w * h));
+    rgb.push_back({offset + 0.1f * float(i % 7), 0.05f * float(i), 0.9f - 0.1f * float(i % 5)});
+    if (alpha) a.push_back(float(i) / float(w * h));
   }
+  Texture t = Texture::fromLinear(w, h, rgb, a);
+  t.name = "tex";
   return t;
 }
 
@@ -172,11 +174,11 @@ TEST(GltfExport, LoaderReadsBackGeometryLightmapUvsMaterialsLightsAndCameras) {
     const Texture& orig = c.scene.textures[0];
     ASSERT_EQ(tex.width, orig.width);
     ASSERT_EQ(tex.height, orig.height);
-    ASSERT_EQ(tex.alpha.size(), orig.alpha.size());
-    for (size_t i = 0; i < orig.texels.size(); ++i) {
+    ASSERT_EQ(tex.hasAlpha(), orig.hasAlpha());
+    for (size_t i = 0; i < orig.texelCount(); ++i) {
       for (int k = 0; k < 3; ++k)
-        EXPECT_EQ(encodeSrgb8(tex.texels[i][k]), encodeSrgb8(orig.texels[i][k])) << i;
-      EXPECT_NEAR(tex.alpha[i], orig.alpha[i], 0.5f / 255 + 1e-6f) << i;
+        EXPECT_EQ(encodeSrgb8(tex.texelAt(i)[k]), encodeSrgb8(orig.texelAt(i)[k])) << i;
+      EXPECT_NEAR(tex.alphaAt(i), orig.alphaAt(i), 0.5f / 255 + 1e-6f) << i;
     }
     for (size_t m : {size_t(1), size_t(2)}) {
       const Material& lamp = back.materials[m];
@@ -188,9 +190,9 @@ TEST(GltfExport, LoaderReadsBackGeometryLightmapUvsMaterialsLightsAndCameras) {
       EXPECT_EQ(lamp.normalScale, 0.8f);
       ASSERT_GE(lamp.normalTexture, 0);
       const Texture& n = back.textures[size_t(lamp.normalTexture)];
-      for (size_t i = 0; i < n.texels.size(); ++i)
+      for (size_t i = 0; i < n.texelCount(); ++i)
         for (int k = 0; k < 3; ++k)
-          EXPECT_NEAR(n.texels[i][k], std::clamp(c.scene.textures[1].texels[i][k], 0.0f, 1.0f),
+          EXPECT_NEAR(n.texelAt(i)[k], std::clamp(c.scene.textures[1].texelAt(i)[k], 0.0f, 1.0f),
                       0.5f / 255 + 1e-6f);
     }
 
@@ -221,6 +223,41 @@ TEST(GltfExport, LoaderReadsBackGeometryLightmapUvsMaterialsLightsAndCameras) {
 // A scene with a second UV set of its own (not the lightmap): it moves to
 // TEXCOORD_2, and TEXCOORD_1 is the lightmap. With the scene's TEXCOORD_1
 // as the lightmap (--uv texcoord1) there is no TEXCOORD_2.
+// A texture read from a PNG or JPEG goes into the export as the file's own
+// bytes (once, whichever materials use it), not as its texels encoded anew,
+// with its sampler; a texture made in code is encoded as PNG.
+TEST(GltfExport, ImagesReadFromFilesKeepTheirBytesAndSampler) {
+  ExportCase c = exportCase();
+  const std::vector<uint8_t> pixels = {10, 20, 30, 255, 40, 50, 60, 128, 70, 80, 90, 0,
+                                       1,  2,  3,  4,   5,  6,  7,  8,   9,  10, 11, 12};
+  const std::vector<unsigned char> png = encodePng8(3, 2, 4, pixels.data());
+  Texture fromFile;
+  fromFile.width = 3;
+  fromFile.height = 2;
+  fromFile.channels = 4;
+  fromFile.format = TexelFormat::Unorm8;
+  fromFile.srgb = true;
+  fromFile.unorm8 = pixels;
+  fromFile.encoded = std::make_shared<const std::vector<uint8_t>>(png.begin(), png.end());
+  fromFile.mimeType = "image/png";
+  fromFile.sampler.wrapS = TextureSampler::kClampToEdge;
+  c.scene.textures[0] = fromFile;
+  c.scene.materials[1].emissiveTexture = 0;  // the same image, used twice
+  const GltfFiles files = encodeLightmapGltf(c.scene, c.lm, "files.gltf");
+  const nlohmann::json doc = nlohmann::json::parse(files.gltf);
+  ASSERT_EQ(doc["images"].size(), 2u) << "the file's image once, the code-made normal map once";
+  const nlohmann::json& view = doc["bufferViews"][doc["images"][0]["bufferView"].get<int>()];
+  const size_t offset = view.value("byteOffset", size_t(0)), length = view["byteLength"];
+  ASSERT_LE(offset + length, files.bin.size());
+  EXPECT_EQ(std::string(files.bin, offset, length), std::string(png.begin(), png.end()));
+  EXPECT_EQ(doc["images"][0]["mimeType"], "image/png");
+  EXPECT_EQ(doc["images"][1]["mimeType"], "image/png");
+  const nlohmann::json& texture = doc["textures"][doc["materials"][0]["pbrMetallicRoughness"]
+                                                    ["baseColorTexture"]["index"].get<int>()];
+  ASSERT_TRUE(texture.contains("sampler"));
+  EXPECT_EQ(doc["samplers"][texture["sampler"].get<int>()]["wrapS"], TextureSampler::kClampToEdge);
+}
+
 TEST(GltfExport, OwnSecondUvSetMovesToTexcoord2) {
   ExportCase c = exportCase();
   const std::string dir = test::outputDir("GltfExportTexcoord2");
@@ -269,7 +306,7 @@ TEST(GltfExport, UnlitFormShowsThePreviewOnTexcoord1) {
     ASSERT_EQ(t.width, 4);
     for (size_t i = 0; i < want.pixelCount(); ++i)
       for (int k = 0; k < 3; ++k)
-        ASSERT_EQ(encodeSrgb8(t.texels[i][k]), encodeSrgb8(want.at(i)[k])) << m << " " << i;
+        ASSERT_EQ(encodeSrgb8(t.texelAt(i)[k]), encodeSrgb8(want.at(i)[k])) << m << " " << i;
   }
 }
 

@@ -528,9 +528,9 @@ TEST(SceneGltf, MaterialExtensionsAndTexture) {
   const Texture& t = s.textures[0];
   ASSERT_EQ(t.width, 2);
   ASSERT_EQ(t.height, 1);
-  expectNear(t.texels[0], {1, 0, 0}, 1e-6f, "red texel");
+  expectNear(t.texelAt(0), {1, 0, 0}, 1e-6f, "red texel");
   // sRGB 188/255 = 0.737 -> linear ((0.737 + 0.055) / 1.055)^2.4 = 0.5029.
-  expectNear(t.texels[1], Vec3{0.50289f}, 1e-4f, "grey texel");
+  expectNear(t.texelAt(1), Vec3{0.50289f}, 1e-4f, "grey texel");
 }
 
 // KHR_texture_transform on the base colour texture: offset, rotation, scale
@@ -582,9 +582,9 @@ TEST(SceneGltf, NormalTextureIsLinearData) {
   EXPECT_NE(m.normalTexture, m.baseColorTexture);
   EXPECT_FLOAT_EQ(m.normalScale, 0.5f);
   EXPECT_EQ(m.normalTexCoord, 0);
-  expectNear(s.textures[size_t(m.normalTexture)].texels[1], Vec3{188.0f / 255.0f}, 1e-6f,
+  expectNear(s.textures[size_t(m.normalTexture)].texelAt(1), Vec3{188.0f / 255.0f}, 1e-6f,
              "data texel");
-  expectNear(s.textures[size_t(m.baseColorTexture)].texels[1], Vec3{0.50289f}, 1e-4f,
+  expectNear(s.textures[size_t(m.baseColorTexture)].texelAt(1), Vec3{0.50289f}, 1e-4f,
              "colour texel");
   // The other data maps share the data decoding of the image.
   EXPECT_EQ(m.metallicRoughnessTexture, m.normalTexture);
@@ -843,11 +843,8 @@ TEST(SkyMesh, ASkyBoxBecomesTheSkyItShows) {
   scene.materials[1].name = "sky";
   scene.materials[1].baseColor = {1, 1, 1};
   scene.materials[1].baseColorTexture = 0;
-  Texture colours;
-  colours.width = 2;
-  colours.height = 1;
   const Vec3 blue{0.2f, 0.4f, 0.8f}, orange{0.9f, 0.5f, 0.2f};
-  colours.texels = {blue, orange};
+  Texture colours = Texture::fromLinear(2, 1, {blue, orange});
   scene.textures.push_back(colours);
   auto quad = [&](const Vec3& corner, const Vec3& eu, const Vec3& ev, int material, float u) {
     const uint32_t base = uint32_t(scene.positions.size());
@@ -883,7 +880,7 @@ TEST(SkyMesh, ASkyBoxBecomesTheSkyItShows) {
   // half is not used (black).
   for (int x = 0; x < 64; ++x) {
     for (int y = 0; y < 32; ++y) {
-      const Vec3 texel = sky.texels[size_t(y) * 64 + size_t(x)];
+      const Vec3 texel = sky.texel(x, y);
       const Vec3 expected = y < 8 ? blue : (y >= 10 && y < 16) ? orange : y >= 16 ? Vec3{} : texel;
       const Vec3 d = texel - expected;
       ASSERT_LT(std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}), 1e-6f)
@@ -969,7 +966,7 @@ TEST(PhysicalSky, ZenithSunRatioAndShapeAreThoseOfTheModel) {
   for (int y = 0; y < sky.height / 2; ++y) {
     for (int x = 0; x < sky.width; ++x) {
       const Vec3 d = skyPixelDirection(float(x) + 0.5f, float(y) + 0.5f, sky.width, sky.height);
-      skyOnFloor += luminanceOf(sky.texels[size_t(y) * size_t(sky.width) + size_t(x)]) * d.y *
+      skyOnFloor += luminanceOf(sky.texel(x, y)) * d.y *
                     skyPixelSolidAngle(y, sky.width, sky.height);
     }
   }
@@ -1260,9 +1257,10 @@ TEST(SceneGltf, AlphaModesAndEmissiveTexture) {
   EXPECT_FLOAT_EQ(m.baseAlpha, 0.8f);
   ASSERT_EQ(m.emissiveTexture, m.baseColorTexture) << "one sRGB decoding of the image, shared";
   const Texture& t = s.textures[size_t(m.baseColorTexture)];
-  ASSERT_EQ(t.alpha.size(), 2u);
-  EXPECT_NEAR(t.alpha[0], 1.0f, 1e-6f);
-  EXPECT_NEAR(t.alpha[1], 64.0f / 255.0f, 1e-6f) << "alpha is linear, not sRGB-decoded";
+  ASSERT_TRUE(t.hasAlpha());
+  ASSERT_EQ(t.texelCount(), 2u);
+  EXPECT_NEAR(t.alphaAt(0), 1.0f, 1e-6f);
+  EXPECT_NEAR(t.alphaAt(1), 64.0f / 255.0f, 1e-6f) << "alpha is linear, not sRGB-decoded";
   // Vertex UVs of oneTriangle: find a barycentric point on each texel.
   s.texcoords0 = {0.25f, 0.5f, 0.75f, 0.5f, 0.25f, 0.5f};
   // b1 = 0: u = 0.25 (opaque texel) -> 0.8 >= 0.4: covered.
@@ -1409,10 +1407,8 @@ namespace {
 
 /// A 2 x 2 texture of texel values 0, 1 (top row), 2, 3 (bottom row).
 Texture fourTexels(const TextureSampler& sampler) {
-  Texture t;
-  t.width = t.height = 2;
+  Texture t = Texture::fromLinear(2, 2, {Vec3(0.0f), Vec3(1.0f), Vec3(2.0f), Vec3(3.0f)});
   t.sampler = sampler;
-  for (float v : {0.0f, 1.0f, 2.0f, 3.0f}) t.texels.push_back(Vec3(v));
   return t;
 }
 
@@ -1460,11 +1456,9 @@ TEST(SkySampler, DensityIntegratesToOneAndMatchesItsDraws) {
   // A 16 x 8 sky image with one bright texel (a sun) and a dim rest: the
   // density over the upper hemisphere integrates to 1, the draws report the
   // density pdf() gives their direction, and the sun's texel gets its share.
-  auto image = std::make_shared<Texture>();
-  image->width = 16;
-  image->height = 8;
-  image->texels.assign(16 * 8, Vec3(0.2f));
-  image->texels[2 * 16 + 5] = Vec3(500.0f);
+  std::vector<Vec3> radiance(16 * 8, Vec3(0.2f));
+  radiance[2 * 16 + 5] = Vec3(500.0f);
+  auto image = std::make_shared<Texture>(Texture::fromLinear(16, 8, radiance));
   Sky sky;
   sky.image = image;
   sky.radiance = {1, 1, 1};
@@ -1501,7 +1495,7 @@ TEST(SkySampler, DensityIntegratesToOneAndMatchesItsDraws) {
   double total = 0, sunShare = 0;
   for (int y = 0; y < 4; ++y) {
     for (int x = 0; x < 16; ++x) {
-      const double w = average(image->texels[size_t(y * 16 + x)]) * skyPixelSolidAngle(y, 16, 8);
+      const double w = average(image->texel(x, y)) * skyPixelSolidAngle(y, 16, 8);
       total += w;
       if (x == 5 && y == 2) sunShare = w;
     }
