@@ -28,7 +28,7 @@ def import_bake(context, path, strength=1.0, arrows=False, max_arrows=20000):
     # (x, y, z) -> (x, -z, y), is +90 degrees about X.
     obj.rotation_euler = (math.pi / 2, 0.0, 0.0)
     context.collection.objects.link(obj)
-    obj.data.materials.append(_material(name, strength))
+    obj.data.materials.append(_irradiance_material(f"{name} irradiance", strength))
     obj["lightoctree"] = {"source": path, "up_axis": "+Y (turned to +Z)"}
     if arrows:
         add_vdl_arrows(context, path, obj, max_arrows)
@@ -66,7 +66,7 @@ def add_vdl_arrows(context, path, volume_obj, max_arrows=20000):
     obj.rotation_euler = volume_obj.rotation_euler  # the same turn to Z up
     context.collection.objects.link(obj)
     modifier = obj.modifiers.new("VDL arrows", "NODES")
-    modifier.node_group = _arrow_nodes(0.8 * grid.voxel_size, _arrow_material(name))
+    modifier.node_group = _arrow_nodes(0.8 * grid.voxel_size, _irradiance_material(name))
     obj["lightoctree"] = {"source": path, "arrows": len(keep), "voxels": grid.size}
     return obj
 
@@ -109,34 +109,26 @@ def _arrow_nodes(length, material):
     return g
 
 
-def _arrow_material(name):
-    """Emission of the arrow's `irradiance` attribute (W/m^2 as is)."""
+def _irradiance_material(name, volume_strength=None):
+    """A material that shows the `irradiance` attribute (W/m^2 as is) as
+    emission: of a volume (a Principled Volume of density 0, its emission
+    scaled by `volume_strength`) or, when that is None, of a surface."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
     nodes.clear()
     out = nodes.new("ShaderNodeOutputMaterial")
-    emission = nodes.new("ShaderNodeEmission")
     attr = nodes.new("ShaderNodeAttribute")
     attr.attribute_name = "irradiance"
-    links.new(attr.outputs["Color"], emission.inputs["Color"])
-    links.new(emission.outputs[0], out.inputs["Surface"])
-    attr.location, emission.location, out.location = (-400, 0), (-150, 0), (150, 0)
-    return mat
-
-
-def _material(name, strength):
-    mat = bpy.data.materials.new(f"{name} irradiance")
-    mat.use_nodes = True
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
-    out = nodes.new("ShaderNodeOutputMaterial")
-    vol = nodes.new("ShaderNodeVolumePrincipled")
-    attr = nodes.new("ShaderNodeAttribute")
-    attr.attribute_name = "irradiance"
-    vol.inputs["Density"].default_value = 0.0
-    vol.inputs["Emission Strength"].default_value = strength
-    links.new(attr.outputs["Color"], vol.inputs["Emission Color"])
-    links.new(vol.outputs["Volume"], out.inputs["Volume"])
-    attr.location, vol.location, out.location = (-400, 0), (-150, 0), (150, 0)
+    if volume_strength is None:
+        shader = nodes.new("ShaderNodeEmission")
+        links.new(attr.outputs["Color"], shader.inputs["Color"])
+        links.new(shader.outputs[0], out.inputs["Surface"])
+    else:
+        shader = nodes.new("ShaderNodeVolumePrincipled")
+        shader.inputs["Density"].default_value = 0.0
+        shader.inputs["Emission Strength"].default_value = volume_strength
+        links.new(attr.outputs["Color"], shader.inputs["Emission Color"])
+        links.new(shader.outputs["Volume"], out.inputs["Volume"])
+    attr.location, shader.location, out.location = (-400, 0), (-150, 0), (150, 0)
     return mat

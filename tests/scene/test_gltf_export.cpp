@@ -220,9 +220,6 @@ TEST(GltfExport, LoaderReadsBackGeometryLightmapUvsMaterialsLightsAndCameras) {
   }
 }
 
-// A scene with a second UV set of its own (not the lightmap): it moves to
-// TEXCOORD_2, and TEXCOORD_1 is the lightmap. With the scene's TEXCOORD_1
-// as the lightmap (--uv texcoord1) there is no TEXCOORD_2.
 // A texture read from a PNG or JPEG goes into the export as the file's own
 // bytes (once, whichever materials use it), not as its texels encoded anew,
 // with its sampler; a texture made in code is encoded as PNG.
@@ -258,6 +255,9 @@ TEST(GltfExport, ImagesReadFromFilesKeepTheirBytesAndSampler) {
   EXPECT_EQ(doc["samplers"][texture["sampler"].get<int>()]["wrapS"], TextureSampler::kClampToEdge);
 }
 
+// A scene with a second UV set of its own (not the lightmap): it moves to
+// TEXCOORD_2, and TEXCOORD_1 is the lightmap. With the scene's TEXCOORD_1
+// as the lightmap (--uv texcoord1) there is no TEXCOORD_2.
 TEST(GltfExport, OwnSecondUvSetMovesToTexcoord2) {
   ExportCase c = exportCase();
   const std::string dir = test::outputDir("GltfExportTexcoord2");
