@@ -10,11 +10,14 @@ room and the truck under spot lights (../shared/scenes/real), and, when
 (DamagedHelmet.gltf, its .bin and five 2048^2 JPEGs; CC BY-NC, so it is not
 in this repository), that helmet in a room under a spot light and lit by its
 emissive texture alone (tools/make_helmet_room.py writes both beside it).
+On a machine with a GPU, `--backend egl --out docs/results/real-assets-egl.md`
+fills the same table through EGL.
 
 Per scene: the bake at the defaults (a fixed 1,000,000 photons for the
 emissive helmet, to count paths per stored photon); `render` at 320 x 240
 (osmesa) with the `--json` report's stages (load, read grid, GL context,
-octree, upload and prepare, first frame); `lightmap` and the .glb's size
+octree, shaders, octree upload, geometry and textures, lights and shadow maps,
+first frame); `lightmap` and the .glb's size
 against the scene's files. Wall time and peak memory (the process's maximum
 resident set, from wait4) of each command. The machine is shared: compare
 rows of one run, not runs.
@@ -56,6 +59,9 @@ def main():
     ap.add_argument("--helmet", help="folder with DamagedHelmet.gltf and its files")
     ap.add_argument("--work", default=os.path.join(ROOT, "out/bench-real"))
     ap.add_argument("--out", default=os.path.join(ROOT, "docs/results/real-assets.md"))
+    ap.add_argument("--backend", default="osmesa", choices=["osmesa", "egl"],
+                    help="render's headless GL: osmesa (llvmpipe) or egl (a GPU; with --out "
+                         "docs/results/real-assets-egl.md)")
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     cli = args.cli
@@ -91,7 +97,8 @@ def main():
         traced = [s for s in bake["stages"] if s["name"] == "trace photons"]
         render_json = os.path.join(args.work, name + "-render.json")
         render_wall, render_peak = run([cli, "render", scene, vdb, "-o", os.path.join(args.work, name + ".png"),
-                                        "--width", "320", "--height", "240", "--json", render_json, "--quiet"])
+                                        "--width", "320", "--height", "240", "--backend", args.backend,
+                                        "--json", render_json, "--quiet"])
         r = stages(render_json)
         glb = os.path.join(args.work, name + "-lit.glb")
         lightmap_wall, lightmap_peak = run([cli, "lightmap", scene, vdb, "-o", glb, "--quiet",
@@ -111,7 +118,11 @@ def main():
             "paths": bake["counts"].get("emitted_paths", 0) if "counts" in bake else 0,
             "render_s": render_wall, "render_mb": render_peak,
             "load_s": r["load scene"]["seconds"],
-            "upload_s": r["upload and prepare"]["seconds"],
+            "upload_s": sum(r[k]["seconds"] for k in ("shaders", "octree upload", "geometry and textures",
+                                                      "lights and shadow maps", "prepare lighting") if k in r),
+            "textures_mb": (r["geometry and textures"]["rss_bytes"] - r["octree upload"]["rss_bytes"]) / 2**20,
+            "shadows_mb": (r["lights and shadow maps"]["rss_bytes"] -
+                           r["geometry and textures"]["rss_bytes"]) / 2**20,
             "frame_s": r["first frame"]["seconds"],
             "lightmap_s": lightmap_wall, "lightmap_mb": lightmap_peak,
             "glb_mb": glb_bytes / 2**20, "inputs_mb": inputs / 2**20, "pages_mb": pages / 2**20,
@@ -122,20 +133,25 @@ def main():
         "# Real assets: load, first frame, memory",
         "",
         "Written by `python3 tools/bench_real_assets.py" + (" --helmet DIR" if args.helmet else "") +
-        "` (this machine: 2 cores, llvmpipe through OSMesa, shared with other work;",
+        (" --backend egl" if args.backend == "egl" else "") +
+        "` (" + ("a GPU through EGL" if args.backend == "egl" else
+                 "this machine: 2 cores, llvmpipe through OSMesa") + ", shared with other work;",
         "compare the rows of one run). Every figure is one run of the command a user types:",
         "wall time and peak resident memory of the process. `render` is 320 × 240 in full mode;",
-        "its stages come from its `--json` report. The bake runs at the defaults (target noise",
-        "0.07), the emissive helmet's at a fixed 1,000,000 photons.",
+        "its stages come from its `--json` report (upload: shaders, octree, geometry and",
+        "textures, lights and shadow maps, with what the last two added to the process's memory).",
+        "The bake runs at the defaults (target noise 0.07), the emissive helmet's at a fixed",
+        "1,000,000 photons.",
         "",
-        "| scene | bake s | bake MB | bake: load s / MB | photons / paths | render s | render MB | load s | upload s | first frame s | lightmap s / MB | .glb MB (scene files + pages) |",
+        "| scene | bake s | bake MB | bake: load s / MB | photons / paths | render s | render MB | load s | upload s (+MB: textures, shadows) | first frame s | lightmap s / MB | .glb MB (scene files + pages) |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for x in rows:
         lines.append(
             f"| {x['scene']} | {x['bake_s']:.2f} | {x['bake_mb']:.0f} | {x['bake_load_s']:.2f} / {x['bake_load_mb']:.0f} | "
             f"{x['photons'] / max(x['paths'], 1):.2f} | "
-            f"{x['render_s']:.2f} | {x['render_mb']:.0f} | {x['load_s']:.2f} | {x['upload_s']:.2f} | {x['frame_s']:.2f} | "
+            f"{x['render_s']:.2f} | {x['render_mb']:.0f} | {x['load_s']:.2f} | "
+            f"{x['upload_s']:.2f} (+{x['textures_mb']:.0f}, +{x['shadows_mb']:.0f}) | {x['frame_s']:.2f} | "
             f"{x['lightmap_s']:.1f} / {x['lightmap_mb']:.0f} | {x['glb_mb']:.2f} ({x['inputs_mb']:.2f} + {x['pages_mb']:.2f}) |")
     lines.append("")
     text = "\n".join(lines)

@@ -152,10 +152,11 @@ int runRender(const RenderOptions& opt) {
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
   report.figures["octree"] = octree.ToString();
 
-  StageTimer uploadTimer(rows, "upload and prepare");
   Renderer renderer(scene, octree, opt.shading.rendererParams());
+  rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
+  StageTimer lightingTimer(rows, "prepare lighting");
   opt.shading.prepareLighting(renderer, scene, octree, opt.quiet);
-  uploadTimer.finish("");
+  lightingTimer.finish(renderer.hasAtlas() ? "lightmap atlas" : "");
   StageTimer frameTimer(rows, "first frame");
   RgbImage image = renderer.render(camera, params);
   frameTimer.finish(std::to_string(opt.width) + " x " + std::to_string(opt.height));

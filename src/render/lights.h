@@ -34,6 +34,9 @@ struct SceneLights {
   float cascadeDepth[4] = {1, 1, 1, 1};  ///< world depth range of each cascade's map
   std::array<float, 12> fittedCamera{};  ///< the camera the cascades were fitted to
 
+  /// Shadow map layers of the lights in the block (6 per point light or VPL).
+  int layerCount() const;
+
   /// Builds the block (punctual lights, then area lights or VPLs), uploads
   /// it and renders every shadow map once, drawing `draw`'s depth-only
   /// geometry with the vertex array `vao`. @throws InputError past LO_MAX_LIGHTS.
@@ -72,7 +75,6 @@ struct SceneLights {
   void beginLayer(int layer, bool checkComplete);
   void fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
                           float yfov, float aspect, float znear, float zfar);
-  int layerCount() const;
 
   template <class DrawDepthOnly>
   void renderShadowMaps(GLuint vao, const DrawDepthOnly& draw) {

@@ -59,6 +59,7 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
     : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
   r.params = params;
+  StageTimer shaders(r.startup, "shaders");
   if (params.shadowMapSize < 1 || params.shadowMapSize > 16384) {
     throw InputError("shadow map size must be 1..16384, got " +
                      std::to_string(params.shadowMapSize));
@@ -109,12 +110,24 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
       checkGl("uploading the sky image");
     }
   }
+  shaders.finish(maxComponent(r.sky) > 0 && scene.sky.image ? "and the sky image" : "");
+  StageTimer octreeTimer(r.startup, "octree upload");
   r.uploadOctree(octree);
+  octreeTimer.finish(formatCount(octree.leafCount) + " leaves");
+  StageTimer geometryTimer(r.startup, "geometry and textures");
   r.geometry.upload(scene, r.space);
   r.geometry.sceneTriangles = scene.triangleCount();
+  size_t textures = 0;
+  for (const auto& t : r.geometry.textures) textures += t.get() != 0 ? 1 : 0;
+  geometryTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
+                       formatCount(textures) + " textures (" +
+                       formatBytes(r.geometry.textureBytes) + " on the GPU)");
+  StageTimer lightsTimer(r.startup, "lights and shadow maps");
   r.lights.setup(scene, r.space, params, r.geometry.vao.get(), [&r](GLuint program, bool shadows) {
     r.geometry.drawDepthOnly(program, shadows);
   });
+  lightsTimer.finish(std::to_string(r.lights.layerCount()) + " shadow layers of " +
+                     std::to_string(r.lights.shadowMapSize) + "^2");
   for (const Material& m : scene.materials) {
     r.probe.wanted =
         r.probe.wanted || m.roughness < shader::LO_PROBE_NONE || m.metallicRoughnessTexture >= 0;
@@ -122,6 +135,8 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
 }
 
 bool Renderer::hasReflectionProbe() const { return impl_->probe.wanted; }
+
+const std::vector<StageReport>& Renderer::startupStages() const { return impl_->startup; }
 
 bool Renderer::hasAtlas() const { return bool(impl_->atlasVbo); }
 

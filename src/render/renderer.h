@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "core/resources.h"
 #include "image/image.h"
 #include "lightmap/lightmap_atlas.h"
 #include "lightmap/lightmap_uv.h"
@@ -117,6 +118,10 @@ class Renderer {
   void setAtlas(const LightmapUvs& uvs, const LightmapAtlas& atlas);
   bool hasAtlas() const;
   size_t atlasBytes() const;  ///< GPU bytes of the atlas textures (0 without one)
+  /// What the constructor did, a row each with its time and the process's
+  /// memory after it: shaders, octree, geometry and textures (their count
+  /// and GPU bytes), lights and shadow maps (their layers and size).
+  const std::vector<StageReport>& startupStages() const;
 
   /// Renders into an offscreen RGBA32F target and reads its RGB back.
   RgbImage render(const PinholeCamera& camera, const RenderParams& params);

@@ -86,6 +86,7 @@ struct SceneGeometry {
   GLint blendFirst = 0;
   GlBuffer blendEbo;
   std::vector<GlTexture> textures;  ///< per Scene::textures entry; 0 = not used
+  size_t textureBytes = 0;           ///< their GPU bytes (mipmaps included)
   /// Per vertex of the vertex buffer: 3 x its Scene triangle + its corner
   /// (the buffer is grouped by material, not in triangle order).
   std::vector<uint32_t> vertexCorner;
@@ -102,7 +103,7 @@ struct SceneGeometry {
   void sortBlended(const glm::vec3& eye);
 
  private:
-  GlTexture uploadTexture(const Texture& t) const;
+  GlTexture uploadTexture(const Texture& t);
   /// Scene::textures[index] on the GPU, uploaded on first use; returns index.
   int useTexture(const Scene& scene, int index);
   /// The textures and uniforms material `mat` draws with.
@@ -128,6 +129,7 @@ struct ReflectionProbe {
 
 struct Renderer::Impl {
   RendererParams params;
+  std::vector<StageReport> startup;  ///< Renderer::startupStages
   render_internal::RenderSpace space;
   int depth = 0;
   Vec3 octreeOrigin;

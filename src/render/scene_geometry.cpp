@@ -44,7 +44,7 @@ DrawCategory categoryOf(const Material& m) {
 /// GL_SRGB8_ALPHA8, whose fetches the GPU decodes to linear before it
 /// filters (as Texture::lookup does), data maps as GL_RGBA8. 16-bit and
 /// float texels go up as linear half floats.
-GlTexture SceneGeometry::uploadTexture(const Texture& t) const {
+GlTexture SceneGeometry::uploadTexture(const Texture& t) {
   GlTexture id = GlTexture::create();
   glBindTexture(GL_TEXTURE_2D, id.get());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
@@ -82,6 +82,9 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t) const {
   const GLint minFilter = sampler.minFilter ? sampler.minFilter : GL_LINEAR_MIPMAP_LINEAR;
   const bool mipmapped = minFilter != GL_NEAREST && minFilter != GL_LINEAR;
   if (mipmapped) glGenerateMipmap(GL_TEXTURE_2D);
+  const size_t texelBytes = t.format == TexelFormat::Unorm8 ? 4 : 8;
+  const size_t levelBytes = t.texelCount() * texelBytes;
+  textureBytes += mipmapped ? levelBytes + levelBytes / 3 : levelBytes;
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, minFilter);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, sampler.magFilter);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, sampler.wrapS);
