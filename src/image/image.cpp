@@ -487,15 +487,12 @@ void checkImageSize(int64_t width, int64_t height, double bytesPerPixel) {
 }
 
 
-StoredImage decodeStoredImage(const unsigned char* bytes, size_t size) {
-  if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
-    throw InputError("empty or too large");
-  }
+namespace {
+
+/// decodeStoredImage once checkEncodedImage has passed the bytes.
+StoredImage decodeChecked(const unsigned char* bytes, size_t size) {
   const int n = int(size);
   int w = 0, h = 0, comp = 0;
-  // The header's size first: stb's pixels and the caller's copy, at most 4
-  // channels of 16 bits each.
-  checkEncodedImage(bytes, size, 2 * 4 * 2);
   StoredImage out;
   if (size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0) out.mimeType = "image/png";
   if (jpegBody(bytes, size) != 0) out.mimeType = "image/jpeg";
@@ -524,10 +521,27 @@ StoredImage decodeStoredImage(const unsigned char* bytes, size_t size) {
   return out;
 }
 
+void checkBytesSize(size_t size) {
+  if (size == 0 || size > size_t(std::numeric_limits<int>::max())) {
+    throw InputError("empty or too large");
+  }
+}
+
+}  // namespace
+
+StoredImage decodeStoredImage(const unsigned char* bytes, size_t size) {
+  checkBytesSize(size);
+  // The header's size first: stb's pixels and the caller's copy, at most 4
+  // channels of 16 bits each.
+  checkEncodedImage(bytes, size, 2 * 4 * 2);
+  return decodeChecked(bytes, size);
+}
+
 DecodedImage decodeImageBytes(const unsigned char* bytes, size_t size) {
+  checkBytesSize(size);
   // The stored pixels and their floats (4 channels of 4 bytes) per pixel.
   checkEncodedImage(bytes, size, 2 * 4 * 2 + 4 * 4);
-  const StoredImage stored = decodeStoredImage(bytes, size);
+  const StoredImage stored = decodeChecked(bytes, size);
   DecodedImage out;
   out.width = stored.width;
   out.height = stored.height;
