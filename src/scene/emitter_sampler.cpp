@@ -10,7 +10,7 @@ namespace lo {
 
 namespace emitter_sampler_internal {
 void cellCorner(int c, int& i, int& j, bool& down);
-void cellCentroid(int c, float& b1, float& b2);
+void cellSamples(int c, float b1[4], float b2[4]);
 }  // namespace emitter_sampler_internal
 
 EmitterSampler buildEmitterSampler(const Scene& scene) {
@@ -37,10 +37,12 @@ EmitterSampler buildEmitterSampler(const Scene& scene) {
     if (m.emissiveTexture >= 0) {
       s.cellTable.back() = int32_t(s.cellCdf.size());
       float sum = 0;
+      // A cell's weight: the emission at its four sub-triangles' centroids,
+      // four of the 256 points its triangle's mean averages.
       for (int c = 0; c < kEmitterCells; ++c) {
-        float b1 = 0, b2 = 0;
-        emitter_sampler_internal::cellCentroid(c, b1, b2);
-        sum += std::max(0.0f, average(scene.emission(t, b1, b2)));
+        float b1[4], b2[4];
+        emitter_sampler_internal::cellSamples(c, b1, b2);
+        for (int k = 0; k < 4; ++k) sum += std::max(0.0f, average(scene.emission(t, b1[k], b2[k])));
         s.cellCdf.push_back(sum);
       }
     }
@@ -66,13 +68,29 @@ void cellCorner(int c, int& i, int& j, bool& down) {
   j = k;
 }
 
-void cellCentroid(int c, float& b1, float& b2) {
+void cellSamples(int c, float b1[4], float b2[4]) {
   int i = 0, j = 0;
   bool down = false;
   cellCorner(c, i, j, down);
-  const float off = down ? 2.0f / 3.0f : 1.0f / 3.0f;
-  b1 = (float(i) + off) / 8.0f;
-  b2 = (float(j) + off) / 8.0f;
+  // The cell halved along its edges, in the 16 x 16 split: an upward
+  // sub-triangle (a, b) has its centroid at (a + 1/3, b + 1/3), a downward
+  // one at (a + 2/3, b + 2/3), in sixteenths.
+  const float a = float(2 * i), b = float(2 * j);
+  const float up = 1.0f / 3.0f, dn = 2.0f / 3.0f;
+  float p[4][2];
+  if (down) {
+    const float q[4][2] = {{a + 1 + dn, b + dn}, {a + dn, b + 1 + dn}, {a + 1 + dn, b + 1 + dn},
+                           {a + 1 + up, b + 1 + up}};
+    std::copy(&q[0][0], &q[0][0] + 8, &p[0][0]);
+  } else {
+    const float q[4][2] = {{a + up, b + up}, {a + 1 + up, b + up}, {a + up, b + 1 + up},
+                           {a + dn, b + dn}};
+    std::copy(&q[0][0], &q[0][0] + 8, &p[0][0]);
+  }
+  for (int k = 0; k < 4; ++k) {
+    b1[k] = p[k][0] / 16.0f;
+    b2[k] = p[k][1] / 16.0f;
+  }
 }
 
 }  // namespace emitter_sampler_internal
@@ -85,13 +103,12 @@ void EmitterSampler::samplePoint(size_t k, float u0, float u1, float u2, float& 
   if (table >= 0) {
     const float* cdf = cellCdf.data() + table;
     const float total = cdf[kEmitterCells - 1];
-    // The share drawn evenly over the cells. The cells' weights are one
-    // texture sample each, so a cell may emit more than its centroid says:
-    // evenly half the time keeps the weights at most 2 (on the emissive
-    // DamagedHelmet, 1M photons: 9% of paths start on a black texel against
-    // 18% for uniform points, and the noise figure is 12.2% against 15.1%;
-    // with 5% evenly, 1% and 17.5%).
-    constexpr float kSpread = 0.5f;
+    // The share drawn evenly over the cells: a cell's four samples may miss
+    // some of its texels, and the even share keeps every point possible and
+    // every weight at most 4. On the emissive DamagedHelmet, 1M photons take
+    // 443,880 paths and reach a noise figure of 9.9%; with uniform points
+    // 513,516 paths and 14.3% (half evenly: 10.1%).
+    constexpr float kSpread = 0.25f;
     if (total > 0) {
       // The cell: evenly with probability kSpread, else by its emission;
       // u0 is reused, rescaled, for the choice within each branch.

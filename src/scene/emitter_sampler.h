@@ -46,11 +46,11 @@ struct EmitterSampler {
 
   /// Emissive textures: where on a triangle its light comes from. The
   /// triangle is cut into kEmitterCells equal sub-triangles (8 x 8 along
-  /// its edges) whose centroid emissions are the 64 points its mean
-  /// (Scene::triangleEmission) averages; a point is drawn in a cell picked by
-  /// that emission half the time and evenly the other half (no emitting
-  /// texel is missed and no photon weighs more than twice its share), then
-  /// uniformly in it. Per entry: -1 (no texture: uniform points), or
+  /// its edges), each weighted by the emission at 4 of the 256 points its
+  /// mean (Scene::triangleEmission) averages; a point is drawn in a cell
+  /// picked by that weight three times in four and evenly the fourth (no
+  /// emitting texel is missed and no photon weighs more than 4 times its
+  /// share), then uniformly in it. Per entry: -1 (no texture: uniform points), or
   /// where its kEmitterCells cumulative weights start in cellCdf.
   std::vector<int32_t> cellTable;
   std::vector<float> cellCdf;

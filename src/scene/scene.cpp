@@ -437,8 +437,9 @@ Vec3 Scene::emission(size_t t, float b1, float b2) const {
 Vec3 Scene::triangleEmission(size_t t) const {
   const Material& m = materials[size_t(triangleMaterial[t])];
   if (m.emissiveTexture < 0 || !m.isEmissive()) return m.emission;
-  // 64 stratified points: the centroids of the 8 x 8 sub-triangles.
-  constexpr int kSplit = 8;
+  // 256 stratified points: the centroids of the 16 x 16 sub-triangles
+  // (four in each of the emitter sampler's 64 cells).
+  constexpr int kSplit = 16;
   Vec3 sum{0, 0, 0};
   int count = 0;
   for (int i = 0; i < kSplit; ++i) {

@@ -328,8 +328,9 @@ struct Scene {
   /// texture applied.
   Vec3 emission(size_t t, float b1, float b2) const;
   /// Mean emitted radiance over triangle t: `emission` of its material
-  /// exactly when it has no emissive texture, else the mean of 64 stratified
-  /// samples (what emitter sampling picks triangles by).
+  /// exactly when it has no emissive texture, else the mean of 256
+  /// stratified samples, the centroids of its 16 x 16 sub-triangles (what
+  /// emitter sampling picks triangles by).
   Vec3 triangleEmission(size_t t) const;
   /// Texture coordinates of UV set `texCoord` (0 or 1) of triangle t at
   /// (b1, b2) after `transform`; false when the set is missing.

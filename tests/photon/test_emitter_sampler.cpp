@@ -152,7 +152,7 @@ TEST(EmitterSampler, TexturedPointsFollowTheTextureWithoutBias) {
       ASSERT_GE(b1, -1e-6f);
       ASSERT_GE(b2, -1e-6f);
       ASSERT_LE(b1 + b2, 1.0f + 1e-5f);
-      ASSERT_LE(w, 2.0f + 1e-5f);
+      ASSERT_LE(w, 4.0f + 1e-5f);
       const float e = scene.emission(t, b1, b2).x;
       if (e == 0) ++dark;
       sum += double(w) * double(e);
@@ -163,9 +163,9 @@ TEST(EmitterSampler, TexturedPointsFollowTheTextureWithoutBias) {
                 k, mean, exact, 100.0 * dark / kDraws, 100.0 * blackArea);
     EXPECT_NEAR(mean, exact, 0.01 * exact);
     // Uniform points would land on black texels as often as they cover the
-    // triangle; half the draws are even, the other half find the light (but
-    // in the few cells the texture's edge crosses).
-    EXPECT_LT(double(dark) / kDraws, 0.5 * blackArea + 0.05);
+    // triangle; a quarter of the draws are even, the rest find the light
+    // (but in the few cells the texture's edge crosses).
+    EXPECT_LT(double(dark) / kDraws, 0.25 * blackArea + 0.05);
   }
 }
 
