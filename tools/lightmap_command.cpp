@@ -44,7 +44,7 @@ LightmapExportParams exportParams(const LightmapOptions& opt) {
   checkLightmapExportPath(opt.output, "--output");
   NamedPaths inputs = sceneInputs(opt.scene);
   inputs.push_back({"LIGHTS", opt.lights});
-  checkLightmapOutputs(opt.output, opt.image == "png", opt.previewUnlit, opt.chartImage, inputs);
+  checkLightmapOutputs(opt.output, opt.previewUnlit, inputs);
   if (!opt.json.empty()) {
     checkOutputFolder(opt.json, "--json");
     checkDistinctFiles({{"--output", opt.output}, {"--json", opt.json}}, inputs);
@@ -216,7 +216,8 @@ std::function<int()> addLightmapCommand(CLI::App& app) {
   cmd->add_option("--directions", opt->directions,
                   "Also write OUT-directionN.png beside each page: the mean direction the light "
                   "comes from per texel (world space, 8-bit unit vectors, extras.lightmap.direction), "
-                  "so viewers shade normal maps and gloss from the lightmap (on) or not (off)")
+                  "so viewers shade normal maps and gloss from the lightmap (on) or not (off); "
+                  "never with --content full, whose E holds direct light from other directions")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   cmd->add_flag("--chart-image", opt->chartImage,

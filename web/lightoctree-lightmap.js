@@ -19,13 +19,12 @@
 // Direction pages (`extras.lightmap.direction`, written by default): the
 // mean direction the light of each texel comes from. With them the light map
 // is not added as flat irradiance; each fragment gets one directional light
-// of colour E / max(n_vertex . d, 0.05) from d, as `lightoctree render
-// --lighting atlas` does: its diffuse part baseColor / pi times that light's
-// irradiance (the page's contract; at the vertex normal exactly
-// baseColor / pi * E), plus three's GGX reflection of it, so normal maps show
-// their relief and glossy surfaces a highlight (needs r187's
-// MeshStandardMaterial shader chunks; other materials take three's RE_Direct).
-// Pass `directions: false` to use the irradiance alone.
+// of colour E / max(n_vertex . d, 0.05) from d through the material's BRDF
+// (three's RE_Direct: glTF's Fresnel mix of the diffuse and GGX lobes), as
+// `lightoctree render --lighting atlas` does, so normal maps show their
+// relief and glossy surfaces a highlight. A texel without a direction, or a
+// page that cannot be read, is used as irradiance alone. Pass
+// `directions: false` to use the irradiance alone everywhere.
 // Materials of the unlit preview (`extras.lightmapPreview`) already show the
 // bake and are left alone. A `content: "full"` map holds the direct light
 // too: remove the scene's lights then (`result.userData.lightOctree.content`
@@ -66,16 +65,14 @@ const directionalLightMap = /* glsl */ `
 			loLight.color = loE / max( dot( nonPerturbedNormal, loLight.direction ), 0.05 );
 			loLight.visible = true;
 			#ifdef STANDARD
-				// The page's contract (extras.lightmap.shading): the diffuse part is
-				// baseColor / pi * E, no Fresnel share taken from it; the light's
-				// specular reflection is added.
-				vec3 loIrradiance = loLight.color * saturate( dot( geometryNormal, loLight.direction ) );
-				reflectedLight.directDiffuse += loIrradiance * BRDF_Lambert( material.diffuseContribution );
-				reflectedLight.directSpecular += loIrradiance * material.multiScatteringCompensation *
-					BRDF_GGX( loLight.direction, geometryViewDir, geometryNormal, material );
-			#else
-				RE_Direct( loLight, geometryPosition, geometryNormal, geometryViewDir, geometryClearcoatNormal, material, reflectedLight );
+				// three sets this only when the scene has punctual lights: the
+				// same multiple-scattering compensation, from material.dfg.
+				material.multiScatteringCompensation = 1.0 + material.specularColorBlended *
+					( 1.0 / ( material.dfg.x + material.dfg.y ) - 1.0 );
 			#endif
+			RE_Direct( loLight, geometryPosition, geometryNormal, geometryViewDir, geometryClearcoatNormal, material, reflectedLight );
+		} else {
+			irradiance += loE;  // no direction: the irradiance as it is
 		}
 	}
 #endif
@@ -113,10 +110,9 @@ export class LightOctreeLightmaps {
     await Promise.all(uses.map(async ([material, lightmap]) => {
       material.lightMap = await this.page(lightmap);
       material.lightMapIntensity = this.intensity;
-      if (this.directions && lightmap.direction) {
-        this.useDirections(material, await this.directionPage(lightmap.direction),
-                           lightmap.encoding === 'linear-exr');
-      }
+      const directionMap = this.directions && lightmap.direction
+        ? await this.directionPage(lightmap.direction) : null;
+      if (directionMap) this.useDirections(material, directionMap, lightmap.encoding === 'linear-exr');
       material.needsUpdate = true;
     }));
     result.userData.lightOctree = {
@@ -162,12 +158,18 @@ export class LightOctreeLightmaps {
     material.customProgramCacheKey = () => 'lightoctree-direction';
   }
 
+  // The direction page, or null (with a warning) when it cannot be used: the
+  // light map then lights the material by its irradiance alone.
   directionPage(direction) {
     if (!this.directionPages.has(direction.uri)) {
       const url = THREE.LoaderUtils.resolveURL(direction.uri, this.parser.options.path);
-      this.directionPages.set(direction.uri, direction.encoding !== 'unit-vector-png'
-        ? Promise.reject(new Error(`lightmap direction ${direction.uri}: unknown encoding '${direction.encoding}'`))
-        : this.dataPng(url, THREE.LinearFilter));
+      const page = direction.encoding !== 'unit-vector-png'
+        ? Promise.reject(new Error(`unknown encoding '${direction.encoding}'`))
+        : this.dataPng(url, THREE.LinearFilter);
+      this.directionPages.set(direction.uri, page.catch((e) => {
+        console.warn(`lightmap direction ${direction.uri}: ${e.message || e}; using the irradiance alone`);
+        return null;
+      }));
     }
     return this.directionPages.get(direction.uri);
   }

@@ -83,6 +83,11 @@ def _directional(n, principled, direction, folder, uv, irradiance):
 
     factor = n.math("DIVIDE", n.math("MAXIMUM", facing(shading), 0.0),
                     n.math("MAXIMUM", facing(geometry.outputs["Normal"]), 0.05))
+    # No direction (a texel no light reaches): the irradiance as it is.
+    length = n.new("ShaderNodeVectorMath", operation="LENGTH")
+    n.link(frame.outputs["Vector"], length.inputs[0])
+    has = n.math("GREATER_THAN", length.outputs["Value"], 1e-3)
+    factor = n.math("ADD", n.math("MULTIPLY", n.math("SUBTRACT", factor, 1.0), has), 1.0)
     scaled = n.new("ShaderNodeVectorMath", operation="SCALE")
     n.link(irradiance, scaled.inputs[0])
     n.link(factor, scaled.inputs["Scale"])

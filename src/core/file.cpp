@@ -351,6 +351,18 @@ void AtomicFileSet::commit() {
     e.committed = true;
     if (&e == &entries_.front()) pauseForTest("commit", 0);
   }
+  for (const std::string& path : removals_) {
+    std::error_code ec;
+    if (fs::is_regular_file(fs::symlink_status(path, ec))) fs::remove(path, ec);
+  }
+  removals_.clear();
+}
+
+void AtomicFileSet::removeOnCommit(const std::string& path) {
+  for (const Entry& e : entries_) {
+    if (e.path == path) return;
+  }
+  removals_.push_back(path);
 }
 
 uint64_t AtomicFileSet::bytesOf(const std::string& path) const {

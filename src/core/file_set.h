@@ -27,7 +27,13 @@ class AtomicFileSet {
   /// a failed write); the set's other files are then still uncommitted.
   void add(const std::string& path, const std::function<void(const std::string& tmp)>& write);
   void addText(const std::string& path, const std::string& text);
-  /// Checks every final name once more, then renames every temporary over it.
+  /// Also removes `path` (a file an earlier set had that this one replaces
+  /// with nothing: a page beyond its page count) at commit, after the
+  /// renames and with them: a signal waits for both. Not a file in the set;
+  /// a link or anything but a regular file there is left alone.
+  void removeOnCommit(const std::string& path);
+  /// Checks every final name once more, then renames every temporary over
+  /// it, then removes the removeOnCommit files.
   /// @throws IoError when a name became a link or a device meanwhile (nothing
   /// renamed) or a rename fails (the files renamed before it stay).
   void commit();
@@ -44,6 +50,7 @@ class AtomicFileSet {
     bool committed;
   };
   std::vector<Entry> entries_;
+  std::vector<std::string> removals_;
 };
 
 /// Writes `path` through `write(tmp)`: into `set` when one is given (renamed

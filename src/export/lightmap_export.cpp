@@ -49,6 +49,37 @@ void addRow(std::vector<StageReport>& rows, const std::string& name, double seco
   rows.push_back(r);
 }
 
+/// Marks for removal at `set`'s commit the files beside `output` named like
+/// its numbered outputs (OUT-lightmapN.exr|png, OUT-directionN.png,
+/// OUT-chartsN.png) that the set does not write.
+void removeStaleSiblings(const std::string& output, AtomicFileSet& set) {
+  const fs::path out(output);
+  const fs::path folder = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  const std::string stem = out.stem().string();
+  const std::vector<std::string> written = set.paths();
+  auto numbered = [&stem](const std::string& name, const std::string& head, const std::string& tail) {
+    const std::string prefix = stem + head;
+    if (name.size() <= prefix.size() + tail.size() || name.compare(0, prefix.size(), prefix) != 0 ||
+        name.compare(name.size() - tail.size(), tail.size(), tail) != 0) {
+      return false;
+    }
+    for (size_t i = prefix.size(); i < name.size() - tail.size(); ++i) {
+      if (name[i] < '0' || name[i] > '9') return false;
+    }
+    return true;
+  };
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (!(numbered(name, "-lightmap", ".exr") || numbered(name, "-lightmap", ".png") ||
+          numbered(name, "-direction", ".png") || numbered(name, "-charts", ".png"))) {
+      continue;
+    }
+    const std::string path = (out.parent_path() / name).string();
+    if (std::find(written.begin(), written.end(), path) == written.end()) set.removeOnCommit(path);
+  }
+}
+
 /// The export, its octree made by `makeOctree` in the "octree" row.
 LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctree()>& makeOctree,
                                 const LightmapExportParams& params) {
@@ -135,7 +166,9 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
     ex.pageUris.push_back(fs::path(result.pagePaths.back()).filename().string());
   }
   std::vector<std::vector<unsigned char>> directionPngs;
-  if (params.directionPages) {
+  // With the direct light in E (content full) the direction would describe
+  // only its indirect part: no direction pages then.
+  if (params.directionPages && params.content == AtlasContent::Indirect) {
     for (int p = 0; p < atlas.pageCount; ++p) {
       result.directionPaths.push_back(lightmapDirectionPath(params.output, p));
       ex.directionUris.push_back(fs::path(result.directionPaths.back()).filename().string());
@@ -185,6 +218,10 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
       set.addText(result.chartPaths.back(), std::string(png.begin(), png.end()));
     }
   }
+  // Numbered files an earlier export left beside OUT that this one does not
+  // write (more pages, the other page image, direction pages, chart images)
+  // go with the commit, so the folder holds one set.
+  removeStaleSiblings(params.output, set);
   if (params.beforeCommit) params.beforeCommit(result, set);
   set.commit();
   writeTimer.finish(formatCount(size_t(atlas.pageCount) + result.directionPaths.size() + 1 +
@@ -211,8 +248,7 @@ void checkLightmapExportPath(const std::string& output, const char* flag) {
   }
 }
 
-void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bool charts,
-                          const NamedPaths& inputs) {
+void checkLightmapOutputs(const std::string& output, bool preview, const NamedPaths& inputs) {
   using lightmap_export_internal::besideOutput;
   NamedPaths outputs{{"--output", output}};
   if (hasExtension(output, ".gltf")) outputs.push_back({"--output's buffer", besideOutput(output, ".bin")});
@@ -241,8 +277,11 @@ void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bo
     const fs::path in = fs::weakly_canonical(fs::absolute(path, e), e);
     if (e || in.parent_path() != folder) continue;
     const std::string name = in.filename().string();
-    const bool page = numbered(name, stem + "-lightmap", rgbm ? ".png" : ".exr");
-    const bool chart = charts && numbered(name, stem + "-charts", ".png");
+    // Every numbered name, whatever this export writes: it replaces them, or
+    // removes those an earlier export left (removeStaleSiblings).
+    const bool page = numbered(name, stem + "-lightmap", ".png") ||
+                      numbered(name, stem + "-lightmap", ".exr");
+    const bool chart = numbered(name, stem + "-charts", ".png");
     const bool direction = numbered(name, stem + "-direction", ".png");
     if (page || chart || direction) {
       throw InputError("--output: the " +

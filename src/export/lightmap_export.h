@@ -18,7 +18,10 @@
 ///   D/OUT-preview.glb            preview
 ///   D/OUT-chartsN.png            chartImages, one per page
 /// Each is written atomically (core/file.h), and all of them as one: when
-/// one cannot be written, those written before it are removed again.
+/// one cannot be written, those written before it are removed again. Files
+/// an earlier export left beside OUT under those numbered names that this
+/// one does not write (more pages, direction pages, the other page format)
+/// are removed with the commit.
 
 #include <cstddef>
 #include <functional>
@@ -69,7 +72,10 @@ struct LightmapExportParams {
   /// Also OUT-directionN.png beside each page: the atlas's per-texel mean
   /// light direction (LightmapAtlas::direction, world space,
   /// encodeUnitVectorPng), named in extras.lightmap.direction, so a viewer
-  /// can shade normal maps and glossy surfaces from the lightmap.
+  /// can shade normal maps and glossy surfaces from the lightmap. Indirect
+  /// content only: with the direct light in E (AtlasContent::Full) the
+  /// atlas's direction would describe only its indirect part, so none are
+  /// written.
   bool directionPages = true;
   /// Set: the octree is rendered into the atlas by GL in a headless context
   /// of this kind (OSMesa or EGL). Unset: on the CPU (the same bytes on every
@@ -112,11 +118,11 @@ std::string lightmapDirectionPath(const std::string& output, int page);
 
 /// Refuses, before any work, an export some file of which would replace one
 /// of `inputs` (the scene, its buffers and images, the grid: checkDistinctFiles'
-/// pairs): the glTF, its .bin (a .gltf output), the preview, and the pages
-/// and chart images whatever their count (any input named like one of them
-/// beside the output). @throws InputError naming both.
-void checkLightmapOutputs(const std::string& output, bool rgbm, bool preview, bool charts,
-                          const NamedPaths& inputs);
+/// pairs): the glTF, its .bin (a .gltf output), the preview, and any input
+/// beside the output named like a numbered page (.exr or .png), direction
+/// page or chart image: the export writes those, or removes the ones an
+/// earlier export left that it does not write. @throws InputError naming both.
+void checkLightmapOutputs(const std::string& output, bool preview, const NamedPaths& inputs);
 
 /// @brief The export described in the file comment of `grid` over `scene`.
 /// @throws InputError for a bad output path, unusable TEXCOORD_1 (see

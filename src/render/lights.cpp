@@ -131,7 +131,7 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
   // until they fit, but not below 256 texels.
   while (shadowMapSize > 256 &&
          double(shadowMapSize) * double(shadowMapSize) * 4.0 * double(layers) > kShadowMapBudget) {
-    shadowMapSize /= 2;
+    shadowMapSize = std::max(256, shadowMapSize / 2);
   }
   std::copy(lights.begin(), lights.end(), block.uLights);
   block.uLightCount[0] = int32_t(lights.size());

@@ -69,6 +69,18 @@ void gltfFiles(const std::string& path, const std::string& baseDir,
   if (j.is_discarded() || !j.is_object()) return;
   addUris(path, baseDir, j, "buffers", out);
   addUris(path, baseDir, j, "images", out);
+  // The sky image a scene's extras name (loadScene reads it too).
+  auto scenes = j.find("scenes");
+  if (scenes == j.end() || !scenes->is_array()) return;
+  for (const nlohmann::json& scene : *scenes) {
+    if (!scene.is_object() || !scene.contains("extras") || !scene["extras"].is_object()) continue;
+    auto sky = scene["extras"].find("lightoctree_sky_image");
+    if (sky == scene["extras"].end() || !sky->is_string()) continue;
+    try {
+      out.push_back(resolveInsideFolder(path, baseDir, sky->get<std::string>(), "sky image"));
+    } catch (const InputError&) {
+    }
+  }
 }
 
 /// The whitespace-separated words of `line` after its first.

@@ -59,7 +59,8 @@ TEST(SceneFiles, WhatCannotBeReadListsTheSceneAlone) {
 }
 
 // A lightmap export refuses outputs that would replace the scene's files:
-// its glTF, its .bin, its preview, and its numbered pages and chart images.
+// its glTF, its .bin, its preview, and any numbered page, direction page or
+// chart image (what it writes, or removes when an earlier export left it).
 TEST(SceneFiles, ALightmapExportWouldNotReplaceTheScenesFiles) {
   const std::string dir = test::outputDir("SceneFiles.Lightmap");
   const NamedPaths inputs{{"SCENE", dir + "/room.gltf"},
@@ -67,18 +68,21 @@ TEST(SceneFiles, ALightmapExportWouldNotReplaceTheScenesFiles) {
                           {"SCENE's file 'out-lightmap3.exr'", dir + "/out-lightmap3.exr"},
                           {"SCENE's file 'out-charts0.png'", dir + "/out-charts0.png"},
                           {"SCENE's file 'y-preview.glb'", dir + "/y-preview.glb"}};
-  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/lit.gltf", false, true, true, inputs));
-  EXPECT_THROW(checkLightmapOutputs(dir + "/room.gltf", false, false, false, inputs), InputError);
-  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/room.glb", false, false, false, {inputs[1]}))
+  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/lit.gltf", true, inputs));
+  EXPECT_THROW(checkLightmapOutputs(dir + "/room.gltf", false, inputs), InputError);
+  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/room.glb", false, {inputs[1]}))
       << "no .bin beside a .glb: only a .gltf output writes room.bin";
-  EXPECT_THROW(checkLightmapOutputs(dir + "/out.glb", false, false, false, inputs), InputError);
-  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/out.glb", true, false, false, {inputs[2]}))
-      << "PNG pages are named .png";
-  EXPECT_THROW(checkLightmapOutputs(dir + "/out.glb", true, false, true, {inputs[3]}), InputError);
-  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/out.glb", true, false, false, {inputs[3]}));
-  EXPECT_THROW(checkLightmapOutputs(dir + "/y.glb", false, true, false, inputs), InputError);
+  EXPECT_THROW(checkLightmapOutputs(dir + "/out.glb", false, {inputs[2]}), InputError)
+      << "an EXR page name, even for PNG pages: an earlier export's page is removed";
+  EXPECT_THROW(checkLightmapOutputs(dir + "/out.glb", false, {inputs[3]}), InputError)
+      << "a chart image name, even without --chart-image";
+  EXPECT_THROW(checkLightmapOutputs(dir + "/room.glb", false,
+                                    {{"SCENE's file 'room-direction2.png'", dir + "/room-direction2.png"}}),
+               InputError);
+  EXPECT_NO_THROW(checkLightmapOutputs(dir + "/out.glb", false, {inputs[4]}));
+  EXPECT_THROW(checkLightmapOutputs(dir + "/y.glb", true, inputs), InputError);
   try {
-    checkLightmapOutputs(dir + "/lit.gltf", false, false, false,
+    checkLightmapOutputs(dir + "/lit.gltf", false,
                          {{"SCENE's file 'lit.bin'", dir + "/lit.bin"}});
     FAIL() << "lit.gltf writes lit.bin";
   } catch (const InputError& e) {
