@@ -52,12 +52,11 @@ void addRow(std::vector<StageReport>& rows, const std::string& name, double seco
 /// Marks for removal at `set`'s commit the files beside `output` named like
 /// its numbered outputs (OUT-lightmapN.exr|png, OUT-directionN.png,
 /// OUT-chartsN.png) that the set does not write.
-void removeStaleSiblings(const std::string& output, AtomicFileSet& set) {
-  const fs::path out(output);
-  const fs::path folder = out.parent_path().empty() ? fs::path(".") : out.parent_path();
-  const std::string stem = out.stem().string();
-  const std::vector<std::string> written = set.paths();
-  auto numbered = [&stem](const std::string& name, const std::string& head, const std::string& tail) {
+/// What numbered output of the export to `stem` the file `name` is named
+/// like: "lightmap pages" (STEM-lightmapN.exr|png), "direction pages"
+/// (STEM-directionN.png), "chart images" (STEM-chartsN.png), or null.
+const char* numberedOutputKind(const std::string& name, const std::string& stem) {
+  auto numbered = [&](const std::string& head, const std::string& tail) {
     const std::string prefix = stem + head;
     if (name.size() <= prefix.size() + tail.size() || name.compare(0, prefix.size(), prefix) != 0 ||
         name.compare(name.size() - tail.size(), tail.size(), tail) != 0) {
@@ -68,13 +67,21 @@ void removeStaleSiblings(const std::string& output, AtomicFileSet& set) {
     }
     return true;
   };
+  if (numbered("-lightmap", ".exr") || numbered("-lightmap", ".png")) return "lightmap pages";
+  if (numbered("-direction", ".png")) return "direction pages";
+  if (numbered("-charts", ".png")) return "chart images";
+  return nullptr;
+}
+
+void removeStaleSiblings(const std::string& output, AtomicFileSet& set) {
+  const fs::path out(output);
+  const fs::path folder = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  const std::string stem = out.stem().string();
+  const std::vector<std::string> written = set.paths();
   std::error_code ec;
   for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
-    if (!(numbered(name, "-lightmap", ".exr") || numbered(name, "-lightmap", ".png") ||
-          numbered(name, "-direction", ".png") || numbered(name, "-charts", ".png"))) {
-      continue;
-    }
+    if (!numberedOutputKind(name, stem)) continue;
     const std::string path = (out.parent_path() / name).string();
     if (std::find(written.begin(), written.end(), path) == written.end()) set.removeOnCommit(path);
   }
@@ -257,35 +264,19 @@ void checkLightmapOutputs(const std::string& output, bool preview, const NamedPa
   // The longest name the set writes (up to 1,000 pages) must fit the file
   // system's limit, found now and not after the bake.
   checkOutputName(besideOutput(output, "-direction999.png"), "--output");
-  // The pages and chart images: OUT-lightmap<k>.exr|png, OUT-charts<k>.png.
+  // The numbered outputs: pages, direction pages, chart images.
   std::error_code ec;
   const fs::path folder = fs::weakly_canonical(fs::absolute(fs::path(output).parent_path(), ec), ec);
   const std::string stem = fs::path(output).stem().string();
-  auto numbered = [](const std::string& name, const std::string& head, const std::string& tail) {
-    if (name.size() <= head.size() + tail.size() || name.compare(0, head.size(), head) != 0 ||
-        name.compare(name.size() - tail.size(), tail.size(), tail) != 0) {
-      return false;
-    }
-    for (size_t i = head.size(); i < name.size() - tail.size(); ++i) {
-      if (name[i] < '0' || name[i] > '9') return false;
-    }
-    return true;
-  };
   for (const auto& [what, path] : inputs) {
     if (path.empty()) continue;
     std::error_code e;
     const fs::path in = fs::weakly_canonical(fs::absolute(path, e), e);
     if (e || in.parent_path() != folder) continue;
-    const std::string name = in.filename().string();
     // Every numbered name, whatever this export writes: it replaces them, or
     // removes those an earlier export left (removeStaleSiblings).
-    const bool page = numbered(name, stem + "-lightmap", ".png") ||
-                      numbered(name, stem + "-lightmap", ".exr");
-    const bool chart = numbered(name, stem + "-charts", ".png");
-    const bool direction = numbered(name, stem + "-direction", ".png");
-    if (page || chart || direction) {
-      throw InputError("--output: the " +
-                       std::string(page ? "lightmap pages" : chart ? "chart images" : "direction pages") +
+    if (const char* kind = lightmap_export_internal::numberedOutputKind(in.filename().string(), stem)) {
+      throw InputError("--output: the " + std::string(kind) +
                        " of '" + output + "' would replace the input " + what + " ('" + path +
                        "'); write to another name");
     }
