@@ -90,18 +90,21 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
       r.skyImage = GlTexture::create();
       glBindTexture(GL_TEXTURE_2D, r.skyImage.get());
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      // Float: a sun in a sky image exceeds half floats' 65504.
-      std::vector<float> rgb(image.texelCount() * 3);
-      for (int y = 0; y < image.height; ++y)
-        for (int x = 0; x < image.width; ++x) {
-          const Vec3 v = image.texel(x, y);
-          float* out = rgb.data() + 3 * (size_t(y) * size_t(image.width) + size_t(x));
-          out[0] = v.x;
-          out[1] = v.y;
-          out[2] = v.z;
+      // Float: a sun in a sky image exceeds half floats' 65504. Float RGB
+      // texels (what loadSkyImage and Texture::fromLinear make) go up as they
+      // are, without a copy of what may be a gigabyte; others are converted.
+      std::vector<float> converted;
+      if (image.format != TexelFormat::Float32 || image.channels != 3) {
+        converted.resize(image.texelCount() * 3);
+        for (size_t i = 0; i < image.texelCount(); ++i) {
+          const Vec3 v = image.texelAt(i);
+          converted[3 * i] = v.x;
+          converted[3 * i + 1] = v.y;
+          converted[3 * i + 2] = v.z;
         }
+      }
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, image.width, image.height, 0, GL_RGB, GL_FLOAT,
-                   rgb.data());
+                   converted.empty() ? image.floats.data() : converted.data());
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
