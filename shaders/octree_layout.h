@@ -188,6 +188,31 @@ LO_LAYOUT_FN float loShCosineBand(uint i) {
   return LO_PI / 4.0;
 }
 
+/* Free-space octree (the volume light, lightgrid/volume_light.h): a second
+ * octree of the same layout over the same cube, coarser, whose every leaf
+ * holds LO_SH_TERMS SH texels of the light from all directions, preceded by
+ * one header texel at (first index - 1): RGB = per axis lower * 16 + upper,
+ * the box [lower / 16, (upper + 1) / 16] (voxel units from its lower corner)
+ * the voxel's light filled; A = 0. Stored like a layer block's header. */
+const float LO_VOLUME_BOX_STEPS = 16.0f;
+LO_LAYOUT_FN float loPackVolumeBox(float lower, float upper) {
+  float lo = min(floor(lower * LO_VOLUME_BOX_STEPS), LO_VOLUME_BOX_STEPS - 1.0f);
+  float hi = min(floor(upper * LO_VOLUME_BOX_STEPS - 0.001f), LO_VOLUME_BOX_STEPS - 1.0f);
+  lo = lo < 0.0f ? 0.0f : lo;
+  hi = hi < lo ? lo : hi;
+  return lo * LO_VOLUME_BOX_STEPS + hi;
+}
+LO_LAYOUT_FN float loVolumeBoxLower(float code) {
+  return floor(code / LO_VOLUME_BOX_STEPS + 0.001f) / LO_VOLUME_BOX_STEPS;
+}
+LO_LAYOUT_FN float loVolumeBoxUpper(float code) {
+  float lo = floor(code / LO_VOLUME_BOX_STEPS + 0.001f);
+  return (code - lo * LO_VOLUME_BOX_STEPS + 1.0f) / LO_VOLUME_BOX_STEPS;
+}
+/* A voxel lends its light to a point that lies within this many voxels
+ * beyond its lit box, on a side where the box stops inside the voxel. */
+const float LO_VOLUME_BOX_MARGIN = 0.1f;
+
 #ifdef __cplusplus
 #undef LO_LAYOUT_FN
 }  // namespace layout

@@ -21,6 +21,8 @@
  *                    renormalized (§4.2.1), else the voxel in front, else behind
  *   loOctreeIrradiance the same lookup's irradiance and the direction it comes
  *                    from, for lightmaps (§4.2.3)
+ *   loVolumeIndirect the free-space octree's light at a point of an object
+ *                    that was not baked (trilinear, lit boxes respected)
  *
  * The includer defines, before including:
  *   LO_FETCH_POOL(p)      RGBA8UI texel of the pool at ivec3 p, as uvec4
@@ -388,6 +390,49 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
     return loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, direction);
   }
   return vec3(0.0f);
+}
+
+/* Whether free-space voxel c lends its light to q (both in its octree's
+ * voxel units): q lies within its lit box, grown by LO_VOLUME_BOX_MARGIN on
+ * the sides where the box stops inside the voxel (a wall cuts it); a side
+ * where the light reached the voxel's face bounds nothing. */
+LO_LOOKUP_FN bool loVolumeLends(LO_TEX_PARAM uint first, ivec3 c, vec3 q) {
+  vec4 h = loFetchTexel(LO_TEX first - 1u);
+  vec3 local = q - vec3(c);
+  vec3 box = vec3(h);
+  for (int a = 0; a < 3; ++a) {
+    float lower = loVolumeBoxLower(box[a]);
+    float upper = loVolumeBoxUpper(box[a]);
+    if (lower > 0.0f && local[a] < lower - LO_VOLUME_BOX_MARGIN) return false;
+    if (upper < 1.0f && local[a] > upper + LO_VOLUME_BOX_MARGIN) return false;
+  }
+  return true;
+}
+
+/* The free-space light at world position p of a surface s that was not in
+ * the bake (an object added later): trilinear over the 8 voxels of the
+ * free-space octree around p, voxels without light or whose lit box p lies
+ * beyond (loVolumeLends) left out and the weights renormalized. */
+LO_LOOKUP_FN vec3 loVolumeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize, int depth,
+                                   LoSurface s) {
+  vec3 q = (p - origin) / voxelSize;
+  vec3 u = q - vec3(0.5f);
+  ivec3 base = ivec3(floor(u));
+  vec3 f = u - floor(u);
+  vec3 sum = vec3(0.0f);
+  float weightSum = 0.0f;
+  for (int k = 0; k < 8; ++k) {
+    ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+    float w = loTrilinearWeight(f, o);
+    if (w <= 0.0f) continue;
+    uvec4 leaf;
+    if (!loLookupLeaf(LO_TEX base + o, depth, leaf)) continue;
+    uint first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
+    if (!loVolumeLends(LO_TEX first, base + o, q)) continue;
+    sum += w * loShadeSh(LO_TEX first, s);
+    weightSum += w;
+  }
+  return weightSum > 0.0f ? sum / weightSum : vec3(0.0f);
 }
 
 #ifdef __cplusplus

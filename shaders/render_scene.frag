@@ -75,7 +75,11 @@ vec3 indirectLight(vec3 n, vec3 v, vec3 ng, vec3 baseColor, float metallic, floa
       indirect = loVdlResponse(s, d) * E / max(dot(nb, d), 0.05);
     }
   } else {
-#ifndef LO_ATLAS_LIGHTING
+#if defined(LO_FREE_SPACE)
+    // An object added after the bake: the free-space octree's light, bound
+    // in place of the surfaces' (scene_pass.cpp).
+    indirect = loVolumeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, s);
+#elif !defined(LO_ATLAS_LIGHTING)
     indirect = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
                                 uInterpolation, uMaxVdls, s);
 #endif

@@ -30,6 +30,8 @@ BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   params.edgeCorrection = edgeCorrection == "on";
   params.separateCaustics = separateCaustics == "on";
   params.smoothing = smoothing == "on";
+  params.freeSpace = freeSpace == "on";
+  params.freeSpaceLevels = freeSpaceLevels;
   params.autoCap = autoCap;
   params.autoThreshold = autoThreshold;
   parseRepresentation(representation, &params.representation);  // checked by the flag
@@ -145,6 +147,16 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
                   "Smooth each voxel's estimate with its neighbours on the same surface, where "
                   "they differ by no more than the photon noise explains (shadow edges kept)")
       ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--free-space", opt.freeSpace,
+                  "Also bake the light in free space, on a grid --free-space-levels coarser: "
+                  "what lights objects that were not baked (render/view --add)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--free-space-levels", opt.freeSpaceLevels,
+                  "How many levels coarser than the surface grid the free-space grid is "
+                  "(2: a free-space voxel is 4 surface voxels wide)")
+      ->check(CLI::Range(0, 11))
       ->capture_default_str();
   cmd->add_option("--bounds", opt.bounds,
                   "A region of interest, x0,y0,z0,x1,y1,z1 in scene units: the grid covers it "

@@ -37,6 +37,8 @@ struct BakeOptions {
   std::string edgeCorrection = "on";
   std::string separateCaustics = "on";
   std::string smoothing = "on";
+  std::string freeSpace = "on";
+  int freeSpaceLevels = 2;
   int autoCap = BakeParams{}.autoCap;
   float autoThreshold = BakeParams{}.autoThreshold;
   std::vector<double> bounds;  // x0 y0 z0 x1 y1 z1, empty = the whole scene

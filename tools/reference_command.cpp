@@ -28,6 +28,7 @@ namespace {
 struct ReferenceOptions {
   std::string scene;
   SceneOptions sceneOptions;  // --sky
+  AddedObjects objects;       // --add, --at
   std::string output;
   std::string stdErrorOutput;
   std::string emitterMaskOutput;
@@ -69,8 +70,31 @@ int runReference(const ReferenceOptions& opt) {
   ThreadLimit threadLimit(opt.threads);
 
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
+  placeObjects(scene, opt.objects);
   printSceneWarnings(scene);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
+  if (opt.part == "added-mask") {
+    if (opt.objects.empty()) throw InputError("--part added-mask: add an object first (--add, --at)");
+    FirstHitParams fp;
+    fp.width = opt.width;
+    fp.height = opt.height;
+    fp.samplesPerPixel = std::min(opt.spp, 64);
+    fp.seed = opt.seed;
+    ConsoleProgress progress(opt.quiet);
+    const RgbImage mask = renderFirstHits(
+        scene, camera, fp,
+        [&scene](const FirstHit& hit) {
+          const bool added = size_t(scene.triangleMaterial[hit.triangle]) >= scene.movingMaterialsFrom;
+          return added ? Vec3{1, 1, 1} : Vec3{0, 0, 0};
+        },
+        &progress);
+    AtomicFileSet outputs;
+    writeImage(opt.output, mask, 0.0f, &outputs);
+    if (!opt.json.empty()) report.addTo(outputs, opt.json, rows);
+    outputs.commit();
+    if (!opt.quiet) std::printf("added-object mask: wrote %s\n", opt.output.c_str());
+    return 0;
+  }
   if (opt.part == "edge-mask") {
     FirstHitParams fp;
     fp.width = opt.width;
@@ -158,6 +182,7 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   addSceneOptions(cmd, opt->sceneOptions);
+  addObjectOptions(cmd, opt->objects);
   cmd->add_option("-o,--output", opt->output,
                   "Image: .exr (linear float) or .png (sRGB, for a quick look)")
       ->required();
@@ -181,10 +206,10 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
       ->excludes(spp);
   cmd->add_option("--part", opt->part,
                   "full | direct | indirect (what `render --mode indirect` approximates) | "
-                  "irradiance (indirect irradiance at the first hit, W/m^2) | edge-mask (1 where "
+                  "irradiance (indirect irradiance at the first hit, W/m^2) | added-mask (the share of each pixel's rays that first hit an --add object) | edge-mask (1 where "
                   "the first hit lies within --edge-distance of an edge, for `compare --mask`; "
                   "--spp up to 64 rays per pixel)")
-      ->check(CLI::IsMember({"full", "direct", "indirect", "irradiance", "edge-mask"}))
+      ->check(CLI::IsMember({"full", "direct", "indirect", "irradiance", "edge-mask", "added-mask"}))
       ->capture_default_str();
   cmd->add_option("--edge-distance", opt->edgeDistance,
                   "With --part edge-mask: how near an edge, in scene units (default: one voxel "

@@ -32,6 +32,7 @@ namespace {
 struct RenderOptions {
   std::string scene;
   SceneOptions sceneOptions;  // --sky
+  AddedObjects objects;       // --add, --at
   std::string lights;
   std::string output;
   CameraOptions camera;
@@ -92,7 +93,15 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
   params.height = opt.height;
   params.samplesPerPixel = opt.irradianceSpp;
   StageTimer renderTimer(rows, "render");
+  // Added objects read the free-space light (the renderer's LO_FREE_SPACE).
+  GpuOctree volume;
+  if (!opt.objects.empty() && !baked.grid.volume.empty()) {
+    volume = buildVolumeOctree(baked.grid.volume, opt.shading.octreeParams());
+  }
   RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {
+    const bool moving =
+        size_t(scene.triangleMaterial[hit.triangle]) >= scene.movingMaterialsFrom;
+    if (moving && volume.depth > 0) return volumeIrradiance(volume, hit.position, hit.normal);
     return octreeIrradiance(octree, hit.position, hit.normal, shade);
   });
   renderTimer.finish(std::to_string(opt.irradianceSpp) + " rays per pixel");
@@ -116,6 +125,7 @@ int runRender(const RenderOptions& opt) {
   checkCameraOptions(opt.camera);
   StageTimer loadTimer(rows, "load scene");
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
+  placeObjects(scene, opt.objects);
   printSceneWarnings(scene);
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.textures.size()) + " textures");
@@ -154,6 +164,12 @@ int runRender(const RenderOptions& opt) {
 
   Renderer renderer(scene, octree, opt.shading.rendererParams());
   rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
+  if (!opt.objects.empty()) {
+    StageTimer volumeTimer(rows, "free-space light");
+    setAddedObjectsLight(renderer, baked.grid, opt.shading, opt.shading.octreeParams(&context->info()),
+                         opt.lights);
+    volumeTimer.finish(renderer.hasFreeSpaceLight() ? "for the added objects" : "none in the bake");
+  }
   StageTimer lightingTimer(rows, "prepare lighting");
   opt.shading.prepareLighting(renderer, scene, octree, opt.quiet);
   lightingTimer.finish(renderer.hasAtlas() ? "lightmap atlas" : "");
@@ -185,6 +201,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   addSceneOptions(cmd, opt->sceneOptions);
+  addObjectOptions(cmd, opt->objects);
   cmd->add_option("lights", opt->lights, "Baked VDL grid (.vdb from `lightoctree bake`)")
       ->required()
       ->check(CLI::ExistingFile);

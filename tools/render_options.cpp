@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "core/error.h"
 #include "lightmap/lightmap_bake.h"
 
 namespace lo::tool {
@@ -147,6 +148,23 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
                   "leaf at the bake's depth; docs/octree.md)")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
+}
+
+void setAddedObjectsLight(Renderer& renderer, const VdlGrid& baked, const ShadingOptions& shading,
+                          const GpuOctreeParams& params, const std::string& lightsPath) {
+  if (shading.lighting == "atlas") {
+    throw InputError("--add: not with --lighting atlas (the atlas holds the baked surfaces' light "
+                     "only); added objects are lit by the octree's free-space light");
+  }
+  if (baked.volume.empty()) {
+    std::fprintf(stderr,
+                 "warning: %s holds no free-space light (baked with --free-space off, or by an "
+                 "older lightoctree): the added objects take the light "
+                 "of the surfaces near them\n",
+                 lightsPath.c_str());
+    return;
+  }
+  renderer.setFreeSpaceLight(buildVolumeOctree(baked.volume, params));
 }
 
 }  // namespace lo::tool

@@ -64,4 +64,11 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window);
 /// "on" | "off".
 CLI::Validator onOff();
 
+/// The light of the objects --add placed: the bake's free-space light
+/// (buildVolumeOctree) on `renderer`, or, when `baked` has none, a warning
+/// that the objects take the surfaces' light. @throws InputError with
+/// --lighting atlas (the atlas has no texels for them).
+void setAddedObjectsLight(Renderer& renderer, const VdlGrid& baked, const ShadingOptions& shading,
+                          const GpuOctreeParams& params, const std::string& lightsPath);
+
 }  // namespace lo::tool

@@ -7,6 +7,7 @@
 
 #include "camera_options.h"
 #include "core/error.h"
+#include "scene/place_model.h"
 #include "scene/scene_files.h"
 
 namespace lo::tool {
@@ -100,6 +101,34 @@ Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
     scene.sky.image.reset();
   }
   return scene;
+}
+
+void addObjectOptions(CLI::App* cmd, AddedObjects& opt) {
+  cmd->add_option("--add", opt.models,
+                  "A model (.gltf, .glb or .obj) added to the baked scene, not in the bake: lit "
+                  "by the bake's free-space light, casting shadows (repeatable; each needs an --at)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--at", opt.placements,
+                  "Where the --add of the same rank goes: x,y,z[,yaw[,scale]] (its origin to "
+                  "x,y,z in scene units, turned yaw degrees about +Y, scaled)");
+}
+
+void placeObjects(Scene& scene, const AddedObjects& opt) {
+  if (opt.models.size() != opt.placements.size()) {
+    throw InputError("--add and --at: " + std::to_string(opt.models.size()) + " models and " +
+                     std::to_string(opt.placements.size()) +
+                     " placements; give one --at per --add, in the same order");
+  }
+  for (size_t i = 0; i < opt.models.size(); ++i) {
+    const Placement placement = parsePlacement(opt.placements[i]);
+    Scene model;
+    try {
+      model = loadScene(opt.models[i]);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--add: ") + e.what());
+    }
+    placeModel(scene, std::move(model), placement);
+  }
 }
 
 }  // namespace lo::tool

@@ -7,6 +7,7 @@
 /// `reference`, `lightmap` and `view` light a scene alike.
 
 #include <string>
+#include <vector>
 
 #include "core/file.h"
 #include "scene/scene.h"
@@ -35,5 +36,21 @@ NamedPaths sceneInputs(const std::string& scene);
 /// loadScene(path) with the flags applied. @throws InputError naming the flag
 /// (a radiance that is negative or not a number) or the file.
 Scene loadSceneWith(const std::string& path, const SceneOptions& opt);
+
+/// Objects added to a baked scene (`render`, `view`, `reference`): --add
+/// MODEL (repeatable) placed by the --at x,y,z[,yaw[,scale]] of the same rank.
+struct AddedObjects {
+  std::vector<std::string> models;
+  std::vector<std::string> placements;
+  bool empty() const { return models.empty(); }
+};
+
+/// Registers --add and --at on `cmd`.
+void addObjectOptions(CLI::App* cmd, AddedObjects& opt);
+
+/// Loads each --add model and joins it to `scene` at its --at
+/// (scene/place_model.h). @throws InputError naming the flag when the counts
+/// differ, a placement does not parse or a model does not load.
+void placeObjects(Scene& scene, const AddedObjects& opt);
 
 }  // namespace lo::tool

@@ -38,6 +38,7 @@ namespace {
 struct ViewOptions {
   std::string scene;
   SceneOptions sceneOptions;  // --sky
+  AddedObjects objects;       // --add, --at
   std::string lights;
   CameraOptions camera;
   int width = 800, height = 600;
@@ -72,6 +73,7 @@ int runView(const ViewOptions& opt) {
   view.path = std::move(path);
 
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
+  placeObjects(scene, opt.objects);
   printSceneWarnings(scene);
   std::optional<LoadedVdl> baked;
   if (!opt.progressive) {
@@ -131,6 +133,9 @@ int runView(const ViewOptions& opt) {
   }
 
   Renderer renderer(scene, octree, opt.shading.rendererParams());
+  if (!opt.objects.empty() && baked) {
+    setAddedObjectsLight(renderer, baked->grid, opt.shading, octreeParams, opt.lights);
+  }
   opt.shading.prepareLighting(renderer, scene, octree, opt.view.quiet);
   octree = GpuOctree();  // uploaded; the CPU copy is not needed any more
   if (!opt.view.quiet && !view.path) std::printf("%s", viewerKeyHelp());
@@ -158,6 +163,7 @@ std::function<int()> addViewCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   addSceneOptions(cmd, opt->sceneOptions);
+  addObjectOptions(cmd, opt->objects);
   cmd->add_option("lights", opt->lights,
                   "Baked VDL grid (.vdb from `lightoctree bake`); not with --progressive")
       ->check(CLI::ExistingFile);

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "cluster/volume_light.h"
 #include "core/error.h"
 #include "scene/scene_files.h"
 #include "raytrace/ray_tracer.h"
@@ -49,6 +50,7 @@ PhotonParams BakeParams::photonParams() const {
   p.includeDirect = includeDirect;
   p.seed = seed;
   p.region = region;
+  p.segments = freeSpace;
   return p;
 }
 
@@ -100,6 +102,7 @@ std::string BakeParams::ToString() const {
          (occlusion ? "" : ", no occlusion") + (edgeCorrection ? "" : ", no edge correction") +
          (separateCaustics ? "" : ", caustics merged") +
          (smoothing ? ", smoothing" : "") +
+         (freeSpace ? ", free space " + std::to_string(freeSpaceLevels) + " levels up" : "") +
          "}";
 }
 
@@ -361,6 +364,11 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
   BakeParams params = requested;
   if (params.region.empty()) params.region = scene.region;
   checkParams(params, processes);
+  if (params.freeSpaceLevels < 0 || params.freeSpaceLevels >= params.depth) {
+    throw InputError("--free-space-levels " + std::to_string(params.freeSpaceLevels) +
+                     ": the free-space grid is 0 to depth - 1 = " +
+                     std::to_string(params.depth - 1) + " levels coarser than the surface grid");
+  }
   // What the .vdb can store, checked before any work: OpenVDB refuses a
   // transform whose scale cubed is below 3e-15 (math::ScaleMap).
   if (scene.triangleCount() > 0) {
@@ -429,6 +437,19 @@ LevelParams BakeParams::levelParams() const {
 
 namespace bake_internal {
 
+/// The free-space light of a bake, timed as its own stage.
+VolumeLight freeSpaceLight(const std::vector<PhotonSegment>& segments, const GridFrame& frame,
+                           const BakeParams& params, ProgressSink* progress,
+                           std::vector<StageReport>& stages) {
+  StageTimer timer(stages, "free-space light");
+  VolumeLightParams vp;
+  vp.levels = params.freeSpaceLevels;
+  VolumeLight volume = buildVolumeLight(segments, frame, vp, progress);
+  timer.finish(formatCount(volume.size()) + " voxels from " + formatCount(segments.size()) +
+               " light rays");
+  return volume;
+}
+
 /// The photons a target bake may store: maxPhotons, or fewer when the
 /// memory left beside the voxels (kBakeBytesPerVoxel) does not hold them at
 /// kBakeBytesPerPhoton plus the unscaled copy the passes keep.
@@ -474,6 +495,7 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   const double target = params.targetError;
 
   std::vector<Photon> raw;  // photons of paths 0 .. emitted-1, powers not yet scaled
+  std::vector<PhotonSegment> rawSegments;  // their segments (BakeParams::freeSpace)
   size_t emitted = 0, empty = 0, missed = 0;
   size_t goal = std::min(cap, std::max(kMinPilotPhotons, kPilotPhotonsPerVoxel * grid.size()));
   std::vector<Photon> scaled;
@@ -491,11 +513,15 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
         missed += pathMissed;
         return raw.size() < goal;
       };
+      const PhotonTracer::SegmentSink keepSegments = [&](const PhotonSegment* p, uint32_t n) {
+        rawSegments.insert(rawSegments.end(), p, p + n);
+      };
       while (tracer.canStore() && raw.size() < goal) {
         const size_t batch = photonBatchPaths(goal, raw.size(), emitted, maxEmitted);
         if (batch == 0) break;
         const size_t before = raw.size();
-        tracer.trace(uint64_t(emitted), batch, take);
+        tracer.trace(uint64_t(emitted), batch, take,
+                     params.freeSpace ? keepSegments : PhotonTracer::SegmentSink());
         bar.advance(std::min(raw.size(), goal) - std::min(before, goal));
       }
     }
@@ -528,6 +554,11 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
     goal = nextPassPhotons(raw.size(), s.noise.quantile, target, cap);
   }
   r.metadata = bakeMetadata(scene, params, int64_t(raw.size()), int64_t(emitted), s.level.radius);
+  if (params.freeSpace) {
+    scaleSegmentPower(rawSegments, emitted);
+    r.grid.volume = freeSpaceLight(rawSegments, r.grid.frame, params, progress, s.stages);
+  }
+  rawSegments = std::vector<PhotonSegment>();
   if (params.keepPhotons) {
     r.photons.photons = std::move(scaled);
     r.photons.emittedPaths = emitted;
@@ -560,6 +591,11 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
 
   r.grid = bakeLevel(scene, photons.photons, params.levelParams(), progress, &s.level, &s.stages);
   s.noise = summarizeNoise(r.grid);
+  if (params.freeSpace) {
+    r.grid.volume = bake_internal::freeSpaceLight(photons.segments, r.grid.frame, params, progress,
+                                                  s.stages);
+  }
+  photons.segments = std::vector<PhotonSegment>();
   r.metadata = bakeMetadata(scene, params, int64_t(photons.photons.size()),
                             int64_t(photons.emittedPaths), s.level.radius);
   if (params.keepPhotons) r.photons = std::move(photons);

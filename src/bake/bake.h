@@ -118,6 +118,13 @@ struct BakeParams {
   bool separateCaustics = true;
   /// Layer-aware smoothing of the estimates (`--smoothing`): smoothVdlGrid.
   bool smoothing = true;
+  /// Free-space light (`--free-space`): the light in every voxel of a grid
+  /// freeSpaceLevels coarser than the surface grid, surfaces or not, from the
+  /// photon paths' track lengths (cluster/volume_light.h), for objects that
+  /// were not baked (VdlGrid::volume). A distributed bake makes it on rank 0
+  /// from every rank's segments: the same bytes.
+  bool freeSpace = true;
+  int freeSpaceLevels = 2;
   /// A region of interest (`--bounds`; empty = the whole scene): the grid
   /// covers it alone, photons are stored only inside it, and directional
   /// lights emit over its footprint (PhotonParams::region).

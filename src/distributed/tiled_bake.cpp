@@ -23,6 +23,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "cluster/volume_light.h"
 #include "core/error.h"
 #include "core/resources.h"
 #include "distributed/vdl_grid_parts.h"
@@ -297,6 +298,16 @@ class RankBake {
     st_.level.gatherClusterSeconds = mine_.gatherClusterSeconds;
     BakeResult result;
     result.grid = std::move(merged_);
+    if (me_ == 0 && params_.freeSpace) {
+      StageTimer timer(st_.stages, "free-space light");
+      scaleSegmentPower(allSegments_, size_t(emitted_));
+      VolumeLightParams vp;
+      vp.levels = params_.freeSpaceLevels;
+      result.grid.volume = buildVolumeLight(allSegments_, result.grid.frame, vp, progress_);
+      timer.finish(formatCount(result.grid.volume.size()) + " voxels from " +
+                   formatCount(allSegments_.size()) + " light rays");
+    }
+    allSegments_ = std::vector<PhotonSegment>();
     result.metadata =
         bakeMetadata(scene_, params_, int64_t(stored_), int64_t(emitted_), st_.level.radius);
     if (me_ == 0) {
@@ -326,6 +337,9 @@ class RankBake {
     bool planned = false;
     std::vector<Photon> batch;
     std::vector<uint32_t> pathPhotons;
+    std::vector<PhotonSegment> segments;
+    std::vector<uint32_t> pathSegments;
+    allSegments_.clear();
     Progress bar(progress_, "Tracing photons", target);
     while (target > 0 && tracer.canStore() && stored_ < target) {
       const size_t paths = photonBatchPaths(target, size_t(stored_), size_t(emitted_), maxEmitted);
@@ -335,8 +349,21 @@ class RankBake {
       const uint64_t last = emitted_ + uint64_t(paths) * uint64_t(me_ + 1) / uint64_t(ranks_);
       batch.clear();
       pathPhotons.clear();
+      segments.clear();
+      pathSegments.clear();
       Stopwatch traceClock;
-      tracer.trace(first, size_t(last - first), batch, pathPhotons);
+      tracer.trace(
+          first, size_t(last - first),
+          [&](const Photon* path, uint32_t n, uint32_t, bool) {
+            if (n > 0) batch.insert(batch.end(), path, path + n);
+            pathPhotons.push_back(n);
+            return true;
+          },
+          params_.freeSpace ? PhotonTracer::SegmentSink([&](const PhotonSegment* p, uint32_t n) {
+            segments.insert(segments.end(), p, p + n);
+            pathSegments.push_back(n);
+          })
+                            : PhotonTracer::SegmentSink());
       mine_.traceSeconds += traceClock.seconds();
 
       // Where the map's last photon lies: the ranks before hold `before`.
@@ -351,6 +378,25 @@ class RankBake {
         kept[1] += pathPhotons[i] == 0;
       }
       batch.resize(size_t(kept[2]));
+      if (params_.freeSpace) {
+        // The kept paths' segments, to rank 0 in rank (= path) order: the
+        // free-space light is made there from all of them, as one process
+        // makes it (the same bytes).
+        size_t keep = 0;
+        for (size_t i = 0; i < size_t(kept[0]) && i < pathSegments.size(); ++i) keep += pathSegments[i];
+        segments.resize(keep);
+        const char* bytes = reinterpret_cast<const char*>(segments.data());
+        const std::vector<std::vector<char>> parts =
+            comm_.gatherBytes(std::vector<char>(bytes, bytes + keep * sizeof(PhotonSegment)), 0);
+        if (me_ == 0) {
+          for (const std::vector<char>& part : parts) {
+            const size_t n = part.size() / sizeof(PhotonSegment);
+            const size_t old = allSegments_.size();
+            allSegments_.resize(old + n);
+            std::memcpy(static_cast<void*>(allSegments_.data() + old), part.data(), n * sizeof(PhotonSegment));
+          }
+        }
+      }
       mine_.photonsTraced += kept[2];
       comm_.allreduceSum(kept, 3);
       emitted_ += kept[0];
@@ -573,6 +619,8 @@ class RankBake {
   RankStats mine_;
   TilePlan plan_;
   std::vector<Photon> held_;  ///< this rank's tiles' and halo's photons, in map order
+  /// Rank 0 with BakeParams::freeSpace: every kept path's segments, in path order.
+  std::vector<PhotonSegment> allSegments_;
   uint64_t stored_ = 0, emitted_ = 0, empty_ = 0, unsent_ = 0;
   SurfaceGrid grid_;             ///< this rank's tiles and halo
   std::vector<uint32_t> owned_;  ///< grid_ indices of this rank's voxels

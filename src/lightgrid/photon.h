@@ -23,4 +23,15 @@ struct Photon {
   uint16_t caustic = 0;
 };
 
+/// One ray of a photon path whose light the octree holds: it starts where
+/// the light left its last surface (or, for the sky's and with
+/// --include-direct, its emitter) and ends at the next hit, or beyond the
+/// scene when it hit nothing. The free-space light is the track length of
+/// these rays through each volume voxel (cluster/volume_light.h).
+struct PhotonSegment {
+  Vec3 from;   ///< world space
+  Vec3 to;     ///< world space
+  Vec3 power;  ///< RGB flux carried along it, W
+};
+
 }  // namespace lo

@@ -18,6 +18,7 @@
 
 #include "core/math.h"
 #include "lightgrid/grid_frame.h"
+#include "lightgrid/volume_light.h"
 
 namespace lo {
 
@@ -152,6 +153,9 @@ struct VdlGrid : LightGridVoxels {
   /// empty = none recorded (files without layers).
   std::vector<Vec3> points;
   VdlLayers layers;  ///< layers 1 and 2 of the voxels that have them
+  /// The free-space light (empty when not baked): not a voxel array of the
+  /// table above; it has its own, coarser voxels.
+  VolumeLight volume;
 
   const Vdl* vdlsOf(size_t v) const { return vdls.data() + v * size_t(maxVdls); }
   const Vdl* layerVdlsOf(size_t e) const { return layers.vdls.data() + e * size_t(maxVdls); }

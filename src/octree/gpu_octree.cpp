@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "lightgrid/light_grid_schema.h"
 #include "octree/adaptive_leaves.h"
 
 namespace lo {
@@ -256,6 +257,15 @@ class OctreeBuilder {
         depth_(grid.frame.depth),
         sh_(grid.shTerms > 0),
         adaptive_(collapseLeaves(grid, params.tolerance, params.cosineCorrection)) {}
+  /// A free-space octree: each leaf's light preceded by its header texel
+  /// (octree_layout.h), headers[v] for voxel v; no collapsed leaves.
+  OctreeBuilder(const VdlGrid& grid, const GpuOctreeParams& params, std::vector<Vec3> headers)
+      : grid_(grid),
+        params_(params),
+        depth_(grid.frame.depth),
+        sh_(grid.shTerms > 0),
+        adaptive_(collapseLeaves(grid, 0.0f, false)),
+        headers_(std::move(headers)) {}
 
   GpuOctree build() {
     indexLayers();
@@ -300,6 +310,7 @@ class OctreeBuilder {
 
   /// Texels of a voxel's leaf: its light, or a layer block (octree_layout.h).
   size_t voxelTexels(size_t v) const {
+    if (!headers_.empty()) return 1 + texelsOf(grid_.vdlCount[v]);
     if (extraCount_[v] == 0) return texelsOf(grid_.vdlCount[v]);
     size_t n = 2 + texelsOf(grid_.vdlCount[v]);
     for (uint32_t e = extraFirst_[v]; e < extraFirst_[v] + extraCount_[v]; ++e) {
@@ -596,6 +607,7 @@ class OctreeBuilder {
   /// A voxel's leaf: its VDLs (or SH terms), or a layer block.
   void writeVoxelLeaf(uint8_t* t, size_t v) {
     const int count = grid_.vdlCount[v];
+    if (!headers_.empty()) writeTexel(nextVdl_++, headers_[v], 0.0f);
     // An SH leaf's flag is 1 (a leaf); its texel count is the octree's shTerms.
     writeLeafTexel(t, uint8_t(extraCount_[v] > 0 ? LO_FLAG_LAYERED : sh_ ? 1u : uint(count)));
     if (extraCount_[v] > 0) {
@@ -654,6 +666,7 @@ class OctreeBuilder {
   const int depth_;
   const bool sh_;
   const AdaptiveLeaves adaptive_;
+  std::vector<Vec3> headers_;  ///< free-space octree: per voxel
   std::vector<uint32_t> extraFirst_;
   std::vector<uint8_t> extraCount_;
   std::vector<Leaf> leaves_;
@@ -672,6 +685,39 @@ class OctreeBuilder {
 GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params) {
   gpu_octree_internal::validate(grid, params);
   return gpu_octree_internal::OctreeBuilder(grid, params).build();
+}
+
+GpuOctree buildVolumeOctree(const VolumeLight& volume, const GpuOctreeParams& params) {
+  using namespace layout;
+  const size_t n = volume.size();
+  if (volume.frame.depth < 1 || volume.irradiance.size() != n ||
+      volume.sh.size() != n * size_t(volume.shTerms) || volume.litLower.size() != n ||
+      volume.litUpper.size() != n) {
+    throw InputError("free-space octree: depth " + std::to_string(volume.frame.depth) + ", " +
+                     std::to_string(n) + " voxels and arrays of other lengths");
+  }
+  // The volume as a light grid of SH voxels without surfaces.
+  VdlGrid grid;
+  grid.frame = volume.frame;
+  grid.coords = volume.coords;
+  grid.irradiance = volume.irradiance;
+  grid.shTerms = volume.shTerms;
+  grid.sh = volume.sh;
+  grid.maxVdls = 1;
+  resizeVoxelArrays(grid);
+  grid.irradiance = volume.irradiance;
+  grid.sh = volume.sh;
+  std::vector<Vec3> headers(n);
+  for (size_t v = 0; v < n; ++v) {
+    for (int a = 0; a < 3; ++a) {
+      headers[v][a] = loPackVolumeBox(volume.litLower[v][a], volume.litUpper[v][a]);
+    }
+  }
+  GpuOctreeParams p = params;
+  p.tolerance = 0;
+  p.cosineCorrection = false;
+  gpu_octree_internal::validate(grid, p);
+  return gpu_octree_internal::OctreeBuilder(grid, p, std::move(headers)).build();
 }
 
 std::string GpuOctree::ToString() const {

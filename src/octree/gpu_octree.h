@@ -86,6 +86,14 @@ struct GpuOctree {
 /// space) and by how much the scene exceeds it.
 GpuOctree buildGpuOctree(const VdlGrid& grid, const GpuOctreeParams& params = {});
 
+/// The free-space light (VdlGrid::volume) as an octree of its own, in the
+/// same texel layout and precision as `params` asks (its tolerance and
+/// cosine correction do not apply): each leaf its SH texels after a header
+/// with the voxel's lit box (shaders/octree_layout.h). Drawn on the objects
+/// that were not baked (loVolumeIndirect). @throws InputError as
+/// buildGpuOctree, and for arrays of the wrong lengths.
+GpuOctree buildVolumeOctree(const VolumeLight& volume, const GpuOctreeParams& params = {});
+
 /// Memory of this octree per leaf next to the paper's figure (§4.2.1: 512 KiB
 /// octree + 4 MiB VDLs for 100k leaves of a depth-6 octree with k = 4 VDLs),
 /// as a few lines of text. Sizes only, no timing.

@@ -124,6 +124,20 @@ Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3&
                                           params.maxVdls, s));
 }
 
+Vec3 volumeIrradiance(const GpuOctree& volume, const Vec3& position, const Vec3& normal) {
+  if (volume.depth < 1 || volume.pool.empty()) return {0, 0, 0};
+  const float voxelSize = volume.cubeSize / float(1 << volume.depth);
+  lookup::LoSurface s;
+  s.n = toGlm(normal);
+  s.v = s.n;
+  s.baseColor = glm::vec3(1.0f);
+  s.metallic = 0.0f;
+  s.roughness = 1.0f;
+  s.ng = s.n;
+  return fromGlm(lookup::loVolumeIndirect(volume, toGlm(position), toGlm(volume.origin), voxelSize,
+                                          volume.depth, s));
+}
+
 OctreeIrradianceSample octreeIrradianceSample(const GpuOctree& octree, const Vec3& position,
                                               const Vec3& normal, const OctreeShadeParams& params) {
   OctreeIrradianceSample out;

@@ -26,6 +26,11 @@ struct OctreeShadeParams {
 Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3& normal,
                       const OctreeShadeParams& params = {});
 
+/// E(p, n) of a surface that was not baked, from the free-space octree
+/// (buildVolumeOctree): shaders/octree_lookup.h's loVolumeIndirect with the
+/// cosine as the response. Zero where no lit voxel lends its light.
+Vec3 volumeIrradiance(const GpuOctree& volume, const Vec3& position, const Vec3& normal);
+
 /// E(p, n) and the direction it comes from, for a directional lightmap
 /// (paper §4.2.3: one VDL per texel rebuilt for the specular term).
 struct OctreeIrradianceSample {

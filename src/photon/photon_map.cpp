@@ -87,8 +87,11 @@ struct Context {
   /// margin (emitBoxOfRegion).
   Bounds3 emitBounds;
   float epsilon = 0;
+  /// Where a ray that hits nothing ends as a PhotonSegment: beyond the scene.
+  float farDistance = 0;
   int maxBounces = 0;
   bool includeDirect = false;
+  bool segments = false;  ///< PhotonParams::segments
   uint64_t seed = 0;
 };
 
@@ -98,6 +101,8 @@ struct ChunkResult {
   std::vector<uint32_t> pathPhotons;  ///< stored photons per path
   std::vector<uint32_t> pathRays;     ///< rays per path
   std::vector<uint8_t> pathMissed;    ///< 1: the path's first ray hit nothing
+  std::vector<PhotonSegment> segments;   ///< with PhotonParams::segments
+  std::vector<uint32_t> pathSegments;    ///< segments per path
 };
 
 inline Vec3 uniformSphere(float u1, float u2) {
@@ -322,9 +327,13 @@ inline bool roulette(Rng& rng, const Vec3& tint, Vec3& power) {
 }
 
 /// Traces path `pathIndex` and appends its stored photons (unscaled power) to `out`.
+/// With ctx.segments, also appends to `segments` every ray whose light a
+/// stored photon would carry (PhotonSegment), and counts them in segmentCount.
 inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon>& out,
-                      uint32_t& photonCount, uint32_t& rayCount, bool& missed) {
+                      uint32_t& photonCount, uint32_t& rayCount, bool& missed,
+                      std::vector<PhotonSegment>& segments, uint32_t& segmentCount) {
   Rng rng(ctx.seed, pathIndex);
+  segmentCount = 0;
   photonCount = 0;
   rayCount = 0;
   missed = false;
@@ -340,8 +349,15 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
   bool specularChain = true;
   for (uint32_t bounce = 0;; ++bounce) {
     ++rayCount;
+    // The light of this ray is what the octree holds (a photon at its end
+    // would be stored): bounced light, the sky's, or direct with --include-direct.
+    const bool held = bounce > 0 || ctx.includeDirect || start.storeFirstHit;
     if (!ctx.tracer->intersect(org, dir, hit)) {
       missed = bounce == 0;
+      if (ctx.segments && held) {
+        segments.push_back({org, org + dir * ctx.farDistance, power});
+        ++segmentCount;
+      }
       return;
     }
 
@@ -353,6 +369,10 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     // From the ray parameter rather than the barycentrics: exactly coincident
     // triangles give the same t whichever of them Embree reports.
     Vec3 p = org + dir * t;
+    if (ctx.segments && held) {
+      segments.push_back({org, p, power});
+      ++segmentCount;
+    }
     const TriangleInfo& tri = ctx.triangles[hit.triangle];
     const BsdfLobes mat =
         bsdfLobesAt(*ctx.scene, ctx.materials[tri.material], hit.triangle, hit.b1, hit.b2);
@@ -501,11 +521,14 @@ struct TraceChunks {
       out.pathPhotons.clear();
       out.pathRays.clear();
       out.pathMissed.clear();
+      out.segments.clear();
+      out.pathSegments.clear();
       size_t begin = c * kChunkPaths, end = std::min(batchPaths, begin + kChunkPaths);
       for (size_t i = begin; i < end; ++i) {
-        uint32_t photons = 0, rays = 0;
+        uint32_t photons = 0, rays = 0, segments = 0;
         bool missed = false;
-        tracePath(*ctx, firstPath + i, out.photons, photons, rays, missed);
+        tracePath(*ctx, firstPath + i, out.photons, photons, rays, missed, out.segments, segments);
+        if (ctx->segments) out.pathSegments.push_back(segments);
         out.pathPhotons.push_back(photons);
         out.pathRays.push_back(rays);
         out.pathMissed.push_back(missed ? 1 : 0);
@@ -555,6 +578,7 @@ PhotonTracer::PhotonTracer(const Scene& scene, const PhotonParams& params)
   ctx.emitBounds = region.empty() ? ctx.bounds : emitBoxOfRegion(region, ctx.bounds);
   ctx.maxBounces = params.maxBounces;
   ctx.includeDirect = params.includeDirect;
+  ctx.segments = params.segments;
   ctx.seed = params.seed;
 
   ctx.triangles.resize(traced.triangleCount());
@@ -573,6 +597,7 @@ PhotonTracer::PhotonTracer(const Scene& scene, const PhotonParams& params)
   Vec3 ext = ctx.bounds.extent();
   float scale = length(ext) + maxComponent(max(abs3(ctx.bounds.lower), abs3(ctx.bounds.upper)));
   ctx.epsilon = kRayEpsilonScale * std::max(scale, 1e-6f);
+  ctx.farDistance = 2.0f * std::max(scale, 1e-6f);
   st.tracer = std::make_unique<RayTracer>(traced);
   ctx.tracer = st.tracer.get();
 }
@@ -583,7 +608,8 @@ Vec3 PhotonTracer::emittedPower() const { return state_->emittedPower; }
 
 bool PhotonTracer::canStore() const { return state_->tracer != nullptr; }
 
-void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath) const {
+void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath,
+                         const SegmentSink& onSegments) const {
   using namespace photon_internal;
   if (count == 0) return;
   if (!state_->tracer) {
@@ -602,9 +628,18 @@ void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath) c
     ChunkResult& chunk = chunks[c];
     if (origin != Vec3{0, 0, 0}) {
       for (Photon& photon : chunk.photons) photon.position += origin;
+      for (PhotonSegment& segment : chunk.segments) {
+        segment.from += origin;
+        segment.to += origin;
+      }
     }
     const Photon* photons = chunk.photons.data();
+    const PhotonSegment* segments = chunk.segments.data();
     for (size_t i = 0; i < chunk.pathPhotons.size(); ++i) {
+      if (onSegments && !chunk.pathSegments.empty()) {
+        onSegments(segments, chunk.pathSegments[i]);
+        segments += chunk.pathSegments[i];
+      }
       if (!onPath(photons, chunk.pathPhotons[i], chunk.pathRays[i], chunk.pathMissed[i] != 0)) {
         return;
       }
@@ -666,11 +701,16 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
     empty += n == 0;
     return map.photons.size() < target;
   };
+  const PhotonTracer::SegmentSink keepSegments =
+      params.segments ? PhotonTracer::SegmentSink([&](const PhotonSegment* segments, uint32_t n) {
+        map.segments.insert(map.segments.end(), segments, segments + n);
+      })
+                      : PhotonTracer::SegmentSink();
   while (map.photons.size() < target) {
     const size_t batch = photonBatchPaths(target, map.photons.size(), emitted, maxEmitted);
     if (batch == 0) break;
     const size_t before = map.photons.size();
-    tracer.trace(uint64_t(emitted), batch, take);
+    tracer.trace(uint64_t(emitted), batch, take, keepSegments);
     bar.advance(map.photons.size() - before);
   }
 
@@ -679,12 +719,18 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   map.missedPaths = missed;
   map.raysTraced = rays;
   scalePhotonPower(map.photons, emitted);
+  scaleSegmentPower(map.segments, emitted);
   return map;
 }
 
 void scalePhotonPower(std::vector<Photon>& photons, size_t emittedPaths) {
   const float invPaths = emittedPaths > 0 ? float(1.0 / double(emittedPaths)) : 0.0f;
   for (Photon& ph : photons) ph.power *= invPaths;
+}
+
+void scaleSegmentPower(std::vector<PhotonSegment>& segments, size_t emittedPaths) {
+  const float invPaths = emittedPaths > 0 ? float(1.0 / double(emittedPaths)) : 0.0f;
+  for (PhotonSegment& segment : segments) segment.power *= invPaths;
 }
 
 }  // namespace lo

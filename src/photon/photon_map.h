@@ -23,6 +23,9 @@ struct PhotonParams {
   /// Stop after this many emitted paths even if fewer photons were stored
   /// (a scene whose light never reaches a diffuse surface). 0 = 64 * storedPhotons.
   size_t maxEmitted = 0;
+  /// Also keep the rays the stored light travels along (PhotonMap::segments):
+  /// what the free-space light of the octree is estimated from.
+  bool segments = false;
   /// A region of interest (world space; empty = the whole scene): only
   /// photons inside it are stored, and directional lights emit over its
   /// footprint (a disc of its bounding sphere) instead of the whole scene's,
@@ -32,6 +35,9 @@ struct PhotonParams {
 
 struct PhotonMap {
   std::vector<Photon> photons;
+  /// With PhotonParams::segments: the rays of the same paths whose light the
+  /// photons hold (lightgrid/photon.h), in path order, powers scaled as theirs.
+  std::vector<PhotonSegment> segments;
   size_t emittedPaths = 0;      ///< paths traced to obtain `photons`
   size_t emptyPaths = 0;        ///< of those, paths that stored no photon
   /// Of those, paths whose first ray hit no surface (light aimed beside the
@@ -73,7 +79,11 @@ class PhotonTracer {
       std::function<bool(const Photon* photons, uint32_t count, uint32_t rays, bool missed)>;
   /// Traces paths [first, first + count) in parallel (TBB) and hands each to
   /// `onPath` in path order. Not reentrant (one call at a time per tracer).
-  void trace(uint64_t first, size_t count, const PathSink& onPath) const;
+  /// With PhotonParams::segments, `onSegments` gets each path's segments
+  /// just before `onPath` gets its photons.
+  using SegmentSink = std::function<void(const PhotonSegment* segments, uint32_t count)>;
+  void trace(uint64_t first, size_t count, const PathSink& onPath,
+             const SegmentSink& onSegments = {}) const;
   /// The same, appending the photons to `photons` and each path's photon
   /// count to `pathPhotons`.
   void trace(uint64_t first, size_t count, std::vector<Photon>& photons,
@@ -97,5 +107,7 @@ size_t maxEmittedPaths(const PhotonParams& params);
 /// Divides every photon's power by the paths emitted to obtain them (the
 /// Monte Carlo estimator of the emitted flux): the last step of a map.
 void scalePhotonPower(std::vector<Photon>& photons, size_t emittedPaths);
+/// The same for segments.
+void scaleSegmentPower(std::vector<PhotonSegment>& segments, size_t emittedPaths);
 
 }  // namespace lo

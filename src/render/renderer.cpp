@@ -119,6 +119,7 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   octreeTimer.finish(formatCount(octree.leafCount) + " leaves");
   StageTimer geometryTimer(r.startup, "geometry and textures");
   r.geometry.upload(scene, r.space);
+  for (const DrawRange& range : r.geometry.ranges) r.hasMovingRanges = r.hasMovingRanges || range.moving;
   r.geometry.sceneTriangles = scene.triangleCount();
   size_t textures = 0;
   for (const auto& t : r.geometry.textures) textures += t.get() != 0 ? 1 : 0;
@@ -221,6 +222,25 @@ void Renderer::setOctree(const GpuOctree& octree) {
   impl_->probe.valid = false;  // it shows the old octree's light
 }
 
+void Renderer::setFreeSpaceLight(const GpuOctree& volume) {
+  Impl& r = *impl_;
+  OctreeTextures::checkLimits(volume, r.params.max3DTextureSize, r.params.max2DTextureSize);
+  if (!r.sceneMovingProgram) {
+    r.sceneMovingProgram = GlProgram(
+        buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT", "LO_FREE_SPACE"}));
+    glUniformBlockBinding(r.sceneMovingProgram.get(),
+                          glGetUniformBlockIndex(r.sceneMovingProgram.get(), "LightBlock"), 0);
+    r.sceneIndirectMovingProgram =
+        GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_FREE_SPACE"}));
+  }
+  r.volumeTextures.upload(volume);
+  r.volumeOrigin = r.space.toRender(volume.origin);
+  r.hasVolume = true;
+  r.probe.valid = false;
+}
+
+bool Renderer::hasFreeSpaceLight() const { return impl_->hasVolume; }
+
 RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& params) {
   Impl& r = *impl_;
   const int s = params.supersample;
@@ -282,7 +302,11 @@ void compileAllShaders() {
     const GlProgram program(buildProgram(files));
   }
   for (const std::vector<std::string>& defines : std::vector<std::vector<std::string>>{
-           {"LO_DIRECT_LIGHT"}, {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"}, {"LO_ATLAS_LIGHTING"}}) {
+           {"LO_DIRECT_LIGHT"},
+           {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"},
+           {"LO_ATLAS_LIGHTING"},
+           {"LO_DIRECT_LIGHT", "LO_FREE_SPACE"},
+           {"LO_FREE_SPACE"}}) {
     const GlProgram program(buildProgram({"render_scene.vert", "render_scene.frag"}, defines));
   }
 }

@@ -107,6 +107,14 @@ class Renderer {
   /// context's limits (the old octree is kept then).
   void setOctree(const GpuOctree& octree);
 
+  /// The free-space light (buildVolumeOctree of VdlGrid::volume): what the
+  /// objects added after the bake (Scene::movingMaterialsFrom) take their
+  /// indirect light from, instead of the surfaces' octree, whose light
+  /// belongs to the baked surfaces. Without it they read the surfaces'.
+  /// @throws InputError like setOctree.
+  void setFreeSpaceLight(const GpuOctree& volume);
+  bool hasFreeSpaceLight() const;
+
   /// Uploads lightmap UVs (per triangle corner, of the scene given to the
   /// constructor) and the pages baked for them, for RenderParams::lighting =
   /// Atlas: the indirect light of a fragment is then one VDL rebuilt from the

@@ -69,6 +69,9 @@ struct DrawRange {
   float dielectricF0 = 0.04f;  ///< the dielectric's specular layer (Material::dielectricF0)
   float specular = 1;          ///< its weight (KHR_materials_specular)
   bool unlit = false;          ///< Material::unlit: unshaded, no shadow
+  /// An object added after the bake (Scene::movingMaterialsFrom): lit by
+  /// the free-space light when the renderer has it.
+  bool moving = false;
 };
 
 /// The scene's triangles on the GPU, grouped by material in DrawCategory
@@ -152,6 +155,14 @@ struct Renderer::Impl {
   render_internal::SceneLights lights;
   render_internal::ReflectionProbe probe;
   render_internal::OctreeTextures octreeTextures;
+  /// The free-space light (setFreeSpaceLight) and the scene programs that
+  /// draw the added objects with it (LO_FREE_SPACE), with and without the
+  /// direct light; empty until set.
+  render_internal::OctreeTextures volumeTextures;
+  bool hasVolume = false;
+  Vec3 volumeOrigin{0, 0, 0};  ///< render space
+  render_internal::GlProgram sceneMovingProgram, sceneIndirectMovingProgram;
+  bool hasMovingRanges = false;
 
   render_internal::GlBuffer atlasVbo;
   render_internal::GlTexture atlasIrradiance, atlasDirection;
@@ -180,7 +191,10 @@ struct Renderer::Impl {
   void setFrameUniforms(GLuint program, const PinholeCamera& camera, const RenderParams& rp,
                         const glm::mat4& viewProj, bool reflect, float exposureScale,
                         bool encodeSrgb);
-  void drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye, GLuint program);
+  /// `movingProgram` (0: none) draws the ranges of added objects, with the
+  /// free-space light's textures bound in place of the octree's.
+  void drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye, GLuint program,
+                  GLuint movingProgram);
 
   // reflection_probe.cpp
   /// Renders the probe's six faces with the full scene program, reflections

@@ -181,24 +181,39 @@ void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, con
 /// from `eye` without depth writes; transmissive ones over a copy of what
 /// was drawn before them.
 void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye,
-                                GLuint p) {
-  auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
+                                GLuint staticProgram, GLuint movingProgram) {
   glBindVertexArray(geometry.vao.get());
-  const GLint hasTexture = loc("uHasBaseColorTexture");
-  const GLint hasNormal = loc("uHasNormalTexture");
-  const GLint normalScale = loc("uNormalScale");
-  const GLint hasMr = loc("uHasMetallicRoughnessTexture");
-  const GLint hasOcclusion = loc("uHasOcclusionTexture");
-  const GLint occlusionStrength = loc("uOcclusionStrength");
-  const GLint transmission = loc("uTransmission");
-  const GLint hasEmissive = loc("uHasEmissiveTexture");
-  const GLint alphaMode = loc("uAlphaMode");
-  const GLint baseAlpha = loc("uBaseAlpha");
-  const GLint alphaCutoff = loc("uAlphaCutoff");
-  const GLint thickness = loc("uThickness");
-  const GLint ior = loc("uIor");
-  const GLint dielectric = loc("uDielectric");
-  const GLint unlit = loc("uUnlit");
+  GLuint p = 0;
+  GLint hasTexture = -1, hasNormal = -1, normalScale = -1, hasMr = -1, hasOcclusion = -1,
+        occlusionStrength = -1, transmission = -1, hasEmissive = -1, alphaMode = -1, baseAlpha = -1,
+        alphaCutoff = -1, thickness = -1, ior = -1, dielectric = -1, unlit = -1;
+  // The program of a range, in use with its octree's textures bound.
+  auto use = [&](GLuint program) {
+    if (program == p) return;
+    p = program;
+    glUseProgram(p);
+    if (p == movingProgram) {
+      volumeTextures.bind(p, 0, 1, 3);
+    } else {
+      octreeTextures.bind(p, 0, 1, 3);
+    }
+    auto loc = [p](const char* name) { return glGetUniformLocation(p, name); };
+    hasTexture = loc("uHasBaseColorTexture");
+    hasNormal = loc("uHasNormalTexture");
+    normalScale = loc("uNormalScale");
+    hasMr = loc("uHasMetallicRoughnessTexture");
+    hasOcclusion = loc("uHasOcclusionTexture");
+    occlusionStrength = loc("uOcclusionStrength");
+    transmission = loc("uTransmission");
+    hasEmissive = loc("uHasEmissiveTexture");
+    alphaMode = loc("uAlphaMode");
+    baseAlpha = loc("uBaseAlpha");
+    alphaCutoff = loc("uAlphaCutoff");
+    thickness = loc("uThickness");
+    ior = loc("uIor");
+    dielectric = loc("uDielectric");
+    unlit = loc("uUnlit");
+  };
   // glTF: single-sided materials are culled from behind (counter-clockwise
   // winding in front, as the loader keeps it).
   glFrontFace(GL_CCW);
@@ -206,6 +221,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
   bool copied = false, blending = false;
   for (size_t i = 0; i < geometry.ranges.size(); ++i) {
     const DrawRange& range = geometry.ranges[i];
+    use(range.moving && movingProgram ? movingProgram : staticProgram);
     const bool blended = geometry.rangeCategory[i] == kBlended;
     if (blended && !blending) {
       // Over the opaque scene, back to front, without depth writes.
@@ -355,7 +371,20 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
   const GLuint p = sceneProgramFor(rp, withDirect);
   glUseProgram(p);
   setFrameUniforms(p, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
-  drawRanges(width, height, encodeSrgb, eye, p);
+  // Added objects: the free-space light's program, its frame uniforms, and
+  // the free-space octree's frame in place of the surfaces'.
+  GLuint moving = 0;
+  if (hasVolume && hasMovingRanges && rp.mode != RenderMode::Voxels &&
+      rp.lighting == Lighting::Octree) {
+    moving = withDirect ? sceneMovingProgram.get() : sceneIndirectMovingProgram.get();
+    glUseProgram(moving);
+    setFrameUniforms(moving, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
+    glUniform3f(glGetUniformLocation(moving, "uOctreeOrigin"), volumeOrigin.x, volumeOrigin.y,
+                volumeOrigin.z);
+    glUniform1f(glGetUniformLocation(moving, "uVoxelSize"), volumeTextures.voxelSize);
+    glUniform1i(glGetUniformLocation(moving, "uDepth"), volumeTextures.depth);
+  }
+  drawRanges(width, height, encodeSrgb, eye, p, moving);
   glDisable(GL_CULL_FACE);
   glBindVertexArray(0);
   glBindSampler(5, 0);

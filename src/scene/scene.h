@@ -302,6 +302,10 @@ struct Scene {
   /// of the marker nodes' meshes, which are not part of the scene. Empty =
   /// none. The bake uses it when `--bounds` gives none.
   Bounds3 region;
+  /// Materials from this index on belong to objects added after the bake
+  /// (scene/place_model.h): the renderer lights them from the free-space
+  /// light, not the surfaces'. SIZE_MAX: none.
+  size_t movingMaterialsFrom = SIZE_MAX;
 
   size_t triangleCount() const { return indices.size() / 3; }
   Bounds3 bounds() const;

@@ -17,6 +17,15 @@ namespace lo::vdb_internal {
 /// droppableVdlGridNames): not part of the contract, ignored by the readers.
 constexpr const char* kDensityGrid = "density";
 
+/// The free-space light's grids (VdlGrid::volume), on their own coarser
+/// transform, and the file metadata giving their depth.
+constexpr const char* kVolumeIrradianceGrid = "volume_irradiance";
+constexpr const char* kVolumeShPrefix = "volume_sh";
+constexpr const char* kVolumeLitLowerGrid = "volume_lit_lower";
+constexpr const char* kVolumeLitUpperGrid = "volume_lit_upper";
+constexpr const char* kVolumeSegmentsGrid = "volume_segments";
+constexpr const char* kMetaFreeSpaceDepth = "free_space_depth";
+
 /// "layer<l>_": the prefix of surface layer l's grids (l = 1, 2).
 std::string layerPrefix(int layer);
 

@@ -241,19 +241,26 @@ class VdlChecker {
                  : std::to_string(bad) + " active values with NaN/Inf (first in '" + first + "')");
   }
 
+  /// The free-space light's grids (volume_*): on a coarser transform and
+  /// voxels of their own, checked among themselves.
+  static bool isVolumeGrid(const std::string& name) { return name.rfind("volume_", 0) == 0; }
+
   void checkSameTransform() {
-    const openvdb::GridBase* ref = nullptr;
+    const openvdb::GridBase* ref[2] = {nullptr, nullptr};
     for (const auto& g : *f_.grids) {
       if (!g) continue;
-      if (!ref) {
-        ref = g.get();
-      } else if (!(g->transform() == ref->transform())) {
+      const openvdb::GridBase*& r = ref[isVolumeGrid(g->getName()) ? 1 : 0];
+      if (!r) {
+        r = g.get();
+      } else if (!(g->transform() == r->transform())) {
         add("same_transform", false,
-            "grid '" + g->getName() + "' differs from '" + ref->getName() + "'");
+            "grid '" + g->getName() + "' differs from '" + r->getName() + "'");
         return;
       }
     }
-    add("same_transform", true, "every grid on one transform");
+    add("same_transform", true,
+        ref[1] ? "every grid on one transform, the free-space grids on theirs"
+               : "every grid on one transform");
   }
 
   /// Which active set a grid shares: the voxels' (0), or surface layer l's
@@ -339,11 +346,16 @@ class VdlChecker {
       if (!g) continue;
       const std::string slot = vdlSlot(g->getName());
       const int group = layerGroup(g->getName());
-      const std::string key = !slot.empty() ? slot : "layer" + std::to_string(group);
+      const bool volume = isVolumeGrid(g->getName());
+      const std::string key =
+          volume ? "volume" : !slot.empty() ? slot : "layer" + std::to_string(group);
       const openvdb::GridBase*& r = ref[key];
       if (!r) {
         r = g.get();
-        if (slot.empty()) {
+        if (volume) {
+          counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
+                    " in every free-space grid";
+        } else if (slot.empty()) {
           counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
                     (group == 0 ? " in every voxel grid"
                                 : " in every layer" + std::to_string(group) + " grid");

@@ -198,6 +198,87 @@ void readLayers(const std::string& path, const OpenedFile& f, const Transform& x
   }
 }
 
+/// The free-space light (vdb_write.cpp addVolumeSources) into g.volume,
+/// when the file has it. @throws InputError for grids that disagree or
+/// values a renderer cannot draw.
+void readVolume(const std::string& path, const OpenedFile& f, VdlGrid& g) {
+  const int depth = metaInt(path, *f.meta, kMetaFreeSpaceDepth, false, 0);
+  if (depth == 0 && !findGrid(f, kVolumeIrradianceGrid)) return;
+  if (depth < 1 || depth > g.frame.depth) {
+    throw InputError(path + ": file metadata " + kMetaFreeSpaceDepth + " = " +
+                     std::to_string(depth) + " is outside [1, depth " +
+                     std::to_string(g.frame.depth) + "]");
+  }
+  auto key = requireGrid<Vec3SGrid>(path, f, kVolumeIrradianceGrid);
+  const Transform& xform = key->transform();
+  VolumeLight& v = g.volume;
+  v.frame = readFrame(path, xform, depth, g.frame.offset);
+  const float expected = g.frame.voxelSize * float(1 << (g.frame.depth - depth));
+  if (!(std::fabs(v.frame.voxelSize - expected) <= 1e-4f * expected) ||
+      !(length(v.frame.origin - g.frame.origin) <= 1e-3f * expected)) {
+    throw InputError(path + ": grid '" + kVolumeIrradianceGrid + "' is not on the light grid's cube " +
+                     std::to_string(g.frame.depth - depth) + " levels coarser");
+  }
+  v.frame.origin = g.frame.origin;
+  v.frame.voxelSize = expected;
+  for (auto it = key->cbeginValueOn(); it; ++it) v.coords.push_back(fromVdb(it.getCoord()));
+  std::sort(v.coords.begin(), v.coords.end(), canonicalLess);
+  const int res = 1 << depth;
+  for (const Coord& c : v.coords) {
+    if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= res || c.y >= res || c.z >= res) {
+      throw InputError(path + ": free-space voxel " + c.ToString() + " lies outside [0, " +
+                       std::to_string(res) + ")^3");
+    }
+  }
+  int terms = 0;
+  while (terms < 9 && findGrid(f, kVolumeShPrefix + std::to_string(terms))) ++terms;
+  if (terms != 4 && terms != 9) {
+    throw InputError(path + ": " + std::to_string(terms) + " '" + kVolumeShPrefix +
+                     "<i>' grids; the free-space light has 4 or 9");
+  }
+  v.shTerms = terms;
+  const size_t n = v.coords.size();
+  auto readVec = [&](const std::string& name, std::vector<Vec3>& out, size_t per, size_t slot) {
+    auto grid = requireGrid<Vec3SGrid>(path, f, name);
+    checkTransform(path, *grid, xform);
+    if (grid->activeVoxelCount() != openvdb::Index64(n)) {
+      throw InputError(path + ": grid '" + name + "' has " +
+                       std::to_string(grid->activeVoxelCount()) + " active voxels, '" +
+                       kVolumeIrradianceGrid + "' has " + std::to_string(n));
+    }
+    out.resize(n * per);
+    auto acc = grid->getConstAccessor();
+    for (size_t k = 0; k < n; ++k) {
+      const Vec3 value = fromVdb(acc.getValue(toVdb(v.coords[k])));
+      if (!isFinite(value) || std::fabs(maxComponent(max(value, -value))) > kMaxStoredIrradiance) {
+        throw InputError(path + ": grid '" + name + "' at " + v.coords[k].ToString() + " holds " +
+                         value.ToString());
+      }
+      out[k * per + slot] = value;
+    }
+  };
+  readVec(kVolumeIrradianceGrid, v.irradiance, 1, 0);
+  for (int i = 0; i < terms; ++i) {
+    readVec(kVolumeShPrefix + std::to_string(i), v.sh, size_t(terms), size_t(i));
+  }
+  readVec(kVolumeLitLowerGrid, v.litLower, 1, 0);
+  readVec(kVolumeLitUpperGrid, v.litUpper, 1, 0);
+  for (size_t k = 0; k < n; ++k) {
+    for (int a = 0; a < 3; ++a) {
+      if (!(v.litLower[k][a] >= 0 && v.litUpper[k][a] <= 1 && v.litLower[k][a] <= v.litUpper[k][a])) {
+        throw InputError(path + ": free-space voxel " + v.coords[k].ToString() + " has lit box " +
+                         v.litLower[k].ToString() + " .. " + v.litUpper[k].ToString() +
+                         "; expected 0 <= lower <= upper <= 1");
+      }
+    }
+  }
+  v.segments.assign(n, 0.0f);
+  if (auto segments = openvdb::gridPtrCast<FloatGrid>(findGrid(f, kVolumeSegmentsGrid))) {
+    auto acc = segments->getConstAccessor();
+    for (size_t k = 0; k < n; ++k) v.segments[k] = acc.getValue(toVdb(v.coords[k]));
+  }
+}
+
 }  // namespace
 
 LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& origin) {
@@ -311,6 +392,7 @@ LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& 
     }
   }
   readLayers(path, f, xform, out);
+  readVolume(path, f, out.grid);
   checkReadableValues(path, out.grid);
   return out;
 }

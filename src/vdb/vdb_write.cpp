@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -184,6 +185,37 @@ FloatGrid::Ptr densityGrid(const VdlGrid& g, const Transform::Ptr& xform) {
   return grid;
 }
 
+/// The free-space light's grids (docs/vdb-contract.md), on its own
+/// coarser transform: volume_irradiance, volume_sh<i>, volume_lit_lower,
+/// volume_lit_upper, volume_segments.
+void addVolumeSources(std::vector<GridSource>& out, const VolumeLight& v, bool half) {
+  if (v.empty()) return;
+  const Transform::Ptr xform = frameTransform(v.frame);
+  auto vec = [&](const std::string& name, const std::string& units, bool mayHalve,
+                 std::function<Vec3(size_t)> value) {
+    out.push_back({name, [&v, xform, name, units, value, half, mayHalve]() -> openvdb::GridBase::Ptr {
+                     auto g = vectorGrid(name, units, openvdb::VEC_INVARIANT, xform, v.coords, value);
+                     if (half && mayHalve) g->setSaveFloatAsHalf(true);
+                     return g;
+                   }});
+  };
+  vec(kVolumeIrradianceGrid, "W/m^2 (mean over a surface's orientations: fluence / 4)", true,
+      [&v](size_t k) { return v.irradiance[k]; });
+  for (int i = 0; i < v.shTerms; ++i) {
+    vec(std::string(kVolumeShPrefix) + std::to_string(i),
+        "W/m^2 (SH term; E(n) = sum_i volume_sh<i> Y_i(n))", true,
+        [&v, i](size_t k) { return v.sh[k * size_t(v.shTerms) + size_t(i)]; });
+  }
+  vec(kVolumeLitLowerGrid, "voxel units from the voxel's lower corner", false,
+      [&v](size_t k) { return v.litLower[k]; });
+  vec(kVolumeLitUpperGrid, "voxel units from the voxel's lower corner", false,
+      [&v](size_t k) { return v.litUpper[k]; });
+  out.push_back({kVolumeSegmentsGrid, [&v, xform]() -> openvdb::GridBase::Ptr {
+                   return floatGrid(kVolumeSegmentsGrid, "light rays", xform, v.coords,
+                                    [&v](size_t k) { return v.segments[k]; });
+                 }});
+}
+
 void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& meta,
               const VdlWriteOptions& options, const Damage* damage, AtomicFileSet* into) {
   initOpenVdb();
@@ -234,7 +266,11 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
                          return g;
                        }});
   }
+  addVolumeSources(sources, grid.volume, options.halfFloat);
   openvdb::MetaMap fileMeta = fileMetadata(meta, grid);
+  if (!grid.volume.empty()) {
+    fileMeta.insertMeta(kMetaFreeSpaceDepth, openvdb::Int32Metadata(grid.volume.frame.depth));
+  }
   if (damage && damage->formatVersion != kVdlFormatVersion) {
     fileMeta.removeMeta(kMetaFormatVersion);
     if (damage->formatVersion != 0) {

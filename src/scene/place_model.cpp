@@ -1,0 +1,132 @@
+/// @file scene/place_model.cpp
+/// @brief placeModel: a model's arrays appended to a scene's, moved into place.
+
+#include "scene/place_model.h"
+
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "core/error.h"
+
+namespace lo {
+
+Placement parsePlacement(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    if (part.empty() || end == part.c_str() || *end != '\0' || !std::isfinite(v)) {
+      throw InputError("--at '" + text + "': '" + part + "' is not a finite number");
+    }
+    values.push_back(v);
+  }
+  if (values.size() < 3 || values.size() > 5) {
+    throw InputError("--at '" + text + "': expected x,y,z[,yaw[,scale]], got " +
+                     std::to_string(values.size()) + " numbers");
+  }
+  Placement p;
+  p.at = Vec3d{values[0], values[1], values[2]};
+  if (values.size() > 3) p.yawDegrees = float(values[3]);
+  if (values.size() > 4) {
+    if (!(values[4] > 0) || values[4] > 1e6) {
+      throw InputError("--at '" + text + "': the scale must lie in (0, 1e6]");
+    }
+    p.scale = float(values[4]);
+  }
+  return p;
+}
+
+namespace {
+
+/// Per-vertex values of `n` vertices from an array that may be empty: the
+/// array, or `fill` repeated.
+template <typename T>
+void appendOrFill(std::vector<T>& to, size_t toVertices, const std::vector<T>& from,
+                  size_t fromVertices, size_t per, const std::vector<T>& fill) {
+  if (to.empty() && from.empty()) return;
+  if (to.empty()) {
+    for (size_t v = 0; v < toVertices; ++v) to.insert(to.end(), fill.begin(), fill.end());
+  }
+  if (from.empty()) {
+    for (size_t v = 0; v < fromVertices; ++v) to.insert(to.end(), fill.begin(), fill.end());
+  } else {
+    to.insert(to.end(), from.begin(), from.begin() + std::ptrdiff_t(fromVertices * per));
+  }
+}
+
+/// Per-vertex normals from the faces (area-weighted), where a scene has none.
+std::vector<Vec3> faceAveragedNormals(const Scene& s) {
+  std::vector<Vec3> n(s.positions.size(), Vec3{0, 0, 0});
+  for (size_t t = 0; t < s.triangleCount(); ++t) {
+    const Vec3& a = s.positions[s.indices[3 * t]];
+    const Vec3 c = cross(s.positions[s.indices[3 * t + 1]] - a, s.positions[s.indices[3 * t + 2]] - a);
+    for (int k = 0; k < 3; ++k) n[s.indices[3 * t + size_t(k)]] += c;
+  }
+  for (Vec3& v : n) v = lengthSquared(v) > 0 ? normalize(v) : Vec3{0, 1, 0};
+  return n;
+}
+
+}  // namespace
+
+void placeModel(Scene& scene, Scene model, const Placement& placement) {
+  const float yaw = placement.yawDegrees * float(kPi / 180.0);
+  const float c = std::cos(yaw), s = std::sin(yaw);
+  auto turn = [c, s](const Vec3& v) { return Vec3{c * v.x + s * v.z, v.y, -s * v.x + c * v.z}; };
+  const Vec3 at = scene.toLocal(placement.at);
+  const Vec3d modelOrigin = model.origin;
+  for (Vec3& p : model.positions) {
+    const Vec3d world = Vec3d(p) + modelOrigin;  // the model's own coordinates
+    const Vec3 placed = turn(world.toVec3() * placement.scale) + at;
+    if (!isFinite(placed) || maxComponent(max(placed, -placed)) > kMaxCoordinate) {
+      throw InputError(model.sourcePath + " placed at --at puts a vertex at " + placed.ToString() +
+                       ", beyond " + std::to_string(kMaxCoordinate) + " scene units");
+    }
+    p = placed;
+  }
+  for (Vec3& n : model.normals) n = turn(n);
+  for (size_t v = 0; 4 * v + 3 < model.tangents.size(); ++v) {
+    const Vec3 t = turn(Vec3{model.tangents[4 * v], model.tangents[4 * v + 1], model.tangents[4 * v + 2]});
+    model.tangents[4 * v] = t.x;
+    model.tangents[4 * v + 1] = t.y;
+    model.tangents[4 * v + 2] = t.z;
+  }
+
+  const size_t baseVertices = scene.positions.size(), addVertices = model.positions.size();
+  const uint32_t vertexOffset = uint32_t(baseVertices);
+  const int32_t materialOffset = int32_t(scene.materials.size());
+  const int textureOffset = int(scene.textures.size());
+  // Normals: where one side has none, from its faces.
+  if (scene.normals.empty() != model.normals.empty()) {
+    if (scene.normals.empty()) scene.normals = faceAveragedNormals(scene);
+    if (model.normals.empty()) model.normals = faceAveragedNormals(model);
+  }
+  scene.normals.insert(scene.normals.end(), model.normals.begin(), model.normals.end());
+  appendOrFill(scene.texcoords0, baseVertices, model.texcoords0, addVertices, 2, {0.0f, 0.0f});
+  appendOrFill(scene.texcoords1, baseVertices, model.texcoords1, addVertices, 2, {0.0f, 0.0f});
+  appendOrFill(scene.tangents, baseVertices, model.tangents, addVertices, 4,
+               {0.0f, 0.0f, 0.0f, 0.0f});
+  scene.positions.insert(scene.positions.end(), model.positions.begin(), model.positions.end());
+  for (uint32_t i : model.indices) scene.indices.push_back(i + vertexOffset);
+  for (int32_t m : model.triangleMaterial) scene.triangleMaterial.push_back(m + materialOffset);
+  for (Material& m : model.materials) {
+    for (int* t : {&m.baseColorTexture, &m.normalTexture, &m.metallicRoughnessTexture,
+                   &m.occlusionTexture, &m.emissiveTexture}) {
+      if (*t >= 0) *t += textureOffset;
+    }
+    scene.materials.push_back(std::move(m));
+  }
+  for (Texture& t : model.textures) scene.textures.push_back(std::move(t));
+  if (scene.movingMaterialsFrom > size_t(materialOffset)) {
+    scene.movingMaterialsFrom = size_t(materialOffset);
+  }
+  if (!model.lights.empty()) {
+    scene.warnings.push_back(model.sourcePath + ": its " + std::to_string(model.lights.size()) +
+                             " lights are left out: an added object does not change the baked light");
+  }
+  for (std::string& w : model.warnings) scene.warnings.push_back(std::move(w));
+}
+
+}  // namespace lo

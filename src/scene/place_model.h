@@ -1,0 +1,36 @@
+#pragma once
+/// @file scene/place_model.h
+/// @brief Objects added to a baked scene (`render`/`view`/`reference --add`):
+/// a model's triangles, materials and textures joined to the scene where the
+/// user puts it. The renderer lights them from the free-space light
+/// (Scene::movingMaterialsFrom); the path tracer traces them as any surface.
+
+#include <string>
+
+#include "core/math.h"
+#include "scene/scene.h"
+
+namespace lo {
+
+/// Where an added model goes: its own origin to `at` (world space), turned
+/// `yawDegrees` about +Y (glTF's up) and scaled by `scale`.
+struct Placement {
+  Vec3d at;
+  float yawDegrees = 0;
+  float scale = 1;
+};
+
+/// Parses "x,y,z[,yaw[,scale]]" (scene units, degrees). @throws InputError
+/// naming the value when it is not 3 to 5 finite numbers, or the scale is
+/// not positive.
+Placement parsePlacement(const std::string& text);
+
+/// Joins `model` to `scene` at `placement`: its vertices (positions, normals,
+/// tangents turned with it; UV sets kept), triangles, materials and textures
+/// appended. The first model added sets Scene::movingMaterialsFrom. Lights
+/// and cameras of the model are left out (a warning says so): an added
+/// object does not change the baked light. @throws InputError when the
+/// placed vertices lie beyond kMaxCoordinate.
+void placeModel(Scene& scene, Scene model, const Placement& placement);
+
+}  // namespace lo
