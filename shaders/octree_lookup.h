@@ -410,12 +410,21 @@ LO_LOOKUP_FN bool loVolumeLends(LO_TEX_PARAM uint first, ivec3 c, vec3 q) {
 }
 
 /* The free-space light at world position p of a surface s that was not in
- * the bake (an object added later): trilinear over the 8 voxels of the
+ * the bake (an object added later): none when p's own voxel has no light
+ * or p lies beyond its lit box; else trilinear over the 8 voxels of the
  * free-space octree around p, voxels without light or whose lit box p lies
  * beyond (loVolumeLends) left out and the weights renormalized. */
 LO_LOOKUP_FN vec3 loVolumeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize, int depth,
                                    LoSurface s) {
   vec3 q = (p - origin) / voxelSize;
+  /* The point's own voxel first: without light there (a room the light
+   * never reached, where a wall lies on the voxels' face), or with its
+   * light beyond a wall, the neighbours lend none either. */
+  uvec4 own;
+  if (!loLookupLeaf(LO_TEX ivec3(floor(q)), depth, own) ||
+      !loVolumeLends(LO_TEX loUnpackAddress(own.r, own.g, own.b), ivec3(floor(q)), q)) {
+    return vec3(0.0f);
+  }
   vec3 u = q - vec3(0.5f);
   ivec3 base = ivec3(floor(u));
   vec3 f = u - floor(u);

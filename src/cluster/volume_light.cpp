@@ -45,6 +45,9 @@ bool clipToBox(const Vec3dd& p0, const Vec3dd& d, const double lower[3], const d
   return true;
 }
 
+/// Shortest track, in voxels, that counts as light in a voxel.
+constexpr double kMinTrack = 1e-4;
+
 /// A lit box within this of a voxel's face reaches it.
 constexpr double kFaceTolerance = 1e-6;
 
@@ -154,7 +157,9 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
       double t = ta;
       for (int guard = 0; guard < 2 * res + layers + 4; ++guard) {
         const double tNext = std::min({tMax[0], tMax[1], tMax[2], tb});
-        if (tNext > t) {
+        // A track shorter than kMinTrack (a ray ending on a wall that lies on
+        // a voxel face, rounded into the next voxel) lights nothing there.
+        if ((tNext - t) * length > kMinTrack) {
           Cell& c = cells[(size_t(cell[2] - zLow) * size_t(res) + size_t(cell[1])) * size_t(res) +
                           size_t(cell[0])];
           const double dt = tNext - t;

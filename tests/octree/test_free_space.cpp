@@ -1,0 +1,110 @@
+// The free-space light drawn through its octree (buildVolumeOctree,
+// volumeIrradiance: the shader's loVolumeIndirect): values, the lit box
+// against thin walls, and a whole bake of a sealed room behind a divider.
+
+#include <gtest/gtest.h>
+#include <octree_layout.h>
+
+#include "bake/bake.h"
+#include "core/error.h"
+#include "octree/gpu_octree.h"
+#include "octree/octree_irradiance.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+/// A 4^3 grid of unit voxels, each lit by E(n) = 1 from every direction,
+/// but for the row x = 0 (no light: the far side of a wall at x = 1.5) and
+/// the row x = 1, whose light fills only x >= 1.5 (the wall cuts it).
+VolumeLight walledVolume() {
+  VolumeLight v;
+  v.frame.origin = Vec3{0, 0, 0};
+  v.frame.voxelSize = 1.0f;
+  v.frame.depth = 2;
+  v.shTerms = 9;
+  const float y0 = layout::loShBasis(0u, 0, 0, 1);
+  for (int x = 1; x < 4; ++x) {
+    for (int y = 0; y < 4; ++y) {
+      for (int z = 0; z < 4; ++z) {
+        v.coords.push_back(Coord{x, y, z});
+        v.irradiance.push_back(Vec3(1.0f));
+        for (int i = 0; i < 9; ++i) v.sh.push_back(i == 0 ? Vec3(1.0f / y0) : Vec3(0.0f));
+        v.segments.push_back(100);
+        v.litLower.push_back(Vec3{x == 1 ? 0.5f : 0.0f, 0, 0});
+        v.litUpper.push_back(Vec3(1.0f));
+      }
+    }
+  }
+  return v;
+}
+
+TEST(VolumeOctree, ReadsEachVoxelsLightAndNotBeyondItsLitBox) {
+  for (const bool compact : {false, true}) {
+    GpuOctreeParams params;
+    params.compact = compact;
+    const GpuOctree octree = buildVolumeOctree(walledVolume(), params);
+    EXPECT_EQ(octree.leafCount, 48u);
+    EXPECT_EQ(octree.vdlCount, 48u * 10u);  // a header and 9 SH terms per leaf
+    for (const Vec3& n : {Vec3{1, 0, 0}, Vec3{0, -1, 0}, Vec3{0, 0.6f, 0.8f}}) {
+      // Lit side: E = 1 from every normal.
+      EXPECT_NEAR(volumeIrradiance(octree, Vec3{2.5f, 2, 2}, n).x, 1.0f, 2e-3f);
+      EXPECT_NEAR(volumeIrradiance(octree, Vec3{1.8f, 2, 2}, n).y, 1.0f, 2e-3f);
+      // Behind the wall, even within the wall's voxel: no light.
+      EXPECT_EQ(volumeIrradiance(octree, Vec3{1.2f, 2, 2}, n), Vec3(0.0f));
+      EXPECT_EQ(volumeIrradiance(octree, Vec3{0.5f, 2, 2}, n), Vec3(0.0f));
+      // Outside the cube: nothing.
+      EXPECT_EQ(volumeIrradiance(octree, Vec3{9, 2, 2}, n), Vec3(0.0f));
+    }
+  }
+}
+
+TEST(VolumeOctree, RefusesArraysOfOtherLengths) {
+  VolumeLight v = walledVolume();
+  v.litUpper.pop_back();
+  EXPECT_THROW(buildVolumeOctree(v), InputError);
+}
+
+/// Two rooms side by side, [0, 1] and [1, 2] along x, sealed from each
+/// other by a thin divider at x = 1 (one quad per side); a point light in
+/// the first.
+Scene sealedRooms() {
+  Scene scene;
+  Material grey;
+  grey.baseColor = Vec3(0.7f);
+  scene.materials.push_back(grey);
+  test::addClosedBox(scene, Vec3{0, 0, 0}, Vec3{2, 1, 1}, 0);
+  test::addQuad(scene, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{-1, 0, 0}, 0);
+  test::addQuad(scene, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{1, 0, 0}, 0);
+  Light light;
+  light.position = Vec3{0.5f, 0.7f, 0.5f};
+  light.intensity = 1.0f;
+  scene.lights.push_back(light);
+  return scene;
+}
+
+TEST(FreeSpace, AnObjectBehindTheDividerOfASealedRoomStaysDark) {
+  BakeParams params;
+  params.depth = 5;
+  params.photons = 60000;
+  const BakeResult baked = bake(sealedRooms(), params);
+  const VolumeLight& v = baked.grid.volume;
+  ASSERT_FALSE(v.empty());
+  EXPECT_EQ(v.frame.depth, 3);
+  const GpuOctree octree = buildVolumeOctree(v);
+  const Vec3 normals[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}};
+  // In the lit room the bounced light reaches every side of an object...
+  for (const Vec3& n : normals) {
+    EXPECT_GT(volumeIrradiance(octree, Vec3{0.5f, 0.4f, 0.5f}, n).y, 0.0f);
+    EXPECT_GT(volumeIrradiance(octree, Vec3{0.95f, 0.5f, 0.5f}, n).y, 0.0f);
+  }
+  // ...behind the divider nothing does, even right next to it.
+  for (const float x : {1.02f, 1.06f, 1.15f, 1.5f, 1.9f}) {
+    for (const Vec3& n : normals) {
+      EXPECT_EQ(volumeIrradiance(octree, Vec3{x, 0.5f, 0.5f}, n), Vec3(0.0f)) << "x = " << x;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lo
