@@ -71,6 +71,19 @@ namespace {
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
 Vec3 fromGlm(const glm::vec3& v) { return {v.x, v.y, v.z}; }
 
+/// A white Lambertian surface facing `normal`: with the cosine as the
+/// response, the lookup's value is the irradiance.
+lookup::LoSurface irradianceSurface(const Vec3& normal) {
+  lookup::LoSurface s;
+  s.n = toGlm(normal);
+  s.v = s.n;
+  s.baseColor = glm::vec3(1.0f);
+  s.metallic = 0.0f;
+  s.roughness = 1.0f;
+  s.ng = s.n;
+  return s;
+}
+
 }  // namespace
 
 OctreeSample lookupOctree(const GpuOctree& octree, const Vec3& worldPosition) {
@@ -112,13 +125,7 @@ Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3&
                       const OctreeShadeParams& params) {
   if (octree.depth < 1 || octree.pool.empty()) return {0, 0, 0};
   const float voxelSize = octree.cubeSize / float(1 << octree.depth);
-  lookup::LoSurface s;
-  s.n = toGlm(normal);
-  s.v = s.n;
-  s.baseColor = glm::vec3(1.0f);
-  s.metallic = 0.0f;
-  s.roughness = 1.0f;
-  s.ng = s.n;
+  const lookup::LoSurface s = irradianceSurface(normal);
   return fromGlm(lookup::loOctreeIndirect(octree, toGlm(position), toGlm(octree.origin), voxelSize,
                                           octree.depth, params.normalOffset, params.interpolation,
                                           params.maxVdls, s));
@@ -127,15 +134,8 @@ Vec3 octreeIrradiance(const GpuOctree& octree, const Vec3& position, const Vec3&
 Vec3 volumeIrradiance(const GpuOctree& volume, const Vec3& position, const Vec3& normal) {
   if (volume.depth < 1 || volume.pool.empty()) return {0, 0, 0};
   const float voxelSize = volume.cubeSize / float(1 << volume.depth);
-  lookup::LoSurface s;
-  s.n = toGlm(normal);
-  s.v = s.n;
-  s.baseColor = glm::vec3(1.0f);
-  s.metallic = 0.0f;
-  s.roughness = 1.0f;
-  s.ng = s.n;
   return fromGlm(lookup::loVolumeIndirect(volume, toGlm(position), toGlm(volume.origin), voxelSize,
-                                          volume.depth, s));
+                                          volume.depth, irradianceSurface(normal)));
 }
 
 OctreeIrradianceSample octreeIrradianceSample(const GpuOctree& octree, const Vec3& position,
