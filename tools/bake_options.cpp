@@ -32,6 +32,7 @@ BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   params.smoothing = smoothing == "on";
   params.freeSpace = freeSpace == "on";
   params.freeSpaceLevels = freeSpaceLevels;
+  params.freeSpaceOrder = freeSpaceOrder;
   params.autoCap = autoCap;
   params.autoThreshold = autoThreshold;
   parseRepresentation(representation, &params.representation);  // checked by the flag
@@ -157,6 +158,11 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
                   "How many levels coarser than the surface grid the free-space grid is "
                   "(2: a free-space voxel is 4 surface voxels wide)")
       ->check(CLI::Range(0, 11))
+      ->capture_default_str();
+  cmd->add_option("--free-space-order", opt.freeSpaceOrder,
+                  "SH order of the free-space light: 2 (9 terms, 80 bytes a voxel on the GPU) or "
+                  "1 (4 terms, 40 bytes; smoother across directions)")
+      ->check(CLI::IsMember({1, 2}))
       ->capture_default_str();
   cmd->add_option("--bounds", opt.bounds,
                   "A region of interest, x0,y0,z0,x1,y1,z1 in scene units: the grid covers it "

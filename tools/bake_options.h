@@ -39,6 +39,7 @@ struct BakeOptions {
   std::string smoothing = "on";
   std::string freeSpace = "on";
   int freeSpaceLevels = 2;
+  int freeSpaceOrder = 1;
   int autoCap = BakeParams{}.autoCap;
   float autoThreshold = BakeParams{}.autoThreshold;
   std::vector<double> bounds;  // x0 y0 z0 x1 y1 z1, empty = the whole scene

@@ -54,6 +54,13 @@ PhotonParams BakeParams::photonParams() const {
   return p;
 }
 
+VolumeLightParams BakeParams::volumeParams() const {
+  VolumeLightParams p;
+  p.levels = freeSpaceLevels;
+  p.shTerms = freeSpaceOrder == 1 ? 4 : 9;
+  return p;
+}
+
 GridParams BakeParams::gridParams() const {
   GridParams p;
   p.depth = depth;
@@ -102,7 +109,9 @@ std::string BakeParams::ToString() const {
          (occlusion ? "" : ", no occlusion") + (edgeCorrection ? "" : ", no edge correction") +
          (separateCaustics ? "" : ", caustics merged") +
          (smoothing ? ", smoothing" : "") +
-         (freeSpace ? ", free space " + std::to_string(freeSpaceLevels) + " levels up" : "") +
+         (freeSpace ? ", free space " + std::to_string(freeSpaceLevels) + " levels up, SH order " +
+                          std::to_string(freeSpaceOrder)
+                    : "") +
          "}";
 }
 
@@ -364,6 +373,10 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
   BakeParams params = requested;
   if (params.region.empty()) params.region = scene.region;
   checkParams(params, processes);
+  if (params.freeSpaceOrder != 1 && params.freeSpaceOrder != 2) {
+    throw InputError("--free-space-order " + std::to_string(params.freeSpaceOrder) +
+                     ": the free-space light's SH are of order 1 or 2");
+  }
   if (params.freeSpaceLevels < 0 || params.freeSpaceLevels >= params.depth) {
     throw InputError("--free-space-levels " + std::to_string(params.freeSpaceLevels) +
                      ": the free-space grid is 0 to depth - 1 = " +
@@ -442,9 +455,7 @@ VolumeLight freeSpaceLight(const std::vector<PhotonSegment>& segments, const Gri
                            const BakeParams& params, ProgressSink* progress,
                            std::vector<StageReport>& stages) {
   StageTimer timer(stages, "free-space light");
-  VolumeLightParams vp;
-  vp.levels = params.freeSpaceLevels;
-  VolumeLight volume = buildVolumeLight(segments, frame, vp, progress);
+  VolumeLight volume = buildVolumeLight(segments, frame, params.volumeParams(), progress);
   timer.finish(formatCount(volume.size()) + " voxels from " + formatCount(segments.size()) +
                " light rays");
   return volume;

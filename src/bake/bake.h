@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cluster/vdl_cluster.h"
+#include "cluster/volume_light.h"
 #include "core/progress.h"
 #include "core/resources.h"
 #include "gather/gather.h"
@@ -125,6 +126,9 @@ struct BakeParams {
   /// from every rank's segments: the same bytes.
   bool freeSpace = true;
   int freeSpaceLevels = 2;
+  /// SH order of the free-space light: 1 (4 terms, the default: as close to the
+  /// path tracer on the moving-sphere test as 2, at half the GPU bytes) or 2 (9).
+  int freeSpaceOrder = 1;
   /// A region of interest (`--bounds`; empty = the whole scene): the grid
   /// covers it alone, photons are stored only inside it, and directional
   /// lights emit over its footprint (PhotonParams::region).
@@ -136,6 +140,7 @@ struct BakeParams {
   LevelParams levelParams() const;  ///< the grid, gather and cluster settings together
   GridParams gridParams() const;
   GatherParams gatherParams() const;
+  VolumeLightParams volumeParams() const;  ///< the free-space light's settings
   ClusterParams clusterParams() const;
   std::string ToString() const;
 };

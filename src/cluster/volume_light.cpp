@@ -8,6 +8,7 @@
 #include <octree_layout.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -88,25 +89,34 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
   // Slabs of `thick` z layers: each ray listed in the slabs it crosses, in
   // order, with the part of it inside the cube. A voxel's sums follow the
   // rays' order whatever the slabs, so their thickness changes no bit.
-  const int thick = std::max(1, res / 8);
+  // Two slabs per thread: a ray's set-up (its SH basis, clipping) is paid
+  // once per slab it crosses.
+  const int threads = std::max(1, tbb::this_task_arena::max_concurrency());
+  const int thick = std::max(1, (res + 2 * threads - 1) / (2 * threads));
   const int slabCount = (res + thick - 1) / thick;
   std::vector<std::vector<uint32_t>> slabs(static_cast<size_t>(slabCount));
   std::vector<float> clipStart(segments.size(), 0.0f), clipEnd(segments.size(), 0.0f);
+  std::vector<int32_t> firstSlab(segments.size(), -1), lastSlab(segments.size(), -1);
   const double cubeLower[3] = {0, 0, 0}, cubeUpper[3] = {double(res), double(res), double(res)};
   LO_CHECK(segments.size() < size_t(std::numeric_limits<uint32_t>::max()));
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 16384),
+                    [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const PhotonSegment& s = segments[i];
+      if (!(maxComponent(s.power) > 0) || !isFinite(s.from) || !isFinite(s.to)) continue;
+      const Vec3dd p0 = local(s.from), p1 = local(s.to);
+      const Vec3dd d{p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
+      double t0, t1;
+      if (!clipToBox(p0, d, cubeLower, cubeUpper, t0, t1)) continue;
+      clipStart[i] = float(t0);
+      clipEnd[i] = float(t1);
+      const double za = p0.z + d.z * t0, zb = p0.z + d.z * t1;
+      firstSlab[i] = std::clamp(int(std::floor(std::min(za, zb))), 0, res - 1) / thick;
+      lastSlab[i] = std::clamp(int(std::floor(std::max(za, zb))), 0, res - 1) / thick;
+    }
+  });
   for (size_t i = 0; i < segments.size(); ++i) {
-    const PhotonSegment& s = segments[i];
-    if (!(maxComponent(s.power) > 0) || !isFinite(s.from) || !isFinite(s.to)) continue;
-    const Vec3dd p0 = local(s.from), p1 = local(s.to);
-    const Vec3dd d{p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
-    double t0, t1;
-    if (!clipToBox(p0, d, cubeLower, cubeUpper, t0, t1)) continue;
-    clipStart[i] = float(t0);
-    clipEnd[i] = float(t1);
-    const double za = p0.z + d.z * t0, zb = p0.z + d.z * t1;
-    const int z0 = std::clamp(int(std::floor(std::min(za, zb))), 0, res - 1) / thick;
-    const int z1 = std::clamp(int(std::floor(std::max(za, zb))), 0, res - 1) / thick;
-    for (int z = z0; z <= z1; ++z) slabs[size_t(z)].push_back(uint32_t(i));
+    for (int z = firstSlab[i]; z >= 0 && z <= lastSlab[i]; ++z) slabs[size_t(z)].push_back(uint32_t(i));
   }
 
   std::vector<std::vector<Coord>> slabCoords(static_cast<size_t>(slabCount));

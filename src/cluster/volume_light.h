@@ -17,7 +17,7 @@ struct VolumeLightParams {
   /// Levels coarser than the surface grid (its depth minus these, at least
   /// 1): 2 gives a voxel 4 surface voxels wide.
   int levels = 2;
-  int shTerms = 9;  ///< 4 or 9
+  int shTerms = 4;  ///< 4 (order 1) or 9 (order 2)
 };
 
 /// The track-length estimate of the light in each voxel: a ray of power P

@@ -301,9 +301,8 @@ class RankBake {
     if (me_ == 0 && params_.freeSpace) {
       StageTimer timer(st_.stages, "free-space light");
       scaleSegmentPower(allSegments_, size_t(emitted_));
-      VolumeLightParams vp;
-      vp.levels = params_.freeSpaceLevels;
-      result.grid.volume = buildVolumeLight(allSegments_, result.grid.frame, vp, progress_);
+      result.grid.volume =
+          buildVolumeLight(allSegments_, result.grid.frame, params_.volumeParams(), progress_);
       timer.finish(formatCount(result.grid.volume.size()) + " voxels from " +
                    formatCount(allSegments_.size()) + " light rays");
     }

@@ -19,7 +19,7 @@ struct VolumeLight {
   /// The same cube as the surface grid's, `levels` coarser; depth 0: no
   /// free-space light was baked.
   GridFrame frame{{0, 0, 0}, 1.0f, 0, {}};
-  int shTerms = 9;  ///< SH terms per voxel (order 2)
+  int shTerms = 4;  ///< SH terms per voxel: 4 (order 1) or 9 (order 2)
   /// Voxels light passed through, in canonical order (canonicalVoxelKey).
   std::vector<Coord> coords;
   /// The irradiance a surface in the voxel receives, averaged over its

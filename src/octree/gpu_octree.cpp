@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 #include "core/error.h"
@@ -245,6 +246,112 @@ float halfToFloat(uint16_t bits) {
 
 namespace gpu_octree_internal {
 
+/// The free-space leaves that merge (GpuOctreeParams::tolerance > 0): eight
+/// siblings whose light filled each of them whole, and whose irradiance,
+/// for each of 14 normals (the axes and the cube's diagonals), lies within
+/// `tolerance` of their mean's, the mean of the eight taken over all those
+/// normals, become one leaf holding their mean SH terms; level by level up
+/// to level 1, as long as all eight children of a node are leaves.
+AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
+  AdaptiveLeaves out;
+  const size_t n = v.size();
+  out.collapsed.assign(n, 0);
+  if (!(tolerance > 0) || n == 0) return out;
+  const int terms = v.shTerms;
+  struct Node {
+    std::vector<Vec3> sh;
+    bool mergeable = true;  ///< a leaf whose light filled it whole
+  };
+  auto pack = [](const Coord& c) {
+    return (uint64_t(uint32_t(c.x)) << 42) | (uint64_t(uint32_t(c.y)) << 21) | uint64_t(uint32_t(c.z));
+  };
+  std::map<uint64_t, Node> level;
+  std::map<std::pair<int, uint64_t>, CollapsedLeaf> merged;  ///< by (level, node)
+  for (size_t k = 0; k < n; ++k) {
+    Node node;
+    node.sh.assign(v.shOf(k), v.shOf(k) + terms);
+    for (int a = 0; a < 3; ++a) {
+      node.mergeable = node.mergeable && v.litLower[k][a] <= 0.0f && v.litUpper[k][a] >= 1.0f;
+    }
+    level[pack(v.coords[k])] = std::move(node);
+  }
+  Vec3 normals[14];
+  int m = 0;
+  for (int a = 0; a < 3; ++a) {
+    Vec3 e{0, 0, 0};
+    e[a] = 1;
+    normals[m++] = e;
+    normals[m++] = -e;
+  }
+  for (int s = 0; s < 8; ++s) {
+    normals[m++] = normalize(Vec3{s & 1 ? 1.0f : -1.0f, s & 2 ? 1.0f : -1.0f, s & 4 ? 1.0f : -1.0f});
+  }
+  auto irradiance = [terms](const std::vector<Vec3>& sh, const Vec3& d) {
+    float e = 0;
+    for (int i = 0; i < terms; ++i) e += luminance(sh[size_t(i)]) * loShBasis(uint(i), d.x, d.y, d.z);
+    return e;
+  };
+  for (int l = v.frame.depth - 1; l >= 1; --l) {
+    std::map<uint64_t, std::vector<uint64_t>> parents;
+    for (const auto& [key, node] : level) {
+      const Coord c{int((key >> 42) & 0x1fffff), int((key >> 21) & 0x1fffff), int(key & 0x1fffff)};
+      parents[pack(Coord{c.x >> 1, c.y >> 1, c.z >> 1})].push_back(key);
+    }
+    std::map<uint64_t, Node> next;
+    for (const auto& [parent, children] : parents) {
+      bool merge = children.size() == 8;
+      for (uint64_t k : children) merge = merge && level[k].mergeable;
+      Node joined;
+      if (merge) {
+        joined.sh.assign(size_t(terms), Vec3{0, 0, 0});
+        for (uint64_t k : children) {
+          for (int i = 0; i < terms; ++i) joined.sh[size_t(i)] += level[k].sh[size_t(i)] * 0.125f;
+        }
+        float mean = 0;
+        for (const Vec3& d : normals) mean += irradiance(joined.sh, d) / 14.0f;
+        for (uint64_t k : children) {
+          for (const Vec3& d : normals) {
+            if (!(std::fabs(irradiance(level[k].sh, d) - irradiance(joined.sh, d)) <= tolerance * mean)) {
+              merge = false;
+            }
+          }
+        }
+      }
+      if (merge) next[parent] = std::move(joined);
+    }
+    if (next.empty()) break;
+    // Merged nodes go up a level and may merge again; the others stay.
+    for (auto& [parent, node] : next) {
+      CollapsedLeaf leaf;
+      leaf.coord = Coord{int((parent >> 42) & 0x1fffff), int((parent >> 21) & 0x1fffff),
+                         int(parent & 0x1fffff)};
+      leaf.level = l;
+      leaf.sh = node.sh;
+      merged[std::make_pair(l, parent)] = std::move(leaf);
+    }
+    level = std::move(next);
+  }
+  // Only the topmost merge of each branch is a leaf.
+  const int depth = v.frame.depth;
+  auto ancestorMerged = [&](const Coord& c, int fromLevel, int belowLevel) {
+    for (int l = 1; l < belowLevel; ++l) {
+      const int shift = fromLevel - l;
+      if (merged.count({l, pack(Coord{c.x >> shift, c.y >> shift, c.z >> shift})})) return true;
+    }
+    return false;
+  };
+  for (auto& [key, leaf] : merged) {
+    if (!ancestorMerged(leaf.coord, leaf.level, leaf.level)) out.leaves.push_back(std::move(leaf));
+  }
+  for (size_t k = 0; k < n; ++k) {
+    if (ancestorMerged(v.coords[k], depth, depth)) {
+      out.collapsed[k] = 1;
+      ++out.voxelsCollapsed;
+    }
+  }
+  return out;
+}
+
 /// buildGpuOctree in named steps, in the order it runs them: the leaves in
 /// Morton order, the nodes per level and their tiles, the pool's and the
 /// VDL texture's sizes, the compact scale, then every node's texel (and a
@@ -259,12 +366,13 @@ class OctreeBuilder {
         adaptive_(collapseLeaves(grid, params.tolerance, params.cosineCorrection)) {}
   /// A free-space octree: each leaf's light preceded by its header texel
   /// (octree_layout.h), headers[v] for voxel v; no collapsed leaves.
-  OctreeBuilder(const VdlGrid& grid, const GpuOctreeParams& params, std::vector<Vec3> headers)
+  OctreeBuilder(const VdlGrid& grid, const GpuOctreeParams& params, AdaptiveLeaves adaptive,
+                std::vector<Vec3> headers)
       : grid_(grid),
         params_(params),
         depth_(grid.frame.depth),
         sh_(grid.shTerms > 0),
-        adaptive_(collapseLeaves(grid, 0.0f, false)),
+        adaptive_(std::move(adaptive)),
         headers_(std::move(headers)) {}
 
   GpuOctree build() {
@@ -323,7 +431,7 @@ class OctreeBuilder {
   size_t leafTexels(const Leaf& leaf) const {
     if (leaf.level == depth_) return voxelTexels(leaf.voxel);
     const CollapsedLeaf& c = adaptive_.leaves[leaf.voxel];
-    return sh_ ? c.sh.size() : c.vdls.size();
+    return (headers_.empty() ? 0 : 1) + (sh_ ? c.sh.size() : c.vdls.size());
   }
 
   /// Lit voxels in Morton order. A voxel without VDLs is left out entirely:
@@ -596,6 +704,9 @@ class OctreeBuilder {
 
   /// A collapsed leaf: its texels, stored as they are (intensities, SH terms).
   void writeCollapsedLeaf(uint8_t* t, const CollapsedLeaf& c) {
+    // A free-space leaf stands for voxels whose light filled them whole.
+    const float whole = loPackVolumeBox(0.0f, 1.0f);
+    if (!headers_.empty()) writeTexel(nextVdl_++, Vec3(whole), 0.0f);
     writeLeafTexel(t, uint8_t(sh_ ? 1u : uint(c.vdls.size())));
     if (sh_) {
       for (const Vec3& term : c.sh) writeSh(nextVdl_++, term);
@@ -714,10 +825,10 @@ GpuOctree buildVolumeOctree(const VolumeLight& volume, const GpuOctreeParams& pa
     }
   }
   GpuOctreeParams p = params;
-  p.tolerance = 0;
   p.cosineCorrection = false;
   gpu_octree_internal::validate(grid, p);
-  return gpu_octree_internal::OctreeBuilder(grid, p, std::move(headers)).build();
+  AdaptiveLeaves adaptive = gpu_octree_internal::collapseVolume(volume, params.tolerance);
+  return gpu_octree_internal::OctreeBuilder(grid, p, std::move(adaptive), std::move(headers)).build();
 }
 
 std::string GpuOctree::ToString() const {

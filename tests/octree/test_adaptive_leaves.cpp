@@ -157,7 +157,9 @@ TEST(AdaptiveLeaves, LayersAndDarkVoxelsAreNeverCovered) {
     const Coord c = g.coords[v];
     const bool nearLayer = c.x / 2 == 0 && c.y / 2 == 0;  // shares the level-2 parent
     const bool nearDark = c.x / 2 == 3 && c.y / 2 == 3;
-    if (nearLayer || nearDark) EXPECT_FALSE(a.collapsed[v]) << c.ToString();
+    if (nearLayer || nearDark) {
+      EXPECT_FALSE(a.collapsed[v]) << c.ToString();
+    }
   }
   // Everything else collapses: two level-1 nodes (4 x 4 voxels) whole, and
   // in the other two the three level-2 nodes (2 x 2) beside the layered and
