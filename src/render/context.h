@@ -42,7 +42,7 @@ struct GlInfo {
 enum class Key {
   Unknown, Escape, Space, LeftShift, RightShift, LeftControl, RightControl,
   Left, Right, Up, Down,
-  A, D, E, G, H, I, P, Q, R, S, V, W,
+  A, D, E, G, H, I, M, P, Q, R, S, V, W,
   Num0, Num1, Num2, Num3, Num4,
   LeftBracket, RightBracket, Equal, Minus, KeypadAdd, KeypadSubtract, Comma, Period,
 };

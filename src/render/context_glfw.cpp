@@ -31,6 +31,7 @@ Key keyOf(int key) {
     case GLFW_KEY_G: return Key::G;
     case GLFW_KEY_H: return Key::H;
     case GLFW_KEY_I: return Key::I;
+    case GLFW_KEY_M: return Key::M;
     case GLFW_KEY_P: return Key::P;
     case GLFW_KEY_Q: return Key::Q;
     case GLFW_KEY_R: return Key::R;

@@ -63,6 +63,14 @@ struct SceneLights {
     renderCascades(vao, draw);
   }
 
+  /// Draws every shadow map again (a caster moved): the lights' now, the
+  /// sun's cascades at the next fitCascades.
+  template <class DrawDepthOnly>
+  void redrawShadowMaps(GLuint vao, const DrawDepthOnly& draw) {
+    renderShadowMaps(vao, draw);
+    fittedCamera = {};
+  }
+
  private:
   void build(const Scene& scene, const RenderSpace& space, const RendererParams& params);
   void allocateShadowMaps();

@@ -241,6 +241,19 @@ void Renderer::setFreeSpaceLight(const GpuOctree& volume) {
 
 bool Renderer::hasFreeSpaceLight() const { return impl_->hasVolume; }
 
+bool Renderer::hasAddedObjects() const { return impl_->hasMovingRanges; }
+
+void Renderer::moveAddedObjects(const Vec3& offset) {
+  Impl& r = *impl_;
+  if (!r.hasMovingRanges) return;
+  // A translation: the same in render space as in the world.
+  r.geometry.offsetMovingVertices(offset);
+  r.lights.redrawShadowMaps(r.geometry.vao.get(), [&r](GLuint program, bool shadows) {
+    r.geometry.drawDepthOnly(program, shadows);
+  });
+  r.probe.valid = false;
+}
+
 RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& params) {
   Impl& r = *impl_;
   const int s = params.supersample;

@@ -114,6 +114,13 @@ class Renderer {
   /// @throws InputError like setOctree.
   void setFreeSpaceLight(const GpuOctree& volume);
   bool hasFreeSpaceLight() const;
+  /// Whether the scene has objects added after the bake.
+  bool hasAddedObjects() const;
+  /// Moves the added objects by `offset` (world units) from where the scene
+  /// put them: their vertices rewritten, the shadow maps drawn again (they
+  /// cast where they are now), the reflection probe captured again. The
+  /// baked light stays as it is.
+  void moveAddedObjects(const Vec3& offset);
 
   /// Uploads lightmap UVs (per triangle corner, of the scene given to the
   /// constructor) and the pages baked for them, for RenderParams::lighting =

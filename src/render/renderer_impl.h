@@ -95,6 +95,9 @@ struct SceneGeometry {
   std::vector<uint32_t> vertexCorner;
   size_t sceneTriangles = 0;
   float maxAnisotropy = 1;  ///< of the context (1: no anisotropic filtering)
+  /// The vertices of the added objects' ranges as uploaded (render space),
+  /// range by range: what moveAddedObjects offsets.
+  std::vector<Vertex> movingVertices;
 
   void upload(const Scene& scene, const RenderSpace& space);
   /// The GL name of Scene::textures[texture], 0 for -1.
@@ -112,6 +115,11 @@ struct SceneGeometry {
   /// The textures and uniforms material `mat` draws with.
   DrawRange rangeOf(const Scene& scene, const Material& mat);
   void uploadVertices(const std::vector<Vertex>& vertices);
+
+ public:
+  /// Rewrites the added objects' vertices in the buffer moved by `offset`
+  /// (render space units) from where they were uploaded.
+  void offsetMovingVertices(const Vec3& offset);
 };
 
 /// The reflection probe: a mipmapped RGBA16F cube map of the lit scene seen

@@ -241,6 +241,12 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
     if (category == kSolid) opaqueCount = GLsizei(vertices.size());
     if (category < kBlended) blendFirst = GLsizei(vertices.size());
   }
+  for (const DrawRange& range : ranges) {
+    if (range.moving) {
+      movingVertices.insert(movingVertices.end(), vertices.begin() + range.first,
+                            vertices.begin() + range.first + range.count);
+    }
+  }
   uploadVertices(vertices);
 }
 
@@ -343,6 +349,27 @@ void SceneGeometry::sortBlended(const glm::vec3& eye) {
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, blendEbo.get());
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)),
                indices.data(), GL_STREAM_DRAW);
+}
+
+void SceneGeometry::offsetMovingVertices(const Vec3& offset) {
+  glBindBuffer(GL_ARRAY_BUFFER, vbo.get());
+  size_t k = 0;
+  std::vector<Vertex> moved;
+  for (const DrawRange& range : ranges) {
+    if (!range.moving) continue;
+    moved.assign(movingVertices.begin() + std::ptrdiff_t(k),
+                 movingVertices.begin() + std::ptrdiff_t(k + size_t(range.count)));
+    for (Vertex& v : moved) {
+      v.position[0] += offset.x;
+      v.position[1] += offset.y;
+      v.position[2] += offset.z;
+    }
+    glBufferSubData(GL_ARRAY_BUFFER, GLintptr(size_t(range.first) * sizeof(Vertex)),
+                    GLsizeiptr(moved.size() * sizeof(Vertex)), moved.data());
+    k += size_t(range.count);
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  checkGl("moving the added objects");
 }
 
 }  // namespace lo::render_internal

@@ -103,6 +103,7 @@ const char* viewerKeyHelp() {
          "  G                 glossy (GGX) lobe on/off\n"
          "  [ / ]             fewer / more VDLs used per voxel (1..8)\n"
          "  , / .             exposure -0.5 / +0.5 EV;  0: back to --exposure\n"
+         "  M + move keys     hold M: W A S D E Q move the objects added with --add instead\n"
          "  P                 append the current camera to the --record path file\n"
          "  R                 back to the start camera\n"
          "  H                 these keys on the screen (and printed, with the camera); H again hides them\n"
@@ -127,6 +128,8 @@ struct Viewer::Impl final : InputHandler {
   bool printHelp = false;
   bool showKeys = false;  // H: the keys on the HUD too
   bool damaged = false;  // the window needs a redraw (exposed, resized)
+  Vec3 objectOffset{0, 0, 0};  // M + move keys: where the added objects are, from --at
+  bool objectMoved = false;    // they moved this frame: redraw
   std::unique_ptr<HudOverlay> hud;  // made in run(), with the window's context current
 
   Impl(GlContext& w, Renderer& r, const ViewerParams& p, OctreeLevelSource* l)
@@ -247,6 +250,21 @@ struct Viewer::Impl final : InputHandler {
     if (held(Key::E) || held(Key::Space)) d.y += 1;
     if (held(Key::Q) || held(Key::LeftControl) || held(Key::RightControl)) d.y -= 1;
     const bool fast = held(Key::LeftShift) || held(Key::RightShift);
+    if (held(Key::M) && renderer.hasAddedObjects()) {
+      // The added objects move instead of the camera: along the view's
+      // horizontal forward and right, and up.
+      if (d != Vec3(0, 0, 0)) {
+        Vec3 forward = fly.forward();
+        forward.y = 0;
+        forward = lengthSquared(forward) > 0 ? normalize(forward) : Vec3(0, 0, -1);
+        const Vec3 step = (forward * d.z + fly.right() * d.x + Vec3(0, 1, 0) * d.y) *
+                          (fly.speed * seconds * (fast ? 4.0f : 1.0f));
+        objectOffset += step;
+        renderer.moveAddedObjects(objectOffset);
+        objectMoved = true;
+      }
+      d = Vec3(0, 0, 0);
+    }
     fly.move(d, seconds * (fast ? 4.0f : 1.0f));
     const float turn = viewer_internal::kKeyTurnRadiansPerSecond * seconds;
     float yaw = pendingYaw, pitch = pendingPitch;
@@ -388,7 +406,7 @@ ViewerStats Viewer::Impl::run() {
     // (camera, settings, window, a new level), so that a still view leaves
     // the cores to the bake; paths, --frames and --save-frames draw every
     // iteration, as does --continuous.
-    const bool drawScene = alwaysDraw || stats.framesDrawn == 0 || damaged || justShown ||
+    const bool drawScene = alwaysDraw || stats.framesDrawn == 0 || damaged || justShown || objectMoved ||
                            !sameView(camera, lastCamera) || !sameParams(render, lastParams) ||
                            exposure != lastExposure;
     // The HUD's text but for its frame time: a change (the bake's progress,
@@ -413,6 +431,7 @@ ViewerStats Viewer::Impl::run() {
       ++titleFrames;
       ++stats.framesDrawn;
       damaged = false;
+      objectMoved = false;
       lastCamera = camera;
       lastParams = render;
       lastExposure = exposure;

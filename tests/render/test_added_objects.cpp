@@ -1,0 +1,125 @@
+// Objects added after the bake (render --add): lit by the free-space light
+// in the GL renderer as the C++ lookup says, and moved (view's M keys) to
+// the picture of a scene that placed them there from the start.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bake/bake.h"
+#include "core/error.h"
+#include "octree/gpu_octree.h"
+#include "octree/octree_irradiance.h"
+#include "render/context.h"
+#include "render/renderer.h"
+#include "scene/place_model.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+/// The point-lit unit room with the project's sphere (radius `r`) at `at`.
+Scene roomWithSphere(const Vec3& at, float r) {
+  Scene scene = test::pointLitRoom();
+  Placement p;
+  p.at = Vec3d(at);
+  p.scale = r;
+  placeModel(scene, loadScene(test::dataDir() + "/models/sphere.obj"), p);
+  return scene;
+}
+
+double meanAbs(const RgbImage& a, const RgbImage& b) {
+  double sum = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) sum += std::fabs(double(a.rgb[i]) - double(b.rgb[i]));
+  return sum / double(a.rgb.size());
+}
+
+double mean(const RgbImage& a) {
+  double sum = 0;
+  for (float v : a.rgb) sum += double(v);
+  return sum / double(a.rgb.size());
+}
+
+TEST(AddedObjects, PlacementJoinsTheModelAndMarksItsMaterials) {
+  const Scene room = test::pointLitRoom();
+  const Scene scene = roomWithSphere(Vec3(0.7f, 0.3f, 0.6f), 0.1f);
+  EXPECT_EQ(scene.movingMaterialsFrom, room.materials.size());
+  EXPECT_GT(scene.triangleCount(), room.triangleCount());
+  Bounds3 sphere;
+  for (size_t v = room.positions.size(); v < scene.positions.size(); ++v) sphere.extend(scene.positions[v]);
+  EXPECT_NEAR(sphere.lower.x, 0.6f, 1e-4f);
+  EXPECT_NEAR(sphere.upper.y, 0.4f, 1e-4f);
+  EXPECT_EQ(scene.lights.size(), room.lights.size());
+  EXPECT_THROW(parsePlacement("1,2"), InputError);
+  EXPECT_THROW(parsePlacement("1,2,nan"), InputError);
+  EXPECT_THROW(parsePlacement("1,2,3,0,-1"), InputError);
+  EXPECT_NEAR(parsePlacement("1,2,3,90,2").yawDegrees, 90.0f, 0.0f);
+}
+
+TEST(AddedObjects, MovedObjectsDrawAsIfPlacedThere) {
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
+  BakeParams bp;
+  bp.depth = 4;
+  bp.photons = 30000;
+  const BakeResult baked = bake(test::pointLitRoom(), bp);
+  ASSERT_FALSE(baked.grid.volume.empty());
+  const GpuOctree octree = buildGpuOctree(baked.grid);
+  const GpuOctree volume = buildVolumeOctree(baked.grid.volume);
+
+  RenderParams params;
+  params.width = 64;
+  params.height = 48;
+  params.reflections = false;
+  const PinholeCamera camera =
+      PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.98f), Vec3(0.5f, 0.35f, 0), 1.2f);
+  const Vec3 from(0.75f, 0.25f, 0.3f), offset(-0.1f, 0.05f, 0.25f);
+
+  Renderer moved(roomWithSphere(from, 0.1f), octree, {});
+  moved.setFreeSpaceLight(volume);
+  ASSERT_TRUE(moved.hasAddedObjects());
+  const RgbImage before = moved.render(camera, params);
+  moved.moveAddedObjects(offset);
+  const RgbImage after = moved.render(camera, params);
+
+  Renderer placed(roomWithSphere(from + offset, 0.1f), octree, {});
+  placed.setFreeSpaceLight(volume);
+  const RgbImage there = placed.render(camera, params);
+  // The same picture up to the rounding of two render spaces (the scene's
+  // bounds, and so their centre, differ by the sphere's place).
+  EXPECT_LT(meanAbs(after, there), 1e-3 * mean(there));
+  EXPECT_GT(meanAbs(after, before), 0.02 * mean(there)) << "the sphere did not move";
+}
+
+TEST(AddedObjects, TheFreeSpaceLightLightsThemAsTheCppLookupSays) {
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
+  BakeParams bp;
+  bp.depth = 4;
+  bp.photons = 30000;
+  const BakeResult baked = bake(test::pointLitRoom(), bp);
+  const GpuOctree octree = buildGpuOctree(baked.grid);
+  const GpuOctree volume = buildVolumeOctree(baked.grid.volume);
+  // A large white sphere filling the view: its indirect radiance is a / pi
+  // times the free-space irradiance at its surface (diffuse, albedo 0.8).
+  const Vec3 centre(0.5f, 0.5f, 0.5f);
+  const float r = 0.15f;
+  Renderer renderer(roomWithSphere(centre, r), octree, {});
+  renderer.setFreeSpaceLight(volume);
+  RenderParams params;
+  params.width = 32;
+  params.height = 32;
+  params.mode = RenderMode::Indirect;
+  params.reflections = false;
+  params.specular = false;
+  const Vec3 eye(0.5f, 0.5f, 0.95f);
+  const RgbImage image = renderer.render(PinholeCamera::lookAt(eye, centre, 0.2f), params);
+  // The pixel at the centre sees the sphere's point nearest the eye.
+  const Vec3 p = centre + Vec3(0, 0, r);
+  const Vec3 e = volumeIrradiance(volume, p, Vec3(0, 0, 1));
+  ASSERT_GT(e.y, 0.0f);
+  const Vec3 expected = e * (0.8f / float(kPi));
+  const Vec3 got = image.at(size_t(16) * 32 + 16);
+  EXPECT_NEAR(got.y, expected.y, 0.03f * expected.y);
+}
+
+}  // namespace
+}  // namespace lo
