@@ -143,6 +143,18 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
     r.method += " (the input's surface layers are not carried to another depth: bake again, "
                 "or convert with --photon-map, for layers at depth " + std::to_string(depth) + ")";
   }
+  // The free-space light has its own grid over the same cube (the frames of
+  // one scene nest at every depth): it goes along while it is no finer than
+  // the new surface grid.
+  if (!in.volume.empty() && r.grid.volume.empty()) {
+    if (in.volume.frame.depth <= depth) {
+      r.grid.volume = in.volume;
+    } else {
+      r.method += " (the free-space light, " + std::to_string(in.volume.frame.depth) +
+                  " levels deep, is left out of a grid of depth " + std::to_string(depth) +
+                  ": bake again for it)";
+    }
+  }
   return r;
 }
 

@@ -6,6 +6,7 @@
 #include <octree_layout.h>
 
 #include "bake/bake.h"
+#include "bake/convert.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
@@ -104,6 +105,24 @@ TEST(FreeSpace, AnObjectBehindTheDividerOfASealedRoomStaysDark) {
       EXPECT_EQ(volumeIrradiance(octree, Vec3{x, 0.5f, 0.5f}, n), Vec3(0.0f)) << "x = " << x;
     }
   }
+}
+
+TEST(FreeSpace, ConvertKeepsItWhileItIsNoFinerThanTheNewGrid) {
+  BakeParams params;
+  params.depth = 5;
+  params.photons = 20000;
+  const BakeResult baked = bake(test::pointLitRoom(), params);
+  ASSERT_EQ(baked.grid.volume.frame.depth, 3);
+  ConvertParams to4;
+  to4.depth = 4;
+  const ConvertResult coarser = convertLightGrid(baked.grid, baked.metadata, to4);
+  EXPECT_EQ(coarser.grid.volume.coords, baked.grid.volume.coords);
+  EXPECT_EQ(coarser.grid.volume.sh, baked.grid.volume.sh);
+  ConvertParams to2;
+  to2.depth = 2;
+  const ConvertResult tooCoarse = convertLightGrid(baked.grid, baked.metadata, to2);
+  EXPECT_TRUE(tooCoarse.grid.volume.empty());
+  EXPECT_NE(tooCoarse.method.find("free-space light"), std::string::npos) << tooCoarse.method;
 }
 
 }  // namespace
