@@ -13,6 +13,7 @@ half that faces the green one.
 Usage:
   measure_moving_sphere.py LIGHTOCTREE SCENE SPHERE WORKDIR [--size N] [--spp N]
                            [--check] [--table FILE] [--pictures DIR] [--bake-flag=FLAG ...]
+                           [--render-flag=FLAG ...]
 
 --check exits 1 unless every position is within 10% (RMSE and mean) and the
 wall positions bleed their wall's colour onto the side that faces it.
@@ -133,6 +134,8 @@ def main():
     ap.add_argument("--pictures")
     ap.add_argument("--bake-flag", action="append", default=[],
                     help="a flag for the bake, e.g. --bake-flag=--free-space-order=1 (repeatable)")
+    ap.add_argument("--render-flag", action="append", default=[],
+                    help="a flag for render, e.g. --render-flag=--free-space-tolerance=0 (repeatable)")
     a = ap.parse_args()
     os.makedirs(a.workdir, exist_ok=True)
     cli = a.lightoctree
@@ -143,8 +146,10 @@ def main():
     for k, (name, at, wall, bound) in enumerate(POSITIONS):
         place = ["--add", a.sphere, "--at", f"{at},0,{RADIUS}"]
         f = lambda ext, tag: os.path.join(a.workdir, f"{k}-{tag}.{ext}")
-        run(cli, "render", a.scene, grid, "-o", f("exr", "render"), *size, *place, "--quiet")
-        run(cli, "render", a.scene, grid, "-o", f("png", "render"), *size, *place, "--quiet")
+        run(cli, "render", a.scene, grid, "-o", f("exr", "render"), *size, *place, "--quiet",
+            *a.render_flag)
+        run(cli, "render", a.scene, grid, "-o", f("png", "render"), *size, *place, "--quiet",
+            *a.render_flag)
         run(cli, "reference", a.scene, "-o", f("exr", "reference"), *size, "--spp", a.spp, *place,
             "--quiet")
         run(cli, "reference", a.scene, "-o", f("png", "mask"), "--part", "added-mask", *size,

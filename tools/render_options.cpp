@@ -36,6 +36,7 @@ GpuOctreeParams ShadingOptions::octreeParams(const GlInfo* info) const {
   p.compact = texels == "compact";
   p.cosineCorrection = cosineCorrection == "on";
   p.tolerance = tolerance;
+  p.volumeTolerance = freeSpaceTolerance;
   if (info) {
     p.max3DTextureSize = info->max3DTextureSize;
     p.max2DTextureSize = info->max2DTextureSize;
@@ -146,6 +147,11 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
                   "Adaptive leaves: siblings whose light agrees within this share of each "
                   "voxel's irradiance, at its own surface, become one coarser leaf (0 = every "
                   "leaf at the bake's depth; docs/octree.md)")
+      ->check(CLI::Range(0.0f, 1.0f))
+      ->capture_default_str();
+  cmd->add_option("--free-space-tolerance", opt.freeSpaceTolerance,
+                  "The same for the free-space light the --add objects take: eight voxels whose "
+                  "irradiance agrees within this share, for 14 normals, become one (0 = none)")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
 }

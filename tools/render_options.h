@@ -40,6 +40,9 @@ struct ShadingOptions {
   /// Adaptive leaves (GpuOctreeParams::tolerance); 0 = off. 0.1: 2.5x less GPU
   /// memory at equal irradiance error on the test scenes (docs/octree.md).
   float tolerance = 0.1f;
+  /// Free-space leaves merge where their light agrees within this share
+  /// (GpuOctreeParams::volumeTolerance); 0 = off.
+  float freeSpaceTolerance = 0.4f;
   std::string cosineCorrection = "on";
 
   /// Mode, interpolation, GGX lobe and VDLs of a frame (size left at default).

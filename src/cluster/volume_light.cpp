@@ -52,9 +52,9 @@ constexpr double kMinTrack = 1e-4;
 /// A lit box within this of a voxel's face reaches it.
 constexpr double kFaceTolerance = 1e-6;
 
-/// What one voxel of a slab gathers.
+/// What one voxel of a slab gathers, but its SH sums (kept apart, so that
+/// a slab's cells stay small in the cache).
 struct Cell {
-  double sh[layout::LO_SH_MAX_TERMS][3] = {};
   double fluence[3] = {0, 0, 0};
   double lower[3] = {1, 1, 1}, upper[3] = {0, 0, 0};
   uint32_t rays = 0;
@@ -121,11 +121,14 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
 
   std::vector<std::vector<Coord>> slabCoords(static_cast<size_t>(slabCount));
   std::vector<std::vector<Cell>> slabCells(static_cast<size_t>(slabCount));
+  std::vector<std::vector<double>> slabSums(static_cast<size_t>(slabCount));  // terms x 3 per cell
   const int terms = params.shTerms;
   auto walkSlab = [&](int slab) {
     const int zLow = slab * thick, zHigh = std::min(res, zLow + thick);
     const int layers = zHigh - zLow;
     std::vector<Cell> cells(size_t(res) * size_t(res) * size_t(layers));
+    const size_t per = size_t(terms) * 3;
+    std::vector<double> sums(cells.size() * per, 0.0);
     for (uint32_t i : slabs[size_t(slab)]) {
       const PhotonSegment& s = segments[i];
       const Vec3dd p0 = local(s.from), p1 = local(s.to);
@@ -170,8 +173,10 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
         // A track shorter than kMinTrack (a ray ending on a wall that lies on
         // a voxel face, rounded into the next voxel) lights nothing there.
         if ((tNext - t) * length > kMinTrack) {
-          Cell& c = cells[(size_t(cell[2] - zLow) * size_t(res) + size_t(cell[1])) * size_t(res) +
-                          size_t(cell[0])];
+          const size_t index =
+              (size_t(cell[2] - zLow) * size_t(res) + size_t(cell[1])) * size_t(res) + size_t(cell[0]);
+          Cell& c = cells[index];
+          double* sum = &sums[index * per];
           const double dt = tNext - t;
           for (int a = 0; a < 3; ++a) c.fluence[a] += flux[a] * dt;
           if (!c.full) {
@@ -192,7 +197,7 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
             }
           }
           for (int k = 0; k < terms; ++k) {
-            for (int a = 0; a < 3; ++a) c.sh[k][a] += weighted[k][a] * dt;
+            for (int a = 0; a < 3; ++a) sum[k * 3 + a] += weighted[k][a] * dt;
           }
           ++c.rays;
         }
@@ -207,10 +212,13 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
     for (int z = zLow; z < zHigh; ++z) {
       for (int y = 0; y < res; ++y) {
         for (int x = 0; x < res; ++x) {
-          const Cell& c = cells[(size_t(z - zLow) * size_t(res) + size_t(y)) * size_t(res) + size_t(x)];
+          const size_t index = (size_t(z - zLow) * size_t(res) + size_t(y)) * size_t(res) + size_t(x);
+          const Cell& c = cells[index];
           if (c.rays == 0 || !(c.fluence[0] + c.fluence[1] + c.fluence[2] > 0)) continue;
           slabCoords[size_t(slab)].push_back(Coord{x, y, z});
           slabCells[size_t(slab)].push_back(c);
+          slabSums[size_t(slab)].insert(slabSums[size_t(slab)].end(), sums.begin() + std::ptrdiff_t(index * per),
+                                        sums.begin() + std::ptrdiff_t((index + 1) * per));
         }
       }
     }
@@ -244,12 +252,13 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
   out.litUpper.resize(n);
   for (size_t v = 0; v < n; ++v) {
     const Cell& c = slabCells[size_t(order[v].z)][order[v].index];
+    const double* sum = &slabSums[size_t(order[v].z)][order[v].index * size_t(terms) * 3];
     out.coords[v] = slabCoords[size_t(order[v].z)][order[v].index];
     out.irradiance[v] = Vec3{float(c.fluence[0] / 4), float(c.fluence[1] / 4), float(c.fluence[2] / 4)};
     for (int k = 0; k < terms; ++k) {
       const double band = double(layout::loShCosineBand(uint32_t(k)));
       out.sh[v * size_t(terms) + size_t(k)] =
-          Vec3{float(c.sh[k][0] * band), float(c.sh[k][1] * band), float(c.sh[k][2] * band)};
+          Vec3{float(sum[k * 3] * band), float(sum[k * 3 + 1] * band), float(sum[k * 3 + 2] * band)};
     }
     out.segments[v] = float(c.rays);
     out.litLower[v] = Vec3{float(c.lower[0]), float(c.lower[1]), float(c.lower[2])};

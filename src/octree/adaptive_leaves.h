@@ -25,6 +25,9 @@ struct CollapsedLeaf {
   /// terms (VdlGrid::shTerms of them).
   std::vector<Vdl> vdls;
   std::vector<Vec3> sh;
+  /// A free-space leaf (buildVolumeOctree): the box its voxels' light
+  /// filled, in its own units (VolumeLight::litLower / litUpper).
+  Vec3 litLower{0, 0, 0}, litUpper{1, 1, 1};
 };
 
 /// The adaptive tree of a grid: the collapsed leaves, and per voxel of the

@@ -260,7 +260,7 @@ AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
   const int terms = v.shTerms;
   struct Node {
     std::vector<Vec3> sh;
-    bool mergeable = true;  ///< a leaf whose light filled it whole
+    Vec3 lower{0, 0, 0}, upper{1, 1, 1};  ///< its lit box, node units
   };
   auto pack = [](const Coord& c) {
     return (uint64_t(uint32_t(c.x)) << 42) | (uint64_t(uint32_t(c.y)) << 21) | uint64_t(uint32_t(c.z));
@@ -270,9 +270,8 @@ AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
   for (size_t k = 0; k < n; ++k) {
     Node node;
     node.sh.assign(v.shOf(k), v.shOf(k) + terms);
-    for (int a = 0; a < 3; ++a) {
-      node.mergeable = node.mergeable && v.litLower[k][a] <= 0.0f && v.litUpper[k][a] >= 1.0f;
-    }
+    node.lower = v.litLower[k];
+    node.upper = v.litUpper[k];
     level[pack(v.coords[k])] = std::move(node);
   }
   Vec3 normals[14];
@@ -300,8 +299,23 @@ AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
     std::map<uint64_t, Node> next;
     for (const auto& [parent, children] : parents) {
       bool merge = children.size() == 8;
-      for (uint64_t k : children) merge = merge && level[k].mergeable;
       Node joined;
+      joined.lower = Vec3{1, 1, 1};
+      joined.upper = Vec3{0, 0, 0};
+      // A child's light may stop short of its faces on the parent's outside
+      // only (a wall along the parent's side), never inside the parent: the
+      // parent's box is then the children's together.
+      for (uint64_t k : children) {
+        if (!merge) break;
+        const Node& child = level[k];
+        const int o[3] = {int((k >> 42) & 1), int((k >> 21) & 1), int(k & 1)};
+        for (int a = 0; a < 3; ++a) {
+          const bool inner = o[a] == 0 ? child.upper[a] >= 1.0f : child.lower[a] <= 0.0f;
+          merge = merge && inner;
+          joined.lower[a] = std::min(joined.lower[a], (float(o[a]) + child.lower[a]) * 0.5f);
+          joined.upper[a] = std::max(joined.upper[a], (float(o[a]) + child.upper[a]) * 0.5f);
+        }
+      }
       if (merge) {
         joined.sh.assign(size_t(terms), Vec3{0, 0, 0});
         for (uint64_t k : children) {
@@ -327,6 +341,8 @@ AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
                          int(parent & 0x1fffff)};
       leaf.level = l;
       leaf.sh = node.sh;
+      leaf.litLower = node.lower;
+      leaf.litUpper = node.upper;
       merged[std::make_pair(l, parent)] = std::move(leaf);
     }
     level = std::move(next);
@@ -705,8 +721,11 @@ class OctreeBuilder {
   /// A collapsed leaf: its texels, stored as they are (intensities, SH terms).
   void writeCollapsedLeaf(uint8_t* t, const CollapsedLeaf& c) {
     // A free-space leaf stands for voxels whose light filled them whole.
-    const float whole = loPackVolumeBox(0.0f, 1.0f);
-    if (!headers_.empty()) writeTexel(nextVdl_++, Vec3(whole), 0.0f);
+    if (!headers_.empty()) {
+      Vec3 header;
+      for (int a = 0; a < 3; ++a) header[a] = loPackVolumeBox(c.litLower[a], c.litUpper[a]);
+      writeTexel(nextVdl_++, header, 0.0f);
+    }
     writeLeafTexel(t, uint8_t(sh_ ? 1u : uint(c.vdls.size())));
     if (sh_) {
       for (const Vec3& term : c.sh) writeSh(nextVdl_++, term);
@@ -827,7 +846,7 @@ GpuOctree buildVolumeOctree(const VolumeLight& volume, const GpuOctreeParams& pa
   GpuOctreeParams p = params;
   p.cosineCorrection = false;
   gpu_octree_internal::validate(grid, p);
-  AdaptiveLeaves adaptive = gpu_octree_internal::collapseVolume(volume, params.tolerance);
+  AdaptiveLeaves adaptive = gpu_octree_internal::collapseVolume(volume, params.volumeTolerance);
   return gpu_octree_internal::OctreeBuilder(grid, p, std::move(adaptive), std::move(headers)).build();
 }
 

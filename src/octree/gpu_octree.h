@@ -37,6 +37,11 @@ struct GpuOctreeParams {
   /// within this share of a voxel's irradiance, at every voxel's own surface,
   /// collapse into one coarser leaf. 0 = every leaf at the grid's depth.
   float tolerance = 0.0f;
+  /// The same for the free-space octree (buildVolumeOctree): eight siblings
+  /// whose irradiance agrees within this share, for 14 normals, merge. Its
+  /// light varies more slowly than the surfaces' and is read on objects
+  /// only, so it may merge more. 0 = no merging.
+  float volumeTolerance = 0.0f;
 };
 
 /// Smallest cosine cosineCorrection divides by: bounds the gain of grazing

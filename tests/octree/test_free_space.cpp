@@ -60,6 +60,25 @@ TEST(VolumeOctree, ReadsEachVoxelsLightAndNotBeyondItsLitBox) {
   }
 }
 
+TEST(VolumeOctree, LeavesWhoseLightAgreesMergeAndReadTheSame) {
+  GpuOctreeParams params;
+  params.volumeTolerance = 0.1f;
+  const GpuOctree merged = buildVolumeOctree(walledVolume(), params);
+  // The 32 voxels of x = 2, 3 merge into 4 leaves (the rows x = 1 and 0
+  // cannot: their parents lack the dark row's children).
+  EXPECT_EQ(merged.collapsedVoxels, 32u);
+  EXPECT_EQ(merged.leafCount, 16u + 4u);
+  for (const Vec3& n : {Vec3{1, 0, 0}, Vec3{0, 0.6f, 0.8f}}) {
+    EXPECT_NEAR(volumeIrradiance(merged, Vec3{2.5f, 2, 2}, n).x, 1.0f, 2e-3f);
+    EXPECT_NEAR(volumeIrradiance(merged, Vec3{3.9f, 0.1f, 3.9f}, n).x, 1.0f, 2e-3f);
+    EXPECT_EQ(volumeIrradiance(merged, Vec3{1.2f, 2, 2}, n), Vec3(0.0f));
+  }
+  // Light that differs by more than the tolerance keeps its leaves.
+  VolumeLight v = walledVolume();
+  v.sh[v.sh.size() - 9] = v.sh[v.sh.size() - 9] * 2.0f;  // the last voxel twice as bright
+  EXPECT_EQ(buildVolumeOctree(v, params).collapsedVoxels, 24u);
+}
+
 TEST(VolumeOctree, RefusesArraysOfOtherLengths) {
   VolumeLight v = walledVolume();
   v.litUpper.pop_back();
