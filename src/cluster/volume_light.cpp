@@ -89,10 +89,10 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
   // Slabs of `thick` z layers: each ray listed in the slabs it crosses, in
   // order, with the part of it inside the cube. A voxel's sums follow the
   // rays' order whatever the slabs, so their thickness changes no bit.
-  // Two slabs per thread: a ray's set-up (its SH basis, clipping) is paid
-  // once per slab it crosses.
+  // A slab per thread: a ray's set-up (its SH basis, clipping) is paid once
+  // per slab it crosses, which costs more than the slabs' uneven loads.
   const int threads = std::max(1, tbb::this_task_arena::max_concurrency());
-  const int thick = std::max(1, (res + 2 * threads - 1) / (2 * threads));
+  const int thick = std::max(1, (res + threads - 1) / threads);
   const int slabCount = (res + thick - 1) / thick;
   std::vector<std::vector<uint32_t>> slabs(static_cast<size_t>(slabCount));
   std::vector<float> clipStart(segments.size(), 0.0f), clipEnd(segments.size(), 0.0f);
