@@ -90,6 +90,21 @@ std::shared_ptr<const Texture> twoBandSkyImage() {
   return std::make_shared<Texture>(Texture::fromLinear(8, 8, rows));
 }
 
+Scene sealedRooms() {
+  Scene scene;
+  Material grey;
+  grey.baseColor = Vec3(0.7f);
+  scene.materials.push_back(grey);
+  addClosedBox(scene, Vec3{0, 0, 0}, Vec3{2, 1, 1}, 0);
+  addQuad(scene, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{-1, 0, 0}, 0);
+  addQuad(scene, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{1, 0, 0}, 0);
+  Light light;
+  light.position = Vec3{0.5f, 0.7f, 0.5f};
+  light.intensity = 1.0f;
+  scene.lights.push_back(light);
+  return scene;
+}
+
 Scene pointLitRoom() {
   Scene scene;
   Material grey;

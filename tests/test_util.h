@@ -52,6 +52,11 @@ std::string runCommand(const std::string& command);
 /// of intensity 1 at (0.5, 0.8, 0.5): a small scene for whole-bake tests.
 Scene pointLitRoom();
 
+/// Two rooms side by side, [0, 1] and [1, 2] along x (y, z in [0, 1]),
+/// sealed from each other by a thin divider at x = 1 (one quad per side;
+/// albedo 0.7); a point light of intensity 1 at (0.5, 0.7, 0.5), in the first.
+Scene sealedRooms();
+
 /// An 8 x 8 sky image (Sky::image): radiance 4 within 45 degrees of the
 /// zenith (rows 0 and 1), 1 down to the horizon (rows 2 and 3), 7 below
 /// (unused). An open surface facing up receives E = 4 pi sin^2(45) +

@@ -85,29 +85,11 @@ TEST(VolumeOctree, RefusesArraysOfOtherLengths) {
   EXPECT_THROW(buildVolumeOctree(v), InputError);
 }
 
-/// Two rooms side by side, [0, 1] and [1, 2] along x, sealed from each
-/// other by a thin divider at x = 1 (one quad per side); a point light in
-/// the first.
-Scene sealedRooms() {
-  Scene scene;
-  Material grey;
-  grey.baseColor = Vec3(0.7f);
-  scene.materials.push_back(grey);
-  test::addClosedBox(scene, Vec3{0, 0, 0}, Vec3{2, 1, 1}, 0);
-  test::addQuad(scene, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{-1, 0, 0}, 0);
-  test::addQuad(scene, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{1, 0, 0}, 0);
-  Light light;
-  light.position = Vec3{0.5f, 0.7f, 0.5f};
-  light.intensity = 1.0f;
-  scene.lights.push_back(light);
-  return scene;
-}
-
 TEST(FreeSpace, AnObjectBehindTheDividerOfASealedRoomStaysDark) {
   BakeParams params;
   params.depth = 5;
   params.photons = 60000;
-  const BakeResult baked = bake(sealedRooms(), params);
+  const BakeResult baked = bake(test::sealedRooms(), params);
   const VolumeLight& v = baked.grid.volume;
   ASSERT_FALSE(v.empty());
   EXPECT_EQ(v.frame.depth, 3);

@@ -121,5 +121,47 @@ TEST(AddedObjects, TheFreeSpaceLightLightsThemAsTheCppLookupSays) {
   EXPECT_NEAR(got.y, expected.y, 0.03f * expected.y);
 }
 
+TEST(AddedObjects, ASphereBehindTheDividerOfASealedRoomIsBlack) {
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
+  BakeParams bp;
+  bp.depth = 5;
+  bp.photons = 60000;
+  const Scene rooms = test::sealedRooms();
+  const BakeResult baked = bake(rooms, bp);
+  const GpuOctree octree = buildGpuOctree(baked.grid);
+  const GpuOctree volume = buildVolumeOctree(baked.grid.volume);
+  RenderParams params;
+  params.width = 48;
+  params.height = 48;
+  params.reflections = false;
+  for (const float x : {1.12f, 1.5f}) {  // 2 cm from the divider, and mid-room
+    Scene scene = rooms;
+    Placement p;
+    p.at = Vec3d{x, 0.5, 0.5};
+    p.scale = 0.1f;
+    placeModel(scene, loadScene(test::dataDir() + "/models/sphere.obj"), p);
+    Renderer renderer(scene, octree, {});
+    renderer.setFreeSpaceLight(volume);
+    // From the dark room's far wall, the sphere fills the middle of the view.
+    const RgbImage image = renderer.render(
+        PinholeCamera::lookAt(Vec3(1.95f, 0.5f, 0.5f), Vec3(x, 0.5f, 0.5f), 0.6f), params);
+    for (size_t i = 0; i < image.pixelCount(); ++i) {
+      ASSERT_EQ(image.at(i), Vec3(0.0f)) << "pixel " << i << " with the sphere at x = " << x;
+    }
+    // The same sphere in the lit room is lit.
+  }
+  Scene lit = rooms;
+  Placement p;
+  p.at = Vec3d{0.5, 0.4, 0.5};
+  p.scale = 0.1f;
+  placeModel(lit, loadScene(test::dataDir() + "/models/sphere.obj"), p);
+  Renderer renderer(lit, octree, {});
+  renderer.setFreeSpaceLight(volume);
+  params.mode = RenderMode::Indirect;
+  const RgbImage image = renderer.render(
+      PinholeCamera::lookAt(Vec3(0.5f, 0.4f, 0.95f), Vec3(0.5f, 0.4f, 0.5f), 0.3f), params);
+  EXPECT_GT(image.at(size_t(24) * 48 + 24).y, 0.0f);
+}
+
 }  // namespace
 }  // namespace lo
