@@ -390,6 +390,7 @@ class RankBake {
         if (me_ == 0) {
           for (const std::vector<char>& part : parts) {
             const size_t n = part.size() / sizeof(PhotonSegment);
+            if (n == 0) continue;  // a rank whose paths kept none
             const size_t old = allSegments_.size();
             allSegments_.resize(old + n);
             std::memcpy(static_cast<void*>(allSegments_.data() + old), part.data(), n * sizeof(PhotonSegment));
