@@ -51,6 +51,7 @@ PhotonParams BakeParams::photonParams() const {
   p.seed = seed;
   p.region = region;
   p.segments = freeSpace;
+  p.maxSegments = freeSpaceRays;
   return p;
 }
 
@@ -506,7 +507,7 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   const double target = params.targetError;
 
   std::vector<Photon> raw;  // photons of paths 0 .. emitted-1, powers not yet scaled
-  std::vector<PhotonSegment> rawSegments;  // their segments (BakeParams::freeSpace)
+  SegmentCollector rawSegments(photonParams.maxSegments);  // their rays (BakeParams::freeSpace)
   size_t emitted = 0, empty = 0, missed = 0;
   size_t goal = std::min(cap, std::max(kMinPilotPhotons, kPilotPhotonsPerVoxel * grid.size()));
   std::vector<Photon> scaled;
@@ -525,14 +526,15 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
         return raw.size() < goal;
       };
       const PhotonTracer::SegmentSink keepSegments = [&](const PhotonSegment* p, uint32_t n) {
-        rawSegments.insert(rawSegments.end(), p, p + n);
+        rawSegments.addPath(p, n);
       };
       while (tracer.canStore() && raw.size() < goal) {
         const size_t batch = photonBatchPaths(goal, raw.size(), emitted, maxEmitted);
         if (batch == 0) break;
         const size_t before = raw.size();
         tracer.trace(uint64_t(emitted), batch, take,
-                     params.freeSpace ? keepSegments : PhotonTracer::SegmentSink());
+                     params.freeSpace && !rawSegments.full() ? keepSegments
+                                                             : PhotonTracer::SegmentSink());
         bar.advance(std::min(raw.size(), goal) - std::min(before, goal));
       }
     }
@@ -566,10 +568,8 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   }
   r.metadata = bakeMetadata(scene, params, int64_t(raw.size()), int64_t(emitted), s.level.radius);
   if (params.freeSpace) {
-    scaleSegmentPower(rawSegments, emitted);
-    r.grid.volume = freeSpaceLight(rawSegments, r.grid.frame, params, progress, s.stages);
+    r.grid.volume = freeSpaceLight(rawSegments.take(), r.grid.frame, params, progress, s.stages);
   }
-  rawSegments = std::vector<PhotonSegment>();
   if (params.keepPhotons) {
     r.photons.photons = std::move(scaled);
     r.photons.emittedPaths = emitted;

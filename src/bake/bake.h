@@ -129,6 +129,9 @@ struct BakeParams {
   /// SH order of the free-space light: 1 (4 terms, the default: as close to the
   /// path tracer on the moving-sphere test as 2, at half the GPU bytes) or 2 (9).
   int freeSpaceOrder = 1;
+  /// At most this many rays make it (PhotonParams::maxSegments): the whole
+  /// paths from the first on.
+  size_t freeSpaceRays = kDefaultMaxSegments;
   /// A region of interest (`--bounds`; empty = the whole scene): the grid
   /// covers it alone, photons are stored only inside it, and directional
   /// lights emit over its footprint (PhotonParams::region).

@@ -300,13 +300,11 @@ class RankBake {
     result.grid = std::move(merged_);
     if (me_ == 0 && params_.freeSpace) {
       StageTimer timer(st_.stages, "free-space light");
-      scaleSegmentPower(allSegments_, size_t(emitted_));
-      result.grid.volume =
-          buildVolumeLight(allSegments_, result.grid.frame, params_.volumeParams(), progress_);
+      const std::vector<PhotonSegment> rays = collector_.take();
+      result.grid.volume = buildVolumeLight(rays, result.grid.frame, params_.volumeParams(), progress_);
       timer.finish(formatCount(result.grid.volume.size()) + " voxels from " +
-                   formatCount(allSegments_.size()) + " light rays");
+                   formatCount(rays.size()) + " light rays");
     }
-    allSegments_ = std::vector<PhotonSegment>();
     result.metadata =
         bakeMetadata(scene_, params_, int64_t(stored_), int64_t(emitted_), st_.level.radius);
     if (me_ == 0) {
@@ -338,7 +336,8 @@ class RankBake {
     std::vector<uint32_t> pathPhotons;
     std::vector<PhotonSegment> segments;
     std::vector<uint32_t> pathSegments;
-    allSegments_.clear();
+    collector_ = SegmentCollector(photonParams.maxSegments);
+    bool segmentsFull = false;
     Progress bar(progress_, "Tracing photons", target);
     while (target > 0 && tracer.canStore() && stored_ < target) {
       const size_t paths = photonBatchPaths(target, size_t(stored_), size_t(emitted_), maxEmitted);
@@ -358,7 +357,8 @@ class RankBake {
             pathPhotons.push_back(n);
             return true;
           },
-          params_.freeSpace ? PhotonTracer::SegmentSink([&](const PhotonSegment* p, uint32_t n) {
+          params_.freeSpace && !segmentsFull
+              ? PhotonTracer::SegmentSink([&](const PhotonSegment* p, uint32_t n) {
             segments.insert(segments.end(), p, p + n);
             pathSegments.push_back(n);
           })
@@ -377,25 +377,39 @@ class RankBake {
         kept[1] += pathPhotons[i] == 0;
       }
       batch.resize(size_t(kept[2]));
-      if (params_.freeSpace) {
-        // The kept paths' segments, to rank 0 in rank (= path) order: the
-        // free-space light is made there from all of them, as one process
-        // makes it (the same bytes).
+      if (params_.freeSpace && !segmentsFull) {
+        // The kept paths' segments and their counts per path, to rank 0 in
+        // rank (= path) order: the free-space light is made there from the
+        // same whole paths as one process makes it from (the same bytes).
+        const size_t paths = std::min<size_t>(size_t(kept[0]), pathSegments.size());
         size_t keep = 0;
-        for (size_t i = 0; i < size_t(kept[0]) && i < pathSegments.size(); ++i) keep += pathSegments[i];
+        for (size_t i = 0; i < paths; ++i) keep += pathSegments[i];
         segments.resize(keep);
-        const char* bytes = reinterpret_cast<const char*>(segments.data());
-        const std::vector<std::vector<char>> parts =
-            comm_.gatherBytes(std::vector<char>(bytes, bytes + keep * sizeof(PhotonSegment)), 0);
+        pathSegments.resize(paths);
+        const auto bytesOf = [](const auto& v) {
+          const char* b = reinterpret_cast<const char*>(v.data());
+          return std::vector<char>(b, b + v.size() * sizeof(v[0]));
+        };
+        const std::vector<std::vector<char>> parts = comm_.gatherBytes(bytesOf(segments), 0);
+        const std::vector<std::vector<char>> counts = comm_.gatherBytes(bytesOf(pathSegments), 0);
+        uint64_t full = 0;
         if (me_ == 0) {
-          for (const std::vector<char>& part : parts) {
-            const size_t n = part.size() / sizeof(PhotonSegment);
-            if (n == 0) continue;  // a rank whose paths kept none
-            const size_t old = allSegments_.size();
-            allSegments_.resize(old + n);
-            std::memcpy(static_cast<void*>(allSegments_.data() + old), part.data(), n * sizeof(PhotonSegment));
+          for (size_t r = 0; r < parts.size(); ++r) {
+            std::vector<PhotonSegment> part(parts[r].size() / sizeof(PhotonSegment));
+            std::vector<uint32_t> perPath(counts[r].size() / sizeof(uint32_t));
+            if (!part.empty()) std::memcpy(static_cast<void*>(part.data()), parts[r].data(), parts[r].size());
+            if (!perPath.empty()) std::memcpy(perPath.data(), counts[r].data(), counts[r].size());
+            const PhotonSegment* next = part.data();
+            for (uint32_t n : perPath) {
+              if (!collector_.addPath(next, n)) break;
+              next += n;
+            }
           }
+          full = collector_.full() ? 1 : 0;
         }
+        // Every rank stops sending once rank 0 holds what it takes.
+        comm_.allreduceSum(&full, 1);
+        segmentsFull = full > 0;
       }
       mine_.photonsTraced += kept[2];
       comm_.allreduceSum(kept, 3);
@@ -619,8 +633,9 @@ class RankBake {
   RankStats mine_;
   TilePlan plan_;
   std::vector<Photon> held_;  ///< this rank's tiles' and halo's photons, in map order
-  /// Rank 0 with BakeParams::freeSpace: every kept path's segments, in path order.
-  std::vector<PhotonSegment> allSegments_;
+  /// Rank 0 with BakeParams::freeSpace: the kept paths' segments, in path
+  /// order, as one process collects them.
+  SegmentCollector collector_{0};
   uint64_t stored_ = 0, emitted_ = 0, empty_ = 0, unsent_ = 0;
   SurfaceGrid grid_;             ///< this rank's tiles and halo
   std::vector<uint32_t> owned_;  ///< grid_ indices of this rank's voxels

@@ -701,9 +701,10 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
     empty += n == 0;
     return map.photons.size() < target;
   };
+  SegmentCollector collector(params.maxSegments);
   const PhotonTracer::SegmentSink keepSegments =
       params.segments ? PhotonTracer::SegmentSink([&](const PhotonSegment* segments, uint32_t n) {
-        map.segments.insert(map.segments.end(), segments, segments + n);
+        collector.addPath(segments, n);
       })
                       : PhotonTracer::SegmentSink();
   while (map.photons.size() < target) {
@@ -719,7 +720,7 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   map.missedPaths = missed;
   map.raysTraced = rays;
   scalePhotonPower(map.photons, emitted);
-  scaleSegmentPower(map.segments, emitted);
+  map.segments = collector.take();
   return map;
 }
 
@@ -728,9 +729,23 @@ void scalePhotonPower(std::vector<Photon>& photons, size_t emittedPaths) {
   for (Photon& ph : photons) ph.power *= invPaths;
 }
 
-void scaleSegmentPower(std::vector<PhotonSegment>& segments, size_t emittedPaths) {
-  const float invPaths = emittedPaths > 0 ? float(1.0 / double(emittedPaths)) : 0.0f;
-  for (PhotonSegment& segment : segments) segment.power *= invPaths;
+bool SegmentCollector::addPath(const PhotonSegment* segments, uint32_t count) {
+  if (full_) return false;
+  if (segments_.size() + count > cap_) {
+    full_ = true;
+    return false;
+  }
+  segments_.insert(segments_.end(), segments, segments + count);
+  ++paths_;
+  return true;
+}
+
+std::vector<PhotonSegment> SegmentCollector::take() {
+  const float invPaths = paths_ > 0 ? float(1.0 / double(paths_)) : 0.0f;
+  for (PhotonSegment& segment : segments_) segment.power *= invPaths;
+  std::vector<PhotonSegment> out = std::move(segments_);
+  segments_ = std::vector<PhotonSegment>();
+  return out;
 }
 
 }  // namespace lo

@@ -15,6 +15,9 @@
 
 namespace lo {
 
+/// PhotonParams::maxSegments by default: 2M rays, 72 MB.
+constexpr size_t kDefaultMaxSegments = size_t(2) << 20;
+
 struct PhotonParams {
   size_t storedPhotons = 600000;  ///< photons to store (exact count unless the scene stores none)
   int maxBounces = 16;            ///< path length cap (Russian roulette usually ends paths first)
@@ -26,6 +29,10 @@ struct PhotonParams {
   /// Also keep the rays the stored light travels along (PhotonMap::segments):
   /// what the free-space light of the octree is estimated from.
   bool segments = false;
+  /// At most this many of them: the whole paths from path 0 on until the
+  /// next would pass it (SegmentCollector). A coarse grid needs far fewer
+  /// rays than the surfaces need photons; 36 bytes each.
+  size_t maxSegments = kDefaultMaxSegments;
   /// A region of interest (world space; empty = the whole scene): only
   /// photons inside it are stored, and directional lights emit over its
   /// footprint (a disc of its bounding sphere) instead of the whole scene's,
@@ -35,8 +42,9 @@ struct PhotonParams {
 
 struct PhotonMap {
   std::vector<Photon> photons;
-  /// With PhotonParams::segments: the rays of the same paths whose light the
-  /// photons hold (lightgrid/photon.h), in path order, powers scaled as theirs.
+  /// With PhotonParams::segments: the rays of the first paths whose light the
+  /// photons hold (lightgrid/photon.h), in path order, up to
+  /// PhotonParams::maxSegments, powers divided by the paths they came from.
   std::vector<PhotonSegment> segments;
   size_t emittedPaths = 0;      ///< paths traced to obtain `photons`
   size_t emptyPaths = 0;        ///< of those, paths that stored no photon
@@ -107,7 +115,25 @@ size_t maxEmittedPaths(const PhotonParams& params);
 /// Divides every photon's power by the paths emitted to obtain them (the
 /// Monte Carlo estimator of the emitted flux): the last step of a map.
 void scalePhotonPower(std::vector<Photon>& photons, size_t emittedPaths);
-/// The same for segments.
-void scaleSegmentPower(std::vector<PhotonSegment>& segments, size_t emittedPaths);
+/// The rays a free-space light is made from: each path's segments handed
+/// in path order, taken whole from path 0 on until the next path would pass
+/// `cap` rays; then none. The estimate is the taken paths' alone, so their
+/// powers are divided by the paths taken (take()), not by all emitted.
+class SegmentCollector {
+ public:
+  explicit SegmentCollector(size_t cap) : cap_(cap) {}
+  /// The next path's segments. @returns false once full.
+  bool addPath(const PhotonSegment* segments, uint32_t count);
+  bool full() const { return full_; }
+  size_t paths() const { return paths_; }
+  /// The segments taken, powers scaled by 1 / paths(); leaves it empty.
+  std::vector<PhotonSegment> take();
+
+ private:
+  size_t cap_;
+  std::vector<PhotonSegment> segments_;
+  size_t paths_ = 0;
+  bool full_ = false;
+};
 
 }  // namespace lo

@@ -823,3 +823,42 @@ TEST(Photons, CausticPhotonsCameThroughTheMirrorAlone) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+TEST(SegmentCollector, TakesWholePathsAndScalesByThePathsTaken) {
+  const PhotonSegment s{{0, 0, 0}, {1, 0, 0}, {6, 6, 6}};
+  const std::vector<PhotonSegment> path(3, s);
+  SegmentCollector c(7);
+  EXPECT_TRUE(c.addPath(path.data(), 3));
+  EXPECT_TRUE(c.addPath(path.data(), 0));  // a path without rays counts
+  EXPECT_TRUE(c.addPath(path.data(), 3));
+  EXPECT_FALSE(c.addPath(path.data(), 3));  // would pass 7: full, none of it
+  EXPECT_FALSE(c.addPath(path.data(), 1));
+  EXPECT_TRUE(c.full());
+  EXPECT_EQ(c.paths(), 3u);
+  const std::vector<PhotonSegment> taken = c.take();
+  ASSERT_EQ(taken.size(), 6u);
+  EXPECT_EQ(taken[0].power, Vec3(2.0f));  // 6 / 3 paths
+}
+
+TEST(SegmentCollector, TracePhotonsKeepsAtMostTheCap) {
+  PhotonParams params;
+  params.storedPhotons = 5000;
+  params.segments = true;
+  params.maxSegments = 1000;
+  const PhotonMap map = tracePhotons(test::pointLitRoom(), params);
+  EXPECT_LE(map.segments.size(), 1000u);
+  EXPECT_GT(map.segments.size(), 900u);
+  params.maxSegments = kDefaultMaxSegments;
+  const PhotonMap all = tracePhotons(test::pointLitRoom(), params);
+  EXPECT_GT(all.segments.size(), map.segments.size());
+  // The first paths' rays are the same rays, scaled by fewer paths.
+  ASSERT_FALSE(map.segments.empty());
+  EXPECT_EQ(map.segments[0].from, all.segments[0].from);
+  EXPECT_GT(map.segments[0].power.x, all.segments[0].power.x);
+}
+
+}  // namespace
+}  // namespace lo
