@@ -85,9 +85,12 @@ struct LoSurface {
 vec3 loVdlResponse(LoSurface s, vec3 d); /* defined by the includer */
 
 /* Octree descent (paper Fig. 6): from the root tile to the leaf holding voxel
- * c. False in empty space or outside the cube. */
-LO_LOOKUP_FN bool loLookupLeaf(LO_TEX_PARAM ivec3 c, int depth, LO_OUT(uvec4) leaf) {
+ * c, and the leaf's edge in voxels (1 at the octree's depth, 2^k for a leaf k
+ * levels up). False in empty space or outside the cube. */
+LO_LOOKUP_FN bool loLookupLeafSize(LO_TEX_PARAM ivec3 c, int depth, LO_OUT(uvec4) leaf,
+                                   LO_OUT(int) size) {
   leaf = uvec4(0u);
+  size = 1;
   int resolution = 1 << depth;
   if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(resolution)))) return false;
   ivec3 tile = ivec3(0);
@@ -97,11 +100,18 @@ LO_LOOKUP_FN bool loLookupLeaf(LO_TEX_PARAM ivec3 c, int depth, LO_OUT(uvec4) le
     if (t.a == LO_FLAG_EMPTY) return false;
     if (t.a != LO_FLAG_INNER) {
       leaf = t;
+      size = 1 << level;
       return loIsLeaf(t.a);
     }
     tile = ivec3(t);
   }
   return false;
+}
+
+/* loLookupLeafSize without the size. */
+LO_LOOKUP_FN bool loLookupLeaf(LO_TEX_PARAM ivec3 c, int depth, LO_OUT(uvec4) leaf) {
+  int size;
+  return loLookupLeafSize(LO_TEX c, depth, leaf, size);
 }
 
 /* IEEE binary16 bits -> float, exact (unpackHalf2x16 needs GLSL 4.20). */
@@ -392,19 +402,23 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
   return vec3(0.0f);
 }
 
-/* Whether free-space voxel c lends its light to q (both in its octree's
- * voxel units): q lies within its lit box, grown by LO_VOLUME_BOX_MARGIN on
- * the sides where the box stops inside the voxel (a wall cuts it); a side
- * where the light reached the voxel's face bounds nothing. */
-LO_LOOKUP_FN bool loVolumeLends(LO_TEX_PARAM uint first, ivec3 c, vec3 q) {
+/* Whether the free-space leaf of voxel c, `size` voxels wide (a merged
+ * leaf's; loLookupLeafSize), lends its light to q (voxel units of its
+ * octree): q lies within the leaf's lit box (in the leaf's own units), grown
+ * by LO_VOLUME_BOX_MARGIN voxels on the sides where the box stops inside the
+ * leaf (a wall cuts it); a side where the light reached the leaf's face
+ * bounds nothing. */
+LO_LOOKUP_FN bool loVolumeLends(LO_TEX_PARAM uint first, ivec3 c, int size, vec3 q) {
   vec4 h = loFetchTexel(LO_TEX first - 1u);
-  vec3 local = q - vec3(c);
+  vec3 corner = vec3((c / size) * size);
+  vec3 local = (q - corner) / float(size);
+  float margin = LO_VOLUME_BOX_MARGIN / float(size);
   vec3 box = vec3(h);
   for (int a = 0; a < 3; ++a) {
     float lower = loVolumeBoxLower(box[a]);
     float upper = loVolumeBoxUpper(box[a]);
-    if (lower > 0.0f && local[a] < lower - LO_VOLUME_BOX_MARGIN) return false;
-    if (upper < 1.0f && local[a] > upper + LO_VOLUME_BOX_MARGIN) return false;
+    if (lower > 0.0f && local[a] < lower - margin) return false;
+    if (upper < 1.0f && local[a] > upper + margin) return false;
   }
   return true;
 }
@@ -421,8 +435,9 @@ LO_LOOKUP_FN vec3 loVolumeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
    * never reached, where a wall lies on the voxels' face), or with its
    * light beyond a wall, the neighbours lend none either. */
   uvec4 own;
-  if (!loLookupLeaf(LO_TEX ivec3(floor(q)), depth, own) ||
-      !loVolumeLends(LO_TEX loUnpackAddress(own.r, own.g, own.b), ivec3(floor(q)), q)) {
+  int size;
+  if (!loLookupLeafSize(LO_TEX ivec3(floor(q)), depth, own, size) ||
+      !loVolumeLends(LO_TEX loUnpackAddress(own.r, own.g, own.b), ivec3(floor(q)), size, q)) {
     return vec3(0.0f);
   }
   vec3 u = q - vec3(0.5f);
@@ -435,9 +450,9 @@ LO_LOOKUP_FN vec3 loVolumeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
     float w = loTrilinearWeight(f, o);
     if (w <= 0.0f) continue;
     uvec4 leaf;
-    if (!loLookupLeaf(LO_TEX base + o, depth, leaf)) continue;
+    if (!loLookupLeafSize(LO_TEX base + o, depth, leaf, size)) continue;
     uint first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
-    if (!loVolumeLends(LO_TEX first, base + o, q)) continue;
+    if (!loVolumeLends(LO_TEX first, base + o, size, q)) continue;
     sum += w * loShadeSh(LO_TEX first, s);
     weightSum += w;
   }

@@ -156,7 +156,7 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->capture_default_str();
   cmd->add_option("--free-space-levels", opt.freeSpaceLevels,
                   "How many levels coarser than the surface grid the free-space grid is "
-                  "(2: a free-space voxel is 4 surface voxels wide)")
+                  "(2: a free-space voxel is 4 surface voxels wide; never coarser than depth 1)")
       ->check(CLI::Range(0, 11))
       ->capture_default_str();
   cmd->add_option("--free-space-order", opt.freeSpaceOrder,

@@ -378,10 +378,9 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
     throw InputError("--free-space-order " + std::to_string(params.freeSpaceOrder) +
                      ": the free-space light's SH are of order 1 or 2");
   }
-  if (params.freeSpaceLevels < 0 || params.freeSpaceLevels >= params.depth) {
+  if (params.freeSpaceLevels < 0) {
     throw InputError("--free-space-levels " + std::to_string(params.freeSpaceLevels) +
-                     ": the free-space grid is 0 to depth - 1 = " +
-                     std::to_string(params.depth - 1) + " levels coarser than the surface grid");
+                     ": the free-space grid is 0 or more levels coarser than the surface grid");
   }
   // What the .vdb can store, checked before any work: OpenVDB refuses a
   // transform whose scale cubed is below 3e-15 (math::ScaleMap).

@@ -120,7 +120,7 @@ struct BakeParams {
   /// Layer-aware smoothing of the estimates (`--smoothing`): smoothVdlGrid.
   bool smoothing = true;
   /// Free-space light (`--free-space`): the light in every voxel of a grid
-  /// freeSpaceLevels coarser than the surface grid, surfaces or not, from the
+  /// freeSpaceLevels coarser than the surface grid (at least 1 level deep), surfaces or not, from the
   /// photon paths' track lengths (cluster/volume_light.h), for objects that
   /// were not baked (VdlGrid::volume). A distributed bake makes it on rank 0
   /// from every rank's segments: the same bytes.

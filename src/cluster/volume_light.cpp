@@ -91,8 +91,9 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
   // rays' order whatever the slabs, so their thickness changes no bit.
   // A slab per thread: a ray's set-up (its SH basis, clipping) is paid once
   // per slab it crosses, which costs more than the slabs' uneven loads.
-  const int threads = std::max(1, tbb::this_task_arena::max_concurrency());
-  const int thick = std::max(1, (res + threads - 1) / threads);
+  const int slabsWanted =
+      params.slabs > 0 ? params.slabs : std::max(1, tbb::this_task_arena::max_concurrency());
+  const int thick = std::max(1, (res + slabsWanted - 1) / slabsWanted);
   const int slabCount = (res + thick - 1) / thick;
   std::vector<std::vector<uint32_t>> slabs(static_cast<size_t>(slabCount));
   std::vector<float> clipStart(segments.size(), 0.0f), clipEnd(segments.size(), 0.0f);
@@ -158,14 +159,13 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
       const double tEps = (tb - ta) * 1e-9;
       const int lowCell[3] = {0, 0, zLow}, highCell[3] = {res - 1, res - 1, zHigh - 1};
       int cell[3], step[3];
-      double tMax[3], tDelta[3];
+      double tMax[3];
       for (int a = 0; a < 3; ++a) {
         const double pa = p0[a] + d[a] * (ta + tEps);
         cell[a] = std::clamp(int(std::floor(pa)), lowCell[a], highCell[a]);
         step[a] = d[a] > 0 ? 1 : -1;
         tMax[a] = d[a] != 0 ? (double(cell[a] + (d[a] > 0 ? 1 : 0)) - p0[a]) / d[a]
                             : std::numeric_limits<double>::infinity();
-        tDelta[a] = d[a] != 0 ? std::fabs(1.0 / d[a]) : std::numeric_limits<double>::infinity();
       }
       double t = ta;
       for (int guard = 0; guard < 2 * res + layers + 4; ++guard) {
@@ -206,7 +206,9 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
         cell[a] += step[a];
         if (cell[a] < lowCell[a] || cell[a] > highCell[a]) break;
         t = tNext;
-        tMax[a] += tDelta[a];
+        // From the face's own coordinate, not summed steps: a crossing's t
+        // is the same whichever slab the walk started in.
+        tMax[a] = (double(cell[a] + (d[a] > 0 ? 1 : 0)) - p0[a]) / d[a];
       }
     }
     for (int z = zLow; z < zHigh; ++z) {

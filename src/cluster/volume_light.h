@@ -18,6 +18,9 @@ struct VolumeLightParams {
   /// 1): 2 gives a voxel 4 surface voxels wide.
   int levels = 2;
   int shTerms = 4;  ///< 4 (order 1) or 9 (order 2)
+  /// Slabs of voxels walked in parallel; 0 = one per thread. The bytes do
+  /// not depend on it (tests set it).
+  int slabs = 0;
 };
 
 /// The track-length estimate of the light in each voxel: a ray of power P

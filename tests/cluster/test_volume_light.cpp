@@ -84,7 +84,7 @@ TEST(VolumeLight, TheFluenceOfAVoxelIsTheTrackLengthOverItsVolume) {
   EXPECT_NEAR(sum, expected, 1e-4 * expected);
 }
 
-TEST(VolumeLight, SameBytesWhateverTheThreadCount) {
+TEST(VolumeLight, SameBytesWhateverTheThreadsAndSlabs) {
   Rng rng(3, 0);
   std::vector<PhotonSegment> rays;
   for (int i = 0; i < 20000; ++i) {
@@ -92,11 +92,19 @@ TEST(VolumeLight, SameBytesWhateverTheThreadCount) {
                     {rng.uniform() * 20 - 2, rng.uniform() * 20 - 2, rng.uniform() * 20 - 2},
                     {rng.uniform(), rng.uniform(), rng.uniform()}});
   }
-  auto bake = [&](int threads) {
+  // The slabs follow the machine's cores (tbb::this_task_arena), which a
+  // thread limit does not change: both are varied.
+  auto bake = [&](int threads, int slabs) {
     ThreadLimit limit(threads);
-    return buildVolumeLight(rays, unitFrame(5));
+    VolumeLightParams params;
+    params.shTerms = 9;
+    params.slabs = slabs;
+    return buildVolumeLight(rays, unitFrame(5), params);
   };
-  const VolumeLight one = bake(1), many = bake(4);
+  const VolumeLight one = bake(1, 1), many = bake(4, 7);
+  const VolumeLight other = bake(2, 32);
+  ASSERT_EQ(other.sh, one.sh);
+  ASSERT_EQ(other.litUpper, one.litUpper);
   ASSERT_EQ(one.size(), many.size());
   ASSERT_GT(one.size(), 100u);
   for (size_t k = 0; k < one.size(); ++k) {

@@ -79,6 +79,33 @@ TEST(VolumeOctree, LeavesWhoseLightAgreesMergeAndReadTheSame) {
   EXPECT_EQ(buildVolumeOctree(v, params).collapsedVoxels, 24u);
 }
 
+TEST(VolumeOctree, AMergedLeafCutByAWallOnItsOutsideKeepsBothSidesRight) {
+  // A 4^3 grid lit everywhere with E = 1, but for a wall at x = 0.6 inside
+  // the row x = 0 (its light only beyond it). The row merges with x = 1: the
+  // joined box starts at 0.3 of the merged leaf.
+  VolumeLight v = walledVolume();
+  const float y0 = layout::loShBasis(0u, 0, 0, 1);
+  for (size_t k = 0; k < v.size(); ++k) v.litLower[k] = Vec3(0.0f);
+  for (int y = 0; y < 4; ++y) {
+    for (int z = 0; z < 4; ++z) {
+      v.coords.push_back(Coord{0, y, z});
+      v.irradiance.push_back(Vec3(1.0f));
+      for (int i = 0; i < 9; ++i) v.sh.push_back(i == 0 ? Vec3(1.0f / y0) : Vec3(0.0f));
+      v.segments.push_back(100);
+      v.litLower.push_back(Vec3{0.6f, 0, 0});
+      v.litUpper.push_back(Vec3(1.0f));
+    }
+  }
+  GpuOctreeParams params;
+  params.volumeTolerance = 0.1f;
+  const GpuOctree merged = buildVolumeOctree(v, params);
+  EXPECT_EQ(merged.collapsedVoxels, 64u);
+  const Vec3 n{0, 1, 0};
+  EXPECT_NEAR(volumeIrradiance(merged, Vec3{1.2f, 1.5f, 1.5f}, n).y, 1.0f, 2e-3f);  // lit
+  EXPECT_NEAR(volumeIrradiance(merged, Vec3{0.7f, 1.5f, 1.5f}, n).y, 1.0f, 2e-3f);  // just past the wall
+  EXPECT_EQ(volumeIrradiance(merged, Vec3{0.3f, 1.5f, 1.5f}, n), Vec3(0.0f));      // behind it
+}
+
 TEST(VolumeOctree, RefusesArraysOfOtherLengths) {
   VolumeLight v = walledVolume();
   v.litUpper.pop_back();
