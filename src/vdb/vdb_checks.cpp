@@ -62,11 +62,56 @@ void checkFinite(const std::string& path, const VdlGrid& g, const LightGridField
 
 }  // namespace
 
+/// The free-space light's arrays and values (docs/vdb-contract.md): what a
+/// renderer can draw, checked by the writer and the reader alike.
+void checkVolume(const std::string& path, const VolumeLight& v, int depth) {
+  if (v.empty()) return;
+  const size_t n = v.size();
+  if ((v.shTerms != 4 && v.shTerms != 9) || v.irradiance.size() != n ||
+      v.sh.size() != n * size_t(v.shTerms) || v.segments.size() != n || v.litLower.size() != n ||
+      v.litUpper.size() != n) {
+    throw InputError(path + ": the free-space light's arrays disagree (" + std::to_string(n) +
+                     " voxels, " + std::to_string(v.shTerms) + " SH terms)");
+  }
+  if (v.frame.depth < 1 || v.frame.depth > depth) {
+    throw InputError(path + ": free-space depth " + std::to_string(v.frame.depth) +
+                     " is outside [1, depth " + std::to_string(depth) + "]");
+  }
+  const int res = 1 << v.frame.depth;
+  auto bad = [&](size_t k, const std::string& what) {
+    throw InputError(path + ": free-space voxel " + v.coords[k].ToString() + " " + what);
+  };
+  auto inRange = [](const Vec3& x) {
+    return isFinite(x) && std::fabs(x.x) <= kMaxStoredIrradiance &&
+           std::fabs(x.y) <= kMaxStoredIrradiance && std::fabs(x.z) <= kMaxStoredIrradiance;
+  };
+  for (size_t k = 0; k < n; ++k) {
+    const Coord& c = v.coords[k];
+    if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= res || c.y >= res || c.z >= res) {
+      bad(k, "lies outside [0, " + std::to_string(res) + ")^3");
+    }
+    if (!inRange(v.irradiance[k])) bad(k, "has irradiance " + v.irradiance[k].ToString());
+    for (int i = 0; i < v.shTerms; ++i) {
+      if (!inRange(v.shOf(k)[i])) bad(k, "has SH term " + v.shOf(k)[i].ToString());
+    }
+    if (!(v.segments[k] >= 0) || !std::isfinite(v.segments[k])) {
+      bad(k, "counts " + std::to_string(v.segments[k]) + " rays");
+    }
+    for (int a = 0; a < 3; ++a) {
+      if (!(v.litLower[k][a] >= 0 && v.litUpper[k][a] <= 1 && v.litLower[k][a] <= v.litUpper[k][a])) {
+        bad(k, "has lit box " + v.litLower[k].ToString() + " .. " + v.litUpper[k].ToString() +
+                   "; expected 0 <= lower <= upper <= 1");
+      }
+    }
+  }
+}
+
 void checkReadableValues(const std::string& path, const VdlGrid& g) {
   if (g.frame.depth < 1 || g.frame.depth > kMaxGridDepth) {
     throw InputError(path + ": file metadata depth = " + std::to_string(g.frame.depth) +
                      " is outside [1, " + std::to_string(kMaxGridDepth) + "]");
   }
+  checkVolume(path, g.volume, g.frame.depth);
   for (size_t v = 0; v < g.size(); ++v) {
     forEachField([&](const auto& row) { checkFinite(path, g, row, 0, v, g.coords[v]); });
   }

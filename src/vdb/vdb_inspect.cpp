@@ -304,11 +304,17 @@ class VdlChecker {
     add("transform", transform.empty(),
         transform.empty() ? "uniform scale and translation" : transform);
     if (!depthOk) return;
-    const int res = 1 << depth;
+    // The free-space grids lie on their own, coarser grid (free_space_depth).
+    int freeDepth = depth;
+    if (auto i32 = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(
+            (*f_.meta)[vdb_internal::kMetaFreeSpaceDepth])) {
+      freeDepth = std::clamp(int(i32->value()), 0, depth);
+    }
     std::string outside;
     uint64_t count = 0;
     for (const auto& g : *f_.grids) {
       if (!g || g->isType<openvdb::points::PointDataGrid>()) continue;
+      const int res = 1 << (isVolumeGrid(g->getName()) ? freeDepth : depth);
       const openvdb::CoordBBox box = g->evalActiveVoxelBoundingBox();
       if (g->activeVoxelCount() == 0) continue;
       const openvdb::Coord lo = box.min(), hi = box.max();
@@ -322,7 +328,7 @@ class VdlChecker {
       }
     }
     add("voxel_bounds", count == 0,
-        count == 0 ? "every voxel within [0, " + std::to_string(res) + ") of depth " +
+        count == 0 ? "every voxel within [0, " + std::to_string(1 << depth) + ") of depth " +
                          std::to_string(depth)
                    : std::to_string(count) + " grid(s) beyond it; first " + outside);
   }

@@ -221,15 +221,20 @@ void readVolume(const std::string& path, const OpenedFile& f, VdlGrid& g) {
   }
   v.frame.origin = g.frame.origin;
   v.frame.voxelSize = expected;
+  // Before any voxel is listed: a few bytes of file may stand for tiles of
+  // millions of active voxels.
+  const int res = 1 << depth;
+  const openvdb::CoordBBox box = key->evalActiveVoxelBoundingBox();
+  if (key->activeVoxelCount() > openvdb::Index64(res) * openvdb::Index64(res) * openvdb::Index64(res) ||
+      (key->activeVoxelCount() > 0 &&
+       (box.min().x() < 0 || box.min().y() < 0 || box.min().z() < 0 || box.max().x() >= res ||
+        box.max().y() >= res || box.max().z() >= res))) {
+    throw InputError(path + ": grid '" + kVolumeIrradianceGrid + "' has " +
+                     std::to_string(key->activeVoxelCount()) +
+                     " active voxels, some outside [0, " + std::to_string(res) + ")^3");
+  }
   for (auto it = key->cbeginValueOn(); it; ++it) v.coords.push_back(fromVdb(it.getCoord()));
   std::sort(v.coords.begin(), v.coords.end(), canonicalLess);
-  const int res = 1 << depth;
-  for (const Coord& c : v.coords) {
-    if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= res || c.y >= res || c.z >= res) {
-      throw InputError(path + ": free-space voxel " + c.ToString() + " lies outside [0, " +
-                       std::to_string(res) + ")^3");
-    }
-  }
   int terms = 0;
   while (terms < 9 && findGrid(f, kVolumeShPrefix + std::to_string(terms))) ++terms;
   if (terms != 4 && terms != 9) {
@@ -263,20 +268,13 @@ void readVolume(const std::string& path, const OpenedFile& f, VdlGrid& g) {
   }
   readVec(kVolumeLitLowerGrid, v.litLower, 1, 0);
   readVec(kVolumeLitUpperGrid, v.litUpper, 1, 0);
-  for (size_t k = 0; k < n; ++k) {
-    for (int a = 0; a < 3; ++a) {
-      if (!(v.litLower[k][a] >= 0 && v.litUpper[k][a] <= 1 && v.litLower[k][a] <= v.litUpper[k][a])) {
-        throw InputError(path + ": free-space voxel " + v.coords[k].ToString() + " has lit box " +
-                         v.litLower[k].ToString() + " .. " + v.litUpper[k].ToString() +
-                         "; expected 0 <= lower <= upper <= 1");
-      }
-    }
-  }
   v.segments.assign(n, 0.0f);
   if (auto segments = openvdb::gridPtrCast<FloatGrid>(findGrid(f, kVolumeSegmentsGrid))) {
+    checkTransform(path, *segments, xform);
     auto acc = segments->getConstAccessor();
     for (size_t k = 0; k < n; ++k) v.segments[k] = acc.getValue(toVdb(v.coords[k]));
   }
+  // The values: checkReadableValues, after.
 }
 
 }  // namespace

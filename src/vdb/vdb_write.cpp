@@ -188,8 +188,13 @@ FloatGrid::Ptr densityGrid(const VdlGrid& g, const Transform::Ptr& xform) {
 /// The free-space light's grids (docs/vdb-contract.md), on its own
 /// coarser transform: volume_irradiance, volume_sh<i>, volume_lit_lower,
 /// volume_lit_upper, volume_segments.
-void addVolumeSources(std::vector<GridSource>& out, const VolumeLight& v, bool half) {
+void addVolumeSources(std::vector<GridSource>& out, const VolumeLight& v, bool halfAsked) {
   if (v.empty()) return;
+  // Halves overflow at 65504: a light brighter than that stays in floats.
+  float largest = 0;
+  for (const Vec3& e : v.irradiance) largest = std::max(largest, maxComponent(max(e, -e)));
+  for (const Vec3& e : v.sh) largest = std::max(largest, maxComponent(max(e, -e)));
+  const bool half = halfAsked && largest <= 65504.0f;
   const Transform::Ptr xform = frameTransform(v.frame);
   auto vec = [&](const std::string& name, const std::string& units, bool mayHalve,
                  std::function<Vec3(size_t)> value) {

@@ -396,3 +396,60 @@ TEST(Inspect, FailsWhatTheReadersRefuse) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+/// floorGrid with a free-space light over its cube, 2 levels coarser.
+VdlGrid floorWithVolume() {
+  VdlGrid g = floorGrid();
+  VolumeLight& v = g.volume;
+  v.frame = g.frame;
+  v.frame.depth = 2;
+  v.frame.voxelSize = g.frame.voxelSize * 4;
+  v.shTerms = 4;
+  for (int x = 0; x < 4; ++x) {
+    v.coords.push_back({x, 1, 2});
+    v.irradiance.push_back(Vec3(0.5f));
+    for (int i = 0; i < 4; ++i) v.sh.push_back(i == 0 ? Vec3(1.7f) : Vec3(0.1f * float(x)));
+    v.segments.push_back(10);
+    v.litLower.push_back(Vec3(0.0f));
+    v.litUpper.push_back(Vec3(x == 0 ? 0.5f : 1.0f));
+  }
+  return g;
+}
+
+TEST(Inspect, FreeSpaceGridsRoundTripAndTheirDamageIsRefused) {
+  const std::string dir = test::outputDir("Inspect.FreeSpace");
+  const VdlGrid g = floorWithVolume();
+  writeVdlGrid(dir + "/ok.vdb", g, meta());
+  const VdbReport ok = inspectVdb(dir + "/ok.vdb");
+  EXPECT_TRUE(ok.ok());
+  const LoadedVdl back = readVdlGrid(dir + "/ok.vdb");
+  EXPECT_EQ(back.grid.volume.coords, g.volume.coords);
+  EXPECT_EQ(back.grid.volume.sh, g.volume.sh);
+  EXPECT_EQ(back.grid.volume.litUpper, g.volume.litUpper);
+  EXPECT_EQ(back.grid.volume.frame.depth, 2);
+
+  // A voxel beyond the free-space grid, a box upside down, a NaN: the writer
+  // refuses them; written past it, inspect and the reader do.
+  auto damaged = [&](const char* name, auto edit) {
+    VdlGrid bad = floorWithVolume();
+    edit(bad.volume);
+    EXPECT_THROW(writeVdlGrid(dir + "/" + name + ".vdb", bad, meta()), InputError) << name;
+    vdb_internal::writeVdlGridDamaged(dir + "/" + name + ".vdb", bad, meta(), vdb_internal::Damage{});
+    return dir + "/" + name + ".vdb";
+  };
+  const std::string outside = damaged("outside", [](VolumeLight& v) { v.coords[3].x = 4; });
+  expectCheck(inspectVdb(outside), "voxel_bounds", false);
+  EXPECT_NE(readError(outside).find("active voxels, some outside"), std::string::npos)
+      << readError(outside);
+  const std::string box = damaged("box", [](VolumeLight& v) { v.litLower[1].y = 0.9f; v.litUpper[1].y = 0.2f; });
+  EXPECT_NE(readError(box).find("lit box"), std::string::npos) << readError(box);
+  const std::string nan = damaged("nan", [](VolumeLight& v) { v.sh[5].x = std::nanf(""); });
+  EXPECT_FALSE(inspectVdb(nan).ok());
+  EXPECT_NE(readError(nan).find("volume_sh1"), std::string::npos) << readError(nan);
+}
+
+}  // namespace
+}  // namespace lo
