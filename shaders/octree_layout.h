@@ -192,8 +192,9 @@ LO_LAYOUT_FN float loShCosineBand(uint i) {
  * octree of the same layout over the same cube, coarser, whose every leaf
  * holds LO_SH_TERMS SH texels of the light from all directions, preceded by
  * one header texel at (first index - 1): RGB = per axis lower * 16 + upper,
- * the box [lower / 16, (upper + 1) / 16] (voxel units from its lower corner)
- * the voxel's light filled; A = 0. Stored like a layer block's header. */
+ * the box [lower / 16, (upper + 1) / 16] (in the leaf's own units from its
+ * lower corner: a voxel's, or a merged leaf's) its light filled; A = 0.
+ * Stored like a layer block's header. */
 const float LO_VOLUME_BOX_STEPS = 16.0f;
 LO_LAYOUT_FN float loPackVolumeBox(float lower, float upper) {
   float lo = min(floor(lower * LO_VOLUME_BOX_STEPS), LO_VOLUME_BOX_STEPS - 1.0f);

@@ -84,8 +84,7 @@ int runReference(const ReferenceOptions& opt) {
     const RgbImage mask = renderFirstHits(
         scene, camera, fp,
         [&scene](const FirstHit& hit) {
-          const bool added = size_t(scene.triangleMaterial[hit.triangle]) >= scene.movingMaterialsFrom;
-          return added ? Vec3{1, 1, 1} : Vec3{0, 0, 0};
+          return scene.isAdded(hit.triangle) ? Vec3{1, 1, 1} : Vec3{0, 0, 0};
         },
         &progress);
     AtomicFileSet outputs;

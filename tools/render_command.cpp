@@ -99,9 +99,7 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
     volume = buildVolumeOctree(baked.grid.volume, opt.shading.octreeParams());
   }
   RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {
-    const bool moving =
-        size_t(scene.triangleMaterial[hit.triangle]) >= scene.movingMaterialsFrom;
-    if (moving && volume.depth > 0) return volumeIrradiance(volume, hit.position, hit.normal);
+    if (scene.isAdded(hit.triangle) && volume.depth > 0) return volumeIrradiance(volume, hit.position, hit.normal);
     return octreeIrradiance(octree, hit.position, hit.normal, shade);
   });
   renderTimer.finish(std::to_string(opt.irradianceSpp) + " rays per pixel");

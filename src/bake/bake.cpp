@@ -427,6 +427,16 @@ void recordSourceScene(BakeMetadata& meta, const std::string& scenePath) {
   meta.sourceSceneHash = sceneContentHash(scenePath);
 }
 
+VolumeLight bakeFreeSpaceLight(const std::vector<PhotonSegment>& segments, const GridFrame& frame,
+                               const BakeParams& params, ProgressSink* progress,
+                               std::vector<StageReport>& stages) {
+  StageTimer timer(stages, "free-space light");
+  VolumeLight volume = buildVolumeLight(segments, frame, params.volumeParams(), progress);
+  timer.finish(formatCount(volume.size()) + " voxels from " + formatCount(segments.size()) +
+               " light rays");
+  return volume;
+}
+
 std::string staleBakeWarning(const BakeMetadata& meta, const std::string& scenePath) {
   if (meta.sourceSceneHash.empty()) return "";
   const std::string now = sceneContentHash(scenePath);
@@ -449,17 +459,6 @@ LevelParams BakeParams::levelParams() const {
 }
 
 namespace bake_internal {
-
-/// The free-space light of a bake, timed as its own stage.
-VolumeLight freeSpaceLight(const std::vector<PhotonSegment>& segments, const GridFrame& frame,
-                           const BakeParams& params, ProgressSink* progress,
-                           std::vector<StageReport>& stages) {
-  StageTimer timer(stages, "free-space light");
-  VolumeLight volume = buildVolumeLight(segments, frame, params.volumeParams(), progress);
-  timer.finish(formatCount(volume.size()) + " voxels from " + formatCount(segments.size()) +
-               " light rays");
-  return volume;
-}
 
 /// The photons a target bake may store: maxPhotons, or fewer when the
 /// memory left beside the voxels (kBakeBytesPerVoxel) does not hold them at
@@ -567,7 +566,7 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   }
   r.metadata = bakeMetadata(scene, params, int64_t(raw.size()), int64_t(emitted), s.level.radius);
   if (params.freeSpace) {
-    r.grid.volume = freeSpaceLight(rawSegments.take(), r.grid.frame, params, progress, s.stages);
+    r.grid.volume = bakeFreeSpaceLight(rawSegments.take(), r.grid.frame, params, progress, s.stages);
   }
   if (params.keepPhotons) {
     r.photons.photons = std::move(scaled);
@@ -602,8 +601,7 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
   r.grid = bakeLevel(scene, photons.photons, params.levelParams(), progress, &s.level, &s.stages);
   s.noise = summarizeNoise(r.grid);
   if (params.freeSpace) {
-    r.grid.volume = bake_internal::freeSpaceLight(photons.segments, r.grid.frame, params, progress,
-                                                  s.stages);
+    r.grid.volume = bakeFreeSpaceLight(photons.segments, r.grid.frame, params, progress, s.stages);
   }
   photons.segments = std::vector<PhotonSegment>();
   r.metadata = bakeMetadata(scene, params, int64_t(photons.photons.size()),

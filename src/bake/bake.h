@@ -256,6 +256,13 @@ struct BakeResult {
   PhotonMap photons;  ///< filled when BakeParams::keepPhotons
 };
 
+/// The free-space light of a bake from its rays (PhotonMap::segments,
+/// scaled), timed as the stage "free-space light" in `stages`; the one-process
+/// and the distributed bakes both call it.
+VolumeLight bakeFreeSpaceLight(const std::vector<PhotonSegment>& segments, const GridFrame& frame,
+                               const BakeParams& params, ProgressSink* progress,
+                               std::vector<StageReport>& stages);
+
 /// "" when the photon tracing stored what was asked without aiming most
 /// paths past the scene; else a sentence saying which of the two happened
 /// and what helps. Paths that hit a surface and store nothing are not a

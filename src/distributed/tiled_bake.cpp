@@ -299,11 +299,8 @@ class RankBake {
     BakeResult result;
     result.grid = std::move(merged_);
     if (me_ == 0 && params_.freeSpace) {
-      StageTimer timer(st_.stages, "free-space light");
-      const std::vector<PhotonSegment> rays = collector_.take();
-      result.grid.volume = buildVolumeLight(rays, result.grid.frame, params_.volumeParams(), progress_);
-      timer.finish(formatCount(result.grid.volume.size()) + " voxels from " +
-                   formatCount(rays.size()) + " light rays");
+      result.grid.volume =
+          bakeFreeSpaceLight(collector_.take(), result.grid.frame, params_, progress_, st_.stages);
     }
     result.metadata =
         bakeMetadata(scene_, params_, int64_t(stored_), int64_t(emitted_), st_.level.radius);

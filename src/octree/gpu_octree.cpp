@@ -246,12 +246,18 @@ float halfToFloat(uint16_t bits) {
 
 namespace gpu_octree_internal {
 
-/// The free-space leaves that merge (GpuOctreeParams::tolerance > 0): eight
-/// siblings whose light filled each of them whole, and whose irradiance,
-/// for each of 14 normals (the axes and the cube's diagonals), lies within
-/// `tolerance` of their mean's, the mean of the eight taken over all those
-/// normals, become one leaf holding their mean SH terms; level by level up
-/// to level 1, as long as all eight children of a node are leaves.
+/// The free-space leaves that merge (GpuOctreeParams::volumeTolerance > 0):
+/// eight siblings whose light reaches every face they share (a wall may cut
+/// them on the parent's outside only), and whose irradiance, for each of 14
+/// normals (the axes and the cube's diagonals), lies within `tolerance` of
+/// their mean's, the mean of the eight taken over all those normals, become
+/// one leaf holding their mean SH terms and their boxes joined (in its own
+/// units); level by level up to level 1, as long as all eight children of a
+/// node are leaves.
+/// A lit box this near a face reaches it (cluster/volume_light.cpp keeps the
+/// same rule).
+constexpr float kVolumeFaceTolerance = 1e-6f;
+
 AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
   AdaptiveLeaves out;
   const size_t n = v.size();
@@ -264,6 +270,9 @@ AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
   };
   auto pack = [](const Coord& c) {
     return (uint64_t(uint32_t(c.x)) << 42) | (uint64_t(uint32_t(c.y)) << 21) | uint64_t(uint32_t(c.z));
+  };
+  auto unpack = [](uint64_t k) {
+    return Coord{int((k >> 42) & 0x1fffff), int((k >> 21) & 0x1fffff), int(k & 0x1fffff)};
   };
   std::map<uint64_t, Node> level;
   std::map<std::pair<int, uint64_t>, CollapsedLeaf> merged;  ///< by (level, node)
@@ -293,7 +302,7 @@ AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
   for (int l = v.frame.depth - 1; l >= 1; --l) {
     std::map<uint64_t, std::vector<uint64_t>> parents;
     for (const auto& [key, node] : level) {
-      const Coord c{int((key >> 42) & 0x1fffff), int((key >> 21) & 0x1fffff), int(key & 0x1fffff)};
+      const Coord c = unpack(key);
       parents[pack(Coord{c.x >> 1, c.y >> 1, c.z >> 1})].push_back(key);
     }
     std::map<uint64_t, Node> next;
@@ -310,7 +319,8 @@ AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
         const Node& child = level[k];
         const int o[3] = {int((k >> 42) & 1), int((k >> 21) & 1), int(k & 1)};
         for (int a = 0; a < 3; ++a) {
-          const bool inner = o[a] == 0 ? child.upper[a] >= 1.0f : child.lower[a] <= 0.0f;
+          const bool inner = o[a] == 0 ? child.upper[a] >= 1.0f - kVolumeFaceTolerance
+                                       : child.lower[a] <= kVolumeFaceTolerance;
           merge = merge && inner;
           joined.lower[a] = std::min(joined.lower[a], (float(o[a]) + child.lower[a]) * 0.5f);
           joined.upper[a] = std::max(joined.upper[a], (float(o[a]) + child.upper[a]) * 0.5f);
@@ -337,8 +347,7 @@ AdaptiveLeaves collapseVolume(const VolumeLight& v, float tolerance) {
     // Merged nodes go up a level and may merge again; the others stay.
     for (auto& [parent, node] : next) {
       CollapsedLeaf leaf;
-      leaf.coord = Coord{int((parent >> 42) & 0x1fffff), int((parent >> 21) & 0x1fffff),
-                         int(parent & 0x1fffff)};
+      leaf.coord = unpack(parent);
       leaf.level = l;
       leaf.sh = node.sh;
       leaf.litLower = node.lower;
@@ -381,7 +390,8 @@ class OctreeBuilder {
         sh_(grid.shTerms > 0),
         adaptive_(collapseLeaves(grid, params.tolerance, params.cosineCorrection)) {}
   /// A free-space octree: each leaf's light preceded by its header texel
-  /// (octree_layout.h), headers[v] for voxel v; no collapsed leaves.
+  /// (octree_layout.h), headers[v] for voxel v; `adaptive` its merged leaves
+  /// (collapseVolume), whose headers hold their joined boxes.
   OctreeBuilder(const VdlGrid& grid, const GpuOctreeParams& params, AdaptiveLeaves adaptive,
                 std::vector<Vec3> headers)
       : grid_(grid),
@@ -720,7 +730,7 @@ class OctreeBuilder {
 
   /// A collapsed leaf: its texels, stored as they are (intensities, SH terms).
   void writeCollapsedLeaf(uint8_t* t, const CollapsedLeaf& c) {
-    // A free-space leaf stands for voxels whose light filled them whole.
+    // A merged free-space leaf: the box its voxels' light filled together.
     if (!headers_.empty()) {
       Vec3 header;
       for (int a = 0; a < 3; ++a) header[a] = loPackVolumeBox(c.litLower[a], c.litUpper[a]);
@@ -830,11 +840,9 @@ GpuOctree buildVolumeOctree(const VolumeLight& volume, const GpuOctreeParams& pa
   VdlGrid grid;
   grid.frame = volume.frame;
   grid.coords = volume.coords;
-  grid.irradiance = volume.irradiance;
   grid.shTerms = volume.shTerms;
-  grid.sh = volume.sh;
   grid.maxVdls = 1;
-  resizeVoxelArrays(grid);
+  resizeVoxelArrays(grid);  // zero normals, counts and VDL slots beside them
   grid.irradiance = volume.irradiance;
   grid.sh = volume.sh;
   std::vector<Vec3> headers(n);

@@ -219,7 +219,7 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
     const Material& mat = materialOf(scene, group.front());
     const DrawCategory category = categoryOf(mat);
     DrawRange range = rangeOf(scene, mat);
-    range.moving = size_t(scene.triangleMaterial[group.front()]) >= scene.movingMaterialsFrom;
+    range.moving = scene.isAdded(group.front());
     range.first = GLint(vertices.size());
     for (size_t t : group) {
       const Vec3 faceNormal = scene.faceNormal(t);

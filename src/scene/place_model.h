@@ -27,9 +27,9 @@ Placement parsePlacement(const std::string& text);
 
 /// Joins `model` to `scene` at `placement`: its vertices (positions, normals,
 /// tangents turned with it; UV sets kept), triangles, materials and textures
-/// appended. The first model added sets Scene::movingMaterialsFrom. Lights
-/// and cameras of the model are left out (a warning says so): an added
-/// object does not change the baked light. @throws InputError when the
+/// appended. The first model added sets Scene::movingMaterialsFrom. The
+/// model's lights are left out (a warning says so: an added object does not
+/// change the baked light), and its cameras. @throws InputError when the
 /// placed vertices lie beyond kMaxCoordinate.
 void placeModel(Scene& scene, Scene model, const Placement& placement);
 

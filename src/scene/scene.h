@@ -306,6 +306,8 @@ struct Scene {
   /// (scene/place_model.h): the renderer lights them from the free-space
   /// light, not the surfaces'. SIZE_MAX: none.
   size_t movingMaterialsFrom = SIZE_MAX;
+  /// Whether triangle t belongs to an object added after the bake.
+  bool isAdded(size_t t) const { return size_t(triangleMaterial[t]) >= movingMaterialsFrom; }
 
   size_t triangleCount() const { return indices.size() / 3; }
   Bounds3 bounds() const;
