@@ -56,8 +56,16 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
   float far = L.colorFar.w;
   float dr = length(d);
   if (dr / far > 1.0) return 1.0;
-  mat4 clipToRender = inverse(uShadowMatrices[layer]);
   float plane = dot(d, n);  // the receiver's tangent plane, as seen from the light centre
+  // The light's centre below the receiver's horizon (the side of a sphere
+  // under a large light, which sees the light's edge but not its centre):
+  // what the map holds in any direction from the centre, up to where it
+  // crosses that horizon, lies below it, and nothing below a surface's
+  // tangent plane lies on a ray that reaches the surface from above it. The
+  // map cannot tell what hides the light's visible part; the part itself is
+  // exact (polygonIrradiance clips the light at the horizon): count p lit.
+  if (plane > 0.0) return 1.0;
+  mat4 clipToRender = inverse(uShadowMatrices[layer]);
   float h = 0.5 * L.corner0.w;
   // Blockers from 0.3 d_r out can hide the light: search that cone (in a
   // cube face, an angle's tangent t spans t/2 in uv).

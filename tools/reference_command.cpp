@@ -40,6 +40,7 @@ struct ReferenceOptions {
   uint64_t seed = 1;
   int threads = 0;
   int maxBounces = 256;
+  bool addedOnlyReceive = false;  // --added-only-receive
   float exposure = 0;  // PNG only, as `render --exposure`
   double edgeDistance = 0;  // 0 = one voxel of a depth-6 bake
   std::string json;  // --json FILE: tools/json_report.h
@@ -73,6 +74,8 @@ int runReference(const ReferenceOptions& opt) {
   placeObjects(scene, opt.objects);
   printSceneWarnings(scene);
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
+  if (opt.addedOnlyReceive && opt.objects.empty())
+    throw InputError("--added-only-receive: add an object first (--add, --at)");
   if (opt.part == "added-mask") {
     if (opt.objects.empty()) throw InputError("--part added-mask: add an object first (--add, --at)");
     FirstHitParams fp;
@@ -127,6 +130,7 @@ int runReference(const ReferenceOptions& opt) {
   params.samplesPerPixel = opt.spp;
   params.timeBudgetSeconds = opt.timeBudget;
   params.maxBounces = opt.maxBounces;
+  params.addedOnlyReceive = opt.addedOnlyReceive;
   params.seed = opt.seed;
 
   ConsoleProgress progress(opt.quiet);
@@ -182,6 +186,10 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   addSceneOptions(cmd, opt->sceneOptions);
   addObjectOptions(cmd, opt->objects);
+  cmd->add_flag("--added-only-receive", opt->addedOnlyReceive,
+                "With --add: the camera sees the added objects, no other ray does: they are lit "
+                "by the scene as it was baked and neither shadow nor light it, as `render --add` "
+                "draws them (the judge of the free-space light alone)");
   cmd->add_option("-o,--output", opt->output,
                   "Image: .exr (linear float) or .png (sRGB, for a quick look)")
       ->required();

@@ -98,8 +98,19 @@ void alphaFilter(const RTCFilterFunctionNArguments* args) {
 
 }  // namespace
 
-RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+RayTracer::RayTracer(const Scene& scene) : RayTracer(scene, Objects::All) {}
+
+RayTracer::RayTracer(const Scene& scene, Objects objects) : impl_(std::make_unique<Impl>()) {
   checkSceneIndices(scene);
+  size_t triangles = scene.triangleCount();
+  if (objects == Objects::AsBaked && scene.movingMaterialsFrom != SIZE_MAX) {
+    while (triangles > 0 && scene.isAdded(triangles - 1)) --triangles;
+    for (size_t t = 0; t < triangles; ++t) {
+      if (scene.isAdded(t))
+        throw InternalError("RayTracer: added objects' triangles must come last (triangle " +
+                            std::to_string(t) + ")");
+    }
+  }
   impl_->faceNormals.resize(scene.triangleCount());
   for (size_t t = 0; t < scene.triangleCount(); ++t) impl_->faceNormals[t] = scene.faceNormal(t);
 
@@ -111,7 +122,7 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   // and the closed test boxes must not leak rays through shared edges.
   rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
-  if (scene.triangleCount() > 0) {
+  if (triangles > 0) {
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     // Copied into Embree-owned buffers: Embree reads vertices as 16 bytes,
     // past the end of a tightly packed Vec3 array.
@@ -120,7 +131,7 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
                                 3 * sizeof(float), scene.positions.size()));
     auto* indices = static_cast<uint32_t*>(
         rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                3 * sizeof(uint32_t), scene.triangleCount()));
+                                3 * sizeof(uint32_t), triangles));
     if (!vertices || !indices) {
       rtcReleaseGeometry(geom);
       throw InternalError("Embree buffer allocation failed (error " + errorCode(device) + ")");
@@ -130,7 +141,7 @@ RayTracer::RayTracer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
       vertices[3 * i + 1] = scene.positions[i].y;
       vertices[3 * i + 2] = scene.positions[i].z;
     }
-    std::copy(scene.indices.begin(), scene.indices.begin() + 3 * scene.triangleCount(), indices);
+    std::copy(scene.indices.begin(), scene.indices.begin() + 3 * triangles, indices);
     bool alpha = false;
     for (const Material& m : scene.materials) alpha = alpha || m.hasAlpha() || m.unlit;
     if (alpha) {

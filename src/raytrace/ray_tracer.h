@@ -30,6 +30,14 @@ class RayTracer {
   /// @throws InputError when a triangle's vertex index is out of range;
   /// InternalError when Embree fails.
   explicit RayTracer(const Scene& scene);
+  /// Which triangles the structure holds.
+  enum class Objects {
+    All,
+    /// Every triangle but those of objects added after the bake
+    /// (Scene::isAdded), which come last: the scene as it was baked.
+    AsBaked,
+  };
+  RayTracer(const Scene& scene, Objects objects);
   ~RayTracer();
   RayTracer(const RayTracer&) = delete;
   RayTracer& operator=(const RayTracer&) = delete;

@@ -58,7 +58,8 @@ constexpr int kTileSize = 16;
 
 struct Context {
   const Scene* scene = nullptr;
-  const RayTracer* tracer = nullptr;
+  const RayTracer* tracer = nullptr;        ///< every ray but the camera's
+  const RayTracer* cameraTracer = nullptr;  ///< rays from the camera
   std::vector<BsdfLobes> lobes;    ///< per material
   EmitterSampler emitters;  ///< emissive triangles, picked by power
   std::vector<float>
@@ -199,8 +200,10 @@ inline Vec3 sampleLights(const Context& ctx, const Vec3& p, const Vec3& normal, 
 }
 
 /// Traces one path from (org, dir) and splits its radiance by PathRadiance's
-/// rules. The first surface hit is vertex 1.
-inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) {
+/// rules. The first surface hit is vertex 1; `fromCamera`: the first ray is
+/// the camera's.
+inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng,
+                              bool fromCamera = false) {
   PathRadiance out;
   Vec3 beta{1, 1, 1};
   bool prevDelta = true;  // the camera ray: emission at vertex 1 counts fully
@@ -208,7 +211,8 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng) 
   Hit hit;
   for (int depth = 1;; ++depth) {
     ++out.rays;
-    if (!ctx.tracer->intersect(org, dir, hit)) {
+    const RayTracer& tracer = depth == 1 && fromCamera ? *ctx.cameraTracer : *ctx.tracer;
+    if (!tracer.intersect(org, dir, hit)) {
       // Escaped: the sky's light, MIS-weighted against the sky's light
       // sample at the previous vertex (none after a mirror or glass). Seen by
       // the camera it is the background; at vertex 2 it is direct light of
@@ -283,7 +287,7 @@ inline Vec3 samplePixel(const Context& ctx, const PinholeCamera& cam, const Vec3
     // An unlit surface in front: its base colour, seen by the camera alone.
     Hit seen;
     ++rays;
-    if (ctx.tracer->intersectFromCamera(cam.eye, dir, seen)) {
+    if (ctx.cameraTracer->intersectFromCamera(cam.eye, dir, seen)) {
       const Material& m = ctx.scene->materials[size_t(ctx.scene->triangleMaterial[seen.triangle])];
       if (m.unlit) {
         const bool shown = part == ReferencePart::Full || part == ReferencePart::Direct;
@@ -292,7 +296,7 @@ inline Vec3 samplePixel(const Context& ctx, const PinholeCamera& cam, const Vec3
     }
   }
   if (part != ReferencePart::Irradiance) {
-    PathRadiance r = tracePath(ctx, cam.eye, dir, rng);
+    PathRadiance r = tracePath(ctx, cam.eye, dir, rng, true);
     rays += r.rays;
     switch (part) {
       case ReferencePart::Direct:
@@ -308,7 +312,7 @@ inline Vec3 samplePixel(const Context& ctx, const PinholeCamera& cam, const Vec3
   // radiance arriving along it minus the emission of the surface it hits.
   Hit hit;
   ++rays;
-  if (!ctx.tracer->intersect(cam.eye, dir, hit)) return Vec3{0, 0, 0};
+  if (!ctx.cameraTracer->intersect(cam.eye, dir, hit)) return Vec3{0, 0, 0};
   Vec3 p = cam.eye + dir * hit.t;
   const Vec3& normal = hit.geometricNormal;
   Vec3 n = dot(dir, normal) < 0 ? normal : -normal;
@@ -428,7 +432,14 @@ ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
   Context ctx;
   buildContext(scene, params, ctx);
   RayTracer tracer(scene);
-  ctx.tracer = &tracer;
+  ctx.cameraTracer = &tracer;
+  std::unique_ptr<RayTracer> asBaked;
+  if (params.addedOnlyReceive) {
+    asBaked = std::make_unique<RayTracer>(scene, RayTracer::Objects::AsBaked);
+    ctx.tracer = asBaked.get();
+  } else {
+    ctx.tracer = &tracer;
+  }
 
   const size_t pixels = size_t(params.width) * size_t(params.height);
   std::vector<Rng> rngs;
@@ -532,6 +543,7 @@ DirectIrradiance::DirectIrradiance(const Scene& scene) : impl_(std::make_unique<
   reference_internal::buildContext(scene, ReferenceParams{}, impl_->ctx);
   impl_->tracer = std::make_unique<RayTracer>(scene);
   impl_->ctx.tracer = impl_->tracer.get();
+  impl_->ctx.cameraTracer = impl_->tracer.get();
 }
 
 DirectIrradiance::~DirectIrradiance() = default;

@@ -55,6 +55,12 @@ struct ReferenceParams {
   /// Russian roulette starts after this many scattering events.
   int rouletteStart = 3;
   uint64_t seed = 1;
+  /// Objects added after the bake (Scene::isAdded) seen by the camera
+  /// alone: every later ray, of light or shadow, passes through them, so
+  /// that they are lit by the scene as it was baked, neither shadowing nor
+  /// lighting it. The light `render --add` gives them (docs/render.md), the
+  /// judge of the free-space light itself.
+  bool addedOnlyReceive = false;
 };
 
 struct ReferenceImage {

@@ -142,7 +142,10 @@ Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& 
   };
   Vertex v{};
   const Vec3 p = space.toRender(scene.positions[index]);
-  const Vec3 n = scene.normals.empty() ? faceNormal : scene.normals[index];
+  // No vertex normal (none, or zero: Scene::normals): the face's.
+  const Vec3 n = scene.normals.empty() || lengthSquared(scene.normals[index]) == 0
+                     ? faceNormal
+                     : scene.normals[index];
   std::memcpy(v.position, &p, sizeof v.position);
   std::memcpy(v.normal, &n, sizeof v.normal);
   std::memcpy(v.baseColor, &mat.baseColor, sizeof v.baseColor);

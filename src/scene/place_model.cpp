@@ -57,18 +57,6 @@ void appendOrFill(std::vector<T>& to, size_t toVertices, const std::vector<T>& f
   }
 }
 
-/// Per-vertex normals from the faces (area-weighted), where a scene has none.
-std::vector<Vec3> faceAveragedNormals(const Scene& s) {
-  std::vector<Vec3> n(s.positions.size(), Vec3{0, 0, 0});
-  for (size_t t = 0; t < s.triangleCount(); ++t) {
-    const Vec3& a = s.positions[s.indices[3 * t]];
-    const Vec3 c = cross(s.positions[s.indices[3 * t + 1]] - a, s.positions[s.indices[3 * t + 2]] - a);
-    for (int k = 0; k < 3; ++k) n[s.indices[3 * t + size_t(k)]] += c;
-  }
-  for (Vec3& v : n) v = lengthSquared(v) > 0 ? normalize(v) : Vec3{0, 1, 0};
-  return n;
-}
-
 }  // namespace
 
 void placeModel(Scene& scene, Scene model, const Placement& placement) {
@@ -98,12 +86,10 @@ void placeModel(Scene& scene, Scene model, const Placement& placement) {
   const uint32_t vertexOffset = uint32_t(baseVertices);
   const int32_t materialOffset = int32_t(scene.materials.size());
   const int textureOffset = int(scene.textures.size());
-  // Normals: where one side has none, from its faces.
-  if (scene.normals.empty() != model.normals.empty()) {
-    if (scene.normals.empty()) scene.normals = faceAveragedNormals(scene);
-    if (model.normals.empty()) model.normals = faceAveragedNormals(model);
-  }
-  scene.normals.insert(scene.normals.end(), model.normals.begin(), model.normals.end());
+  // Normals: where one side has none, zero vectors, which every reader
+  // takes for the face's own normal (Scene::normals): flat faces stay flat,
+  // where normals averaged over shared corners would bend them.
+  appendOrFill(scene.normals, baseVertices, model.normals, addVertices, 1, {Vec3{0, 0, 0}});
   appendOrFill(scene.texcoords0, baseVertices, model.texcoords0, addVertices, 2, {0.0f, 0.0f});
   appendOrFill(scene.texcoords1, baseVertices, model.texcoords1, addVertices, 2, {0.0f, 0.0f});
   appendOrFill(scene.tangents, baseVertices, model.tangents, addVertices, 4,

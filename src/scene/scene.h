@@ -282,7 +282,10 @@ struct Scene {
   /// above 1 clamped): one sentence each, naming the file and the thing.
   std::vector<std::string> warnings;
   std::vector<Vec3> positions;    ///< world space
-  std::vector<Vec3> normals;      ///< per vertex, unit, world space; empty = use face normals
+  /// Per vertex, unit, world space; empty = use face normals. A zero vector
+  /// stands for the face's normal too (the part of a scene that had none,
+  /// joined to one that has them: scene/place_model.h).
+  std::vector<Vec3> normals;
   std::vector<float> texcoords0;  ///< 2 floats per vertex, or empty
   std::vector<float> texcoords1;  ///< 2 floats per vertex, or empty
   /// glTF TANGENT, 4 floats per vertex: the unit world-space tangent and w =

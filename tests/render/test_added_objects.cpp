@@ -10,6 +10,8 @@
 #include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
+#include "raytrace/ray_tracer.h"
+#include "reference/path_tracer.h"
 #include "render/context.h"
 #include "render/renderer.h"
 #include "scene/place_model.h"
@@ -18,15 +20,17 @@
 namespace lo {
 namespace {
 
-/// The point-lit unit room with the project's sphere (radius `r`) at `at`.
-Scene roomWithSphere(const Vec3& at, float r) {
-  Scene scene = test::pointLitRoom();
+/// `scene` with the project's sphere (radius `r`) added at `at`.
+Scene withSphere(Scene scene, const Vec3& at, float r) {
   Placement p;
   p.at = Vec3d(at);
   p.scale = r;
   placeModel(scene, loadScene(test::dataDir() + "/models/sphere.obj"), p);
   return scene;
 }
+
+/// The point-lit unit room with the sphere at `at`.
+Scene roomWithSphere(const Vec3& at, float r) { return withSphere(test::pointLitRoom(), at, r); }
 
 double meanAbs(const RgbImage& a, const RgbImage& b) {
   double sum = 0;
@@ -135,11 +139,7 @@ TEST(AddedObjects, ASphereBehindTheDividerOfASealedRoomIsBlack) {
   params.height = 48;
   params.reflections = false;
   for (const float x : {1.12f, 1.5f}) {  // 2 cm from the divider, and mid-room
-    Scene scene = rooms;
-    Placement p;
-    p.at = Vec3d{x, 0.5, 0.5};
-    p.scale = 0.1f;
-    placeModel(scene, loadScene(test::dataDir() + "/models/sphere.obj"), p);
+    const Scene scene = withSphere(rooms, Vec3(x, 0.5f, 0.5f), 0.1f);
     Renderer renderer(scene, octree, {});
     renderer.setFreeSpaceLight(volume);
     // From the dark room's far wall, the sphere fills the middle of the view.
@@ -150,17 +150,68 @@ TEST(AddedObjects, ASphereBehindTheDividerOfASealedRoomIsBlack) {
     }
     // The same sphere in the lit room is lit.
   }
-  Scene lit = rooms;
-  Placement p;
-  p.at = Vec3d{0.5, 0.4, 0.5};
-  p.scale = 0.1f;
-  placeModel(lit, loadScene(test::dataDir() + "/models/sphere.obj"), p);
+  const Scene lit = withSphere(rooms, Vec3(0.5f, 0.4f, 0.5f), 0.1f);
   Renderer renderer(lit, octree, {});
   renderer.setFreeSpaceLight(volume);
   params.mode = RenderMode::Indirect;
   const RgbImage image = renderer.render(
       PinholeCamera::lookAt(Vec3(0.5f, 0.4f, 0.95f), Vec3(0.5f, 0.4f, 0.5f), 0.3f), params);
   EXPECT_GT(image.at(size_t(24) * 48 + 24).y, 0.0f);
+}
+
+TEST(AddedObjects, ThePathTracerCanLetThemOnlyReceiveLight) {
+  // A sphere between the point light (0.5, 0.8, 0.5) and the wall x = 1,
+  // which it shadows around (1, 0.3, 0.5), where the camera sees it.
+  const Vec3 at(0.8f, 0.5f, 0.5f);
+  const float r = 0.08f;
+  const Scene room = test::pointLitRoom();
+  const Scene scene = withSphere(room, at, r);
+  // A ray at the sphere meets it; through the scene as baked, the wall.
+  Hit hit;
+  ASSERT_TRUE(RayTracer(scene).intersect({0.2f, 0.5f, 0.5f}, {1, 0, 0}, hit));
+  EXPECT_NEAR(hit.t, 0.6f - r, 0.01f);
+  ASSERT_TRUE(RayTracer(scene, RayTracer::Objects::AsBaked).intersect({0.2f, 0.5f, 0.5f}, {1, 0, 0}, hit));
+  EXPECT_NEAR(hit.t, 0.8f, 1e-5f);
+
+  ReferenceParams params;
+  params.width = params.height = 24;
+  params.samplesPerPixel = 16;
+  const PinholeCamera camera = PinholeCamera::lookAt({0.1f, 0.5f, 0.15f}, {1, 0.35f, 0.5f}, 1.0f);
+  const ReferenceImage without = renderReference(room, camera, params);
+  params.addedOnlyReceive = true;
+  const ReferenceImage receiving = renderReference(scene, camera, params);
+  params.addedOnlyReceive = false;
+  params.part = ReferencePart::Direct;
+  const ReferenceImage directWithout = renderReference(room, camera, params);
+  const ReferenceImage added = renderReference(scene, camera, params);
+  // The pixels whose rays pass well clear of the sphere (by more than
+  // two pixels) see the room as if the sphere were not there, to the byte;
+  // with the sphere in the scene, its shadow darkens some of them.
+  const float tanHalf = std::tan(0.5f);
+  const Vec3 right = normalize(cross(camera.forward, camera.up));
+  const float pixel = 2.0f * tanHalf / float(params.width) * length(at - camera.eye);
+  int clear = 0, shadowed = 0, sphere = 0;
+  for (int y = 0; y < params.height; ++y) {
+    for (int x = 0; x < params.width; ++x) {
+      const float sx = (2.0f * (float(x) + 0.5f) / float(params.width) - 1.0f) * tanHalf;
+      const float sy = (1.0f - 2.0f * (float(y) + 0.5f) / float(params.height)) * tanHalf;
+      const Vec3 d = normalize(camera.forward + right * sx + camera.up * sy);
+      const Vec3 toCentre = at - camera.eye;
+      const float miss = length(toCentre - d * dot(toCentre, d));
+      const size_t i = size_t(y) * size_t(params.width) + size_t(x);
+      if (miss > r + 2.0f * pixel) {
+        ++clear;
+        ASSERT_EQ(receiving.image.at(i), without.image.at(i)) << "pixel " << x << ", " << y;
+        if (added.image.at(i).y < 0.5f * directWithout.image.at(i).y) ++shadowed;
+      } else if (miss < 0.8f * r) {
+        ++sphere;
+        EXPECT_GT(receiving.image.at(i).y, 0.0f) << "pixel " << x << ", " << y;
+      }
+    }
+  }
+  EXPECT_GT(clear, params.width * params.height / 2);
+  EXPECT_GT(shadowed, 5);
+  EXPECT_GT(sphere, 5);
 }
 
 }  // namespace
