@@ -291,6 +291,17 @@ LO_LOOKUP_FN vec3 loOctreePosition(vec3 p, vec3 n, vec3 origin, float voxelSize,
   return (p - origin) / voxelSize + normalOffset * n;
 }
 
+/* The cell of 8 voxel centres around q (voxel units) that a trilinear
+ * interpolation reads: its lowest voxel, and q's fraction f across it. */
+LO_LOOKUP_FN ivec3 loTrilinearCell(vec3 q, LO_OUT(vec3) f) {
+  vec3 u = q - vec3(0.5f);
+  f = u - floor(u);
+  return ivec3(floor(u));
+}
+
+/* Corner k (0..7) of that cell: 0 or 1 per axis. */
+LO_LOOKUP_FN ivec3 loCellCorner(int k) { return ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1); }
+
 /* Weight of corner o (0 or 1 per axis) of the cell in a trilinear
  * interpolation at fraction f. */
 LO_LOOKUP_FN float loTrilinearWeight(vec3 f, ivec3 o) {
@@ -311,13 +322,12 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
      * left out and the remaining weights renormalized, so light never leaks
      * in from empty space, through a thin wall or fades at the edge of the
      * geometry. */
-    vec3 u = q - vec3(0.5f);
-    ivec3 base = ivec3(floor(u));
-    vec3 f = u - floor(u);
+    vec3 f;
+    ivec3 base = loTrilinearCell(q, f);
     vec3 sum = vec3(0.0f);
     float weightSum = 0.0f;
     for (int k = 0; k < 8; ++k) {
-      ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+      ivec3 o = loCellCorner(k);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
       if (loServingLeaf(LO_TEX base + o, q, s.ng, depth, first, count)) {
@@ -374,14 +384,13 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
   vec3 d;
   direction = vec3(0.0f);
   if (interpolation) {
-    vec3 u = q - vec3(0.5f);
-    ivec3 base = ivec3(floor(u));
-    vec3 f = u - floor(u);
+    vec3 f;
+    ivec3 base = loTrilinearCell(q, f);
     vec3 sum = vec3(0.0f);
     vec3 directionSum = vec3(0.0f);
     float weightSum = 0.0f;
     for (int k = 0; k < 8; ++k) {
-      ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+      ivec3 o = loCellCorner(k);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
       if (loServingLeaf(LO_TEX base + o, q, n, depth, first, count)) {
@@ -440,13 +449,12 @@ LO_LOOKUP_FN vec3 loVolumeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
       !loVolumeLends(LO_TEX loUnpackAddress(own.r, own.g, own.b), ivec3(floor(q)), size, q)) {
     return vec3(0.0f);
   }
-  vec3 u = q - vec3(0.5f);
-  ivec3 base = ivec3(floor(u));
-  vec3 f = u - floor(u);
+  vec3 f;
+  ivec3 base = loTrilinearCell(q, f);
   vec3 sum = vec3(0.0f);
   float weightSum = 0.0f;
   for (int k = 0; k < 8; ++k) {
-    ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+    ivec3 o = loCellCorner(k);
     float w = loTrilinearWeight(f, o);
     if (w <= 0.0f) continue;
     uvec4 leaf;

@@ -358,7 +358,8 @@ void SceneGeometry::offsetMovingVertices(const Vec3& offset) {
   glBindBuffer(GL_ARRAY_BUFFER, vbo.get());
   size_t k = 0;
   std::vector<Vertex> moved;
-  for (const DrawRange& range : ranges) {
+  for (size_t ri = 0; ri < ranges.size(); ++ri) {
+    const DrawRange& range = ranges[ri];
     if (!range.moving) continue;
     moved.assign(movingVertices.begin() + std::ptrdiff_t(k),
                  movingVertices.begin() + std::ptrdiff_t(k + size_t(range.count)));
@@ -366,6 +367,16 @@ void SceneGeometry::offsetMovingVertices(const Vec3& offset) {
       v.position[0] += offset.x;
       v.position[1] += offset.y;
       v.position[2] += offset.z;
+    }
+    if (rangeCategory[ri] == kBlended) {
+      // Their centroids move with them: the back-to-front sort reads them.
+      const size_t firstTriangle = size_t(range.first - blendFirst) / 3;
+      for (size_t t = 0; 3 * t + 2 < moved.size(); ++t) {
+        blendCentroids[firstTriangle + t] = (glm::make_vec3(moved[3 * t].position) +
+                                             glm::make_vec3(moved[3 * t + 1].position) +
+                                             glm::make_vec3(moved[3 * t + 2].position)) /
+                                            3.0f;
+      }
     }
     glBufferSubData(GL_ARRAY_BUFFER, GLintptr(size_t(range.first) * sizeof(Vertex)),
                     GLsizeiptr(moved.size() * sizeof(Vertex)), moved.data());

@@ -76,22 +76,51 @@ TEST(AddedObjects, MovedObjectsDrawAsIfPlacedThere) {
   params.reflections = false;
   const PinholeCamera camera =
       PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.98f), Vec3(0.5f, 0.35f, 0), 1.2f);
-  const Vec3 from(0.75f, 0.25f, 0.3f), offset(-0.1f, 0.05f, 0.25f);
+  // Opaque; and see-through, moved from in front of a see-through pane to
+  // behind it: the blended triangles are drawn back to front, sorted each
+  // frame by centroids that must move with them.
+  for (const bool blended : {false, true}) {
+    auto sphereAt = [blended](const Vec3& at) {
+      Scene room = test::pointLitRoom();
+      if (blended) {
+        Material pane;
+        pane.baseColor = Vec3(0.9f, 0.1f, 0.1f);
+        pane.alphaMode = AlphaMode::Blend;
+        pane.baseAlpha = 0.5f;
+        pane.doubleSided = true;
+        room.materials.push_back(pane);
+        test::addQuad(room, {0.05f, 0.05f, 0.6f}, {0.9f, 0, 0}, {0, 0.9f, 0}, {0, 0, 1},
+                      int(room.materials.size()) - 1);
+      }
+      Scene scene = withSphere(room, at, 0.1f);
+      if (blended) {
+        Material& m = scene.materials[scene.movingMaterialsFrom];
+        m.baseColor = Vec3(0.1f, 0.1f, 0.9f);
+        m.alphaMode = AlphaMode::Blend;
+        m.baseAlpha = 0.5f;
+        m.doubleSided = true;  // its far side seen through its near side
+      }
+      return scene;
+    };
+    // Blended: moved across the view by more than a right angle as the eye
+    // sees it (a convex object's triangles sort differently only then).
+    const Vec3 from = blended ? Vec3(0.15f, 0.85f, 0.88f) : Vec3(0.75f, 0.25f, 0.3f);
+    const Vec3 offset = blended ? Vec3(0.6f, -0.55f, -0.38f) : Vec3(-0.1f, 0.05f, 0.25f);
+    Renderer moved(sphereAt(from), octree, {});
+    moved.setFreeSpaceLight(volume);
+    ASSERT_TRUE(moved.hasAddedObjects());
+    const RgbImage before = moved.render(camera, params);
+    moved.moveAddedObjects(offset);
+    const RgbImage after = moved.render(camera, params);
 
-  Renderer moved(roomWithSphere(from, 0.1f), octree, {});
-  moved.setFreeSpaceLight(volume);
-  ASSERT_TRUE(moved.hasAddedObjects());
-  const RgbImage before = moved.render(camera, params);
-  moved.moveAddedObjects(offset);
-  const RgbImage after = moved.render(camera, params);
-
-  Renderer placed(roomWithSphere(from + offset, 0.1f), octree, {});
-  placed.setFreeSpaceLight(volume);
-  const RgbImage there = placed.render(camera, params);
-  // The same picture up to the rounding of two render spaces (the scene's
-  // bounds, and so their centre, differ by the sphere's place).
-  EXPECT_LT(meanAbs(after, there), 1e-3 * mean(there));
-  EXPECT_GT(meanAbs(after, before), 0.02 * mean(there)) << "the sphere did not move";
+    Renderer placed(sphereAt(from + offset), octree, {});
+    placed.setFreeSpaceLight(volume);
+    const RgbImage there = placed.render(camera, params);
+    // The same picture up to the rounding of two render spaces (the scene's
+    // bounds, and so their centre, differ by the sphere's place).
+    EXPECT_LT(meanAbs(after, there), 1e-3 * mean(there)) << (blended ? "blended" : "opaque");
+    EXPECT_GT(meanAbs(after, before), 0.02 * mean(there)) << "the sphere did not move";
+  }
 }
 
 TEST(AddedObjects, TheFreeSpaceLightLightsThemAsTheCppLookupSays) {
