@@ -95,7 +95,7 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
   StageTimer renderTimer(rows, "render");
   // Added objects read the free-space light (the renderer's LO_FREE_SPACE).
   GpuOctree volume;
-  if (!opt.objects.empty() && !baked.grid.volume.empty()) {
+  if (!opt.objects.empty() && hasLightForAddedObjects(baked.grid, opt.lights)) {
     volume = buildVolumeOctree(baked.grid.volume, opt.shading.octreeParams());
   }
   RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {

@@ -162,15 +162,19 @@ void setAddedObjectsLight(Renderer& renderer, const VdlGrid& baked, const Shadin
     throw InputError("--add: not with --lighting atlas (the atlas holds the baked surfaces' light "
                      "only); added objects are lit by the octree's free-space light");
   }
-  if (baked.volume.empty()) {
-    std::fprintf(stderr,
-                 "warning: %s holds no free-space light (baked with --free-space off, or by an "
-                 "older lightoctree): the added objects take the light "
-                 "of the surfaces near them\n",
-                 lightsPath.c_str());
-    return;
+  if (hasLightForAddedObjects(baked, lightsPath)) {
+    renderer.setFreeSpaceLight(buildVolumeOctree(baked.volume, params));
   }
-  renderer.setFreeSpaceLight(buildVolumeOctree(baked.volume, params));
+}
+
+bool hasLightForAddedObjects(const VdlGrid& baked, const std::string& lightsPath) {
+  if (!baked.volume.empty()) return true;
+  std::fprintf(stderr,
+               "warning: %s holds no free-space light (baked with --free-space off, or by an "
+               "older lightoctree): the added objects take the light "
+               "of the surfaces near them\n",
+               lightsPath.c_str());
+  return false;
 }
 
 }  // namespace lo::tool

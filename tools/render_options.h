@@ -67,6 +67,10 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window);
 /// "on" | "off".
 CLI::Validator onOff();
 
+/// Whether `baked` holds free-space light for the objects --add placed;
+/// if not, a warning that they take the surfaces' light instead.
+bool hasLightForAddedObjects(const VdlGrid& baked, const std::string& lightsPath);
+
 /// The light of the objects --add placed: the bake's free-space light
 /// (buildVolumeOctree) on `renderer`, or, when `baked` has none, a warning
 /// that the objects take the surfaces' light. @throws InputError with
