@@ -159,12 +159,13 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
       const double tEps = (tb - ta) * 1e-9;
       const int lowCell[3] = {0, 0, zLow}, highCell[3] = {res - 1, res - 1, zHigh - 1};
       int cell[3], step[3];
-      double tMax[3];
+      double tMax[3], inverse[3];
       for (int a = 0; a < 3; ++a) {
         const double pa = p0[a] + d[a] * (ta + tEps);
         cell[a] = std::clamp(int(std::floor(pa)), lowCell[a], highCell[a]);
         step[a] = d[a] > 0 ? 1 : -1;
-        tMax[a] = d[a] != 0 ? (double(cell[a] + (d[a] > 0 ? 1 : 0)) - p0[a]) / d[a]
+        inverse[a] = d[a] != 0 ? 1.0 / d[a] : 0.0;
+        tMax[a] = d[a] != 0 ? (double(cell[a] + (d[a] > 0 ? 1 : 0)) - p0[a]) * inverse[a]
                             : std::numeric_limits<double>::infinity();
       }
       double t = ta;
@@ -208,7 +209,7 @@ VolumeLight buildVolumeLight(const std::vector<PhotonSegment>& segments, const G
         t = tNext;
         // From the face's own coordinate, not summed steps: a crossing's t
         // is the same whichever slab the walk started in.
-        tMax[a] = (double(cell[a] + (d[a] > 0 ? 1 : 0)) - p0[a]) / d[a];
+        tMax[a] = (double(cell[a] + (d[a] > 0 ? 1 : 0)) - p0[a]) * inverse[a];
       }
     }
     for (int z = zLow; z < zHigh; ++z) {
