@@ -2,6 +2,9 @@
 
 #include <sys/resource.h>
 #include <unistd.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <cctype>
@@ -62,6 +65,12 @@ double StageTimer::finish(std::string detail) {
   const double seconds = clock_.seconds();
   rows_.push_back({name_, seconds, currentRssBytes(), peakRssBytes(), std::move(detail)});
   return seconds;
+}
+
+void returnFreeMemory() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
 }
 
 std::string formatBytes(size_t bytes) {

@@ -64,6 +64,11 @@ class StageTimer {
   Stopwatch clock_;
 };
 
+/// Gives the pages of freed heap blocks back to the system (glibc's
+/// malloc_trim; nothing elsewhere). Large buffers freed in the middle of the
+/// heap otherwise stay in the process's resident memory.
+void returnFreeMemory();
+
 std::string formatBytes(size_t bytes);  ///< "12.3 MiB"
 std::string formatCount(size_t n);      ///< 1234567 -> "1,234,567"
 std::string formatNumber(double v);     ///< shortest text, as std::ostream prints it: "1.5", "600000"
