@@ -25,7 +25,6 @@
 #include "image/image.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
-#include "scene/texture_detail.h"
 #include "vdb/vdb_io.h"
 
 namespace lo::tool {
@@ -44,7 +43,6 @@ struct RenderOptions {
   std::string backend = "osmesa";
   int frames = 0;
   int irradianceSpp = 64;
-  std::string textureDetail = "view";  // --texture-detail
   std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
@@ -149,34 +147,6 @@ int runRender(const RenderOptions& opt) {
                  opt.lights.c_str(), opt.mode.c_str());
   }
 
-  // Only the texture levels this frame can sample (scene/texture_detail.h):
-  // the finer ones leave the scene's copy, or only its upload where the
-  // lights read the texels too.
-  RendererParams rendererParams = opt.shading.rendererParams();
-  if (opt.textureDetail == "view" && !scene.textures.empty()) {
-    StageTimer detailTimer(rows, "texture detail");
-    TextureViews views;
-    const int s = params.supersample;
-    views.cameras.push_back({camera, params.width * s, params.height * s});
-    if (params.reflections) {
-      views.cubeCentre = scene.bounds().center();
-      views.cubeFaceSize = rendererParams.probeSize;
-    }
-    const TextureLevels levels = textureLevelsFor(scene, views);
-    size_t before = 0, after = 0;
-    for (const Texture& t : scene.textures) before += t.byteSize();
-    reduceTextures(scene, levels.kept);
-    for (const Texture& t : scene.textures) after += t.byteSize();
-    rendererParams.textureLevels.resize(levels.drawn.size());
-    int finest = 64;
-    for (size_t i = 0; i < levels.drawn.size(); ++i) {
-      rendererParams.textureLevels[i] = levels.drawn[i] - levels.kept[i];
-      finest = std::min(finest, levels.drawn[i]);
-    }
-    detailTimer.finish("finest level " + std::to_string(finest) + ", texels " +
-                       formatBytes(before) + " -> " + formatBytes(after));
-  }
-
   StageTimer contextTimer(rows, "GL context");
   GlContextParams contextParams;
   contextParams.backend = parseGlBackend(opt.backend);
@@ -191,10 +161,10 @@ int runRender(const RenderOptions& opt) {
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
   report.figures["octree"] = octree.ToString();
 
-  Renderer renderer(scene, octree, rendererParams);
+  Renderer renderer(scene, octree, opt.shading.rendererParams());
   rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
   // The renderer holds its own copies now; nothing below reads a texel.
-  releaseTexels(scene);
+  scene.releaseTexels();
   returnFreeMemory();
   if (!opt.objects.empty()) {
     StageTimer volumeTimer(rows, "free-space light");
@@ -263,12 +233,6 @@ std::function<int()> addRenderCommand(CLI::App& app) {
   cmd->add_option("--frames", opt->frames,
                   "Also time this many frames (no read-back) and print the mean frame time")
       ->check(CLI::Range(0, 100000));
-  cmd->add_option("--texture-detail", opt->textureDetail,
-                  "view: keep and upload only the mip levels this camera, image size and the "
-                  "reflection probe can sample (textures streamed for a fixed view; the "
-                  "picture is the same) | full: every level")
-      ->check(CLI::IsMember({"view", "full"}))
-      ->capture_default_str();
   cmd->add_option("--spp", opt->irradianceSpp,
                   "--mode irradiance: camera rays per pixel, averaged as the reference averages "
                   "its samples (pixels across an edge need many)")

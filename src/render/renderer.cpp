@@ -118,7 +118,6 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.uploadOctree(octree);
   octreeTimer.finish(formatCount(octree.leafCount) + " leaves");
   StageTimer geometryTimer(r.startup, "geometry and textures");
-  r.geometry.textureLevels = params.textureLevels;
   r.geometry.upload(scene, r.space);
   for (const DrawRange& range : r.geometry.ranges) r.hasMovingRanges = r.hasMovingRanges || range.moving;
   r.geometry.sceneTriangles = scene.triangleCount();

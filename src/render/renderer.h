@@ -85,11 +85,6 @@ struct RendererParams {
   /// Texels per side of each face of the reflection probe's cube map
   /// (RenderParams::reflections); captured on the first frame that needs it.
   int probeSize = 128;
-  /// Per Scene::textures entry, the mip levels left out of its upload (the
-  /// finest ones, which the frames to draw never sample:
-  /// scene/texture_detail.h); empty or 0 = the whole chain. For renders from
-  /// known cameras, not for a camera that can go anywhere.
-  std::vector<int> textureLevels;
 };
 
 

@@ -95,7 +95,6 @@ struct SceneGeometry {
   std::vector<uint32_t> vertexCorner;
   size_t sceneTriangles = 0;
   float maxAnisotropy = 1;  ///< of the context (1: no anisotropic filtering)
-  std::vector<int> textureLevels;  ///< RendererParams::textureLevels
   /// The vertices of the added objects' ranges as uploaded (render space),
   /// range by range: what moveAddedObjects offsets.
   std::vector<Vertex> movingVertices;

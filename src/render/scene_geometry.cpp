@@ -10,7 +10,6 @@
 
 #include "render/gl_util.h"
 #include "render/renderer_impl.h"
-#include "scene/texture_detail.h"
 
 namespace lo::render_internal {
 namespace {
@@ -171,11 +170,8 @@ Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& 
 }  // namespace
 
 int SceneGeometry::useTexture(const Scene& scene, int index) {
-  if (!textures[size_t(index)]) {
-    const Texture& t = scene.textures[size_t(index)];
-    const int level = size_t(index) < textureLevels.size() ? textureLevels[size_t(index)] : 0;
-    textures[size_t(index)] = level > 0 ? uploadTexture(reducedTexture(t, level)) : uploadTexture(t);
-  }
+  if (!textures[size_t(index)])
+    textures[size_t(index)] = uploadTexture(scene.textures[size_t(index)]);
   return index;
 }
 

@@ -434,6 +434,15 @@ Vec3 Scene::emission(size_t t, float b1, float b2) const {
   return m.emission * textures[size_t(m.emissiveTexture)].lookup(u, v);
 }
 
+void Scene::releaseTexels() {
+  for (Texture& t : textures) {
+    Texture empty;
+    empty.name = std::move(t.name);
+    empty.sampler = t.sampler;
+    t = std::move(empty);
+  }
+}
+
 Vec3 Scene::triangleEmission(size_t t) const {
   const Material& m = materials[size_t(triangleMaterial[t])];
   if (m.emissiveTexture < 0 || !m.isEmissive()) return m.emission;

@@ -311,6 +311,10 @@ struct Scene {
   size_t movingMaterialsFrom = SIZE_MAX;
   /// Whether triangle t belongs to an object added after the bake.
   bool isAdded(size_t t) const { return size_t(triangleMaterial[t]) >= movingMaterialsFrom; }
+  /// Frees every texture's texels and file bytes: each becomes empty (a
+  /// lookup reads white), its name and sampler kept. For a caller that has
+  /// handed the texels to the GPU and reads them no more (`render`).
+  void releaseTexels();
 
   size_t triangleCount() const { return indices.size() / 3; }
   Bounds3 bounds() const;

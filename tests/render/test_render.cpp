@@ -19,7 +19,6 @@
 #include "image/image.h"
 #include "render/layout_probe.h"
 #include "render/renderer.h"
-#include "scene/texture_detail.h"
 
 namespace lo {
 namespace {
@@ -551,64 +550,6 @@ std::vector<bool> checkCheckerQuad(const TextureTransform& transform, const std:
         << "/rendered.png)";
   }
   return isRed;
-}
-
-// Textures streamed for a fixed view (scene/texture_detail.h): uploading
-// only the levels the view can sample draws the picture of the whole chain;
-// leaving out more blurs it (the check can fail).
-TEST(RenderImage, TheTextureLevelsAViewSamplesDrawTheSamePicture) {
-  REQUIRE_OSMESA();
-  QuadSetup s;
-  // An 8-bit sRGB checker, 512^2 texels in cells of 8, over the 2 x 2 quad:
-  // 256 texels per unit, cells of about 2.3 pixels in this view.
-  Texture checker;
-  checker.width = checker.height = 512;
-  checker.channels = 3;
-  checker.format = TexelFormat::Unorm8;
-  checker.srgb = true;
-  for (int y = 0; y < 512; ++y) {
-    for (int x = 0; x < 512; ++x) {
-      const bool red = (x / 8 + y / 8) % 2 == 0;
-      checker.unorm8.insert(checker.unorm8.end(), {uint8_t(red ? 220 : 30), 40, uint8_t(red ? 30 : 220)});
-    }
-  }
-  s.scene.textures.push_back(checker);
-  s.scene.materials[0].baseColor = {1, 1, 1};
-  s.scene.materials[0].baseColorTexture = 0;
-  s.scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};
-  Light light;
-  light.type = Light::Type::Point;
-  light.position = {0.1f, -0.05f, 1.0f};
-  light.intensity = 2.0f;
-  s.scene.lights.push_back(light);
-  const GpuOctree octree =
-      makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
-  RenderParams p = QuadSetup::params(false);
-  p.width = 128;
-  p.height = 96;
-  p.mode = RenderMode::Direct;
-  TextureViews views;
-  views.cameras.push_back({s.camera, p.width, p.height});
-  const TextureLevels levels = textureLevelsFor(s.scene, views);
-  ASSERT_EQ(levels.drawn.size(), 1u);
-  ASSERT_GT(levels.drawn[0], 0) << "the view needs fewer texels than the map holds";
-  const RgbImage whole = Renderer(s.scene, octree).render(s.camera, p);
-  RendererParams streamed;
-  streamed.textureLevels = levels.drawn;
-  const RgbImage same = Renderer(s.scene, octree, streamed).render(s.camera, p);
-  streamed.textureLevels = {levels.drawn[0] + 3};
-  const RgbImage blurred = Renderer(s.scene, octree, streamed).render(s.camera, p);
-  double mean = 0, sameError = 0, blurError = 0;
-  for (size_t i = 0; i < whole.rgb.size(); ++i) {
-    mean += double(whole.rgb[i]);
-    sameError += std::fabs(double(same.rgb[i]) - double(whole.rgb[i]));
-    blurError += std::fabs(double(blurred.rgb[i]) - double(whole.rgb[i]));
-  }
-  const std::string dir = test::outputDir("texture_levels");
-  writePng(dir + "/whole.png", whole);
-  writePng(dir + "/streamed.png", same);
-  EXPECT_LT(sameError, 0.005 * mean) << "level " << levels.drawn[0] << " (" << dir << ")";
-  EXPECT_GT(blurError, 0.05 * mean) << "three levels more should blur the checker";
 }
 
 // The sky is drawn behind the scene where the view looks above the horizon,

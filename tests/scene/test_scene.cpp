@@ -1509,5 +1509,26 @@ TEST(SkySampler, DensityIntegratesToOneAndMatchesItsDraws) {
   EXPECT_TRUE(SkySampler(Sky{}).empty());
 }
 
+TEST(Scene, ReleasedTexelsLeaveEmptyTexturesWithTheirSamplers) {
+  Scene scene;
+  Material m;
+  m.baseColor = Vec3(1.0f);
+  m.baseColorTexture = 0;
+  scene.materials.push_back(m);
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 0);
+  scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};
+  scene.textures.push_back(Texture::fromLinear(2, 1, {Vec3(0.2f), Vec3(0.4f)}));
+  scene.textures[0].name = "map";
+  scene.textures[0].sampler.wrapS = 33071;  // GL_CLAMP_TO_EDGE
+  EXPECT_NEAR(scene.albedo(0, 0.5f, 0.0f).x, 0.3f, 0.05f);
+  scene.releaseTexels();
+  ASSERT_EQ(scene.textures.size(), 1u);
+  EXPECT_TRUE(scene.textures[0].empty());
+  EXPECT_EQ(scene.textures[0].byteSize(), 0u);
+  EXPECT_EQ(scene.textures[0].name, "map");
+  EXPECT_EQ(scene.textures[0].sampler.wrapS, 33071);
+  EXPECT_EQ(scene.albedo(0, 0.5f, 0.0f), Vec3(1.0f)) << "an empty texture reads white";
+}
+
 }  // namespace
 }  // namespace lo
