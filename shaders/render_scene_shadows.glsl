@@ -64,7 +64,9 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
   // tangent plane lies on a ray that reaches the surface from above it. The
   // map cannot tell what hides the light's visible part; the part itself is
   // exact (polygonIrradiance clips the light at the horizon): count p lit.
-  if (plane > 0.0) return 1.0;
+  // Judged at p itself, not at the offset point, which would count points
+  // that see the centre just above their horizon.
+  if (dot(p - lc, n) > 0.0) return 1.0;
   mat4 clipToRender = inverse(uShadowMatrices[layer]);
   float h = 0.5 * L.corner0.w;
   // Blockers from 0.3 d_r out can hide the light: search that cone (in a

@@ -188,8 +188,9 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
   addObjectOptions(cmd, opt->objects);
   cmd->add_flag("--added-only-receive", opt->addedOnlyReceive,
                 "With --add: the camera sees the added objects, no other ray does: they are lit "
-                "by the scene as it was baked and neither shadow nor light it, as `render --add` "
-                "draws them (the judge of the free-space light alone)");
+                "by the scene as it was baked and neither shadow nor light it (not even their "
+                "direct shadows, which `render --add` draws): on a convex object's own pixels, "
+                "the judge of the free-space light alone");
   cmd->add_option("-o,--output", opt->output,
                   "Image: .exr (linear float) or .png (sRGB, for a quick look)")
       ->required();

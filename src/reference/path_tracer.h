@@ -58,8 +58,11 @@ struct ReferenceParams {
   /// Objects added after the bake (Scene::isAdded) seen by the camera
   /// alone: every later ray, of light or shadow, passes through them, so
   /// that they are lit by the scene as it was baked, neither shadowing nor
-  /// lighting it. The light `render --add` gives them (docs/render.md), the
-  /// judge of the free-space light itself.
+  /// lighting it: on a convex added object's own pixels, the light the
+  /// free-space light stands for (docs/render.md), its judge. Not `render
+  /// --add`'s whole picture: there the objects also cast direct shadows, on
+  /// the scene and on each other. Added objects that emit light are not
+  /// meant for it (their light still reaches the scene by light samples).
   bool addedOnlyReceive = false;
 };
 

@@ -3,7 +3,9 @@
 /// @brief Objects added to a baked scene (`render`/`view`/`reference --add`):
 /// a model's triangles, materials and textures joined to the scene where the
 /// user puts it. The renderer lights them from the free-space light
-/// (Scene::movingMaterialsFrom); the path tracer traces them as any surface.
+/// (Scene::movingMaterialsFrom); the path tracer traces them as any surface
+/// (or, with ReferenceParams::addedOnlyReceive, meets them with camera rays
+/// alone).
 
 #include <string>
 

@@ -284,7 +284,7 @@ struct Scene {
   std::vector<Vec3> positions;    ///< world space
   /// Per vertex, unit, world space; empty = use face normals. A zero vector
   /// stands for the face's normal too (the part of a scene that had none,
-  /// joined to one that has them: scene/place_model.h).
+  /// joined to one that has them: placeModel, scene/place_model.cpp).
   std::vector<Vec3> normals;
   std::vector<float> texcoords0;  ///< 2 floats per vertex, or empty
   std::vector<float> texcoords1;  ///< 2 floats per vertex, or empty

@@ -76,9 +76,11 @@ TEST(AddedObjects, MovedObjectsDrawAsIfPlacedThere) {
   params.reflections = false;
   const PinholeCamera camera =
       PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.98f), Vec3(0.5f, 0.35f, 0), 1.2f);
-  // Opaque; and see-through, moved from in front of a see-through pane to
-  // behind it: the blended triangles are drawn back to front, sorted each
-  // frame by centroids that must move with them.
+  // Opaque; and see-through with both sides drawn, moved from in front of
+  // a see-through pane to behind it: the sphere's own triangles are drawn
+  // back to front, sorted each frame by centroids that must move with them.
+  // (Blended ranges are sorted within themselves and drawn in material
+  // order, so the pane and the sphere keep their order wherever they are.)
   for (const bool blended : {false, true}) {
     auto sphereAt = [blended](const Vec3& at) {
       Scene room = test::pointLitRoom();
