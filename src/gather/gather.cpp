@@ -12,14 +12,9 @@
 
 #include "gather/gather.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <functional>
 #include <string>
 #include <utility>
 
@@ -362,74 +357,63 @@ std::shared_ptr<const BinnedPhotons> binPhotonsForGather(const SurfaceGrid& grid
   }
   auto binned = std::make_shared<BinnedPhotons>();
   binned->entries.resize(grid.binPhotons.size());
-  // In parallel: each entry and each bin is written by one task alone.
-  binned->causticPhotons = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, grid.binPhotons.size(), 65536), size_t(0),
-      [&](const tbb::blocked_range<size_t>& r, size_t caustic) {
-        for (size_t j = r.begin(); j != r.end(); ++j) {
-          const uint32_t i = grid.binPhotons[j];
-          LO_CHECK_LT(size_t(i), photons.size());
-          const Photon& p = photons[i];
-          binned->entries[j] = {p.position, p.normal, average(p.power), i, BinnedPhotons::kNoGroup,
-                                p.caustic};
-          caustic += p.caustic != 0;
-        }
-        return caustic;
-      },
-      std::plus<size_t>());
+  for (size_t j = 0; j < grid.binPhotons.size(); ++j) {
+    const uint32_t i = grid.binPhotons[j];
+    LO_CHECK_LT(size_t(i), photons.size());
+    const Photon& p = photons[i];
+    binned->entries[j] = {p.position, p.normal, average(p.power), i, BinnedPhotons::kNoGroup,
+                          p.caustic};
+    binned->causticPhotons += p.caustic != 0;
+  }
   binned->bins.resize(grid.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.size(), 256),
-                    [&](const tbb::blocked_range<size_t>& range) {
-                      for (size_t v = range.begin(); v != range.end(); ++v) {
-                        BinnedPhotons::Bin& bin = binned->bins[v];
-                        const uint32_t b = grid.binStart[v], e = grid.binStart[v + 1];
-                        if (b == e) continue;
-                        bin.lower = bin.upper = binned->entries[b].position;
-                        bool finite = true;
-                        for (uint32_t j = b; j != e; ++j) {
-                          const BinnedPhotons::Entry& entry = binned->entries[j];
-                          finite = finite && isFinite(entry.position) && isFinite(entry.normal);
-                          for (int a = 0; a < 3; ++a) {
-                            bin.lower[a] = std::min(bin.lower[a], entry.position[a]);
-                            bin.upper[a] = std::max(bin.upper[a], entry.position[a]);
-                          }
-                          if (bin.groups < 0) continue;
-                          int g = 0;
-                          while (g < bin.groups && !(bin.normal[g] == entry.normal)) ++g;
-                          if (g == bin.groups) {
-                            if (g == BinnedPhotons::kMaxGroups) {
-                              bin.groups = -1;  // too many normals: vote per photon
-                              continue;
-                            }
-                            bin.normal[g] = entry.normal;
-                            ++bin.groups;
-                          }
-                          bin.weight[g] += entry.weight;
-                        }
-                        if (bin.groups < 0 || !finite) bin.groups = 0;
-                        // Where each group (or the whole bin) lies, for the occlusion test.
-                        double sum[BinnedPhotons::kMaxGroups][3] = {};
-                        uint32_t count[BinnedPhotons::kMaxGroups] = {};
-                        for (uint32_t j = b; j != e; ++j) {
-                          BinnedPhotons::Entry& entry = binned->entries[j];
-                          int g = 0;
-                          if (bin.groups > 0) {
-                            while (!(bin.normal[g] == entry.normal)) ++g;
-                            entry.group = uint16_t(g);
-                          } else {
-                            bin.normalSum += entry.normal;
-                          }
-                          for (int a = 0; a < 3; ++a) sum[g][a] += double(entry.position[a]);
-                          ++count[g];
-                        }
-                        for (int g = 0; g < std::max(1, bin.groups); ++g) {
-                          if (count[g] == 0) continue;
-                          bin.point[g] =
-                              Vec3{float(sum[g][0] / count[g]), float(sum[g][1] / count[g]),
-                                   float(sum[g][2] / count[g])};
-                        }
-                      }
-                    });
+  for (size_t v = 0; v < grid.size(); ++v) {
+    BinnedPhotons::Bin& bin = binned->bins[v];
+    const uint32_t b = grid.binStart[v], e = grid.binStart[v + 1];
+    if (b == e) continue;
+    bin.lower = bin.upper = binned->entries[b].position;
+    bool finite = true;
+    for (uint32_t j = b; j != e; ++j) {
+      const BinnedPhotons::Entry& entry = binned->entries[j];
+      finite = finite && isFinite(entry.position) && isFinite(entry.normal);
+      for (int a = 0; a < 3; ++a) {
+        bin.lower[a] = std::min(bin.lower[a], entry.position[a]);
+        bin.upper[a] = std::max(bin.upper[a], entry.position[a]);
+      }
+      if (bin.groups < 0) continue;
+      int g = 0;
+      while (g < bin.groups && !(bin.normal[g] == entry.normal)) ++g;
+      if (g == bin.groups) {
+        if (g == BinnedPhotons::kMaxGroups) {
+          bin.groups = -1;  // too many normals: vote per photon
+          continue;
+        }
+        bin.normal[g] = entry.normal;
+        ++bin.groups;
+      }
+      bin.weight[g] += entry.weight;
+    }
+    if (bin.groups < 0 || !finite) bin.groups = 0;
+    // Where each group (or the whole bin) lies, for the occlusion test.
+    double sum[BinnedPhotons::kMaxGroups][3] = {};
+    uint32_t count[BinnedPhotons::kMaxGroups] = {};
+    for (uint32_t j = b; j != e; ++j) {
+      BinnedPhotons::Entry& entry = binned->entries[j];
+      int g = 0;
+      if (bin.groups > 0) {
+        while (!(bin.normal[g] == entry.normal)) ++g;
+        entry.group = uint16_t(g);
+      } else {
+        bin.normalSum += entry.normal;
+      }
+      for (int a = 0; a < 3; ++a) sum[g][a] += double(entry.position[a]);
+      ++count[g];
+    }
+    for (int g = 0; g < std::max(1, bin.groups); ++g) {
+      if (count[g] == 0) continue;
+      bin.point[g] = Vec3{float(sum[g][0] / count[g]), float(sum[g][1] / count[g]),
+                          float(sum[g][2] / count[g])};
+    }
+  }
   return binned;
 }
 
