@@ -37,7 +37,9 @@ def room_mesh_buffer(half=3.0, floor=-1.2, height=4.0):
         for a, b in ((0, 0), (1, 0), (1, 1), (0, 1)):
             pos += [c[k] + a * u[k] + b * v[k] for k in range(3)]
             nrm += list(n)
-        idx += [base, base + 1, base + 2, base, base + 2, base + 3]
+        # Counter-clockwise seen from inside: (v, u) turns about the inward
+        # normal (u x v points out of the room).
+        idx += [base, base + 2, base + 1, base, base + 3, base + 2]
     return pos, nrm, idx
 
 
