@@ -4,8 +4,9 @@ DamagedHelmet (DamagedHelmet.gltf with its .bin and five 2048^2 JPEG maps;
 CC BY-NC 4.0, theblueturtle_, so it is not part of this repository): the
 helmet as it is, in a 6 x 4 x 6 m room (off-white, single-sided walls facing
 in) lit by one KHR_lights_punctual spot light from above the camera, and a
-camera looking at the helmet. The real-asset benchmarks (tools/bench_render,
-tools/bench_bake with --helmet) and docs/results/real-assets.md use it.
+camera looking at the helmet. The real-asset benchmark
+(tools/bench_real_assets.py --helmet, which writes docs/results/real-assets.md)
+runs it.
 
 --emissive-only leaves the spot out: the helmet's emissive texture is the only
 light (helmet-emissive.gltf), the case of an emissive-texture-lit scene.
