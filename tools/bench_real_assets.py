@@ -16,7 +16,7 @@ fills the same table through EGL.
 Per scene: the bake at the defaults (a fixed 1,000,000 photons for the
 emissive helmet, to count paths per stored photon); `render` at 320 x 240
 (osmesa) with the `--json` report's stages (load, read grid, GL context,
-octree, shaders, octree upload, geometry and textures, lights and shadow maps,
+octree, shaders, octree upload, lights, geometry and textures, shadow maps,
 first frame); `lightmap` and the .glb's size
 against the scene's files. Wall time and peak memory (the process's maximum
 resident set, from wait4) of each command. The machine is shared: compare
@@ -123,11 +123,10 @@ def main():
             "paths": bake["counts"].get("emitted_paths", 0) if "counts" in bake else 0,
             "render_s": render_wall, "render_mb": render_peak,
             "load_s": r["load scene"]["seconds"],
-            "upload_s": sum(r[k]["seconds"] for k in ("shaders", "octree upload", "geometry and textures",
-                                                      "lights and shadow maps", "prepare lighting") if k in r),
-            "textures_mb": (r["geometry and textures"]["rss_bytes"] - r["octree upload"]["rss_bytes"]) / 2**20,
-            "shadows_mb": (r["lights and shadow maps"]["rss_bytes"] -
-                           r["geometry and textures"]["rss_bytes"]) / 2**20,
+            "upload_s": sum(r[k]["seconds"] for k in ("shaders", "octree upload", "lights", "geometry and textures",
+                                                      "shadow maps", "prepare lighting") if k in r),
+            "textures_mb": (r["geometry and textures"]["rss_bytes"] - r["lights"]["rss_bytes"]) / 2**20,
+            "shadows_mb": (r["shadow maps"]["rss_bytes"] - r["geometry and textures"]["rss_bytes"]) / 2**20,
             "frame_s": r["first frame"]["seconds"],
             "lightmap_s": lightmap_wall, "lightmap_mb": lightmap_peak,
             "glb_mb": glb_bytes / 2**20, "inputs_mb": inputs / 2**20, "pages_mb": pages / 2**20,
@@ -143,8 +142,9 @@ def main():
                  "this machine: 2 cores, llvmpipe through OSMesa") + ", shared with other work;",
         "compare the rows of one run). Every figure is one run of the command a user types:",
         "wall time and peak resident memory of the process. `render` is 320 × 240 in full mode;",
-        "its stages come from its `--json` report (upload: shaders, octree, geometry and",
-        "textures, lights and shadow maps, with what the last two added to the process's memory);",
+        "its stages come from its `--json` report (upload: shaders, octree, lights, geometry and",
+        "textures (the scene's texels freed as each texture's GPU copy is made), shadow maps, with",
+        "what the last two added to the process's memory);",
         "it runs twice and the second run is measured, the driver's shader cache then warm (a",
         "first run compiles each shader program it meets, about a second each on llvmpipe).",
         "The bake runs at the defaults (target noise 0.07), the emissive helmet's at a fixed",

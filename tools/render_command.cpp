@@ -157,14 +157,24 @@ int runRender(const RenderOptions& opt) {
 
   StageTimer octreeTimer(rows, "octree");
   GpuOctree octree = buildGpuOctree(baked.grid, opt.shading.octreeParams(&context->info()));
+  if (opt.objects.empty()) {
+    // The octree holds all the renderer reads of the grid; only the added
+    // objects' free-space light reads it again.
+    baked.grid = VdlGrid{};
+    returnFreeMemory();
+  }
   octreeTimer.finish("");
   if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
   report.figures["octree"] = octree.ToString();
 
-  Renderer renderer(scene, octree, opt.shading.rendererParams());
+  // Nothing after the renderer's construction reads a texel: each texture's
+  // are freed as soon as its GPU copy is made.
+  Renderer renderer(scene, octree, opt.shading.rendererParams(), [&scene](int texture) {
+    scene.releaseTexels(size_t(texture));
+    returnFreeMemory();
+  });
   rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
-  // The renderer holds its own copies now; nothing below reads a texel.
-  scene.releaseTexels();
+  scene.releaseTexels();  // those no material draws with
   returnFreeMemory();
   if (!opt.objects.empty()) {
     StageTimer volumeTimer(rows, "free-space light");

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -128,11 +129,21 @@ int runView(const ViewOptions& opt) {
     }
   } else {
     octree = buildGpuOctree(baked->grid, octreeParams);
+    if (opt.objects.empty()) baked.reset();  // only the added objects' light reads it again
     view.shownDepth = octree.depth;
     if (!opt.view.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
   }
 
-  Renderer renderer(scene, octree, opt.shading.rendererParams());
+  // Without a bake tracing the scene beside it, nothing reads a texel after
+  // the renderer's construction: each texture's are freed once on the GPU.
+  std::function<void(int)> releaseTexels;
+  if (!bake) {
+    releaseTexels = [&scene](int texture) {
+      scene.releaseTexels(size_t(texture));
+      returnFreeMemory();
+    };
+  }
+  Renderer renderer(scene, octree, opt.shading.rendererParams(), releaseTexels);
   if (!opt.objects.empty() && baked) {
     setAddedObjectsLight(renderer, baked->grid, opt.shading, octreeParams, opt.lights);
   }

@@ -19,7 +19,10 @@ namespace {
 
 constexpr int kMaxLights = shader::LO_MAX_LIGHTS;
 constexpr int kMaxShadowLayers = shader::LO_MAX_SHADOW_LAYERS;
-/// The most bytes the shadow maps take (4 per texel: 24-bit depth as stored).
+/// The most bytes the shadow maps take (2 per texel: 16-bit depth). The
+/// maps hold linear depth over the far plane (render_shadow.frag), which 16
+/// bits resolve to 1/65536, under the lookup's bias of 1/size (one over the
+/// map's texels per side) at every size up to 16384.
 constexpr double kShadowMapBudget = 96.0 * 1024 * 1024;
 constexpr int kCascades = shader::LO_SUN_CASCADES;
 
@@ -130,7 +133,7 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
   // emissive texture's VPLs take 6 layers each) gets smaller maps, halved
   // until they fit, but not below 256 texels.
   while (shadowMapSize > 256 &&
-         double(shadowMapSize) * double(shadowMapSize) * 4.0 * double(layers) > kShadowMapBudget) {
+         double(shadowMapSize) * double(shadowMapSize) * 2.0 * double(layers) > kShadowMapBudget) {
     shadowMapSize = std::max(256, shadowMapSize / 2);
   }
   std::copy(lights.begin(), lights.end(), block.uLights);
@@ -153,7 +156,7 @@ void SceneLights::allocateShadowMaps() {
   shadowTexture = GlTexture::create();
   glBindTexture(GL_TEXTURE_2D_ARRAY, shadowTexture.get());
   const int size = layers > 0 ? shadowMapSize : 1;
-  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT24, size, size, std::max(layers, 1), 0,
+  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT16, size, size, std::max(layers, 1), 0,
                GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);

@@ -37,13 +37,15 @@ struct SceneLights {
   /// Shadow map layers of the lights in the block (6 per point light or VPL).
   int layerCount() const;
 
-  /// Builds the block (punctual lights, then area lights or VPLs), uploads
-  /// it and renders every shadow map once, drawing `draw`'s depth-only
-  /// geometry with the vertex array `vao`. @throws InputError past LO_MAX_LIGHTS.
+  /// Builds the block (punctual lights, then area lights or VPLs) and
+  /// uploads it: the step that reads the scene's emission, emissive texels
+  /// included. @throws InputError past LO_MAX_LIGHTS.
+  void build(const Scene& scene, const RenderSpace& space, const RendererParams& params);
+
+  /// Allocates the shadow maps of the built block and renders each once,
+  /// drawing `draw`'s depth-only geometry with the vertex array `vao`.
   template <class DrawDepthOnly>
-  void setup(const Scene& scene, const RenderSpace& space, const RendererParams& params, GLuint vao,
-             const DrawDepthOnly& draw) {
-    build(scene, space, params);
+  void createShadowMaps(GLuint vao, const DrawDepthOnly& draw) {
     allocateShadowMaps();
     renderShadowMaps(vao, draw);
   }
@@ -72,7 +74,6 @@ struct SceneLights {
   }
 
  private:
-  void build(const Scene& scene, const RenderSpace& space, const RendererParams& params);
   void allocateShadowMaps();
   /// Binds the shadow framebuffer and the shadow program for depth-only
   /// draws at the maps' size; returns the framebuffer bound before.

@@ -55,7 +55,8 @@ void Renderer::Impl::uploadOctree(const GpuOctree& octree) {
   voxelSize = octreeTextures.voxelSize;
 }
 
-Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererParams& params)
+Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererParams& params,
+                   const std::function<void(int)>& textureUploaded)
     : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
   r.params = params;
@@ -117,8 +118,13 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   StageTimer octreeTimer(r.startup, "octree upload");
   r.uploadOctree(octree);
   octreeTimer.finish(formatCount(octree.leafCount) + " leaves");
+  // The lights first: emitter VPLs read the emissive texels, which
+  // `textureUploaded` may free once the textures are on the GPU.
+  StageTimer lightsTimer(r.startup, "lights");
+  r.lights.build(scene, r.space, params);
+  lightsTimer.finish(std::to_string(r.lights.block.uLightCount[0]) + " in the light block");
   StageTimer geometryTimer(r.startup, "geometry and textures");
-  r.geometry.upload(scene, r.space);
+  r.geometry.upload(scene, r.space, textureUploaded);
   for (const DrawRange& range : r.geometry.ranges) r.hasMovingRanges = r.hasMovingRanges || range.moving;
   r.geometry.sceneTriangles = scene.triangleCount();
   size_t textures = 0;
@@ -126,11 +132,11 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   geometryTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                        formatCount(textures) + " textures (" +
                        formatBytes(r.geometry.textureBytes) + " on the GPU)");
-  StageTimer lightsTimer(r.startup, "lights and shadow maps");
-  r.lights.setup(scene, r.space, params, r.geometry.vao.get(), [&r](GLuint program, bool shadows) {
+  StageTimer shadowTimer(r.startup, "shadow maps");
+  r.lights.createShadowMaps(r.geometry.vao.get(), [&r](GLuint program, bool shadows) {
     r.geometry.drawDepthOnly(program, shadows);
   });
-  lightsTimer.finish(std::to_string(r.lights.layerCount()) + " shadow layers of " +
+  shadowTimer.finish(std::to_string(r.lights.layerCount()) + " layers of " +
                      std::to_string(r.lights.shadowMapSize) + "^2");
   for (const Material& m : scene.materials) {
     r.probe.wanted =

@@ -6,6 +6,7 @@
 /// shadow maps. Needs a current GlContext (render/context.h). Output is linear
 /// HDR radiance, W/(m^2 sr) in the scene's light units. See docs/render.md.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -95,7 +96,13 @@ class Renderer {
   /// @throws InputError naming GL_MAX_3D_TEXTURE_SIZE / GL_MAX_TEXTURE_SIZE and
   /// by how much when the octree's textures exceed the context's limits;
   /// GlError on a GL failure.
-  Renderer(const Scene& scene, const GpuOctree& octree, const RendererParams& params = {});
+  /// `textureUploaded`, when given, is called with each Scene::textures
+  /// index whose GPU copy is made, after the constructor's last read of its
+  /// texels: a caller that reads them no more may free them there, so that
+  /// the scene's texels and their GPU copies are not all held at once (on a
+  /// software GL both live in the process).
+  Renderer(const Scene& scene, const GpuOctree& octree, const RendererParams& params = {},
+           const std::function<void(int)>& textureUploaded = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -134,8 +141,9 @@ class Renderer {
   bool hasAtlas() const;
   size_t atlasBytes() const;  ///< GPU bytes of the atlas textures (0 without one)
   /// What the constructor did, a row each with its time and the process's
-  /// memory after it: shaders, octree, geometry and textures (their count
-  /// and GPU bytes), lights and shadow maps (their layers and size).
+  /// memory after it: shaders, octree upload, lights (the light block),
+  /// geometry and textures (their count and GPU bytes), shadow maps (their
+  /// layers and size).
   const std::vector<StageReport>& startupStages() const;
 
   /// Renders into an offscreen RGBA32F target and reads its RGB back.

@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
 #include <vector>
 
@@ -76,6 +77,9 @@ struct DrawRange {
 
 /// The scene's triangles on the GPU, grouped by material in DrawCategory
 /// order, and its textures (scene_geometry.cpp).
+/// Channels of a texture the scene shader reads (SceneGeometry::uploadTexture).
+enum : unsigned { kReadR = 1, kReadG = 2, kReadB = 4, kReadA = 8 };
+
 struct SceneGeometry {
   GlVertexArray vao;
   GlBuffer vbo;
@@ -99,7 +103,11 @@ struct SceneGeometry {
   /// range by range: what moveAddedObjects offsets.
   std::vector<Vertex> movingVertices;
 
-  void upload(const Scene& scene, const RenderSpace& space);
+  /// Uploads the vertices and the textures the materials use, calling
+  /// `textureUploaded` (when set) with each texture's index once it is on
+  /// the GPU (Renderer's constructor).
+  void upload(const Scene& scene, const RenderSpace& space,
+              const std::function<void(int)>& textureUploaded = {});
   /// The GL name of Scene::textures[texture], 0 for -1.
   GLuint texture(int index) const { return index >= 0 ? textures[size_t(index)].get() : 0; }
   /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
@@ -109,7 +117,9 @@ struct SceneGeometry {
   void sortBlended(const glm::vec3& eye);
 
  private:
-  GlTexture uploadTexture(const Texture& t);
+  GlTexture uploadTexture(const Texture& t, unsigned read);
+  std::vector<unsigned> channelsRead;  ///< per texture, during upload: kReadR | ...
+  std::function<void(int)> textureUploaded_;
   /// Scene::textures[index] on the GPU, uploaded on first use; returns index.
   int useTexture(const Scene& scene, int index);
   /// The textures and uniforms material `mat` draws with.

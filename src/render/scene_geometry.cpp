@@ -37,30 +37,56 @@ DrawCategory categoryOf(const Material& m) {
 
 }  // namespace
 
-/// Uploads a texture (its colour, and its alpha where it has one) with its
-/// glTF sampler's filters and wrap modes; mipmaps and anisotropic filtering
-/// where the minification filter uses mipmaps (glTF's default). 8-bit
-/// texels go up as they are stored, 4 bytes per texel: sRGB colour maps as
-/// GL_SRGB8_ALPHA8, whose fetches the GPU decodes to linear before it
-/// filters (as Texture::lookup does), data maps as GL_RGBA8. 16-bit and
-/// float texels go up as linear half floats.
-GlTexture SceneGeometry::uploadTexture(const Texture& t) {
+/// Uploads a texture with its glTF sampler's filters and wrap modes; mipmaps
+/// and anisotropic filtering where the minification filter uses mipmaps
+/// (glTF's default). `read` is the channels the scene shader reads of it
+/// (kReadR | ...). 8-bit texels go up as they are stored: sRGB colour maps
+/// as GL_SRGB8_ALPHA8, whose fetches the GPU decodes to linear before it
+/// filters (as Texture::lookup does), data maps as GL_RGBA8, or as GL_R8
+/// (occlusion: R read) and GL_RG8 swizzled back to .gb (metallic-roughness:
+/// G and B read), a quarter and a half of the bytes. 16-bit and float
+/// texels go up as linear half floats.
+GlTexture SceneGeometry::uploadTexture(const Texture& t, unsigned read) {
   GlTexture id = GlTexture::create();
   glBindTexture(GL_TEXTURE_2D, id.get());
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   const size_t n = t.texelCount(), c = size_t(t.channels);
+  size_t texelBytes = 4;
   if (t.format == TexelFormat::Unorm8) {
-    // Grey (and grey + alpha) spread to RGBA: one layout for every image.
-    std::vector<uint8_t> rgba(n * 4);
-    for (size_t i = 0; i < n; ++i) {
-      const uint8_t* p = t.unorm8.data() + i * c;
-      rgba[4 * i] = p[0];
-      rgba[4 * i + 1] = c >= 3 ? p[1] : p[0];
-      rgba[4 * i + 2] = c >= 3 ? p[2] : p[0];
-      rgba[4 * i + 3] = t.hasAlpha() ? p[c - 1] : 255;
+    // A grey value is its texel's R, G and B.
+    auto channel = [&](size_t i, int k) { return t.unorm8[i * c + (c >= 3 ? size_t(k) : 0)]; };
+    if (!t.srgb && (read & ~kReadR) == 0) {
+      std::vector<uint8_t> r(n);
+      for (size_t i = 0; i < n; ++i) r[i] = channel(i, 0);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, t.width, t.height, 0, GL_RED, GL_UNSIGNED_BYTE,
+                   r.data());
+      texelBytes = 1;
+    } else if (!t.srgb && (read & ~(kReadG | kReadB)) == 0) {
+      std::vector<uint8_t> gb(2 * n);
+      for (size_t i = 0; i < n; ++i) {
+        gb[2 * i] = channel(i, 1);
+        gb[2 * i + 1] = channel(i, 2);
+      }
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RG8, t.width, t.height, 0, GL_RG, GL_UNSIGNED_BYTE,
+                   gb.data());
+      const GLint swizzle[4] = {GL_ZERO, GL_RED, GL_GREEN, GL_ONE};
+      glTexParameteriv(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_RGBA, swizzle);
+      texelBytes = 2;
+    } else if (c == 3 || c == 4) {
+      // RGB and RGBA go up as they are (the driver adds RGB's alpha).
+      glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0,
+                   c == 3 ? GL_RGB : GL_RGBA, GL_UNSIGNED_BYTE, t.unorm8.data());
+    } else {
+      // Grey (and grey + alpha) spread to RGBA.
+      std::vector<uint8_t> rgba(n * 4);
+      for (size_t i = 0; i < n; ++i) {
+        const uint8_t* p = t.unorm8.data() + i * c;
+        rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = p[0];
+        rgba[4 * i + 3] = t.hasAlpha() ? p[c - 1] : 255;
+      }
+      glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0,
+                   GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
     }
-    glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0,
-                 GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
   } else {
     // Half floats: linear colour with 11 bits of precision, filterable and
     // mipmappable on every GL 3.3 context.
@@ -75,14 +101,15 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t) {
     }
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT,
                  rgba.data());
+    texelBytes = 8;
   }
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   // The glTF sampler (its codes are OpenGL's); an undefined minFilter is
   // trilinear, as glTF viewers draw it.
   const TextureSampler& sampler = t.sampler;
   const GLint minFilter = sampler.minFilter ? sampler.minFilter : GL_LINEAR_MIPMAP_LINEAR;
   const bool mipmapped = minFilter != GL_NEAREST && minFilter != GL_LINEAR;
   if (mipmapped) glGenerateMipmap(GL_TEXTURE_2D);
-  const size_t texelBytes = t.format == TexelFormat::Unorm8 ? 4 : 8;
   const size_t levelBytes = t.texelCount() * texelBytes;
   textureBytes += mipmapped ? levelBytes + levelBytes / 3 : levelBytes;
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, minFilter);
@@ -129,6 +156,24 @@ bool usable(const Scene& scene, int texture, int texCoord) {
          uvSet(scene, texCoord).size() == 2 * scene.positions.size();
 }
 
+/// The channels of each Scene::textures entry the scene shader reads, over
+/// every material that uses it (render_scene.frag, render_alpha.h).
+std::vector<unsigned> channelsReadOf(const Scene& scene) {
+  std::vector<unsigned> read(scene.textures.size(), 0);
+  auto add = [&](int texture, int texCoord, unsigned channels) {
+    if (usable(scene, texture, texCoord)) read[size_t(texture)] |= channels;
+  };
+  const unsigned rgb = kReadR | kReadG | kReadB;
+  for (const Material& m : scene.materials) {
+    add(m.baseColorTexture, m.baseColorTexCoord, rgb | kReadA);
+    add(m.emissiveTexture, m.emissiveTexCoord, rgb);
+    add(m.normalTexture, m.normalTexCoord, rgb);
+    add(m.metallicRoughnessTexture, m.metallicRoughnessTexCoord, kReadG | kReadB);
+    add(m.occlusionTexture, m.occlusionTexCoord, kReadR);
+  }
+  return read;
+}
+
 /// Corner k of triangle t as drawn with `range` (which textures it reads).
 Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& mat,
                   const DrawRange& range, size_t t, int k, const Vec3& faceNormal) {
@@ -170,8 +215,10 @@ Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& 
 }  // namespace
 
 int SceneGeometry::useTexture(const Scene& scene, int index) {
-  if (!textures[size_t(index)])
-    textures[size_t(index)] = uploadTexture(scene.textures[size_t(index)]);
+  if (!textures[size_t(index)]) {
+    textures[size_t(index)] = uploadTexture(scene.textures[size_t(index)], channelsRead[size_t(index)]);
+    if (textureUploaded_) textureUploaded_(index);
+  }
   return index;
 }
 
@@ -207,7 +254,8 @@ DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat) {
   return range;
 }
 
-void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
+void SceneGeometry::upload(const Scene& scene, const RenderSpace& space,
+                           const std::function<void(int)>& textureUploaded) {
   // Anisotropic filtering: core in GL 4.6, an extension before.
   if (GLAD_GL_ARB_texture_filter_anisotropic || GLAD_GL_EXT_texture_filter_anisotropic) {
     glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &maxAnisotropy);
@@ -215,6 +263,8 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
   }
   textures.clear();
   textures.resize(scene.textures.size());
+  channelsRead = channelsReadOf(scene);
+  textureUploaded_ = textureUploaded;
   std::vector<Vertex> vertices;
   vertices.reserve(scene.triangleCount() * 3);
   for (const std::vector<size_t>& group : trianglesByMaterial(scene)) {
@@ -250,6 +300,7 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space) {
                             vertices.begin() + range.first + range.count);
     }
   }
+  textureUploaded_ = {};
   uploadVertices(vertices);
 }
 

@@ -435,12 +435,15 @@ Vec3 Scene::emission(size_t t, float b1, float b2) const {
 }
 
 void Scene::releaseTexels() {
-  for (Texture& t : textures) {
-    Texture empty;
-    empty.name = std::move(t.name);
-    empty.sampler = t.sampler;
-    t = std::move(empty);
-  }
+  for (size_t i = 0; i < textures.size(); ++i) releaseTexels(i);
+}
+
+void Scene::releaseTexels(size_t index) {
+  Texture& t = textures.at(index);
+  Texture empty;
+  empty.name = std::move(t.name);
+  empty.sampler = t.sampler;
+  t = std::move(empty);
 }
 
 Vec3 Scene::triangleEmission(size_t t) const {

@@ -315,6 +315,8 @@ struct Scene {
   /// lookup reads white), its name and sampler kept. For a caller that has
   /// handed the texels to the GPU and reads them no more (`render`).
   void releaseTexels();
+  /// The same for textures[index] alone.
+  void releaseTexels(size_t index);
 
   size_t triangleCount() const { return indices.size() / 3; }
   Bounds3 bounds() const;

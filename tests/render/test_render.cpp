@@ -842,6 +842,80 @@ TEST(RenderImage, MetallicRoughnessAndOcclusionMaps) {
   EXPECT_NEAR(render(false, 0.25f, RenderMode::Direct).pixel(x, y)[0], direct, 1e-6f + 1e-4f * direct);
 }
 
+// 8-bit data maps go up as the channels the shader reads of them (occlusion
+// as one, R8; metallic-roughness as two, RG8 swizzled back to .gb): each
+// renders as its float twin, which goes up whole. R of the
+// metallic-roughness map and G, B of the occlusion map are 1 where the
+// shader must not read them, so a channel read wrongly shows. The caller
+// may free each texture's texels once its copy is made: the image stays.
+TEST(RenderImage, EightBitDataMapsRenderAsTheirFloatTwins) {
+  REQUIRE_OSMESA();
+  auto unorm8 = [](uint8_t r, uint8_t g, uint8_t b) {
+    Texture t;
+    t.width = t.height = 1;
+    t.channels = 3;
+    t.format = TexelFormat::Unorm8;
+    t.unorm8 = {r, g, b};
+    return t;
+  };
+  enum class Maps { None, Float, EightBit, EightBitReleased };
+  auto render = [&](Maps maps) {
+    QuadSetup s;
+    Material& m = s.scene.materials[0];
+    m.metallic = 1.0f;
+    s.scene.texcoords0 = {0, 0, 1, 0, 1, 1, 0, 1};
+    if (maps != Maps::None) {
+      const bool eightBit = maps != Maps::Float;
+      s.scene.textures.push_back(eightBit ? unorm8(255, 153, 51)
+                                          : Texture::fromLinear(1, 1, {Vec3{1.0f, 0.6f, 0.2f}}));
+      m.metallicRoughnessTexture = 0;  // roughness 0.6, metallic 0.2
+      s.scene.textures.push_back(eightBit ? unorm8(64, 255, 255)
+                                          : Texture::fromLinear(1, 1, {Vec3{64 / 255.0f, 1, 1}}));
+      m.occlusionTexture = 1;
+    }
+    Light light;
+    light.position = {0.3f, 0.1f, 1.0f};
+    light.intensity = 2.0f;
+    s.scene.lights.push_back(light);
+    GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl* out) {
+      out[0] = {{1, 1, 1}, {0, 0, 1}};
+      return 1;
+    });
+    RenderParams p = QuadSetup::params(false);
+    p.specular = true;
+    p.mode = RenderMode::Full;
+    std::vector<int> uploaded;
+    Renderer renderer(s.scene, octree, {}, [&](int texture) {
+      uploaded.push_back(texture);
+      if (maps == Maps::EightBitReleased) s.scene.releaseTexels(size_t(texture));
+    });
+    std::sort(uploaded.begin(), uploaded.end());
+    EXPECT_EQ(uploaded.size(), s.scene.textures.size()) << "each texture reported once";
+    for (size_t i = 0; i < uploaded.size(); ++i) EXPECT_EQ(uploaded[i], int(i));
+    return renderer.render(s.camera, p);
+  };
+  const RgbImage unmapped = render(Maps::None);
+  const RgbImage twin = render(Maps::Float);
+  const RgbImage eightBit = render(Maps::EightBit);
+  const RgbImage released = render(Maps::EightBitReleased);
+  double mapEffect = 0;
+  int offTwin = 0, offReleased = 0;
+  for (int y = 0; y < twin.height; ++y) {
+    for (int x = 0; x < twin.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const float t = twin.pixel(x, y)[c], e = eightBit.pixel(x, y)[c];
+        offTwin += std::fabs(e - t) > 1e-4f + 3e-3f * t;
+        offReleased += released.pixel(x, y)[c] != e;
+        mapEffect = std::max(mapEffect, double(std::fabs(t - unmapped.pixel(x, y)[c]) /
+                                               std::max(unmapped.pixel(x, y)[c], 1e-3f)));
+      }
+    }
+  }
+  EXPECT_EQ(offTwin, 0) << "pixel channels of the 8-bit maps' image off their float twins' by > 0.3%";
+  EXPECT_EQ(offReleased, 0) << "pixel channels that changed when the texels were freed";
+  EXPECT_GT(mapEffect, 0.2) << "the maps change the image (the comparison is not of equals)";
+}
+
 // Glass (KHR_materials_transmission): a clear pane between the camera and a
 // lit quad shows the quad through it, dimmed only by the Fresnel reflectance
 // at normal incidence (4%), where it used to be drawn as an opaque white
