@@ -71,7 +71,7 @@ GridParams BakeParams::gridParams() const {
 
 int targetKnn(double targetError) {
   if (!(targetError > 0)) return 0;
-  return int(std::min(1e5, std::ceil(2.0 / (targetError * targetError))));
+  return int(std::min(1e5, std::ceil(3.0 / (targetError * targetError))));
 }
 
 int BakeParams::effectiveKnn() const {

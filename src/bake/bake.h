@@ -214,8 +214,13 @@ VdlGrid gatherLevel(const Scene& scene, SurfaceGrid& grid, const std::vector<Pho
                     const LevelParams& params, ProgressSink* progress = nullptr,
                     LevelStats* stats = nullptr, std::vector<StageReport>* stages = nullptr);
 
-/// The k a target bake gathers with: 2 / E^2 photons, so that a disc
-/// holding k equal photons is at noise E / sqrt(2) before smoothing.
+/// The k a target bake gathers with: 3 / E^2 photons. A disc holding k
+/// photons whose powers vary with a coefficient of variation c is at noise
+/// sqrt((1 + c^2) / k) before smoothing, what more photons no longer lower
+/// once k of them fit within the radius: this k reaches E with c up to
+/// sqrt(2) (an emissive texture's paths weighted by their texel; measured on
+/// the DamagedHelmet lit by its emissive map, where 2 / E^2 held the noise
+/// figure near E and took five passes to pass it).
 int targetKnn(double targetError);
 
 /// One pass of a target bake.
