@@ -19,8 +19,11 @@
 #include "camera_options.h"
 #include "cli_checks.h"
 #include "commands.h"
+#include "json_report.h"
 #include "core/error.h"
 #include "core/file.h"
+#include "core/file_set.h"
+#include "core/resources.h"
 #include "octree/gpu_octree.h"
 #include "render/camera_path.h"
 #include "render/context.h"
@@ -50,6 +53,7 @@ struct ViewOptions {
   ViewerParams view;  // the flags bound to it: --save-frames, --frames, --record, ...
   bool progressive = false;
   ProgressiveParams bake;  // --photons, --depth (target), --knn, --seed
+  std::string json;        // --json: the start-up stages and the frames, as `render --json`
 };
 
 int runView(const ViewOptions& opt) {
@@ -65,6 +69,14 @@ int runView(const ViewOptions& opt) {
     throw InputError("LIGHTS.vdb is required (a bake of the scene), or use --progressive");
   }
   checkCameraOptions(opt.camera);
+  if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
+  NamedPaths inputs = sceneInputs(opt.scene);
+  if (!opt.lights.empty()) inputs.push_back({"LIGHTS", opt.lights});
+  checkDistinctFiles({{"--json", opt.json}}, inputs);
+  JsonReport report{"view", inputs,
+                    {{"mode", opt.mode}, {"width", opt.width}, {"height", opt.height},
+                     {"progressive", opt.progressive}}};
+  std::vector<StageReport> rows;
   std::optional<CameraPath> path;
   if (!opt.cameraPath.empty()) path = readCameraPath(opt.cameraPath);
   if (!opt.view.saveFrames.empty()) makeOutputFolder(opt.view.saveFrames, "--save-frames");
@@ -73,12 +85,17 @@ int runView(const ViewOptions& opt) {
   view.exposure = opt.shading.exposure;
   view.path = std::move(path);
 
+  StageTimer loadTimer(rows, "load scene");
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   placeObjects(scene, opt.objects);
   printSceneWarnings(scene);
+  loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
+                   std::to_string(scene.textures.size()) + " textures");
   std::optional<LoadedVdl> baked;
   if (!opt.progressive) {
+    StageTimer readTimer(rows, "read grid");
     baked = readVdlGrid(opt.lights, scene.origin);
+    readTimer.finish(formatCount(baked->grid.size()) + " voxels");
     const std::string stale = staleBakeWarning(baked->meta, opt.scene);
     if (!stale.empty()) std::fprintf(stderr, "warning: %s: %s\n", opt.lights.c_str(), stale.c_str());
   }
@@ -103,8 +120,11 @@ int runView(const ViewOptions& opt) {
   contextParams.width = opt.width;
   contextParams.height = opt.height;
   contextParams.title = "Light Octree: " + std::filesystem::path(opt.scene).filename().string();
+  StageTimer contextTimer(rows, "GL context");
   std::unique_ptr<GlContext> context = createGlContext(contextParams);
+  contextTimer.finish("glfw");
   if (!opt.view.quiet) std::printf("glfw: %s\n", context->info().ToString().c_str());
+  report.figures["gl"] = context->info().ToString();
 
   const GpuOctreeParams octreeParams = opt.shading.octreeParams(&context->info());
 
@@ -114,6 +134,7 @@ int runView(const ViewOptions& opt) {
   std::unique_ptr<ProgressiveBake> bake;
   std::unique_ptr<OctreeLevelSource> levels;
   GpuOctree octree;
+  StageTimer octreeTimer(rows, opt.progressive ? "start progressive bake" : "octree");
   if (opt.progressive) {
     ProgressiveParams pp = opt.bake;
     pp.firstDepth = std::min(4, pp.targetDepth);
@@ -132,7 +153,9 @@ int runView(const ViewOptions& opt) {
     if (opt.objects.empty()) baked.reset();  // only the added objects' light reads it again
     view.shownDepth = octree.depth;
     if (!opt.view.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
+    report.figures["octree"] = octree.ToString();
   }
+  octreeTimer.finish("");
 
   // Without a bake tracing the scene beside it, nothing reads a texel after
   // the renderer's construction: each texture's are freed once on the GPU.
@@ -144,16 +167,34 @@ int runView(const ViewOptions& opt) {
     };
   }
   Renderer renderer(scene, octree, opt.shading.rendererParams(), releaseTexels);
+  rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
   if (!opt.objects.empty() && baked) {
+    StageTimer volumeTimer(rows, "free-space light");
     setAddedObjectsLight(renderer, baked->grid, opt.shading, octreeParams, opt.lights);
+    volumeTimer.finish(renderer.hasFreeSpaceLight() ? "for the added objects" : "none in the bake");
   }
+  StageTimer lightingTimer(rows, "prepare lighting");
   opt.shading.prepareLighting(renderer, scene, octree, opt.view.quiet);
+  lightingTimer.finish(renderer.hasAtlas() ? "lightmap atlas" : "");
   octree = GpuOctree();  // uploaded; the CPU copy is not needed any more
   if (!opt.view.quiet && !view.path) std::printf("%s", viewerKeyHelp());
 
   Viewer viewer(*context, renderer, view, levels.get());
+  StageTimer framesTimer(rows, "frames");
   const ViewerStats stats = viewer.run();
+  framesTimer.finish(stats.ToString(opt.view.saveFrames));
   if (!opt.view.quiet) std::printf("%s\n", stats.ToString(opt.view.saveFrames).c_str());
+  if (!opt.json.empty()) {
+    report.figures["frames"] = {{"drawn", stats.framesDrawn},
+                                {"saved", stats.framesSaved},
+                                {"seconds", stats.seconds},
+                                {"ms_per_frame", stats.framesDrawn > 0
+                                                     ? 1000.0 * stats.seconds / stats.framesDrawn
+                                                     : 0.0}};
+    AtomicFileSet outputs;
+    report.addTo(outputs, opt.json, rows);
+    outputs.commit();
+  }
   return 0;
 }
 
@@ -224,6 +265,11 @@ std::function<int()> addViewCommand(CLI::App& app) {
   cmd->add_flag_callback("--no-hud", [opt] { opt->view.hud = false; },
                 "No heads-up display in the window (frame time, mode, octree level, the "
                 "progressive bake's progress; H shows the keys there)");
+  cmd->add_option("--json", opt->json,
+                  "Also write a JSON report when the window closes: the files read, time and "
+                  "memory per start-up stage (load, grid, GL context, octree, shaders, lights, "
+                  "geometry and textures, shadow maps) and the frames drawn (README.md, "
+                  "\"Scripting\")");
   cmd->add_flag("-q,--quiet", opt->view.quiet, "Only errors");
   return [cmd, opt]() -> int { return cmd->parsed() ? runView(*opt) : -1; };
 }

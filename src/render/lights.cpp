@@ -19,11 +19,12 @@ namespace {
 
 constexpr int kMaxLights = shader::LO_MAX_LIGHTS;
 constexpr int kMaxShadowLayers = shader::LO_MAX_SHADOW_LAYERS;
-/// The most bytes the shadow maps take (2 per texel: 16-bit depth). The
-/// maps hold linear depth over the far plane (render_shadow.frag), which 16
-/// bits resolve to 1/65536, under the lookup's bias of 1/size (one over the
-/// map's texels per side) at every size up to 16384.
-constexpr double kShadowMapBudget = 96.0 * 1024 * 1024;
+/// The most bytes the shadow maps take: 48 MiB, 24M texels of 16-bit
+/// depth (2 B). The maps hold linear depth over the far plane
+/// (render_shadow.frag), which 16 bits resolve to 1/65536, under the
+/// lookup's bias of 1/size (one over the map's texels per side) at every
+/// size up to 16384.
+constexpr double kShadowMapBudget = 48.0 * 1024 * 1024;
 constexpr int kCascades = shader::LO_SUN_CASCADES;
 
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
