@@ -203,10 +203,9 @@ py::array_t<float> renderImage(const std::string& scenePath, const Grid& g, int 
     octreeParams.max2DTextureSize = context->info().max2DTextureSize;
     const GpuOctree octree = buildGpuOctree(g.grid, octreeParams);
     Renderer renderer(scene, octree, RendererParams{});
-    // The scene's first camera, else one framing its bounds (as `render`).
-    const PinholeCamera camera = scene.cameras.empty()
-                                     ? PinholeCamera::framing(scene.bounds(), 45.0f * kPi / 180.0f)
-                                     : PinholeCamera::fromScene(scene.cameras.front());
+    // The scene's first camera, else one framing its bounds from the side its
+    // surfaces face (as `render`).
+    const PinholeCamera camera = PinholeCamera::ofScene(scene);
     image = renderer.render(camera, params);
   }
   py::array_t<float> out({size_t(height), size_t(width), size_t(3)});

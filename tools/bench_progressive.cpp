@@ -82,8 +82,7 @@ struct SceneResult {
 };
 
 lo::PinholeCamera sceneCamera(const lo::Scene& scene) {
-  if (!scene.cameras.empty()) return lo::PinholeCamera::fromScene(scene.cameras.front());
-  return lo::PinholeCamera::framing(scene.bounds(), 45.0f * lo::kPi / 180.0f);
+  return lo::PinholeCamera::ofScene(scene);
 }
 
 SceneResult runScene(const SceneSpec& spec, const std::string& path, lo::GlContext& context,

@@ -217,9 +217,7 @@ int main(int argc, char** argv) try {
              << fixed(mib100k(pool + vdl), 2) << " MiB | " << fixed(mib100k(pool + vdlHalf), 2)
              << " MiB |\n";
     }
-    lo::PinholeCamera camera =
-        b.scene.cameras.empty() ? lo::PinholeCamera::framing(b.scene.bounds(), 45.0f * lo::kPi / 180)
-                                : lo::PinholeCamera::fromScene(b.scene.cameras.front());
+    lo::PinholeCamera camera = lo::PinholeCamera::ofScene(b.scene);
     lo::Renderer renderer(b.scene, o);
     // The octree rendered into a lightmap atlas (CPU, the renderer's lookup
     // with interpolation), once per scene.

@@ -70,7 +70,7 @@ PinholeCamera chooseCamera(const CameraOptions& opt, const Scene& scene,
     return PinholeCamera::lookAt(eye, target, fov);
   }
   const Camera* chosen = findSceneCamera(opt, scene, scenePath);
-  if (!chosen) return PinholeCamera::framing(scene.bounds(), fov);
+  if (!chosen) return PinholeCamera::framing(scene, fov);
   PinholeCamera camera = PinholeCamera::fromScene(*chosen);
   if (opt.fovDegrees > 0) camera.yfov = fov;
   return camera;

@@ -32,11 +32,36 @@ PinholeCamera PinholeCamera::lookAt(const Vec3& eye, const Vec3& target, float y
   return c;
 }
 
-PinholeCamera PinholeCamera::framing(const Bounds3& bounds, float yfovRadians) {
+PinholeCamera PinholeCamera::framing(const Bounds3& bounds, float yfovRadians, const Vec3& side) {
   Vec3 center = bounds.center();
   float radius = 0.5f * length(bounds.extent());
   float distance = radius / std::sin(0.5f * yfovRadians);
-  return lookAt(center + Vec3(0, 0, std::max(distance, 1e-3f)), center, yfovRadians);
+  return lookAt(center + side * std::max(distance, 1e-3f), center, yfovRadians);
+}
+
+PinholeCamera PinholeCamera::framing(const Scene& scene, float yfovRadians) {
+  return framing(scene.bounds(), yfovRadians, viewSide(scene));
+}
+
+PinholeCamera PinholeCamera::ofScene(const Scene& scene, float yfovRadians) {
+  return scene.cameras.empty() ? framing(scene, yfovRadians) : fromScene(scene.cameras.front());
+}
+
+Vec3 viewSide(const Scene& scene) {
+  double sum[3] = {0, 0, 0}, area = 0;
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const Vec3& a = scene.positions[scene.indices[3 * t]];
+    const Vec3 n = cross(scene.positions[scene.indices[3 * t + 1]] - a,
+                         scene.positions[scene.indices[3 * t + 2]] - a);  // 2 x area
+    if (!isFinite(n)) continue;
+    sum[0] += double(n.x);
+    sum[1] += double(n.y);
+    sum[2] += double(n.z);
+    area += double(length(n));
+  }
+  const double norm = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+  if (!(area > 0) || norm < 0.2 * area) return Vec3(0, 0, 1);
+  return Vec3(float(sum[0] / norm), float(sum[1] / norm), float(sum[2] / norm));
 }
 
 }  // namespace lo

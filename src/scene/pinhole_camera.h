@@ -25,8 +25,23 @@ struct PinholeCamera {
   /// Looks at `target` from `eye`; world up is +Y unless the view is along it
   /// (then -Z). @throws InputError when eye and target are the same point.
   static PinholeCamera lookAt(const Vec3& eye, const Vec3& target, float yfovRadians);
-  /// Frames the bounds' bounding sphere from the +Z side.
-  static PinholeCamera framing(const Bounds3& bounds, float yfovRadians);
+  /// Frames the bounds' bounding sphere from the side `side` (unit; +Z by
+  /// default), looking at its centre.
+  static PinholeCamera framing(const Bounds3& bounds, float yfovRadians,
+                               const Vec3& side = Vec3(0, 0, 1));
+  /// The camera for a scene without one of its own: its bounds framed from
+  /// viewSide(scene).
+  static PinholeCamera framing(const Scene& scene, float yfovRadians);
+  /// The scene's first camera, else framing(scene, yfovRadians).
+  static PinholeCamera ofScene(const Scene& scene, float yfovRadians = 45.0f * kPi / 180.0f);
 };
+
+/// The side a scene shows its front faces to: the direction of the sum of
+/// its triangles' area-weighted normals, where that sum is at least a fifth
+/// of their area (an open room's walls and floor facing in, a terrain facing
+/// up); else +Z, for closed objects and rooms, whose normals cancel. A room
+/// corner framed from +Z would show the backs of its walls: black in every
+/// renderer, their light on the other side.
+Vec3 viewSide(const Scene& scene);
 
 }  // namespace lo

@@ -180,9 +180,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
 
   ThreadLimit threadLimit(params.threads);
   const Scene scene = loadScene(params.scene);
-  const PinholeCamera camera = scene.cameras.empty()
-                                     ? PinholeCamera::framing(scene.bounds(), kPi / 4)
-                                     : PinholeCamera::fromScene(scene.cameras.front());
+  const PinholeCamera camera = PinholeCamera::ofScene(scene, kPi / 4);
   const References refs = loadOrRenderReferences(params, scene, camera, cache, log);
   const CompareParams compareParams = sweepCompareParams(refs.emitterMask);
   const RgbImage binnedMask = binMask(refs.emitterMask, kSweepBin);

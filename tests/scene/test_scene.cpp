@@ -17,6 +17,7 @@
 #include "core/rng.h"
 #include "scene/sky_sampler.h"
 #include "core/error.h"
+#include "scene/pinhole_camera.h"
 #include "scene/scene.h"
 
 namespace lo {
@@ -1528,6 +1529,40 @@ TEST(Scene, ReleasedTexelsLeaveEmptyTexturesWithTheirSamplers) {
   EXPECT_EQ(scene.textures[0].name, "map");
   EXPECT_EQ(scene.textures[0].sampler.wrapS, 33071);
   EXPECT_EQ(scene.albedo(0, 0.5f, 0.0f), Vec3(1.0f)) << "an empty texture reads white";
+}
+
+// A scene without a camera is framed from the side its surfaces face: a room
+// corner (a floor and two walls facing in) from its open octant, so that the
+// camera sees their fronts (framed from +Z it saw the backs of a wall, black
+// in every renderer); a closed room, whose normals cancel, from +Z as before;
+// a scene's own camera first.
+TEST(SceneCamera, FramingLooksAtTheFrontFaces) {
+  Scene corner;
+  corner.materials.push_back(Material{});
+  const Vec3 normals[3] = {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}};
+  test::addQuad(corner, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, normals[0], 0);  // floor
+  test::addQuad(corner, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, normals[1], 0);  // wall x = 0
+  test::addQuad(corner, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, normals[2], 0);  // wall z = 0
+  const Vec3 side = viewSide(corner);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(side[a], 1.0f / std::sqrt(3.0f), 1e-5f) << a;
+  const PinholeCamera camera = PinholeCamera::framing(corner, 0.8f);
+  for (const Vec3& n : normals) EXPECT_LT(dot(camera.forward, n), -0.5f) << "sees the fronts";
+  EXPECT_GT(length(camera.eye - corner.bounds().center()), 0.5f * length(corner.bounds().extent()));
+
+  Scene room;
+  room.materials.push_back(Material{});
+  test::addClosedBox(room, {0, 0, 0}, {1, 1, 1}, 0);
+  EXPECT_EQ(viewSide(room), Vec3(0, 0, 1));
+  EXPECT_EQ(PinholeCamera::ofScene(room, 0.8f).forward, Vec3(0, 0, -1));
+
+  Camera own;
+  own.position = {0.5f, 0.5f, 0.5f};
+  own.forward = {1, 0, 0};
+  own.up = {0, 1, 0};
+  own.yfov = 0.5f;
+  room.cameras.push_back(own);
+  EXPECT_EQ(PinholeCamera::ofScene(room, 0.8f).forward, Vec3(1, 0, 0));
+  EXPECT_EQ(PinholeCamera::ofScene(room, 0.8f).yfov, 0.5f);
 }
 
 }  // namespace
