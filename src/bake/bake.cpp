@@ -462,13 +462,13 @@ namespace bake_internal {
 
 /// The photons a target bake may store: maxPhotons, or fewer when the
 /// memory left beside the voxels (kBakeBytesPerVoxel) does not hold them at
-/// kBakeBytesPerPhoton plus the unscaled copy the passes keep.
+/// kBakeBytesPerPhoton plus the raw power the passes keep apart.
 size_t targetPhotonCap(const BakeParams& params, size_t activeVoxels) {
   size_t cap = params.maxPhotons;
   const size_t available = availableMemoryBytes();
   if (available > 0) {
     const double left = double(available) - double(activeVoxels) * double(kBakeBytesPerVoxel);
-    const double fits = left / double(kBakeBytesPerPhoton + sizeof(Photon));
+    const double fits = left / double(kBakeBytesPerPhoton + sizeof(Vec3));
     cap = size_t(std::clamp(fits, 0.0, double(cap)));
   }
   return std::max<size_t>(cap, 1);
@@ -504,15 +504,19 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   const size_t maxEmitted = maxEmittedPaths(photonParams);
   const double target = params.targetError;
 
-  std::vector<Photon> raw;  // photons of paths 0 .. emitted-1, powers not yet scaled
+  // Photons of paths 0 .. emitted-1, powers not yet scaled (during a
+  // gather, and after the last, scaled: see below).
+  std::vector<Photon> raw;
   SegmentCollector rawSegments(photonParams.maxSegments);  // their rays (BakeParams::freeSpace)
   size_t emitted = 0, empty = 0, missed = 0;
   size_t goal = std::min(cap, std::max(kMinPilotPhotons, kPilotPhotonsPerVoxel * grid.size()));
-  std::vector<Photon> scaled;
   for (int pass = 1;; ++pass) {
     const double passStart = elapsed();
     StageTimer trace(s.stages, "trace photons");
     {
+      // The pass's photons, where growing by doubling would hold up to
+      // twice them; a path stores at most maxBounces + 1 past the goal.
+      raw.reserve(goal + size_t(photonParams.maxBounces) + 1);
       Progress bar(progress, "Tracing photons, pass " + std::to_string(pass), goal);
       bar.advance(std::min(raw.size(), goal));
       const PhotonTracer::PathSink take = [&](const Photon* photons, uint32_t n, uint32_t,
@@ -545,9 +549,13 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
                                    formatCount(emitted) + " paths (pass " +
                                    std::to_string(pass) + ")");
 
-    scaled = raw;
-    scalePhotonPower(scaled, emitted);
-    r.grid = gatherLevel(scene, grid, scaled, level, progress, &s.level, &s.stages);
+    // The gather reads powers scaled by the paths traced: the photons are
+    // scaled in place, their raw powers kept apart (12 B a photon, where a
+    // scaled copy took 52) and put back if another pass follows.
+    std::vector<Vec3> rawPower(raw.size());
+    for (size_t i = 0; i < raw.size(); ++i) rawPower[i] = raw[i].power;
+    scalePhotonPower(raw, emitted);
+    r.grid = gatherLevel(scene, grid, raw, level, progress, &s.level, &s.stages);
     s.noise = summarizeNoise(r.grid);
     s.passes.push_back({raw.size(), emitted, s.noise, elapsed() - passStart});
     if (s.noise.quantile <= target) {
@@ -563,13 +571,15 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
     }
     if (!s.targetStop.empty()) break;
     goal = nextPassPhotons(raw.size(), s.noise.quantile, target, cap);
+    for (size_t i = 0; i < raw.size(); ++i) raw[i].power = rawPower[i];
   }
   r.metadata = bakeMetadata(scene, params, int64_t(raw.size()), int64_t(emitted), s.level.radius);
+  if (!params.keepPhotons) raw = std::vector<Photon>();
   if (params.freeSpace) {
     r.grid.volume = bakeFreeSpaceLight(rawSegments.take(), r.grid.frame, params, progress, s.stages);
   }
   if (params.keepPhotons) {
-    r.photons.photons = std::move(scaled);
+    r.photons.photons = std::move(raw);  // scaled
     r.photons.emittedPaths = emitted;
     r.photons.emptyPaths = empty;
     r.photons.missedPaths = missed;
