@@ -793,6 +793,24 @@ TEST(RenderImage, FileTangentsOrientTheNormalMap) {
   EXPECT_NEAR(n.z, std::cos(theta), 1e-3f);
 }
 
+/// The light of the material map tests: a point light of intensity 2 at
+/// (0.3, 0.1, 1) above QuadSetup's quad.
+void addMapTestLights(QuadSetup& s) {
+  Light light;
+  light.type = Light::Type::Point;
+  light.position = {0.3f, 0.1f, 1.0f};
+  light.intensity = 2.0f;
+  s.scene.lights.push_back(light);
+}
+
+/// Their indirect light: one white VDL along +Z in every voxel.
+GpuOctree whiteVdlsAlongZ() {
+  return makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl* out) {
+    out[0] = {{1, 1, 1}, {0, 0, 1}};
+    return 1;
+  });
+}
+
 // metallicRoughnessTexture: B scales metallic, G roughness. A metal material
 // (factor 1) whose map says metallic 0 renders as the dielectric of the same
 // roughness; and occlusionTexture darkens the octree's light only: R = 0.25
@@ -815,19 +833,11 @@ TEST(RenderImage, MetallicRoughnessAndOcclusionMaps) {
       s.scene.textures.push_back(ao);
       m.occlusionTexture = int(s.scene.textures.size()) - 1;
     }
-    Light light;
-    light.type = Light::Type::Point;
-    light.position = {0.3f, 0.1f, 1.0f};
-    light.intensity = 2.0f;
-    s.scene.lights.push_back(light);
-    GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl* out) {
-      out[0] = {{1, 1, 1}, {0, 0, 1}};
-      return 1;
-    });
+    addMapTestLights(s);
     RenderParams p = QuadSetup::params(false);
     p.specular = true;
     p.mode = mode;
-    return Renderer(s.scene, octree).render(s.camera, p);
+    return Renderer(s.scene, whiteVdlsAlongZ()).render(s.camera, p);
   };
   const RgbImage dielectric = render(false, 1.0f, RenderMode::Full);
   const RgbImage mapped = render(true, 1.0f, RenderMode::Full);
@@ -873,19 +883,12 @@ TEST(RenderImage, EightBitDataMapsRenderAsTheirFloatTwins) {
                                           : Texture::fromLinear(1, 1, {Vec3{64 / 255.0f, 1, 1}}));
       m.occlusionTexture = 1;
     }
-    Light light;
-    light.position = {0.3f, 0.1f, 1.0f};
-    light.intensity = 2.0f;
-    s.scene.lights.push_back(light);
-    GpuOctree octree = makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl* out) {
-      out[0] = {{1, 1, 1}, {0, 0, 1}};
-      return 1;
-    });
+    addMapTestLights(s);
     RenderParams p = QuadSetup::params(false);
     p.specular = true;
     p.mode = RenderMode::Full;
     std::vector<int> uploaded;
-    Renderer renderer(s.scene, octree, {}, [&](int texture) {
+    Renderer renderer(s.scene, whiteVdlsAlongZ(), {}, [&](int texture) {
       uploaded.push_back(texture);
       if (maps == Maps::EightBitReleased) s.scene.releaseTexels(size_t(texture));
     });
