@@ -72,8 +72,45 @@ static void checkIntegerRanges(const std::string& path, const nlohmann::json& j,
   }
 }
 
+bool readsGltfExtension(const std::string& name) {
+  static const char* const kRead[] = {
+      "KHR_lights_punctual",          "KHR_materials_emissive_strength", "KHR_materials_ior",
+      "KHR_materials_specular",       "KHR_materials_transmission",      "KHR_materials_unlit",
+      "KHR_materials_volume",         "KHR_mesh_quantization",           "KHR_texture_transform"};
+  for (const char* read : kRead) {
+    if (name == read) return true;
+  }
+  return false;
+}
+
+/// What a user can do about a required extension the loader does not read.
+static std::string unreadExtensionAdvice(const std::string& name) {
+  if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression") {
+    return "its meshes are compressed: write them uncompressed with a glTF tool first";
+  }
+  if (name == "KHR_texture_basisu" || name == "EXT_texture_webp" || name == "EXT_texture_avif") {
+    return "its textures are KTX2, WebP or AVIF images, which the loader does not decode: "
+           "convert them to PNG or JPEG with a glTF tool first";
+  }
+  return "the scene cannot be read as its author meant without it";
+}
+
 void prevalidateJson(const std::string& path, const std::string& baseDir, const nlohmann::json& j) {
   if (!j.is_object()) fail(path, "invalid glTF: the top level is not a JSON object");
+  auto required = j.find("extensionsRequired");
+  if (required != j.end() && required->is_array()) {
+    for (const nlohmann::json& e : *required) {
+      if (!e.is_string() || readsGltfExtension(e.get<std::string>())) continue;
+      // The name as a message may show it: printable ASCII, at most 80.
+      std::string name;
+      for (char c : e.get<std::string>()) {
+        if (name.size() == 80) break;
+        name += c >= 0x20 && c < 0x7f ? c : '?';
+      }
+      fail(path, "requires the glTF extension " + name + ", which lightoctree does not read; " +
+                     unreadExtensionAdvice(name));
+    }
+  }
   checkIntegerRanges(path, j, "", 0);
   std::vector<uint64_t> bufferLengths;
   auto buffers = j.find("buffers");

@@ -13,9 +13,17 @@ namespace lo::scene_internal {
 /// once per level), counted outside strings.
 void checkJsonNesting(const std::string& path, const std::string& text);
 
-/// The parsed JSON's buffers, buffer views and images: indices and sizes in
-/// range, external files inside `baseDir` and present.
+/// The parsed JSON's required extensions (each one the loader reads:
+/// refused naming it otherwise, where tinygltf would fail on what the
+/// extension left out, or load a scene without it), buffers, buffer views
+/// and images: indices and sizes in range, external files inside `baseDir`
+/// and present.
 void prevalidateJson(const std::string& path, const std::string& baseDir, const nlohmann::json& j);
+
+/// Whether the loader reads the glTF extension `name` (KHR_lights_punctual,
+/// the KHR_materials_* it maps to Material, KHR_texture_transform,
+/// KHR_mesh_quantization's integer attributes).
+bool readsGltfExtension(const std::string& name);
 
 /// Checks the GLB container (https://registry.khronos.org/glTF/specs/2.0/
 /// glTF-2.0.html#binary-gltf-layout) and returns the JSON chunk.

@@ -317,6 +317,12 @@ class SceneBuilder {
       : path_(path), model_(model), reader_(path, model), skyMeshFlag_(skyMesh) {}
 
   Scene build() {
+    for (const std::string& name : model_.extensionsUsed) {
+      if (!readsGltfExtension(name)) {
+        scene_.warnings.push_back(path_ + ": uses the glTF extension " + name +
+                                  ", which is not read: the scene is loaded without it");
+      }
+    }
     convertMaterials();
     traverse();
     readSky();

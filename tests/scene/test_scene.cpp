@@ -1077,6 +1077,38 @@ TEST(SceneGltf, MissingTextureFileIsWarnedOnceByName) {
   expectNear(s.materials[0].baseColor, {0.5f, 0.25f, 1.0f}, 1e-6f);
 }
 
+// Extensions: one the file requires and the loader does not read is
+// refused by name, with what to do (a Draco file failed on its accessors'
+// missing buffer views, naming neither); one it only uses is a warning;
+// one the loader reads may be required.
+TEST(SceneGltf, ExtensionsTheLoaderDoesNotReadAreNamed) {
+  std::string dir = test::outputDir("SceneGltf_Extensions");
+  MiniGltf draco = oneTriangle();
+  draco.extraTop = R"("extensionsUsed": ["KHR_draco_mesh_compression"],
+                      "extensionsRequired": ["KHR_draco_mesh_compression"], )";
+  expectInputError(writeGltf(dir, "draco.gltf", draco),
+                   "requires the glTF extension KHR_draco_mesh_compression");
+  expectInputError(writeGltf(dir, "draco.gltf", draco), "uncompressed");
+  MiniGltf webp = oneTriangle();
+  webp.extraTop = R"("extensionsRequired": ["EXT_texture_webp"], )";
+  expectInputError(writeGltf(dir, "webp.gltf", webp), "PNG or JPEG");
+
+  MiniGltf used = oneTriangle();
+  used.extraTop = R"("extensionsUsed": ["KHR_materials_clearcoat", "KHR_texture_transform"], )";
+  const Scene s = loadScene(writeGltf(dir, "clearcoat.gltf", used));
+  EXPECT_EQ(s.triangleCount(), 1u);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("KHR_materials_clearcoat, which is not read"), std::string::npos)
+      << s.warnings[0];
+
+  MiniGltf read = oneTriangle();
+  read.extraTop = R"("extensionsUsed": ["KHR_texture_transform", "KHR_mesh_quantization"],
+                     "extensionsRequired": ["KHR_texture_transform", "KHR_mesh_quantization"], )";
+  const Scene r = loadScene(writeGltf(dir, "read.gltf", read));
+  EXPECT_EQ(r.triangleCount(), 1u);
+  EXPECT_TRUE(r.warnings.empty());
+}
+
 TEST(SceneReject, TruncatedGlb) {
   std::string dir = test::outputDir("SceneReject_Glb");
   std::string glb = oneTriangle().glb();
