@@ -213,7 +213,7 @@ void main() {
   // glTF: base colour = factor x texture, sampled per pixel (trilinear,
   // anisotropic where the context has it).
   vec3 baseColor = vBaseColor;
-  float alpha = uBaseAlpha;
+  float alpha = vBaseAlpha;
   if (uHasBaseColorTexture) {
     vec4 texel = texture(uBaseColorTexture, vUv);
     baseColor *= texel.rgb;

@@ -4,7 +4,7 @@
 // per-triangle materials stay exact).
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
-layout(location = 2) in vec3 aBaseColor;  // linear base colour factor
+layout(location = 2) in vec4 aBaseColor;  // linear base colour factor and alpha x COLOR_0
 layout(location = 3) in vec2 aMetallicRoughness;
 layout(location = 4) in vec3 aEmission;  // W/(m^2 sr)
 layout(location = 5) in vec2 aUv;        // the UV set the base colour texture names
@@ -21,6 +21,7 @@ invariant gl_Position;  // as render_depth.vert: the depth pre-pass must match e
 out vec3 vPosition;
 out vec3 vNormal;
 out vec3 vBaseColor;
+out float vBaseAlpha;
 out vec2 vMetallicRoughness;
 out vec3 vEmission;
 out vec2 vUv;
@@ -34,7 +35,8 @@ out vec4 vTangent;
 void main() {
   vPosition = aPosition;
   vNormal = aNormal;
-  vBaseColor = aBaseColor;
+  vBaseColor = aBaseColor.rgb;
+  vBaseAlpha = aBaseColor.a;
   vMetallicRoughness = aMetallicRoughness;
   vEmission = aEmission;
   vUv = aUv;

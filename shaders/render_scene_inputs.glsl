@@ -4,6 +4,7 @@
 in vec3 vPosition;  // world
 in vec3 vNormal;    // world, interpolated
 in vec3 vBaseColor;
+in float vBaseAlpha;  // baseColorFactor's alpha x COLOR_0's
 in vec2 vMetallicRoughness;
 in vec3 vEmission;
 in vec2 vUv;
@@ -49,7 +50,6 @@ uniform sampler2D uEmissiveTexture;  // linear RGB emission map (sRGB decoded at
 uniform bool uHasEmissiveTexture;
 uniform float uEmissionScale;  // 1; 0 while the probe is captured if emitters are lights
 uniform int uAlphaMode;      // LO_ALPHA_OPAQUE, LO_ALPHA_MASK or LO_ALPHA_BLEND (glTF alphaMode)
-uniform float uBaseAlpha;    // baseColorFactor's alpha
 uniform float uAlphaCutoff;  // glTF alphaCutoff (mask)
 uniform float uTransmission;  // KHR_materials_transmission of this draw; 0 = opaque
 uniform bool uUnlit;          // KHR_materials_unlit: the base colour, unshaded (Material::unlit)

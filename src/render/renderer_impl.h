@@ -33,7 +33,9 @@ namespace render_internal {
 struct Vertex {
   float position[3];
   float normal[3];
-  float baseColor[3];  ///< the material's base colour factor (textures apply per pixel)
+  /// The material's base colour factor and its alpha times the vertex
+  /// colour (COLOR_0; textures apply per pixel).
+  float baseColor[4];
   float metallicRoughness[2];
   float emission[3];
   float uv[2];        ///< the texture coordinates the base colour texture names (TEXCOORD_0 or _1)
@@ -59,7 +61,6 @@ struct DrawRange {
   float occlusionStrength = 1;
   int emissiveTexture = -1;
   int alphaMode = shader::LO_ALPHA_OPAQUE;
-  float baseAlpha = 1;
   float alphaCutoff = 0.5f;
   bool doubleSided = true;  ///< false: back faces culled from the camera's view (glTF)
   GLint first = 0;

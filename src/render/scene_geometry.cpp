@@ -193,7 +193,15 @@ Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& 
                      : scene.normals[index];
   std::memcpy(v.position, &p, sizeof v.position);
   std::memcpy(v.normal, &n, sizeof v.normal);
-  std::memcpy(v.baseColor, &mat.baseColor, sizeof v.baseColor);
+  Vec3 color = mat.baseColor;
+  float alpha = mat.baseAlpha;
+  if (scene.colors.size() == 4 * scene.positions.size()) {
+    const float* c = &scene.colors[4 * size_t(index)];
+    color = color * Vec3(c[0], c[1], c[2]);
+    alpha *= c[3];
+  }
+  std::memcpy(v.baseColor, &color, 3 * sizeof(float));
+  v.baseColor[3] = alpha;
   v.metallicRoughness[0] = mat.metallic;
   v.metallicRoughness[1] = mat.roughness;
   std::memcpy(v.emission, &mat.emission, sizeof v.emission);
@@ -230,7 +238,6 @@ DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat) {
   range.dielectricF0 = mat.dielectricF0();
   range.specular = mat.specular;
   range.alphaMode = alphaModeOf(mat);
-  range.baseAlpha = mat.baseAlpha;
   range.alphaCutoff = mat.alphaCutoff;
   range.doubleSided = mat.doubleSided;
   range.unlit = mat.unlit;
@@ -318,7 +325,7 @@ void SceneGeometry::uploadVertices(const std::vector<Vertex>& vertices) {
   };
   attrib(0, 3, offsetof(Vertex, position));
   attrib(1, 3, offsetof(Vertex, normal));
-  attrib(2, 3, offsetof(Vertex, baseColor));
+  attrib(2, 4, offsetof(Vertex, baseColor));
   attrib(3, 2, offsetof(Vertex, metallicRoughness));
   attrib(4, 3, offsetof(Vertex, emission));
   attrib(5, 2, offsetof(Vertex, uv));
@@ -348,7 +355,6 @@ void SceneGeometry::drawDepthOnly(GLuint program, bool shadows) const {
   glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
   glUniform1i(glGetUniformLocation(program, "uBaseColorTexture"), 4);
   const GLint hasTexture = glGetUniformLocation(program, "uHasBaseColorTexture");
-  const GLint baseAlpha = glGetUniformLocation(program, "uBaseAlpha");
   const GLint cutoff = glGetUniformLocation(program, "uAlphaCutoff");
   for (size_t i = 0; i < ranges.size(); ++i) {
     const DrawRange& range = ranges[i];
@@ -356,7 +362,6 @@ void SceneGeometry::drawDepthOnly(GLuint program, bool shadows) const {
     if (shadows && range.unlit) continue;  // light passes unlit surfaces
     glUniform1i(alphaTest, 1);
     glUniform1i(hasTexture, range.texture >= 0 ? 1 : 0);
-    glUniform1f(baseAlpha, range.baseAlpha);
     // An unlit opaque range keeps every fragment (cutoff 0).
     const bool masked = range.alphaMode == shader::LO_ALPHA_MASK;
     glUniform1f(cutoff, rangeCategory[i] == kMasked ? (masked ? range.alphaCutoff : 0.0f) : 0.5f);

@@ -185,7 +185,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
   glBindVertexArray(geometry.vao.get());
   GLuint p = 0;
   GLint hasTexture = -1, hasNormal = -1, normalScale = -1, hasMr = -1, hasOcclusion = -1,
-        occlusionStrength = -1, transmission = -1, hasEmissive = -1, alphaMode = -1, baseAlpha = -1,
+        occlusionStrength = -1, transmission = -1, hasEmissive = -1, alphaMode = -1,
         alphaCutoff = -1, thickness = -1, ior = -1, dielectric = -1, unlit = -1;
   // The program of a range, in use with its octree's textures bound.
   auto use = [&](GLuint program) {
@@ -207,7 +207,6 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
     transmission = loc("uTransmission");
     hasEmissive = loc("uHasEmissiveTexture");
     alphaMode = loc("uAlphaMode");
-    baseAlpha = loc("uBaseAlpha");
     alphaCutoff = loc("uAlphaCutoff");
     thickness = loc("uThickness");
     ior = loc("uIor");
@@ -268,7 +267,6 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(hasEmissive, range.emissiveTexture >= 0 ? 1 : 0);
     glUniform1i(alphaMode, range.alphaMode);
-    glUniform1f(baseAlpha, range.baseAlpha);
     glUniform1f(alphaCutoff, range.alphaCutoff);
     if (range.doubleSided) {
       glDisable(GL_CULL_FACE);

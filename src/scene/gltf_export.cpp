@@ -377,10 +377,11 @@ class Exporter {
   void addPrimitive(const std::vector<uint32_t>& triangles, int material, bool withTangents) {
     std::unordered_map<VertexKey, uint32_t, VertexKeyHash> slot;
     slot.reserve(triangles.size() * 2);
-    std::vector<float> pos, nrm, uv0, uv1, uv2;
+    std::vector<float> pos, nrm, uv0, uv1, uv2, rgba;
     std::vector<uint32_t> indices;
     indices.reserve(3 * triangles.size());
     const bool normals = !scene_.normals.empty();
+    const bool colors = scene_.colors.size() == 4 * scene_.positions.size();
     const bool writeUv2 = hasUv1_ && !uv1IsLightmap_;
     for (uint32_t t : triangles) {
       for (int k = 0; k < 3; ++k) {
@@ -407,6 +408,7 @@ class Exporter {
         }
         if (writeUv2)
           uv2.insert(uv2.end(), {scene_.texcoords1[2 * v], scene_.texcoords1[2 * v + 1]});
+        if (colors) rgba.insert(rgba.end(), &scene_.colors[4 * v], &scene_.colors[4 * v] + 4);
       }
     }
     const size_t count = pos.size() / 3;
@@ -441,6 +443,10 @@ class Exporter {
     if (writeUv2) {
       attributes["TEXCOORD_2"] =
           addAccessor(uv2.data(), uv2.size() * 4, kArrayBuffer, kFloat, count, "VEC2");
+    }
+    if (colors) {
+      attributes["COLOR_0"] =
+          addAccessor(rgba.data(), rgba.size() * 4, kArrayBuffer, kFloat, count, "VEC4");
     }
     int indexAccessor;
     // 16-bit indices while every index stays below 65535, glTF's

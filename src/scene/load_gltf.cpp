@@ -785,8 +785,10 @@ class SceneBuilder {
     Scene& sc = scene_;
     const size_t positions = sc.positions.size(), normals = sc.normals.size(),
                  uv0 = sc.texcoords0.size(), uv1 = sc.texcoords1.size(),
-                 tangents = sc.tangents.size(), indices = sc.indices.size(),
+                 tangents = sc.tangents.size(), colors = sc.colors.size(),
+                 indices = sc.indices.size(),
                  materials = sc.triangleMaterial.size();
+    const bool hadTangents = hasTangents_, hadColors = hasColors_;
     addMesh(node.mesh, world);
     for (size_t i = positions; i < sc.positions.size(); ++i) sc.region.extend(sc.positions[i]);
     world_.region.insert(world_.region.end(), world_.vertices.begin() + ptrdiff_t(positions),
@@ -797,6 +799,9 @@ class SceneBuilder {
     sc.texcoords0.resize(uv0);
     sc.texcoords1.resize(uv1);
     sc.tangents.resize(tangents);
+    sc.colors.resize(colors);
+    hasTangents_ = hadTangents;
+    hasColors_ = hadColors;
     sc.indices.resize(indices);
     sc.triangleMaterial.resize(materials);
   }
@@ -901,13 +906,30 @@ class SceneBuilder {
         }
         return v;
       };
-      std::vector<double> nrm, uv0, uv1, tan;
+      std::vector<double> nrm, uv0, uv1, tan, color;
       if (attr("NORMAL") >= 0) nrm = readSameCount(attr("NORMAL"), TINYGLTF_TYPE_VEC3, "NORMAL");
       if (attr("TANGENT") >= 0) tan = readSameCount(attr("TANGENT"), TINYGLTF_TYPE_VEC4, "TANGENT");
       if (attr("TEXCOORD_0") >= 0)
         uv0 = readSameCount(attr("TEXCOORD_0"), TINYGLTF_TYPE_VEC2, "TEXCOORD_0");
       if (attr("TEXCOORD_1") >= 0)
         uv1 = readSameCount(attr("TEXCOORD_1"), TINYGLTF_TYPE_VEC2, "TEXCOORD_1");
+      if (attr("COLOR_0") >= 0) {
+        // VEC3 or VEC4; floats, or normalized unsigned bytes or shorts (the
+        // reader scales those to [0, 1]).
+        const size_t acc = size_t(attr("COLOR_0"));
+        const int type = acc < model_.accessors.size() &&
+                                 model_.accessors[acc].type == TINYGLTF_TYPE_VEC3
+                             ? TINYGLTF_TYPE_VEC3
+                             : TINYGLTF_TYPE_VEC4;
+        color = readSameCount(attr("COLOR_0"), type, "COLOR_0");
+        if (type == TINYGLTF_TYPE_VEC3) {
+          std::vector<double> rgba(4 * nverts, 1.0);
+          for (size_t v = 0; v < nverts; ++v) {
+            for (int a = 0; a < 3; ++a) rgba[4 * v + size_t(a)] = color[3 * v + size_t(a)];
+          }
+          color = std::move(rgba);
+        }
+      }
 
       std::vector<uint32_t> idx;
       if (prim.indices >= 0) {
@@ -948,6 +970,7 @@ class SceneBuilder {
       appendUv(scene_.texcoords0, hasUv0_, uv0, nverts, base);
       appendUv(scene_.texcoords1, hasUv1_, uv1, nverts, base);
       appendTangents(tan, world, nverts, base, flip);
+      appendColors(color, nverts, base, what);
 
       for (auto& t : tris) {
         if (flip) std::swap(t[1], t[2]);
@@ -1061,6 +1084,25 @@ class SceneBuilder {
     }
   }
 
+  /// COLOR_0 of a primitive (RGBA) into Scene::colors, clamped to [0, 1]
+  /// (glTF's range); vertices of primitives without one are white.
+  void appendColors(const std::vector<double>& color, size_t nverts, uint32_t base,
+                    const std::string& what) {
+    if (color.empty() && !hasColors_) return;
+    if (!hasColors_) {
+      hasColors_ = true;
+      scene_.colors.assign(4 * size_t(base), 1.0f);
+    }
+    if (color.empty()) {
+      scene_.colors.resize(scene_.colors.size() + 4 * nverts, 1.0f);
+      return;
+    }
+    for (double c : color) {
+      if (!std::isfinite(c)) fail(path_, what + ": non-finite vertex colour (COLOR_0)");
+      scene_.colors.push_back(float(std::clamp(c, 0.0, 1.0)));
+    }
+  }
+
   /// Positions were gathered in double (world_): a scene far from the
   /// origin is stored relative to its centre (Scene::origin), the rest as
   /// the file places it.
@@ -1128,7 +1170,8 @@ class SceneBuilder {
   /// Each image's file bytes, kept by the textures that decode it (Texture::encoded).
   std::map<int, std::shared_ptr<const std::vector<uint8_t>>> imageBytes_;
   int defaultMaterial_ = -1;
-  bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false;
+  bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false,
+       hasColors_ = false;
 };
 
 }  // namespace

@@ -94,6 +94,7 @@ void placeModel(Scene& scene, Scene model, const Placement& placement) {
   appendOrFill(scene.texcoords1, baseVertices, model.texcoords1, addVertices, 2, {0.0f, 0.0f});
   appendOrFill(scene.tangents, baseVertices, model.tangents, addVertices, 4,
                {0.0f, 0.0f, 0.0f, 0.0f});
+  appendOrFill(scene.colors, baseVertices, model.colors, addVertices, 4, {1.0f, 1.0f, 1.0f, 1.0f});
   scene.positions.insert(scene.positions.end(), model.positions.begin(), model.positions.end());
   for (uint32_t i : model.indices) scene.indices.push_back(i + vertexOffset);
   for (int32_t m : model.triangleMaterial) scene.triangleMaterial.push_back(m + materialOffset);

@@ -324,16 +324,35 @@ bool Scene::texcoord(size_t t, float b1, float b2, int texCoord, const TextureTr
 
 Vec3 Scene::albedo(size_t t, float b1, float b2) const {
   const Material& m = materials[size_t(triangleMaterial[t])];
+  const Vec3 factor = colors.empty() ? m.baseColor : m.baseColor * vertexColor(t, b1, b2);
   float u, v;
   if (m.baseColorTexture < 0 || !texcoord(t, b1, b2, m.baseColorTexCoord, m.baseColorTransform, u, v))
-    return m.baseColor;
-  return m.baseColor * textures[size_t(m.baseColorTexture)].lookup(u, v);
+    return factor;
+  return factor * textures[size_t(m.baseColorTexture)].lookup(u, v);
+}
+
+Vec3 Scene::vertexColor(size_t t, float b1, float b2, float* alpha) const {
+  if (alpha) *alpha = 1.0f;
+  if (colors.size() != 4 * positions.size()) return Vec3(1.0f);
+  const float w[3] = {1.0f - b1 - b2, b1, b2};
+  float c[4] = {0, 0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const float* corner = &colors[4 * size_t(indices[3 * t + size_t(k)])];
+    for (int a = 0; a < 4; ++a) c[a] += w[k] * corner[a];
+  }
+  if (alpha) *alpha = c[3];
+  return Vec3(c[0], c[1], c[2]);
 }
 
 float Scene::coverage(size_t t, float b1, float b2) const {
   const Material& m = materials[size_t(triangleMaterial[t])];
   if (m.alphaMode == AlphaMode::Opaque) return 1.0f;
   float alpha = m.baseAlpha;
+  if (!colors.empty()) {
+    float vertexAlpha;
+    vertexColor(t, b1, b2, &vertexAlpha);
+    alpha *= vertexAlpha;
+  }
   float u, v;
   if (m.baseColorTexture >= 0 &&
       texcoord(t, b1, b2, m.baseColorTexCoord, m.baseColorTransform, u, v)) {

@@ -293,6 +293,10 @@ struct Scene {
   /// primitives that had none (their tangent is derived from the UVs). Empty
   /// when no primitive had one.
   std::vector<float> tangents;
+  /// glTF COLOR_0, 4 floats per vertex: linear RGBA in [0, 1], which
+  /// multiplies the base colour and its alpha. Empty when no primitive had
+  /// one (white); the vertices of primitives without one are white.
+  std::vector<float> colors;
   std::vector<uint32_t> indices;  ///< 3 per triangle, into positions
   std::vector<int32_t> triangleMaterial;  ///< one per triangle, into materials
   std::vector<Material> materials;
@@ -323,8 +327,12 @@ struct Scene {
   /// Geometric normal (unit, from the winding) and area of triangle t.
   Vec3 faceNormal(size_t t) const;
   float triangleArea(size_t t) const;
-  /// Base colour of triangle t at barycentrics (b1, b2), texture applied.
+  /// Base colour of triangle t at barycentrics (b1, b2), texture and
+  /// vertex colour applied.
   Vec3 albedo(size_t t, float b1, float b2) const;
+  /// The vertex colour (COLOR_0) of triangle t at (b1, b2), and its alpha
+  /// into `alpha` when given: white and 1 without vertex colours.
+  Vec3 vertexColor(size_t t, float b1, float b2, float* alpha = nullptr) const;
   /// Coverage of triangle t at (b1, b2) as its material's alpha mode reads
   /// it: 1 for Opaque; 1 or 0 against the cutoff for Mask; alpha for Blend.
   float coverage(size_t t, float b1, float b2) const;

@@ -106,6 +106,7 @@ void removeTriangles(Scene& scene, Drop drop) {
   compact(scene.texcoords0, 2);
   compact(scene.texcoords1, 2);
   compact(scene.tangents, 4);
+  compact(scene.colors, 4);
   scene.indices = std::move(keptIndices);
   scene.triangleMaterial = std::move(keptMaterials);
 }

@@ -919,6 +919,38 @@ TEST(RenderImage, EightBitDataMapsRenderAsTheirFloatTwins) {
   EXPECT_GT(mapEffect, 0.2) << "the maps change the image (the comparison is not of equals)";
 }
 
+// Vertex colours (COLOR_0) multiply the base colour as a factor does: a
+// quad whose corners all carry (0.5, 1, 0.25) draws as the quad whose factor
+// holds that colour; a masked quad whose vertex alpha is 0 is cut out.
+TEST(RenderImage, VertexColoursMultiplyTheBaseColour) {
+  REQUIRE_OSMESA();
+  const GpuOctree octree = whiteVdlsAlongZ();
+  const RenderParams p = QuadSetup::params(false);
+  QuadSetup tinted;
+  for (size_t v = 0; v < tinted.scene.positions.size(); ++v) {
+    tinted.scene.colors.insert(tinted.scene.colors.end(), {0.5f, 1.0f, 0.25f, 1.0f});
+  }
+  QuadSetup factor;
+  factor.scene.materials[0].baseColor = factor.albedo * Vec3(0.5f, 1.0f, 0.25f);
+  const RgbImage a = Renderer(tinted.scene, octree).render(tinted.camera, p);
+  const RgbImage b = Renderer(factor.scene, octree).render(factor.camera, p);
+  const float centre = b.pixel(32, 24)[0];
+  EXPECT_GT(centre, 0.01f) << "the quad is lit";
+  int off = 0;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      for (int c = 0; c < 3; ++c) off += std::fabs(a.pixel(x, y)[c] - b.pixel(x, y)[c]) > 1e-5f;
+    }
+  }
+  EXPECT_EQ(off, 0) << "pixel channels where the vertex colour differs from the factor";
+
+  QuadSetup cut = tinted;
+  cut.scene.materials[0].alphaMode = AlphaMode::Mask;
+  for (size_t v = 0; v < cut.scene.positions.size(); ++v) cut.scene.colors[4 * v + 3] = 0.0f;
+  EXPECT_EQ(Renderer(cut.scene, octree).render(cut.camera, p).pixel(32, 24)[0], 0.0f)
+      << "vertex alpha 0 under a mask: no surface";
+}
+
 // Glass (KHR_materials_transmission): a clear pane between the camera and a
 // lit quad shows the quad through it, dimmed only by the Fresnel reflectance
 // at normal incidence (4%), where it used to be drawn as an opaque white

@@ -276,6 +276,26 @@ TEST(GltfExport, OwnSecondUvSetMovesToTexcoord2) {
   expectTexcoord1(loadScene(dir + "/same.glb"), c.lm);
 }
 
+// Vertex colours (COLOR_0) go out as they came in: the export of a scene
+// that has them reads back with the same colours at every corner.
+TEST(GltfExport, VertexColoursGoOutAsTheyCameIn) {
+  ExportCase c = exportCase();
+  const std::string dir = test::outputDir("GltfExportColors");
+  for (size_t v = 0; v < c.scene.positions.size(); ++v) {
+    c.scene.colors.insert(c.scene.colors.end(), {float(v % 3) / 2.0f, 0.25f, 1.0f, 0.5f});
+  }
+  writeLightmapGltf(c.scene, c.lm, dir + "/colors.glb");
+  const Scene back = loadScene(dir + "/colors.glb");
+  ASSERT_EQ(back.colors.size(), 4 * back.positions.size());
+  for (size_t i = 0; i < c.scene.indices.size(); ++i) {
+    for (int a = 0; a < 4; ++a) {
+      ASSERT_EQ(back.colors[4 * back.indices[i] + size_t(a)],
+                c.scene.colors[4 * c.scene.indices[i] + size_t(a)])
+          << "corner " << i << " channel " << a;
+    }
+  }
+}
+
 TEST(GltfExport, UnlitFormShowsThePreviewOnTexcoord1) {
   ExportCase c = exportCase();
   const std::string dir = test::outputDir("GltfExportUnlit");

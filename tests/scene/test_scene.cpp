@@ -1077,6 +1077,51 @@ TEST(SceneGltf, MissingTextureFileIsWarnedOnceByName) {
   expectNear(s.materials[0].baseColor, {0.5f, 0.25f, 1.0f}, 1e-6f);
 }
 
+// COLOR_0 multiplies the base colour and its alpha (glTF 2.0, "Metallic-
+// Roughness Material"): as normalized unsigned bytes (VEC4) or floats
+// (VEC3, alpha 1); a primitive without one is white. Both tracers read it
+// through Scene::albedo and Scene::coverage (the GL renderer through its
+// vertices, test RenderImage.VertexColoursMultiplyTheBaseColour).
+TEST(SceneGltf, VertexColoursMultiplyTheBaseColour) {
+  std::string dir = test::outputDir("SceneGltf_VertexColors");
+  std::string blob;
+  append(blob, std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0});                          // 0, 36 B
+  append(blob, std::vector<uint8_t>{255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0});  // 36, 12 B
+  append(blob, std::vector<float>{0.5f, 0.25f, 1, 1, 1, 1, 0, 0, 0});                   // 48, 36 B
+  std::ostringstream os;
+  os << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"mesh": 0}],
+    "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 1, 1, 0.8]}, "alphaMode": "BLEND"}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "material": 0},
+                               {"attributes": {"POSITION": 0, "COLOR_0": 2}, "material": 0},
+                               {"attributes": {"POSITION": 0}, "material": 0}]}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                  {"bufferView": 1, "componentType": 5121, "normalized": true, "count": 3, "type": "VEC4"},
+                  {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC3"}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                    {"buffer": 0, "byteOffset": 36, "byteLength": 12},
+                    {"buffer": 0, "byteOffset": 48, "byteLength": 36}],
+    "buffers": [{"byteLength": )"
+     << blob.size() << R"(, "uri": "data:application/octet-stream;base64,)" << base64(blob)
+     << R"("}]})";
+  writeFile(dir + "/colors.gltf", os.str());
+  const Scene s = loadScene(dir + "/colors.gltf");
+  ASSERT_EQ(s.triangleCount(), 3u);
+  ASSERT_EQ(s.colors.size(), 4 * s.positions.size());
+  // Triangle 0 at its corner 0 (red), at corner 1 (green, alpha 128/255).
+  expectNear(s.albedo(0, 0, 0), {0.5f, 0, 0}, 1e-6f, "red corner");
+  expectNear(s.albedo(0, 1, 0), {0, 1, 0}, 1e-6f, "green corner");
+  EXPECT_NEAR(s.coverage(0, 1, 0), 0.8f * 128.0f / 255.0f, 1e-6f);
+  EXPECT_NEAR(s.coverage(0, 0, 1), 0.0f, 1e-6f) << "blue corner: alpha 0";
+  // Triangle 1: float RGB, alpha 1; halfway along its first edge.
+  expectNear(s.albedo(1, 0, 0), {0.25f, 0.25f, 1}, 1e-6f, "float colour");
+  expectNear(s.albedo(1, 0.5f, 0), {0.375f, 0.625f, 1}, 1e-6f, "interpolated");
+  EXPECT_NEAR(s.coverage(1, 0.3f, 0.3f), 0.8f, 1e-6f);
+  // Triangle 2: no COLOR_0, white.
+  expectNear(s.albedo(2, 0.2f, 0.3f), {0.5f, 1, 1}, 1e-6f, "no colour");
+  EXPECT_NEAR(s.coverage(2, 0.2f, 0.3f), 0.8f, 1e-6f);
+}
+
 // Extensions: one the file requires and the loader does not read is
 // refused by name, with what to do (a Draco file failed on its accessors'
 // missing buffer views, naming neither); one it only uses is a warning;
