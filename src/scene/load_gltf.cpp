@@ -1059,18 +1059,27 @@ class SceneBuilder {
     }
   }
 
+  /// An attribute only some primitives carry, `width` floats a vertex, in
+  /// `dst`: from the first primitive that has one (`present`), the vertices
+  /// before it get `fill`, as do those of a later primitive without one.
+  /// Returns whether this primitive's values are to be appended.
+  bool optionalAttribute(std::vector<float>& dst, bool& seen, bool present, uint32_t base,
+                         size_t nverts, size_t width, float fill) {
+    if (!present && !seen) return false;
+    if (!seen) {
+      seen = true;
+      dst.assign(width * size_t(base), fill);
+    }
+    if (!present) dst.resize(dst.size() + width * nverts, fill);
+    return present;
+  }
+
   /// TANGENT of a primitive into Scene::tangents (xyz by the node's linear
   /// part, normalised; w flipped with the winding under a mirroring
   /// transform); vertices of primitives without one get w = 0.
   void appendTangents(const std::vector<double>& tan, const Mat4& world, size_t nverts,
                       uint32_t base, bool flip) {
-    if (tan.empty() && !hasTangents_) return;
-    if (!hasTangents_) {
-      hasTangents_ = true;
-      scene_.tangents.assign(4 * size_t(base), 0.0f);
-    }
-    if (tan.empty()) {
-      scene_.tangents.resize(scene_.tangents.size() + 4 * nverts, 0.0f);
+    if (!optionalAttribute(scene_.tangents, hasTangents_, !tan.empty(), base, nverts, 4, 0.0f)) {
       return;
     }
     for (size_t v = 0; v < nverts; ++v) {
@@ -1088,13 +1097,7 @@ class SceneBuilder {
   /// (glTF's range); vertices of primitives without one are white.
   void appendColors(const std::vector<double>& color, size_t nverts, uint32_t base,
                     const std::string& what) {
-    if (color.empty() && !hasColors_) return;
-    if (!hasColors_) {
-      hasColors_ = true;
-      scene_.colors.assign(4 * size_t(base), 1.0f);
-    }
-    if (color.empty()) {
-      scene_.colors.resize(scene_.colors.size() + 4 * nverts, 1.0f);
+    if (!optionalAttribute(scene_.colors, hasColors_, !color.empty(), base, nverts, 4, 1.0f)) {
       return;
     }
     for (double c : color) {
