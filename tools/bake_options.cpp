@@ -89,7 +89,7 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->capture_default_str();
   cmd->add_option("--knn", opt.knn,
                   "Nearest photons gathered per voxel (paper: 300); a target bake raises it to "
-                  "2/E^2 so that it does not hold the noise up")
+                  "3/E^2 so that it does not hold the noise up")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--radius", opt.radius,

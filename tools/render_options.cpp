@@ -127,7 +127,7 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   cmd->add_option("--shadow-map-size", opt.shadowMapSize, "Shadow map resolution per face, at most: many shadowed lights (6 faces per "
-                  "emitter VPL) get smaller maps, halved until all fit in 96 MiB")
+                  "emitter VPL) get smaller maps, halved until all fit in 48 MiB (16-bit depth)")
       ->check(CLI::Range(16, 8192))
       ->capture_default_str();
   cmd->add_option("--cosine-correction", opt.cosineCorrection,

@@ -72,6 +72,9 @@ int runView(const ViewOptions& opt) {
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
   NamedPaths inputs = sceneInputs(opt.scene);
   if (!opt.lights.empty()) inputs.push_back({"LIGHTS", opt.lights});
+  if (!opt.cameraPath.empty()) inputs.push_back({"--camera-path", opt.cameraPath});
+  // The file P appends to may be the path played: only --json must differ from it.
+  inputs.push_back({"--record", opt.view.record});
   checkDistinctFiles({{"--json", opt.json}}, inputs);
   JsonReport report{"view", inputs,
                     {{"mode", opt.mode}, {"width", opt.width}, {"height", opt.height},

@@ -22,7 +22,8 @@ void prevalidateJson(const std::string& path, const std::string& baseDir, const 
 
 /// Whether the loader reads the glTF extension `name` (KHR_lights_punctual,
 /// the KHR_materials_* it maps to Material, KHR_texture_transform,
-/// KHR_mesh_quantization's integer attributes).
+/// KHR_mesh_quantization's integer attributes; the archived
+/// KHR_materials_pbrSpecularGlossiness approximately).
 bool readsGltfExtension(const std::string& name);
 
 /// Checks the GLB container (https://registry.khronos.org/glTF/specs/2.0/

@@ -422,6 +422,7 @@ class SceneBuilder {
           m.baseColorTexCoord = texCoord;
         }  // other UV sets are not loaded: the factor alone is used
       }
+      const bool specularGlossiness = readSpecularGlossiness(g.extensions, i, m);
       // Data maps (no sRGB curve): normal, metallic-roughness, occlusion.
       auto dataMap = [&](int index, int texCoord, const tinygltf::ExtensionMap& extensions,
                          const char* what, int& texture, int& texCoordOut,
@@ -458,6 +459,7 @@ class SceneBuilder {
               pbr.metallicRoughnessTexture.extensions, "metallic-roughness texture",
               m.metallicRoughnessTexture, m.metallicRoughnessTexCoord,
               m.metallicRoughnessTransform);
+      if (specularGlossiness) m.metallicRoughnessTexture = -1;  // the fallback's, not read
       dataMap(g.occlusionTexture.index, g.occlusionTexture.texCoord, g.occlusionTexture.extensions,
               "occlusion texture", m.occlusionTexture, m.occlusionTexCoord, m.occlusionTransform);
       m.occlusionStrength = float(g.occlusionTexture.strength);
@@ -473,6 +475,62 @@ class SceneBuilder {
       }
       scene_.materials.push_back(std::move(m));
     }
+  }
+
+  /// KHR_materials_pbrSpecularGlossiness (archived, written by older
+  /// exporters) read approximately, as a dielectric: the diffuse factor and
+  /// texture as the base colour, 1 - glossiness as the roughness (0.5 where
+  /// a specular-glossiness texture holds the glossiness, which is not read),
+  /// metallic 0; the specular colour is not read. Warned once per file.
+  bool readSpecularGlossiness(const tinygltf::ExtensionMap& extensions, size_t i, Material& m) {
+    auto it = extensions.find("KHR_materials_pbrSpecularGlossiness");
+    if (it == extensions.end() || !it->second.IsObject()) return false;
+    const tinygltf::Value& e = it->second;
+    const std::string what = "material " + std::to_string(i) + ": KHR_materials_pbrSpecularGlossiness ";
+    float diffuse[4] = {1, 1, 1, 1};
+    if (e.Has("diffuseFactor")) {
+      const tinygltf::Value& f = e.Get("diffuseFactor");
+      if (!f.IsArray() || f.ArrayLen() != 4) fail(path_, what + "diffuseFactor must hold 4 numbers");
+      for (int k = 0; k < 4; ++k) {
+        const tinygltf::Value& c = f.Get(k);
+        diffuse[k] = c.IsNumber() ? float(c.GetNumberAsDouble()) : -1.0f;
+        if (!(diffuse[k] >= 0 && diffuse[k] <= 1)) fail(path_, what + "diffuseFactor must lie in [0, 1]");
+      }
+    }
+    const double glossiness = numberExt(extensions, "KHR_materials_pbrSpecularGlossiness",
+                                        "glossinessFactor", 1.0);
+    if (!(glossiness >= 0 && glossiness <= 1)) fail(path_, what + "glossinessFactor must lie in [0, 1]");
+    m.baseColor = {diffuse[0], diffuse[1], diffuse[2]};
+    m.baseAlpha = diffuse[3];
+    m.metallic = 0;
+    m.roughness = e.Has("specularGlossinessTexture") ? 0.5f : float(1.0 - glossiness);
+    m.baseColorTexture = -1;
+    if (e.Has("diffuseTexture") && e.Get("diffuseTexture").IsObject()) {
+      const tinygltf::Value& t = e.Get("diffuseTexture");
+      const tinygltf::Value& index = t.Get("index");
+      const int tex = index.IsInt() ? index.GetNumberAsInt() : -1;
+      if (tex < 0 || size_t(tex) >= model_.textures.size()) {
+        fail(path_, what + "diffuseTexture index out of range");
+      }
+      int texCoord = t.Has("texCoord") && t.Get("texCoord").IsInt() ? t.Get("texCoord").GetNumberAsInt() : 0;
+      tinygltf::ExtensionMap textureExtensions;
+      if (t.Has("extensions") && t.Get("extensions").IsObject()) {
+        const tinygltf::Value& x = t.Get("extensions");
+        for (const std::string& key : x.Keys()) textureExtensions[key] = x.Get(key);
+      }
+      readTextureTransform(textureExtensions, i, m.baseColorTransform, texCoord);
+      if (texCoord == 0 || texCoord == 1) {
+        m.baseColorTexture = textureFromImage(model_.textures[size_t(tex)].source, tex);
+        m.baseColorTexCoord = texCoord;
+      }
+    }
+    if (!warnedSpecularGlossiness_) {
+      warnedSpecularGlossiness_ = true;
+      scene_.warnings.push_back(path_ + ": KHR_materials_pbrSpecularGlossiness read approximately, "
+                                        "as dielectrics: diffuse as the base colour, 1 - glossiness "
+                                        "as the roughness; specular colours not read");
+    }
+    return true;
   }
 
   /// KHR_texture_transform of a texture reference into `out`; its texCoord
@@ -788,7 +846,8 @@ class SceneBuilder {
                  tangents = sc.tangents.size(), colors = sc.colors.size(),
                  indices = sc.indices.size(),
                  materials = sc.triangleMaterial.size();
-    const bool hadTangents = hasTangents_, hadColors = hasColors_;
+    const bool hadNormals = hasNormals_, hadUv0 = hasUv0_, hadUv1 = hasUv1_,
+               hadTangents = hasTangents_, hadColors = hasColors_;
     addMesh(node.mesh, world);
     for (size_t i = positions; i < sc.positions.size(); ++i) sc.region.extend(sc.positions[i]);
     world_.region.insert(world_.region.end(), world_.vertices.begin() + ptrdiff_t(positions),
@@ -800,6 +859,9 @@ class SceneBuilder {
     sc.texcoords1.resize(uv1);
     sc.tangents.resize(tangents);
     sc.colors.resize(colors);
+    hasNormals_ = hadNormals;
+    hasUv0_ = hadUv0;
+    hasUv1_ = hadUv1;
     hasTangents_ = hadTangents;
     hasColors_ = hadColors;
     sc.indices.resize(indices);
@@ -917,6 +979,11 @@ class SceneBuilder {
         // VEC3 or VEC4; floats, or normalized unsigned bytes or shorts (the
         // reader scales those to [0, 1]).
         const size_t acc = size_t(attr("COLOR_0"));
+        if (acc < model_.accessors.size() &&
+            model_.accessors[acc].componentType != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+            !model_.accessors[acc].normalized) {
+          fail(path_, what + ": COLOR_0 of integers must be normalized (glTF 2.0, meshes)");
+        }
         const int type = acc < model_.accessors.size() &&
                                  model_.accessors[acc].type == TINYGLTF_TYPE_VEC3
                              ? TINYGLTF_TYPE_VEC3
@@ -1174,7 +1241,7 @@ class SceneBuilder {
   std::map<int, std::shared_ptr<const std::vector<uint8_t>>> imageBytes_;
   int defaultMaterial_ = -1;
   bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false,
-       hasColors_ = false;
+       hasColors_ = false, warnedSpecularGlossiness_ = false;
 };
 
 }  // namespace

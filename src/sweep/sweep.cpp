@@ -48,7 +48,7 @@ References loadOrRenderReferences(const SweepParams& params, const Scene& scene,
                                   const PinholeCamera& camera, const SweepCache& cache,
                                   std::FILE* log) {
   References refs;
-  if (cache.loadReferences(refs)) {
+  if (cache.loadReferences(refs, camera)) {
     if (log) std::fprintf(log, "reference: cached in %s\n", cache.dir().c_str());
     return refs;
   }
@@ -75,7 +75,7 @@ References loadOrRenderReferences(const SweepParams& params, const Scene& scene,
     refs.indirectNoise = referenceNoise(ind.image, ind.stdError, compared);
     refs.seconds += ind.seconds;
   }
-  cache.storeReferences(refs);
+  cache.storeReferences(refs, camera);
   if (log) {
     std::fprintf(log,
                  "reference: %d x %d, %d spp, %.1f s; noise (rel. RMS std. error) "

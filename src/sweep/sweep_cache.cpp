@@ -133,18 +133,21 @@ std::string SweepCache::imagePath(const SweepPoint& point, const std::string& wh
 namespace {
 
 /// What the references were rendered with: another key renders them again.
-nlohmann::json referenceKey(const SweepParams& params) {
+nlohmann::json referenceKey(const SweepParams& params, const PinholeCamera& camera) {
   return {{"scene", fs::path(params.scene).filename().string()},
           {"width", params.width},
           {"height", params.height},
           {"spp", params.referenceSpp},
           {"seed", params.seed},
-          {"indirect", params.frames > 0}};
+          {"indirect", params.frames > 0},
+          {"camera",
+           {camera.eye.x, camera.eye.y, camera.eye.z, camera.forward.x, camera.forward.y,
+            camera.forward.z, camera.up.x, camera.up.y, camera.up.z, camera.yfov}}};
 }
 
 }  // namespace
 
-bool SweepCache::loadReferences(References& refs) const {
+bool SweepCache::loadReferences(References& refs, const PinholeCamera& camera) const {
   const std::string keyFile = dir_ + "/reference.json";
   const std::string irrFile = dir_ + "/reference-irradiance.exr";
   const std::string indFile = dir_ + "/reference-indirect.exr";
@@ -153,7 +156,7 @@ bool SweepCache::loadReferences(References& refs) const {
       (params_.frames > 0 && !fs::exists(indFile)))
     return false;
   const nlohmann::json cached = readJson(keyFile);
-  if (cached["key"] != referenceKey(params_)) return false;
+  if (cached["key"] != referenceKey(params_, camera)) return false;
   if (!cached.contains("irradiance_binned_noise")) return false;  // before the emitter mask
   refs.irradiance = readImage(irrFile);
   refs.emitterMask = readImage(maskFile);
@@ -165,11 +168,11 @@ bool SweepCache::loadReferences(References& refs) const {
   return true;
 }
 
-void SweepCache::storeReferences(const References& refs) const {
+void SweepCache::storeReferences(const References& refs, const PinholeCamera& camera) const {
   writeExr(dir_ + "/reference-irradiance.exr", refs.irradiance);
   writeExr(dir_ + "/reference-emitters.exr", refs.emitterMask);
   if (params_.frames > 0) writeExr(dir_ + "/reference-indirect.exr", refs.indirect);
-  const nlohmann::json j = {{"key", referenceKey(params_)},
+  const nlohmann::json j = {{"key", referenceKey(params_, camera)},
                             {"irradiance_noise", refs.irradianceNoise},
                             {"indirect_noise", refs.indirectNoise},
                             {"irradiance_binned_noise", refs.irradianceBinnedNoise},

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "scene/pinhole_camera.h"
 #include "sweep/sweep.h"
 
 namespace lo {
@@ -60,8 +61,10 @@ class SweepCache {
   /// The point's image `what` ("irradiance", "indirect") as EXR.
   std::string imagePath(const SweepPoint& point, const std::string& what) const;
 
-  bool loadReferences(References& refs) const;
-  void storeReferences(const References& refs) const;
+  /// The references of `camera` (part of the key: a scene without a
+  /// camera of its own is framed by a rule that may change).
+  bool loadReferences(References& refs, const PinholeCamera& camera) const;
+  void storeReferences(const References& refs, const PinholeCamera& camera) const;
   bool loadBake(const SweepPoint& point, BakeFigures& figures) const;
   void storeBake(const SweepPoint& point, const BakeFigures& figures) const;
   bool loadResult(const SweepPoint& point, SweepResult& result) const;

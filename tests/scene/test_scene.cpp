@@ -1146,6 +1146,27 @@ TEST(SceneGltf, ExtensionsTheLoaderDoesNotReadAreNamed) {
   EXPECT_NE(s.warnings[0].find("KHR_materials_clearcoat, which is not read"), std::string::npos)
       << s.warnings[0];
 
+  // The archived specular-glossiness extension is read approximately, as a
+  // dielectric, with a warning, even where the file requires it.
+  MiniGltf sg = oneTriangle();
+  sg.material = 0;
+  sg.extraTop = R"("extensionsUsed": ["KHR_materials_pbrSpecularGlossiness"],
+                   "extensionsRequired": ["KHR_materials_pbrSpecularGlossiness"], )";
+  sg.materials = R"([{"pbrMetallicRoughness": {"metallicFactor": 1},
+                      "extensions": {"KHR_materials_pbrSpecularGlossiness": {
+                        "diffuseFactor": [0.2, 0.4, 0.6, 0.5], "glossinessFactor": 0.3,
+                        "specularFactor": [1, 0.8, 0.2]}}}])";
+  const Scene g = loadScene(writeGltf(dir, "specgloss.gltf", sg));
+  ASSERT_EQ(g.materials.size(), 1u);
+  expectNear(g.materials[0].baseColor, {0.2f, 0.4f, 0.6f}, 1e-6f, "diffuse");
+  EXPECT_FLOAT_EQ(g.materials[0].baseAlpha, 0.5f);
+  EXPECT_FLOAT_EQ(g.materials[0].roughness, 0.7f);
+  EXPECT_EQ(g.materials[0].metallic, 0.0f);
+  ASSERT_EQ(g.warnings.size(), 1u);
+  EXPECT_NE(g.warnings[0].find("read approximately"), std::string::npos) << g.warnings[0];
+  sg.materials = R"([{"extensions": {"KHR_materials_pbrSpecularGlossiness": {"glossinessFactor": 2}}}])";
+  expectInputError(writeGltf(dir, "badgloss.gltf", sg), "glossinessFactor must lie in [0, 1]");
+
   MiniGltf read = oneTriangle();
   read.extraTop = R"("extensionsUsed": ["KHR_texture_transform", "KHR_mesh_quantization"],
                      "extensionsRequired": ["KHR_texture_transform", "KHR_mesh_quantization"], )";
