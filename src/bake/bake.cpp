@@ -374,6 +374,18 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
   BakeParams params = requested;
   if (params.region.empty()) params.region = scene.region;
   checkParams(params, processes);
+  // A scene of unlit surfaces only (KHR_materials_unlit) holds no light to
+  // bake: said at once, where the photons found nothing to store after the
+  // whole path budget.
+  const bool allUnlit =
+      scene.triangleCount() > 0 &&
+      std::all_of(scene.triangleMaterial.begin(), scene.triangleMaterial.end(), [&](int32_t m) {
+        return m >= 0 && size_t(m) < scene.materials.size() && scene.materials[size_t(m)].unlit;
+      });
+  if (allUnlit) {
+    throw InputError("every surface of the scene is unlit (KHR_materials_unlit): none receives "
+                     "or reflects light, so there is no light to bake");
+  }
   if (params.freeSpaceOrder != 1 && params.freeSpaceOrder != 2) {
     throw InputError("--free-space-order " + std::to_string(params.freeSpaceOrder) +
                      ": the free-space light's SH are of order 1 or 2");

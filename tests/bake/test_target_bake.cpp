@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "bake/bake.h"
@@ -122,6 +123,22 @@ TEST(TargetBake, SameInputsSameGridWhateverTheThreads) {
             0);
   EXPECT_EQ(std::memcmp(one.noise.data(), many.noise.data(), one.noise.size() * sizeof(float)), 0);
   EXPECT_EQ(std::memcmp(one.vdls.data(), many.vdls.data(), one.vdls.size() * sizeof(Vdl)), 0);
+}
+
+// A scene whose every material is unlit holds no light to bake: refused at
+// once, saying so, instead of after the whole path budget stored nothing.
+TEST(Bake, AllUnlitSceneIsRefusedSayingSo) {
+  Scene unlit = cornellBox();
+  for (Material& m : unlit.materials) m.unlit = true;
+  BakeParams p;
+  p.depth = 3;
+  try {
+    bake(unlit, p);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("every surface of the scene is unlit"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(TargetBake, RefusesATargetOutsideItsRange) {
