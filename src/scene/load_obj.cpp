@@ -244,6 +244,11 @@ Scene loadObj(const std::string& path) {
   std::map<VertexKey, uint32_t> vertexOf;
   std::vector<char> hasNormal;
   std::vector<float> uv;
+  // Vertex colours (`v x y z r g b`, the extension MeshLab and others
+  // write), when every `v` line has one: linear RGB, as Blender reads them,
+  // clamped to [0, 1]; Scene::colors.
+  const bool vertexColors = attrib.colors.size() == v.size() && !v.empty();
+  std::vector<float> rgba;
   bool anyNormals = false, anyUv = false;
   auto vertex = [&](const tinyobj::index_t& ix) -> uint32_t {
     if (ix.vertex_index < 0 || size_t(ix.vertex_index) >= nv) {
@@ -270,6 +275,14 @@ Scene loadObj(const std::string& path) {
       fail(path, "non-finite vertex position (v " + std::to_string(p + 1) + ")");
     }
     scene.positions.push_back(pos);
+    if (vertexColors) {
+      for (size_t a = 0; a < 3; ++a) {
+        const float c = float(attrib.colors[3 * p + a]);
+        if (!std::isfinite(c)) fail(path, "non-finite vertex colour (v " + std::to_string(p + 1) + ")");
+        rgba.push_back(std::clamp(c, 0.0f, 1.0f));
+      }
+      rgba.push_back(1.0f);
+    }
     Vec3 n{};
     if (ix.normal_index >= 0) {
       size_t q = size_t(ix.normal_index);
@@ -348,6 +361,7 @@ Scene loadObj(const std::string& path) {
       if (!hasNormal[i]) scene.normals[i] = normalize(acc[i]);
   }
   if (anyUv) scene.texcoords0 = std::move(uv);
+  if (vertexColors) scene.colors = std::move(rgba);
   return scene;
 }
 

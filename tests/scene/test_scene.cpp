@@ -1270,6 +1270,25 @@ TEST(SceneObj, UndefinedMaterialIsWarnedOnceByName) {
   EXPECT_EQ(defaults, 2);
 }
 
+// OBJ vertex colours (`v x y z r g b`) multiply the base colour like glTF's
+// COLOR_0, when every vertex has one; a file where only some have one keeps
+// none (white).
+TEST(SceneObj, VertexColoursMultiplyTheBaseColour) {
+  std::string dir = test::outputDir("SceneObj_VertexColors");
+  writeFile(dir + "/m.mtl", "newmtl a\nKd 0.5 0.5 0.5\n");
+  writeFile(dir + "/c.obj",
+            "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nusemtl a\nf 1 2 3\n");
+  const Scene s = loadScene(dir + "/c.obj");
+  ASSERT_EQ(s.colors.size(), 4 * s.positions.size());
+  expectNear(s.albedo(0, 0, 0), {0.5f, 0, 0}, 1e-6f, "red corner");
+  expectNear(s.albedo(0, 1.0f / 3, 1.0f / 3), {0.5f / 3, 0.5f / 3, 0.5f / 3}, 1e-6f, "centre");
+  writeFile(dir + "/some.obj",
+            "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  const Scene some = loadScene(dir + "/some.obj");
+  EXPECT_TRUE(some.colors.empty());
+  expectNear(some.albedo(0, 0, 0), {0.5f, 0.5f, 0.5f}, 1e-6f, "no colours");
+}
+
 TEST(SceneObj, MissingTextureFileIsWarnedOnceByName) {
   std::string dir = test::outputDir("SceneObj_MissingTexture");
   writeFile(dir + "/m.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n"
