@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "image/image.h"
 #include "scene/scene_internal.h"
 
 namespace lo::scene_internal {
@@ -245,8 +246,9 @@ Scene loadObj(const std::string& path) {
   std::vector<char> hasNormal;
   std::vector<float> uv;
   // Vertex colours (`v x y z r g b`, the extension MeshLab and others
-  // write), when every `v` line has one: linear RGB, as Blender reads them,
-  // clamped to [0, 1]; Scene::colors.
+  // write), when every `v` line has one: display (sRGB) values in [0, 1],
+  // as the tools that write them and Blender's and three.js's readers take
+  // them, decoded to linear for Scene::colors.
   const bool vertexColors = attrib.colors.size() == v.size() && !v.empty();
   std::vector<float> rgba;
   bool anyNormals = false, anyUv = false;
@@ -279,7 +281,7 @@ Scene loadObj(const std::string& path) {
       for (size_t a = 0; a < 3; ++a) {
         const float c = float(attrib.colors[3 * p + a]);
         if (!std::isfinite(c)) fail(path, "non-finite vertex colour (v " + std::to_string(p + 1) + ")");
-        rgba.push_back(std::clamp(c, 0.0f, 1.0f));
+        rgba.push_back(srgbToLinear(std::clamp(c, 0.0f, 1.0f)));
       }
       rgba.push_back(1.0f);
     }

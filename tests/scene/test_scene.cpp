@@ -1271,17 +1271,19 @@ TEST(SceneObj, UndefinedMaterialIsWarnedOnceByName) {
 }
 
 // OBJ vertex colours (`v x y z r g b`) multiply the base colour like glTF's
-// COLOR_0, when every vertex has one; a file where only some have one keeps
-// none (white).
+// COLOR_0, when every vertex has one, read as the display (sRGB) values the
+// tools that write them mean; a file where only some have one keeps none
+// (white).
 TEST(SceneObj, VertexColoursMultiplyTheBaseColour) {
   std::string dir = test::outputDir("SceneObj_VertexColors");
   writeFile(dir + "/m.mtl", "newmtl a\nKd 0.5 0.5 0.5\n");
   writeFile(dir + "/c.obj",
-            "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nusemtl a\nf 1 2 3\n");
+            "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 0.5 0\nv 0 1 0 0 0 1\nusemtl a\nf 1 2 3\n");
   const Scene s = loadScene(dir + "/c.obj");
   ASSERT_EQ(s.colors.size(), 4 * s.positions.size());
   expectNear(s.albedo(0, 0, 0), {0.5f, 0, 0}, 1e-6f, "red corner");
-  expectNear(s.albedo(0, 1.0f / 3, 1.0f / 3), {0.5f / 3, 0.5f / 3, 0.5f / 3}, 1e-6f, "centre");
+  // Display values: 0.5 is sRGB, 0.214 linear.
+  expectNear(s.albedo(0, 1, 0), {0, 0.5f * 0.21404f, 0}, 1e-5f, "sRGB 0.5 corner");
   writeFile(dir + "/some.obj",
             "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
   const Scene some = loadScene(dir + "/some.obj");
