@@ -247,8 +247,8 @@ Scene loadObj(const std::string& path) {
   std::vector<float> uv;
   // Vertex colours (`v x y z r g b`, the extension MeshLab and others
   // write), when every `v` line has one: display (sRGB) values in [0, 1],
-  // as the tools that write them and Blender's and three.js's readers take
-  // them, decoded to linear for Scene::colors.
+  // as the tools that write them mean them, decoded to linear for
+  // Scene::colors.
   const bool vertexColors = attrib.colors.size() == v.size() && !v.empty();
   std::vector<float> rgba;
   bool anyNormals = false, anyUv = false;
