@@ -409,59 +409,29 @@ class SceneBuilder {
           !std::isfinite(m.roughness) || !std::isfinite(m.transmission) || !std::isfinite(m.ior)) {
         fail(path_, "material " + std::to_string(i) + " has a non-finite factor");
       }
-      int tex = pbr.baseColorTexture.index;
-      if (tex >= 0) {
-        if (size_t(tex) >= model_.textures.size()) {
-          fail(path_, "material " + std::to_string(i) + ": texture index " + std::to_string(tex) +
-                          " out of range");
-        }
-        int texCoord = pbr.baseColorTexture.texCoord;
-        readTextureTransform(pbr.baseColorTexture.extensions, i, m.baseColorTransform, texCoord);
-        if (texCoord == 0 || texCoord == 1) {
-          m.baseColorTexture = textureFromImage(model_.textures[size_t(tex)].source, tex);
-          m.baseColorTexCoord = texCoord;
-        }  // other UV sets are not loaded: the factor alone is used
-      }
+      // Colour maps (sRGB): base colour, emissive.
+      textureReference(i, "texture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                       pbr.baseColorTexture.extensions, true, m.baseColorTexture,
+                       m.baseColorTexCoord, m.baseColorTransform);
       const bool specularGlossiness = readSpecularGlossiness(g.extensions, i, m);
+      textureReference(i, "emissive texture", g.emissiveTexture.index, g.emissiveTexture.texCoord,
+                       g.emissiveTexture.extensions, true, m.emissiveTexture, m.emissiveTexCoord,
+                       m.emissiveTransform);
       // Data maps (no sRGB curve): normal, metallic-roughness, occlusion.
-      auto dataMap = [&](int index, int texCoord, const tinygltf::ExtensionMap& extensions,
-                         const char* what, int& texture, int& texCoordOut,
-                         TextureTransform& transform) {
-        if (index < 0) return;
-        if (size_t(index) >= model_.textures.size()) {
-          fail(path_, "material " + std::to_string(i) + ": " + what + " index " +
-                          std::to_string(index) + " out of range");
-        }
-        readTextureTransform(extensions, i, transform, texCoord);
-        if (texCoord == 0 || texCoord == 1) {
-          texture = textureFromImage(model_.textures[size_t(index)].source, index, false);
-          texCoordOut = texCoord;
-        }
-      };
-      // Emissive texture: sRGB colour like the base colour.
-      if (g.emissiveTexture.index >= 0) {
-        const int index = g.emissiveTexture.index;
-        if (size_t(index) >= model_.textures.size()) {
-          fail(path_, "material " + std::to_string(i) + ": emissive texture index " +
-                          std::to_string(index) + " out of range");
-        }
-        int texCoord = g.emissiveTexture.texCoord;
-        readTextureTransform(g.emissiveTexture.extensions, i, m.emissiveTransform, texCoord);
-        if (texCoord == 0 || texCoord == 1) {
-          m.emissiveTexture = textureFromImage(model_.textures[size_t(index)].source, index);
-          m.emissiveTexCoord = texCoord;
-        }
-      }
-      dataMap(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions,
-              "normal texture", m.normalTexture, m.normalTexCoord, m.normalTransform);
+      textureReference(i, "normal texture", g.normalTexture.index, g.normalTexture.texCoord,
+                       g.normalTexture.extensions, false, m.normalTexture, m.normalTexCoord,
+                       m.normalTransform);
       m.normalScale = float(g.normalTexture.scale);
-      dataMap(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-              pbr.metallicRoughnessTexture.extensions, "metallic-roughness texture",
-              m.metallicRoughnessTexture, m.metallicRoughnessTexCoord,
-              m.metallicRoughnessTransform);
-      if (specularGlossiness) m.metallicRoughnessTexture = -1;  // the fallback's, not read
-      dataMap(g.occlusionTexture.index, g.occlusionTexture.texCoord, g.occlusionTexture.extensions,
-              "occlusion texture", m.occlusionTexture, m.occlusionTexCoord, m.occlusionTransform);
+      if (!specularGlossiness) {  // else the metal-rough fallback's map, not read
+        textureReference(i, "metallic-roughness texture", pbr.metallicRoughnessTexture.index,
+                         pbr.metallicRoughnessTexture.texCoord,
+                         pbr.metallicRoughnessTexture.extensions, false,
+                         m.metallicRoughnessTexture, m.metallicRoughnessTexCoord,
+                         m.metallicRoughnessTransform);
+      }
+      textureReference(i, "occlusion texture", g.occlusionTexture.index,
+                       g.occlusionTexture.texCoord, g.occlusionTexture.extensions, false,
+                       m.occlusionTexture, m.occlusionTexCoord, m.occlusionTransform);
       m.occlusionStrength = float(g.occlusionTexture.strength);
       if (!std::isfinite(m.normalScale) || !std::isfinite(m.occlusionStrength)) {
         fail(path_, "material " + std::to_string(i) + ": a texture scale or strength is not finite");
@@ -507,22 +477,19 @@ class SceneBuilder {
     m.baseColorTexture = -1;
     if (e.Has("diffuseTexture") && e.Get("diffuseTexture").IsObject()) {
       const tinygltf::Value& t = e.Get("diffuseTexture");
-      const tinygltf::Value& index = t.Get("index");
-      const int tex = index.IsInt() ? index.GetNumberAsInt() : -1;
-      if (tex < 0 || size_t(tex) >= model_.textures.size()) {
-        fail(path_, what + "diffuseTexture index out of range");
+      if (!t.Get("index").IsInt() || t.Get("index").GetNumberAsInt() < 0) {
+        fail(path_, what + "diffuseTexture has no texture index");
       }
-      int texCoord = t.Has("texCoord") && t.Get("texCoord").IsInt() ? t.Get("texCoord").GetNumberAsInt() : 0;
+      const int texCoord =
+          t.Has("texCoord") && t.Get("texCoord").IsInt() ? t.Get("texCoord").GetNumberAsInt() : 0;
       tinygltf::ExtensionMap textureExtensions;
       if (t.Has("extensions") && t.Get("extensions").IsObject()) {
         const tinygltf::Value& x = t.Get("extensions");
         for (const std::string& key : x.Keys()) textureExtensions[key] = x.Get(key);
       }
-      readTextureTransform(textureExtensions, i, m.baseColorTransform, texCoord);
-      if (texCoord == 0 || texCoord == 1) {
-        m.baseColorTexture = textureFromImage(model_.textures[size_t(tex)].source, tex);
-        m.baseColorTexCoord = texCoord;
-      }
+      textureReference(i, "KHR_materials_pbrSpecularGlossiness diffuseTexture",
+                       t.Get("index").GetNumberAsInt(), texCoord, textureExtensions, true,
+                       m.baseColorTexture, m.baseColorTexCoord, m.baseColorTransform);
     }
     if (!warnedSpecularGlossiness_) {
       warnedSpecularGlossiness_ = true;
@@ -531,6 +498,26 @@ class SceneBuilder {
                                         "as the roughness; specular colours not read");
     }
     return true;
+  }
+
+  /// A texture reference `what` of material i: its index checked, its
+  /// KHR_texture_transform into `transform`, and its texture (sRGB colour
+  /// or linear data) into `texture` and `texCoordOut` where it names UV set
+  /// 0 or 1 (other sets are not loaded: the factor alone is used). Nothing
+  /// for a negative index.
+  void textureReference(size_t i, const std::string& what, int index, int texCoord,
+                        const tinygltf::ExtensionMap& extensions, bool srgb, int& texture,
+                        int& texCoordOut, TextureTransform& transform) {
+    if (index < 0) return;
+    if (size_t(index) >= model_.textures.size()) {
+      fail(path_, "material " + std::to_string(i) + ": " + what + " index " +
+                      std::to_string(index) + " out of range");
+    }
+    readTextureTransform(extensions, i, transform, texCoord);
+    if (texCoord == 0 || texCoord == 1) {
+      texture = textureFromImage(model_.textures[size_t(index)].source, index, srgb);
+      texCoordOut = texCoord;
+    }
   }
 
   /// KHR_texture_transform of a texture reference into `out`; its texCoord
@@ -989,13 +976,6 @@ class SceneBuilder {
                              ? TINYGLTF_TYPE_VEC3
                              : TINYGLTF_TYPE_VEC4;
         color = readSameCount(attr("COLOR_0"), type, "COLOR_0");
-        if (type == TINYGLTF_TYPE_VEC3) {
-          std::vector<double> rgba(4 * nverts, 1.0);
-          for (size_t v = 0; v < nverts; ++v) {
-            for (int a = 0; a < 3; ++a) rgba[4 * v + size_t(a)] = color[3 * v + size_t(a)];
-          }
-          color = std::move(rgba);
-        }
       }
 
       std::vector<uint32_t> idx;
@@ -1160,16 +1140,21 @@ class SceneBuilder {
     }
   }
 
-  /// COLOR_0 of a primitive (RGBA) into Scene::colors, clamped to [0, 1]
-  /// (glTF's range); vertices of primitives without one are white.
+  /// COLOR_0 of a primitive (RGB, alpha 1, or RGBA) into Scene::colors,
+  /// clamped to [0, 1] (glTF's range); vertices of primitives without one
+  /// are white.
   void appendColors(const std::vector<double>& color, size_t nverts, uint32_t base,
                     const std::string& what) {
     if (!optionalAttribute(scene_.colors, hasColors_, !color.empty(), base, nverts, 4, 1.0f)) {
       return;
     }
-    for (double c : color) {
-      if (!std::isfinite(c)) fail(path_, what + ": non-finite vertex colour (COLOR_0)");
-      scene_.colors.push_back(float(std::clamp(c, 0.0, 1.0)));
+    const size_t channels = color.size() / nverts;  // 3 or 4
+    for (size_t v = 0; v < nverts; ++v) {
+      for (size_t a = 0; a < 4; ++a) {
+        const double c = a < channels ? color[channels * v + a] : 1.0;
+        if (!std::isfinite(c)) fail(path_, what + ": non-finite vertex colour (COLOR_0)");
+        scene_.colors.push_back(float(std::clamp(c, 0.0, 1.0)));
+      }
     }
   }
 
