@@ -76,11 +76,11 @@ struct DrawRange {
   bool moving = false;
 };
 
-/// The scene's triangles on the GPU, grouped by material in DrawCategory
-/// order, and its textures (scene_geometry.cpp).
 /// Channels of a texture the scene shader reads (SceneGeometry::uploadTexture).
 enum : unsigned { kReadR = 1, kReadG = 2, kReadB = 4, kReadA = 8 };
 
+/// The scene's triangles on the GPU, grouped by material in DrawCategory
+/// order, and its textures (scene_geometry.cpp).
 struct SceneGeometry {
   GlVertexArray vao;
   GlBuffer vbo;
@@ -119,12 +119,16 @@ struct SceneGeometry {
 
  private:
   GlTexture uploadTexture(const Texture& t, unsigned read);
-  std::vector<unsigned> channelsRead;  ///< per texture, during upload: kReadR | ...
-  std::function<void(int)> textureUploaded_;
+  /// What upload() hands on to each texture's upload: the channels read of
+  /// each (kReadR | ...) and the caller's callback.
+  struct TextureUploads {
+    std::vector<unsigned> channelsRead;
+    const std::function<void(int)>& uploaded;
+  };
   /// Scene::textures[index] on the GPU, uploaded on first use; returns index.
-  int useTexture(const Scene& scene, int index);
+  int useTexture(const Scene& scene, int index, const TextureUploads& uploads);
   /// The textures and uniforms material `mat` draws with.
-  DrawRange rangeOf(const Scene& scene, const Material& mat);
+  DrawRange rangeOf(const Scene& scene, const Material& mat, const TextureUploads& uploads);
   void uploadVertices(const std::vector<Vertex>& vertices);
 
  public:

@@ -193,15 +193,11 @@ Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& 
                      : scene.normals[index];
   std::memcpy(v.position, &p, sizeof v.position);
   std::memcpy(v.normal, &n, sizeof v.normal);
-  Vec3 color = mat.baseColor;
-  float alpha = mat.baseAlpha;
-  if (scene.colors.size() == 4 * scene.positions.size()) {
-    const float* c = &scene.colors[4 * size_t(index)];
-    color = color * Vec3(c[0], c[1], c[2]);
-    alpha *= c[3];
-  }
+  float alpha;  // the corner's own vertex colour: barycentrics (0, 0), (1, 0), (0, 1)
+  const Vec3 color =
+      mat.baseColor * scene.vertexColor(t, k == 1 ? 1.0f : 0.0f, k == 2 ? 1.0f : 0.0f, &alpha);
   std::memcpy(v.baseColor, &color, 3 * sizeof(float));
-  v.baseColor[3] = alpha;
+  v.baseColor[3] = mat.baseAlpha * alpha;
   v.metallicRoughness[0] = mat.metallic;
   v.metallicRoughness[1] = mat.roughness;
   std::memcpy(v.emission, &mat.emission, sizeof v.emission);
@@ -222,15 +218,17 @@ Vertex makeVertex(const Scene& scene, const RenderSpace& space, const Material& 
 
 }  // namespace
 
-int SceneGeometry::useTexture(const Scene& scene, int index) {
+int SceneGeometry::useTexture(const Scene& scene, int index, const TextureUploads& uploads) {
   if (!textures[size_t(index)]) {
-    textures[size_t(index)] = uploadTexture(scene.textures[size_t(index)], channelsRead[size_t(index)]);
-    if (textureUploaded_) textureUploaded_(index);
+    textures[size_t(index)] =
+        uploadTexture(scene.textures[size_t(index)], uploads.channelsRead[size_t(index)]);
+    if (uploads.uploaded) uploads.uploaded(index);
   }
   return index;
 }
 
-DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat) {
+DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat,
+                                 const TextureUploads& uploads) {
   DrawRange range;
   range.transmission = mat.transmission;
   range.thickness = mat.thickness;
@@ -242,20 +240,20 @@ DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat) {
   range.doubleSided = mat.doubleSided;
   range.unlit = mat.unlit;
   if (usable(scene, mat.emissiveTexture, mat.emissiveTexCoord) && mat.isEmissive()) {
-    range.emissiveTexture = useTexture(scene, mat.emissiveTexture);
+    range.emissiveTexture = useTexture(scene, mat.emissiveTexture, uploads);
   }
   if (usable(scene, mat.baseColorTexture, mat.baseColorTexCoord)) {
-    range.texture = useTexture(scene, mat.baseColorTexture);
+    range.texture = useTexture(scene, mat.baseColorTexture, uploads);
   }
   if (usable(scene, mat.normalTexture, mat.normalTexCoord)) {
-    range.normalTexture = useTexture(scene, mat.normalTexture);
+    range.normalTexture = useTexture(scene, mat.normalTexture, uploads);
     range.normalScale = mat.normalScale;
   }
   if (usable(scene, mat.metallicRoughnessTexture, mat.metallicRoughnessTexCoord)) {
-    range.metallicRoughnessTexture = useTexture(scene, mat.metallicRoughnessTexture);
+    range.metallicRoughnessTexture = useTexture(scene, mat.metallicRoughnessTexture, uploads);
   }
   if (usable(scene, mat.occlusionTexture, mat.occlusionTexCoord)) {
-    range.occlusionTexture = useTexture(scene, mat.occlusionTexture);
+    range.occlusionTexture = useTexture(scene, mat.occlusionTexture, uploads);
     range.occlusionStrength = mat.occlusionStrength;
   }
   return range;
@@ -270,15 +268,14 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space,
   }
   textures.clear();
   textures.resize(scene.textures.size());
-  channelsRead = channelsReadOf(scene);
-  textureUploaded_ = textureUploaded;
+  const TextureUploads uploads{channelsReadOf(scene), textureUploaded};
   std::vector<Vertex> vertices;
   vertices.reserve(scene.triangleCount() * 3);
   for (const std::vector<size_t>& group : trianglesByMaterial(scene)) {
     if (group.empty()) continue;
     const Material& mat = materialOf(scene, group.front());
     const DrawCategory category = categoryOf(mat);
-    DrawRange range = rangeOf(scene, mat);
+    DrawRange range = rangeOf(scene, mat, uploads);
     range.moving = scene.isAdded(group.front());
     range.first = GLint(vertices.size());
     for (size_t t : group) {
@@ -307,7 +304,6 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space,
                             vertices.begin() + range.first + range.count);
     }
   }
-  textureUploaded_ = {};
   uploadVertices(vertices);
 }
 

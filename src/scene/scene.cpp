@@ -324,7 +324,7 @@ bool Scene::texcoord(size_t t, float b1, float b2, int texCoord, const TextureTr
 
 Vec3 Scene::albedo(size_t t, float b1, float b2) const {
   const Material& m = materials[size_t(triangleMaterial[t])];
-  const Vec3 factor = colors.empty() ? m.baseColor : m.baseColor * vertexColor(t, b1, b2);
+  const Vec3 factor = m.baseColor * vertexColor(t, b1, b2);
   float u, v;
   if (m.baseColorTexture < 0 || !texcoord(t, b1, b2, m.baseColorTexCoord, m.baseColorTransform, u, v))
     return factor;
@@ -347,12 +347,9 @@ Vec3 Scene::vertexColor(size_t t, float b1, float b2, float* alpha) const {
 float Scene::coverage(size_t t, float b1, float b2) const {
   const Material& m = materials[size_t(triangleMaterial[t])];
   if (m.alphaMode == AlphaMode::Opaque) return 1.0f;
-  float alpha = m.baseAlpha;
-  if (!colors.empty()) {
-    float vertexAlpha;
-    vertexColor(t, b1, b2, &vertexAlpha);
-    alpha *= vertexAlpha;
-  }
+  float vertexAlpha;
+  vertexColor(t, b1, b2, &vertexAlpha);
+  float alpha = m.baseAlpha * vertexAlpha;
   float u, v;
   if (m.baseColorTexture >= 0 &&
       texcoord(t, b1, b2, m.baseColorTexCoord, m.baseColorTransform, u, v)) {
