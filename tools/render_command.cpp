@@ -169,10 +169,7 @@ int runRender(const RenderOptions& opt) {
 
   // Nothing after the renderer's construction reads a texel: each texture's
   // are freed as soon as its GPU copy is made.
-  Renderer renderer(scene, octree, opt.shading.rendererParams(), [&scene](int texture) {
-    scene.releaseTexels(size_t(texture));
-    returnFreeMemory();
-  });
+  Renderer renderer(scene, octree, opt.shading.rendererParams(), freeTexelsOnUpload(scene));
   rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
   scene.releaseTexels();  // those no material draws with
   returnFreeMemory();

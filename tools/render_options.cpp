@@ -156,6 +156,13 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
       ->capture_default_str();
 }
 
+std::function<void(int)> freeTexelsOnUpload(Scene& scene) {
+  return [&scene](int texture) {
+    scene.releaseTexels(size_t(texture));
+    returnFreeMemory();
+  };
+}
+
 void setAddedObjectsLight(Renderer& renderer, const VdlGrid& baked, const ShadingOptions& shading,
                           const GpuOctreeParams& params, const std::string& lightsPath) {
   if (shading.lighting == "atlas") {

@@ -6,6 +6,7 @@
 /// into the renderer's parameters, so both commands draw the same picture
 /// from the same flags.
 
+#include <functional>
 #include <string>
 
 #include "lightgrid/vdl_grid.h"
@@ -77,5 +78,10 @@ bool hasLightForAddedObjects(const VdlGrid& baked, const std::string& lightsPath
 /// --lighting atlas (the atlas has no texels for them).
 void setAddedObjectsLight(Renderer& renderer, const VdlGrid& baked, const ShadingOptions& shading,
                           const GpuOctreeParams& params, const std::string& lightsPath);
+
+/// The Renderer's textureUploaded callback of a command that reads no texel
+/// after the renderer's construction: each texture's texels freed, and the
+/// pages given back, as soon as its GPU copy is made.
+std::function<void(int)> freeTexelsOnUpload(Scene& scene);
 
 }  // namespace lo::tool

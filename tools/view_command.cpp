@@ -162,14 +162,8 @@ int runView(const ViewOptions& opt) {
 
   // Without a bake tracing the scene beside it, nothing reads a texel after
   // the renderer's construction: each texture's are freed once on the GPU.
-  std::function<void(int)> releaseTexels;
-  if (!bake) {
-    releaseTexels = [&scene](int texture) {
-      scene.releaseTexels(size_t(texture));
-      returnFreeMemory();
-    };
-  }
-  Renderer renderer(scene, octree, opt.shading.rendererParams(), releaseTexels);
+  Renderer renderer(scene, octree, opt.shading.rendererParams(),
+                    bake ? std::function<void(int)>() : freeTexelsOnUpload(scene));
   rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
   if (!opt.objects.empty() && baked) {
     StageTimer volumeTimer(rows, "free-space light");
