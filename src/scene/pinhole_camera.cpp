@@ -61,7 +61,22 @@ Vec3 viewSide(const Scene& scene) {
   }
   const double norm = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
   if (!(area > 0) || norm < 0.2 * area) return Vec3(0, 0, 1);
-  return Vec3(float(sum[0] / norm), float(sum[1] / norm), float(sum[2] / norm));
+  // At most 60 degrees above or below the horizon: a scene that mostly
+  // faces up (a ground under an object) is seen from above at a slant, not
+  // straight down; from +Z where the normals have no horizontal lean.
+  constexpr double kMaxSin = 0.8660254037844386;  // sin 60 degrees
+  const double up = std::clamp(sum[1] / norm, -kMaxSin, kMaxSin);
+  double hx = sum[0], hz = sum[2];
+  const double h = std::sqrt(hx * hx + hz * hz);
+  if (h < 1e-3 * norm) {
+    hx = 0;
+    hz = 1;
+  } else {
+    hx /= h;
+    hz /= h;
+  }
+  const double across = std::sqrt(1 - up * up);
+  return Vec3(float(hx * across), float(up), float(hz * across));
 }
 
 }  // namespace lo

@@ -38,10 +38,11 @@ struct PinholeCamera {
 
 /// The side a scene shows its front faces to: the direction of the sum of
 /// its triangles' area-weighted normals, where that sum is at least a fifth
-/// of their area (an open room's walls and floor facing in, a terrain facing
-/// up); else +Z, for closed objects and rooms, whose normals cancel. A room
-/// corner framed from +Z would show the backs of its walls: black in every
-/// renderer, their light on the other side.
+/// of their area (an open room's walls and floor facing in, a ground facing
+/// up), at most 60 degrees from the horizon (from +Z where it leans no way
+/// across); else +Z, for closed objects and rooms, whose normals cancel. A
+/// room corner framed from +Z would show the backs of its walls: black in
+/// every renderer, their light on the other side.
 Vec3 viewSide(const Scene& scene);
 
 }  // namespace lo

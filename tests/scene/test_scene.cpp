@@ -1668,6 +1668,16 @@ TEST(SceneCamera, FramingLooksAtTheFrontFaces) {
   for (const Vec3& n : normals) EXPECT_LT(dot(camera.forward, n), -0.5f) << "sees the fronts";
   EXPECT_GT(length(camera.eye - corner.bounds().center()), 0.5f * length(corner.bounds().extent()));
 
+  // A ground alone faces straight up: seen from 60 degrees above the
+  // horizon, from the +Z side, not from straight above.
+  Scene ground;
+  ground.materials.push_back(Material{});
+  test::addQuad(ground, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, 0);
+  const Vec3 above = viewSide(ground);
+  EXPECT_NEAR(above.y, std::sqrt(3.0f) / 2, 1e-5f);
+  EXPECT_NEAR(above.z, 0.5f, 1e-5f);
+  EXPECT_NEAR(above.x, 0.0f, 1e-6f);
+
   Scene room;
   room.materials.push_back(Material{});
   test::addClosedBox(room, {0, 0, 0}, {1, 1, 1}, 0);
