@@ -22,7 +22,7 @@
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
 #include "render/context.h"
-#include "render/renderer.h"
+#include "render/render_session.h"
 #include "scene/pinhole_camera.h"
 #include "scene/scene.h"
 #include "vdb/vdb_inspect.h"
@@ -183,32 +183,83 @@ py::array_t<float> lookup(Grid& g, py::array_t<float, py::array::c_style | py::a
   return out;
 }
 
+/// The render settings the keywords select: the command line's flags by
+/// their Python names, defaults the library's (RenderSettings{}), so that
+/// `lightoctree.render` draws what `lightoctree render` draws.
+RenderSettings renderSettings(int width, int height, const std::string& mode, const py::kwargs& kw) {
+  RenderSettings s;
+  s.frame.width = width;
+  s.frame.height = height;
+  s.frame.mode = parseRenderMode(mode);
+  for (const auto& [key, value] : kw) {
+    const std::string name = py::str(key);
+    if (name == "interpolation") s.frame.interpolation = value.cast<bool>();
+    else if (name == "specular") s.frame.specular = value.cast<bool>();
+    else if (name == "reflections") s.frame.reflections = value.cast<bool>();
+    else if (name == "lighting") s.frame.lighting = parseLighting(value.cast<std::string>());
+    else if (name == "supersample") s.frame.supersample = value.cast<int>();
+    else if (name == "vdls") s.frame.maxVdls = value.cast<int>();
+    else if (name == "area_lights") s.renderer.areaLights = value.cast<bool>();
+    else if (name == "emitter_lights") s.renderer.emitterLights = value.cast<int>();
+    else if (name == "shadow_map_size") s.renderer.shadowMapSize = value.cast<int>();
+    else if (name == "cosine_correction") s.octree.cosineCorrection = value.cast<bool>();
+    else if (name == "tolerance") s.octree.tolerance = value.cast<float>();
+    else if (name == "free_space_tolerance") s.octree.volumeTolerance = value.cast<float>();
+    else if (name == "texels") {
+      const std::string texels = value.cast<std::string>();
+      if (texels != "float" && texels != "half" && texels != "compact") {
+        throw InputError("render: texels '" + texels + "': expected float, half or compact");
+      }
+      s.octree.halfFloat = texels == "half";
+      s.octree.compact = texels == "compact";
+    } else {
+      throw InputError("render: unknown setting '" + name + "'");
+    }
+  }
+  if (width < 1 || height < 1 || width > 16384 || height > 16384) {
+    throw InputError("render: width and height must be 1..16384");
+  }
+  if (s.frame.supersample < 1 || s.frame.supersample > 16) throw InputError("render: supersample must be 1..16");
+  if (s.frame.maxVdls < 1 || s.frame.maxVdls > kMaxVdls) throw InputError("render: vdls must be 1..8");
+  if (s.renderer.emitterLights < 0 || s.renderer.emitterLights > 16) {
+    throw InputError("render: emitter_lights must be 0..16");
+  }
+  if (s.renderer.shadowMapSize < 16 || s.renderer.shadowMapSize > 8192) {
+    throw InputError("render: shadow_map_size must be 16..8192");
+  }
+  for (const float t : {s.octree.tolerance, s.octree.volumeTolerance}) {
+    if (!(t >= 0.0f && t <= 1.0f)) throw InputError("render: tolerances must be 0..1");
+  }
+  return s;
+}
+
 /// The scene lit by the grid, drawn by the GL renderer (OSMesa, headless)
-/// from the scene's camera: linear RGB, shape (height, width, 3).
+/// from the scene's camera through the library's render session: linear
+/// RGB, shape (height, width, 3).
 py::array_t<float> renderImage(const std::string& scenePath, const Grid& g, int width, int height,
-                               const std::string& mode) {
-  const Scene scene = loadScene(scenePath);
-  RenderParams params;
-  params.mode = parseRenderMode(mode);
-  params.width = width;
-  params.height = height;
+                               const std::string& mode, const py::kwargs& kw) {
+  const RenderSettings settings = renderSettings(width, height, mode, kw);
+  Scene scene = loadScene(scenePath);
   RgbImage image;
   {
     py::gil_scoped_release unlocked;
     GlContextParams contextParams;
     contextParams.backend = GlBackend::OSMesa;
     std::unique_ptr<GlContext> context = createGlContext(contextParams);
-    GpuOctreeParams octreeParams;
-    octreeParams.max3DTextureSize = context->info().max3DTextureSize;
-    octreeParams.max2DTextureSize = context->info().max2DTextureSize;
-    const GpuOctree octree = buildGpuOctree(g.grid, octreeParams);
-    Renderer renderer(scene, octree, RendererParams{});
+    RenderSession session(scene, g.grid, *context, settings);
     // The scene's first camera, else one framing its bounds from the side its
     // surfaces face (as `render`).
-    const PinholeCamera camera = PinholeCamera::ofScene(scene);
-    image = renderer.render(camera, params);
+    image = session.render(PinholeCamera::ofScene(scene), settings.frame.mode);
   }
   py::array_t<float> out({size_t(height), size_t(width), size_t(3)});
+  std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
+  return out;
+}
+
+/// An EXR (linear) or PNG (sRGB decoded) image as (height, width, 3) floats.
+py::array_t<float> readImageFile(const std::string& path) {
+  const RgbImage image = readImage(path);
+  py::array_t<float> out({size_t(image.height), size_t(image.width), size_t(3)});
   std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
   return out;
 }
@@ -304,7 +355,12 @@ PYBIND11_MODULE(lightoctree, m) {
   m.def("render", &renderImage, py::arg("scene"), py::arg("grid"), py::arg("width") = 400,
         py::arg("height") = 300, py::arg("mode") = "full",
         "The scene lit by the grid from its camera, as `lightoctree render` draws it (OSMesa): "
-        "linear RGB, shape (height, width, 3).");
+        "linear RGB, shape (height, width, 3). Keywords as the command's flags, defaults the "
+        "same: interpolation, specular, reflections, area_lights, cosine_correction (bool); "
+        "lighting ('octree' | 'atlas'), texels ('compact' | 'half' | 'float'); supersample, vdls, "
+        "emitter_lights, shadow_map_size (int); tolerance, free_space_tolerance (0..1).");
+  m.def("read_image", &readImageFile, py::arg("path"),
+        "An image file: EXR as linear floats, PNG decoded from sRGB; shape (height, width, 3).");
 }
 
 }  // namespace lo::python

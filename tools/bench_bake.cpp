@@ -25,6 +25,7 @@
 #include "core/file.h"
 #include "core/resources.h"
 #include "octree/gpu_octree.h"
+#include "render/render_session.h"
 #include "scene/scene.h"
 
 namespace {
@@ -75,10 +76,8 @@ Row runOne(const std::string& path, int depth, size_t photons) {
     if (stage.name == "free-space light") row.freeSpace += stage.seconds;
   }
   row.freeVoxels = baked.grid.volume.size();
-  lo::GpuOctreeParams compact;  // the renderer's defaults: compact texels, adaptive leaves
-  compact.compact = true;
-  compact.tolerance = 0.1f;
-  compact.volumeTolerance = 0.4f;
+  // The renderer's defaults: compact texels, adaptive leaves.
+  const lo::GpuOctreeParams compact = lo::renderOctreeDefaults();
   const lo::GpuOctree surface = lo::buildGpuOctree(baked.grid, compact);
   row.surfaceBytes = surface.poolBytes() + surface.vdlBytes();
   if (!baked.grid.volume.empty()) {

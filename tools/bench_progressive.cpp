@@ -27,7 +27,7 @@
 #include "bake/progressive_bake.h"
 #include "core/file.h"
 #include "render/context.h"
-#include "render/renderer.h"
+#include "render/render_session.h"
 #include "scene/scene.h"
 
 namespace {
@@ -128,7 +128,10 @@ SceneResult runScene(const SceneSpec& spec, const std::string& path, lo::GlConte
   // cores). On demand: a still view, so a frame is drawn only when a level
   // arrives (the viewer's default).
   clock.reset();
-  lo::Renderer renderer(scene, lo::GpuOctree(), {});
+  lo::RenderSessionOptions options;
+  options.freeTexels = false;  // the bakes trace the same scene
+  lo::RenderSession session(scene, lo::VdlGrid{}, context, lo::RenderSettings{}, options);
+  lo::Renderer& renderer = session.renderer();
   r.rendererSetup = clock.seconds();
   r.frameEmpty = renderer.timeFrames(camera, renderParams, 3) / 3;
   for (bool continuous : {true, false}) {

@@ -32,7 +32,7 @@
 #include "render/atlas_gpu.h"
 #include "render/atlas_lighting.h"
 #include "render/context.h"
-#include "render/renderer.h"
+#include "render/render_session.h"
 #include "scene/scene.h"
 #include "vdb/vdb_io.h"
 
@@ -71,8 +71,7 @@ const ModeSpec kModes[] = {
 
 struct Baked {
   lo::Scene scene;
-  lo::GpuOctree octree;
-  lo::GpuOctree octreeHalf;
+  lo::VdlGrid grid;
   lo::BakeMetadata meta;
 };
 
@@ -85,10 +84,7 @@ Baked load(const std::string& scenePath, const std::string& vdbPath) {
   b.scene = lo::loadScene(scenePath);
   lo::LoadedVdl vdl = lo::readVdlGrid(vdbPath, b.scene.origin);
   b.meta = vdl.meta;
-  b.octree = lo::buildGpuOctree(vdl.grid);
-  lo::GpuOctreeParams half;
-  half.halfFloat = true;
-  b.octreeHalf = lo::buildGpuOctree(vdl.grid, half);
+  b.grid = std::move(vdl.grid);
   return b;
 }
 
@@ -201,7 +197,22 @@ int main(int argc, char** argv) try {
       continue;
     }
     Baked b = load(s.path, s.vdb);
-    const lo::GpuOctree& o = b.octree;
+    // The octree stage's lossless layout (RGBA32F VDL texels, every leaf at
+    // the bake's depth): what the paper's memory figures count. The octree
+    // is also rendered into a lightmap atlas (CPU, the renderer's lookup with
+    // interpolation), once per scene, for the atlas rows.
+    lo::RenderSettings settings;
+    settings.octree = lo::GpuOctreeParams{};
+    settings.frame.lighting = lo::Lighting::Atlas;
+    lo::RenderSessionOptions options;
+    options.keepOctree = true;
+    options.freeTexels = false;
+    lo::RenderSettings halfSettings = settings;
+    halfSettings.octree.halfFloat = true;
+    const lo::GpuOctree octreeHalf = lo::buildRenderOctree(b.grid, halfSettings);
+    lo::RenderSession session(b.scene, std::move(b.grid), *context, settings, options);
+    lo::Renderer& renderer = session.renderer();
+    const lo::GpuOctree& o = session.octree();
     const double leaves = double(std::max<size_t>(o.leafCount, 1));
     std::printf("%s: %s; %s\n", s.label, s.vdb.c_str(), o.ToString().c_str());
     bakeSettings.push_back(std::string(s.label) + ": " + lo::formatCount(size_t(b.meta.photons)) +
@@ -209,7 +220,7 @@ int main(int argc, char** argv) try {
                            b.meta.vdls + " VDLs, depth " + std::to_string(b.meta.depth));
     {
       double pool = double(o.poolBytes()) / leaves, vdl = double(o.vdlBytes()) / leaves;
-      double vdlHalf = double(b.octreeHalf.vdlBytes()) / leaves;
+      double vdlHalf = double(octreeHalf.vdlBytes()) / leaves;
       auto mib100k = [](double bytesPerLeaf) { return bytesPerLeaf * 1e5 / (1024.0 * 1024.0); };
       memory << "| " << s.label << " | " << o.leafCount << " | "
              << fixed(double(o.vdlCount) / leaves, 2) << " | " << o.nodeCount << " | "
@@ -218,12 +229,7 @@ int main(int argc, char** argv) try {
              << " MiB |\n";
     }
     lo::PinholeCamera camera = lo::PinholeCamera::ofScene(b.scene);
-    lo::Renderer renderer(b.scene, o);
-    // The octree rendered into a lightmap atlas (CPU, the renderer's lookup
-    // with interpolation), once per scene.
-    lo::LightingParams lighting;
-    lighting.lighting = lo::Lighting::Atlas;
-    const lo::LightmapBake atlas = *lo::prepareLighting(renderer, b.scene, o, lighting);
+    const lo::LightmapBake& atlas = *session.atlas();
     std::printf("  atlas: %s\n", atlas.ToString().c_str());
     // The same atlas baked in this GL context (render/atlas_gpu.h); the
     // program is linked before the bake's clocks start.

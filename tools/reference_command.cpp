@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "camera_options.h"
+#include "picture_options.h"
 #include "cli_checks.h"
 #include "commands.h"
 #include "scene_options.h"
@@ -41,7 +42,7 @@ struct ReferenceOptions {
   int threads = 0;
   int maxBounces = 256;
   bool addedOnlyReceive = false;  // --added-only-receive
-  float exposure = 0;  // PNG only, as `render --exposure`
+  PictureOptions picture;  // PNG only, as `render --exposure --tone-map`
   double edgeDistance = 0;  // 0 = one voxel of a depth-6 bake
   std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
@@ -68,6 +69,7 @@ int runReference(const ReferenceOptions& opt) {
   JsonReport report{"reference", inputs, {{"part", opt.part}, {"width", opt.width}, {"height", opt.height}}};
   std::vector<StageReport> rows;
   checkCameraOptions(opt.camera);
+  (void)opt.picture.toneParams();  // a bad --exposure is refused before the work
   ThreadLimit threadLimit(opt.threads);
 
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
@@ -139,7 +141,8 @@ int runReference(const ReferenceOptions& opt) {
   traceTimer.finish(std::to_string(result.samplesPerPixel) + " spp");
   // The image and its side images (and the report) appear together.
   AtomicFileSet outputs;
-  writeImage(opt.output, result.image, opt.exposure, &outputs);
+  ToneReport tone;
+  writeTonedImage(opt.output, result.image, opt.picture.toneParams(), &outputs, &tone);
   if (!opt.stdErrorOutput.empty()) writeImage(opt.stdErrorOutput, result.stdError, 0.0f, &outputs);
   if (!opt.emitterMaskOutput.empty()) {
     writeImage(opt.emitterMaskOutput, result.emitterMask, 0.0f, &outputs);
@@ -152,6 +155,9 @@ int runReference(const ReferenceOptions& opt) {
   }
   outputs.commit();
 
+  if (!opt.quiet && hasExtension(opt.output, ".png")) {
+    std::printf("picture: %s\n", tone.ToString().c_str());
+  }
   if (!opt.quiet) {
     // The mean standard error relative to the mean value: how far the
     // reference itself is from converged, to weigh errors measured against it.
@@ -201,9 +207,7 @@ std::function<int()> addReferenceCommand(CLI::App& app) {
   cmd->add_option("--height", opt->height, "Image height in pixels")
       ->check(CLI::Range(1, 16384))
       ->capture_default_str();
-  cmd->add_option("--exposure", opt->exposure, "PNG exposure in EV (radiance * 2^EV), as render's")
-      ->check(CLI::Range(-30.0f, 30.0f))
-      ->capture_default_str();
+  addPictureOptions(cmd, opt->picture);
   auto* spp = cmd->add_option("--spp", opt->spp, "Samples per pixel")
                   ->check(CLI::Range(1, 1000000))
                   ->capture_default_str();

@@ -1,29 +1,24 @@
 // `lightoctree render`: scene + baked .vdb -> GPU light octree -> image.
 
 #include <CLI/CLI.hpp>
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
-#include <sstream>
 
 #include "camera_options.h"
+#include "picture_options.h"
 #include "render_options.h"
 #include "scene_options.h"
 #include "commands.h"
-#include "bake/bake.h"
-#include "core/resources.h"
 #include "core/file.h"
 #include "core/file_set.h"
 #include "core/error.h"
-#include "octree/gpu_octree.h"
-#include "octree/octree_irradiance.h"
+#include "bake/bake.h"
 #include "reference/first_hit.h"
 #include "render/context.h"
+#include "render/render_session.h"
 #include "json_report.h"
 #include "report.h"
 #include "image/image.h"
-#include "render/renderer.h"
 #include "scene/scene.h"
 #include "vdb/vdb_io.h"
 
@@ -40,6 +35,7 @@ struct RenderOptions {
   int width = 800, height = 600;
   std::string mode = "full";
   ShadingOptions shading;
+  PictureOptions picture;  // --exposure, --tone-map
   std::string backend = "osmesa";
   int frames = 0;
   int irradianceSpp = 64;
@@ -54,19 +50,29 @@ double meanLuminance(const RgbImage& image) {
   return image.pixelCount() ? sum / double(image.pixelCount()) : 0.0;
 }
 
-/// Writes the image and, with --json, the report, as one set.
+/// Writes the image and, with --json, the report, as one set; says how the
+/// PNG was exposed and what share of it clips.
 void writeRenderOutputs(const RenderOptions& opt, const RgbImage& image, JsonReport& report,
                         const std::vector<StageReport>& rows) {
   AtomicFileSet outputs;
-  writeImage(opt.output, image, opt.shading.exposure, &outputs);
+  ToneReport tone;
+  writeTonedImage(opt.output, image, opt.picture.toneParams(), &outputs, &tone);
+  const bool png = hasExtension(opt.output, ".png");
   if (!opt.json.empty()) {
     report.figures["image"] = {{"width", image.width},
                                {"height", image.height},
-                               {"mean_luminance", meanLuminance(image)},
-                               {"exposure_ev", opt.shading.exposure}};
+                               {"mean_luminance", meanLuminance(image)}};
+    if (png) {
+      report.figures["image"]["exposure_ev"] = tone.exposureEv;
+      report.figures["image"]["auto_exposure"] = tone.autoExposure;
+      report.figures["image"]["tone_map"] = toString(tone.curve);
+      report.figures["image"]["clipped_share"] = tone.clippedShare;
+      report.figures["image"]["white_share"] = tone.whiteShare;
+    }
     report.addTo(outputs, opt.json, rows);
   }
   outputs.commit();
+  if (png && !opt.quiet) std::printf("picture: %s\n", tone.ToString().c_str());
 }
 
 /// `--mode irradiance`: the octree's indirect irradiance at the first hit,
@@ -82,27 +88,18 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
                      JsonReport& report, std::vector<StageReport>& rows) {
   if (opt.frames > 0) throw InputError("--frames: not with --mode irradiance (no GL frame)");
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
-  // No GL context to ask: the limits of the GL 3.3 contexts we render with.
-  GpuOctree octree = buildGpuOctree(baked.grid, opt.shading.octreeParams());
-  if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
-  OctreeShadeParams shade;
-  shade.interpolation = opt.shading.interpolation == "on";
-  shade.maxVdls = opt.shading.vdls;
-  shade.normalOffset = RenderParams().normalOffset;
-  FirstHitParams params;
-  params.width = opt.width;
-  params.height = opt.height;
-  params.samplesPerPixel = opt.irradianceSpp;
+  const RenderSettings settings = opt.shading.settings(RenderMode::Full, opt.width, opt.height);
+  FirstHitParams hits;
+  hits.width = opt.width;
+  hits.height = opt.height;
+  hits.samplesPerPixel = opt.irradianceSpp;
   StageTimer renderTimer(rows, "render");
-  // Added objects read the free-space light (the renderer's LO_FREE_SPACE).
-  GpuOctree volume;
-  if (!opt.objects.empty() && hasLightForAddedObjects(baked.grid, opt.lights)) {
-    volume = buildVolumeOctree(baked.grid.volume, opt.shading.octreeParams());
-  }
-  RgbImage image = renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {
-    if (scene.isAdded(hit.triangle) && volume.depth > 0) return volumeIrradiance(volume, hit.position, hit.normal);
-    return octreeIrradiance(octree, hit.position, hit.normal, shade);
-  });
+  // No GL context to ask: the octrees within the GL 3.3 limits we render with.
+  const LookupOctrees octrees = buildLookupOctrees(scene, baked.grid, settings, opt.lights);
+  for (const std::string& w : octrees.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (!opt.quiet) std::printf("octree: %s\n", octrees.surface.ToString().c_str());
+  const RgbImage image = renderOctreeIrradiance(scene, camera, octrees.surface, octrees.volume,
+                                                shadeParamsOf(settings.frame), hits);
   renderTimer.finish(std::to_string(opt.irradianceSpp) + " rays per pixel");
   writeRenderOutputs(opt, image, report, rows);
   if (!opt.quiet) std::printf("wrote %s\n", opt.output.c_str());
@@ -122,6 +119,7 @@ int runRender(const RenderOptions& opt) {
     throw InputError("--output: '" + opt.output + "' must end in .png or .exr");
   }
   checkCameraOptions(opt.camera);
+  (void)opt.picture.toneParams();  // a bad --exposure is refused before the work
   StageTimer loadTimer(rows, "load scene");
   Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
   placeObjects(scene, opt.objects);
@@ -134,10 +132,9 @@ int runRender(const RenderOptions& opt) {
   const std::string stale = staleBakeWarning(baked.meta, opt.scene);
   if (!stale.empty()) std::fprintf(stderr, "warning: %s: %s\n", opt.lights.c_str(), stale.c_str());
   if (opt.mode == "irradiance") return renderIrradiance(opt, scene, baked, report, rows);
-  RenderParams params = opt.shading.renderParams(parseRenderMode(opt.mode));
-  params.width = opt.width;
-  params.height = opt.height;
-
+  const RenderSettings settings =
+      opt.shading.settings(parseRenderMode(opt.mode), opt.width, opt.height);
+  const RenderParams& params = settings.frame;
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
   if (baked.meta.includeDirect == 1 &&
       (params.mode == RenderMode::Full || params.mode == RenderMode::Direct)) {
@@ -155,33 +152,17 @@ int runRender(const RenderOptions& opt) {
   if (!opt.quiet) std::printf("%s: %s\n", opt.backend.c_str(), context->info().ToString().c_str());
   report.figures["gl"] = context->info().ToString();
 
-  StageTimer octreeTimer(rows, "octree");
-  GpuOctree octree = buildGpuOctree(baked.grid, opt.shading.octreeParams(&context->info()));
-  if (opt.objects.empty()) {
-    // The octree holds all the renderer reads of the grid; only the added
-    // objects' free-space light reads it again.
-    baked.grid = VdlGrid{};
-    returnFreeMemory();
+  RenderSessionOptions sessionOptions;
+  sessionOptions.gridName = opt.lights;
+  RenderSession session(scene, std::move(baked.grid), *context, settings, sessionOptions);
+  rows.insert(rows.end(), session.stages().begin(), session.stages().end());
+  printWarnings(session);
+  if (!opt.quiet) {
+    std::printf("octree: %s\n", session.octreeSummary().c_str());
+    if (!session.atlasSummary().empty()) std::printf("atlas: %s\n", session.atlasSummary().c_str());
   }
-  octreeTimer.finish("");
-  if (!opt.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
-  report.figures["octree"] = octree.ToString();
-
-  // Nothing after the renderer's construction reads a texel: each texture's
-  // are freed as soon as its GPU copy is made.
-  Renderer renderer(scene, octree, opt.shading.rendererParams(), freeTexelsOnUpload(scene));
-  rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
-  scene.releaseTexels();  // those no material draws with
-  returnFreeMemory();
-  if (!opt.objects.empty()) {
-    StageTimer volumeTimer(rows, "free-space light");
-    setAddedObjectsLight(renderer, baked.grid, opt.shading, opt.shading.octreeParams(&context->info()),
-                         opt.lights);
-    volumeTimer.finish(renderer.hasFreeSpaceLight() ? "for the added objects" : "none in the bake");
-  }
-  StageTimer lightingTimer(rows, "prepare lighting");
-  opt.shading.prepareLighting(renderer, scene, octree, opt.quiet);
-  lightingTimer.finish(renderer.hasAtlas() ? "lightmap atlas" : "");
+  report.figures["octree"] = session.octreeSummary();
+  Renderer& renderer = session.renderer();
   StageTimer frameTimer(rows, "first frame");
   RgbImage image = renderer.render(camera, params);
   frameTimer.finish(std::to_string(opt.width) + " x " + std::to_string(opt.height));
@@ -215,7 +196,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", opt->output,
-                  "Image: .exr (linear float radiance) or .png (exposure, sRGB)")
+                  "Image: .exr (linear float radiance) or .png (--exposure, --tone-map, sRGB)")
       ->required();
   addCameraOptions(cmd, opt->camera);
   cmd->add_option("--width", opt->width, "Image width in pixels")
@@ -231,6 +212,7 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"full", "direct", "indirect", "voxels", "irradiance"}))
       ->capture_default_str();
   addShadingOptions(cmd, opt->shading, false);
+  addPictureOptions(cmd, opt->picture);
   cmd->add_option("--backend", opt->backend, "Headless OpenGL: osmesa (software) or egl")
       ->check(CLI::IsMember({"osmesa", "egl"}))
       ->capture_default_str();

@@ -3,65 +3,39 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <optional>
 
 #include "core/error.h"
 #include "lightmap/lightmap_bake.h"
 
 namespace lo::tool {
 
-RenderParams ShadingOptions::renderParams(RenderMode mode) const {
-  RenderParams p;
-  p.mode = mode;
-  p.interpolation = interpolation == "on";
-  p.specular = specular == "on";
-  p.reflections = reflections == "on";
-  p.lighting = parseLighting(lighting);
-  p.supersample = supersample;
-  p.maxVdls = vdls;
-  return p;
+RenderSettings ShadingOptions::settings(RenderMode mode, int width, int height) const {
+  RenderSettings s;
+  s.frame.mode = mode;
+  s.frame.width = width;
+  s.frame.height = height;
+  s.frame.interpolation = interpolation == "on";
+  s.frame.specular = specular == "on";
+  s.frame.reflections = reflections == "on";
+  s.frame.lighting = parseLighting(lighting);
+  s.frame.supersample = supersample;
+  s.frame.maxVdls = vdls;
+  s.renderer.areaLights = areaLights == "on";
+  s.renderer.emitterLights = emitterLights;
+  s.renderer.shadowMapSize = shadowMapSize;
+  s.octree.halfFloat = halfFloat || texels == "half";
+  s.octree.compact = texels == "compact" && !halfFloat;
+  s.octree.cosineCorrection = cosineCorrection == "on";
+  s.octree.tolerance = tolerance;
+  s.octree.volumeTolerance = freeSpaceTolerance;
+  s.uvSource = parseUvSource(uv);
+  s.stitchSeams = stitchSeams == "on";
+  s.atlasOnGpu = atlasOn == "gpu";
+  return s;
 }
 
-RendererParams ShadingOptions::rendererParams() const {
-  RendererParams p;
-  p.areaLights = areaLights == "on";
-  p.emitterLights = emitterLights;
-  p.shadowMapSize = shadowMapSize;
-  return p;
-}
-
-GpuOctreeParams ShadingOptions::octreeParams(const GlInfo* info) const {
-  GpuOctreeParams p;
-  p.halfFloat = halfFloat || texels == "half";
-  p.compact = texels == "compact";
-  p.cosineCorrection = cosineCorrection == "on";
-  p.tolerance = tolerance;
-  p.volumeTolerance = freeSpaceTolerance;
-  if (info) {
-    p.max3DTextureSize = info->max3DTextureSize;
-    p.max2DTextureSize = info->max2DTextureSize;
-  }
-  return p;
-}
-
-LightingParams ShadingOptions::lightingParams() const {
-  LightingParams p;
-  p.lighting = parseLighting(lighting);
-  p.uvSource = parseUvSource(uv);
-  p.shade = shadeParamsOf(renderParams(RenderMode::Full));
-  p.stitchSeams = stitchSeams == "on";
-  p.atlasOnGpu = atlasOn == "gpu";
-  return p;
-}
-
-void ShadingOptions::prepareLighting(Renderer& renderer, const Scene& scene,
-                                     const GpuOctree& octree, bool quiet) const {
-  const std::optional<LightmapBake> baked =
-      lo::prepareLighting(renderer, scene, octree, lightingParams());
-  if (baked && !quiet) {
-    std::printf("atlas: %s; %.1f MiB on the GPU\n", baked->ToString().c_str(),
-                double(renderer.atlasBytes()) / (1024.0 * 1024.0));
-  }
+void printWarnings(const RenderSession& session) {
+  for (const std::string& w : session.warnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
 }
 
 CLI::Validator onOff() { return CLI::IsMember({"on", "off"}); }
@@ -108,11 +82,11 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
         ->check(CLI::Range(1, 16))
         ->capture_default_str();
   }
-  cmd->add_option("--exposure", opt.exposure,
-                  std::string(window ? "Exposure" : "PNG exposure") +
-                      " in EV (radiance * 2^EV)" + key("keys , . 0"))
-      ->check(CLI::Range(-30.0f, 30.0f))
-      ->capture_default_str();
+  if (window) {  // `render` has --exposure auto|EV (picture_options.h)
+    cmd->add_option("--exposure", opt.exposure, "Exposure in EV (radiance * 2^EV)" + key("keys , . 0"))
+        ->check(CLI::Range(-30.0f, 30.0f))
+        ->capture_default_str();
+  }
   cmd->add_option("--vdls", opt.vdls, "VDLs used per voxel, strongest first" + key("keys [ ]"))
       ->check(CLI::Range(1, kMaxVdls))
       ->capture_default_str();
@@ -154,34 +128,6 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
                   "irradiance agrees within this share, for 14 normals, become one (0 = none)")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
-}
-
-std::function<void(int)> freeTexelsOnUpload(Scene& scene) {
-  return [&scene](int texture) {
-    scene.releaseTexels(size_t(texture));
-    returnFreeMemory();
-  };
-}
-
-void setAddedObjectsLight(Renderer& renderer, const VdlGrid& baked, const ShadingOptions& shading,
-                          const GpuOctreeParams& params, const std::string& lightsPath) {
-  if (shading.lighting == "atlas") {
-    throw InputError("--add: not with --lighting atlas (the atlas holds the baked surfaces' light "
-                     "only); added objects are lit by the octree's free-space light");
-  }
-  if (hasLightForAddedObjects(baked, lightsPath)) {
-    renderer.setFreeSpaceLight(buildVolumeOctree(baked.volume, params));
-  }
-}
-
-bool hasLightForAddedObjects(const VdlGrid& baked, const std::string& lightsPath) {
-  if (!baked.volume.empty()) return true;
-  std::fprintf(stderr,
-               "warning: %s holds no free-space light (baked with --free-space off, or by an "
-               "older lightoctree): the added objects take the light "
-               "of the surfaces near them\n",
-               lightsPath.c_str());
-  return false;
 }
 
 }  // namespace lo::tool

@@ -23,12 +23,10 @@
 #include "core/error.h"
 #include "core/file.h"
 #include "core/file_set.h"
-#include "core/resources.h"
-#include "octree/gpu_octree.h"
 #include "render/camera_path.h"
 #include "render/context.h"
 #include "render/fly_camera.h"
-#include "render/renderer.h"
+#include "render/render_session.h"
 #include "render/viewer.h"
 #include "render_options.h"
 #include "report.h"
@@ -84,7 +82,9 @@ int runView(const ViewOptions& opt) {
   if (!opt.cameraPath.empty()) path = readCameraPath(opt.cameraPath);
   if (!opt.view.saveFrames.empty()) makeOutputFolder(opt.view.saveFrames, "--save-frames");
   ViewerParams view = opt.view;
-  view.render = opt.shading.renderParams(parseRenderMode(opt.mode));
+  const RenderSettings settings =
+      opt.shading.settings(parseRenderMode(opt.mode), opt.width, opt.height);
+  view.render = settings.frame;
   view.exposure = opt.shading.exposure;
   view.path = std::move(path);
 
@@ -129,51 +129,46 @@ int runView(const ViewOptions& opt) {
   if (!opt.view.quiet) std::printf("glfw: %s\n", context->info().ToString().c_str());
   report.figures["gl"] = context->info().ToString();
 
-  const GpuOctreeParams octreeParams = opt.shading.octreeParams(&context->info());
-
-  // Progressive: the bake thread starts before the renderer's set-up (scene
+  // Progressive: the bake thread starts before the session's set-up (scene
   // upload, shadow maps) so that the two overlap; until the first level is
   // ready the window shows direct light over an empty octree.
   std::unique_ptr<ProgressiveBake> bake;
   std::unique_ptr<OctreeLevelSource> levels;
-  GpuOctree octree;
-  StageTimer octreeTimer(rows, opt.progressive ? "start progressive bake" : "octree");
   if (opt.progressive) {
+    StageTimer bakeTimer(rows, "start progressive bake");
     ProgressiveParams pp = opt.bake;
     pp.firstDepth = std::min(4, pp.targetDepth);
     pp.cluster.seed = pp.photons.seed;
-    pp.octree = octreeParams;
+    pp.octree = settings.octreeParams(&context->info());
     bake = std::make_unique<ProgressiveBake>(scene, pp);
     levels = progressiveLevelSource(*bake, pp.targetDepth);
     view.firstDepth = pp.firstDepth;
     view.targetDepth = pp.targetDepth;
+    bakeTimer.finish("");
     if (!opt.view.quiet) {
       std::printf("progressive: tracing %zu photons, then depth %d to %d\n", pp.photons.storedPhotons,
                   pp.firstDepth, pp.targetDepth);
     }
-  } else {
-    octree = buildGpuOctree(baked->grid, octreeParams);
-    if (opt.objects.empty()) baked.reset();  // only the added objects' light reads it again
-    view.shownDepth = octree.depth;
-    if (!opt.view.quiet) std::printf("octree: %s\n", octree.ToString().c_str());
-    report.figures["octree"] = octree.ToString();
   }
-  octreeTimer.finish("");
-
   // Without a bake tracing the scene beside it, nothing reads a texel after
   // the renderer's construction: each texture's are freed once on the GPU.
-  Renderer renderer(scene, octree, opt.shading.rendererParams(),
-                    bake ? std::function<void(int)>() : freeTexelsOnUpload(scene));
-  rows.insert(rows.end(), renderer.startupStages().begin(), renderer.startupStages().end());
-  if (!opt.objects.empty() && baked) {
-    StageTimer volumeTimer(rows, "free-space light");
-    setAddedObjectsLight(renderer, baked->grid, opt.shading, octreeParams, opt.lights);
-    volumeTimer.finish(renderer.hasFreeSpaceLight() ? "for the added objects" : "none in the bake");
+  RenderSessionOptions sessionOptions;
+  sessionOptions.freeTexels = !bake;
+  sessionOptions.gridName = opt.lights;
+  RenderSession session(scene, baked ? std::move(baked->grid) : VdlGrid{}, *context, settings,
+                        sessionOptions);
+  baked.reset();
+  rows.insert(rows.end(), session.stages().begin(), session.stages().end());
+  printWarnings(session);
+  if (!bake) {
+    view.shownDepth = session.octreeDepth();
+    if (!opt.view.quiet) std::printf("octree: %s\n", session.octreeSummary().c_str());
+    report.figures["octree"] = session.octreeSummary();
   }
-  StageTimer lightingTimer(rows, "prepare lighting");
-  opt.shading.prepareLighting(renderer, scene, octree, opt.view.quiet);
-  lightingTimer.finish(renderer.hasAtlas() ? "lightmap atlas" : "");
-  octree = GpuOctree();  // uploaded; the CPU copy is not needed any more
+  if (!opt.view.quiet && !session.atlasSummary().empty()) {
+    std::printf("atlas: %s\n", session.atlasSummary().c_str());
+  }
+  Renderer& renderer = session.renderer();
   if (!opt.view.quiet && !view.path) std::printf("%s", viewerKeyHelp());
 
   Viewer viewer(*context, renderer, view, levels.get());

@@ -101,3 +101,30 @@ def test_errors_are_python_exceptions(tmp_path):
     assert issubclass(lightoctree.InputError, ValueError)
     with pytest.raises(ValueError):
         lightoctree.bake(SCENE, photons=1000, target_error=0.1)
+
+
+def test_render_equals_the_command(grid, tmp_path):
+    """lightoctree.render and `lightoctree render` go through one render
+    session: the same grid file at the same size gives the same floats."""
+    cli = os.environ.get("LIGHTOCTREE_CLI")
+    if not cli:
+        pytest.skip("LIGHTOCTREE_CLI not set (ctest sets it)")
+    import subprocess
+    vdb = str(tmp_path / "grid.vdb")
+    exr = str(tmp_path / "frame.exr")
+    lightoctree.write(vdb, grid)
+    subprocess.run([cli, "render", SCENE, vdb, "-o", exr, "--width", "64", "--height", "48",
+                    "--quiet"], check=True)
+    command = lightoctree.read_image(exr)
+    module = lightoctree.render(SCENE, lightoctree.read(vdb), width=64, height=48)
+    assert command.shape == module.shape == (48, 64, 3)
+    assert module.mean() > 0
+    assert np.array_equal(command, module), \
+        f"mean absolute difference {np.abs(command - module).mean()}"
+    # A setting reaches the picture: diffuse only differs from the default.
+    diffuse = lightoctree.render(SCENE, lightoctree.read(vdb), width=64, height=48, specular=False)
+    assert not np.array_equal(diffuse, module)
+    with pytest.raises(lightoctree.InputError):
+        lightoctree.render(SCENE, grid, width=8, height=8, no_such_setting=1)
+    with pytest.raises(lightoctree.InputError):
+        lightoctree.render(SCENE, grid, width=8, height=8, texels="double")

@@ -89,4 +89,15 @@ RgbImage renderEdgeMask(const Scene& scene, const PinholeCamera& camera,
   return renderFirstHits(scene, camera, params, nearEdge, progress);
 }
 
+RgbImage renderOctreeIrradiance(const Scene& scene, const PinholeCamera& camera,
+                                const GpuOctree& octree, const GpuOctree& volume,
+                                const OctreeShadeParams& shade, const FirstHitParams& params) {
+  return renderFirstHits(scene, camera, params, [&](const FirstHit& hit) {
+    if (volume.depth > 0 && scene.isAdded(hit.triangle)) {
+      return volumeIrradiance(volume, hit.position, hit.normal);
+    }
+    return octreeIrradiance(octree, hit.position, hit.normal, shade);
+  });
+}
+
 }  // namespace lo

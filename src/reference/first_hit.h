@@ -13,6 +13,8 @@
 #include "core/progress.h"
 #include "image/image.h"
 #include "reference/path_tracer.h"
+#include "octree/gpu_octree.h"
+#include "octree/octree_irradiance.h"
 #include "scene/scene.h"
 
 namespace lo {
@@ -40,6 +42,15 @@ RgbImage renderFirstHits(const Scene& scene, const PinholeCamera& camera,
                          const FirstHitParams& params,
                          const std::function<Vec3(const FirstHit&)>& shade,
                          ProgressSink* progress = nullptr);
+
+/// @brief The light octree's indirect irradiance at the first hits, on the
+/// CPU (octreeIrradiance: the shader's lookup with the cosine alone), the
+/// objects added after the bake (Scene::isAdded) read from `volume`, their
+/// free-space light, when it is not empty: the image that compares with the
+/// reference's irradiance part (`render --mode irradiance`, the sweep).
+RgbImage renderOctreeIrradiance(const Scene& scene, const PinholeCamera& camera,
+                                const GpuOctree& octree, const GpuOctree& volume,
+                                const OctreeShadeParams& shade, const FirstHitParams& params);
 
 /// The pixels whose first hit lies within `distance` (scene units) of an
 /// edge: where the surface meets another one (a wall joint, an object

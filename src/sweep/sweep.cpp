@@ -22,7 +22,7 @@
 #include "reference/first_hit.h"
 #include "reference/path_tracer.h"
 #include "render/context.h"
-#include "render/renderer.h"
+#include "render/render_session.h"
 #include "scene/scene.h"
 #include "sweep/sweep_internal.h"
 #include "vdb/vdb_io.h"
@@ -138,27 +138,50 @@ BakeFigures bakeAndWrite(const Scene& scene, const std::string& scenePath, const
   return f;
 }
 
-/// The GL renderer of the indirect images: one context and one set of scene
-/// resources for the whole sweep (the renderer is made on first use).
+/// The render settings of a sweep point: the octree stage's lossless
+/// texels (the point chooses half floats, the cosine correction and the
+/// adaptive leaves), the point's interpolation, indirect light alone.
+RenderSettings renderSettingsOf(const SweepPoint& point, int width, int height) {
+  RenderSettings s;
+  s.frame.width = width;
+  s.frame.height = height;
+  s.frame.mode = RenderMode::Indirect;
+  s.frame.interpolation = point.interpolation;
+  s.octree = GpuOctreeParams{};
+  s.octree.halfFloat = point.halfFloat;
+  s.octree.cosineCorrection = point.cosineCorrection;
+  s.octree.tolerance = point.tolerance;
+  return s;
+}
+
+/// The GL render session of the indirect images: one context and one set of
+/// scene resources for the whole sweep (made with the first point's grid,
+/// each later point's light swapped in).
 struct IndirectRenderer {
   std::unique_ptr<GlContext> context;
-  std::unique_ptr<Renderer> renderer;
+  std::unique_ptr<RenderSession> session;
 
-  /// The indirect image of `octree` and its mean frame time over `frames`.
-  RgbImage render(const Scene& scene, const GpuOctree& octree, const SweepPoint& point,
-                  const PinholeCamera& camera, int width, int height, int frames, double& frameMs) {
-    if (!renderer) {
-      renderer = std::make_unique<Renderer>(scene, octree, RendererParams{});
+  /// The octree of `grid` as the point's renderer draws it (within the
+  /// context's limits, when frames are timed), for the CPU lookup too.
+  GpuOctree octreeOf(Scene& scene, const VdlGrid& grid, const RenderSettings& settings) {
+    if (!context) return buildRenderOctree(grid, settings);
+    if (!session) {
+      RenderSessionOptions options;
+      options.freeTexels = false;  // the first-hit images read the textures
+      options.keepOctree = true;
+      session = std::make_unique<RenderSession>(scene, grid, *context, settings, options);
     } else {
-      renderer->setOctree(octree);
+      session->setGrid(grid, settings.octree);
     }
-    RenderParams rp;
-    rp.width = width;
-    rp.height = height;
-    rp.mode = RenderMode::Indirect;
-    rp.interpolation = point.interpolation;
-    const RgbImage image = renderer->render(camera, rp);
-    frameMs = 1000.0 * renderer->timeFrames(camera, rp, frames) / frames;
+    return session->octree();
+  }
+
+  /// The indirect image of the octree octreeOf built last and its mean frame
+  /// time over `frames`.
+  RgbImage render(const PinholeCamera& camera, const RenderSettings& settings, int frames,
+                  double& frameMs) {
+    const RgbImage image = session->renderer().render(camera, settings.frame);
+    frameMs = 1000.0 * session->renderer().timeFrames(camera, settings.frame, frames) / frames;
     return image;
   }
 };
@@ -179,7 +202,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     writeTextAtomically(params.outDir + "/.gitignore", "cache/\n");
 
   ThreadLimit threadLimit(params.threads);
-  const Scene scene = loadScene(params.scene);
+  Scene scene = loadScene(params.scene);
   const PinholeCamera camera = PinholeCamera::ofScene(scene, kPi / 4);
   const References refs = loadOrRenderReferences(params, scene, camera, cache, log);
   const CompareParams compareParams = sweepCompareParams(refs.emitterMask);
@@ -227,21 +250,11 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     r.noiseFigure = figures.noiseFigure;
     // The octree's irradiance at the reference's first hits.
     const LoadedVdl baked = readVdlGrid(vdb);
-    GpuOctreeParams octreeParams;
-    octreeParams.halfFloat = point.halfFloat;
-    octreeParams.cosineCorrection = point.cosineCorrection;
-    octreeParams.tolerance = point.tolerance;
-    if (const GlContext* gl = indirectRenderer.context.get()) {
-      octreeParams.max3DTextureSize = gl->info().max3DTextureSize;
-      octreeParams.max2DTextureSize = gl->info().max2DTextureSize;
-    }
-    const GpuOctree octree = buildGpuOctree(baked.grid, octreeParams);
+    const RenderSettings settings = renderSettingsOf(point, params.width, params.height);
+    const GpuOctree octree = indirectRenderer.octreeOf(scene, baked.grid, settings);
     r.gpuBytes = double(octree.poolBytes() + octree.vdlBytes());
     r.vdlTexels = double(octree.vdlCount);
     r.gpuLeaves = double(octree.leafCount);
-    OctreeShadeParams shade;
-    shade.interpolation = point.interpolation;
-    shade.normalOffset = RenderParams().normalOffset;
     FirstHitParams hitParams;
     hitParams.width = params.width;
     hitParams.height = params.height;
@@ -249,9 +262,8 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     // the reference's samples do (4 rays made up to a quarter of the jump).
     hitParams.samplesPerPixel = 64;
     hitParams.seed = params.seed;
-    const RgbImage irradiance = renderFirstHits(scene, camera, hitParams, [&](const FirstHit& h) {
-      return octreeIrradiance(octree, h.position, h.normal, shade);
-    });
+    const RgbImage irradiance = renderOctreeIrradiance(scene, camera, octree, GpuOctree(),
+                                                       shadeParamsOf(settings.frame), hitParams);
     writeExr(cache.imagePath(point, "irradiance"), irradiance);
     const CompareResult irrError = compareImages(irradiance, refs.irradiance, compareParams);
     r.irradianceRelRmse = irrError.luminance.relRmse;
@@ -261,9 +273,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
             .luminance.relRmse;
     // The indirect image through the GL renderer, and its frame time.
     if (params.frames > 0) {
-      const RgbImage indirect =
-          indirectRenderer.render(scene, octree, point, camera, params.width, params.height,
-                                  params.frames, r.frameMs);
+      const RgbImage indirect = indirectRenderer.render(camera, settings, params.frames, r.frameMs);
       writeExr(cache.imagePath(point, "indirect"), indirect);
       r.indirectRelRmse = compareImages(indirect, refs.indirect, compareParams).luminance.relRmse;
     }

@@ -21,7 +21,7 @@ run "$cli" bake "$scene" -o "$dir/grid.vdb" --depth 5 --photons 200000
 run "$cli" lightmap "$scene" "$dir/grid.vdb" -o "$dir/cornell-exr.glb" --image exr
 run "$cli" lightmap "$scene" "$dir/grid.vdb" -o "$dir/cornell-rgbm.glb" --image png
 run "$cli" render "$scene" "$dir/grid.vdb" --lighting atlas --mode indirect --width $size --height $size \
-  -o "$dir/ours.png"
+  -o "$dir/ours.png" --exposure 0 --tone-map clamp
 run "$cli" reference "$scene" -o "$dir/first-hit.exr" --width $size --height $size --spp 1 \
   --emitter-mask "$dir/emitter-mask.png"
 failures=0

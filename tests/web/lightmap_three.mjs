@@ -43,7 +43,7 @@ const prepare = (scene, name, images) => {
          '--image', image, '--quiet']);
   }
   run(['render', scene, join(out, `${name}.vdb`), '--lighting', 'atlas', '--mode', 'indirect', '--reflections', 'off',
-       '--width', String(size), '--height', String(size), '-o', join(out, `ours-${name}.png`), '--quiet']);
+       '--width', String(size), '--height', String(size), '-o', join(out, `ours-${name}.png`), '--exposure', '0', '--tone-map', 'clamp', '--quiet']);
   run(['reference', scene, '-o', join(out, `${name}-first-hit.exr`), '--width', String(size), '--height',
        String(size), '--spp', '1', '--emitter-mask', join(out, `${name}-emitters.png`), '--quiet']);
 };
