@@ -42,6 +42,16 @@ const int LO_SUN_CASCADES = 4;
 const float LO_PROBE_FULL = 0.5;
 const float LO_PROBE_NONE = 0.8;
 
+/* Irradiance normalisation of the probe (shaders/render_scene_probe.glsl):
+ * its light is scaled by the octree's irradiance at the surface over the
+ * probe's own, at most LO_PROBE_NORMALIZATION_MAX (1: it only takes light
+ * away, never adds any). The octree knows the light on the surfaces the
+ * photon tracer stores photons on: those with a diffuse lobe and metals
+ * rougher than LO_PROBE_GLOSSY_ROUGHNESS (kGlossyRoughness, material/bsdf.h:
+ * keep the two equal). */
+const float LO_PROBE_NORMALIZATION_MAX = 1.0;
+const float LO_PROBE_GLOSSY_ROUGHNESS = 0.2;
+
 /* Array sizes of the std140 LightBlock. */
 const int LO_MAX_LIGHTS = 32;
 const int LO_MAX_SHADOW_LAYERS = 96;

@@ -22,9 +22,14 @@
 #include "octree_lookup.h"
 
 // The VDLs light the diffuse lobe and the share of the specular one that the
-// probe does not (gVdlSpecular, set by main).
+// probe does not (gVdlSpecular, set by main). With gVdlIrradiance their
+// response is the cosine alone, as in C++ (octree/octree_irradiance.cpp) and
+// the atlas bake: the same lookup then gives the irradiance E(n) that the
+// probe's light is normalised by (indirectLight).
 float gVdlSpecular = 1.0;
+bool gVdlIrradiance = false;
 vec3 loVdlResponse(LoSurface s, vec3 d) {
+  if (gVdlIrradiance) return vec3(max(dot(s.n, d), 0.0));
   return loBrdfCosWeighted(s.n, s.v, d, s.baseColor, s.metallic, s.roughness, uTransmission,
                            uDielectric, uSpecular, gVdlSpecular);
 }
@@ -47,13 +52,17 @@ vec3 hashColor(ivec3 c) {
 
 // Indirect light at the fragment (paper §3.2): the octree's VDLs (or the
 // lightmap atlas's one rebuilt VDL) through the BRDF, and the probe's share
-// of the specular lobe. ng: the geometric normal, turned to the viewer.
+// of the specular lobe, normalised by the irradiance that the same light
+// gives here (probeNormalization). ng: the geometric normal, turned to the
+// viewer.
 vec3 indirectLight(vec3 n, vec3 v, vec3 ng, vec3 baseColor, float metallic, float roughness,
                    vec3 nLayer) {
   LoSurface s = LoSurface(n, v, baseColor, metallic, roughness, nLayer);
   float probe = probeWeight(roughness);
+  float known = probe > 0.0 ? probeKnowsLight(metallic, roughness) : 0.0;
   gVdlSpecular = 1.0 - probe;
-  vec3 indirect;
+  vec3 indirect = vec3(0.0);
+  vec3 irradiance = vec3(0.0);  // E(n) of the same light (W/m^2), for the probe
   // The atlas programs (LO_ATLAS_LIGHTING) leave the octree walk out: on
   // a software rasterizer the code's mere presence costs (scene_pass.cpp).
 #ifdef LO_ATLAS_LIGHTING
@@ -67,7 +76,7 @@ vec3 indirectLight(vec3 n, vec3 v, vec3 ng, vec3 baseColor, float metallic, floa
     vec3 E = texture(uAtlasIrradiance, vLightmap).rgb;
     vec3 d = texture(uAtlasDirection, vLightmap).rgb;
     float dl = length(d);
-    indirect = vec3(0.0);
+    irradiance = E;
     if (dl > 1e-3) {
       d /= dl;
       vec3 nb = normalize(vNormal);
@@ -75,17 +84,33 @@ vec3 indirectLight(vec3 n, vec3 v, vec3 ng, vec3 baseColor, float metallic, floa
       indirect = loVdlResponse(s, d) * E / max(dot(nb, d), 0.05);
     }
   } else {
+    // Where the probe needs the irradiance the walk runs a second time, with
+    // the cosine as the response: a loop, not a second call, so that the
+    // program holds one copy of the walk (on a software rasterizer its code
+    // alone costs).
+    int passes = known > 0.0 ? 2 : 1;
+    for (int pass = 0; pass < passes; ++pass) {
+      gVdlIrradiance = pass == 1;
+      vec3 light = vec3(0.0);
 #if defined(LO_FREE_SPACE)
-    // An object added after the bake: the free-space octree's light, bound
-    // in place of the surfaces' (scene_pass.cpp).
-    indirect = loVolumeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, s);
+      // An object added after the bake: the free-space octree's light, bound
+      // in place of the surfaces' (scene_pass.cpp).
+      light = loVolumeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, s);
 #elif !defined(LO_ATLAS_LIGHTING)
-    indirect = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
-                                uInterpolation, uMaxVdls, s);
+      light = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
+                               uInterpolation, uMaxVdls, s);
 #endif
+      if (pass == 0) {
+        indirect = light;
+      } else {
+        irradiance = light;
+      }
+    }
+    gVdlIrradiance = false;
   }
   if (probe > 0.0) {
-    indirect += probe * probeSpecular(vPosition, n, v, baseColor, metallic, roughness);
+    float scale = known > 0.0 ? mix(1.0, probeNormalization(n, irradiance), known) : 1.0;
+    indirect += probe * scale * probeSpecular(vPosition, n, v, baseColor, metallic, roughness);
   }
   return indirect;
 }

@@ -66,6 +66,7 @@ uniform samplerCube uProbe;    // the lit scene seen from the render-space origi
 uniform vec3 uProbeBoxMin;     // the scene's bounds (render space): the parallax box
 uniform vec3 uProbeBoxMax;
 uniform float uProbeMaxLod;
+uniform vec3 uProbeIrradiance[9];  // the probe's irradiance at its centre: SH terms E_i (octree_layout.h)
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 uniform float uThickness;     // KHR_materials_volume thickness; 0 = thin-walled
 uniform float uIor;           // KHR_materials_ior

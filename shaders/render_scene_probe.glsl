@@ -4,6 +4,7 @@
 // The probe's share of a surface's specular indirect light: all of it up to
 // roughness LO_PROBE_FULL, none above LO_PROBE_NONE (the VDLs' directions
 // light broad lobes well; a handful of VDLs cannot show a sharp reflection).
+// Its light is normalised by the octree's (probeNormalization, below).
 float probeWeight(float roughness) {
   return uHasProbe && uSpecular ? 1.0 - smoothstep(LO_PROBE_FULL, LO_PROBE_NONE, roughness) : 0.0;
 }
@@ -28,4 +29,41 @@ vec3 probeSpecular(vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float
   vec3 radiance = textureLod(uProbe, dir, lod).rgb;
   float nv = clamp(dot(n, v), 0.0, 1.0);
   return radiance * loEnvironmentBrdf(baseColor, metallic, roughness, nv, uDielectric);
+}
+
+// The probe's own irradiance towards n at its centre (W/m^2): its 9 SH
+// terms, octree_layout.h's basis convolved with the clamped cosine,
+// projected when it was captured (render/reflection_probe.cpp).
+vec3 probeIrradiance(vec3 n) {
+  vec3 e = vec3(0.0);
+  for (int i = 0; i < 9; ++i) e += uProbeIrradiance[i] * loShBasis(uint(i), n.x, n.y, n.z);
+  return max(e, vec3(0.0));
+}
+
+// How much the octree knows of the light at a surface: the photon tracer
+// stores photons on surfaces with a diffuse lobe and on metals rougher than
+// LO_PROBE_GLOSSY_ROUGHNESS (material/bsdf.cpp, storesPhotons), eased in
+// over 0.1 of roughness. On a mirror or clear glass the octree holds only
+// what neighbouring voxels lend: the probe keeps its own light there.
+float probeKnowsLight(float metallic, float roughness) {
+  if ((1.0 - metallic) * (1.0 - uTransmission) > 0.0) return 1.0;
+  return metallic > 0.0
+             ? smoothstep(LO_PROBE_GLOSSY_ROUGHNESS, LO_PROBE_GLOSSY_ROUGHNESS + 0.1, roughness)
+             : 0.0;
+}
+
+// Irradiance normalisation (Lazarov 2013; Lagarde and de Rousiers 2014;
+// Unreal's lightmap mixing): the probe shows the light around the scene's
+// centre, not what reaches this point. Its light is scaled by the luminance
+// of the irradiance the octree gives here (`irradiance`, E(n)) over the
+// probe's own towards n, clamped to [0, LO_PROBE_NORMALIZATION_MAX]: where
+// the octree knows of less light (a face turned from every emitter, the
+// shade under a table) the reflection dims with it, to nothing where no
+// light arrives (specular occlusion). The ratio of luminances keeps the
+// reflection's colours.
+float probeNormalization(vec3 n, vec3 irradiance) {
+  const vec3 luminance = vec3(0.2126, 0.7152, 0.0722);
+  float here = dot(irradiance, luminance);
+  float there = dot(probeIrradiance(n), luminance);
+  return clamp(here / max(there, 1e-6), 0.0, LO_PROBE_NORMALIZATION_MAX);
 }

@@ -2,6 +2,11 @@
 // lit scene seen from its centre, drawn by the scene pass itself.
 
 #include <glad/gl.h>
+#include <octree_layout.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
 
 #include "core/error.h"
 #include "render/context.h"
@@ -11,6 +16,32 @@
 namespace lo {
 
 using namespace render_internal;
+
+namespace {
+
+/// The direction (not unit) through the centre of texel (x, y) of an n x n
+/// face of a GL cube map: the OpenGL specification's cube-face table, s
+/// along x, t along y, both in [-1, 1].
+glm::vec3 cubeTexelDirection(int face, int x, int y, int n) {
+  const float s = 2.0f * (float(x) + 0.5f) / float(n) - 1.0f;
+  const float t = 2.0f * (float(y) + 0.5f) / float(n) - 1.0f;
+  switch (face) {
+    case 0:
+      return {1.0f, -t, -s};
+    case 1:
+      return {-1.0f, -t, s};
+    case 2:
+      return {s, 1.0f, t};
+    case 3:
+      return {s, -1.0f, -t};
+    case 4:
+      return {s, -t, 1.0f};
+    default:
+      return {-s, -t, -1.0f};
+  }
+}
+
+}  // namespace
 
 /// The six faces are 90-degree views from the scene's centre in GL's
 /// cube-face orientations; the mips are box-filtered (a blur that grows with
@@ -70,9 +101,49 @@ void Renderer::Impl::captureProbe(const RenderParams& rp) {
   probe.capturing = false;
   glBindTexture(GL_TEXTURE_CUBE_MAP, probe.texture.get());
   glGenerateMipmap(GL_TEXTURE_CUBE_MAP);
+  projectProbeIrradiance();
   glBindFramebuffer(GL_FRAMEBUFFER, GLuint(previous));
   probe.valid = true;
   checkGl("capturing the reflection probe");
+}
+
+/// The probe's irradiance as SH terms (octree_layout.h's basis and bands, as
+/// the octree's sh2 leaves hold theirs), from the mip level whose faces are
+/// 16 texels wide (the base level of a smaller probe), read back: each
+/// texel's radiance projected with its solid angle, (2/n)^2 / (1 + s^2 +
+/// t^2)^(3/2), the sum scaled so that the texels cover 4 pi.
+void Renderer::Impl::projectProbeIrradiance() {
+  const int level = std::max(0, probe.levels - 5);
+  const int n = std::max(1, params.probeSize >> level);
+  std::vector<float> texels(size_t(n) * size_t(n) * 4);
+  double sum[9][3] = {};
+  double solidAngle = 0;
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  for (int f = 0; f < 6; ++f) {
+    glGetTexImage(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), level, GL_RGBA, GL_FLOAT,
+                  texels.data());
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const glm::vec3 d = cubeTexelDirection(f, x, y, n);
+        const double r2 = double(glm::dot(d, d));
+        const double w = 4.0 / (double(n) * double(n) * r2 * std::sqrt(r2));
+        const glm::vec3 u = glm::normalize(d);
+        const float* radiance = &texels[(size_t(y) * size_t(n) + size_t(x)) * 4];
+        for (uint32_t i = 0; i < 9; ++i) {
+          const double yw = w * double(layout::loShBasis(i, u.x, u.y, u.z));
+          for (int a = 0; a < 3; ++a) sum[i][a] += yw * double(radiance[a]);
+        }
+        solidAngle += w;
+      }
+    }
+  }
+  const double scale = 4.0 * double(kPi) / solidAngle;
+  for (uint32_t i = 0; i < 9; ++i) {
+    const double band = double(layout::loShCosineBand(i)) * scale;
+    probe.irradiance[i] =
+        glm::vec3(float(sum[i][0] * band), float(sum[i][1] * band), float(sum[i][2] * band));
+  }
+  checkGl("projecting the reflection probe's irradiance");
 }
 
 }  // namespace lo

@@ -149,6 +149,11 @@ struct ReflectionProbe {
   GlFramebuffer fbo;
   GlRenderbuffer depth;
   int levels = 1;
+  /// Its irradiance at the centre as 9 SH terms (octree_layout.h's basis
+  /// convolved with the clamped cosine: E(n) = sum_i E_i Y_i(n), W/m^2),
+  /// projected after each capture: the scene shader scales the probe's
+  /// light by the octree's irradiance over this (render_scene_probe.glsl).
+  std::array<glm::vec3, 9> irradiance{};
 };
 
 }  // namespace render_internal
@@ -223,6 +228,8 @@ struct Renderer::Impl {
   /// Renders the probe's six faces with the full scene program, reflections
   /// off, then builds the mip chain that rough surfaces read.
   void captureProbe(const RenderParams& rp);
+  /// probe.irradiance from the captured cube map (its texture bound).
+  void projectProbeIrradiance();
 };
 
 }  // namespace lo

@@ -146,6 +146,7 @@ void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, con
   glUniform3f(loc("uProbeBoxMin"), bounds.lower.x, bounds.lower.y, bounds.lower.z);
   glUniform3f(loc("uProbeBoxMax"), bounds.upper.x, bounds.upper.y, bounds.upper.z);
   glUniform1f(loc("uProbeMaxLod"), float(probe.levels - 1));
+  glUniform3fv(loc("uProbeIrradiance"), 9, glm::value_ptr(probe.irradiance[0]));
   glActiveTexture(GL_TEXTURE11);
   glBindTexture(GL_TEXTURE_CUBE_MAP, reflect ? probe.texture.get() : 0);
   glActiveTexture(GL_TEXTURE0);

@@ -1402,5 +1402,87 @@ TEST(RenderImage, MirrorReflectsTheWallItsRayHits) {
   EXPECT_LT(off[0] + off[1] + off[2], 1e-4f);
 }
 
+// Irradiance normalisation of the probe: a face that no light reaches shows
+// none, however bright the probe. Around the probe, walls glowing in six
+// colours (not drawn as lights, not in the octree: only the probe sees
+// them); off the centre, a closet of inward-facing walls inside which
+// nothing arrives (the path tracer gives exactly 0 there). Its back wall,
+// seen from inside, a rough near-black dielectric (the table's pole: base
+// 0.02, roughness 0.5) or a glossy metal (roughness 0.3), stays black with
+// the probe on. With light in the octree the same wall does show the probe:
+// the normalisation scales its light, it does not switch it off.
+TEST(RenderImage, ProbeAddsNoLightWhereNoneArrives) {
+  REQUIRE_OSMESA();
+  struct Case {
+    const char* name;
+    Vec3 baseColor;
+    float metallic, roughness;
+  };
+  for (const Case& c : {Case{"dielectric", {0.02f, 0.02f, 0.02f}, 0.0f, 0.5f},
+                        Case{"metal", {0.9f, 0.9f, 0.9f}, 1.0f, 0.3f}}) {
+    SCOPED_TRACE(c.name);
+    Scene scene;
+    auto glow = [&scene](const Vec3& radiance) {
+      Material m;
+      m.baseColor = {0, 0, 0};
+      m.emission = radiance;
+      scene.materials.push_back(m);
+      return int(scene.materials.size()) - 1;
+    };
+    test::addQuad(scene, {1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {-1, 0, 0}, glow({1, 0, 0}));  // +x
+    test::addQuad(scene, {-1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {1, 0, 0}, glow({0, 1, 0}));  // -x
+    test::addQuad(scene, {-1, 1, -1}, {2, 0, 0}, {0, 0, 2}, {0, -1, 0}, glow({0, 0, 1}));  // ceiling
+    test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, glow({1, 0, 1}));  // floor
+    test::addQuad(scene, {-1, -1, 1}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, glow({1, 1, 0}));  // +z
+    test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, glow({0, 1, 1}));  // -z
+    Material closet;
+    closet.baseColor = c.baseColor;
+    closet.metallic = c.metallic;
+    closet.roughness = c.roughness;
+    scene.materials.push_back(closet);
+    // Single-sided and facing in: from outside (the probe at the centre) it
+    // is culled, so the probe is bright in every direction.
+    test::addClosedBox(scene, {0.2f, -0.9f, 0.2f}, {0.9f, -0.2f, 0.9f},
+                       int(scene.materials.size()) - 1);
+    RendererParams rp;
+    rp.areaLights = false;
+    rp.emitterLights = 0;
+    const GpuOctree dark =
+        makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl*) { return 0; });
+    Renderer renderer(scene, dark, rp);
+    ASSERT_TRUE(renderer.hasReflectionProbe());
+    RenderParams p;
+    p.width = p.height = 32;
+    p.mode = RenderMode::Full;
+    // From just inside the closet's front wall at its back wall (z = 0.9,
+    // facing -z), which fills the view; the reflected ray leaves along -z
+    // and, box-projected, reads the cyan wall at z = -1.
+    const PinholeCamera camera = PinholeCamera::lookAt({0.55f, -0.55f, 0.25f},
+                                                       {0.55f, -0.55f, 0.9f}, 40.0f * kPi / 180.0f);
+    const RgbImage image = renderer.render(camera, p);  // kept: pixel() points into it
+    writePng(test::outputDir(std::string("render_probe_no_light_") + c.name) + "/rendered.png",
+             image, 0.0f);
+    const float* unlit = image.pixel(p.width / 2, p.height / 2);
+    EXPECT_LT(unlit[0] + unlit[1] + unlit[2], 1e-4f)
+        << "the probe lights a face that no light reaches: " << unlit[0] << " " << unlit[1]
+        << " " << unlit[2];
+    // One VDL in every voxel, 72 degrees off the back wall's normal (its
+    // own GGX response at the centre is small), 16 W/m^2: E(n) = 5 there,
+    // more than the probe's own irradiance towards -z (pi x 0.58 = 1.8 in
+    // luminance), so the normalisation keeps all of the probe's light.
+    renderer.setOctree(makeOctree(2, {-1.5f, -1.5f, -1.5f}, 3.0f, [](const Coord&, Vdl* out) {
+      out[0] = {{16, 16, 16}, normalize(Vec3{0, 0.95f, -0.31f})};
+      return 1;
+    }));
+    const RgbImage lit = renderer.render(camera, p);
+    p.reflections = false;
+    const RgbImage litOff = renderer.render(camera, p);
+    const float* on = lit.pixel(p.width / 2, p.height / 2);
+    const float* off = litOff.pixel(p.width / 2, p.height / 2);
+    EXPECT_GT(on[2], off[2] + 0.01f) << "the probe's cyan is gone where light arrives: " << on[2]
+                                     << " with the probe, " << off[2] << " without";
+  }
+}
+
 }  // namespace
 }  // namespace lo
