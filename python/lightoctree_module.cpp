@@ -205,31 +205,10 @@ RenderSettings renderSettings(int width, int height, const std::string& mode, co
     else if (name == "cosine_correction") s.octree.cosineCorrection = value.cast<bool>();
     else if (name == "tolerance") s.octree.tolerance = value.cast<float>();
     else if (name == "free_space_tolerance") s.octree.volumeTolerance = value.cast<float>();
-    else if (name == "texels") {
-      const std::string texels = value.cast<std::string>();
-      if (texels != "float" && texels != "half" && texels != "compact") {
-        throw InputError("render: texels '" + texels + "': expected float, half or compact");
-      }
-      s.octree.halfFloat = texels == "half";
-      s.octree.compact = texels == "compact";
-    } else {
-      throw InputError("render: unknown setting '" + name + "'");
-    }
+    else if (name == "texels") setTexels(s.octree, value.cast<std::string>());
+    else throw InputError("render: unknown setting '" + name + "'");
   }
-  if (width < 1 || height < 1 || width > 16384 || height > 16384) {
-    throw InputError("render: width and height must be 1..16384");
-  }
-  if (s.frame.supersample < 1 || s.frame.supersample > 16) throw InputError("render: supersample must be 1..16");
-  if (s.frame.maxVdls < 1 || s.frame.maxVdls > kMaxVdls) throw InputError("render: vdls must be 1..8");
-  if (s.renderer.emitterLights < 0 || s.renderer.emitterLights > 16) {
-    throw InputError("render: emitter_lights must be 0..16");
-  }
-  if (s.renderer.shadowMapSize < 16 || s.renderer.shadowMapSize > 8192) {
-    throw InputError("render: shadow_map_size must be 16..8192");
-  }
-  for (const float t : {s.octree.tolerance, s.octree.volumeTolerance}) {
-    if (!(t >= 0.0f && t <= 1.0f)) throw InputError("render: tolerances must be 0..1");
-  }
+  s.check();
   return s;
 }
 

@@ -200,10 +200,10 @@ std::function<int()> addRenderCommand(CLI::App& app) {
       ->required();
   addCameraOptions(cmd, opt->camera);
   cmd->add_option("--width", opt->width, "Image width in pixels")
-      ->check(CLI::Range(1, 16384))
+      ->check(CLI::Range(1, kMaxImageSide))
       ->capture_default_str();
   cmd->add_option("--height", opt->height, "Image height in pixels")
-      ->check(CLI::Range(1, 16384))
+      ->check(CLI::Range(1, kMaxImageSide))
       ->capture_default_str();
   cmd->add_option("--mode", opt->mode,
                   "full | direct (emission + lights) | indirect (octree only) | voxels | "

@@ -23,8 +23,7 @@ RenderSettings ShadingOptions::settings(RenderMode mode, int width, int height) 
   s.renderer.areaLights = areaLights == "on";
   s.renderer.emitterLights = emitterLights;
   s.renderer.shadowMapSize = shadowMapSize;
-  s.octree.halfFloat = halfFloat || texels == "half";
-  s.octree.compact = texels == "compact" && !halfFloat;
+  setTexels(s.octree, halfFloat ? "half" : texels);
   s.octree.cosineCorrection = cosineCorrection == "on";
   s.octree.tolerance = tolerance;
   s.octree.volumeTolerance = freeSpaceTolerance;
@@ -79,7 +78,7 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
     cmd->add_option("--supersample", opt.supersample,
                     "Anti-aliasing: each pixel the mean of N x N samples (the image drawn N times "
                     "larger, then box-filtered), as the path tracer integrates a pixel")
-        ->check(CLI::Range(1, 16))
+        ->check(CLI::Range(1, kMaxSupersample))
         ->capture_default_str();
   }
   if (window) {  // `render` has --exposure auto|EV (picture_options.h)
@@ -98,11 +97,11 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
   cmd->add_option("--emitter-lights", opt.emitterLights,
                   "Shadowed virtual point lights sampled on emissive triangles when they are not "
                   "area lights (0: none)")
-      ->check(CLI::Range(0, 16))
+      ->check(CLI::Range(0, kMaxEmitterLights))
       ->capture_default_str();
   cmd->add_option("--shadow-map-size", opt.shadowMapSize, "Shadow map resolution per face, at most: many shadowed lights (6 faces per "
                   "emitter VPL) get smaller maps, halved until all fit in 48 MiB (16-bit depth)")
-      ->check(CLI::Range(16, 8192))
+      ->check(CLI::Range(kMinShadowMapSize, kMaxShadowMapSize))
       ->capture_default_str();
   cmd->add_option("--cosine-correction", opt.cosineCorrection,
                   "Divide each VDL by the cosine to its voxel's normal on upload, so that the "

@@ -19,31 +19,34 @@ namespace lo::tool {
 
 inline std::string onOffOf(bool on) { return on ? "on" : "off"; }
 
+/// The library's defaults, which the flags show.
+inline const RenderSettings kRenderDefaults{};
+
 
 /// The flags as text ("on" | "off", names), their defaults the library's
-/// (RenderSettings{}), so that the command line and Python agree.
+/// (kRenderDefaults), so that the command line and Python agree.
 struct ShadingOptions {
-  std::string interpolation = onOffOf(RenderSettings{}.frame.interpolation);
-  std::string specular = onOffOf(RenderSettings{}.frame.specular);
-  std::string reflections = onOffOf(RenderSettings{}.frame.reflections);
-  std::string lighting = toString(RenderSettings{}.frame.lighting);  ///< octree | atlas
+  std::string interpolation = onOffOf(kRenderDefaults.frame.interpolation);
+  std::string specular = onOffOf(kRenderDefaults.frame.specular);
+  std::string reflections = onOffOf(kRenderDefaults.frame.reflections);
+  std::string lighting = toString(kRenderDefaults.frame.lighting);  ///< octree | atlas
   std::string uv = "default";       ///< lightmap UVs for --lighting atlas: default | auto | texcoord1
-  std::string atlasOn = RenderSettings{}.atlasOnGpu ? "gpu" : "cpu";  ///< where --lighting atlas bakes
-  std::string stitchSeams = onOffOf(RenderSettings{}.stitchSeams);  ///< join the charts' seams
-  int supersample = RenderSettings{}.frame.supersample;  ///< render: samples per pixel side
+  std::string atlasOn = kRenderDefaults.atlasOnGpu ? "gpu" : "cpu";  ///< where --lighting atlas bakes
+  std::string stitchSeams = onOffOf(kRenderDefaults.stitchSeams);  ///< join the charts' seams
+  int supersample = kRenderDefaults.frame.supersample;  ///< render: samples per pixel side
   float exposure = 0;  ///< EV (view; render's is picture_options.h's)
-  int vdls = RenderSettings{}.frame.maxVdls;
-  std::string areaLights = onOffOf(RenderSettings{}.renderer.areaLights);
-  int emitterLights = RenderSettings{}.renderer.emitterLights;
-  int shadowMapSize = RenderSettings{}.renderer.shadowMapSize;
+  int vdls = kRenderDefaults.frame.maxVdls;
+  std::string areaLights = onOffOf(kRenderDefaults.renderer.areaLights);
+  int emitterLights = kRenderDefaults.renderer.emitterLights;
+  int shadowMapSize = kRenderDefaults.renderer.shadowMapSize;
   bool halfFloat = false;
   std::string texels = "compact";  ///< VDL texels: float | half | compact
   /// Adaptive leaves (GpuOctreeParams::tolerance); 0 = off.
-  float tolerance = RenderSettings{}.octree.tolerance;
+  float tolerance = kRenderDefaults.octree.tolerance;
   /// Free-space leaves merge where their light agrees within this share
   /// (GpuOctreeParams::volumeTolerance); 0 = off.
-  float freeSpaceTolerance = RenderSettings{}.octree.volumeTolerance;
-  std::string cosineCorrection = onOffOf(RenderSettings{}.octree.cosineCorrection);
+  float freeSpaceTolerance = kRenderDefaults.octree.volumeTolerance;
+  std::string cosineCorrection = onOffOf(kRenderDefaults.octree.cosineCorrection);
 
   /// The library's settings these flags select (render/render_session.h),
   /// frames at `mode` of width x height.

@@ -10,7 +10,6 @@
 
 #include "core/error.h"
 #include "core/file.h"
-#include "core/file_set.h"
 
 namespace lo {
 namespace tonemap_internal {
@@ -162,10 +161,8 @@ float autoExposureEv(const RgbImage& image, const AutoExposureParams& params) {
 }
 
 std::string ToneParams::ToString() const {
-  return "ToneParams{" +
-         (autoExposure ? "auto exposure " + tonemap_internal::formatEv(exposureEv)
-                       : "exposure " + tonemap_internal::formatEv(exposureEv)) +
-         ", " + toString(curve) + "}";
+  return std::string("ToneParams{") + (autoExposure ? "auto exposure " : "exposure ") +
+         tonemap_internal::formatEv(exposureEv) + ", " + toString(curve) + "}";
 }
 
 std::string ToneReport::ToString() const {
@@ -220,12 +217,8 @@ std::vector<unsigned char> encodeTonedPng(const RgbImage& image, const ToneParam
 void writeTonedImage(const std::string& path, const RgbImage& image, const ToneParams& params,
                      AtomicFileSet* into, ToneReport* report) {
   if (lowerExtension(path) != ".png") return writeImage(path, image, 0.0f, into);
-  if (image.width < 1 || image.height < 1 || image.rgb.size() != image.pixelCount() * 3) {
-    throw InputError(path + ": empty or inconsistent image (" + std::to_string(image.width) +
-                     " x " + std::to_string(image.height) + ")");
-  }
-  const std::vector<unsigned char> png = encodeTonedPng(image, params, report);
-  writeOutputText(into, path, std::string(png.begin(), png.end()));
+  // Display-linear in [0, 1]: writePng's exposure 0 and clamp leave it as it is.
+  writePng(path, toneMapped(image, params, report), 0.0f, into);
 }
 
 }  // namespace lo

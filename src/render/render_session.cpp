@@ -1,6 +1,5 @@
 #include "render/render_session.h"
 
-#include <cstdio>
 #include <optional>
 
 #include "core/error.h"
@@ -34,36 +33,63 @@ LightingParams RenderSettings::lightingParams() const {
   return p;
 }
 
+void setTexels(GpuOctreeParams& octree, const std::string& name) {
+  if (name != "float" && name != "half" && name != "compact") {
+    throw InputError("texels '" + name + "': expected float, half or compact");
+  }
+  octree.halfFloat = name == "half";
+  octree.compact = name == "compact";
+}
+
+void RenderSettings::check() const {
+  auto range = [](const char* name, double value, double lo, double hi) {
+    if (!(value >= lo && value <= hi)) {  // NaN fails too
+      throw InputError(std::string(name) + " " + std::to_string(value) + ": must be " +
+                       std::to_string(lo) + ".." + std::to_string(hi));
+    }
+  };
+  range("width", frame.width, 1, kMaxImageSide);
+  range("height", frame.height, 1, kMaxImageSide);
+  range("supersample", frame.supersample, 1, kMaxSupersample);
+  range("vdls", frame.maxVdls, 1, kMaxVdls);
+  range("emitter lights", renderer.emitterLights, 0, kMaxEmitterLights);
+  range("shadow map size", renderer.shadowMapSize, kMinShadowMapSize, kMaxShadowMapSize);
+  range("tolerance", octree.tolerance, 0, 1);
+  range("free-space tolerance", octree.volumeTolerance, 0, 1);
+}
+
 GpuOctree buildRenderOctree(const VdlGrid& grid, const RenderSettings& settings) {
   return buildGpuOctree(grid, settings.octreeParams());
 }
 
 namespace {
 
-bool hasAddedObjects(const Scene& scene) {
-  return scene.movingMaterialsFrom < scene.materials.size();
-}
-
-std::string noFreeSpaceLight(const std::string& gridName) {
-  return gridName +
-         " holds no free-space light (baked with --free-space off, or by an older lightoctree): "
-         "the added objects take the light of the surfaces near them";
+/// The surfaces' octree of `grid` (none for an empty grid) and, when the
+/// scene has objects added after the bake, the free-space light's, or a
+/// warning naming the grid that it has none.
+LookupOctrees buildOctrees(const Scene& scene, const VdlGrid& grid, const GpuOctreeParams& params,
+                           const std::string& gridName) {
+  LookupOctrees r;
+  if (grid.size() == 0) return r;
+  r.surface = buildGpuOctree(grid, params);
+  if (scene.hasAddedObjects()) {
+    if (!grid.volume.empty()) {
+      r.volume = buildVolumeOctree(grid.volume, params);
+    } else {
+      r.warnings.push_back(gridName +
+                           " holds no free-space light (baked with --free-space off, or by an "
+                           "older lightoctree): the added objects take the light of the surfaces "
+                           "near them");
+    }
+  }
+  return r;
 }
 
 }  // namespace
 
 LookupOctrees buildLookupOctrees(const Scene& scene, const VdlGrid& grid,
                                  const RenderSettings& settings, const std::string& gridName) {
-  LookupOctrees r;
-  r.surface = buildGpuOctree(grid, settings.octreeParams());
-  if (hasAddedObjects(scene)) {
-    if (!grid.volume.empty()) {
-      r.volume = buildVolumeOctree(grid.volume, settings.octreeParams());
-    } else {
-      r.warnings.push_back(noFreeSpaceLight(gridName));
-    }
-  }
-  return r;
+  return buildOctrees(scene, grid, settings.octreeParams(), gridName);
 }
 
 struct RenderSession::Impl {
@@ -86,27 +112,21 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
   s.settings = settings;
   s.options = options;
   s.limits = context.info();
-  const bool added = hasAddedObjects(scene);
+  settings.check();
+  const bool added = scene.hasAddedObjects();
   if (added && settings.frame.lighting == Lighting::Atlas) {
     throw InputError("--add: not with --lighting atlas (the atlas holds the baked surfaces' light "
                      "only); added objects are lit by the octree's free-space light");
   }
-  const GpuOctreeParams octreeParams = settings.octreeParams(&s.limits);
 
   StageTimer octreeTimer(s.stages, "octree");
-  if (grid.size() > 0) s.octree = buildGpuOctree(grid, octreeParams);
-  // The free-space light of the objects added after the bake: built now so
-  // that the grid can go before the renderer's uploads.
-  std::optional<GpuOctree> volume;
-  if (added) {
-    if (!grid.volume.empty()) {
-      volume = buildVolumeOctree(grid.volume, octreeParams);
-    } else if (grid.size() > 0) {
-      s.warnings.push_back(noFreeSpaceLight(options.gridName));
-    }
-  }
+  // The free-space light of the added objects is built now too, so that the
+  // grid can go before the renderer's uploads.
+  LookupOctrees octrees = buildOctrees(scene, grid, settings.octreeParams(&s.limits), options.gridName);
   grid = VdlGrid{};  // the octrees hold all the renderer reads of it
   returnFreeMemory();
+  s.octree = std::move(octrees.surface);
+  s.warnings = std::move(octrees.warnings);
   s.octreeSummary = s.octree.ToString();
   s.octreeDepth = s.octree.depth;
   octreeTimer.finish("");
@@ -127,17 +147,16 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
   }
   if (added) {
     StageTimer volumeTimer(s.stages, "free-space light");
-    if (volume) s.renderer->setFreeSpaceLight(*volume);
+    const bool volume = octrees.volume.depth > 0;
+    if (volume) s.renderer->setFreeSpaceLight(octrees.volume);
+    octrees.volume = GpuOctree();
     volumeTimer.finish(volume ? "for the added objects" : "none in the bake");
   }
   StageTimer lightingTimer(s.stages, "prepare lighting");
   const std::optional<LightmapBake> atlas =
       prepareLighting(*s.renderer, scene, s.octree, settings.lightingParams());
   if (atlas) {
-    char bytes[64];
-    std::snprintf(bytes, sizeof bytes, "; %.1f MiB on the GPU",
-                  double(s.renderer->atlasBytes()) / (1024.0 * 1024.0));
-    s.atlasSummary = atlas->ToString() + bytes;
+    s.atlasSummary = atlas->ToString() + "; " + formatBytes(s.renderer->atlasBytes()) + " on the GPU";
   }
   lightingTimer.finish(atlas ? "lightmap atlas" : "");
   if (options.keepOctree) {

@@ -33,6 +33,18 @@ namespace lo {
 /// the test scenes, docs/octree.md) and free-space leaves merged at 0.4.
 GpuOctreeParams renderOctreeDefaults();
 
+/// "float" | "half" | "compact": the VDL texels of `octree` (RGBA32F, half
+/// floats, or shared-exponent RGB9E5 with a scale per octree).
+/// @throws InputError naming the value.
+void setTexels(GpuOctreeParams& octree, const std::string& name);
+
+/// The ranges of the settings a caller chooses, shared by the command's
+/// flags and the Python keywords (frame.width and height: 1..kMaxImageSide,
+/// image/image.h).
+constexpr int kMaxSupersample = 16;   ///< frame.supersample: 1..
+constexpr int kMaxEmitterLights = 16; ///< renderer.emitterLights: 0..
+constexpr int kMinShadowMapSize = 16, kMaxShadowMapSize = 8192;  ///< renderer.shadowMapSize
+
 /// Everything that decides the picture, defaults as the command line's.
 struct RenderSettings {
   /// Per frame: size, mode, interpolation, GGX lobe, reflections, lighting
@@ -55,6 +67,9 @@ struct RenderSettings {
   GpuOctreeParams octreeParams(const GlInfo* limits = nullptr) const;
   /// The atlas settings, with the frames' lookup (shadeParamsOf(frame)).
   LightingParams lightingParams() const;
+  /// @throws InputError naming the setting that is out of its range (the
+  /// constants above; VDLs 1..kMaxVdls; tolerances 0..1, NaN refused).
+  void check() const;
 };
 
 /// What the caller allows the session to do with its inputs.

@@ -315,6 +315,8 @@ struct Scene {
   size_t movingMaterialsFrom = SIZE_MAX;
   /// Whether triangle t belongs to an object added after the bake.
   bool isAdded(size_t t) const { return size_t(triangleMaterial[t]) >= movingMaterialsFrom; }
+  /// Whether any object was added after the bake.
+  bool hasAddedObjects() const { return movingMaterialsFrom < materials.size(); }
   /// Frees every texture's texels and file bytes: each becomes empty (a
   /// lookup reads white), its name and sampler kept. For a caller that has
   /// handed the texels to the GPU and reads them no more (`render`).

@@ -1348,6 +1348,28 @@ TEST(RenderImage, SunCascadesResolveASmallShadowOnALargeGround) {
 }
 
 
+/// Walls of the cube [-1, 1]^3, facing in, that glow in their own colours
+/// (black, emissive: +x red, -x green, ceiling blue, +z yellow, -z cyan, and
+/// with `floor` a magenta floor), lit by nothing: what the reflection probe
+/// shows in the probe tests.
+void addGlowingWalls(Scene& scene, bool floor) {
+  auto glow = [&scene](const Vec3& radiance) {
+    Material m;
+    m.baseColor = {0, 0, 0};
+    m.emission = radiance;
+    scene.materials.push_back(m);
+    return int(scene.materials.size()) - 1;
+  };
+  test::addQuad(scene, {1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {-1, 0, 0}, glow({1, 0, 0}));  // +x
+  test::addQuad(scene, {-1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {1, 0, 0}, glow({0, 1, 0}));  // -x
+  test::addQuad(scene, {-1, 1, -1}, {2, 0, 0}, {0, 0, 2}, {0, -1, 0}, glow({0, 0, 1}));  // ceiling
+  if (floor) {
+    test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, glow({1, 0, 1}));
+  }
+  test::addQuad(scene, {-1, -1, 1}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, glow({1, 1, 0}));  // +z
+  test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, glow({0, 1, 1}));  // -z
+}
+
 // Environment reflections: a mirror floor in a box of walls that glow in six
 // colours, lit by nothing else (no VDLs, emitters not drawn as lights), shows
 // the colour of the wall its reflected ray really hits: the probe at the box's
@@ -1356,18 +1378,7 @@ TEST(RenderImage, SunCascadesResolveASmallShadowOnALargeGround) {
 TEST(RenderImage, MirrorReflectsTheWallItsRayHits) {
   REQUIRE_OSMESA();
   Scene scene;
-  auto glow = [&scene](const Vec3& radiance) {
-    Material m;
-    m.baseColor = {0, 0, 0};
-    m.emission = radiance;
-    scene.materials.push_back(m);
-    return int(scene.materials.size()) - 1;
-  };
-  test::addQuad(scene, {1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {-1, 0, 0}, glow({1, 0, 0}));   // +x
-  test::addQuad(scene, {-1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {1, 0, 0}, glow({0, 1, 0}));   // -x
-  test::addQuad(scene, {-1, 1, -1}, {2, 0, 0}, {0, 0, 2}, {0, -1, 0}, glow({0, 0, 1}));   // ceiling
-  test::addQuad(scene, {-1, -1, 1}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, glow({1, 1, 0}));   // +z
-  test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, glow({0, 1, 1}));   // -z
+  addGlowingWalls(scene, false);
   Material mirror;
   mirror.baseColor = {1, 1, 1};
   mirror.metallic = 1.0f;
@@ -1422,19 +1433,7 @@ TEST(RenderImage, ProbeAddsNoLightWhereNoneArrives) {
                         Case{"metal", {0.9f, 0.9f, 0.9f}, 1.0f, 0.3f}}) {
     SCOPED_TRACE(c.name);
     Scene scene;
-    auto glow = [&scene](const Vec3& radiance) {
-      Material m;
-      m.baseColor = {0, 0, 0};
-      m.emission = radiance;
-      scene.materials.push_back(m);
-      return int(scene.materials.size()) - 1;
-    };
-    test::addQuad(scene, {1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {-1, 0, 0}, glow({1, 0, 0}));  // +x
-    test::addQuad(scene, {-1, -1, -1}, {0, 2, 0}, {0, 0, 2}, {1, 0, 0}, glow({0, 1, 0}));  // -x
-    test::addQuad(scene, {-1, 1, -1}, {2, 0, 0}, {0, 0, 2}, {0, -1, 0}, glow({0, 0, 1}));  // ceiling
-    test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, glow({1, 0, 1}));  // floor
-    test::addQuad(scene, {-1, -1, 1}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, glow({1, 1, 0}));  // +z
-    test::addQuad(scene, {-1, -1, -1}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, glow({0, 1, 1}));  // -z
+    addGlowingWalls(scene, true);
     Material closet;
     closet.baseColor = c.baseColor;
     closet.metallic = c.metallic;
