@@ -17,6 +17,7 @@
  * the analytic render tests rely on that.
  *
  *   loBrdfAlpha        GGX alpha of a perceptual roughness (roughness^2, floored)
+ *   loGgxD, loGgxLambda  GGX's distribution and Smith's Lambda (also the tracers')
  *   loBrdfDiffuseOnly  the diffuse lobe alone, no Fresnel weight (specular off)
  *   loBrdfLobes        the two lobes towards l, no cosine: (1 - F) diffuse, F D V
  *   loBrdf             their sum, no cosine (what a tracer's f(wo, wi) is)
@@ -60,6 +61,24 @@ const float LO_BRDF_PI = 3.14159265358979323846f;
  * finite for a point light (a highlight of about one pixel, not a NaN). */
 LO_BRDF_FN float loBrdfAlpha(float roughness) { return max(roughness * roughness, 2e-3f); }
 
+/* GGX's normal distribution D(m) at nh = n.m > 0 (Walter et al. 2007, eq.
+ * 33), alpha a: the renderer's specular lobe and the tracers' sampling
+ * densities (material/bsdf.cpp) read this one text. */
+LO_BRDF_FN float loGgxD(float nh, float a) {
+  float a2 = a * a;
+  float dd = nh * nh * (a2 - 1.0f) + 1.0f;
+  return a2 / (LO_BRDF_PI * dd * dd);
+}
+
+/* Smith's Lambda for GGX (Heitz 2014, eq. 72) at a direction whose cosine to
+ * the normal is c; 0 at and below the horizon. */
+LO_BRDF_FN float loGgxLambda(float c, float a) {
+  float c2 = c * c;
+  if (c2 <= 0.0f) return 0.0f;
+  float tan2 = max(0.0f, 1.0f - c2) / c2;
+  return 0.5f * (-1.0f + sqrt(1.0f + a * a * tan2));
+}
+
 LO_BRDF_FN vec3 loBrdfDiffuseOnly(vec3 baseColor, float metallic, float transmission) {
   return baseColor * (1.0f - metallic) * (1.0f - transmission) / LO_BRDF_PI;
 }
@@ -77,8 +96,7 @@ LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metall
   float nh = max(dot(n, h), 0.0f);
   float vh = clamp(dot(v, h), 0.0f, 1.0f); /* pow(1 - vh, 5) is NaN for vh a rounding above 1 */
   float a2 = a * a;
-  float dd = nh * nh * (a2 - 1.0f) + 1.0f;
-  float D = a2 / (LO_BRDF_PI * dd * dd);
+  float D = loGgxD(nh, a);
   float vis =
       0.5f / (nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2));
   /* The specification's mix (glTF 2.0, Appendix B): the dielectric's

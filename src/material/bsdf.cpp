@@ -6,6 +6,8 @@
 
 #include "material/gltf_brdf.h"
 
+#include <material_brdf.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -13,21 +15,12 @@ namespace lo {
 
 namespace {
 
-/// Smith Lambda for GGX, w in the local frame (z = normal).
-float smithLambda(const Vec3& w, float alpha) {
-  float z2 = w.z * w.z;
-  if (z2 <= 0) return 0;
-  float tan2 = std::max(0.0f, 1.0f - z2) / z2;
-  return 0.5f * (-1.0f + std::sqrt(1.0f + alpha * alpha * tan2));
-}
+/// Smith Lambda for GGX, w in the local frame (z = normal): the renderer's
+/// text (shaders/material_brdf.h).
+float smithLambda(const Vec3& w, float alpha) { return brdf::loGgxLambda(w.z, alpha); }
 
-/// GGX normal distribution D(m), m in the local frame.
-float ggxD(const Vec3& m, float alpha) {
-  if (m.z <= 0) return 0;
-  float a2 = alpha * alpha;
-  float d = m.z * m.z * (a2 - 1.0f) + 1.0f;
-  return a2 / (kPi * d * d);
-}
+/// GGX normal distribution D(m), m in the local frame; 0 below the surface.
+float ggxD(const Vec3& m, float alpha) { return m.z > 0 ? brdf::loGgxD(m.z, alpha) : 0.0f; }
 
 /// GGX visible-normal sample (Heitz 2018) for local outgoing direction wo (wo.z > 0).
 Vec3 sampleGgxVisibleNormal(const Vec3& wo, float alpha, float u1, float u2) {

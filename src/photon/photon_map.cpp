@@ -19,6 +19,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/discrete_distribution.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "material/bsdf.h"
@@ -75,7 +76,8 @@ struct Context {
   std::vector<TriangleInfo> triangles;
   std::vector<BsdfLobes> materials;
   std::vector<Emitter> emitters;
-  std::vector<double> emitterCdf;  ///< cumulative selection weights, back() = total
+  /// Which emitter a path starts from: by average(samplePower), across kinds.
+  DiscreteDistribution emitterPick;
   EmitterSampler triangleEmitters;  ///< the emissive triangles (where on them light starts)
   std::vector<LightFootprint> footprints;  ///< of the directional lights
   /// The sky's directions: an image's texels weighted by the covered box's
@@ -224,11 +226,7 @@ inline bool emitFromSky(const Context& ctx, const Emitter& e, Rng& rng, EmittedR
 inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
   const Scene& scene = *ctx.scene;
   // 53 random bits (scenes with millions of emissive triangles).
-  double pick = uniform53(rng) * ctx.emitterCdf.back();
-  size_t k = size_t(std::upper_bound(ctx.emitterCdf.begin(), ctx.emitterCdf.end(), pick) -
-                    ctx.emitterCdf.begin());
-  k = std::min(k, ctx.emitters.size() - 1);
-  const Emitter& e = ctx.emitters[k];
+  const Emitter& e = ctx.emitters[ctx.emitterPick.sample(uniform53(rng))];
   out.power = e.pathPower;
   out.punctual = false;
   out.storeFirstHit = false;
@@ -486,14 +484,12 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
     e.samplePower = e.power;
     ctx.emitters.push_back(e);
   }
-  double total = 0;
-  ctx.emitterCdf.reserve(ctx.emitters.size());
+  ctx.emitterPick.reserve(ctx.emitters.size());
   for (const Emitter& e : ctx.emitters) {
-    total += double(average(e.samplePower));
-    ctx.emitterCdf.push_back(total);
+    ctx.emitterPick.add(double(average(e.samplePower)));
     totalPower += e.power;
   }
-  if (ctx.emitters.empty() || !(total > 0)) {
+  if (ctx.emitters.empty() || !(ctx.emitterPick.total() > 0)) {
     std::ostringstream os;
     os << "scene has no light with positive power (" << scene.lights.size()
        << " punctual lights, no emissive triangle with positive emission, no sky) in '"
@@ -501,9 +497,9 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
        << "'";
     throw InputError(os.str());
   }
-  for (Emitter& e : ctx.emitters) {
-    double pickProb = double(average(e.samplePower)) / total;
-    e.pathPower = e.samplePower * float(1.0 / pickProb);
+  for (size_t k = 0; k < ctx.emitters.size(); ++k) {
+    Emitter& e = ctx.emitters[k];
+    e.pathPower = e.samplePower * float(1.0 / ctx.emitterPick.pmf(k));
   }
 }
 

@@ -61,10 +61,10 @@ std::vector<GpuLight> emitterVpls(const Scene& scene, const RenderSpace& space, 
   const double total = emitters.total();
   for (int i = 0; i < count; ++i) {
     double u = (i + 0.5) / count;
-    size_t k = emitters.pick(u);
+    double remapped = 0;
+    size_t k = emitters.distribution.sample(u, &remapped);
     size_t t = emitters.triangles[k];
-    double lo = k > 0 ? emitters.cdf[k - 1] : 0.0;
-    float s = float((u * total - lo) / (emitters.cdf[k] - lo));
+    float s = float(remapped);
     // Second coordinate from the base-2 radical inverse of i.
     float r = radicalInverse(uint32_t(i));
     float su = std::sqrt(std::clamp(s, 0.0f, 1.0f));

@@ -15,7 +15,6 @@ void cellSamples(int c, float b1[4], float b2[4]);
 
 EmitterSampler buildEmitterSampler(const Scene& scene) {
   EmitterSampler s;
-  double total = 0;
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
     const Material& m = scene.materials[size_t(scene.triangleMaterial[t])];
     if (!m.isEmissive()) continue;
@@ -28,11 +27,10 @@ EmitterSampler buildEmitterSampler(const Scene& scene) {
       throw InputError("material '" + m.name + "' of triangle " + std::to_string(t) +
                        " emits non-finite power " + power.ToString());
     if (!(average(power) > 0)) continue;
-    total += double(average(power));
     s.triangles.push_back(uint32_t(t));
     s.power.push_back(power);
     s.emission.push_back(emission);
-    s.cdf.push_back(total);
+    s.distribution.add(double(average(power)));
     s.cellTable.push_back(-1);
     if (m.emissiveTexture >= 0) {
       s.cellTable.back() = int32_t(s.cellCdf.size());
@@ -146,20 +144,10 @@ void EmitterSampler::samplePoint(size_t k, float u0, float u1, float u2, float& 
   b2 = (o2 + c2) / 8.0f;
 }
 
-size_t EmitterSampler::pick(double u) const {
-  const double x = u * total();
-  size_t k = size_t(std::upper_bound(cdf.begin(), cdf.end(), x) - cdf.begin());
-  return std::min(k, triangles.size() - 1);
-}
-
-double EmitterSampler::pickProbability(size_t k) const {
-  return double(average(power[k])) / total();
-}
-
 std::vector<float> EmitterSampler::areaPdfs(const Scene& scene) const {
   std::vector<float> pdf(scene.triangleCount(), 0.0f);
   for (size_t k = 0; k < triangles.size(); ++k)
-    pdf[triangles[k]] = float(double(average(power[k])) / total()) / scene.triangleArea(triangles[k]);
+    pdf[triangles[k]] = float(pickProbability(k)) / scene.triangleArea(triangles[k]);
   return pdf;
 }
 

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/discrete_distribution.h"
 #include "core/math.h"
 #include "scene/scene.h"
 
@@ -27,18 +28,17 @@ struct EmitterSampler {
   std::vector<Vec3> power;
   /// Per entry: its mean radiance L (Scene::triangleEmission), W/(m^2 sr).
   std::vector<Vec3> emission;
-  /// Per entry: the cumulative sum of average(power) up to and including it;
-  /// back() is the total. Summed in double in triangle order.
-  std::vector<double> cdf;
+  /// The entries by average(power), summed in double in triangle order.
+  DiscreteDistribution distribution;
 
   bool empty() const { return triangles.empty(); }
   size_t size() const { return triangles.size(); }
   /// Sum of average(power) over every emitter, W.
-  double total() const { return cdf.empty() ? 0.0 : cdf.back(); }
-  /// The entry whose stretch of the cdf holds u * total(), u in [0, 1).
-  size_t pick(double u) const;
+  double total() const { return distribution.total(); }
+  /// The entry whose stretch of the distribution holds u * total(), u in [0, 1).
+  size_t pick(double u) const { return distribution.sample(u); }
   /// Probability that pick() returns entry k.
-  double pickProbability(size_t k) const;
+  double pickProbability(size_t k) const { return distribution.pmf(k); }
   /// Per triangle of the scene: pick probability / area (the area density
   /// of a point drawn uniformly on the picked triangle), 0 for triangles that
   /// do not emit. size() = the scene's triangle count.

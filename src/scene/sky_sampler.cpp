@@ -17,7 +17,6 @@ SkySampler::SkySampler(const Sky& sky, const std::function<float(const Vec3&)>& 
   const Texture& image = *sky.image;
   width_ = image.width;
   height_ = image.height;
-  double total = 0;
   for (int y = 0; y < height_; ++y) {
     const float omega = skyPixelSolidAngle(y, width_, height_);
     if (!(omega > 0)) break;
@@ -25,11 +24,10 @@ SkySampler::SkySampler(const Sky& sky, const std::function<float(const Vec3&)>& 
       const Vec3 d = skyPixelDirection(float(x) + 0.5f, float(y) + 0.5f, width_, height_);
       const Vec3 l = sky.radiance * image.texel(x, y);
       const double w = weight ? double(weight(d)) : 1.0;
-      total += std::max(0.0, double(average(l)) * double(omega) * w);
-      cdf_.push_back(total);
+      texels_.add(double(average(l)) * double(omega) * w);
     }
   }
-  if (total > 0) sky_ = &sky;
+  if (texels_.total() > 0) sky_ = &sky;
 }
 
 bool SkySampler::sample(double u0, float u1, float u2, Vec3& towards, float& pdf) const {
@@ -41,10 +39,7 @@ bool SkySampler::sample(double u0, float u1, float u2, Vec3& towards, float& pdf
     pdf = 1.0f / (2.0f * kPi);
     return y > 0;
   }
-  const double total = cdf_.back();
-  size_t k = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), u0 * total) - cdf_.begin());
-  k = std::min(k, cdf_.size() - 1);
-  const double picked = cdf_[k] - (k > 0 ? cdf_[k - 1] : 0.0);
+  const size_t k = texels_.sample(u0);
   const int x = int(k % size_t(width_)), y = int(k / size_t(width_));
   const float top = kPi * float(y) / float(height_);
   const float bottom = std::min(kPi * float(y + 1) / float(height_), 0.5f * kPi);
@@ -52,7 +47,7 @@ bool SkySampler::sample(double u0, float u1, float u2, Vec3& towards, float& pdf
   const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
   const float phi = 2.0f * kPi * ((float(x) + u2) / float(width_) - 0.5f);
   towards = {sinTheta * std::sin(phi), cosTheta, -sinTheta * std::cos(phi)};
-  pdf = float(picked / total / double(skyPixelSolidAngle(y, width_, height_)));
+  pdf = float(texels_.pmf(k) / double(skyPixelSolidAngle(y, width_, height_)));
   return cosTheta > 0 && pdf > 0;
 }
 
@@ -63,9 +58,8 @@ float SkySampler::pdf(const Vec3& towards) const {
   skyPixelOf(towards, width_, height_, x, y);
   const float omega = skyPixelSolidAngle(y, width_, height_);
   const size_t k = size_t(y) * size_t(width_) + size_t(x);
-  if (!(omega > 0) || k >= cdf_.size()) return 0.0f;
-  const double picked = cdf_[k] - (k > 0 ? cdf_[k - 1] : 0.0);
-  return float(picked / cdf_.back() / double(omega));
+  if (!(omega > 0) || k >= texels_.size()) return 0.0f;
+  return float(texels_.pmf(k) / double(omega));
 }
 
 }  // namespace lo

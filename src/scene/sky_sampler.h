@@ -15,6 +15,7 @@
 #include <functional>
 #include <vector>
 
+#include "core/discrete_distribution.h"
 #include "core/math.h"
 #include "scene/scene.h"
 
@@ -38,7 +39,8 @@ class SkySampler {
  private:
   const Sky* sky_ = nullptr;
   int width_ = 0, height_ = 0;  ///< the image's; 0 for a uniform sky
-  std::vector<double> cdf_;     ///< over the texels above the horizon, index y * width + x
+  /// Over the texels above the horizon, index y * width + x.
+  DiscreteDistribution texels_;
 };
 
 }  // namespace lo

@@ -1,11 +1,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <set>
 #include <vector>
 
+#include "core/discrete_distribution.h"
 #include "core/error.h"
 #include "core/math.h"
 #include "core/progress.h"
@@ -130,6 +132,43 @@ TEST(Resources, MemoryLimitTakesUnitsAndRefusesWhatItCannotRead) {
     EXPECT_THROW(availableMemoryBytes(), InputError) << bad;
     unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
   }
+}
+
+
+// The one rule by which every stage picks lights: entry k is drawn with
+// probability weight(k) / total, zero weights never, and the remapped u is
+// uniform in [0, 1] within the drawn entry's stretch.
+TEST(DiscreteDistribution, DrawsEachEntryInProportionToItsWeight) {
+  DiscreteDistribution d;
+  const std::vector<double> weights{0.5, 0.0, 2.0, -1.0, 1.5, 0.0};  // negative counts as 0
+  for (double w : weights) d.add(w);
+  ASSERT_EQ(d.size(), weights.size());
+  EXPECT_DOUBLE_EQ(d.total(), 4.0);
+  const int n = 40000;
+  std::vector<int> count(weights.size(), 0);
+  std::vector<double> remappedSum(weights.size(), 0.0);
+  for (int i = 0; i < n; ++i) {
+    double remapped = -1;
+    const size_t k = d.sample((i + 0.5) / n, &remapped);
+    ASSERT_LT(k, weights.size());
+    ASSERT_GE(remapped, 0.0);
+    ASSERT_LE(remapped, 1.0);
+    ++count[k];
+    remappedSum[k] += remapped;
+  }
+  double pmfSum = 0;
+  for (size_t k = 0; k < weights.size(); ++k) {
+    const double expected = std::max(0.0, weights[k]) / 4.0;
+    EXPECT_DOUBLE_EQ(d.pmf(k), expected) << k;
+    // Stratified draws: each entry gets its share to within one draw.
+    EXPECT_NEAR(count[k], expected * n, 1.0) << k;
+    if (count[k] > 0) EXPECT_NEAR(remappedSum[k] / count[k], 0.5, 1e-3) << k;
+    pmfSum += d.pmf(k);
+  }
+  EXPECT_DOUBLE_EQ(pmfSum, 1.0);
+  // The ends of [0, 1) land on the first and the last entry of positive weight.
+  EXPECT_EQ(d.sample(0.0), 0u);
+  EXPECT_EQ(d.sample(std::nextafter(1.0, 0.0)), 4u);
 }
 
 }  // namespace
