@@ -77,7 +77,7 @@ bool readsGltfExtension(const std::string& name) {
       "KHR_lights_punctual",          "KHR_materials_emissive_strength", "KHR_materials_ior",
       "KHR_materials_specular",       "KHR_materials_transmission",      "KHR_materials_unlit",
       "KHR_materials_volume",         "KHR_mesh_quantization",           "KHR_texture_transform",
-      // Read approximately (load_gltf.cpp, readSpecularGlossiness), with a warning.
+      // Read approximately (gltf_materials.cpp, readSpecularGlossiness), with a warning.
       "KHR_materials_pbrSpecularGlossiness"};
   for (const char* read : kRead) {
     if (name == read) return true;

@@ -1,0 +1,249 @@
+/// @file scene/gltf_meshes.cpp
+/// @brief glTF mesh primitives as Scene triangles (SceneBuilder,
+/// gltf_internal.h): modes triangulated, positions in world space, and
+/// the vertex attributes (normals, two UV sets, tangents, colours) that
+/// only some primitives carry filled in for the others.
+
+#include "scene/gltf_internal.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace lo::scene_internal::gltf_internal {
+
+void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
+  if (size_t(meshIndex) >= model_.meshes.size()) {
+    fail(path_, "mesh index " + std::to_string(meshIndex) + " out of range");
+  }
+  const tinygltf::Mesh& mesh = model_.meshes[size_t(meshIndex)];
+  Mat4 normalMatrix = world.normalMatrix();
+  bool flip = world.det3() < 0;
+  for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+    const tinygltf::Primitive& prim = mesh.primitives[p];
+    std::string what = "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(p);
+    int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      static const char* names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+      std::string name = mode >= 0 && mode < 4 ? names[mode] : std::to_string(mode);
+      fail(path_, what + ": unsupported primitive mode " + name + " (only triangles are loaded)");
+    }
+    auto attr = [&](const char* key) {
+      auto it = prim.attributes.find(key);
+      return it == prim.attributes.end() ? -1 : it->second;
+    };
+    int posAcc = attr("POSITION");
+    if (posAcc < 0) fail(path_, what + " has no POSITION attribute");
+    std::vector<double> pos = reader_.read(posAcc, TINYGLTF_TYPE_VEC3, what + " POSITION");
+    size_t nverts = pos.size() / 3;
+    auto readSameCount = [&](int acc, int type, const char* key) {
+      std::vector<double> v = reader_.read(acc, type, what + " " + key);
+      if (reader_.count(acc) != nverts) {
+        fail(path_, what + ": " + key + " has " + std::to_string(reader_.count(acc)) +
+                        " elements, POSITION has " + std::to_string(nverts));
+      }
+      return v;
+    };
+    std::vector<double> nrm, uv0, uv1, tan, color;
+    if (attr("NORMAL") >= 0) nrm = readSameCount(attr("NORMAL"), TINYGLTF_TYPE_VEC3, "NORMAL");
+    if (attr("TANGENT") >= 0) tan = readSameCount(attr("TANGENT"), TINYGLTF_TYPE_VEC4, "TANGENT");
+    if (attr("TEXCOORD_0") >= 0)
+      uv0 = readSameCount(attr("TEXCOORD_0"), TINYGLTF_TYPE_VEC2, "TEXCOORD_0");
+    if (attr("TEXCOORD_1") >= 0)
+      uv1 = readSameCount(attr("TEXCOORD_1"), TINYGLTF_TYPE_VEC2, "TEXCOORD_1");
+    if (attr("COLOR_0") >= 0) {
+      // VEC3 or VEC4; floats, or normalized unsigned bytes or shorts (the
+      // reader scales those to [0, 1]).
+      const size_t acc = size_t(attr("COLOR_0"));
+      if (acc < model_.accessors.size() &&
+          model_.accessors[acc].componentType != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+          !model_.accessors[acc].normalized) {
+        fail(path_, what + ": COLOR_0 of integers must be normalized (glTF 2.0, meshes)");
+      }
+      const int type = acc < model_.accessors.size() &&
+                               model_.accessors[acc].type == TINYGLTF_TYPE_VEC3
+                           ? TINYGLTF_TYPE_VEC3
+                           : TINYGLTF_TYPE_VEC4;
+      color = readSameCount(attr("COLOR_0"), type, "COLOR_0");
+    }
+
+    std::vector<uint32_t> idx;
+    if (prim.indices >= 0) {
+      idx = reader_.readIndices(prim.indices, what + " indices");
+      for (uint32_t i : idx)
+        if (i >= nverts) {
+          fail(path_, what + ": vertex index " + std::to_string(i) + " out of range (" +
+                          std::to_string(nverts) + " vertices)");
+        }
+    } else {
+      idx.resize(nverts);
+      for (size_t i = 0; i < nverts; ++i) idx[i] = uint32_t(i);
+    }
+    std::vector<std::array<uint32_t, 3>> tris = triangulate(idx, mode);
+
+    int material = prim.material;
+    if (material < 0)
+      material = defaultMaterial();
+    else if (size_t(material) >= model_.materials.size())
+      fail(path_, what + ": material index " + std::to_string(material) + " out of range");
+
+    uint32_t base = uint32_t(scene_.positions.size());
+    if (uint64_t(base) + nverts > std::numeric_limits<uint32_t>::max()) {
+      fail(path_, "too many vertices for 32-bit indices");
+    }
+    for (size_t v = 0; v < nverts; ++v) {
+      const Vec3d pd =
+          world.pointInDouble({float(pos[3 * v]), float(pos[3 * v + 1]), float(pos[3 * v + 2])});
+      const Vec3 pw = pd.toVec3();
+      if (!isFinite(pw)) {
+        fail(path_, what + ": non-finite vertex position (vertex " + std::to_string(v) + ")");
+      }
+      scene_.positions.push_back(pw);
+      world_.vertices.push_back(pd);
+    }
+    // Normals / UV sets present on some primitives only: fill the others.
+    appendNormals(nrm, normalMatrix, nverts, base, tris, flip);
+    appendUv(scene_.texcoords0, hasUv0_, uv0, nverts, base);
+    appendUv(scene_.texcoords1, hasUv1_, uv1, nverts, base);
+    appendTangents(tan, world, nverts, base, flip);
+    appendColors(color, nverts, base, what);
+
+    for (auto& t : tris) {
+      if (flip) std::swap(t[1], t[2]);
+      for (uint32_t i : t) scene_.indices.push_back(base + i);
+      scene_.triangleMaterial.push_back(material);
+    }
+  }
+}
+
+std::vector<std::array<uint32_t, 3>> SceneBuilder::triangulate(const std::vector<uint32_t>& idx,
+                                                               int mode) {
+  std::vector<std::array<uint32_t, 3>> tris;
+  if (mode == TINYGLTF_MODE_TRIANGLES) {
+    for (size_t i = 0; i + 2 < idx.size(); i += 3)
+      tris.push_back({idx[i], idx[i + 1], idx[i + 2]});
+  } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+    for (size_t i = 0; i + 2 < idx.size(); ++i) {
+      if (i % 2 == 0)
+        tris.push_back({idx[i], idx[i + 1], idx[i + 2]});
+      else
+        tris.push_back({idx[i + 1], idx[i], idx[i + 2]});
+    }
+  } else {
+    for (size_t i = 1; i + 1 < idx.size(); ++i) tris.push_back({idx[i], idx[i + 1], idx[0]});
+  }
+  std::vector<std::array<uint32_t, 3>> kept;
+  kept.reserve(tris.size());
+  for (const auto& t : tris)
+    if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) kept.push_back(t);
+  return kept;
+}
+
+void SceneBuilder::appendNormals(const std::vector<double>& nrm, const Mat4& normalMatrix,
+                                 size_t nverts, uint32_t base,
+                                 const std::vector<std::array<uint32_t, 3>>& tris, bool flip) {
+  if (nrm.empty() && !hasNormals_) {
+    return;  // still no normals anywhere: Scene::normals stays empty
+  }
+  if (!hasNormals_) {
+    // The first primitive with normals: earlier primitives get their
+    // (area-weighted) vertex normals from their faces.
+    hasNormals_ = true;
+    scene_.normals.assign(base, Vec3{});
+    for (size_t t = 0; t < scene_.triangleCount(); ++t) {
+      Vec3 n = cross(
+          scene_.positions[scene_.indices[3 * t + 1]] - scene_.positions[scene_.indices[3 * t]],
+          scene_.positions[scene_.indices[3 * t + 2]] - scene_.positions[scene_.indices[3 * t]]);
+      for (int k = 0; k < 3; ++k) scene_.normals[scene_.indices[3 * t + size_t(k)]] += n;
+    }
+    for (Vec3& n : scene_.normals) n = normalize(n);
+  }
+  if (!nrm.empty()) {
+    for (size_t v = 0; v < nverts; ++v) {
+      Vec3 n = normalize(
+          normalMatrix.vector({float(nrm[3 * v]), float(nrm[3 * v + 1]), float(nrm[3 * v + 2])}));
+      if (!isFinite(n)) fail(path_, "non-finite vertex normal");
+      scene_.normals.push_back(n);
+    }
+  } else {
+    std::vector<Vec3> acc(nverts, Vec3{});
+    for (const auto& t : tris) {
+      const Vec3& a = scene_.positions[base + t[0]];
+      Vec3 n = cross(scene_.positions[base + t[1]] - a, scene_.positions[base + t[2]] - a);
+      if (flip) n = -n;
+      for (uint32_t i : t) acc[i] += n;
+    }
+    for (const Vec3& n : acc) scene_.normals.push_back(normalize(n));
+  }
+}
+
+void SceneBuilder::appendUv(std::vector<float>& dst, bool& has, const std::vector<double>& uv,
+                            size_t nverts, uint32_t base) {
+  if (uv.empty() && !has) return;
+  if (!has) {
+    has = true;
+    dst.assign(2 * size_t(base), 0.0f);
+  }
+  if (uv.empty()) {
+    dst.resize(dst.size() + 2 * nverts, 0.0f);
+  } else {
+    for (double x : uv) {
+      if (!std::isfinite(x)) fail(path_, "non-finite texture coordinate");
+      dst.push_back(float(x));
+    }
+  }
+}
+
+bool SceneBuilder::optionalAttribute(std::vector<float>& dst, bool& seen, bool present,
+                                     uint32_t base, size_t nverts, size_t width, float fill) {
+  if (!present && !seen) return false;
+  if (!seen) {
+    seen = true;
+    dst.assign(width * size_t(base), fill);
+  }
+  if (!present) dst.resize(dst.size() + width * nverts, fill);
+  return present;
+}
+
+void SceneBuilder::appendTangents(const std::vector<double>& tan, const Mat4& world, size_t nverts,
+                                  uint32_t base, bool flip) {
+  if (!optionalAttribute(scene_.tangents, hasTangents_, !tan.empty(), base, nverts, 4, 0.0f)) {
+    return;
+  }
+  for (size_t v = 0; v < nverts; ++v) {
+    Vec3 t = world.vector({float(tan[4 * v]), float(tan[4 * v + 1]), float(tan[4 * v + 2])});
+    const float w = float(tan[4 * v + 3]);
+    if (!isFinite(t) || !std::isfinite(w)) fail(path_, "non-finite vertex tangent");
+    const bool usable = lengthSquared(t) > 0 && w != 0;
+    t = usable ? normalize(t) : Vec3{0, 0, 0};
+    scene_.tangents.insert(scene_.tangents.end(),
+                           {t.x, t.y, t.z, usable ? ((w < 0) != flip ? -1.0f : 1.0f) : 0.0f});
+  }
+}
+
+void SceneBuilder::appendColors(const std::vector<double>& color, size_t nverts, uint32_t base,
+                                const std::string& what) {
+  if (!optionalAttribute(scene_.colors, hasColors_, !color.empty(), base, nverts, 4, 1.0f)) {
+    return;
+  }
+  const size_t channels = color.size() / nverts;  // 3 or 4
+  for (size_t v = 0; v < nverts; ++v) {
+    for (size_t a = 0; a < 4; ++a) {
+      const double c = a < channels ? color[channels * v + a] : 1.0;
+      if (!std::isfinite(c)) fail(path_, what + ": non-finite vertex colour (COLOR_0)");
+      scene_.colors.push_back(float(std::clamp(c, 0.0, 1.0)));
+    }
+  }
+}
+
+void SceneBuilder::finishVertexAttributes() {
+  LO_CHECK(!hasNormals_ || scene_.normals.size() == scene_.positions.size());
+}
+
+}  // namespace lo::scene_internal::gltf_internal
