@@ -5,7 +5,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <memory>
 
 #include "bake/bake.h"
 #include "bake/stats_json.h"
@@ -175,13 +174,7 @@ int runBake(const BakeOptions& opt) {
 }  // namespace
 
 std::function<int()> addBakeCommand(CLI::App& app) {
-  auto opt = std::make_shared<BakeOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "bake",
-      "Trace a photon map and compress it into a sparse grid of virtual directional lights "
-      "(VDLs), written as a .vdb file.");
-  addBakeOptions(cmd, *opt);
-  return [cmd, opt]() -> int { return cmd->parsed() ? runBake(*opt) : -1; };
+  return addCommand(app, "bake", addBakeOptions, runBake);
 }
 
 }  // namespace lo::tool

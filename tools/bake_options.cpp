@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "cli_checks.h"
+#include "command_options.h"
 #include "core/error.h"
 #include "core/resources.h"
 
@@ -57,6 +58,9 @@ BakeParams BakeOptions::bakeParams(const Scene& scene) const {
 }
 
 void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
+  cmd->description(
+      "Trace a photon map and compress it into a sparse grid of virtual directional lights "
+      "(VDLs), written as a .vdb file.");
   cmd->add_option("scene", opt.scene, "Scene to bake: .gltf, .glb or .obj")
       ->required()
       ->check(CLI::ExistingFile);
@@ -116,9 +120,7 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->capture_default_str();
   cmd->add_option("--seed", opt.seed, "Random seed (same seed, same bytes)")
       ->check(seedValidator())->capture_default_str();
-  cmd->add_option("--threads", opt.threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, 1024))
-      ->capture_default_str();
+  addThreadsOption(cmd, opt.threads)->capture_default_str();
   cmd->add_flag("--include-direct", opt.includeDirect,
                 "Also store direct-light photons (by default the GL renderer draws direct light)");
   cmd->add_option("--layers", opt.layers,

@@ -54,7 +54,7 @@ struct BakeOptions {
   BakeParams bakeParams(const Scene& scene) const;
 };
 
-/// Registers the flags of `bake` on `cmd`.
+/// Registers the description and the flags of `bake` on `cmd`.
 void addBakeOptions(CLI::App* cmd, BakeOptions& opt);
 
 }  // namespace lo::tool

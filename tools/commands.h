@@ -1,15 +1,28 @@
 #pragma once
 /// @file tools/commands.h
-/// @brief Subcommands of the lightoctree front end. Each registers its flags
-/// on the CLI11 app and returns the function that runs it.
+/// @brief Subcommands of the lightoctree front end. Each registers its
+/// description and flags on the CLI11 app and returns the function that runs
+/// it (addCommand).
 
+#include <CLI/CLI.hpp>
 #include <functional>
-
-namespace CLI {
-class App;
-}
+#include <memory>
+#include <string>
 
 namespace lo::tool {
+
+/// Adds the subcommand `name` to `app`, its description and flags
+/// registered by `addFlags` on an Options that the function returned keeps.
+/// That function runs `run` on them when the command line named this
+/// subcommand and returns its exit status, and returns -1 otherwise.
+template <class Options>
+std::function<int()> addCommand(CLI::App& app, const std::string& name,
+                                void (*addFlags)(CLI::App*, Options&), int (*run)(const Options&)) {
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(name);
+  addFlags(cmd, *opt);
+  return [cmd, opt, run]() -> int { return cmd->parsed() ? run(*opt) : -1; };
+}
 
 /// `lightoctree bake SCENE -o OUT.vdb ...`
 std::function<int()> addBakeCommand(CLI::App& app);

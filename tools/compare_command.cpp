@@ -3,7 +3,6 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
-#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
@@ -130,46 +129,47 @@ int runCompare(const CompareOptions& opt) {
   return 0;
 }
 
-}  // namespace
-
-std::function<int()> addCompareCommand(CLI::App& app) {
-  auto opt = std::make_shared<CompareOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "compare",
+void addCompareOptions(CLI::App* cmd, CompareOptions& opt) {
+  cmd->description(
       "Relative RMSE, relative mean absolute error and maximum error of a test image against "
       "a reference (per channel and luminance), a false-colour difference image, JSON.");
-  cmd->add_option("test", opt->test, "Test image (.exr, or .png decoded to linear)")
+  cmd->add_option("test", opt.test, "Test image (.exr, or .png decoded to linear)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("reference", opt->reference, "Reference image, e.g. from `lightoctree reference`")
+  cmd->add_option("reference", opt.reference, "Reference image, e.g. from `lightoctree reference`")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--mask", opt->mask,
+  cmd->add_option("--mask", opt.mask,
                   "Image of the same size; pixels that are 0 in every channel are left out")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--reference-error", opt->referenceError,
+  cmd->add_option("--reference-error", opt.referenceError,
                   "The reference's per-pixel standard error (`reference --std-error`): prints "
                   "its noise over the compared pixels (binned with --bin), the floor under the "
                   "error, and warns when the error measured is not above it")
       ->check(CLI::ExistingFile);
-  cmd->add_flag("--ignore-background", opt->ignoreBackground,
+  cmd->add_flag("--ignore-background", opt.ignoreBackground,
                 "Leave out pixels where the reference is exactly black");
-  cmd->add_option("--bin", opt->bin,
+  cmd->add_option("--bin", opt.bin,
                   "Average both images (and the mask) over blocks of N x N pixels first: the "
                   "error at the scale of N pixels, without the reference's per-pixel noise "
                   "(--diff is then at that resolution too)")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
-  cmd->add_option("--diff", opt->diff,
+  cmd->add_option("--diff", opt.diff,
                   "Write |Y(test) - Y(reference)| in false colour (.png or .exr): black 0, blue, "
                   "green, yellow, red at --diff-scale; ignored pixels grey");
-  cmd->add_option("--diff-scale", opt->diffScale,
+  cmd->add_option("--diff-scale", opt.diffScale,
                   "Error shown red in --diff, in the images' units (default: a quarter of the "
                   "mean reference luminance)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--json", opt->json, "Write the figures as JSON for scripts");
-  cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing (use with --json)");
-  return [cmd, opt]() -> int { return cmd->parsed() ? runCompare(*opt) : -1; };
+  cmd->add_option("--json", opt.json, "Write the figures as JSON for scripts");
+  cmd->add_flag("-q,--quiet", opt.quiet, "Print nothing (use with --json)");
+}
+
+}  // namespace
+
+std::function<int()> addCompareCommand(CLI::App& app) {
+  return addCommand(app, "compare", addCompareOptions, runCompare);
 }
 
 }  // namespace lo::tool

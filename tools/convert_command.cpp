@@ -6,12 +6,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <memory>
 #include <string>
 #include <vector>
 
 #include "bake/convert.h"
 #include "cli_checks.h"
+#include "command_options.h"
 #include "commands.h"
 #include "core/error.h"
 #include "core/file.h"
@@ -39,6 +39,42 @@ struct ConvertOptions {
   std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
+
+void addConvertOptions(CLI::App* cmd, ConvertOptions& opt) {
+  cmd->description(
+      "Convert a baked .vdb to another depth (merge children / interpolate parents, or re-gather "
+      "from a photon map), VDL count or storage.");
+  cmd->add_option("input", opt.input, "Baked VDL file (.vdb)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", opt.output, "Output .vdb file (written atomically)")->required();
+  cmd->add_option("--depth", opt.depth, "Output depth (default: the input's)")
+      ->check(depthValidator());
+  cmd->add_option(
+         "--vdls", opt.vdls,
+         "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + " or 'auto' (default: the input's)")
+      ->check(vdlCountValidator());
+  cmd->add_flag("--half", opt.half,
+                "Store irradiance, normal, VDL, angular_error and radius grids as half floats");
+  cmd->add_option("--drop", opt.drop,
+                  "Grids to leave out: the optional photon_count, noise, angular_error, radius, "
+                  "area, and the display grid density")
+      ->delimiter(',');
+  cmd->add_option("--scene", opt.scene,
+                  "The baked scene: needed for a finer --depth and for --photon-map")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--photon-map", opt.photonMap,
+                  "Photon file written by 'bake --photon-map': re-gather at the new depth")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--seed", opt.seed, "K-means seed")
+      ->check(seedValidator())
+      ->capture_default_str();
+  addThreadsOption(cmd, opt.threads);
+  cmd->add_option("--json", opt.json,
+                  "Also write a JSON report: the files read and written, depths, voxels, method, "
+                  "energy in and out (README.md, \"Scripting\")");
+  cmd->add_flag("-q,--quiet", opt.quiet, "No progress or summary, only errors");
+}
 
 int runConvert(const ConvertOptions& opt) {
   checkOutputFolder(opt.output, "--output");
@@ -127,40 +163,7 @@ int runConvert(const ConvertOptions& opt) {
 }  // namespace
 
 std::function<int()> addConvertCommand(CLI::App& app) {
-  auto opt = std::make_shared<ConvertOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "convert",
-      "Convert a baked .vdb to another depth (merge children / interpolate parents, or re-gather "
-      "from a photon map), VDL count or storage.");
-  cmd->add_option("input", opt->input, "Baked VDL file (.vdb)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", opt->output, "Output .vdb file (written atomically)")->required();
-  cmd->add_option("--depth", opt->depth, "Output depth (default: the input's)")
-      ->check(depthValidator());
-  cmd->add_option("--vdls", opt->vdls, "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + " or 'auto' (default: the input's)")
-      ->check(vdlCountValidator());
-  cmd->add_flag("--half", opt->half,
-                "Store irradiance, normal, VDL, angular_error and radius grids as half floats");
-  cmd->add_option("--drop", opt->drop,
-                  "Grids to leave out: the optional photon_count, noise, angular_error, radius, "
-                  "area, and the display grid density")
-      ->delimiter(',');
-  cmd->add_option("--scene", opt->scene,
-                  "The baked scene: needed for a finer --depth and for --photon-map")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--photon-map", opt->photonMap,
-                  "Photon file written by 'bake --photon-map': re-gather at the new depth")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--seed", opt->seed, "K-means seed")
-      ->check(seedValidator())->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, 1024));
-  cmd->add_option("--json", opt->json,
-                  "Also write a JSON report: the files read and written, depths, voxels, method, "
-                  "energy in and out (README.md, \"Scripting\")");
-  cmd->add_flag("-q,--quiet", opt->quiet, "No progress or summary, only errors");
-  return [cmd, opt]() -> int { return cmd->parsed() ? runConvert(*opt) : -1; };
+  return addCommand(app, "convert", addConvertOptions, runConvert);
 }
 
 }  // namespace lo::tool

@@ -4,7 +4,6 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -115,17 +114,18 @@ int runInspect(const InspectOptions& opt) {
   return r.ok() ? 0 : kChecksFailed;
 }
 
+void addInspectOptions(CLI::App* cmd, InspectOptions& opt) {
+  cmd->description(
+      "List a .vdb file's grids, metadata, value ranges and memory, and check the VDL contract "
+      "(exit 0: checks pass, 3: a check failed, 1: unreadable file, 2: bad command line).");
+  cmd->add_option("input", opt.input, ".vdb file")->required()->check(CLI::ExistingFile);
+  cmd->add_flag("--json", opt.json, "Print the report as JSON");
+}
+
 }  // namespace
 
 std::function<int()> addInspectCommand(CLI::App& app) {
-  auto opt = std::make_shared<InspectOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "inspect",
-      "List a .vdb file's grids, metadata, value ranges and memory, and check the VDL contract "
-      "(exit 0: checks pass, 3: a check failed, 1: unreadable file, 2: bad command line).");
-  cmd->add_option("input", opt->input, ".vdb file")->required()->check(CLI::ExistingFile);
-  cmd->add_flag("--json", opt->json, "Print the report as JSON");
-  return [cmd, opt]() -> int { return cmd->parsed() ? runInspect(*opt) : -1; };
+  return addCommand(app, "inspect", addInspectOptions, runInspect);
 }
 
 }  // namespace lo::tool

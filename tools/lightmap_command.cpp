@@ -4,16 +4,16 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <memory>
 
+#include "command_options.h"
 #include "commands.h"
-#include "bake/bake.h"
-#include "scene_options.h"
 #include "core/file.h"
 #include "export/lightmap_export.h"
 #include "json_report.h"
+#include "render_stages.h"
 #include "report.h"
 #include "scene/scene.h"
+#include "scene_options.h"
 
 namespace lo::tool {
 namespace {
@@ -38,12 +38,11 @@ struct LightmapOptions {
   bool quiet = false;
 };
 
-/// The export's parameters from the flags, checked before any work.
-LightmapExportParams exportParams(const LightmapOptions& opt) {
+/// The export's parameters from the flags, checked before any work against
+/// the files the command reads, `inputs`.
+LightmapExportParams exportParams(const LightmapOptions& opt, const NamedPaths& inputs) {
   checkOutputFolder(opt.output, "--output");
   checkLightmapExportPath(opt.output, "--output");
-  NamedPaths inputs = sceneInputs(opt.scene);
-  inputs.push_back({"LIGHTS", opt.lights});
   checkLightmapOutputs(opt.output, opt.previewUnlit, inputs);
   if (!opt.json.empty()) {
     checkOutputFolder(opt.json, "--json");
@@ -69,34 +68,31 @@ LightmapExportParams exportParams(const LightmapOptions& opt) {
 nlohmann::json lightmapFigures(const LightmapExportResult& r, const LightmapExportParams& params) {
   const LightmapUvs& uvs = r.lightmap.uvs;
   const LightmapAtlas& atlas = r.lightmap.atlas;
-  nlohmann::json pages = nlohmann::json::array();
-  for (const std::string& path : r.pagePaths) pages.push_back(path);
-  nlohmann::json directions = nlohmann::json::array();
-  for (const std::string& path : r.directionPaths) directions.push_back(path);
-  return {{"uvs", r.lightmap.fromTexcoord1 ? "texcoord1" : "charts"},
-          {"charts", uvs.chartCount},
-          {"pages", atlas.pageCount},
-          {"page_size", {atlas.width, atlas.height}},
-          {"texel_size", uvs.texelSize},
-          {"utilisation", uvs.utilisation},
-          {"covered_texels", atlas.coveredTexels},
-          {"dilated_texels", atlas.dilatedTexels},
-          {"seam_mismatch", {{"before", atlas.seamMismatchBefore}, {"after", atlas.seamMismatchAfter}}},
-          {"content", toString(params.content)},
-          {"encoding", params.rgbm ? "rgbm-png" : "linear-exr"},
-          {"rgbm_range", params.rgbm ? nlohmann::json(r.rgbmRange) : nlohmann::json(nullptr)},
-          {"page_files", pages},
-          {"direction_files", directions},
-          {"gltf", r.output},
-          {"preview", r.previewPath.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.previewPath)},
-          {"octree_bytes", r.octreePoolBytes + r.octreeVdlBytes}};
+  return {
+      {"uvs", r.lightmap.fromTexcoord1 ? "texcoord1" : "charts"},
+      {"charts", uvs.chartCount},
+      {"pages", atlas.pageCount},
+      {"page_size", {atlas.width, atlas.height}},
+      {"texel_size", uvs.texelSize},
+      {"utilisation", uvs.utilisation},
+      {"covered_texels", atlas.coveredTexels},
+      {"dilated_texels", atlas.dilatedTexels},
+      {"seam_mismatch", {{"before", atlas.seamMismatchBefore}, {"after", atlas.seamMismatchAfter}}},
+      {"content", toString(params.content)},
+      {"encoding", params.rgbm ? "rgbm-png" : "linear-exr"},
+      {"rgbm_range", params.rgbm ? nlohmann::json(r.rgbmRange) : nlohmann::json(nullptr)},
+      {"page_files", r.pagePaths},
+      {"direction_files", r.directionPaths},
+      {"gltf", r.output},
+      {"preview", r.previewPath.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.previewPath)},
+      {"octree_bytes", r.octreePoolBytes + r.octreeVdlBytes}};
 }
 
 int runLightmap(const LightmapOptions& opt) {
-  LightmapExportParams params = exportParams(opt);
-  std::vector<StageReport> rows;
   NamedPaths inputs = sceneInputs(opt.scene);
   inputs.push_back({"LIGHTS", opt.lights});
+  LightmapExportParams params = exportParams(opt, inputs);
+  std::vector<StageReport> rows;
   if (!opt.json.empty()) {
     // The report goes into the export's set: it appears with the files or not at all.
     params.beforeCommit = [&](const LightmapExportResult& r, AtomicFileSet& set) {
@@ -113,122 +109,91 @@ int runLightmap(const LightmapOptions& opt) {
                    std::to_string(scene.materials.size()) + " materials");
 
   const LightmapExportResult r = exportLightmap(scene, opt.lights, params);
-  const std::string stale = staleBakeWarning(r.gridMetadata, opt.scene);
-  if (!stale.empty()) std::fprintf(stderr, "warning: %s: %s\n", opt.lights.c_str(), stale.c_str());
+  warnIfStale(r.gridMetadata, opt.scene, opt.lights);
   if (opt.quiet) return 0;
   if (params.atlasGl) std::printf("%s: %s\n", opt.atlasOn.c_str(), r.glInfo.c_str());
   rows.insert(rows.end(), r.stages.begin(), r.stages.end());
   printSummary(stdout, rows);
-  const LightmapUvs& uvs = r.lightmap.uvs;
-  const LightmapAtlas& atlas = r.lightmap.atlas;
-  const size_t texels = size_t(atlas.width) * size_t(atlas.height) * size_t(atlas.pageCount);
-  std::printf(
-      "\nUVs: %s, %d charts, %d page(s) of %d x %d, utilisation %.3f, worst stretch %.3f, "
-      "texel %s scene units\n",
-      r.lightmap.fromTexcoord1 ? "TEXCOORD_1" : "automatic charts", uvs.chartCount, uvs.pageCount,
-      uvs.width, uvs.height, double(uvs.utilisation), double(uvs.worstStretch),
-      formatNumber(uvs.texelSize).c_str());
-  std::printf("atlas: %s covered + %s dilated texels of %s; seams %s -> %s W/m^2\n",
-              formatCount(atlas.coveredTexels).c_str(), formatCount(atlas.dilatedTexels).c_str(),
-              formatCount(texels).c_str(), formatNumber(atlas.seamMismatchBefore).c_str(),
-              formatNumber(atlas.seamMismatchAfter).c_str());
-  std::printf(
-      "memory: atlas %s as RGB32F textures (%s as RGBM8), %s in files; octree %s "
-      "(pool %s + VDLs %s)\n",
-      formatBytes(texels * 12).c_str(), formatBytes(texels * 4).c_str(),
-      formatBytes(r.pageFileBytes).c_str(),
-      formatBytes(r.octreePoolBytes + r.octreeVdlBytes).c_str(),
-      formatBytes(r.octreePoolBytes).c_str(), formatBytes(r.octreeVdlBytes).c_str());
-  if (params.rgbm) std::printf("RGBM range: %s W/m^2\n", formatNumber(r.rgbmRange).c_str());
-  for (const std::string& path : r.pagePaths) std::printf("wrote %s\n", path.c_str());
-  for (const std::string& path : r.directionPaths) std::printf("wrote %s (directions)\n", path.c_str());
-  std::printf("wrote %s (%s)\n", r.output.c_str(), formatBytes(r.outputBytes).c_str());
-  if (params.preview) {
-    std::printf("wrote %s (%s, unlit preview)\n", r.previewPath.c_str(),
-                formatBytes(r.previewBytes).c_str());
-  }
-  for (const std::string& path : r.chartPaths) std::printf("wrote %s (chart layout)\n", path.c_str());
+  std::printf("\n%s", lightmapExportSummary(r, params).c_str());
   return 0;
 }
 
-}  // namespace
-
-std::function<int()> addLightmapCommand(CLI::App& app) {
-  auto opt = std::make_shared<LightmapOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "lightmap",
+void addLightmapOptions(CLI::App* cmd, LightmapOptions& opt) {
+  cmd->description(
       "Bake the light octree into lightmap atlases and export the scene as glTF 2.0 with "
       "lightmap UVs (TEXCOORD_1) and the atlas pages beside it, referenced from each material's "
       "extras.lightmap (docs/lightmap.md).");
-  cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
-      ->required()
-      ->check(CLI::ExistingFile);
-  addSceneOptions(cmd, opt->sceneOptions);
-  cmd->add_option("lights", opt->lights, "Baked VDL grid (.vdb from `lightoctree bake`)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", opt->output,
+  addSceneArgument(cmd, opt.scene);
+  addSceneOptions(cmd, opt.sceneOptions);
+  addLightsArgument(cmd, opt.lights)->required();
+  cmd->add_option("-o,--output", opt.output,
                   "glTF to write: .glb (one file) or .gltf (+ OUT.bin); the atlas pages go beside "
                   "it as OUT-lightmapN.exr or .png")
       ->required();
-  cmd->add_option("--texel-size", opt->texelSize,
+  cmd->add_option("--texel-size", opt.texelSize,
                   "Scene units per lightmap texel (automatic charts only; default: a quarter of "
                   "the octree's voxel, which holds nothing finer)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--atlas", opt->atlas,
+  cmd->add_option("--atlas", opt.atlas,
                   "Largest atlas page in texels (width = height): charts go on the smallest page "
                   "that holds them, up to this size, then on more pages")
       ->check(CLI::Range(8, 16384))
       ->capture_default_str();
-  cmd->add_option("--uv", opt->uv,
+  cmd->add_option("--uv", opt.uv,
                   "Lightmap UVs: texcoord1 (the scene's TEXCOORD_1, which must lie in [0, 1] "
                   "without overlaps) or auto (automatic charts, LSCM, packed). Default: "
                   "TEXCOORD_1 when the scene has one (an invalid one is an error), else auto")
       ->check(CLI::IsMember({"auto", "texcoord1"}));
-  cmd->add_option("--content", opt->content,
+  cmd->add_option("--content", opt.content,
                   "What the atlas holds: indirect (the light octree) or full (the direct light "
                   "too, ray traced with soft shadows: one complete lightmap for engines)")
       ->check(CLI::IsMember({"indirect", "full"}))
       ->capture_default_str();
-  cmd->add_option("--direct-samples", opt->directSamples,
+  cmd->add_option("--direct-samples", opt.directSamples,
                   "With --content full: emitter samples per texel (shadow rays; punctual lights "
                   "take one each)")
       ->check(CLI::Range(1, 65536))
       ->capture_default_str();
-  cmd->add_option("--image", opt->image,
+  cmd->add_option("--image", opt.image,
                   "Page images: exr (linear 32-bit float irradiance, W/m^2) or png (RGBM in "
                   "8-bit RGBA, range recorded in extras.lightmap.rgbmRange)")
       ->check(CLI::IsMember({"exr", "png"}))
       ->capture_default_str();
-  cmd->add_flag("--preview-unlit", opt->previewUnlit,
+  cmd->add_flag("--preview-unlit", opt.previewUnlit,
                 "Also write OUT-preview.glb: every material KHR_materials_unlit with the baked "
                 "radiance (albedo / pi * E + emission) as its base colour, for any glTF viewer");
-  cmd->add_option("--exposure", opt->exposure,
+  cmd->add_option("--exposure", opt.exposure,
                   "Exposure of the unlit preview in EV (radiance * 2^EV before the sRGB curve)")
       ->check(CLI::Range(-30.0f, 30.0f))
       ->capture_default_str();
-  cmd->add_option("--atlas-on", opt->atlasOn,
+  cmd->add_option("--atlas-on", opt.atlasOn,
                   "Where the octree is rendered into the atlas: cpu (the C++ lookup; the same "
                   "bytes on every machine), osmesa (OpenGL in software) or egl (a GPU, "
                   "headless): the scene shader's lookup run per texel (paper 4.2.3)")
       ->check(CLI::IsMember({"cpu", "osmesa", "egl"}))
       ->capture_default_str();
-  cmd->add_option("--directions", opt->directions,
-                  "Also write OUT-directionN.png beside each page: the mean direction the light "
-                  "comes from per texel (world space, 8-bit unit vectors, extras.lightmap.direction), "
-                  "so viewers shade normal maps and gloss from the lightmap (on) or not (off); "
-                  "never with --content full, whose E holds direct light from other directions")
+  cmd->add_option(
+         "--directions", opt.directions,
+         "Also write OUT-directionN.png beside each page: the mean direction the light "
+         "comes from per texel (world space, 8-bit unit vectors, extras.lightmap.direction), "
+         "so viewers shade normal maps and gloss from the lightmap (on) or not (off); "
+         "never with --content full, whose E holds direct light from other directions")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
-  cmd->add_flag("--chart-image", opt->chartImage,
+  cmd->add_flag("--chart-image", opt.chartImage,
                 "Also write OUT-chartsN.png: each page's UV layout, one colour per chart, chart "
                 "borders darker (v = 0 is the top row)");
-  cmd->add_option("--json", opt->json,
-                  "Also write a JSON report: the files read and written (pages, glTF, preview), the "
-                  "RGBM range, page count and size, time and memory per stage (README.md, "
-                  "\"Scripting\"); written with the other files, as one set");
-  cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
-  return [cmd, opt]() -> int { return cmd->parsed() ? runLightmap(*opt) : -1; };
+  cmd->add_option("--json", opt.json,
+                  "Also write a JSON report: the files read and written (pages, glTF, "
+                  "preview), the RGBM range, page count and size, time and memory per stage "
+                  "(README.md, \"Scripting\"); written with the other files, as one set");
+  cmd->add_flag("-q,--quiet", opt.quiet, "Only errors");
+}
+
+}  // namespace
+
+std::function<int()> addLightmapCommand(CLI::App& app) {
+  return addCommand(app, "lightmap", addLightmapOptions, runLightmap);
 }
 
 }  // namespace lo::tool

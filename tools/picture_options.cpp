@@ -3,9 +3,11 @@
 #include <CLI/CLI.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "core/error.h"
+#include "core/file.h"
 
 namespace lo::tool {
 
@@ -38,6 +40,10 @@ void addPictureOptions(CLI::App* cmd, PictureOptions& opt) {
                   "kept, highlights rolled off below white) or clamp (each channel cut at 1)")
       ->check(CLI::IsMember({"neutral", "clamp"}))
       ->capture_default_str();
+}
+
+void printPicture(const std::string& output, const ToneReport& tone, bool quiet) {
+  if (!quiet && hasExtension(output, ".png")) std::printf("picture: %s\n", tone.ToString().c_str());
 }
 
 }  // namespace lo::tool

@@ -26,4 +26,8 @@ struct PictureOptions {
 /// Registers --exposure and --tone-map on `cmd`.
 void addPictureOptions(CLI::App* cmd, PictureOptions& opt);
 
+/// "picture: ..." (how the PNG was exposed, what share clips) on stdout when
+/// `output` is a PNG, unless `quiet`.
+void printPicture(const std::string& output, const ToneReport& tone, bool quiet);
+
 }  // namespace lo::tool

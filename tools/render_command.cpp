@@ -5,30 +5,27 @@
 #include <memory>
 
 #include "camera_options.h"
-#include "picture_options.h"
-#include "render_options.h"
-#include "scene_options.h"
+#include "command_options.h"
 #include "commands.h"
+#include "core/error.h"
 #include "core/file.h"
 #include "core/file_set.h"
-#include "core/error.h"
-#include "bake/bake.h"
+#include "image/image.h"
+#include "json_report.h"
+#include "picture_options.h"
 #include "reference/first_hit.h"
 #include "render/context.h"
 #include "render/render_session.h"
-#include "json_report.h"
-#include "report.h"
-#include "image/image.h"
+#include "render_options.h"
+#include "render_stages.h"
 #include "scene/scene.h"
+#include "scene_options.h"
 #include "vdb/vdb_io.h"
 
 namespace lo::tool {
 namespace {
 
-struct RenderOptions {
-  std::string scene;
-  SceneOptions sceneOptions;  // --sky
-  AddedObjects objects;       // --add, --at
+struct RenderOptions : SceneFlags {
   std::string lights;
   std::string output;
   CameraOptions camera;
@@ -42,13 +39,6 @@ struct RenderOptions {
   std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
-
-/// Mean Rec. 709 luminance of a linear image (the report's figure).
-double meanLuminance(const RgbImage& image) {
-  double sum = 0;
-  for (size_t i = 0; i < image.pixelCount(); ++i) sum += double(luminance(image.at(i)));
-  return image.pixelCount() ? sum / double(image.pixelCount()) : 0.0;
-}
 
 /// Writes the image and, with --json, the report, as one set; says how the
 /// PNG was exposed and what share of it clips.
@@ -72,7 +62,7 @@ void writeRenderOutputs(const RenderOptions& opt, const RgbImage& image, JsonRep
     report.addTo(outputs, opt.json, rows);
   }
   outputs.commit();
-  if (png && !opt.quiet) std::printf("picture: %s\n", tone.ToString().c_str());
+  printPicture(opt.output, tone, opt.quiet);
 }
 
 /// `--mode irradiance`: the octree's indirect irradiance at the first hit,
@@ -96,7 +86,7 @@ int renderIrradiance(const RenderOptions& opt, const Scene& scene, const LoadedV
   StageTimer renderTimer(rows, "render");
   // No GL context to ask: the octrees within the GL 3.3 limits we render with.
   const LookupOctrees octrees = buildLookupOctrees(scene, baked.grid, settings, opt.lights);
-  for (const std::string& w : octrees.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  printWarnings(octrees.warnings);
   if (!opt.quiet) std::printf("octree: %s\n", octrees.surface.ToString().c_str());
   const RgbImage image = renderOctreeIrradiance(scene, camera, octrees.surface, octrees.volume,
                                                 shadeParamsOf(settings.frame), hits);
@@ -120,17 +110,8 @@ int runRender(const RenderOptions& opt) {
   }
   checkCameraOptions(opt.camera);
   (void)opt.picture.toneParams();  // a bad --exposure is refused before the work
-  StageTimer loadTimer(rows, "load scene");
-  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
-  placeObjects(scene, opt.objects);
-  printSceneWarnings(scene);
-  loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
-                   std::to_string(scene.textures.size()) + " textures");
-  StageTimer readTimer(rows, "read grid");
-  LoadedVdl baked = readVdlGrid(opt.lights, scene.origin);
-  readTimer.finish(formatCount(baked.grid.size()) + " voxels");
-  const std::string stale = staleBakeWarning(baked.meta, opt.scene);
-  if (!stale.empty()) std::fprintf(stderr, "warning: %s: %s\n", opt.lights.c_str(), stale.c_str());
+  Scene scene = loadSceneStage(opt, rows);
+  LoadedVdl baked = readLightsStage(opt.lights, scene, opt.scene, rows);
   if (opt.mode == "irradiance") return renderIrradiance(opt, scene, baked, report, rows);
   const RenderSettings settings =
       opt.shading.settings(parseRenderMode(opt.mode), opt.width, opt.height);
@@ -144,24 +125,15 @@ int runRender(const RenderOptions& opt) {
                  opt.lights.c_str(), opt.mode.c_str());
   }
 
-  StageTimer contextTimer(rows, "GL context");
   GlContextParams contextParams;
   contextParams.backend = parseGlBackend(opt.backend);
-  std::unique_ptr<GlContext> context = createGlContext(contextParams);
-  contextTimer.finish(opt.backend);
-  if (!opt.quiet) std::printf("%s: %s\n", opt.backend.c_str(), context->info().ToString().c_str());
-  report.figures["gl"] = context->info().ToString();
+  std::unique_ptr<GlContext> context =
+      openContextStage(contextParams, opt.backend, opt.quiet, report, rows);
 
   RenderSessionOptions sessionOptions;
   sessionOptions.gridName = opt.lights;
   RenderSession session(scene, std::move(baked.grid), *context, settings, sessionOptions);
-  rows.insert(rows.end(), session.stages().begin(), session.stages().end());
-  printWarnings(session);
-  if (!opt.quiet) {
-    std::printf("octree: %s\n", session.octreeSummary().c_str());
-    if (!session.atlasSummary().empty()) std::printf("atlas: %s\n", session.atlasSummary().c_str());
-  }
-  report.figures["octree"] = session.octreeSummary();
+  reportSession(session, /*showOctree=*/true, opt.quiet, report, rows);
   Renderer& renderer = session.renderer();
   StageTimer frameTimer(rows, "first frame");
   RgbImage image = renderer.render(camera, params);
@@ -179,56 +151,46 @@ int runRender(const RenderOptions& opt) {
   return 0;
 }
 
-}  // namespace
-
-std::function<int()> addRenderCommand(CLI::App& app) {
-  auto opt = std::make_shared<RenderOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "render",
+void addRenderOptions(CLI::App* cmd, RenderOptions& opt) {
+  cmd->description(
       "Render a scene lit by its baked light octree (GPU octree of VDLs) plus direct light, "
       "headless, to a PNG or EXR image.");
-  cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
-      ->required()
-      ->check(CLI::ExistingFile);
-  addSceneOptions(cmd, opt->sceneOptions);
-  addObjectOptions(cmd, opt->objects);
-  cmd->add_option("lights", opt->lights, "Baked VDL grid (.vdb from `lightoctree bake`)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", opt->output,
+  addSceneFlags(cmd, opt);
+  addLightsArgument(cmd, opt.lights)->required();
+  cmd->add_option("-o,--output", opt.output,
                   "Image: .exr (linear float radiance) or .png (--exposure, --tone-map, sRGB)")
       ->required();
-  addCameraOptions(cmd, opt->camera);
-  cmd->add_option("--width", opt->width, "Image width in pixels")
-      ->check(CLI::Range(1, kMaxImageSide))
-      ->capture_default_str();
-  cmd->add_option("--height", opt->height, "Image height in pixels")
-      ->check(CLI::Range(1, kMaxImageSide))
-      ->capture_default_str();
-  cmd->add_option("--mode", opt->mode,
+  addCameraOptions(cmd, opt.camera);
+  addSizeOptions(cmd, opt.width, opt.height);
+  cmd->add_option("--mode", opt.mode,
                   "full | direct (emission + lights) | indirect (octree only) | voxels | "
                   "irradiance (the octree's indirect irradiance at the first hit, W/m^2, "
                   "on the CPU: compares with `reference --part irradiance`)")
       ->check(CLI::IsMember({"full", "direct", "indirect", "voxels", "irradiance"}))
       ->capture_default_str();
-  addShadingOptions(cmd, opt->shading, false);
-  addPictureOptions(cmd, opt->picture);
-  cmd->add_option("--backend", opt->backend, "Headless OpenGL: osmesa (software) or egl")
+  addShadingOptions(cmd, opt.shading, false);
+  addPictureOptions(cmd, opt.picture);
+  cmd->add_option("--backend", opt.backend, "Headless OpenGL: osmesa (software) or egl")
       ->check(CLI::IsMember({"osmesa", "egl"}))
       ->capture_default_str();
-  cmd->add_option("--json", opt->json,
+  cmd->add_option("--json", opt.json,
                   "Also write a JSON report: the files read and written, the figures printed, "
                   "time and memory per stage (README.md, \"Scripting\")");
-  cmd->add_option("--frames", opt->frames,
+  cmd->add_option("--frames", opt.frames,
                   "Also time this many frames (no read-back) and print the mean frame time")
       ->check(CLI::Range(0, 100000));
-  cmd->add_option("--spp", opt->irradianceSpp,
+  cmd->add_option("--spp", opt.irradianceSpp,
                   "--mode irradiance: camera rays per pixel, averaged as the reference averages "
                   "its samples (pixels across an edge need many)")
       ->check(CLI::Range(1, 4096))
       ->capture_default_str();
-  cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
-  return [cmd, opt]() -> int { return cmd->parsed() ? runRender(*opt) : -1; };
+  cmd->add_flag("-q,--quiet", opt.quiet, "Only errors");
+}
+
+}  // namespace
+
+std::function<int()> addRenderCommand(CLI::App& app) {
+  return addCommand(app, "render", addRenderOptions, runRender);
 }
 
 }  // namespace lo::tool

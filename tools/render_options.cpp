@@ -33,8 +33,8 @@ RenderSettings ShadingOptions::settings(RenderMode mode, int width, int height) 
   return s;
 }
 
-void printWarnings(const RenderSession& session) {
-  for (const std::string& w : session.warnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
+void printWarnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 }
 
 CLI::Validator onOff() { return CLI::IsMember({"on", "off"}); }

@@ -7,6 +7,7 @@
 /// draw the same picture from the same flags as the Python module does.
 
 #include <string>
+#include <vector>
 
 #include "render/render_session.h"
 
@@ -60,7 +61,8 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window);
 /// "on" | "off".
 CLI::Validator onOff();
 
-/// Prints the session's warnings ("warning: ..." on stderr).
-void printWarnings(const RenderSession& session);
+/// Prints a session's (or the lookup octrees') warnings, "warning: ..." on
+/// stderr.
+void printWarnings(const std::vector<std::string>& warnings);
 
 }  // namespace lo::tool

@@ -12,6 +12,12 @@
 
 namespace lo::tool {
 
+void addSceneArgument(CLI::App* cmd, std::string& scene) {
+  cmd->add_option("scene", scene, "Scene: .gltf, .glb or .obj")
+      ->required()
+      ->check(CLI::ExistingFile);
+}
+
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
   cmd->add_option("--sky", opt.sky,
                   "Light the scene with a uniform sky over the upper hemisphere (+Y): radiance "
@@ -129,6 +135,18 @@ void placeObjects(Scene& scene, const AddedObjects& opt) {
     }
     placeModel(scene, std::move(model), placement);
   }
+}
+
+void addSceneFlags(CLI::App* cmd, SceneFlags& opt) {
+  addSceneArgument(cmd, opt.scene);
+  addSceneOptions(cmd, opt.sceneOptions);
+  addObjectOptions(cmd, opt.objects);
+}
+
+Scene loadSceneWith(const SceneFlags& opt) {
+  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
+  placeObjects(scene, opt.objects);
+  return scene;
 }
 
 }  // namespace lo::tool

@@ -25,6 +25,10 @@ struct SceneOptions {
   float physicalSky = 0; ///< turbidity of a daylight sky for the scene's sun; 0 = none
 };
 
+/// Registers the SCENE argument (required, an existing .gltf, .glb or .obj)
+/// on `cmd`; `bake` has its own wording.
+void addSceneArgument(CLI::App* cmd, std::string& scene);
+
 /// Registers --sky, --sky-image, --sky-mesh and --physical-sky on `cmd`.
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt);
 
@@ -52,5 +56,20 @@ void addObjectOptions(CLI::App* cmd, AddedObjects& opt);
 /// (scene/place_model.h). @throws InputError naming the flag when the counts
 /// differ, a placement does not parse or a model does not load.
 void placeObjects(Scene& scene, const AddedObjects& opt);
+
+/// What `render`, `view` and `reference` load alike: SCENE, lit as the --sky
+/// flags say, with the --add objects placed in it.
+struct SceneFlags {
+  std::string scene;
+  SceneOptions sceneOptions;  // --sky
+  AddedObjects objects;       // --add, --at
+};
+
+/// Registers SCENE (addSceneArgument), the --sky flags and --add, --at on `cmd`.
+void addSceneFlags(CLI::App* cmd, SceneFlags& opt);
+
+/// loadSceneWith with the --add objects placed. @throws as loadSceneWith and
+/// placeObjects.
+Scene loadSceneWith(const SceneFlags& opt);
 
 }  // namespace lo::tool

@@ -3,13 +3,14 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
-#include <memory>
 
 #include "cli_checks.h"
+#include "command_options.h"
 #include "commands.h"
 #include "core/error.h"
 #include "core/file.h"
 #include "report.h"
+#include "scene_options.h"
 #include "sweep/sweep.h"
 
 namespace lo::tool {
@@ -52,41 +53,38 @@ int runSweepCommand(const SweepOptions& opt) {
   return 0;
 }
 
-}  // namespace
-
-std::function<int()> addSweepCommand(CLI::App& app) {
-  auto opt = std::make_shared<SweepOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "sweep",
+void addSweepOptions(CLI::App* cmd, SweepOptions& opt) {
+  cmd->description(
       "Measure the speed/accuracy trade: bake at settings around the paper's (depth, photons, "
       "KNN k, radius, VDLs, interpolation, half floats), compare each with a path-traced "
       "reference, write a table, CSV and plots with the Pareto front.");
-  cmd->add_option("scene", opt->scene, "Scene: .gltf, .glb or .obj")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--out", opt->out,
+  addSceneArgument(cmd, opt.scene);
+  cmd->add_option("--out", opt.out,
                   "Results folder (created); bakes and images go to its cache/ subfolder, "
                   "which a rerun reuses")
       ->required();
-  cmd->add_flag("--quick", opt->quick, "A reduced sweep: fewer points, smaller images");
-  cmd->add_flag("--tiny", opt->tiny, "Three tiny points (a smoke test)")->group("");
-  cmd->add_option("--width", opt->width, "Image width (default: 160, quick 96)")
+  cmd->add_flag("--quick", opt.quick, "A reduced sweep: fewer points, smaller images");
+  cmd->add_flag("--tiny", opt.tiny, "Three tiny points (a smoke test)")->group("");
+  cmd->add_option("--width", opt.width, "Image width (default: 160, quick 96)")
       ->check(CLI::Range(1, 4096));
-  cmd->add_option("--height", opt->height, "Image height (default: 120, quick 72)")
+  cmd->add_option("--height", opt.height, "Image height (default: 120, quick 72)")
       ->check(CLI::Range(1, 4096));
-  cmd->add_option("--spp", opt->spp, "Reference samples per pixel (default: 8192, quick 2048)")
+  cmd->add_option("--spp", opt.spp, "Reference samples per pixel (default: 8192, quick 2048)")
       ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--frames", opt->frames,
+  cmd->add_option("--frames", opt.frames,
                   "Frames timed per point with OSMesa (0: no GL render; default 5, quick 2)")
       ->check(CLI::Range(0, 1000));
-  cmd->add_option("--threads", opt->threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, 1024))
-      ->capture_default_str();
-  cmd->add_option("--seed", opt->seed, "Random seed of bakes and references")
+  addThreadsOption(cmd, opt.threads)->capture_default_str();
+  cmd->add_option("--seed", opt.seed, "Random seed of bakes and references")
       ->check(seedValidator())
       ->capture_default_str();
-  cmd->add_flag("-q,--quiet", opt->quiet, "Only errors");
-  return [cmd, opt]() -> int { return cmd->parsed() ? runSweepCommand(*opt) : -1; };
+  cmd->add_flag("-q,--quiet", opt.quiet, "Only errors");
+}
+
+}  // namespace
+
+std::function<int()> addSweepCommand(CLI::App& app) {
+  return addCommand(app, "sweep", addSweepOptions, runSweepCommand);
 }
 
 }  // namespace lo::tool

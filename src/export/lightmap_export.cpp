@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -237,6 +239,26 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
   return result;
 }
 
+/// printf's `format` of the arguments, appended to `text`.
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+void appendf(std::string& text, const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  va_list again;
+  va_copy(again, args);
+  const int size = std::vsnprintf(nullptr, 0, format, args);
+  va_end(args);
+  if (size > 0) {
+    const size_t at = text.size();
+    text.resize(at + size_t(size) + 1);
+    std::vsnprintf(&text[at], size_t(size) + 1, format, again);
+    text.resize(at + size_t(size));
+  }
+  va_end(again);
+}
+
 }  // namespace lightmap_export_internal
 
 AtlasContent parseAtlasContent(const std::string& name) {
@@ -314,6 +336,46 @@ LightmapExportResult exportLightmap(const Scene& scene, const std::string& light
       params);
   result.gridMetadata = std::move(meta);
   return result;
+}
+
+std::string lightmapExportSummary(const LightmapExportResult& r,
+                                  const LightmapExportParams& params) {
+  using lightmap_export_internal::appendf;
+  const LightmapUvs& uvs = r.lightmap.uvs;
+  const LightmapAtlas& atlas = r.lightmap.atlas;
+  const size_t texels = size_t(atlas.width) * size_t(atlas.height) * size_t(atlas.pageCount);
+  std::string text;
+  appendf(text,
+          "UVs: %s, %d charts, %d page(s) of %d x %d, utilisation %.3f, worst stretch %.3f, "
+          "texel %s scene units\n",
+          r.lightmap.fromTexcoord1 ? "TEXCOORD_1" : "automatic charts", uvs.chartCount,
+          uvs.pageCount, uvs.width, uvs.height, double(uvs.utilisation), double(uvs.worstStretch),
+          formatNumber(uvs.texelSize).c_str());
+  appendf(text, "atlas: %s covered + %s dilated texels of %s; seams %s -> %s W/m^2\n",
+          formatCount(atlas.coveredTexels).c_str(), formatCount(atlas.dilatedTexels).c_str(),
+          formatCount(texels).c_str(), formatNumber(atlas.seamMismatchBefore).c_str(),
+          formatNumber(atlas.seamMismatchAfter).c_str());
+  // Atlas memory: RGB32F is 12 bytes a texel, RGBM8 4.
+  appendf(text,
+          "memory: atlas %s as RGB32F textures (%s as RGBM8), %s in files; octree %s "
+          "(pool %s + VDLs %s)\n",
+          formatBytes(texels * 12).c_str(), formatBytes(texels * 4).c_str(),
+          formatBytes(r.pageFileBytes).c_str(),
+          formatBytes(r.octreePoolBytes + r.octreeVdlBytes).c_str(),
+          formatBytes(r.octreePoolBytes).c_str(), formatBytes(r.octreeVdlBytes).c_str());
+  if (params.rgbm) appendf(text, "RGBM range: %s W/m^2\n", formatNumber(r.rgbmRange).c_str());
+  for (const std::string& path : r.pagePaths) appendf(text, "wrote %s\n", path.c_str());
+  for (const std::string& path : r.directionPaths) {
+    appendf(text, "wrote %s (directions)\n", path.c_str());
+  }
+  appendf(text, "wrote %s (%s)\n", r.output.c_str(), formatBytes(r.outputBytes).c_str());
+  if (params.preview) {
+    appendf(text, "wrote %s (%s, unlit preview)\n", r.previewPath.c_str(),
+            formatBytes(r.previewBytes).c_str());
+  }
+  for (const std::string& path : r.chartPaths)
+    appendf(text, "wrote %s (chart layout)\n", path.c_str());
+  return text;
 }
 
 }  // namespace lo

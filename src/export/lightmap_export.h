@@ -137,4 +137,12 @@ LightmapExportResult exportLightmap(const Scene& scene, const VdlGrid& grid,
 LightmapExportResult exportLightmap(const Scene& scene, const std::string& lightsPath,
                                     const LightmapExportParams& params);
 
+/// @brief What an export made, as `lightoctree lightmap` prints it after its
+/// stage table, one line each: the UVs, the atlas (texels, seam mismatch
+/// before and after stitching), the memory, the RGBM range (params.rgbm),
+/// and every file written (pages, direction pages, the glTF, the preview,
+/// chart images), each line ending in a newline.
+std::string lightmapExportSummary(const LightmapExportResult& result,
+                                  const LightmapExportParams& params);
+
 }  // namespace lo

@@ -142,6 +142,24 @@ double referenceNoise(const RgbImage& reference, const RgbImage& stdError,
   return y2 > 0 ? std::sqrt(se2 / y2) : 0.0;
 }
 
+ImageNoise imageNoise(const RgbImage& image, const RgbImage& stdError) {
+  if (image.pixelCount() == 0 || stdError.width != image.width || stdError.height != image.height) {
+    throw InputError("imageNoise: an image of " + std::to_string(image.width) + " x " +
+                     std::to_string(image.height) + " with standard errors of " +
+                     std::to_string(stdError.width) + " x " + std::to_string(stdError.height));
+  }
+  double sum = 0, se2 = 0;
+  for (size_t i = 0; i < image.rgb.size(); ++i) {
+    sum += image.rgb[i];
+    se2 += double(stdError.rgb[i]) * stdError.rgb[i];
+  }
+  const double n = double(image.rgb.size());
+  ImageNoise noise;
+  noise.mean = sum / n;
+  noise.rmsStdError = std::sqrt(se2 / n);
+  return noise;
+}
+
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
                             const CompareParams& params) {
   checkSizes(test, reference, params);

@@ -70,6 +70,19 @@ RgbImage binStdError(const RgbImage& stdError, int bin);
 double referenceNoise(const RgbImage& reference, const RgbImage& stdError,
                       const CompareParams& params = {});
 
+/// A Monte Carlo image's distance from converged, over all its channel
+/// values v with per-value standard errors se (`reference --std-error`):
+/// mean = mean(v), rmsStdError = sqrt(mean(se^2)), both in the image's units.
+struct ImageNoise {
+  double mean = 0;
+  double rmsStdError = 0;
+  /// rmsStdError as a percentage of the mean, 0 when the mean is not above
+  /// 0 (`reference` prints it, to weigh errors measured against the image).
+  double percent() const { return mean > 0 ? 100.0 * rmsStdError / mean : 0.0; }
+};
+/// @throws InputError naming both sizes if they differ, or if the image is empty.
+ImageNoise imageNoise(const RgbImage& image, const RgbImage& stdError);
+
 /// @throws InputError if the sizes (or the mask's) differ or an image is empty.
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
                             const CompareParams& params = {});

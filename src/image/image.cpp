@@ -136,6 +136,12 @@ RgbImage readExr(const std::string& path) {
 
 }  // namespace
 
+double meanLuminance(const RgbImage& image) {
+  double sum = 0;
+  for (size_t i = 0; i < image.pixelCount(); ++i) sum += double(luminance(image.at(i)));
+  return image.pixelCount() ? sum / double(image.pixelCount()) : 0.0;
+}
+
 float linearToSrgb(float linear) {
   float c = std::isfinite(linear) ? std::clamp(linear, 0.0f, 1.0f) : 0.0f;
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;

@@ -35,6 +35,10 @@ struct RgbImage {
   }
 };
 
+/// Mean Rec. 709 luminance (core/math.h's luminance) of a linear image's
+/// pixels, summed in double; 0 for an empty image.
+double meanLuminance(const RgbImage& image);
+
 /// An image file held in memory (PNG, JPEG, BMP, TGA, GIF, HDR, PNM, PSD:
 /// stb_image), channel values scaled to [0, 1] (8-bit / 255, 16-bit / 65535;
 /// Radiance HDR as stored), no colour conversion.
