@@ -1,10 +1,14 @@
 #include "test_util.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+
+#include "core/error.h"
 
 namespace lo::test {
 
@@ -16,6 +20,12 @@ std::string outputDir(const std::string& testName) {
   std::filesystem::remove_all(p);
   std::filesystem::create_directories(p);
   return p.string();
+}
+
+Scene oneMaterialScene() {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  return scene;
 }
 
 void addQuad(Scene& scene, const Vec3& corner, const Vec3& edgeU, const Vec3& edgeV,
@@ -34,9 +44,25 @@ void addQuad(Scene& scene, const Vec3& corner, const Vec3& edgeU, const Vec3& ed
   }
 }
 
+Light pointLight(const Vec3& position, float intensity, const Vec3& color) {
+  Light l;
+  l.type = Light::Type::Point;
+  l.position = position;
+  l.color = color;
+  l.intensity = intensity;
+  return l;
+}
+
+Light sun(const Vec3& direction, float irradiance) {
+  Light l;
+  l.type = Light::Type::Directional;
+  l.direction = normalize(direction);
+  l.intensity = irradiance;
+  return l;
+}
+
 Scene boxWithTwoBlocks(const Bounds3& block1, const Bounds3& block2) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = oneMaterialScene();
   addClosedBox(scene, {0, 0, 0}, {1, 1, 1}, 0);
   addBlock(scene, block1.lower, block1.upper, 0);
   addBlock(scene, block2.lower, block2.upper, 0);
@@ -48,6 +74,29 @@ Vec3 randomUnit(Rng& rng) {
   const float phi = 2.0f * kPi * rng.uniform();
   const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
   return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+void expectRefusal(const std::function<void()>& run, const std::vector<std::string>& parts) {
+  try {
+    run();
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    for (const std::string& part : parts) {
+      EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
+    }
+  }
+}
+
+void forCosineGrid(int steps, const std::function<void(const Vec3& l, float z)>& at) {
+  for (int i = 0; i < steps; ++i) {
+    const float u1 = (float(i) + 0.5f) / float(steps);
+    const float r = std::sqrt(u1), z = std::sqrt(1.0f - u1);
+    for (int j = 0; j < steps; ++j) {
+      const float phi = 2.0f * kPi * (float(j) + 0.5f) / float(steps);
+      at(Vec3(r * std::cos(phi), r * std::sin(phi), z), z);
+    }
+  }
 }
 
 std::string runCommand(const std::string& command) {

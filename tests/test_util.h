@@ -1,9 +1,12 @@
 #pragma once
 /// @file tests/test_util.h
-/// @brief Small scenes built in code, and paths to test data.
+/// @brief Small scenes and lights built in code, paths to test data, and the
+/// checks and quadratures that the tests of several stages share.
 
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "octree/gpu_octree.h"
 #include "core/rng.h"
@@ -26,6 +29,9 @@ std::string dataDir();
 /// A fresh, empty folder for files a test writes (under the build tree).
 std::string outputDir(const std::string& testName);
 
+/// A scene of one default material and no triangles yet.
+Scene oneMaterialScene();
+
 /// Adds an axis-aligned quad (two triangles) with the given material; the
 /// winding makes its geometric normal equal `normal`.
 void addQuad(Scene& scene, const Vec3& corner, const Vec3& edgeU, const Vec3& edgeV,
@@ -37,6 +43,13 @@ void addClosedBox(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
 /// A block standing on y = lo.y: five outward-facing quads (no bottom face).
 void addBlock(Scene& scene, const Vec3& lo, const Vec3& hi, int material);
 
+/// A point light of `intensity` W/sr (cd) at `position`, of `color`.
+Light pointLight(const Vec3& position, float intensity, const Vec3& color = Vec3(1.0f));
+
+/// A sun (directional light) travelling along `direction`, normalised here;
+/// `irradiance` W/m^2 (lx).
+Light sun(const Vec3& direction, float irradiance);
+
 /// The closed unit box (inward faces, default material) with two blocks
 /// standing on its floor (outward faces, no bottom face): a Cornell-like room.
 Scene boxWithTwoBlocks(const Bounds3& block1, const Bounds3& block2);
@@ -44,6 +57,17 @@ Scene boxWithTwoBlocks(const Bounds3& block1, const Bounds3& block2);
 /// A direction uniform on the unit sphere (z uniform in [-1, 1], then the
 /// azimuth): two numbers from `rng`.
 Vec3 randomUnit(Rng& rng);
+
+/// Expects `run` to throw InputError whose message holds each of `parts`;
+/// a failure quotes the message, or says that nothing was thrown.
+void expectRefusal(const std::function<void()>& run, const std::vector<std::string>& parts);
+
+/// The midpoint rule on the hemisphere around +z, cosine-weighted: calls
+/// `at(l, z)` for the centre of each of steps x steps cells uniform in
+/// (sin^2 theta, phi), l = (r cos phi, r sin phi, z), z = cos theta. A cell
+/// spans the solid angle pi / (steps^2 z): the hemisphere integral of g is
+/// pi / steps^2 times the sum of g(l) / z.
+void forCosineGrid(int steps, const std::function<void(const Vec3& l, float z)>& at);
 
 /// Runs `command` through the shell; its standard output ("" if it cannot start).
 std::string runCommand(const std::string& command);

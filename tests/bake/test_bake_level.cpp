@@ -12,6 +12,14 @@
 namespace lo {
 namespace {
 
+/// A level at `depth`, gathering `k` photons per voxel.
+LevelParams levelParams(int depth, int k) {
+  LevelParams params;
+  params.grid.depth = depth;
+  params.gather.k = k;
+  return params;
+}
+
 const PhotonMap& photons(const Scene& scene) {
   static const PhotonMap map = [&] {
     PhotonParams p;
@@ -40,9 +48,7 @@ void expectSameGrid(const VdlGrid& a, const VdlGrid& b) {
 TEST(BakeLevel, IsTheStagesInSequence) {
   Scene scene = test::pointLitRoom();
   const PhotonMap& map = photons(scene);
-  LevelParams params;
-  params.grid.depth = 4;
-  params.gather.k = 60;
+  LevelParams params = levelParams(4, 60);
   params.cluster.vdls = 3;
   params.cluster.seed = 9;
   params.occlusion = false;  // the ray tracer's segment test is the bake module's own wiring
@@ -70,9 +76,7 @@ TEST(BakeLevel, IsTheStagesInSequence) {
 TEST(BakeLevel, SameBytesWhateverTheThreadCount) {
   Scene scene = test::pointLitRoom();
   const PhotonMap& map = photons(scene);
-  LevelParams params;
-  params.grid.depth = 5;
-  params.gather.k = 40;
+  LevelParams params = levelParams(5, 40);
   VdlGrid many = bakeLevel(scene, map.photons, params);
   tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
   VdlGrid single = bakeLevel(scene, map.photons, params);

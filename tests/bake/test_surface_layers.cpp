@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
@@ -21,13 +22,7 @@
 namespace lo {
 namespace {
 
-Light sun(const Vec3& travel, float intensity) {
-  Light l;
-  l.type = Light::Type::Directional;
-  l.direction = normalize(travel);
-  l.intensity = intensity;
-  return l;
-}
+using test::sun;
 
 Scene blackScene() {
   Scene scene;
@@ -50,9 +45,7 @@ EdgeError edgeError(bool layers, LightRepresentation representation = LightRepre
   test::addQuad(scene, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);
   scene.lights.push_back(sun({0, -1, 0}, 2.0f));
   scene.lights.push_back(sun({-1, 0, 0}, 1.0f));
-  BakeParams p;
-  p.depth = 4;
-  p.photons = 400000;
+  BakeParams p = test::smallBake(4, 400000);
   p.includeDirect = true;
   p.layers = layers;
   p.representation = representation;
@@ -121,9 +114,7 @@ Scene thinWallScene() {
 TEST(SurfaceLayers, NoLightThroughAThinWall) {
   const Scene scene = thinWallScene();
   for (int on = 0; on < 2; ++on) {
-    BakeParams p;
-    p.depth = 5;
-    p.photons = 300000;
+    BakeParams p = test::smallBake(5, 300000);
     p.layers = on;
     p.occlusion = on;
     const BakeResult baked = bake(scene, p);
@@ -156,9 +147,7 @@ TEST(SurfaceLayers, NoLightThroughAThinWall) {
 /// and drew a bright line along the joint's dark side.
 TEST(SurfaceLayers, NoBrightLineWhereAThinWallMeetsTheFloor) {
   const Scene scene = thinWallScene();
-  BakeParams p;
-  p.depth = 5;
-  p.photons = 300000;
+  BakeParams p = test::smallBake(5, 300000);
   const BakeResult baked = bake(scene, p);
   const GpuOctree octree = buildGpuOctree(baked.grid);
   double darkestLit = 1e30, brightestDark = 0;
@@ -195,14 +184,7 @@ TEST(BakeLimits, VoxelsTooSmallForAVdbAreRefusedFirst) {
   for (Light& l : scene.lights) l.position = l.position * 1e-3f;
   BakeParams p;
   p.depth = 8;
-  try {
-    bake(scene, p);
-    FAIL() << "expected an InputError";
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("--depth 8"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("smaller than a .vdb stores"), std::string::npos) << msg;
-  }
+  test::expectRefusal([&] { bake(scene, p); }, {"--depth 8", "smaller than a .vdb stores"});
   p.depth = 4;  // 16 voxels across a millimetre: storable
   p.photons = 2000;
   EXPECT_NO_THROW(bake(scene, p));
@@ -263,10 +245,7 @@ TEST(BakeRegion, ARoomOnAGroundPlane) {
   test::addQuad(scene, {-1, 0, -1}, {0, 0, 2}, {0, 1, 0}, {1, 0, 0}, 1);
   test::addQuad(scene, {1, 0, -1}, {0, 0, 2}, {0, 1, 0}, {-1, 0, 0}, 1);
   scene.lights.push_back(sun({0.3f, -1.0f, 0.2f}, 1.0f));
-  BakeParams p;
-  p.depth = 5;
-  p.photons = 20000;
-  p.knn = 50;
+  BakeParams p = test::smallBake(5, 20000, 50);
   const BakeResult whole = bake(scene, p, nullptr);
   Bounds3 room;
   room.extend(Vec3{-1.2f, -0.1f, -1.2f});

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "core/error.h"
 #include "test_util.h"
 
@@ -33,9 +34,7 @@ double median(std::vector<double> v) {
 // the calibration the estimate must keep (docs/results/noise.md has the
 // figures on four scenes; ~4,000 voxels give the median to about 3%).
 TEST(NoiseEstimate, MatchesTheScatterBetweenSeeds) {
-  BakeParams p;
-  p.depth = 5;
-  p.photons = 60000;
+  BakeParams p = test::smallBake(5, 60000);
   p.seed = 1;
   const VdlGrid a = bake(cornellBox(), p).grid;
   p.seed = 2;
@@ -132,13 +131,7 @@ TEST(Bake, AllUnlitSceneIsRefusedSayingSo) {
   for (Material& m : unlit.materials) m.unlit = true;
   BakeParams p;
   p.depth = 3;
-  try {
-    bake(unlit, p);
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("every surface of the scene is unlit"), std::string::npos)
-        << e.what();
-  }
+  test::expectRefusal([&] { bake(unlit, p); }, {"every surface of the scene is unlit"});
 }
 
 TEST(TargetBake, RefusesATargetOutsideItsRange) {

@@ -24,8 +24,7 @@ struct PlaneBake {
   float powerPerPhoton = 0;
 
   explicit PlaneBake(size_t count) {
-    Scene scene;
-    scene.materials.push_back(Material{});
+    Scene scene = test::oneMaterialScene();
     test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
     GridParams gp;
     gp.depth = 4;
@@ -126,8 +125,7 @@ namespace {
 // that of the 3x3 in-plane neighbourhood: 0.354), with discs far larger
 // than the voxels (every photon shared) it does not fall at all.
 TEST(Smoothing, NoiseFallsByWhatTheNeighboursDoNotShare) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   test::addQuad(scene, {0, 0.01f, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
   GridParams gp;
   gp.depth = 4;
@@ -177,8 +175,7 @@ TEST(Smoothing, NoiseFallsByWhatTheNeighboursDoNotShare) {
 // wall into floor, keeps each voxel's VDL sum equal to its irradiance and
 // its VDL directions, and leaves layered voxels alone.
 TEST(Smoothing, ShrinksNoiseKeepsStepsAndSurfaces) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);  // floor
   test::addQuad(scene, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);  // wall at x = 0
   GridParams gp;

@@ -14,6 +14,7 @@
 #include <set>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "core/error.h"
 #include "distributed/communicator.h"
 #include "distributed/tiled_bake.h"
@@ -112,19 +113,13 @@ void expectSameAsOneProcess(const Scene& scene, const BakeParams& params, int ti
 
 TEST(TiledBake, CornellBoxIsTheOneProcessBakeFor1To4Ranks) {
   const Scene scene = loadScene(test::sharedScenesDir() + "/composed/cornell-box.glb");
-  BakeParams params;
-  params.depth = 5;
-  params.photons = 60000;
-  params.knn = 80;
+  BakeParams params = test::smallBake(5, 60000, 80);
   expectSameAsOneProcess(scene, params, 4, "TiledBake.Cornell");
 }
 
 TEST(TiledBake, DragonWithShIsTheOneProcessBakeFor1To4Ranks) {
   const Scene scene = loadScene(test::sharedScenesDir() + "/composed/cornell-dragon.glb");
-  BakeParams params;
-  params.depth = 5;
-  params.photons = 40000;
-  params.knn = 60;
+  BakeParams params = test::smallBake(5, 40000, 60);
   params.representation = LightRepresentation::Sh1;
   params.includeDirect = true;
   // Fewer free-space rays than the paths make: rank 0 takes the same whole
@@ -136,10 +131,7 @@ TEST(TiledBake, DragonWithShIsTheOneProcessBakeFor1To4Ranks) {
 TEST(TiledBake, AutoVdlsAndAWideRadiusAreTheOneProcessBake) {
   // A radius of 3 voxels widens the halo; --vdls auto and no smoothing.
   Scene scene = test::pointLitRoom();
-  BakeParams params;
-  params.depth = 5;
-  params.photons = 30000;
-  params.knn = 40;
+  BakeParams params = test::smallBake(5, 30000, 40);
   params.radius = 3.0f / 32.0f;
   params.vdls = parseVdlCount("auto");
   params.smoothing = false;
@@ -164,10 +156,7 @@ TEST(TiledBake, ATileBoundaryThroughAWallJointChangesNothing) {
     light.intensity = 1.0f;
     scene.lights.push_back(light);
   }
-  BakeParams params;
-  params.depth = 5;
-  params.photons = 40000;
-  params.knn = 60;
+  BakeParams params = test::smallBake(5, 40000, 60);
   params.includeDirect = true;
   const BakeResult single = bake(scene, params);
   const RankRun run = bakeOnThreadRanks(scene, params, 2, 2, {0, 0, 0, 0, 1, 1, 1, 1});
@@ -191,10 +180,7 @@ TEST(TiledBake, ABinMarginBeyondTheAssumedOneStartsAgainWithTheBound) {
   // An assumed margin below zero is always exceeded: the second attempt,
   // with the bound's wider halo, must give the same grid.
   const Scene scene = test::pointLitRoom();
-  BakeParams params;
-  params.depth = 5;
-  params.photons = 20000;
-  params.knn = 40;
+  BakeParams params = test::smallBake(5, 20000, 40);
   const BakeResult single = bake(scene, params);
   const RankRun first = bakeOnThreadRanks(scene, params, 3, 2);
   const RankRun again = bakeOnThreadRanks(scene, params, 3, 2, {}, -1.0);
@@ -209,10 +195,7 @@ TEST(TiledBake, RanksWithoutTilesHoldNothingAndChangeNothing) {
   // One tile for three ranks: two own nothing, trace their paths and send
   // every photon away.
   const Scene scene = test::pointLitRoom();
-  BakeParams params;
-  params.depth = 4;
-  params.photons = 10000;
-  params.knn = 30;
+  BakeParams params = test::smallBake(4, 10000, 30);
   const BakeResult single = bake(scene, params);
   const RankRun run = bakeOnThreadRanks(scene, params, 3, 1);
   EXPECT_EQ(firstDifference(single.grid, run.result.grid), "");
@@ -235,9 +218,7 @@ TEST(TiledBake, RanksWithoutTilesHoldNothingAndChangeNothing) {
 
 TEST(TiledBake, RefusesAPhotonMapAndBadTileCounts) {
   const Scene scene = test::pointLitRoom();
-  BakeParams params;
-  params.depth = 4;
-  params.photons = 2000;
+  BakeParams params = test::smallBake(4, 2000);
   params.keepPhotons = true;
   EXPECT_THROW(bakeOnThreadRanks(scene, params, 2, 0), InputError);
   params.keepPhotons = false;
@@ -301,10 +282,7 @@ TEST(TilePlan, OwnersNearAVoxelAreThoseABruteForceFinds) {
 
 TEST(VdlGridParts, AGridSplitAnyWayMergesBackToItself) {
   Scene scene = test::pointLitRoom();
-  BakeParams params;
-  params.depth = 5;
-  params.photons = 20000;
-  params.knn = 40;
+  BakeParams params = test::smallBake(5, 20000, 40);
   const VdlGrid grid = bake(scene, params).grid;
   ASSERT_GT(grid.layers.size(), 0u) << "the room's edges have layers";
   std::mt19937 rng(11);

@@ -1,3 +1,9 @@
+// The gather (gather/gather.h): the k nearest photons in a disc squashed
+// along the voxel's normal, checked against a scan of every photon; photons
+// behind a wall or on a nearby inclined surface left out; the irradiance of
+// a uniformly lit plane, at its border too; caustics gathered apart; the same
+// result for any thread count.
+
 #include <gtest/gtest.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -5,73 +11,21 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
 #include "core/rng.h"
 #include "gather/gather.h"
+#include "gather/gather_fixture.h"
 #include "test_util.h"
 
 namespace lo {
 namespace {
 
-// A Cornell-like room: the closed unit box (inward faces) with two blocks
-// standing on the floor (outward faces, no bottom face), placed off the voxel
-// grid's planes.
-Scene cornellLikeBox() {
-  return test::boxWithTwoBlocks({{0.13f, 0.0f, 0.097f}, {0.43f, 0.3f, 0.41f}},
-                                {{0.551f, 0.0f, 0.523f}, {0.847f, 0.61f, 0.83f}});
-}
-
-// `count` photons spread uniformly (by area) over the scene's triangles, each
-// arriving on the side its triangle faces; power 1/count per channel.
-std::vector<Photon> uniformPhotons(const Scene& scene, size_t count, uint64_t seed) {
-  std::vector<double> cdf;
-  double total = 0;
-  for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    total += scene.triangleArea(t);
-    cdf.push_back(total);
-  }
-  std::vector<Photon> photons(count);
-  for (size_t i = 0; i < count; ++i) {
-    Rng rng(seed, i);
-    double u = double(rng.uniform()) * total;
-    size_t t = size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin());
-    t = std::min(t, scene.triangleCount() - 1);
-    float b1 = rng.uniform(), b2 = rng.uniform();
-    if (b1 + b2 > 1) {
-      b1 = 1 - b1;
-      b2 = 1 - b2;
-    }
-    const Vec3& a = scene.positions[scene.indices[3 * t]];
-    const Vec3& b = scene.positions[scene.indices[3 * t + 1]];
-    const Vec3& c = scene.positions[scene.indices[3 * t + 2]];
-    Photon& p = photons[i];
-    p.position = a + (b - a) * b1 + (c - a) * b2;
-    p.normal = scene.faceNormal(t);
-    p.direction = p.normal;
-    p.power = Vec3(1.0f / float(count));
-    p.bounce = 1;
-  }
-  return photons;
-}
-
-SurfaceGrid gridFor(const Scene& scene, int depth, const std::vector<Photon>& photons) {
-  GridParams gp;
-  gp.depth = depth;
-  SurfaceGrid grid = buildSurfaceGrid(scene, gp);
-  EXPECT_EQ(splatPhotons(grid, photons), 0u);
-  return grid;
-}
-
-std::vector<uint32_t> sorted(std::vector<uint32_t> v) {
-  std::sort(v.begin(), v.end());
-  return v;
-}
+using namespace test;  // gather_fixture.h, test_util.h
 
 void expectSameAsBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& photons,
                             const GatherParams& params, size_t stride) {
@@ -96,7 +50,7 @@ void expectSameAsBruteForce(const SurfaceGrid& grid, const std::vector<Photon>& 
   EXPECT_GT(full, 0u) << "no voxel reached k: the test would not exercise the selection";
 }
 
-TEST(Gather, ResolveRadius) {
+TEST_F(Gather, ResolveRadius) {
   GridFrame f;
   f.voxelSize = 0.5f;
   GatherParams p;
@@ -111,12 +65,9 @@ TEST(Gather, ResolveRadius) {
   EXPECT_THROW(resolveRadius(p, f), InputError);
 }
 
-TEST(Gather, BadParametersThrow) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
-  std::vector<Photon> photons = uniformPhotons(scene, 100, 1);
-  SurfaceGrid grid = gridFor(scene, 3, photons);
+TEST_F(Gather, BadParametersThrow) {
+  scene = unitFloor();
+  spreadPhotons(100, 1, 3);
   GatherParams p;
   p.k = 0;
   EXPECT_THROW(Gatherer(grid, photons, p), InputError);
@@ -130,15 +81,14 @@ TEST(Gather, BadParametersThrow) {
 
 // Three crossing planes, photons arriving on both sides of each: the grid
 // gather must select exactly what a scan of every photon selects.
-TEST(Gather, MatchesBruteForceOnPlanes) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+TEST_F(Gather, MatchesBruteForceOnPlanes) {
+  scene = oneMaterialScene();
   test::addQuad(scene, {0, 0.3f, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
   test::addQuad(scene, {0.61f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, 0);
   test::addQuad(scene, {0, 0, 0.2f}, {1, 0.8f, 0}, {0, 0, 0.7f}, normalize(Vec3(-0.8f, 1, 0)), 0);
-  std::vector<Photon> photons = uniformPhotons(scene, 20000, 7);
+  photons = uniformPhotons(scene, 20000, 7);
   for (size_t i = 0; i < photons.size(); i += 3) photons[i].normal = -photons[i].normal;
-  SurfaceGrid grid = gridFor(scene, 4, photons);
+  grid = gridFor(scene, 4, photons);
   for (float squash : {1.0f, 4.0f, 0.5f}) {
     SCOPED_TRACE(squash);
     GatherParams p;
@@ -150,12 +100,11 @@ TEST(Gather, MatchesBruteForceOnPlanes) {
 
 // The Cornell-like box plus a two-sided panel (coincident quads of opposite
 // winding, so its voxels have a zero normal and take the fallback path).
-TEST(Gather, MatchesBruteForceInCornellLikeBox) {
-  Scene scene = cornellLikeBox();
+TEST_F(Gather, MatchesBruteForceInCornellLikeBox) {
+  scene = cornellLikeBox();
   test::addQuad(scene, {0.2f, 0.7f, 0.2f}, {0.3f, 0, 0}, {0, 0, 0.3f}, {0, 1, 0}, 0);
   test::addQuad(scene, {0.2f, 0.7f, 0.2f}, {0.3f, 0, 0}, {0, 0, 0.3f}, {0, -1, 0}, 0);
-  std::vector<Photon> photons = uniformPhotons(scene, 60000, 3);
-  SurfaceGrid grid = gridFor(scene, 5, photons);
+  spreadPhotons(60000, 3, 5);
   size_t zeroNormals = 0;
   for (const Vec3& n : grid.normals) zeroNormals += n == Vec3{};
   EXPECT_GT(zeroNormals, 0u);
@@ -176,15 +125,12 @@ TEST(Gather, MatchesBruteForceInCornellLikeBox) {
 // back rejection alone does not exclude it). Wall photons lie at least `h0`
 // above the floor: a sphere gathers many of them; the squashed ellipsoid,
 // whose half-height is r / squash < h0, gathers none.
-TEST(Gather, SquashExcludesPhotonsOnAnInclinedWall) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+TEST_F(Gather, SquashExcludesPhotonsOnAnInclinedWall) {
+  scene = unitFloor();
   const Vec3 wallUp = normalize(Vec3(-0.3f, 1.0f, 0.0f));
   const Vec3 wallNormal = normalize(Vec3(-1.0f, -0.3f, 0.0f)) * -1.0f;  // faces +x, up a bit
   test::addQuad(scene, {0.5f, 0, 0}, wallUp, {0, 0, 1}, wallNormal, 0);
   const float h0 = 0.02f;
-  std::vector<Photon> photons;
   for (size_t i = 0; i < 40000; ++i) {
     Rng rng(11, i);
     Photon p;
@@ -201,7 +147,7 @@ TEST(Gather, SquashExcludesPhotonsOnAnInclinedWall) {
     photons.push_back(p);
   }
   ASSERT_GT(dot(wallNormal, Vec3(0, 1, 0)), 0.2f);
-  SurfaceGrid grid = gridFor(scene, 5, photons);
+  grid = gridFor(scene, 5, photons);
   // A floor voxel just left of the wall's foot... on the side the wall faces.
   const Coord c = grid.frame.coordOf({0.5f + 1.5f * grid.frame.voxelSize, 0.0f, 0.5f});
   int64_t v = grid.find(c);
@@ -228,17 +174,16 @@ TEST(Gather, SquashExcludesPhotonsOnAnInclinedWall) {
 // A wall thicker than a voxel and one thinner than a voxel, lit on the front
 // (-x) side and, more weakly, on the back: the back photons are closer than r
 // but arrive from behind, so no voxel on the front gathers them.
-TEST(Gather, PhotonsBehindAThinWallAreRejected) {
+TEST_F(Gather, PhotonsBehindAThinWallAreRejected) {
   for (float thicknessVoxels : {1.6f, 0.2f}) {
     SCOPED_TRACE(thicknessVoxels);
-    Scene scene;
-    scene.materials.push_back(Material{});
+    scene = oneMaterialScene();
     const float vs = 1.02f / 16.0f;  // depth 4, unit scene, 1% padding
     const float x0 = 0.5f + 0.3f * vs, x1 = x0 + thicknessVoxels * vs;
     test::addQuad(scene, {x0, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, 0);
     test::addQuad(scene, {x1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);
     test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);  // sets the frame
-    std::vector<Photon> photons;
+    photons.clear();  // this thickness's photons alone
     for (size_t i = 0; i < 30000; ++i) {
       Rng rng(5, i);
       Photon p;
@@ -249,7 +194,7 @@ TEST(Gather, PhotonsBehindAThinWallAreRejected) {
       p.power = Vec3(1e-4f);
       photons.push_back(p);
     }
-    SurfaceGrid grid = gridFor(scene, 4, photons);
+    grid = gridFor(scene, 4, photons);
     ASSERT_NEAR(grid.frame.voxelSize, vs, 1e-6f);
     GatherParams params;
     params.k = 100;
@@ -273,15 +218,13 @@ TEST(Gather, PhotonsBehindAThinWallAreRejected) {
 
 // N photons of power P spread uniformly on area A: E = N P / A. The KNN
 // estimate of one voxel has a relative standard deviation of about 1/sqrt(k).
-TEST(Gather, UniformPlaneIrradiance) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+TEST_F(Gather, UniformPlaneIrradiance) {
+  scene = unitFloor();
   const size_t n = 100000;
-  std::vector<Photon> photons = uniformPhotons(scene, n, 21);
+  photons = uniformPhotons(scene, n, 21);
   for (Photon& p : photons) p.power = Vec3(2e-5f, 1e-5f, 3e-5f);
   const Vec3 expected = Vec3(2e-5f, 1e-5f, 3e-5f) * float(n);  // A = 1 m^2
-  SurfaceGrid grid = gridFor(scene, 5, photons);
+  grid = gridFor(scene, 5, photons);
   GatherParams params;
   params.k = 300;
   Gatherer g(grid, photons, params);
@@ -314,18 +257,16 @@ TEST(Gather, UniformPlaneIrradiance) {
 // the smooth gather reads the other half and gatherCaustics the caustic
 // half within its smaller radius; together they make the plane's
 // irradiance, and with separateCaustics off the smooth gather reads all.
-TEST(Gather, CausticPhotonsAreGatheredApartWithinTheirOwnRadius) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
+TEST_F(Gather, CausticPhotonsAreGatheredApartWithinTheirOwnRadius) {
+  scene = unitFloor();
   const size_t n = 200000;
-  std::vector<Photon> photons = uniformPhotons(scene, n, 23);
+  photons = uniformPhotons(scene, n, 23);
   for (size_t i = 0; i < photons.size(); ++i) {
     photons[i].power = Vec3(1e-5f);
     photons[i].caustic = i % 2;
   }
   const float expected = 1e-5f * float(n);  // A = 1 m^2
-  SurfaceGrid grid = gridFor(scene, 5, photons);
+  grid = gridFor(scene, 5, photons);
   GatherParams params;
   params.k = 100000;  // every photon within the radius
   Gatherer apart(grid, photons, params);
@@ -365,11 +306,9 @@ TEST(Gather, CausticPhotonsAreGatheredApartWithinTheirOwnRadius) {
 // the spot the truth is the smooth light alone; gathered with the smooth
 // light's 1.5-voxel disc the spot bleeds into it, gathered apart within
 // 0.75 voxels it does not, and inside the spot both hold its light.
-TEST(Gather, ACausticGatheredApartDoesNotBleedIntoTheLightAroundIt) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
-  std::vector<Photon> photons = uniformPhotons(scene, 100000, 29);
+TEST_F(Gather, ACausticGatheredApartDoesNotBleedIntoTheLightAroundIt) {
+  scene = unitFloor();
+  photons = uniformPhotons(scene, 100000, 29);
   for (Photon& p : photons) p.power = Vec3(1e-5f);
   const float smooth = 1e-5f * 100000.0f;  // W/m^2 over the 1 m^2 plane
   GridParams gp;
@@ -388,7 +327,7 @@ TEST(Gather, ACausticGatheredApartDoesNotBleedIntoTheLightAroundIt) {
     p.bounce = 1;
     photons.push_back(p);
   }
-  SurfaceGrid grid = gridFor(scene, gp.depth, photons);
+  grid = gridFor(scene, gp.depth, photons);
   GatherParams params;
   params.k = 100000;
   Gatherer apart(grid, photons, params);
@@ -431,12 +370,9 @@ TEST(Gather, ACausticGatheredApartDoesNotBleedIntoTheLightAroundIt) {
 }
 
 // Fewer than k photons within r: all of them are kept and r_k = r.
-TEST(Gather, FewerThanKUsesTheSearchRadius) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
-  std::vector<Photon> photons = uniformPhotons(scene, 400, 9);
-  SurfaceGrid grid = gridFor(scene, 4, photons);
+TEST_F(Gather, FewerThanKUsesTheSearchRadius) {
+  scene = unitFloor();
+  spreadPhotons(400, 9, 4);
   GatherParams params;
   params.k = 300;
   const float r = resolveRadius(params, grid.frame);
@@ -480,12 +416,9 @@ TEST(Gather, FewerThanKUsesTheSearchRadius) {
 
 // Edge correction: on a uniformly lit plane the estimate next to its border
 // (where half the disc reaches past it) is the interior's, not half of it.
-TEST(Gather, EdgeCorrectionKeepsTheBorderOfAPlaneLit) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
-  std::vector<Photon> photons = uniformPhotons(scene, 200000, 11);
-  SurfaceGrid grid = gridFor(scene, 4, photons);
+TEST_F(Gather, EdgeCorrectionKeepsTheBorderOfAPlaneLit) {
+  scene = unitFloor();
+  spreadPhotons(200000, 11, 4);
   for (bool correct : {true, false}) {
     GatherParams params;
     params.k = 2000;  // the radius, not k, bounds the disc: r_k = r everywhere
@@ -525,10 +458,9 @@ TEST(Gather, EdgeCorrectionKeepsTheBorderOfAPlaneLit) {
 }
 
 // Deterministic: the same result whatever the thread count.
-TEST(Gather, SameResultForAnyThreadCount) {
-  Scene scene = cornellLikeBox();
-  std::vector<Photon> photons = uniformPhotons(scene, 30000, 4);
-  SurfaceGrid grid = gridFor(scene, 4, photons);
+TEST_F(Gather, SameResultForAnyThreadCount) {
+  scene = cornellLikeBox();
+  spreadPhotons(30000, 4, 4);
   GatherParams params;
   params.k = 50;
   auto run = [&](int threads) {
@@ -547,153 +479,6 @@ TEST(Gather, SameResultForAnyThreadCount) {
   };
   std::vector<Vec3> one = run(1), two = run(2);
   for (size_t v = 0; v < grid.size(); ++v) ASSERT_EQ(one[v], two[v]) << v;
-}
-
-}  // namespace
-}  // namespace lo
-
-namespace lo {
-namespace {
-
-// Surface layers: the gather of one layer (fixed normal, photons within the
-// layer cosine) equals the brute force over every photon, at the layers the
-// voxels' own photons give.
-TEST(GatherLayers, LayerGatherMatchesBruteForce) {
-  Scene scene = cornellLikeBox();
-  std::vector<Photon> photons = uniformPhotons(scene, 60000, 5);
-  SurfaceGrid grid = gridFor(scene, 5, photons);
-  GatherParams p;
-  p.k = 60;
-  Gatherer gatherer(grid, photons, p);
-  LayerParams lp;
-  lp.minPhotons = 3;  // about 8 photons per voxel face here
-  SurfaceLayer layers[3];
-  size_t checked = 0, layered = 0;
-  GatherResult g;
-  for (size_t v = 0; v < grid.size(); v += 3) {
-    const int n = gatherer.findSurfaceLayers(v, lp, layers);
-    layered += n >= 2;
-    for (int l = 0; l < n; ++l) {
-      gatherer.gatherLayer(v, layers[l].point, layers[l].normal, g);
-      const GatherResult b =
-          gatherLayerBruteForce(grid, photons, layers[l].point, layers[l].normal, p);
-      ASSERT_EQ(sorted(g.photons), sorted(b.photons)) << "voxel " << v << " layer " << l;
-      EXPECT_EQ(g.radius, b.radius);
-      EXPECT_EQ(g.normal, layers[l].normal);
-      for (uint32_t i : g.photons) {
-        ASSERT_GT(dot(photons[i].normal, layers[l].normal), p.layerCosine);
-      }
-      ++checked;
-    }
-  }
-  EXPECT_GT(checked, 100u);
-  EXPECT_GT(layered, 10u) << "the box's edges give voxels with two layers";
-}
-
-// Layer detection in one voxel holding a floor and a thin wall (two quads
-// facing away from each other): the floor is one layer; the wall one per lit
-// side (both here); a surface whose photons are too few keeps the side its
-// winding faces.
-TEST(GatherLayers, FindsTheSurfacesOfAVoxelAndTheirLitSides) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);           // floor
-  test::addQuad(scene, {0.53f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);       // wall, +x face
-  test::addQuad(scene, {0.53f, 0, 0}, {0, 0, 1}, {0, 1, 0}, {-1, 0, 0}, 0);      // wall, -x face
-  std::vector<Photon> photons;
-  auto add = [&](Vec3 p, Vec3 n, int count) {
-    for (int i = 0; i < count; ++i) {
-      Photon ph;
-      ph.position = p + Vec3{0, 0.001f * float(i % 7), 0.001f * float(i % 5)};
-      ph.normal = n;
-      ph.direction = n;
-      ph.power = Vec3(1.0f);
-      photons.push_back(ph);
-    }
-  };
-  // Voxel size 1.02 / 16: all in the voxel holding (0.52, 0.01, 0.51).
-  add({0.52f, 0.0f, 0.51f}, {0, 1, 0}, 40);   // floor
-  add({0.53f, 0.02f, 0.51f}, {1, 0, 0}, 30);  // wall, lit from +x
-  add({0.53f, 0.02f, 0.51f}, {-1, 0, 0}, 20); // and from -x
-  SurfaceGrid grid = gridFor(scene, 4, photons);
-  const int64_t voxel = grid.find(grid.frame.coordOf({0.52f, 0.01f, 0.51f}));
-  ASSERT_GE(voxel, 0);
-  ASSERT_EQ(grid.orientationStart[size_t(voxel) + 1] - grid.orientationStart[size_t(voxel)], 3u)
-      << "floor, and the wall's two faces";
-  Gatherer gatherer(grid, photons, GatherParams{});
-  SurfaceLayer layers[3];
-  LayerParams lp;
-  auto normals = [&](int n) {
-    std::vector<Vec3> out;
-    for (int l = 0; l < n; ++l) out.push_back(layers[l].normal);
-    return out;
-  };
-  auto has = [](const std::vector<Vec3>& v, Vec3 n) {
-    return std::any_of(v.begin(), v.end(), [&](const Vec3& m) { return length(m - n) < 1e-5f; });
-  };
-  int n = gatherer.findSurfaceLayers(size_t(voxel), lp, layers);
-  ASSERT_EQ(n, 3);
-  EXPECT_TRUE(has(normals(n), {0, 1, 0}));
-  EXPECT_TRUE(has(normals(n), {1, 0, 0}));
-  EXPECT_TRUE(has(normals(n), {-1, 0, 0}));
-  for (int l = 0; l < n; ++l) {
-    // Each layer's point lies on its surface.
-    if (layers[l].normal.y > 0.5f) {
-      EXPECT_NEAR(layers[l].point.y, 0.0f, 1e-5f);
-    }
-    if (std::fabs(layers[l].normal.x) > 0.5f) {
-      EXPECT_NEAR(layers[l].point.x, 0.53f, 1e-5f);
-    }
-  }
-  lp.maxLayers = 2;
-  EXPECT_EQ(gatherer.findSurfaceLayers(size_t(voxel), lp, layers), 2);
-  lp.maxLayers = 3;
-  lp.minShare = 0.4f;  // neither side of the wall holds 40%: it keeps one layer
-  n = gatherer.findSurfaceLayers(size_t(voxel), lp, layers);
-  EXPECT_EQ(n, 2);
-  EXPECT_TRUE(has(normals(n), {0, 1, 0}));
-}
-
-// Gather occlusion: a floor split by a thin wall, photons on one side only.
-// Without the occlusion test the dark side's voxels next to the wall gather
-// the lit side's photons; with it (a segment test that knows the wall plane
-// x = 0.5) they gather none.
-TEST(GatherLayers, OcclusionKeepsPhotonsBehindAWallOut) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
-  test::addQuad(scene, {0.5f, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, 0);
-  std::vector<Photon> photons;
-  for (const Photon& p : uniformPhotons(scene, 40000, 9)) {
-    if (p.position.x > 0.5f && p.normal.y > 0.5f) photons.push_back(p);  // the lit floor
-  }
-  SurfaceGrid grid = gridFor(scene, 5, photons);
-  GatherParams p;
-  p.k = 100;
-  p.radius = 0.08f;  // 2.5 voxels: reaches across the wall
-  auto crossesWall = [](const Vec3& a, const Vec3& b) {
-    return (a.x - 0.5f) * (b.x - 0.5f) < 0 && std::min(a.y, b.y) < 1.0f;
-  };
-  size_t leaking = 0, blocked = 0, dark = 0;
-  GatherResult g;
-  for (int occlusion = 0; occlusion < 2; ++occlusion) {
-    GatherParams q = p;
-    if (occlusion) q.blocked = crossesWall;
-    Gatherer gatherer(grid, photons, q);
-    for (size_t v = 0; v < grid.size(); ++v) {
-      const Vec3& c = grid.centroids[v];
-      if (!(c.x < 0.49f && c.y < 0.01f && grid.normals[v].y > 0.9f)) continue;  // dark floor
-      gatherer.gather(v, g);
-      if (occlusion) {
-        blocked += g.photons.empty();
-        ++dark;
-      } else {
-        leaking += !g.photons.empty();
-      }
-    }
-  }
-  EXPECT_GT(leaking, 10u) << "without occlusion the radius reaches across the wall";
-  EXPECT_EQ(blocked, dark) << "with it, no dark voxel gathers a lit photon";
 }
 
 }  // namespace

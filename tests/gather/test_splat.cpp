@@ -13,8 +13,7 @@ namespace lo {
 namespace {
 
 TEST(Splat, BinsPhotonsInActiveVoxels) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   test::addQuad(scene, {0, 0.45f, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);
   test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 0);
   GridParams gp;

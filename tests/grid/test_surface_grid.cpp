@@ -183,8 +183,7 @@ Scene cornellLikeBox(float scale = 1.0f, Vec3 offset = {}) {
 }
 
 Scene randomScene(size_t count, uint64_t seed) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   for (size_t t = 0; t < count; ++t) {
     Rng rng(seed, t);
     const Vec3 a{rng.uniform(), rng.uniform(), rng.uniform()};
@@ -263,18 +262,31 @@ void expectConsistent(const Scene& scene, const SurfaceGrid& grid) {
   EXPECT_NEAR(area, totalArea(scene), 1e-4 * totalArea(scene));
 }
 
+/// A grid and the active set a scan of every voxel gives.
+struct CheckedGrid {
+  SurfaceGrid grid;
+  std::set<Coord> expected;
+};
+
+/// The grid of `scene` at `depth`, checked: its active voxels are the brute
+/// force's, and it is consistent.
+CheckedGrid checkedGrid(const Scene& scene, int depth) {
+  GridParams p;
+  p.depth = depth;
+  CheckedGrid c{buildSurfaceGrid(scene, p), {}};
+  c.expected = bruteForceActive(scene, c.grid.frame);
+  std::set<Coord> got(c.grid.coords.begin(), c.grid.coords.end());
+  EXPECT_TRUE(got == c.expected) << got.size() << " vs " << c.expected.size();
+  expectConsistent(scene, c.grid);
+  return c;
+}
+
 TEST(SurfaceGrid, ActiveSetEqualsBruteForceOnRandomTriangles) {
   Scene scene = randomScene(40, 5);
   for (int depth : {4, 5}) {
     SCOPED_TRACE(depth);
-    GridParams p;
-    p.depth = depth;
-    SurfaceGrid grid = buildSurfaceGrid(scene, p);
-    std::set<Coord> expected = bruteForceActive(scene, grid.frame);
-    std::set<Coord> got(grid.coords.begin(), grid.coords.end());
-    EXPECT_EQ(got.size(), grid.size());
-    EXPECT_TRUE(got == expected) << got.size() << " vs " << expected.size();
-    expectConsistent(scene, grid);
+    const SurfaceGrid grid = checkedGrid(scene, depth).grid;
+    EXPECT_EQ(std::set<Coord>(grid.coords.begin(), grid.coords.end()).size(), grid.size());
   }
 }
 
@@ -282,13 +294,9 @@ TEST(SurfaceGrid, ActiveSetEqualsBruteForceInCornellLikeBox) {
   Scene scene = cornellLikeBox();
   for (int depth : {4, 5}) {
     SCOPED_TRACE(depth);
-    GridParams p;
-    p.depth = depth;
-    SurfaceGrid grid = buildSurfaceGrid(scene, p);
-    std::set<Coord> expected = bruteForceActive(scene, grid.frame);
-    std::set<Coord> got(grid.coords.begin(), grid.coords.end());
-    EXPECT_TRUE(got == expected) << got.size() << " vs " << expected.size();
-    expectConsistent(scene, grid);
+    const CheckedGrid checked = checkedGrid(scene, depth);
+    const SurfaceGrid& grid = checked.grid;
+    const std::set<Coord>& expected = checked.expected;
     // find(): -1 for every inactive voxel and outside the grid.
     const int n = grid.frame.resolution();
     for (int x = -1; x <= n; ++x) {
@@ -311,8 +319,7 @@ TEST(SurfaceGrid, ActiveSetEqualsBruteForceInCornellLikeBox) {
 // areas add up to the plane's area, and the area-weighted centroids to its
 // centre (first moment).
 TEST(SurfaceGrid, AxisAlignedPlaneNormalsAndMoments) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   test::addQuad(scene, {0.1f, 0.37f, 0.2f}, {0.8f, 0, 0}, {0, 0, 0.7f}, {0, -1, 0}, 0);
   test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 0);  // gives the frame depth
   GridParams p;
@@ -339,8 +346,7 @@ TEST(SurfaceGrid, AxisAlignedPlaneNormalsAndMoments) {
 // A slab thinner than a voxel: each voxel holds both faces, which cancel.
 // Coincident triangles of opposite winding (as in the dragon scene) too.
 TEST(SurfaceGrid, OppositeFacesGiveAZeroNormal) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   const float vs = 1.02f / 16.0f;
   const float x0 = 0.5f + 0.3f * vs;
   test::addQuad(scene, {x0, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, 0);

@@ -174,12 +174,7 @@ TEST(ReadImage, APipeIsRefusedNotWaitedOn) {
   // as an image would block the reader forever.
   const std::string fifo = test::outputDir("ReadImage_Pipe") + "/image.png";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
-  try {
-    readImage(fifo);
-    ADD_FAILURE() << "a pipe was read";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("is a pipe"), std::string::npos) << e.what();
-  }
+  test::expectRefusal([&] { readImage(fifo); }, {"is a pipe"});
   EXPECT_THROW(readImage(test::outputDir("ReadImage_Pipe") + "/absent.exr"), InputError);
 }
 
@@ -194,12 +189,10 @@ TEST(ReadImage, AHeaderClaimingAHugeImageIsRefusedBeforeDecoding) {
   png += be32(13) + "IHDR" + be32(16385) + be32(4096) + std::string("\x08\x02\x00\x00\x00", 5);
   png += be32(0);  // CRC: the size is read before anything checks it
   png += be32(0) + "IDAT" + be32(0) + be32(0) + "IEND" + be32(0);
-  try {
-    decodeImageBytes(reinterpret_cast<const unsigned char*>(png.data()), png.size());
-    ADD_FAILURE() << "the bomb was decoded";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("16385 x 4096"), std::string::npos) << e.what();
-  }
+  // The bomb is not decoded.
+  test::expectRefusal(
+      [&] { decodeImageBytes(reinterpret_cast<const unsigned char*>(png.data()), png.size()); },
+      {"16385 x 4096"});
   const std::string path = test::outputDir("ReadImage_Bomb") + "/bomb.png";
   std::ofstream(path, std::ios::binary) << png;
   try {

@@ -48,12 +48,7 @@ TEST(ToneMap, ParseAndToString) {
   EXPECT_EQ(parseToneMap("neutral"), ToneMap::Neutral);
   EXPECT_EQ(toString(ToneMap::Clamp), "clamp");
   EXPECT_EQ(toString(ToneMap::Neutral), "neutral");
-  try {
-    parseToneMap("filmic");
-    FAIL() << "parseToneMap accepted 'filmic'";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("'filmic'"), std::string::npos) << e.what();
-  }
+  test::expectRefusal([] { parseToneMap("filmic"); }, {"'filmic'"});
 }
 
 TEST(ToneMap, NeutralBelowCompressionTakesTheOffsetOnly) {
@@ -242,12 +237,8 @@ TEST(AutoExposure, FiniteForExtremeValues) {
 TEST(AutoExposure, BadParamsAreNamed) {
   AutoExposureParams params;
   params.highlightQuantile = 1.5f;
-  try {
-    autoExposureEv(constantImage(2, 2, Vec3(1.0f)), params);
-    FAIL() << "highlightQuantile 1.5 accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("highlightQuantile"), std::string::npos) << e.what();
-  }
+  test::expectRefusal([&] { autoExposureEv(constantImage(2, 2, Vec3(1.0f)), params); },
+                      {"highlightQuantile"});
   params = {};
   params.key = 0;
   EXPECT_THROW(autoExposureEv(constantImage(2, 2, Vec3(1.0f)), params), InputError);
@@ -356,12 +347,7 @@ TEST(ToneMapped, WriteTonedImageByExtension) {
   // An EXR keeps the radiance: no exposure, no curve.
   writeTonedImage(dir + "/radiance.exr", img);
   EXPECT_EQ(readImage(dir + "/radiance.exr").rgb, img.rgb);
-  try {
-    writeTonedImage(dir + "/picture.txt", img);
-    FAIL() << ".txt accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("picture.txt"), std::string::npos) << e.what();
-  }
+  test::expectRefusal([&] { writeTonedImage(dir + "/picture.txt", img); }, {"picture.txt"});
 }
 
 }  // namespace

@@ -43,11 +43,7 @@ inline GpuOctree denseOctree(const std::function<std::vector<Vdl>(const Coord&)>
   return buildGpuOctree(g, test::paperCosine());
 }
 
-inline Scene emptyScene() {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  return scene;
-}
+inline Scene emptyScene() { return test::oneMaterialScene(); }
 
 // An n x n grid of quads spanning origin + [0, 1] eu + [0, 1] ev, vertices
 // shared, facing cross(eu, ev).
@@ -75,6 +71,13 @@ inline void addCube(Scene& scene, const Vec3& lo, float size) {
   test::addQuad(scene, lo + ex, ey, ez, {1, 0, 0}, 0);
   test::addQuad(scene, lo, ex, ey, {0, 0, -1}, 0);
   test::addQuad(scene, lo + ez, ex, ey, {0, 0, 1}, 0);
+}
+
+// The unit cube [0, 1]^3 (addCube) in an otherwise empty scene.
+inline Scene unitCube() {
+  Scene scene = emptyScene();
+  addCube(scene, Vec3(0.0f), 1.0f);
+  return scene;
 }
 
 }  // namespace lo::atlas_test

@@ -274,6 +274,26 @@ double seamMismatch(const LightmapAtlas& atlas, const std::vector<Seam>& seams, 
   return worst;
 }
 
+/// The atlas of `octree` baked without seam stitching and with it, and the
+/// seams' mismatch (2 points per texel) in each.
+struct StitchingBakes {
+  LightmapAtlas raw, stitched;
+  double before = 0, after = 0;
+};
+
+StitchingBakes bakeUnstitchedAndStitched(const Scene& scene, const LightmapUvs& uvs,
+                                         const GpuOctree& octree, const std::vector<Seam>& seams) {
+  AtlasBakeParams params;
+  params.stitchSeams = false;
+  StitchingBakes b;
+  b.raw = bakeLightmapAtlas(scene, uvs, octree, params);
+  params.stitchSeams = true;
+  b.stitched = bakeLightmapAtlas(scene, uvs, octree, params);
+  b.before = seamMismatch(b.raw, seams, 2);
+  b.after = seamMismatch(b.stitched, seams, 2);
+  return b;
+}
+
 /// Chebyshev distance (texels) from each texel to the nearest covered one;
 /// large where none is near.
 std::vector<int> ringOf(const LightmapAtlas& atlas, int page) {
@@ -606,12 +626,8 @@ TEST(LightmapAtlas, CubeUnderAConstantVdlShowsNoSeamAfterStitching) {
   });
   const std::vector<Seam> seams = seamsOf(scene, uvs);
   ASSERT_EQ(seams.size(), 12u);
-  AtlasBakeParams params;
-  params.stitchSeams = false;
-  const LightmapAtlas raw = bakeLightmapAtlas(scene, uvs, octree, params);
-  params.stitchSeams = true;
-  const LightmapAtlas stitched = bakeLightmapAtlas(scene, uvs, octree, params);
-  const double before = seamMismatch(raw, seams, 2), after = seamMismatch(stitched, seams, 2);
+  const auto [raw, stitched, before, after] =
+      bakeUnstitchedAndStitched(scene, uvs, octree, seams);
   std::printf(
       "cube, constant VDL: seam mismatch %.3g unstitched, %.3g stitched (%.3g at 16 points per "
       "texel)\n",
@@ -645,12 +661,8 @@ TEST(LightmapAtlas, StitchingJoinsSeamsUnderVaryingLightAndMovesOnlyTexelsItRead
   const LightmapUvs uvs = cubeUvs(scene);
   const GpuOctree octree = varyingOctree();
   const std::vector<Seam> seams = seamsOf(scene, uvs);
-  AtlasBakeParams params;
-  params.stitchSeams = false;
-  const LightmapAtlas raw = bakeLightmapAtlas(scene, uvs, octree, params);
-  params.stitchSeams = true;
-  const LightmapAtlas stitched = bakeLightmapAtlas(scene, uvs, octree, params);
-  const double before = seamMismatch(raw, seams, 2), after = seamMismatch(stitched, seams, 2);
+  const auto [raw, stitched, before, after] =
+      bakeUnstitchedAndStitched(scene, uvs, octree, seams);
   std::printf("cube, varying VDLs: seam mismatch %.3g unstitched, %.3g stitched\n", before, after);
   EXPECT_LE(after, 1e-4);
   EXPECT_GT(before, 100 * std::max(after, 1e-6));
@@ -705,12 +717,8 @@ TEST(LightmapAtlas, StitchingJoinsTwoIslandsOfOnePlane) {
   });
   const std::vector<Seam> seams = seamsOf(scene, uvs);
   ASSERT_EQ(seams.size(), 1u);
-  AtlasBakeParams params;
-  params.stitchSeams = false;
-  const LightmapAtlas raw = bakeLightmapAtlas(scene, uvs, octree, params);
-  params.stitchSeams = true;
-  const LightmapAtlas stitched = bakeLightmapAtlas(scene, uvs, octree, params);
-  const double before = seamMismatch(raw, seams, 2), after = seamMismatch(stitched, seams, 2);
+  const auto [raw, stitched, before, after] =
+      bakeUnstitchedAndStitched(scene, uvs, octree, seams);
   const double beforeDense = seamMismatch(raw, seams, 16),
                afterDense = seamMismatch(stitched, seams, 16);
   std::printf(

@@ -227,8 +227,7 @@ TEST(LightmapUv, PlanarGridIsIsometric) {
 }
 
 TEST(LightmapUv, CubeGivesSixFlatCharts) {
-  Scene scene = emptyScene();
-  addCube(scene, Vec3(0.0f), 1.0f);
+  Scene scene = unitCube();
   LightmapUvParams params;
   params.chartConeDegrees = 45;
   const LightmapUvs uvs = buildLightmapUvs(scene, params);
@@ -245,8 +244,7 @@ TEST(LightmapUv, CubeGivesSixFlatCharts) {
 // colour of its own, its border a darker shade, the rest black, and its
 // area the charts' share of the page.
 TEST(LightmapUv, ChartLayoutImageColoursEachChart) {
-  Scene scene = emptyScene();
-  addCube(scene, Vec3(0.0f), 1.0f);
+  Scene scene = unitCube();
   LightmapUvParams params;
   params.atlasSize = 96;
   const LightmapUvs uvs = buildLightmapUvs(scene, params);
@@ -350,8 +348,7 @@ TEST(LightmapUv, Deterministic) {
 }
 
 TEST(LightmapUv, DegenerateTrianglesGetNoChart) {
-  Scene scene = emptyScene();
-  addCube(scene, Vec3(0.0f), 1.0f);
+  Scene scene = unitCube();
   addTriangle(scene, {0, 0, 0}, {1, 0, 0}, {2, 0, 0});  // collinear
   addTriangle(scene, {0, 1, 0}, {0, 1, 0}, {0, 2, 0});  // two corners alike
   const LightmapUvs uvs = buildLightmapUvs(scene, LightmapUvParams{});
@@ -364,8 +361,7 @@ TEST(LightmapUv, DegenerateTrianglesGetNoChart) {
 }
 
 TEST(LightmapUv, BadParametersNameTheField) {
-  Scene scene = emptyScene();
-  addCube(scene, Vec3(0.0f), 1.0f);
+  Scene scene = unitCube();
   auto expectError = [&](LightmapUvParams p, const std::string& field) {
     try {
       buildLightmapUvs(scene, p);

@@ -10,6 +10,7 @@
 #include "core/rng.h"
 #include "material/bsdf.h"
 #include "material/gltf_brdf.h"
+#include "test_util.h"
 
 namespace lo {
 namespace {
@@ -37,17 +38,11 @@ void integrate(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, Vec3&
   const int steps = 768;
   Vec3d sum(0, 0, 0);
   double pdfSum = 0;
-  for (int i = 0; i < steps; ++i) {
-    const float u1 = (float(i) + 0.5f) / float(steps);
-    const float r = std::sqrt(u1), z = std::sqrt(1.0f - u1);
-    for (int j = 0; j < steps; ++j) {
-      const float phi = 2.0f * kPi * (float(j) + 0.5f) / float(steps);
-      const Vec3 wi(r * std::cos(phi), r * std::sin(phi), z);
-      // d(omega) = d(u1) d(phi) / (2 z): the cosine grid's solid angle.
-      sum = sum + Vec3d(evalBsdf(lobes, albedo, wo, wi, n) / z);
-      pdfSum += pdfBsdf(lobes, albedo, wo, wi, n) / z;
-    }
-  }
+  // d(omega) = d(u1) d(phi) / (2 z): the cosine grid's solid angle.
+  test::forCosineGrid(steps, [&](const Vec3& wi, float z) {
+    sum = sum + Vec3d(evalBsdf(lobes, albedo, wo, wi, n) / z);
+    pdfSum += pdfBsdf(lobes, albedo, wo, wi, n) / z;
+  });
   const double scale = kPi / double(steps) / double(steps);
   f = {float(sum.x * scale), float(sum.y * scale), float(sum.z * scale)};
   pdf = pdfSum * scale;

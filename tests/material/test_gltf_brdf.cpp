@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "material/gltf_brdf.h"
+#include "test_util.h"
 
 namespace lo {
 namespace {
@@ -18,15 +19,9 @@ namespace {
 Vec3 albedo(const GltfBrdfMaterial& m, const Vec3& v, bool specular, int steps) {
   const Vec3 n(0, 0, 1);
   Vec3d sum(0, 0, 0);
-  for (int i = 0; i < steps; ++i) {
-    const float u1 = (float(i) + 0.5f) / float(steps);
-    const float r = std::sqrt(u1), z = std::sqrt(1.0f - u1);
-    for (int j = 0; j < steps; ++j) {
-      const float phi = 2.0f * kPi * (float(j) + 0.5f) / float(steps);
-      const Vec3 l(r * std::cos(phi), r * std::sin(phi), z);
-      sum = sum + Vec3d(gltfBrdfCos(m, n, v, l, specular) / z);
-    }
-  }
+  test::forCosineGrid(steps, [&](const Vec3& l, float z) {
+    sum = sum + Vec3d(gltfBrdfCos(m, n, v, l, specular) / z);
+  });
   const double scale = kPi / double(steps) / double(steps);
   return {float(sum.x * scale), float(sum.y * scale), float(sum.z * scale)};
 }

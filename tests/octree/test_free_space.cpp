@@ -6,6 +6,7 @@
 #include <octree_layout.h>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "bake/convert.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
@@ -113,9 +114,7 @@ TEST(VolumeOctree, RefusesArraysOfOtherLengths) {
 }
 
 TEST(FreeSpace, AnObjectBehindTheDividerOfASealedRoomStaysDark) {
-  BakeParams params;
-  params.depth = 5;
-  params.photons = 60000;
+  BakeParams params = test::smallBake(5, 60000);
   const BakeResult baked = bake(test::sealedRooms(), params);
   const VolumeLight& v = baked.grid.volume;
   ASSERT_FALSE(v.empty());
@@ -136,9 +135,7 @@ TEST(FreeSpace, AnObjectBehindTheDividerOfASealedRoomStaysDark) {
 }
 
 TEST(FreeSpace, ConvertKeepsItWhileItIsNoFinerThanTheNewGrid) {
-  BakeParams params;
-  params.depth = 5;
-  params.photons = 20000;
+  BakeParams params = test::smallBake(5, 20000);
   const BakeResult baked = bake(test::pointLitRoom(), params);
   ASSERT_EQ(baked.grid.volume.frame.depth, 3);
   ConvertParams to4;

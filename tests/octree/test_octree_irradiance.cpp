@@ -258,8 +258,7 @@ TEST(OctreeIrradiance, SampleGivesTheLookupsIrradianceAndItsDirection) {
 }
 
 TEST(FirstHit, MissesCountZeroAndBadParamsAreRefused) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   // A quad covering the left half of the view only.
   test::addQuad(scene, {-10, -10, 0}, {10, 0, 0}, {0, 20, 0}, {0, 0, 1}, 0);
   const PinholeCamera camera = PinholeCamera::lookAt({0, 0, 5}, {0, 0, 0}, 0.5f);
@@ -284,8 +283,7 @@ TEST(FirstHit, MissesCountZeroAndBadParamsAreRefused) {
 // within the distance of the wall's foot; the same jittered rays (same seed)
 // give each pixel's hit point, so every pixel is checked against geometry.
 TEST(FirstHit, EdgeMaskMarksTheHitsNearAnEdge) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   test::addQuad(scene, {-3, -3, 0}, {6, 0, 0}, {0, 6, 0}, {0, 0, 1}, 0);              // floor
   test::addQuad(scene, {0.5f, -3, 0}, {0, 6, 0}, {0, 0, 1}, {-1, 0, 0}, 0);           // wall
   const PinholeCamera camera =

@@ -16,6 +16,7 @@
 #include <octree_layout.h>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "bake/convert.h"
 #include "cluster/vdl_cluster.h"
 #include "core/error.h"
@@ -203,10 +204,7 @@ TEST(SphericalHarmonics, OctreeLookupEvaluatesTheTermsInEveryTexelFormat) {
 TEST(SphericalHarmonics, BakeRoundTripsThroughTheVdbFile) {
   const std::string dir = test::outputDir("sh_vdb");
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
-  BakeParams p;
-  p.depth = 4;
-  p.photons = 60000;
-  p.knn = 60;
+  BakeParams p = test::smallBake(4, 60000, 60);
   p.representation = LightRepresentation::Sh2;
   const BakeResult baked = bake(scene, p);
   ASSERT_EQ(baked.grid.shTerms, 9);

@@ -93,8 +93,7 @@ TEST(EmitterSampler, PhotonTracerEmitsItsPower) {
 }
 
 TEST(EmitterSampler, NoEmitterIsEmpty) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 0);
   const EmitterSampler s = buildEmitterSampler(scene);
   EXPECT_TRUE(s.empty());

@@ -23,6 +23,7 @@ namespace {
 
 using test::addClosedBox;
 using test::addQuad;
+using test::pointLight;
 
 struct Dvec3 {
   double v[3] = {0, 0, 0};
@@ -42,22 +43,43 @@ int addMaterial(Scene& scene, const Vec3& baseColor) {
   return int(scene.materials.size()) - 1;
 }
 
-Light pointLight(const Vec3& position, const Vec3& color, float intensity) {
-  Light l;
-  l.type = Light::Type::Point;
-  l.position = position;
-  l.color = color;
-  l.intensity = intensity;
-  return l;
-}
-
-/// Closed cube [-1, 1]^3 of albedo `albedo`, point light in the centre.
-Scene litBox(const Vec3& albedo, const Vec3& lightColor, float intensity) {
+/// Closed cube [-1, 1]^3 facing in, of material 0: albedo `albedo`.
+Scene closedBox(const Vec3& albedo) {
   Scene scene;
   int m = addMaterial(scene, albedo);
   addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, m);
-  scene.lights.push_back(pointLight({0, 0, 0}, lightColor, intensity));
   return scene;
+}
+
+/// closedBox with a point light in the centre.
+Scene litBox(const Vec3& albedo, const Vec3& lightColor, float intensity) {
+  Scene scene = closedBox(albedo);
+  scene.lights.push_back(pointLight({0, 0, 0}, intensity, lightColor));
+  return scene;
+}
+
+/// The 2 x 2 black floor (y = 0, facing up) of the sky and sun tests: every
+/// photon stored where it lands.
+Scene blackFloor() {
+  Scene scene;
+  int floor = addMaterial(scene, {0, 0, 0});
+  addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, floor);
+  return scene;
+}
+
+/// A clear, thin-walled glass material (KHR_materials_transmission); its index.
+int addGlass(Scene& scene) {
+  int glass = addMaterial(scene, {1, 1, 1});
+  scene.materials[size_t(glass)].transmission = 1.0f;
+  return glass;
+}
+
+/// Parameters storing `stored` photons, direct hits included.
+PhotonParams withDirect(size_t stored) {
+  PhotonParams params;
+  params.storedPhotons = stored;
+  params.includeDirect = true;
+  return params;
 }
 
 /// Six outward-facing quads: a closed solid [lo, hi]^3.
@@ -102,9 +124,7 @@ void checkClosedBoxEnergy(const Vec3& albedo) {
   const float intensity = 2.0f;
   const Vec3 color{1.0f, 0.7f, 0.4f};
   Scene scene = litBox(albedo, color, intensity);
-  PhotonParams params;
-  params.storedPhotons = 200000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(200000);
   params.maxBounces = 16;
   params.seed = 7;
   PhotonMap map = tracePhotons(scene, params);
@@ -143,9 +163,7 @@ TEST(Photons, ClosedBoxEnergyGrey) { checkClosedBoxEnergy({0.5f, 0.5f, 0.5f}); }
 TEST(Photons, ClosedBoxEnergyColoured) { checkClosedBoxEnergy({0.8f, 0.5f, 0.2f}); }
 
 TEST(Photons, EmissiveQuadEmitsPiLA) {
-  Scene scene;
-  int wall = addMaterial(scene, {0.5f, 0.5f, 0.5f});
-  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
+  Scene scene = closedBox({0.5f, 0.5f, 0.5f});
   int lamp = addMaterial(scene, {0.5f, 0.5f, 0.5f});
   const Vec3 radiance{1.0f, 2.0f, 3.0f};
   scene.materials[size_t(lamp)].emission = radiance;
@@ -153,9 +171,7 @@ TEST(Photons, EmissiveQuadEmitsPiLA) {
   addQuad(scene, {-0.25f, 0.9f, -0.2f}, {0.5f, 0, 0}, {0, 0, 0.4f}, {0, -1, 0}, lamp);
   const double area = 0.5 * 0.4;
 
-  PhotonParams params;
-  params.storedPhotons = 50000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(50000);
   PhotonMap map = tracePhotons(scene, params);
   ASSERT_EQ(map.photons.size(), params.storedPhotons);
   std::vector<Dvec3> sums = powerPerBounce(map, params.maxBounces);
@@ -175,17 +191,13 @@ TEST(Photons, EmissiveQuadEmitsPiLA) {
 TEST(Photons, MixedLightsAreUnbiasedPerChannel) {
   // Two emitters with different spectra: selection by average power must still
   // give each channel's total emitted power.
-  Scene scene;
-  int wall = addMaterial(scene, {0.3f, 0.3f, 0.3f});
-  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
+  Scene scene = closedBox({0.3f, 0.3f, 0.3f});
   int lamp = addMaterial(scene, {0.3f, 0.3f, 0.3f});
   scene.materials[size_t(lamp)].emission = {0.2f, 0.5f, 4.0f};
   addQuad(scene, {-0.3f, 0.95f, -0.3f}, {0.6f, 0, 0}, {0, 0, 0.6f}, {0, -1, 0}, lamp);
-  scene.lights.push_back(pointLight({0.2f, -0.3f, 0.1f}, {1.0f, 0.3f, 0.05f}, 0.4f));
+  scene.lights.push_back(pointLight({0.2f, -0.3f, 0.1f}, 0.4f, {1.0f, 0.3f, 0.05f}));
 
-  PhotonParams params;
-  params.storedPhotons = 100000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(100000);
   params.seed = 3;
   PhotonMap map = tracePhotons(scene, params);
   std::vector<Dvec3> sums = powerPerBounce(map, params.maxBounces);
@@ -206,9 +218,7 @@ TEST(Photons, MixedLightsAreUnbiasedPerChannel) {
 
 /// A scene with every lobe: diffuse, rough metal, mirror, glass.
 Scene mixedScene() {
-  Scene scene;
-  int wall = addMaterial(scene, {0.7f, 0.6f, 0.5f});
-  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
+  Scene scene = closedBox({0.7f, 0.6f, 0.5f});
   int metal = addMaterial(scene, {0.9f, 0.7f, 0.3f});
   scene.materials[size_t(metal)].metallic = 1.0f;
   scene.materials[size_t(metal)].roughness = 0.4f;
@@ -217,13 +227,12 @@ Scene mixedScene() {
   scene.materials[size_t(mirror)].metallic = 1.0f;
   scene.materials[size_t(mirror)].roughness = 0.0f;
   addQuad(scene, {0.99f, -0.5f, -0.5f}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, mirror);
-  int glass = addMaterial(scene, {1, 1, 1});
-  scene.materials[size_t(glass)].transmission = 1.0f;
+  int glass = addGlass(scene);
   addSolidBox(scene, {0.2f, -1.0f, 0.2f}, {0.7f, -0.2f, 0.7f}, glass);
   // A single-sided panel lit directly on its front and indirectly on its back.
   int panel = addMaterial(scene, {0.6f, 0.6f, 0.6f});
   addQuad(scene, {-0.2f, 0.0f, -0.5f}, {0, 0.6f, 0}, {0, 0, 1}, {1, 0, 0}, panel);
-  scene.lights.push_back(pointLight({0, 0.8f, 0}, {1, 1, 1}, 1.0f));
+  scene.lights.push_back(pointLight({0, 0.8f, 0}, 1.0f));
   return scene;
 }
 
@@ -305,10 +314,8 @@ TEST(Photons, MaxEmittedCapsPathsWhenLightMissesGeometry) {
   Scene scene;
   int floor = addMaterial(scene, {0.5f, 0.5f, 0.5f});
   addQuad(scene, {-0.1f, 0, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, {0, 1, 0}, floor);
-  scene.lights.push_back(pointLight({0, 10, 0}, {1, 1, 1}, 1));
-  PhotonParams params;
-  params.storedPhotons = 1000;
-  params.includeDirect = true;
+  scene.lights.push_back(pointLight({0, 10, 0}, 1));
+  PhotonParams params = withDirect(1000);
   params.maxEmitted = 5000;
   PhotonMap map = tracePhotons(scene, params);
   EXPECT_EQ(map.emittedPaths, params.maxEmitted);
@@ -336,9 +343,7 @@ TEST(Photons, ExcludesDirectByDefault) {
 
 TEST(Photons, NormalFacesDirectionAndDirectionIsUnit) {
   Scene scene = mixedScene();
-  PhotonParams params;
-  params.storedPhotons = 30000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(30000);
   PhotonMap map = tracePhotons(scene, params);
   size_t backOfPanel = 0;
   for (const Photon& p : map.photons) {
@@ -355,9 +360,7 @@ TEST(Photons, NormalFacesDirectionAndDirectionIsUnit) {
 
 TEST(Photons, StoresOnRoughButNotOnMirrorSurfaces) {
   Scene scene = mixedScene();
-  PhotonParams params;
-  params.storedPhotons = 50000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(50000);
   PhotonMap map = tracePhotons(scene, params);
   size_t onMirror = 0, onRoughMetal = 0;
   for (const Photon& p : map.photons) {
@@ -375,16 +378,13 @@ TEST(Photons, GlassStoresNothingAndConservesEnergy) {
   // so the stored total is the same as without it, phi (1 - a^(K+1)) / (1 - a).
   const float a = 0.5f;
   Scene scene = litBox({a, a, a}, {1, 1, 1}, 1.0f);
-  int glass = addMaterial(scene, {1, 1, 1});
-  scene.materials[size_t(glass)].transmission = 1.0f;
+  int glass = addGlass(scene);
   scene.materials[size_t(glass)].ior = 1.5f;
   scene.materials[size_t(glass)].thickness = 0.2f;  // a solid slab (KHR_materials_volume)
   const Vec3 slabLo{-0.8f, -0.4f, -0.8f}, slabHi{0.8f, -0.2f, 0.8f};
   addSolidBox(scene, slabLo, slabHi, glass);
 
-  PhotonParams params;
-  params.storedPhotons = 200000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(200000);
   params.maxBounces = 64;
   PhotonMap map = tracePhotons(scene, params);
   ASSERT_EQ(map.photons.size(), params.storedPhotons);
@@ -411,22 +411,18 @@ TEST(Photons, GlassStoresNothingAndConservesEnergy) {
 }
 
 TEST(Photons, NoLightThrows) {
-  Scene scene;
-  int m = addMaterial(scene, {0.5f, 0.5f, 0.5f});
-  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, m);
+  Scene scene = closedBox({0.5f, 0.5f, 0.5f});
   PhotonParams params;
   params.storedPhotons = 100;
   EXPECT_THROW(tracePhotons(scene, params), InputError);
-  scene.lights.push_back(pointLight({0, 0, 0}, {1, 1, 1}, 0.0f));  // zero power
+  scene.lights.push_back(pointLight({0, 0, 0}, 0.0f));  // zero power
   EXPECT_THROW(tracePhotons(scene, params), InputError);
   scene.lights[0].intensity = 1.0f;
   EXPECT_NO_THROW(tracePhotons(scene, params));
 }
 
 TEST(Photons, SpotPhotonsStayInsideConeWithFalloffPower) {
-  Scene scene;
-  int m = addMaterial(scene, {0.5f, 0.5f, 0.5f});
-  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, m);
+  Scene scene = closedBox({0.5f, 0.5f, 0.5f});
   Light spot;
   spot.type = Light::Type::Spot;
   spot.position = {0.1f, 0.9f, -0.2f};
@@ -436,9 +432,7 @@ TEST(Photons, SpotPhotonsStayInsideConeWithFalloffPower) {
   spot.outerConeAngle = 0.4f;
   scene.lights.push_back(spot);
 
-  PhotonParams params;
-  params.storedPhotons = 60000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(60000);
   PhotonMap map = tracePhotons(scene, params);
   double direct = 0;
   size_t count = 0;
@@ -462,18 +456,11 @@ TEST(Photons, SpotPhotonsStayInsideConeWithFalloffPower) {
 
 TEST(Photons, DirectionalLightFluxThroughFloor) {
   // A black floor facing a directional light: irradiance E over area A.
-  Scene scene;
-  int floor = addMaterial(scene, {0, 0, 0});
-  addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, floor);
-  Light sun;
-  sun.type = Light::Type::Directional;
-  sun.direction = {0, -1, 0};
-  sun.intensity = 2.5f;  // W/m^2
+  Scene scene = blackFloor();
+  const Light sun = test::sun({0, -1, 0}, 2.5f);  // W/m^2
   scene.lights.push_back(sun);
 
-  PhotonParams params;
-  params.storedPhotons = 40000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(40000);
   PhotonMap map = tracePhotons(scene, params);
   ASSERT_EQ(map.photons.size(), params.storedPhotons);
   double sum = 0;
@@ -494,9 +481,7 @@ TEST(Photons, SkyImageLightsAnOpenFloorWithItsCosineIntegral) {
   // and 1), 1 down to the horizon (rows 2 and 3), a colour below (unused).
   // An open floor receives E = 4 pi sin^2(45) + pi cos^2(45) = 2.5 pi, over
   // its 4 m^2.
-  Scene scene;
-  int floor = addMaterial(scene, {0, 0, 0});
-  addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, floor);
+  Scene scene = blackFloor();
   scene.sky.image = test::twoBandSkyImage();
   scene.sky.radiance = {1.0f, 0.5f, 0.25f};  // scales the image
   PhotonParams params;
@@ -523,16 +508,11 @@ TEST(Photons, TiltedSunOverATallBoxSpendsNoPathBesideTheScene) {
   const int black = addMaterial(scene, {0, 0, 0});
   addQuad(scene, {-1, 0, -1}, {0, 0, 2}, {2, 0, 0}, {0, 1, 0}, black);
   test::addBlock(scene, {-0.5f, 0, -0.5f}, {0.5f, 8, 0.5f}, black);
-  Light sun;
-  sun.type = Light::Type::Directional;
   const float elevation = 40.0f * kPi / 180.0f;
-  sun.direction = normalize(Vec3{std::cos(elevation), -std::sin(elevation), 0.0f});
-  sun.intensity = 2.0f;
+  const Light sun = test::sun({std::cos(elevation), -std::sin(elevation), 0.0f}, 2.0f);
   scene.lights.push_back(sun);
 
-  PhotonParams params;
-  params.storedPhotons = 40000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(40000);
   PhotonMap map = tracePhotons(scene, params);
   ASSERT_EQ(map.photons.size(), params.storedPhotons);
   EXPECT_LT(double(map.emptyPaths), 0.05 * double(map.emittedPaths));
@@ -553,9 +533,7 @@ TEST(Photons, SkyLightsAnOpenFloorWithPiL) {
   // area A, every photon stored at its first hit (the sky's light lives in
   // the octree whole, even without --include-direct), and no path wasted:
   // the sky's photons enter through the floor's silhouette.
-  Scene scene;
-  int floor = addMaterial(scene, {0, 0, 0});
-  addQuad(scene, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, floor);
+  Scene scene = blackFloor();
   scene.sky.radiance = {0.5f, 1.0f, 2.0f};  // W/(m^2 sr)
 
   PhotonParams params;
@@ -606,7 +584,7 @@ double wallPowerFromATiltedFloor(int tilt) {
     scene.textures.push_back(map);
     scene.materials[size_t(floor)].normalTexture = 0;
   }
-  scene.lights.push_back(pointLight({-0.5f, 1.0f, 0.0f}, {1, 1, 1}, 5.0f));
+  scene.lights.push_back(pointLight({-0.5f, 1.0f, 0.0f}, 5.0f));
   PhotonParams params;
   params.storedPhotons = 200000;
   PhotonMap map = tracePhotons(scene, params);
@@ -667,9 +645,7 @@ TEST(Photons, RejectsNegativeMaxBounces) {
 // An emissive texture: the quad's emitted power is pi A times the mean
 // radiance over it, and photons start only where the texture emits.
 TEST(Photons, EmissiveTextureWeightsThePhotons) {
-  Scene scene;
-  int wall = addMaterial(scene, {0.5f, 0.5f, 0.5f});
-  addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
+  Scene scene = closedBox({0.5f, 0.5f, 0.5f});
   int lamp = addMaterial(scene, {0.5f, 0.5f, 0.5f});
   scene.materials[size_t(lamp)].emission = {2, 2, 2};
   // x < 0 emits, x > 0 is dark
@@ -685,9 +661,7 @@ TEST(Photons, EmissiveTextureWeightsThePhotons) {
     scene.texcoords0[2 * v] = scene.positions[v].x + 0.5f;  // u = x + 0.5 over the quad
     scene.texcoords0[2 * v + 1] = scene.positions[v].z + 0.5f;
   }
-  PhotonParams params;
-  params.storedPhotons = 40000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(40000);
   PhotonMap map = tracePhotons(scene, params);
   // Mean radiance 2 x (share of the quad with x < 0: 1/2), stratified 64
   // samples per triangle: each triangle's mean is within a sample's share.
@@ -726,10 +700,8 @@ TEST(Photons, MetallicRoughnessMapMakesAMirrorDiffuse) {
     addClosedBox(scene, {-1, -1, -1}, {1, 1, 1}, wall);
     addQuad(scene, {-0.5f, -0.9f, -0.5f}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, mirror);
     scene.texcoords0.assign(2 * scene.positions.size(), 0.5f);
-    scene.lights.push_back(pointLight({0, 0.5f, 0}, {1, 1, 1}, 5.0f));
-    PhotonParams params;
-    params.storedPhotons = 20000;
-    params.includeDirect = true;
+    scene.lights.push_back(pointLight({0, 0.5f, 0}, 5.0f));
+    PhotonParams params = withDirect(20000);
     PhotonMap map = tracePhotons(scene, params);
     size_t onFloor = 0;
     for (const Photon& p : map.photons) {
@@ -750,12 +722,9 @@ TEST(Photons, MetallicRoughnessMapMakesAMirrorDiffuse) {
 TEST(Photons, ThinWalledGlassPassesLightAsDirect) {
   const float a = 0.5f;
   Scene scene = litBox({a, a, a}, {1, 1, 1}, 1.0f);
-  int glass = addMaterial(scene, {1, 1, 1});
-  scene.materials[size_t(glass)].transmission = 1.0f;
+  int glass = addGlass(scene);
   addQuad(scene, {-0.8f, -0.3f, -0.8f}, {1.6f, 0, 0}, {0, 0, 1.6f}, {0, 1, 0}, glass);
-  PhotonParams params;
-  params.storedPhotons = 50000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(50000);
   PhotonMap map = tracePhotons(scene, params);
   double direct = 0;
   for (const Photon& p : map.photons) {
@@ -780,9 +749,7 @@ namespace {
 // without the mirror.
 TEST(Photons, CausticPhotonsCameThroughTheMirrorAlone) {
   Scene scene = litBox({0.7f, 0.7f, 0.7f}, {1, 1, 1}, 10.0f);
-  PhotonParams params;
-  params.storedPhotons = 40000;
-  params.includeDirect = true;
+  PhotonParams params = withDirect(40000);
   const PhotonMap plain = tracePhotons(scene, params);
   for (const Photon& p : plain.photons) ASSERT_EQ(p.caustic, 0u);
 

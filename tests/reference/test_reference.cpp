@@ -26,6 +26,15 @@ namespace {
 using test::addClosedBox;
 using test::addQuad;
 
+/// A `width` x `height` reference image of `spp` samples per pixel.
+ReferenceParams imageParams(int width, int height, int spp) {
+  ReferenceParams params;
+  params.width = width;
+  params.height = height;
+  params.samplesPerPixel = spp;
+  return params;
+}
+
 int addMaterial(Scene& scene, const Vec3& baseColor, const Vec3& emission = {0, 0, 0}) {
   Material m;
   m.baseColor = baseColor;
@@ -59,9 +68,7 @@ Scene furnace(float albedo, float emission) {
 
 ReferenceImage renderFurnace(ReferencePart part, int spp = 64) {
   Scene scene = furnace(0.5f, 1.0f);
-  ReferenceParams params;
-  params.width = params.height = 16;
-  params.samplesPerPixel = spp;
+  ReferenceParams params = imageParams(16, 16, spp);
   params.part = part;
   params.seed = 3;
   return renderReference(scene, PinholeCamera::lookAt({0.2f, 0.1f, 0.3f}, {0, 0, -1}, 1.2f),
@@ -106,9 +113,7 @@ TEST(Reference, SkyOverAnOpenFloorGivesAlbedoTimesL) {
   const int floor = addMaterial(scene, Vec3(0.5f));
   addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, 1, 0}, floor);
   scene.sky.radiance = {0.4f, 0.8f, 1.6f};
-  ReferenceParams params;
-  params.width = params.height = 8;
-  params.samplesPerPixel = 256;
+  ReferenceParams params = imageParams(8, 8, 256);
   params.seed = 5;
   const PinholeCamera down = PinholeCamera::lookAt({0.01f, 1, 0}, {0, 0, 0}, 0.5f);
   for (ReferencePart part : {ReferencePart::Full, ReferencePart::Direct}) {
@@ -138,9 +143,7 @@ TEST(Reference, SkyImageOverAnOpenFloorGivesAlbedoTimesItsIrradiance) {
   addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, 1, 0}, floor);
   scene.sky.image = test::twoBandSkyImage();
   scene.sky.radiance = {1, 1, 1};
-  ReferenceParams params;
-  params.width = params.height = 8;
-  params.samplesPerPixel = 512;
+  ReferenceParams params = imageParams(8, 8, 512);
   params.seed = 5;
   const ReferenceImage r =
       renderReference(scene, PinholeCamera::lookAt({0.01f, 1, 0}, {0, 0, 0}, 0.5f), params);
@@ -160,9 +163,7 @@ TEST(Reference, FurnaceFarFromTheOriginKeepsItsRadiance) {
   const Vec3 offset{1e5f, -1e5f, 1e5f};
   Scene scene = furnace(0.5f, 1.0f).translated(offset);
   ASSERT_EQ(scene.tracingOrigin(), scene.bounds().center());
-  ReferenceParams params;
-  params.width = params.height = 16;
-  params.samplesPerPixel = 64;
+  ReferenceParams params = imageParams(16, 16, 64);
   params.seed = 3;
   ReferenceImage r = renderReference(
       scene,
@@ -185,10 +186,7 @@ TEST(Reference, FurnaceParts) {
 // keeps, and the mask keeps most of the picture.
 TEST(Reference, EmitterMaskMarksTheLightFixture) {
   Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
-  ReferenceParams params;
-  params.width = 64;
-  params.height = 48;
-  params.samplesPerPixel = 2;
+  ReferenceParams params = imageParams(64, 48, 2);
   params.part = ReferencePart::Direct;
   const ReferenceImage direct =
       renderReference(scene, PinholeCamera::fromScene(scene.cameras.at(0)), params);
@@ -232,9 +230,7 @@ TEST(Reference, EmitterMaskMarksTheLightFixture) {
 
 TEST(Reference, DirectPlusIndirectIsFull) {
   Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
-  ReferenceParams params;
-  params.width = params.height = 16;
-  params.samplesPerPixel = 4;
+  ReferenceParams params = imageParams(16, 16, 4);
   PinholeCamera camera = PinholeCamera::fromScene(scene.cameras.at(0));
   params.part = ReferencePart::Full;
   ReferenceImage full = renderReference(scene, camera, params);
@@ -284,9 +280,7 @@ TEST(Reference, PointLightOverDiffusePlane) {
   light.intensity = 2.0f;  // W/sr
   scene.lights.push_back(light);
   PinholeCamera cam = PinholeCamera::lookAt({0, 3, 1}, {0, 0, 0}, 0.3f);
-  ReferenceParams params;
-  params.width = params.height = 8;
-  params.samplesPerPixel = 16;
+  ReferenceParams params = imageParams(8, 8, 16);
   params.part = ReferencePart::Direct;
   ReferenceImage r = renderReference(scene, cam, params);
   for (int y = 0; y < 8; ++y)
@@ -325,9 +319,7 @@ TEST(Reference, AreaLightOverDiffusePlaneWithMis) {
   int emitter = addMaterial(scene, Vec3(0.0f), Vec3(3.0f));
   addQuad(scene, {-0.5f, 1, -0.5f}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, emitter);
   PinholeCamera cam = PinholeCamera::lookAt({0, 0.5f, 3}, {0, 0, 0}, 0.004f);
-  ReferenceParams params;
-  params.width = params.height = 4;
-  params.samplesPerPixel = 1024;
+  ReferenceParams params = imageParams(4, 4, 1024);
   params.part = ReferencePart::Full;
   ReferenceImage r = renderReference(scene, cam, params);
   double expected = 0.5 / kPi * squareEmitterIrradiance(3.0, 0.5, 1.0);
@@ -340,10 +332,7 @@ TEST(Reference, AreaLightOverDiffusePlaneWithMis) {
 
 TEST(Reference, DeterministicAcrossThreadCounts) {
   Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
-  ReferenceParams params;
-  params.width = 24;
-  params.height = 20;
-  params.samplesPerPixel = 3;
+  ReferenceParams params = imageParams(24, 20, 3);
   params.seed = 11;
   PinholeCamera camera = PinholeCamera::fromScene(scene.cameras.at(0));
   std::vector<float> images[2];
@@ -476,9 +465,7 @@ TEST(Reference, UnlitIsSeenByTheCameraAloneAsItsColour) {
   card.unlit = true;
   with.materials.push_back(card);
   test::addQuad(with, {-0.3f, -0.3f, 0.5f}, {0.3f, 0, 0}, {0, 0.6f, 0}, {0, 0, 1}, 1);
-  ReferenceParams params;
-  params.width = params.height = 16;
-  params.samplesPerPixel = 64;
+  ReferenceParams params = imageParams(16, 16, 64);
   params.part = ReferencePart::Direct;
   const PinholeCamera camera = PinholeCamera::lookAt({0, 0, 2}, {0, 0, 0}, 0.9f);
   const ReferenceImage a = renderReference(with, camera, params);

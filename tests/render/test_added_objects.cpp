@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
@@ -44,6 +45,30 @@ double mean(const RgbImage& a) {
   return sum / double(a.rgb.size());
 }
 
+/// A bake of `scene` and the octrees the renderer draws it with: the
+/// surfaces' light and the free-space light the added objects read.
+struct BakedOctrees {
+  BakeResult baked;
+  GpuOctree surface, volume;
+};
+
+BakedOctrees bakeOctrees(const Scene& scene, int depth, size_t photons) {
+  BakeParams bp = test::smallBake(depth, photons);
+  BakedOctrees b{bake(scene, bp), {}, {}};
+  b.surface = buildGpuOctree(b.baked.grid);
+  b.volume = buildVolumeOctree(b.baked.grid.volume);
+  return b;
+}
+
+/// What the tests draw: `width` x `height` pixels without reflections.
+RenderParams viewParams(int width, int height) {
+  RenderParams params;
+  params.width = width;
+  params.height = height;
+  params.reflections = false;
+  return params;
+}
+
 TEST(AddedObjects, PlacementJoinsTheModelAndMarksItsMaterials) {
   const Scene room = test::pointLitRoom();
   const Scene scene = roomWithSphere(Vec3(0.7f, 0.3f, 0.6f), 0.1f);
@@ -62,18 +87,12 @@ TEST(AddedObjects, PlacementJoinsTheModelAndMarksItsMaterials) {
 
 TEST(AddedObjects, MovedObjectsDrawAsIfPlacedThere) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
-  BakeParams bp;
-  bp.depth = 4;
-  bp.photons = 30000;
-  const BakeResult baked = bake(test::pointLitRoom(), bp);
-  ASSERT_FALSE(baked.grid.volume.empty());
-  const GpuOctree octree = buildGpuOctree(baked.grid);
-  const GpuOctree volume = buildVolumeOctree(baked.grid.volume);
+  const BakedOctrees b = bakeOctrees(test::pointLitRoom(), 4, 30000);
+  ASSERT_FALSE(b.baked.grid.volume.empty());
+  const GpuOctree& octree = b.surface;
+  const GpuOctree& volume = b.volume;
 
-  RenderParams params;
-  params.width = 64;
-  params.height = 48;
-  params.reflections = false;
+  const RenderParams params = viewParams(64, 48);
   const PinholeCamera camera =
       PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.98f), Vec3(0.5f, 0.35f, 0), 1.2f);
   // Opaque; and see-through with both sides drawn, moved from in front of
@@ -127,23 +146,16 @@ TEST(AddedObjects, MovedObjectsDrawAsIfPlacedThere) {
 
 TEST(AddedObjects, TheFreeSpaceLightLightsThemAsTheCppLookupSays) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
-  BakeParams bp;
-  bp.depth = 4;
-  bp.photons = 30000;
-  const BakeResult baked = bake(test::pointLitRoom(), bp);
-  const GpuOctree octree = buildGpuOctree(baked.grid);
-  const GpuOctree volume = buildVolumeOctree(baked.grid.volume);
+  const BakedOctrees b = bakeOctrees(test::pointLitRoom(), 4, 30000);
+  const GpuOctree& volume = b.volume;
   // A large white sphere filling the view: its indirect radiance is a / pi
   // times the free-space irradiance at its surface (diffuse, albedo 0.8).
   const Vec3 centre(0.5f, 0.5f, 0.5f);
   const float r = 0.15f;
-  Renderer renderer(roomWithSphere(centre, r), octree, {});
+  Renderer renderer(roomWithSphere(centre, r), b.surface, {});
   renderer.setFreeSpaceLight(volume);
-  RenderParams params;
-  params.width = 32;
-  params.height = 32;
+  RenderParams params = viewParams(32, 32);
   params.mode = RenderMode::Indirect;
-  params.reflections = false;
   params.specular = false;
   const Vec3 eye(0.5f, 0.5f, 0.95f);
   const RgbImage image = renderer.render(PinholeCamera::lookAt(eye, centre, 0.2f), params);
@@ -158,17 +170,11 @@ TEST(AddedObjects, TheFreeSpaceLightLightsThemAsTheCppLookupSays) {
 
 TEST(AddedObjects, ASphereBehindTheDividerOfASealedRoomIsBlack) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
-  BakeParams bp;
-  bp.depth = 5;
-  bp.photons = 60000;
   const Scene rooms = test::sealedRooms();
-  const BakeResult baked = bake(rooms, bp);
-  const GpuOctree octree = buildGpuOctree(baked.grid);
-  const GpuOctree volume = buildVolumeOctree(baked.grid.volume);
-  RenderParams params;
-  params.width = 48;
-  params.height = 48;
-  params.reflections = false;
+  const BakedOctrees b = bakeOctrees(rooms, 5, 60000);
+  const GpuOctree& octree = b.surface;
+  const GpuOctree& volume = b.volume;
+  RenderParams params = viewParams(48, 48);
   for (const float x : {1.12f, 1.5f}) {  // 2 cm from the divider, and mid-room
     const Scene scene = withSphere(rooms, Vec3(x, 0.5f, 0.5f), 0.1f);
     Renderer renderer(scene, octree, {});

@@ -15,12 +15,14 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "lightmap/atlas_test_scenes.h"
 #include "lightmap/lightmap_atlas.h"
 #include "lightmap/lightmap_bake.h"
 #include "octree/octree_irradiance.h"
 #include "render/atlas_gpu.h"
 #include "render/context.h"
+#include "render/render_fixture.h"
 #include "scene/scene.h"
 #include "test_util.h"
 #include "vdb/vdb_io.h"
@@ -152,8 +154,7 @@ TEST(AtlasGpu, CubeMatchesTheCpuPathTexelForTexel) {
 TEST(AtlasGpu, CornellBoxMatchesTheCpuBake) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
-  const GpuOctree octree =
-      buildGpuOctree(readVdlGrid(test::dataDir() + "/../tests/golden/cornell-box-d4.vdb").grid);
+  const GpuOctree octree = test::goldenCornellOctree();
   LightmapParams lp;
   const LightmapBake cpu = bakeLightmap(scene, octree, lp);
   GpuAtlasEvaluator evaluator;
@@ -180,10 +181,7 @@ TEST(AtlasGpu, CornellBoxMatchesTheCpuBake) {
 // (octree_lookup.h's loLeafVdls) is the C++ one.
 void expectLayeredBakeMatches(LightRepresentation representation, float tolerance = 0) {
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
-  BakeParams bp;
-  bp.depth = 5;
-  bp.photons = 100000;
-  bp.knn = 100;
+  BakeParams bp = test::smallBake(5, 100000, 100);
   bp.representation = representation;
   const BakeResult baked = bake(scene, bp);
   ASSERT_GT(baked.grid.layers.size(), 0u);

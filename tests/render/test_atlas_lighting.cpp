@@ -8,6 +8,7 @@
 #include "octree/gpu_octree.h"
 #include "render/atlas_lighting.h"
 #include "render/context.h"
+#include "render/render_fixture.h"
 #include "render/renderer.h"
 #include "scene/pinhole_camera.h"
 #include "scene/scene.h"
@@ -31,8 +32,7 @@ TEST(AtlasLighting, ShadeParamsAreTheFrames) {
 TEST(AtlasLighting, AtlasIsBakedWithTheGivenSettingsAndSet) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
-  const LoadedVdl baked = readVdlGrid(test::dataDir() + "/../tests/golden/cornell-box-d4.vdb");
-  const GpuOctree octree = buildGpuOctree(baked.grid);
+  const GpuOctree octree = test::goldenCornellOctree();
   Renderer renderer(scene, octree);
   LightingParams p;
   EXPECT_FALSE(prepareLighting(renderer, scene, octree, p).has_value());

@@ -14,6 +14,7 @@
 #include "lightmap/lightmap_bake.h"
 #include "octree/gpu_octree.h"
 #include "render/context.h"
+#include "render/render_fixture.h"
 #include "render/renderer.h"
 #include "scene/pinhole_camera.h"
 #include "scene/scene.h"
@@ -26,8 +27,7 @@ namespace {
 TEST(AtlasRender, CornellBoxAtlasEqualsOctree) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
-  const LoadedVdl baked = readVdlGrid(test::dataDir() + "/../tests/golden/cornell-box-d4.vdb");
-  const GpuOctree octree = buildGpuOctree(baked.grid);
+  const GpuOctree octree = test::goldenCornellOctree();
   Renderer renderer(scene, octree);
   EXPECT_FALSE(renderer.hasAtlas());
   const PinholeCamera camera = PinholeCamera::fromScene(scene.cameras.at(0));
@@ -67,8 +67,7 @@ TEST(AtlasRender, CornellBoxAtlasEqualsOctree) {
 // The atlas UV source: a scene whose TEXCOORD_1 overlaps is refused by
 // default, naming the problem and the way out, and charted with --uv auto.
 TEST(AtlasRender, BadTexcoord1IsRefusedUnlessAutoIsAsked) {
-  Scene scene;
-  scene.materials.push_back(Material{});
+  Scene scene = test::oneMaterialScene();
   test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, 0);
   scene.texcoords1 = {0, 0, 1, 0, 1, 1, 0, 1};
   scene.texcoords1[6] = 1.0f;  // corner 3 at (1, 0.5): triangle 1 folds over triangle 0
@@ -78,14 +77,8 @@ TEST(AtlasRender, BadTexcoord1IsRefusedUnlessAutoIsAsked) {
   empty.frame.depth = 2;
   empty.frame.voxelSize = 0.5f;
   const GpuOctree octree = buildGpuOctree(empty);
-  try {
-    bakeLightmap(scene, octree);
-    FAIL() << "expected the overlapping TEXCOORD_1 to be refused";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("TEXCOORD_1"), std::string::npos) << what;
-    EXPECT_NE(what.find("--uv auto"), std::string::npos) << what;
-  }
+  // The overlapping TEXCOORD_1 is refused.
+  test::expectRefusal([&] { bakeLightmap(scene, octree); }, {"TEXCOORD_1", "--uv auto"});
   LightmapParams automatic;
   automatic.uvSource = UvSource::Charts;
   const LightmapBake charted = bakeLightmap(scene, octree, automatic);

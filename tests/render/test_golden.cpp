@@ -27,6 +27,7 @@
 #include <string>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "render/context.h"
@@ -263,9 +264,7 @@ TEST(Golden, CornellBoxInProjectedCoordinatesIsTheSamePicture) {
     EXPECT_LE(m.maxAbsDiff, kMaxAbsDiff) << name << "; images in " << dir;
   }
   // A bake of the far scene stores its frame in the scene's coordinates.
-  BakeParams params;
-  params.depth = 3;
-  params.photons = 2000;
+  BakeParams params = test::smallBake(3, 2000);
   const BakeResult baked = bake(far.scene, params);
   EXPECT_EQ(baked.grid.frame.offset.x, far.scene.origin.x);
   EXPECT_EQ(baked.grid.frame.offset.z, far.scene.origin.z);

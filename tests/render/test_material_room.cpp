@@ -17,6 +17,7 @@
 #include <string>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "image/compare.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
@@ -69,10 +70,7 @@ TEST(MaterialRoom, FullRenderAgainstThePathTracer) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const Scene scene = loadScene(test::dataDir() + "/material-room.gltf");
   ASSERT_FALSE(scene.cameras.empty());
-  BakeParams bp;
-  bp.depth = 5;
-  bp.photons = 200000;
-  bp.knn = 100;
+  BakeParams bp = test::smallBake(5, 200000, 100);
   const BakeResult baked = bake(scene, bp);
   Renderer renderer(scene, buildGpuOctree(baked.grid));
   EXPECT_TRUE(renderer.hasReflectionProbe()) << "the gold ball is glossy";

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "core/error.h"
 #include "octree/gpu_octree.h"
 #include "reference/first_hit.h"
@@ -21,9 +22,7 @@ namespace {
 
 const BakeResult& roomBake() {
   static const BakeResult baked = [] {
-    BakeParams bp;
-    bp.depth = 4;
-    bp.photons = 20000;
+    BakeParams bp = test::smallBake(4, 20000);
     return bake(test::pointLitRoom(), bp);
   }();
   return baked;

@@ -24,6 +24,27 @@ GpuOctree bakeOctree(const Scene& scene, const std::vector<Photon>& photons, int
   return buildGpuOctree(bakeLevel(scene, photons, params));
 }
 
+/// `stored` photons traced in `scene`.
+std::vector<Photon> photonsIn(const Scene& scene, size_t stored) {
+  PhotonParams pp;
+  pp.storedPhotons = stored;
+  return tracePhotons(scene, pp).photons;
+}
+
+/// What the tests draw: `width` x `height` pixels of indirect light.
+RenderParams indirectParams(int width, int height) {
+  RenderParams params;
+  params.width = width;
+  params.height = height;
+  params.mode = RenderMode::Indirect;
+  return params;
+}
+
+/// The point-lit room from just inside its front wall.
+PinholeCamera roomView() {
+  return PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
+}
+
 float maxValue(const RgbImage& image) {
   float m = 0;
   for (size_t i = 0; i < image.rgb.size(); i += 3) {
@@ -35,17 +56,12 @@ float maxValue(const RgbImage& image) {
 TEST(RendererSetOctree, SwappedLevelRendersLikeAFreshRenderer) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   Scene scene = test::pointLitRoom();
-  PhotonParams pp;
-  pp.storedPhotons = 20000;
-  std::vector<Photon> photons = tracePhotons(scene, pp).photons;
+  std::vector<Photon> photons = photonsIn(scene, 20000);
   GpuOctree coarse = bakeOctree(scene, photons, 3);
   GpuOctree fine = bakeOctree(scene, photons, 4);
 
-  RenderParams params;
-  params.width = 64;
-  params.height = 48;
-  params.mode = RenderMode::Indirect;
-  PinholeCamera camera = PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
+  const RenderParams params = indirectParams(64, 48);
+  const PinholeCamera camera = roomView();
 
   Renderer swapped(scene, GpuOctree(), {});
   EXPECT_EQ(maxValue(swapped.render(camera, params)), 0.0f) << "empty octree: no indirect light";
@@ -69,19 +85,14 @@ TEST(RendererSetOctree, SwappedLevelRendersLikeAFreshRenderer) {
 TEST(RendererSetOctree, TooLargeForTheLimitsKeepsTheOldOctree) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   Scene scene = test::pointLitRoom();
-  PhotonParams pp;
-  pp.storedPhotons = 5000;
-  std::vector<Photon> photons = tracePhotons(scene, pp).photons;
+  std::vector<Photon> photons = photonsIn(scene, 5000);
   GpuOctree octree = bakeOctree(scene, photons, 3);
   RendererParams limits;
   limits.max3DTextureSize = std::max({octree.poolWidth(), octree.poolHeight(), octree.poolDepth()});
   limits.max2DTextureSize = 16384;
   Renderer renderer(scene, octree, limits);
-  RenderParams params;
-  params.width = 32;
-  params.height = 24;
-  params.mode = RenderMode::Indirect;
-  PinholeCamera camera = PinholeCamera::lookAt(Vec3(0.5f, 0.5f, 0.95f), Vec3(0.5f, 0.4f, 0), 1.2f);
+  const RenderParams params = indirectParams(32, 24);
+  const PinholeCamera camera = roomView();
   RgbImage before = renderer.render(camera, params);
   GpuOctree larger = bakeOctree(scene, photons, 5);
   ASSERT_GT(std::max({larger.poolWidth(), larger.poolHeight(), larger.poolDepth()}),

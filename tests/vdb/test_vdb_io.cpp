@@ -14,6 +14,7 @@
 #include "core/file.h"
 #include "test_util.h"
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "bake/convert.h"
 #include "core/error.h"
 #include "core/rng.h"
@@ -452,10 +453,7 @@ TEST(VdbIo, AGridOfARebasedSceneIsStoredInWorldCoordinates) {
 }
 
 BakeResult smallRoomBake() {
-  BakeParams p;
-  p.depth = 4;
-  p.photons = 60000;
-  p.knn = 60;
+  BakeParams p = test::smallBake(4, 60000, 60);
   return bake(test::pointLitRoom(), p);
 }
 

@@ -1,0 +1,97 @@
+// The sun's shadow maps under OSMesa: no sunlight leaks into a closed room of
+// zero-thickness walls, and cascades fitted to the view resolve a small
+// shadow on a large ground.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "image/image.h"
+#include "render/render_fixture.h"
+#include "render/renderer.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+using RenderImage = test::GlTest;
+
+/// A scene of one grey (0.8) material, under a sun of 3 W/m^2 travelling
+/// along `sunDirection`, and what the two tests draw of it: 128 x 128
+/// pixels of direct light, no specular.
+struct SunScene {
+  Scene scene;
+  RenderParams params;
+  explicit SunScene(const Vec3& sunDirection) {
+    Material m;
+    m.baseColor = {0.8f, 0.8f, 0.8f};
+    scene.materials.push_back(m);
+    scene.lights.push_back(test::sun(sunDirection, 3.0f));
+    params.width = params.height = 128;
+    params.mode = RenderMode::Direct;
+    params.specular = false;
+  }
+};
+
+// A closed room of zero-thickness walls on a lit ground under a sun: no sun
+// light inside but for isolated pixels along the floor-wall seams (where a
+// shadow-map texel straddles the wall's base and half of it sees the lit
+// ground); the old lookup let full sunlight in there.
+TEST_F(RenderImage, SunDoesNotLeakIntoAClosedRoom) {
+  SunScene s({0.3f, -1.0f, 0.2f});
+  test::addQuad(s.scene, {-5, -0.001f, -5}, {0, 0, 10}, {10, 0, 0}, {0, 1, 0}, 0);
+  test::addClosedBox(s.scene, {-0.5f, 0, -0.5f}, {0.5f, 1, 0.5f}, 0);
+  const RenderParams& p = s.params;
+  Renderer renderer(s.scene, test::constantOctree());
+  float worst = 0;
+  // Two views of the seams of the walls that face the sun (x = -0.5 and
+  // z = -0.5: the sun travels towards +x +z), where the lit ground outside
+  // lies next to the wall's base in the sun's view: down into their corner,
+  // and along the base of one of them.
+  const PinholeCamera views[] = {
+      PinholeCamera::lookAt({0.2f, 0.6f, 0.2f}, {-0.5f, 0.0f, -0.5f}, 70.0f * kPi / 180.0f),
+      PinholeCamera::lookAt({0.4f, 0.3f, 0.0f}, {-0.5f, 0.0f, -0.4f}, 70.0f * kPi / 180.0f)};
+  int k = 0;
+  const std::string dir = test::outputDir("render_sun_room");
+  for (const PinholeCamera& view : views) {
+    const RgbImage image = renderer.render(view, p);
+    writePng(dir + "/view" + std::to_string(k++) + ".png", image, 4.0f);
+    for (size_t i = 0; i < image.pixelCount(); ++i) worst = std::max(worst, image.rgb[3 * i]);
+  }
+  // Lit floor would be 0.8 / pi * 3 * cos(theta) = 0.72. A single map over the
+  // scene with the hardware 2 x 2 comparison let the full 0.72 in along the
+  // seams; the eroded lookup leaves isolated seam pixels with at most 0.124
+  // (measured; docs/render.md): a known remainder, bounded here.
+  EXPECT_LT(worst, 0.2f) << "sun light inside the closed room (" << dir << ")";
+}
+
+// A 50 m ground under a sun, a 10 cm plate 30 cm above it: its shadow, seen
+// from 25 cm, is a sharp square (cascades fitted to the view), not the few
+// texels a map over the whole scene would give it.
+TEST_F(RenderImage, SunCascadesResolveASmallShadowOnALargeGround) {
+  SunScene s({1.0f, -1.0f, 0.0f});
+  test::addQuad(s.scene, {-25, 0, -25}, {0, 0, 50}, {50, 0, 0}, {0, 1, 0}, 0);
+  test::addQuad(s.scene, {-0.05f, 0.3f, -0.05f}, {0.1f, 0, 0}, {0, 0, 0.1f}, {0, -1, 0}, 0);
+  // Straight down at the shadow's centre (x = 0.3), under the plate.
+  const PinholeCamera camera =
+      PinholeCamera::lookAt({0.3f, 0.25f, 0.0f}, {0.3f, 0.0f, 0.0f}, 40.0f * kPi / 180.0f);
+  const RgbImage image = Renderer(s.scene, test::constantOctree()).render(camera, s.params);
+  writePng(test::outputDir("render_sun_cascades") + "/rendered.png", image, 0.0f);
+  const float lit = 0.8f * kInvPi * 3.0f * std::sqrt(0.5f);
+  int dark = 0, between = 0;
+  for (size_t i = 0; i < image.pixelCount(); ++i) {
+    const float v = image.rgb[3 * i];
+    if (v < 0.1f * lit) ++dark;
+    else if (v < 0.9f * lit) ++between;
+  }
+  // The view spans 2 x 0.25 tan(20 deg) = 0.182 m: the 0.1 m square shadow
+  // covers (0.1 / 0.182)^2 = 30% of it; its edges are 4 x 0.1 m = 281 pixels.
+  const double share = double(dark) / double(image.pixelCount());
+  EXPECT_NEAR(share, 0.30, 0.04) << dark << " dark pixels";
+  EXPECT_LT(between, 3 * 281) << "a penumbra wider than 3 pixels on average";
+}
+
+}  // namespace
+}  // namespace lo

@@ -1,0 +1,164 @@
+// What lets light and the view through, in the renderer under OSMesa: glass
+// panes (thin and with KHR_materials_volume), glTF MASK and BLEND, and
+// single-sided surfaces culled from behind.
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "image/image.h"
+#include "render/render_fixture.h"
+#include "render/renderer.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+using RenderImage = test::GlTest;
+using test::QuadSetup;
+
+/// QuadSetup's quad under a point light, drawn (Direct) without and with a
+/// clear glass pane at z = 0.8 covering the view (`thickness` > 0: a
+/// KHR_materials_volume pane).
+struct PaneRenders {
+  RenderParams params = QuadSetup::directParams();
+  RgbImage open, through;
+};
+PaneRenders renderWithAndWithoutAPane(const Vec3& lightAt, float intensity, float thickness) {
+  PaneRenders r;
+  QuadSetup s;
+  s.scene.lights.push_back(test::pointLight(lightAt, intensity));
+  const GpuOctree octree = test::emptyOctree();
+  r.open = s.render(octree, r.params);
+  Material glass;
+  glass.baseColor = {1, 1, 1};
+  glass.roughness = 0.05f;
+  glass.transmission = 1.0f;
+  glass.thickness = thickness;
+  s.scene.materials.push_back(glass);
+  test::addQuad(s.scene, {-1, -1, 0.8f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
+  r.through = s.render(octree, r.params);
+  return r;
+}
+
+// Glass (KHR_materials_transmission): a clear pane between the camera and a
+// lit quad shows the quad through it, dimmed only by the Fresnel reflectance
+// at normal incidence (4%), where it used to be drawn as an opaque white
+// surface; and it casts no shadow on the quad under it.
+TEST_F(RenderImage, GlassShowsWhatIsBehindAndCastsNoShadow) {
+  // The thin pane lies between the light (off to the side: no highlight on
+  // the pane at the centre) and the centre of the quad.
+  const PaneRenders r = renderWithAndWithoutAPane({0.6f, 0.5f, 1.5f}, 4.0f, 0.0f);
+  const RenderParams& p = r.params;
+  const float* a = r.open.pixel(p.width / 2, p.height / 2);
+  const float* b = r.through.pixel(p.width / 2, p.height / 2);
+  ASSERT_GT(a[0], 0.01f);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(b[c] / a[c], 0.96f, 0.01f) << "channel " << c << ": " << b[c] << " vs " << a[c];
+  }
+}
+
+TEST_F(RenderImage, AFlatGlassVolumeIsSeenStraightThroughTwoInterfaces) {
+  // A pane with KHR_materials_volume (thickness 0.05, as exporters give
+  // panes) is flat on the scale of its thickness: the view goes straight
+  // through (not bent as through a ball of that diameter), losing the
+  // Fresnel reflectance at both faces, 1 - 0.04 each at normal incidence.
+  // The light is under the pane: it casts no shadow here.
+  const PaneRenders r = renderWithAndWithoutAPane({0.6f, 0.5f, 0.5f}, 1.0f, 0.05f);
+  const RenderParams& p = r.params;
+  for (int px : {p.width / 2, p.width / 2 + 12}) {  // the centre, and 7 degrees off it
+    const float* a = r.open.pixel(px, p.height / 2);
+    const float* b = r.through.pixel(px, p.height / 2);
+    ASSERT_GT(a[0], 0.01f);
+    EXPECT_NEAR(b[0] / a[0], 0.96f * 0.96f, 0.01f) << "pixel " << px;
+  }
+}
+
+// glTF MASK: the cut-out half of a card neither hides the quad behind it nor
+// shadows it; the other half does both.
+TEST_F(RenderImage, MaskedCardCutsOutTheViewAndTheShadow) {
+  QuadSetup s;
+  s.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
+  Texture half = Texture::fromLinear(2, 1, {Vec3{1, 1, 1}, Vec3{1, 1, 1}},
+                                     {0.0f, 1.0f});  // u < 0.5 (x < 0) cut out
+  s.scene.textures.push_back(half);
+  Material card;
+  card.baseColor = {1, 1, 1};
+  card.baseColorTexture = 0;
+  card.alphaMode = AlphaMode::Mask;
+  s.scene.materials.push_back(card);
+  test::addQuad(s.scene, {-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
+  s.scene.texcoords0.assign(2 * s.scene.positions.size(), 0.0f);
+  for (size_t v = 0; v < s.scene.positions.size(); ++v) {
+    s.scene.texcoords0[2 * v] = 0.5f * (s.scene.positions[v].x + 1.0f);
+  }
+  const RenderParams p = QuadSetup::directParams();
+  const GpuOctree octree = test::constantOctree();
+  const RgbImage masked = s.render(octree, p);
+  writePng(test::outputDir("render_mask") + "/rendered.png", masked, 1.0f);
+  // x = -0.4 on the quad: seen through the cut-out, lit through it (the
+  // light's ray crosses the card at x = -0.15).
+  const float* behind = masked.pixel(test::columnAt(s, p, -0.4f, 0.0f), p.height / 2);
+  EXPECT_GT(behind[0], 0.02f) << "lit through the cut-out";
+  EXPECT_NEAR(behind[0] / behind[2], s.albedo.x / s.albedo.z, 0.03f) << "the quad's colour";
+  // x = 0.4 on the card: the card (white).
+  const float* cardPixel = masked.pixel(test::columnAt(s, p, 0.4f, 0.5f), p.height / 2);
+  EXPECT_NEAR(cardPixel[0] / cardPixel[2], 1.0f, 0.03f) << "the card's colour";
+  // Opaque, the card hides the quad everywhere.
+  s.scene.materials[1].alphaMode = AlphaMode::Opaque;
+  const RgbImage opaque = s.render(octree, p);
+  const float* hidden = opaque.pixel(test::columnAt(s, p, -0.4f, 0.0f), p.height / 2);
+  EXPECT_NEAR(hidden[0] / hidden[2], 1.0f, 0.03f);
+}
+
+// glTF BLEND: a pane of alpha 1/4 over the lit quad shows 1/4 of its own
+// radiance and 3/4 of the quad's; below 1/2 it casts no shadow.
+TEST_F(RenderImage, BlendedPaneCoversItsAlphaOfWhatIsBehind) {
+  QuadSetup s;
+  s.scene.lights.push_back(test::pointLight({0.6f, 0.5f, 1.5f}, 4.0f));
+  const RenderParams p = QuadSetup::directParams();
+  const GpuOctree octree = test::constantOctree();
+  const RgbImage open = s.render(octree, p);
+  Material pane;
+  pane.baseColor = {1, 1, 1};
+  pane.baseAlpha = 0.25f;
+  s.scene.materials.push_back(pane);
+  test::addQuad(s.scene, {-1, -1, 0.8f}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
+  const RgbImage paneImage = s.render(octree, p);  // opaque
+  s.scene.materials[1].alphaMode = AlphaMode::Blend;
+  const RgbImage blended = s.render(octree, p);
+  writePng(test::outputDir("render_blend") + "/rendered.png", blended, 1.0f);
+  for (int x : {p.width / 4, p.width / 2, 3 * p.width / 4}) {
+    const float* a = open.pixel(x, p.height / 2);
+    const float* b = paneImage.pixel(x, p.height / 2);
+    const float* c = blended.pixel(x, p.height / 2);
+    ASSERT_GT(a[0], 0.01f);
+    for (int k = 0; k < 3; ++k) {
+      const float expected = 0.25f * b[k] + 0.75f * a[k];
+      EXPECT_NEAR(c[k], expected, 0.01f * expected) << "pixel " << x << " channel " << k;
+    }
+  }
+}
+
+// glTF doubleSided false: a surface seen from behind is culled (the quad
+// behind it shows); doubleSided true: it is drawn.
+TEST_F(RenderImage, SingleSidedSurfaceIsCulledFromBehind) {
+  QuadSetup s;
+  Material pane;
+  pane.baseColor = {1, 1, 1};
+  s.scene.materials.push_back(pane);
+  // Its winding faces -z, away from the camera.
+  test::addQuad(s.scene, {-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, 1);
+  const RenderParams p = QuadSetup::params(false);
+  const GpuOctree octree = test::constantOctree();
+  const RgbImage culled = s.render(octree, p);
+  const float* c = culled.pixel(p.width / 2, p.height / 2);
+  EXPECT_NEAR(c[0] / c[2], s.albedo.x / s.albedo.z, 0.02f) << "the quad behind shows";
+  s.scene.materials[1].doubleSided = true;
+  const RgbImage drawn = s.render(octree, p);
+  const float* d = drawn.pixel(p.width / 2, p.height / 2);
+  EXPECT_NEAR(d[0] / d[2], 1.0f, 0.02f) << "the pane shows";
+}
+
+}  // namespace
+}  // namespace lo

@@ -1,0 +1,172 @@
+// Lights and cameras as the loader reads them: KHR_lights_punctual under
+// node transforms, values kept in their ranges or refused by name, cameras
+// that cannot show anything refused; and the framing of a scene without a
+// camera.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "scene/pinhole_camera.h"
+#include "scene/scene.h"
+#include "scene/scene_fixture.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+using namespace test;  // scene_fixture.h
+
+TEST_F(SceneGltf, LightAndMaterialValuesStayInTheirRanges) {
+  // glTF's [0, 1] factors are clamped with a warning naming them; a negative
+  // emission is taken as 0, warned; intensities and positions beyond what
+  // the bake can carry are refused, naming the light (docs/scene.md, "Limits").
+  auto withLight = [](const std::string& light, const std::string& translation) {
+    MiniGltf g = oneTriangle();
+    g.material = 0;
+    g.materials = R"([{"name": "odd", "emissiveFactor": [1, -0.5, 1],
+                       "pbrMetallicRoughness": {"metallicFactor": 1e30, "roughnessFactor": -3}}])";
+    g.nodes = R"([{"mesh": 0}, {"name": "L", "translation": )" + translation +
+              R"(, "extensions": {"KHR_lights_punctual": {"light": 0}}}])";
+    g.sceneNodes = "[0, 1]";
+    g.extraTop = R"("extensionsUsed": ["KHR_lights_punctual"], "extensions": {"KHR_lights_punctual":
+                    {"lights": [)" + light + R"(]}}, )";
+    return g;
+  };
+  MiniGltf g = withLight(R"({"name": "lamp", "type": "point", "color": [1, -0.5, 1], "intensity": 2})",
+                         "[0, 1, 0]");
+  const Scene s = loadScene(write("odd.gltf", g));
+  EXPECT_EQ(s.materials[0].metallic, 1.0f);
+  EXPECT_EQ(s.materials[0].roughness, 0.0f);
+  EXPECT_EQ(s.materials[0].emission.y, 0.0f);
+  EXPECT_EQ(s.lights[0].color.y, 0.0f);
+  std::string all;
+  for (const std::string& w : s.warnings) all += w + "\n";
+  EXPECT_NE(all.find("material 'odd' metallic is 1e+30, outside [0, 1]"), std::string::npos) << all;
+  EXPECT_NE(all.find("material 'odd' roughness is -3"), std::string::npos) << all;
+  EXPECT_NE(all.find("material 'odd' has a negative emission"), std::string::npos) << all;
+  EXPECT_NE(all.find("light 'L' colour channel 1 is -0.5"), std::string::npos) << all;
+  expectInputError(
+      write("bright.gltf",
+                withLight(R"({"type": "point", "intensity": 1e37})", "[0, 1, 0]")),
+      "light 'L' has intensity 1e+37");
+  expectInputError(
+      write("far.gltf", withLight(R"({"type": "point", "intensity": 1})", "[1e19, 0, 0]")),
+      "light 'L' lies at");
+}
+
+TEST_F(SceneGltf, PunctualLights) {
+  MiniGltf g = oneTriangle();
+  const float h = std::sqrt(0.5f);
+  g.extraTop =
+      R"("extensionsUsed": ["KHR_lights_punctual"], "extensions": {"KHR_lights_punctual": {"lights": [
+      {"name": "bulb", "type": "point", "color": [1, 0.5, 0.25], "intensity": 10, "range": 5},
+      {"type": "spot", "intensity": 3, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}},
+      {"type": "directional", "intensity": 2}]}}, )";
+  std::ostringstream nodes;
+  nodes << "[{\"mesh\": 0}, {\"translation\": [1, 2, 3], "
+        << "\"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}},"
+        << " {\"translation\": [0, 1, 0], \"children\": [3]},"
+        << " {\"name\": \"spot_node\", \"translation\": [0, 5, 0], \"rotation\": [" << -h
+        << ", 0, 0, " << h << "], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 1}}},"
+        << " {\"rotation\": [0, " << h << ", 0, " << h
+        << "], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 2}}}]";
+  g.nodes = nodes.str();
+  g.sceneNodes = "[0, 1, 2, 4]";
+  Scene s = loadScene(write("lights.gltf", g));
+  ASSERT_EQ(s.lights.size(), 3u);
+  const Light* point = nullptr;
+  const Light* spot = nullptr;
+  const Light* sun = nullptr;
+  for (const Light& l : s.lights) {
+    if (l.type == Light::Type::Point) point = &l;
+    if (l.type == Light::Type::Spot) spot = &l;
+    if (l.type == Light::Type::Directional) sun = &l;
+  }
+  ASSERT_TRUE(point && spot && sun);
+  EXPECT_EQ(point->name, "bulb");
+  expectNear(point->position, {1, 2, 3}, 1e-6f, "point position");
+  expectNear(point->color, {1, 0.5f, 0.25f}, 1e-6f, "point colour");
+  EXPECT_FLOAT_EQ(point->intensity, 10.0f);
+  EXPECT_FLOAT_EQ(point->range, 5.0f);
+  EXPECT_EQ(spot->name, "spot_node");
+  expectNear(spot->position, {0, 6, 0}, 1e-6f, "spot position (parent + child)");
+  expectNear(spot->direction, {0, -1, 0}, 1e-6f, "spot points down");
+  EXPECT_FLOAT_EQ(spot->innerConeAngle, 0.2f);
+  EXPECT_FLOAT_EQ(spot->outerConeAngle, 0.5f);
+  EXPECT_FLOAT_EQ(spot->intensity, 3.0f);
+  expectNear(sun->direction, {-1, 0, 0}, 1e-6f, "R_y(90) turns -z into -x");
+  EXPECT_FLOAT_EQ(sun->intensity, 2.0f);
+}
+
+TEST_F(SceneGltf, CamerasThatCannotShowAnythingAreRefused) {
+  // A camera whose up is parallel to its view (here: squashed to nothing
+  // along its up), whose far plane is nearer than its near one, or that
+  // lies beyond kMaxCoordinate: refused by name instead of a black image.
+  auto withCamera = [&](const std::string& name, const std::string& node,
+                        const std::string& perspective) {
+    MiniGltf g = oneTriangle();
+    g.nodes = R"([{"mesh": 0}, )" + node + "]";
+    g.sceneNodes = "[0, 1]";
+    g.extraTop = R"("cameras": [{"type": "perspective", "perspective": )" + perspective + "}], ";
+    return write(name, g);
+  };
+  const std::string fine = R"({"yfov": 0.8, "znear": 0.1})";
+  EXPECT_NO_THROW(loadScene(withCamera("ok.gltf", R"({"camera": 0, "translation": [0, 0, 3]})", fine)));
+  expectInputError(withCamera("flat.gltf", R"({"camera": 0, "scale": [1, 0, 1]})", fine),
+                   "its up is parallel to its view");
+  expectInputError(withCamera("far.gltf", R"({"camera": 0})",
+                              R"({"yfov": 0.8, "znear": 1.0, "zfar": 0.5})"),
+                   "zfar > znear");
+  expectInputError(withCamera("away.gltf", R"({"camera": 0, "translation": [0, 0, 1e19]})", fine),
+                   "beyond");
+}
+
+// A scene without a camera is framed from the side its surfaces face: a room
+// corner (a floor and two walls facing in) from its open octant, so that the
+// camera sees their fronts (framed from +Z it saw the backs of a wall, black
+// in every renderer); a closed room, whose normals cancel, from +Z as before;
+// a scene's own camera first.
+TEST(SceneCamera, FramingLooksAtTheFrontFaces) {
+  Scene corner;
+  corner.materials.push_back(Material{});
+  const Vec3 normals[3] = {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}};
+  test::addQuad(corner, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, normals[0], 0);  // floor
+  test::addQuad(corner, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, normals[1], 0);  // wall x = 0
+  test::addQuad(corner, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, normals[2], 0);  // wall z = 0
+  const Vec3 side = viewSide(corner);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(side[a], 1.0f / std::sqrt(3.0f), 1e-5f) << a;
+  const PinholeCamera camera = PinholeCamera::framing(corner, 0.8f);
+  for (const Vec3& n : normals) EXPECT_LT(dot(camera.forward, n), -0.5f) << "sees the fronts";
+  EXPECT_GT(length(camera.eye - corner.bounds().center()), 0.5f * length(corner.bounds().extent()));
+
+  // A ground alone faces straight up: seen from 60 degrees above the
+  // horizon, from the +Z side, not from straight above.
+  Scene ground;
+  ground.materials.push_back(Material{});
+  test::addQuad(ground, {-1, 0, -1}, {2, 0, 0}, {0, 0, 2}, {0, 1, 0}, 0);
+  const Vec3 above = viewSide(ground);
+  EXPECT_NEAR(above.y, std::sqrt(3.0f) / 2, 1e-5f);
+  EXPECT_NEAR(above.z, 0.5f, 1e-5f);
+  EXPECT_NEAR(above.x, 0.0f, 1e-6f);
+
+  Scene room;
+  room.materials.push_back(Material{});
+  test::addClosedBox(room, {0, 0, 0}, {1, 1, 1}, 0);
+  EXPECT_EQ(viewSide(room), Vec3(0, 0, 1));
+  EXPECT_EQ(PinholeCamera::ofScene(room, 0.8f).forward, Vec3(0, 0, -1));
+
+  Camera own;
+  own.position = {0.5f, 0.5f, 0.5f};
+  own.forward = {1, 0, 0};
+  own.up = {0, 1, 0};
+  own.yfov = 0.5f;
+  room.cameras.push_back(own);
+  EXPECT_EQ(PinholeCamera::ofScene(room, 0.8f).forward, Vec3(1, 0, 0));
+  EXPECT_EQ(PinholeCamera::ofScene(room, 0.8f).yfov, 0.5f);
+}
+
+}  // namespace
+}  // namespace lo

@@ -1,0 +1,136 @@
+// The OBJ loader: .mtl materials and grouping, undefined materials and
+// missing textures warned once by name, vertex colours, coordinates far from
+// the origin read again in double, and the files it refuses.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+#include "scene/scene_fixture.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+namespace fs = std::filesystem;
+
+using namespace test;  // scene_fixture.h
+
+TEST_F(SceneObj, MaterialMappingAndGrouping) {
+  write("m.mtl",
+        "newmtl shiny\nKd 0.5 0.25 0.125\nKs 0.5 0.625 0.25\nNs 98\nd 0.25\nNi 1.4\n"
+        "newmtl lamp\nKd 0 0 0\nKe 2 3 4\n");
+  write("scene.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\nvt 1 0\n"
+        "usemtl lamp\nf 1 2 3\nusemtl shiny\nf 1/1/1 2/2/1 3/2/1 4/1/1\nusemtl lamp\nf 1 3 4\n");
+  Scene s = loadScene(dir + "/scene.obj");
+  SCOPED_TRACE(s.ToString());
+  ASSERT_EQ(s.materials.size(), 2u);
+  const Material& shiny = s.materials[0];
+  EXPECT_EQ(shiny.name, "shiny");
+  expectNear(shiny.baseColor, {0.5f, 0.25f, 0.125f}, 1e-6f);
+  EXPECT_NEAR(shiny.roughness, std::sqrt(2.0f / 100.0f), 1e-6f);
+  EXPECT_FLOAT_EQ(shiny.specular, 0.625f);  // the largest channel of Ks
+  EXPECT_FLOAT_EQ(s.materials[1].specular, 0.0f);  // no Ks: Lambertian
+  EXPECT_NEAR(shiny.transmission, 0.75f, 1e-6f);
+  EXPECT_NEAR(shiny.ior, 1.4f, 1e-6f);
+  expectNear(s.materials[1].emission, {2, 3, 4}, 1e-6f);
+  ASSERT_EQ(s.triangleCount(), 4u);  // the quad is split in two
+  EXPECT_EQ(s.triangleMaterial, (std::vector<int32_t>{0, 0, 1, 1}));
+  for (size_t t = 0; t < 4; ++t) expectNear(s.faceNormal(t), {0, 0, 1}, 1e-6f);
+  ASSERT_EQ(s.normals.size(), s.positions.size());
+  for (const Vec3& n : s.normals) expectNear(n, {0, 0, 1}, 1e-6f, "normal");
+  ASSERT_EQ(s.texcoords0.size(), 2 * s.positions.size());
+}
+
+TEST_F(SceneObj, UndefinedMaterialIsWarnedOnceByName) {
+  // usemtl of a name the .mtl does not define (a real asset's "Texture1"):
+  // the faces get the default material, and the user hears of it once.
+  write("m.mtl", "newmtl wall\nKd 0.5 0.5 0.5\n");
+  write("scene.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "usemtl Texture1\nf 1 2 3\nusemtl wall\nf 1 3 4\nusemtl Texture1\nf 2 3 4\n");
+  Scene s = loadScene(dir + "/scene.obj");
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("usemtl 'Texture1' names no material"), std::string::npos)
+      << s.warnings[0];
+  ASSERT_EQ(s.triangleCount(), 3u);
+  int defaults = 0;
+  for (int32_t m : s.triangleMaterial) defaults += s.materials[size_t(m)].name == "default";
+  EXPECT_EQ(defaults, 2);
+}
+
+// OBJ vertex colours (`v x y z r g b`) multiply the base colour like glTF's
+// COLOR_0, when every vertex has one, read as the display (sRGB) values the
+// tools that write them mean; a file where only some have one keeps none
+// (white).
+TEST_F(SceneObj, VertexColoursMultiplyTheBaseColour) {
+  write("m.mtl", "newmtl a\nKd 0.5 0.5 0.5\n");
+  write("c.obj",
+        "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 0.5 0\nv 0 1 0 0 0 1\nusemtl a\nf 1 2 3\n");
+  const Scene s = loadScene(dir + "/c.obj");
+  ASSERT_EQ(s.colors.size(), 4 * s.positions.size());
+  expectNear(s.albedo(0, 0, 0), {0.5f, 0, 0}, 1e-6f, "red corner");
+  // Display values: 0.5 is sRGB, 0.214 linear.
+  expectNear(s.albedo(0, 1, 0), {0, 0.5f * 0.21404f, 0}, 1e-5f, "sRGB 0.5 corner");
+  write("some.obj",
+        "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  const Scene some = loadScene(dir + "/some.obj");
+  EXPECT_TRUE(some.colors.empty());
+  expectNear(some.albedo(0, 0, 0), {0.5f, 0.5f, 0.5f}, 1e-6f, "no colours");
+}
+
+TEST_F(SceneObj, MissingTextureFileIsWarnedOnceByName) {
+  write("m.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n"
+                 "newmtl b\nKd 0.2 0.2 0.2\nmap_Kd gone.png\n");
+  write("scene.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                     "usemtl a\nf 1 2 3\nusemtl b\nf 1 3 4\n");
+  Scene s = loadScene(dir + "/scene.obj");
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("map_Kd 'gone.png' is missing"), std::string::npos) << s.warnings[0];
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].baseColorTexture, -1);
+  EXPECT_EQ(s.materials[1].baseColorTexture, -1);
+}
+
+TEST_F(SceneObj, Rejects) {
+  fs::create_directories(dir + "/inner");
+  write("evil.mtl", "newmtl x\nKd 1 1 1\n");
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  expectInputError(write("inner/escape.obj", "mtllib ../evil.mtl\n" + tri + "usemtl x\nf 1 2 3\n"),
+                   "outside the scene folder");
+  expectInputError(write("inner/absolute.obj", "mtllib /etc/passwd\n" + tri + "f 1 2 3\n"),
+                   "outside the scene folder");
+  expectInputError(write("inner/nomtl.obj", "mtllib absent.mtl\n" + tri + "f 1 2 3\n"),
+                   "missing material library");
+  expectInputError(write("inner/index.obj", tri + "f 1 2 9\n"), "out of range");
+  expectInputError(write("inner/quad.obj", tri + "f 1 2 3 12\n"), "out of range");
+  expectInputError(write("inner/nan.obj", "v 0 0 0\nv 1e400 0 0\nv 0 1 0\nf 1 2 3\n"),
+                   "non-finite");
+  write("inner/tex.mtl", "newmtl t\nmap_Kd garbage.png\n");
+  write("inner/garbage.png", "not an image");
+  expectInputError(write("inner/tex.obj", "mtllib tex.mtl\n" + tri + "usemtl t\nf 1 2 3\n"),
+                   "unreadable image");
+}
+
+TEST_F(SceneObj, ASceneFarFromTheOriginKeepsItsPrecision) {
+  // The OBJ's own numbers, read again in double (its parser reads float).
+  write("far.obj",
+        "v 1234567.25 89.5 -7654321.0625\nv 1234567.55 89.5 -7654321.0625\n"
+        "v 1234567.55 89.7 -7654321.0625\nv 1234567.25 89.7 -7654321.0625\nf 1 2 3 4\n");
+  const Scene far = loadScene(dir + "/far.obj");
+  ASSERT_TRUE(far.rebased());
+  EXPECT_DOUBLE_EQ(far.origin.x, (1234567.25 + 1234567.55) / 2);
+  const Vec3d p2 = far.toWorld(far.positions[2]);
+  EXPECT_NEAR(p2.x, 1234567.55, 1e-7);
+  EXPECT_NEAR(p2.y, 89.7, 1e-7);
+  EXPECT_NEAR(p2.z, -7654321.0625, 1e-7);
+  EXPECT_NEAR(far.triangleArea(0) + far.triangleArea(1), 0.06, 1e-7);
+}
+
+}  // namespace
+}  // namespace lo

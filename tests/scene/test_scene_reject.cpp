@@ -1,0 +1,225 @@
+// One malformed file per input the loader refuses, with a message that
+// names the file and what is wrong (docs/scene.md, "Limits"), before it
+// allocates for what the file claims.
+
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include "core/error.h"
+#include "core/file.h"
+#include "scene/scene.h"
+#include "scene/scene_fixture.h"
+#include "test_util.h"
+
+namespace lo {
+namespace {
+
+namespace fs = std::filesystem;
+
+using namespace test;  // scene_fixture.h
+
+TEST_F(SceneReject, MissingFile) {
+  expectInputError(dir + "/nope.gltf", "missing");
+  expectInputError(dir + "/nope.obj", "missing");
+  ASSERT_EQ(mkfifo((dir + "/pipe.gltf").c_str(), 0600), 0);  // would block a reader
+  expectInputError(dir + "/pipe.gltf", "is a pipe");
+}
+
+TEST_F(SceneReject, UnknownExtension) {
+  expectInputError(write("scene.fbx", "whatever"), "extension");
+}
+
+TEST_F(SceneReject, MissingExternalBuffer) {
+  MiniGltf g = oneTriangle();
+  g.bufferUri = "mesh.bin";
+  std::string path = write("scene.gltf", g);
+  expectInputError(path, "missing buffer");
+  expectInputError(path, "mesh.bin");
+  // With the .bin present it loads.
+  write("mesh.bin", g.blob());
+  EXPECT_EQ(loadScene(path).triangleCount(), 1u);
+  // A .bin far larger than its byteLength is refused from its size, unread
+  // (a sparse 64 MiB file: nothing is written to the disk).
+  fs::resize_file(dir + "/mesh.bin", uintmax_t(64) << 20);
+  expectInputError(path, "holds 67108864 bytes where its byteLength says");
+}
+
+TEST_F(SceneReject, TrianglesBeyondMemoryAreCountedBeforeBuilt) {
+  // Twenty nodes instancing a mesh of 1e8 triangles (an accessor without a
+  // buffer view: zeros, as glTF allows): 2e9 triangles, refused from the
+  // accessors' counts before any is built.
+  std::string nodes, roots;
+  for (int i = 0; i < 20; ++i) {
+    nodes += std::string(i ? ", " : "") + R"({"mesh": 0})";
+    roots += std::string(i ? ", " : "") + std::to_string(i);
+  }
+  write("many.gltf",
+        R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [)" + roots +
+            R"(]}], "nodes": [)" + nodes +
+            R"(], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "accessors": [{"componentType": 5126, "count": 300000000, "type": "VEC3",
+            "min": [0, 0, 0], "max": [0, 0, 0]}]})");
+  expectInputError(dir + "/many.gltf", "the node tree makes 2000000000 triangles");
+}
+
+TEST_F(SceneReject, BufferUriEscapingTheFolder) {
+  fs::create_directories(dir + "/inner");
+  MiniGltf g = oneTriangle();
+  write("outside.bin", g.blob());  // exists, and must still be refused
+  g.bufferUri = "../outside.bin";
+  std::string path = writeGltf(dir + "/inner", "escape.gltf", g);
+  expectInputError(path, "outside the scene folder");
+  expectInputError(path, "../outside.bin");
+  g.bufferUri = "sub/%2e%2e/../outside.bin";  // percent-encoded ".."
+  path = writeGltf(dir + "/inner", "encoded.gltf", g);
+  expectInputError(path, "outside the scene folder");
+  g.bufferUri = "/etc/passwd";
+  path = writeGltf(dir + "/inner", "absolute.gltf", g);
+  expectInputError(path, "outside the scene folder");
+  expectInputError(path, "/etc/passwd");
+}
+
+TEST_F(SceneReject, IndexOutOfRange) {
+  MiniGltf g = oneTriangle();
+  g.indices = {0, 1, 7};
+  expectInputError(write("index.gltf", g), "out of range");
+}
+
+TEST_F(SceneReject, AccessorOutOfRangeOfBufferView) {
+  MiniGltf g = oneTriangle();
+  std::string j = g.json();
+  // Claim 300 positions in a 36-byte view.
+  std::string from = "\"count\": 3, \"type\": \"VEC3\"";
+  j.replace(j.find(from), from.size(), "\"count\": 300, \"type\": \"VEC3\"");
+  expectInputError(write("accessor.gltf", j), "out of range");
+  // A bufferView beyond its buffer.
+  j = g.json();
+  from = "\"byteOffset\": 0, \"byteLength\": 36";
+  j.replace(j.find(from), from.size(), "\"byteOffset\": 0, \"byteLength\": 3600");
+  expectInputError(write("view.gltf", j), "out of range");
+}
+
+TEST_F(SceneReject, NonFiniteVertex) {
+  MiniGltf g = oneTriangle();
+  g.positions[4] = std::nanf("");
+  expectInputError(write("nan.gltf", g), "non-finite");
+  g = oneTriangle();
+  g.positions[0] = INFINITY;
+  expectInputError(write("inf.gltf", g), "non-finite");
+}
+
+TEST_F(SceneReject, PointsMode) {
+  MiniGltf g = oneTriangle();
+  g.mode = 0;
+  expectInputError(write("points.gltf", g), "unsupported primitive mode");
+  g.mode = 1;
+  expectInputError(write("lines.gltf", g), "unsupported primitive mode");
+}
+
+TEST_F(SceneReject, UnreadableImage) {
+  write("garbage.png", "this is not a png at all, just bytes");
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])";
+  g.image = "garbage.png";
+  std::string path = write("image.gltf", g);
+  expectInputError(path, "unreadable image");
+  expectInputError(path, "garbage.png");
+}
+
+TEST_F(SceneReject, TruncatedGlb) {
+  std::string glb = oneTriangle().glb();
+  for (size_t keep :
+       {size_t(0), size_t(10), size_t(19), size_t(40), glb.size() / 2, glb.size() - 4}) {
+    std::string name = "cut" + std::to_string(keep) + ".glb";
+    write(name, glb.substr(0, keep));
+    expectInputError(dir + "/" + name, "truncated");
+  }
+  // Garbage with the right magic and sizes that lie.
+  std::string lying = glb;
+  uint32_t huge = 0x7fffffff;
+  std::memcpy(&lying[12], &huge, 4);
+  expectInputError(write("lying.glb", lying), "truncated");
+  // And the shared scene, truncated, if it is there.
+  std::string shared = test::sharedScenesDir() + "/composed/cornell-box.glb";
+  if (fs::exists(shared)) {
+    std::string bytes = readFile(shared);
+    write("cornell-half.glb", bytes.substr(0, bytes.size() / 2));
+    expectInputError(dir + "/cornell-half.glb", "truncated");
+  }
+}
+
+TEST_F(SceneReject, NoTriangles) {
+  MiniGltf g = oneTriangle();
+  g.indices = {0, 1, 1};  // degenerate: dropped
+  expectInputError(write("degenerate.gltf", g), "no triangles");
+  expectInputError(write("empty.obj", "# nothing\nv 0 0 0\n"), "no triangles");
+}
+
+TEST_F(SceneReject, InvalidJson) {
+  expectInputError(write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": ["),
+                   "invalid glTF");
+}
+
+TEST_F(SceneReject, NodeCycle) {
+  MiniGltf g = oneTriangle();
+  g.nodes = R"([{"mesh": 0, "children": [1]}, {"children": [0]}])";
+  expectInputError(write("cycle.gltf", g), "not a tree");
+}
+
+// Hardening (docs/scene.md, "Limits"): inputs that used to crash or load as
+// a silently wrong scene are refused with a message naming the file and the
+// problem; a base colour above 1 is clamped with a warning.
+TEST_F(SceneLimits, DeepJsonIsRefusedBeforeParsing) {
+  MiniGltf g = oneTriangle();
+  std::string deep(100000, '[');
+  deep += std::string(100000, ']');
+  g.extraTop = "\"extras\": " + deep + ", ";
+  expectInputError(write("deep.gltf", g), "nested more than");
+  // Brackets inside strings do not count.
+  g.extraTop = "\"extras\": {\"note\": \"" + std::string(1000, '[') + "\"}, ";
+  EXPECT_EQ(loadScene(write("brackets.gltf", g)).triangleCount(), 1u);
+}
+
+TEST_F(SceneLimits, IndexBeyondInt32IsRefused) {
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{}])";
+  std::string json = g.json();
+  const std::string from = "\"material\": 0", to = "\"material\": 4294967299";  // 2^32 + 3
+  ASSERT_NE(json.find(from), std::string::npos);
+  json.replace(json.find(from), from.size(), to);
+  write("index.gltf", json);
+  expectRefusal([&] { loadScene(dir + "/index.gltf"); },
+                {"/meshes/0/primitives/0/material = 4294967299 is out of range"});
+}
+
+TEST_F(SceneLimits, CoordinatesBeyondTheTracersRangeAreRefused) {
+  MiniGltf g = oneTriangle();
+  g.nodes = R"([{"mesh": 0, "translation": [1e20, 0, 0]}])";
+  expectInputError(write("far.gltf", g), "beyond 1e+12 scene units");
+  g.nodes = R"([{"mesh": 0, "translation": [1e9, 0, 0]}])";  // far, but representable
+  EXPECT_EQ(loadScene(write("farish.gltf", g)).triangleCount(), 1u);
+}
+
+TEST_F(SceneLimits, BaseColourAboveOneIsClampedWithAWarning) {
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"name": "hot", "pbrMetallicRoughness": {"baseColorFactor": [1000, 0.5, 1.5, 1]}}])";
+  const Scene s = loadScene(write("bright.gltf", g));
+  EXPECT_EQ(s.materials[0].baseColor, Vec3(1.0f, 0.5f, 1.0f));
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("material 'hot'"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("clamped"), std::string::npos) << s.warnings[0];
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}])";
+  EXPECT_TRUE(loadScene(write("fine.gltf", g)).warnings.empty());
+}
+
+}  // namespace
+}  // namespace lo
