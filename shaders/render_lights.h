@@ -37,7 +37,8 @@ struct GpuLight {
   vec4 params;         /* x cos outer, y cos inner, z first shadow layer (-1 = none),
                           w near-field area (m^2) */
   vec4 corner0;        /* area light: the triangle's corners; corner0.w = sqrt(area) */
-  vec4 corner1;
+  vec4 corner1;        /* w: the shadow map's tangent per texel (a texel's size at
+                          distance 1 from the light) */
   vec4 corner2;
 };
 
@@ -46,7 +47,7 @@ LO_STD140_BLOCK(LightBlock) {
   GpuLight uLights[LO_MAX_LIGHTS];
   mat4 uShadowMatrices[LO_MAX_SHADOW_LAYERS]; /* render space -> clip, per shadow layer */
   ivec4 uLightCount;  /* x lights, y of them area lights (the last y) */
-  vec4 uShadowParams; /* x depth bias (fraction of far), y normal offset (world units) */
+  vec4 uShadowParams; /* x the least depth bias (fraction of far: two 16-bit steps), yzw 0 */
 };
 
 #undef LO_STD140_BLOCK

@@ -10,13 +10,24 @@ int cubeFace(vec3 d) {
   return d.z > 0.0 ? 4 : 5;
 }
 
-// The point a shadow map is read at: p moved along n by the normal offset,
-// scaled up at grazing angles (toLight the direction to the light), where
-// shadow acne appears.
-vec3 shadowPoint(vec3 p, vec3 n, vec3 toLight) {
+// The size of one shadow texel of light i where it falls at distance d from
+// the light: the map's tangent per texel (render/lights.cpp) times d. The
+// offsets and biases below are this many texels, so that a 7.5 cm car and a
+// 100 m atrium, or a small object in a large scene, shadow alike: nothing
+// in them is in scene units.
+float shadowTexel(int i, float d) { return uLights[i].corner1.w * d; }
+
+// The point a shadow map is read at: p moved along n by the normal offset
+// of 3 texels, scaled up at grazing angles (toLight the direction to the
+// light), where shadow acne appears.
+vec3 shadowPoint(vec3 p, vec3 n, vec3 toLight, float texel) {
   float nl = clamp(dot(n, toLight), 0.0, 1.0);
-  return p + n * uShadowParams.y * (1.0 + 2.0 * (1.0 - nl));
+  return p + n * (1.5 * texel) * (1.0 + 2.0 * (1.0 - nl));
 }
+
+// The depth bias, as a fraction of the map's far plane: one texel, and
+// never under two steps of the 16-bit depth (uShadowParams.x).
+float shadowBias(float texel, float far) { return max(0.5 * texel / far, uShadowParams.x); }
 
 // Soft shadow of area light i (PCSS, Fernando 2005) from its shadow cube at
 // the triangle's centre: the blockers found in the region of the map that
@@ -47,13 +58,15 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
 #define L uLights[i]
   int first = int(L.params.z);
   if (first < 0) return 1.0;
-  vec3 ps = shadowPoint(p, n, toLight);
   vec3 lc = L.positionType.xyz;
+  float far = L.colorFar.w;
+  float texelSize = shadowTexel(i, length(p - lc));
+  float bias = shadowBias(texelSize, far);
+  vec3 ps = shadowPoint(p, n, toLight, texelSize);
   vec3 d = ps - lc;
   int layer = first + cubeFace(d);
   vec4 c = uShadowMatrices[layer] * vec4(ps, 1.0);
   vec2 uv = c.xy / c.w * 0.5 + 0.5;
-  float far = L.colorFar.w;
   float dr = length(d);
   if (dr / far > 1.0) return 1.0;
   float plane = dot(d, n);  // the receiver's tangent plane, as seen from the light centre
@@ -86,7 +99,7 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
       // Behind the emitter's plane no light travels: nothing there blocks it.
       if (receiver < 0.0) continue;
       float stored = texture(uShadowDepths, vec3(t, float(layer))).r;
-      if (stored < receiver - uShadowParams.x) {
+      if (stored < receiver - bias) {
         blockers += 1.0;
         blockerSum += stored * far;
       }
@@ -109,7 +122,7 @@ float areaShadow(int i, vec3 p, vec3 n, vec3 toLight) {
       vec2 t = uv + vec2(kTurn.x * g.x - kTurn.y * g.y, kTurn.y * g.x + kTurn.x * g.y) * radius;
       float receiver = receiverDepth(clipToRender, t, lc, n, L.directionRange.xyz, plane, far);
       lit += receiver < 0.0 ? 1.0
-                            : texture(uShadowMaps, vec4(t, float(layer), receiver - uShadowParams.x));
+                            : texture(uShadowMaps, vec4(t, float(layer), receiver - bias));
     }
   }
   return lit / float(kFilterTaps * kFilterTaps);
@@ -182,7 +195,8 @@ float shadow(int i, vec3 p, vec3 n, vec3 toLight) {
   int first = int(L.params.z);
   if (first < 0) return 1.0;
   int type = int(L.positionType.w);
-  vec3 ps = shadowPoint(p, n, toLight);
+  float texelSize = shadowTexel(i, length(p - L.positionType.xyz));
+  vec3 ps = shadowPoint(p, n, toLight, texelSize);
   int layer = first;
   if (type == LO_LIGHT_POINT || type == LO_LIGHT_EMITTER) layer += cubeFace(ps - L.positionType.xyz);
   vec4 c = uShadowMatrices[layer] * vec4(ps, 1.0);
@@ -191,5 +205,5 @@ float shadow(int i, vec3 p, vec3 n, vec3 toLight) {
   float ref = L.colorFar.w > 0.0 ? length(ps - L.positionType.xyz) / L.colorFar.w
                                  : ndc.z * 0.5 + 0.5;
   if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || ref > 1.0) return 1.0;
-  return texture(uShadowMaps, vec4(uv, float(layer), ref - uShadowParams.x));
+  return texture(uShadowMaps, vec4(uv, float(layer), ref - shadowBias(texelSize, L.colorFar.w)));
 }

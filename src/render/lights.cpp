@@ -36,6 +36,11 @@ glm::vec3 perpendicular(const glm::vec3& d) {
   return glm::normalize(glm::cross(d, glm::cross(a, d)));
 }
 
+/// A spot's shadow map: its outer cone and a little more, at most 172 degrees.
+float spotShadowFov(const GpuLight& l) {
+  return std::min(2.0f * std::acos(std::clamp(l.params[0], -1.0f, 1.0f)) + 0.05f, 3.0f);
+}
+
 GpuLight punctualLight(const Light& light, const RenderSpace& space) {
   GpuLight l{};
   const Vec3 color = light.color * light.intensity;
@@ -113,9 +118,7 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
       }
       l.colorFar[3] = far;
     } else if (type == shader::LO_LIGHT_SPOT) {
-      const float fov =
-          std::min(2.0f * std::acos(std::clamp(l.params[0], -1.0f, 1.0f)) + 0.05f, 3.0f);
-      block.uShadowMatrices[layers] = glm::perspective(fov, 1.0f, nearPlane, far) *
+      block.uShadowMatrices[layers] = glm::perspective(spotShadowFov(l), 1.0f, nearPlane, far) *
                                       glm::lookAt(pos, pos + dir, perpendicular(dir));
       l.colorFar[3] = far;
     } else {
@@ -137,14 +140,19 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
          double(shadowMapSize) * double(shadowMapSize) * 2.0 * double(layers) > kShadowMapBudget) {
     shadowMapSize = std::max(256, shadowMapSize / 2);
   }
+  // Each shadowed light's tangent per texel (the shader's normal offset and
+  // depth bias are texels at the receiver's distance, never scene units): a
+  // cube face spans 90 degrees, a spot's map its field of view.
+  for (GpuLight& l : lights) {
+    if (l.params[2] < 0) continue;
+    const int type = int(l.positionType[3]);
+    const float tanHalf = type == shader::LO_LIGHT_SPOT ? std::tan(0.5f * spotShadowFov(l)) : 1.0f;
+    if (type != shader::LO_LIGHT_DIRECTIONAL) l.corner1[3] = 2.0f * tanHalf / float(shadowMapSize);
+  }
+  block.uShadowParams[0] = 2.0f / 65535.0f;
   std::copy(lights.begin(), lights.end(), block.uLights);
   block.uLightCount[0] = int32_t(lights.size());
   block.uLightCount[1] = int32_t(areaLightCount);  // appended last
-  // Depth bias as a fraction of the far plane and a normal offset, both
-  // about one shadow texel at the scene's scale.
-  const float texel = 2.0f * sceneSize / float(shadowMapSize);
-  block.uShadowParams[0] = 0.5f * texel / std::max(sceneSize, 1e-6f);
-  block.uShadowParams[1] = 1.5f * texel;
 
   ubo = GlBuffer::create();
   glBindBuffer(GL_UNIFORM_BUFFER, ubo.get());

@@ -20,6 +20,24 @@ using namespace render_internal;
 
 namespace {
 
+/// The camera's near plane, raised where the 24-bit depth buffer needs it
+/// (a 1 km scene seen with a glTF's znear of 1 cm z-fights: a surface 1 m
+/// below another flickers through it): outside the scene's box, to 90% of
+/// the eye's distance from the box (nothing lies nearer); and at least
+/// 1e-4 of the far plane (depth steps under 1e-3 of the distance to its end).
+float nearPlane(const PinholeCamera& camera, const RenderSpace& space, float zfar) {
+  const Vec3 eye = space.toRender(camera.eye);
+  const Bounds3& box = space.bounds;
+  float outside = 0;
+  for (int a = 0; a < 3; ++a) {
+    const float d = std::max({box.lower[a] - eye[a], eye[a] - box.upper[a], 0.0f});
+    outside += d * d;
+  }
+  const float authored = camera.znear > 0 ? camera.znear : 0.01f;
+  const float znear = std::max({authored, 0.9f * std::sqrt(outside), 1e-4f * zfar});
+  return std::min(znear, 0.5f * zfar);
+}
+
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
 
 /// uMode of the scene shader for a render mode.
@@ -305,7 +323,7 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
   const float zfar =
       camera.zfar > 0 ? camera.zfar
                       : glm::length(eye - toGlm(space.bounds.center())) + space.sceneSize + 1e-3f;
-  const float znear = std::min(camera.znear > 0 ? camera.znear : 0.01f, 0.5f * zfar);
+  const float znear = nearPlane(camera, space, zfar);
   const float aspect = float(width) / float(height);
   const glm::mat4 viewProj = glm::perspective(camera.yfov, aspect, znear, zfar) *
                              glm::lookAt(eye, eye + toGlm(camera.forward), toGlm(camera.up));
