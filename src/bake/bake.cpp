@@ -340,14 +340,18 @@ std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
   // target bake when its passes ran out of paths (its other stops are
   // reported by the bake's own summary).
   const bool target = params.targetError > 0;
+  const std::string dark = darkLightsWarning(st);
+  const std::string traced =
+      st.reachStop ? " paths (stopped early: at this rate the most a bake traces would store "
+                     "under 1% of them); "
+                   : " paths (the most a bake traces); ";
   if (target ? st.targetStop == "no more paths" : st.storedPhotons < params.photons) {
     const std::string head =
         target ? "the noise target was not reached: " + formatCount(st.storedPhotons) +
-                     " photons were stored from " + formatCount(st.emittedPaths) +
-                     " paths (the most a bake traces); "
+                     " photons were stored from " + formatCount(st.emittedPaths) + traced
                : "only " + formatCount(st.storedPhotons) + " of " + formatCount(params.photons) +
-                     " photons were stored from " + formatCount(st.emittedPaths) +
-                     " paths (the most a bake traces); ";
+                     " photons were stored from " + formatCount(st.emittedPaths) + traced;
+    if (!dark.empty()) return head + dark;
     if (mostlyMissed) return head + missed;
     return head + formatCount(st.emptyPaths) +
            " paths reached a surface but stored nothing (their first hit is direct light, "
@@ -355,13 +359,26 @@ std::string photonBudgetWarning(const BakeParams& params, const BakeStats& st) {
            "absorbed): --include-direct stores the first hits too, or --bounds bakes only the "
            "part that matters";
   }
+  if (!dark.empty()) return dark;
   return mostlyMissed ? missed : "";
+}
+
+std::string darkLightsWarning(const BakeStats& st) {
+  if (st.darkLights.empty()) return "";
+  std::string names;
+  for (const std::string& name : st.darkLights) names += (names.empty() ? "" : "; ") + name;
+  return "no photon was stored from " + names +
+         ": the light reaches no surface of the grid (under or behind geometry, aimed away, "
+         "or outside --bounds)";
 }
 
 void checkPhotonsStored(const BakeParams& params, const BakeStats& st) {
   if (st.storedPhotons > 0) return;
+  std::string lights;
+  for (const std::string& name : st.darkLights) lights += (lights.empty() ? "" : "; ") + name;
   throw InputError(
-      "no photon was stored: " + formatCount(st.emittedPaths) + " photon paths were traced and " +
+      "no photon was stored: " + formatCount(st.emittedPaths) + " photon paths were traced" +
+      (lights.empty() ? std::string() : " (from " + lights + ")") + " and " +
       "none left light on a surface after a bounce" +
       (params.region.empty() ? std::string() : std::string(" inside --bounds")) +
       " (the light's first hit is direct light, which the renderer draws and the bake stores "
@@ -512,7 +529,7 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   const size_t cap = targetPhotonCap(params, grid.size());
   PhotonParams photonParams = params.photonParams();
   photonParams.storedPhotons = cap;
-  const PhotonTracer tracer(scene, photonParams);
+  PhotonTracer tracer(scene, photonParams);
   const size_t maxEmitted = maxEmittedPaths(photonParams);
   const double target = params.targetError;
 
@@ -521,6 +538,8 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   std::vector<Photon> raw;
   SegmentCollector rawSegments(photonParams.maxSegments);  // their rays (BakeParams::freeSpace)
   size_t emitted = 0, empty = 0, missed = 0;
+  LightReach reach;  // paths and photons per light
+  uint64_t firstPath = 0;  // the path index `emitted` counts from
   size_t goal = std::min(cap, std::max(kMinPilotPhotons, kPilotPhotonsPerVoxel * grid.size()));
   for (int pass = 1;; ++pass) {
     const double passStart = elapsed();
@@ -532,8 +551,9 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
       Progress bar(progress, "Tracing photons, pass " + std::to_string(pass), goal);
       bar.advance(std::min(raw.size(), goal));
       const PhotonTracer::PathSink take = [&](const Photon* photons, uint32_t n, uint32_t,
-                                              bool pathMissed) {
+                                              bool pathMissed, uint32_t light) {
         raw.insert(raw.end(), photons, photons + n);
+        reach.add(light, n);
         ++emitted;
         empty += n == 0;
         missed += pathMissed;
@@ -546,7 +566,7 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
         const size_t batch = photonBatchPaths(goal, raw.size(), emitted, maxEmitted);
         if (batch == 0) break;
         const size_t before = raw.size();
-        tracer.trace(uint64_t(emitted), batch, take,
+        tracer.trace(firstPath + uint64_t(emitted), batch, take,
                      params.freeSpace && !rawSegments.full() ? keepSegments
                                                              : PhotonTracer::SegmentSink());
         bar.advance(std::min(raw.size(), goal) - std::min(before, goal));
@@ -556,6 +576,8 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
     s.emittedPaths = emitted;
     s.emptyPaths = empty;
     s.missedPaths = missed;
+    s.darkLights = reach.dark(tracer.lightNames());
+    s.reachStop = raw.size() < goal && emitted < maxEmitted;
     checkPhotonsStored(params, s);
     s.traceSeconds += trace.finish(formatCount(raw.size()) + " photons from " +
                                    formatCount(emitted) + " paths (pass " +
@@ -583,6 +605,18 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
     }
     if (!s.targetStop.empty()) break;
     goal = nextPassPhotons(raw.size(), s.noise.quantile, target, cap);
+    // Lights whose paths stored nothing take no share of the next passes,
+    // which start afresh: the pilot's photons, drawn while the dark lights
+    // took their share, would weigh more than the passes' own and hold the
+    // noise where the pilot left it.
+    if (pass == 1 && !s.darkLights.empty()) {
+      tracer.leaveOut(reach.darkLights());
+      firstPath += uint64_t(emitted);
+      raw.clear();
+      rawPower.clear();
+      rawSegments = SegmentCollector(photonParams.maxSegments);
+      emitted = empty = missed = 0;
+    }
     for (size_t i = 0; i < raw.size(); ++i) raw[i].power = rawPower[i];
   }
   r.metadata = bakeMetadata(scene, params, int64_t(raw.size()), int64_t(emitted), s.level.radius);
@@ -616,6 +650,9 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
   s.emittedPaths = photons.emittedPaths;
   s.emptyPaths = photons.emptyPaths;
   s.missedPaths = photons.missedPaths;
+  s.darkLights = photons.darkLights;
+  s.reachStop = photons.photons.size() < params.photons &&
+                photons.emittedPaths < maxEmittedPaths(params.photonParams());
   checkPhotonsStored(params, s);
   s.traceSeconds = trace.finish(formatCount(photons.photons.size()) + " photons from " +
                                 formatCount(photons.emittedPaths) + " paths");

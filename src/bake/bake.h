@@ -246,6 +246,12 @@ struct BakeStats {
   /// "target reached", "photon cap", "time cap", "pass cap", "no more paths".
   std::vector<TargetPass> passes;
   std::string targetStop;
+  /// Tracing stopped before the most paths a bake traces: the rate so far
+  /// said that they would store under 1% of the photons (photonBatchPaths).
+  bool reachStop = false;
+  /// The lights whose paths stored nothing (PhotonMap::darkLights), named
+  /// with where they are and their paths.
+  std::vector<std::string> darkLights;
   /// One row per stage ("trace photons", "voxelize", "splat photons",
   /// "gather + cluster"), with the process's memory after each.
   std::vector<StageReport> stages;
@@ -276,7 +282,10 @@ VolumeLight bakeFreeSpaceLight(const std::vector<PhotonSegment>& segments, const
 /// open ground: nine paths in ten). When that keeps the bake from storing
 /// the photons asked for, the advice is --include-direct; when most paths
 /// miss every surface, --bounds.
+/// Also names the lights that stored nothing (darkLightsWarning).
 std::string photonBudgetWarning(const BakeParams& params, const BakeStats& stats);
+/// The lights whose paths stored nothing, named with where they are; "" when none.
+std::string darkLightsWarning(const BakeStats& stats);
 
 /// @throws InputError saying why, when the photon tracing stored no photon
 /// at all (a bake of nothing but zeros is never what was asked for).

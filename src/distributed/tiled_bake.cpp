@@ -349,7 +349,7 @@ class RankBake {
       Stopwatch traceClock;
       tracer.trace(
           first, size_t(last - first),
-          [&](const Photon* path, uint32_t n, uint32_t, bool) {
+          [&](const Photon* path, uint32_t n, uint32_t, bool, uint32_t) {
             if (n > 0) batch.insert(batch.end(), path, path + n);
             pathPhotons.push_back(n);
             return true;

@@ -21,6 +21,7 @@
 
 #include "core/discrete_distribution.h"
 #include "core/error.h"
+#include "core/resources.h"
 #include "core/rng.h"
 #include "material/bsdf.h"
 #include "photon/light_footprint.h"
@@ -103,6 +104,7 @@ struct ChunkResult {
   std::vector<uint32_t> pathPhotons;  ///< stored photons per path
   std::vector<uint32_t> pathRays;     ///< rays per path
   std::vector<uint8_t> pathMissed;    ///< 1: the path's first ray hit nothing
+  std::vector<uint32_t> pathLight;    ///< the emitter each path started from
   std::vector<PhotonSegment> segments;   ///< with PhotonParams::segments
   std::vector<uint32_t> pathSegments;    ///< segments per path
 };
@@ -138,6 +140,7 @@ inline Vec3 abs3(const Vec3& v) { return {std::fabs(v.x), std::fabs(v.y), std::f
 /// is rejected (spot falloff), which ends the path with no photon.
 struct EmittedRay {
   Vec3 origin, direction, power;
+  uint32_t light = 0;  ///< the emitter picked (Context::emitters)
   bool punctual = false;
   float range = 0;
   /// Stored at its first hit even without --include-direct: light the
@@ -226,7 +229,9 @@ inline bool emitFromSky(const Context& ctx, const Emitter& e, Rng& rng, EmittedR
 inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
   const Scene& scene = *ctx.scene;
   // 53 random bits (scenes with millions of emissive triangles).
-  const Emitter& e = ctx.emitters[ctx.emitterPick.sample(uniform53(rng))];
+  const size_t k = ctx.emitterPick.sample(uniform53(rng));
+  const Emitter& e = ctx.emitters[k];
+  out.light = uint32_t(k);
   out.power = e.pathPower;
   out.punctual = false;
   out.storeFirstHit = false;
@@ -328,7 +333,7 @@ inline bool roulette(Rng& rng, const Vec3& tint, Vec3& power) {
 /// With ctx.segments, also appends to `segments` every ray whose light a
 /// stored photon would carry (PhotonSegment), and counts them in segmentCount.
 inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon>& out,
-                      uint32_t& photonCount, uint32_t& rayCount, bool& missed,
+                      uint32_t& photonCount, uint32_t& rayCount, bool& missed, uint32_t& light,
                       std::vector<PhotonSegment>& segments, uint32_t& segmentCount) {
   Rng rng(ctx.seed, pathIndex);
   segmentCount = 0;
@@ -336,7 +341,9 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
   rayCount = 0;
   missed = false;
   EmittedRay start;
-  if (!emit(ctx, rng, start)) return;
+  const bool emitted = emit(ctx, rng, start);
+  light = start.light;
+  if (!emitted) return;
   Vec3 org = start.origin, dir = start.direction, power = start.power;
   // A black texel of an emissive texture: a path, but nothing to carry.
   if (!(maxComponent(power) > 0)) return;
@@ -517,17 +524,20 @@ struct TraceChunks {
       out.pathPhotons.clear();
       out.pathRays.clear();
       out.pathMissed.clear();
+      out.pathLight.clear();
       out.segments.clear();
       out.pathSegments.clear();
       size_t begin = c * kChunkPaths, end = std::min(batchPaths, begin + kChunkPaths);
       for (size_t i = begin; i < end; ++i) {
-        uint32_t photons = 0, rays = 0, segments = 0;
+        uint32_t photons = 0, rays = 0, segments = 0, light = 0;
         bool missed = false;
-        tracePath(*ctx, firstPath + i, out.photons, photons, rays, missed, out.segments, segments);
+        tracePath(*ctx, firstPath + i, out.photons, photons, rays, missed, light, out.segments,
+                  segments);
         if (ctx->segments) out.pathSegments.push_back(segments);
         out.pathPhotons.push_back(photons);
         out.pathRays.push_back(rays);
         out.pathMissed.push_back(missed ? 1 : 0);
+        out.pathLight.push_back(light);
       }
     }
   }
@@ -546,7 +556,69 @@ struct PhotonTracer::State {
   std::unique_ptr<RayTracer> tracer;
   Vec3 emittedPower{0, 0, 0};
   mutable std::vector<photon_internal::ChunkResult> chunks;
+  std::vector<uint32_t> lightGroup;     ///< per emitter: its group (lightNames)
+  std::vector<std::string> lightNames;  ///< per group
 };
+
+namespace photon_internal {
+
+std::string formatPoint(const Vec3& p) {
+  std::ostringstream os;
+  os << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+  return os.str();
+}
+
+/// The emitters as a person names them: each punctual light, the sky, and
+/// the emissive triangles of one material together (with where they lie),
+/// in world space (`origin` added back).
+void nameLightGroups(const Context& ctx, const Vec3& origin, std::vector<uint32_t>& group,
+                     std::vector<std::string>& names) {
+  const Scene& scene = *ctx.scene;
+  struct Emissive {
+    size_t material = 0, triangles = 0, group = 0;
+    Bounds3 bounds;
+  };
+  std::vector<int> slotOfMaterial(scene.materials.size(), -1);
+  std::vector<Emissive> emissive;
+  group.assign(ctx.emitters.size(), 0);
+  for (size_t k = 0; k < ctx.emitters.size(); ++k) {
+    const Emitter& e = ctx.emitters[k];
+    if (e.kind == Emitter::Kind::Triangle) {
+      const size_t m = ctx.triangles[e.index].material;
+      if (slotOfMaterial[m] < 0) {
+        slotOfMaterial[m] = int(emissive.size());
+        emissive.push_back({m, 0, names.size(), Bounds3()});
+        names.emplace_back();  // named below, once its bounds are known
+      }
+      Emissive& slot = emissive[size_t(slotOfMaterial[m])];
+      for (int v = 0; v < 3; ++v)
+        slot.bounds.extend(scene.positions[scene.indices[3 * e.index + v]] + origin);
+      ++slot.triangles;
+      group[k] = uint32_t(slot.group);
+      continue;
+    }
+    group[k] = uint32_t(names.size());
+    if (e.kind == Emitter::Kind::Sky) {
+      names.push_back("the sky");
+      continue;
+    }
+    const Light& light = scene.lights[e.index];
+    const std::string name = light.name.empty() ? "" : " '" + light.name + "'";
+    if (e.kind == Emitter::Kind::Directional) {
+      names.push_back("directional light" + name);
+    } else {
+      names.push_back((e.kind == Emitter::Kind::Spot ? "spot light" : "point light") + name +
+                      " at " + formatPoint(light.position + origin));
+    }
+  }
+  for (const Emissive& slot : emissive) {
+    names[slot.group] = formatCount(slot.triangles) + " emissive triangle(s) of material '" +
+                        scene.materials[slot.material].name + "' within " +
+                        formatPoint(slot.bounds.lower) + " - " + formatPoint(slot.bounds.upper);
+  }
+}
+
+}  // namespace photon_internal
 
 PhotonTracer::PhotonTracer(const Scene& scene, const PhotonParams& params)
     : state_(std::make_unique<State>()) {
@@ -588,6 +660,7 @@ PhotonTracer::PhotonTracer(const Scene& scene, const PhotonParams& params)
     ctx.materials[i] = bsdfLobes(traced.materials[i]);
   }
   buildEmitters(traced, ctx, st.emittedPower);
+  nameLightGroups(ctx, st.origin, st.lightGroup, st.lightNames);
   if (traced.triangleCount() == 0) return;
 
   Vec3 ext = ctx.bounds.extent();
@@ -604,13 +677,39 @@ Vec3 PhotonTracer::emittedPower() const { return state_->emittedPower; }
 
 bool PhotonTracer::canStore() const { return state_->tracer != nullptr; }
 
+const std::vector<std::string>& PhotonTracer::lightNames() const { return state_->lightNames; }
+
+void PhotonTracer::leaveOut(const std::vector<uint32_t>& lights) {
+  using namespace photon_internal;
+  State& st = *state_;
+  std::vector<bool> out(st.lightNames.size(), false);
+  for (uint32_t k : lights) {
+    if (k < out.size()) out[k] = true;
+  }
+  Context& ctx = st.ctx;
+  DiscreteDistribution pick;
+  pick.reserve(ctx.emitters.size());
+  for (size_t k = 0; k < ctx.emitters.size(); ++k) {
+    pick.add(out[st.lightGroup[k]] ? 0.0 : double(average(ctx.emitters[k].samplePower)));
+  }
+  if (!(pick.total() > 0)) {
+    throw InputError("PhotonTracer::leaveOut: every light would be left out");
+  }
+  ctx.emitterPick = std::move(pick);
+  for (size_t k = 0; k < ctx.emitters.size(); ++k) {
+    Emitter& e = ctx.emitters[k];
+    const double pmf = ctx.emitterPick.pmf(k);
+    e.pathPower = pmf > 0 ? e.samplePower * float(1.0 / pmf) : Vec3{0, 0, 0};
+  }
+}
+
 void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath,
                          const SegmentSink& onSegments) const {
   using namespace photon_internal;
   if (count == 0) return;
   if (!state_->tracer) {
     for (size_t i = 0; i < count; ++i) {
-      if (!onPath(nullptr, 0, 0, true)) return;
+      if (!onPath(nullptr, 0, 0, true, 0)) return;
     }
     return;
   }
@@ -636,7 +735,9 @@ void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath,
         onSegments(segments, chunk.pathSegments[i]);
         segments += chunk.pathSegments[i];
       }
-      if (!onPath(photons, chunk.pathPhotons[i], chunk.pathRays[i], chunk.pathMissed[i] != 0)) {
+      const uint32_t group = state_->lightGroup[chunk.pathLight[i]];
+      if (!onPath(photons, chunk.pathPhotons[i], chunk.pathRays[i], chunk.pathMissed[i] != 0,
+                  group)) {
         return;
       }
       photons += chunk.pathPhotons[i];
@@ -647,7 +748,7 @@ void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath,
 void PhotonTracer::trace(uint64_t first, size_t count, std::vector<Photon>& photons,
                          std::vector<uint32_t>& pathPhotons) const {
   pathPhotons.reserve(pathPhotons.size() + count);
-  trace(first, count, [&](const Photon* path, uint32_t n, uint32_t, bool) {
+  trace(first, count, [&](const Photon* path, uint32_t n, uint32_t, bool, uint32_t) {
     if (n > 0) photons.insert(photons.end(), path, path + n);
     pathPhotons.push_back(n);
     return true;
@@ -658,12 +759,44 @@ size_t photonBatchPaths(size_t target, size_t stored, size_t emitted, size_t max
   using namespace photon_internal;
   if (emitted >= maxEmitted) return 0;
   if (emitted == 0) return std::min(maxEmitted, std::clamp(target, kMinBatchPaths, size_t(65536)));
+  // Lights that reach (almost) nothing: the rate so far would store under
+  // 1% of the target by the last path a map may trace.
+  if (emitted >= kReachProbePaths &&
+      double(stored) * double(maxEmitted) < 0.01 * double(target) * double(emitted)) {
+    return 0;
+  }
   // The paths the photons-per-path ratio so far says are still needed, plus
   // a margin. Only the amount of wasted work depends on it.
   double need = stored > 0 ? double(target - stored) * double(emitted) / double(stored) * 1.03 + 1024
                            : 4.0 * double(emitted);
   need = std::clamp(need, double(kMinBatchPaths), double(kMaxBatchPaths));
   return std::min(maxEmitted - emitted, size_t(need));
+}
+
+void LightReach::add(uint32_t light, uint32_t stored) {
+  if (light >= paths.size()) {
+    paths.resize(light + 1, 0);
+    photons.resize(light + 1, 0);
+  }
+  ++paths[light];
+  photons[light] += stored;
+}
+
+std::vector<uint32_t> LightReach::darkLights(size_t minPaths) const {
+  std::vector<uint32_t> out;
+  for (size_t k = 0; k < paths.size(); ++k) {
+    if (paths[k] >= minPaths && photons[k] == 0) out.push_back(uint32_t(k));
+  }
+  return out;
+}
+
+std::vector<std::string> LightReach::dark(const std::vector<std::string>& names,
+                                          size_t minPaths) const {
+  std::vector<std::string> out;
+  for (uint32_t k : darkLights(minPaths)) {
+    if (k < names.size()) out.push_back(names[k] + ", " + formatCount(paths[k]) + " paths");
+  }
+  return out;
 }
 
 size_t maxEmittedPaths(const PhotonParams& params) {
@@ -687,9 +820,11 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   // Each path's photons go straight into the map, in path order; the path
   // that reaches the target is the last one taken.
   size_t missed = 0;   // of those, paths whose first ray hit nothing
+  LightReach reach;
   const PhotonTracer::PathSink take = [&](const Photon* photons, uint32_t n, uint32_t pathRays,
-                                          bool pathMissed) {
+                                          bool pathMissed, uint32_t light) {
     missed += pathMissed;
+    reach.add(light, n);
     const size_t kept = std::min<size_t>(n, target - map.photons.size());
     if (kept > 0) map.photons.insert(map.photons.end(), photons, photons + kept);
     rays += pathRays;
@@ -715,6 +850,7 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   map.emptyPaths = empty;
   map.missedPaths = missed;
   map.raysTraced = rays;
+  map.darkLights = reach.dark(tracer.lightNames());
   scalePhotonPower(map.photons, emitted);
   map.segments = collector.take();
   return map;

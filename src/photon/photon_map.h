@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/math.h"
@@ -54,6 +55,25 @@ struct PhotonMap {
   size_t missedPaths = 0;
   Vec3 emittedPower{0, 0, 0};   ///< total RGB power of all lights, W
   size_t raysTraced = 0;        ///< for statistics
+  /// The lights (PhotonTracer::lightNames) whose paths, at least
+  /// kDarkLightPaths of them, stored no photon: they reach no surface that
+  /// holds light (under a floor, aimed away, outside --bounds).
+  std::vector<std::string> darkLights;
+};
+
+/// Paths a light must have started before a map calls it dark.
+constexpr size_t kDarkLightPaths = 4096;
+
+/// Paths and stored photons per light (PhotonTracer::lightNames).
+struct LightReach {
+  std::vector<size_t> paths, photons;
+  void add(uint32_t light, uint32_t stored);
+  /// The lights of at least `minPaths` paths and no photon.
+  std::vector<uint32_t> darkLights(size_t minPaths = kDarkLightPaths) const;
+  /// The names of the lights of at least `minPaths` paths and no photon,
+  /// each with its path count.
+  std::vector<std::string> dark(const std::vector<std::string>& names,
+                                size_t minPaths = kDarkLightPaths) const;
 };
 
 /// Traces photons from punctual lights and emissive triangles (area lights),
@@ -80,11 +100,11 @@ class PhotonTracer {
   PhotonTracer& operator=(const PhotonTracer&) = delete;
 
   /// Called once per path, in path order, with the path's photons (world
-  /// space, power not yet scaled), their count, the rays it traced and
-  /// whether its first ray hit nothing; returning false stops handing on the
-  /// call's remaining paths.
-  using PathSink =
-      std::function<bool(const Photon* photons, uint32_t count, uint32_t rays, bool missed)>;
+  /// space, power not yet scaled), their count, the rays it traced, whether
+  /// its first ray hit nothing and the light it started from (an index into
+  /// lightNames()); returning false stops handing on the call's remaining paths.
+  using PathSink = std::function<bool(const Photon* photons, uint32_t count, uint32_t rays,
+                                      bool missed, uint32_t light)>;
   /// Traces paths [first, first + count) in parallel (TBB) and hands each to
   /// `onPath` in path order. Not reentrant (one call at a time per tracer).
   /// With PhotonParams::segments, `onSegments` gets each path's segments
@@ -98,6 +118,17 @@ class PhotonTracer {
              std::vector<uint32_t>& pathPhotons) const;
   Vec3 emittedPower() const;  ///< total RGB power of all lights, W
   bool canStore() const;      ///< false when the scene has no triangle to store on
+  /// The scene's lights as a person names them, where they are: each
+  /// punctual light, the sky, the emissive triangles of each material.
+  const std::vector<std::string>& lightNames() const;
+  /// Traces no more paths from these lights (indices into lightNames()):
+  /// the others are picked by their power among themselves. Every path
+  /// stays an estimate of all the light (the others' photons carry their
+  /// power over the new pick probability), so photons traced before and
+  /// after sum by the paths traced (scalePhotonPower) as before; what is
+  /// lost is the left-out lights' light, which a light whose thousands of
+  /// paths stored nothing does not have. @throws InputError if none is left.
+  void leaveOut(const std::vector<uint32_t>& lights);
 
  private:
   struct State;
@@ -107,9 +138,16 @@ class PhotonTracer {
 /// Paths of the next batch of a photon map that holds `stored` of `target`
 /// photons from `emitted` paths: the paths the photons per path so far say
 /// are still needed, with a margin, within [4096, 2^19] (the first batch:
-/// min(target, 65536)), and never beyond `maxEmitted`. 0: stop. Only the
-/// work wasted past the target depends on it, never the photons.
+/// min(target, 65536)), and never beyond `maxEmitted`. 0: stop, also once
+/// kReachProbePaths paths say that `maxEmitted` would store under 1% of the
+/// target. Only the work wasted past the target and that early stop depend
+/// on it, never the photons.
 size_t photonBatchPaths(size_t target, size_t stored, size_t emitted, size_t maxEmitted);
+/// Paths traced before photonBatchPaths judges whether the lights reach the
+/// scene at all: from then on, a map that would hold under 1% of its
+/// photons at maxEmitted paths stops (a light under the floor, seen in a
+/// second rather than after a billion paths).
+constexpr size_t kReachProbePaths = size_t(1) << 20;
 /// PhotonParams::maxEmitted, or its default 64 * storedPhotons.
 size_t maxEmittedPaths(const PhotonParams& params);
 /// Divides every photon's power by the paths emitted to obtain them (the
