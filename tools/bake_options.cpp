@@ -20,6 +20,7 @@ BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   if (params.targetError > 0) {
     params.maxPhotons = maxPhotons;
     params.maxSeconds = maxSeconds;
+    params.targetSeenLight = targetLight == "seen";
   }
   params.knn = knn;
   params.radius = radius;
@@ -81,6 +82,13 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
                       "lit area is below (docs/accuracy.md, \"How good is a bake\"). A deeper "
                       "grid gets the photons it needs")
       ->check(CLI::Range(1e-3, 1.0));
+  cmd->add_option("--target-light", opt.targetLight,
+                  "What --target-error measures the indirect light's noise against: 'seen', "
+                  "the light a viewer sees (direct plus indirect: where direct light is bright, "
+                  "as in a sunlit street, the indirect light needs fewer photons), or "
+                  "'indirect', the indirect light alone (a lightmap or .vdb of indirect light)")
+      ->check(CLI::IsMember({"seen", "indirect"}))
+      ->capture_default_str();
   cmd->add_option("--max-photons", opt.maxPhotons,
                   "With --target-error: store at most this many photons (fewer when memory "
                   "holds fewer); the report says when the cap stopped the bake")

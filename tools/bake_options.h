@@ -23,6 +23,7 @@ struct BakeOptions {
   int depth = 6;
   size_t photons = 0;        // 0: not given (a target bake)
   double targetError = 0;    // 0: not given (kDefaultTargetError unless --photons)
+  std::string targetLight = "seen";
   size_t maxPhotons = kDefaultMaxPhotons;
   double maxSeconds = 0;
   int knn = 300;

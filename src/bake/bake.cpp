@@ -513,6 +513,32 @@ size_t nextPassPhotons(size_t photons, double noise, double target, size_t cap) 
   return std::min(cap, size_t(std::ceil(double(photons) * grow)));
 }
 
+/// The luminance of the direct irradiance (W/m^2) of each entry of `baked`
+/// (its voxels, then its surface layers), from the first hits' power summed
+/// per voxel side of `grid` over `paths` paths: a side's light over the
+/// voxel's area shared by its layers, as summarizeNoise weighs them.
+std::vector<float> directIrradiance(const SurfaceGrid& grid, const VdlGrid& baked,
+                                    const std::vector<double>& front,
+                                    const std::vector<double>& back, size_t paths) {
+  const size_t n = baked.size();
+  std::vector<uint8_t> layers(n, 1);
+  for (uint32_t v : baked.layers.voxel) ++layers[v];
+  std::vector<float> out(n + baked.layers.size(), 0.0f);
+  auto entry = [&](size_t voxel, const Vec3& normal) {
+    const int64_t g = grid.find(baked.coords[voxel]);
+    if (g < 0 || paths == 0) return 0.0f;
+    const size_t i = size_t(g);
+    const double power = dot(normal, grid.normals[i]) >= 0 ? front[i] : back[i];
+    const double area = double(grid.areas[i]) / double(layers[voxel]);
+    return area > 0 ? float(power / double(paths) / area) : 0.0f;
+  };
+  for (size_t v = 0; v < n; ++v) out[v] = entry(v, baked.normals[v]);
+  for (size_t e = 0; e < baked.layers.size(); ++e) {
+    out[n + e] = entry(baked.layers.voxel[e], baked.layers.normals[e]);
+  }
+  return out;
+}
+
 /// bake() with params.targetError > 0: passes of more photons over one
 /// voxelization until the noise figure reaches the target.
 BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink* progress) {
@@ -529,7 +555,24 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   const size_t cap = targetPhotonCap(params, grid.size());
   PhotonParams photonParams = params.photonParams();
   photonParams.storedPhotons = cap;
+  photonParams.countDirect = params.targetSeenLight && !params.includeDirect;
   PhotonTracer tracer(scene, photonParams);
+  // The direct light of each voxel's two sides (along its normal and
+  // against it), luminance of the first hits' unscaled power: what the
+  // noise figure weighs the indirect light against (targetSeenLight).
+  std::vector<double> directFront, directBack;
+  if (photonParams.countDirect) {
+    directFront.assign(grid.size(), 0.0);
+    directBack.assign(grid.size(), 0.0);
+  }
+  const PhotonTracer::DirectSink countDirect = [&](const Photon* hits, uint32_t n) {
+    for (uint32_t i = 0; i < n; ++i) {
+      const int64_t v = grid.find(grid.frame.coordOf(hits[i].position));
+      if (v < 0) continue;
+      const double y = double(luminance(hits[i].power));
+      (dot(hits[i].normal, grid.normals[size_t(v)]) >= 0 ? directFront : directBack)[size_t(v)] += y;
+    }
+  };
   const size_t maxEmitted = maxEmittedPaths(photonParams);
   const double target = params.targetError;
 
@@ -568,7 +611,8 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
         const size_t before = raw.size();
         tracer.trace(firstPath + uint64_t(emitted), batch, take,
                      params.freeSpace && !rawSegments.full() ? keepSegments
-                                                             : PhotonTracer::SegmentSink());
+                                                             : PhotonTracer::SegmentSink(),
+                     countDirect);
         bar.advance(std::min(raw.size(), goal) - std::min(before, goal));
       }
     }
@@ -590,7 +634,13 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
     for (size_t i = 0; i < raw.size(); ++i) rawPower[i] = raw[i].power;
     scalePhotonPower(raw, emitted);
     r.grid = gatherLevel(scene, grid, raw, level, progress, &s.level, &s.stages);
-    s.noise = summarizeNoise(r.grid);
+    if (photonParams.countDirect) {
+      const std::vector<float> direct =
+          directIrradiance(grid, r.grid, directFront, directBack, emitted);
+      s.noise = summarizeNoise(r.grid, &direct);
+    } else {
+      s.noise = summarizeNoise(r.grid);
+    }
     s.passes.push_back({raw.size(), emitted, s.noise, elapsed() - passStart});
     if (s.noise.quantile <= target) {
       s.targetStop = "target reached";
@@ -616,6 +666,8 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
       rawPower.clear();
       rawSegments = SegmentCollector(photonParams.maxSegments);
       emitted = empty = missed = 0;
+      std::fill(directFront.begin(), directFront.end(), 0.0);
+      std::fill(directBack.begin(), directBack.end(), 0.0);
     }
     for (size_t i = 0; i < raw.size(); ++i) raw[i].power = rawPower[i];
   }

@@ -86,6 +86,14 @@ struct BakeParams {
   /// The gather then reads photons within its radius up to k =
   /// max(knn, targetKnn(targetError)), so that k does not hold the noise up.
   double targetError = 0;
+  /// Target bakes: what the noise figure weighs each voxel's indirect
+  /// noise against. true (the default): the light a viewer sees there,
+  /// direct plus indirect (the direct part counted from the paths' first
+  /// hits, which the bake does not store): a sunlit street's indirect light
+  /// need not be as smooth as a closed room's, where it is all there is.
+  /// false: the indirect light alone, for what shows it alone (a lightmap
+  /// of indirect light, the .vdb in Houdini).
+  bool targetSeenLight = true;
   size_t maxPhotons = kDefaultMaxPhotons;  ///< target bakes: photon cap
   /// Target bakes: no new pass starts after this many seconds (0: no limit).
   /// The only setting whose result depends on the machine's speed.

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "lightgrid/vdl_grid.h"
 
@@ -24,6 +25,10 @@ constexpr double kNoiseQuantile = 0.9;
 
 struct NoiseSummary {
   bool recorded = false;     ///< the grid holds noise values (false: a file without them)
+  /// The noise is of the light seen: each voxel's indirect light's standard
+  /// deviation over its direct plus indirect light (summarizeNoise with
+  /// `direct`); false: over the indirect light alone.
+  bool seen = false;
   size_t lit = 0;            ///< voxels and layers with light
   size_t unlit = 0;          ///< active voxels and layers without light
   double meanLuminance = 0;  ///< area-weighted, over the lit ones, W/m^2
@@ -34,6 +39,10 @@ struct NoiseSummary {
 
 /// Summarises `grid`'s noise over layer 0 of every voxel and its surface
 /// layers (a layer weighs its voxel's area over the voxel's layer count).
-NoiseSummary summarizeNoise(const VdlGrid& grid);
+/// With `direct` (luminance of the direct irradiance, W/m^2, per voxel then
+/// per entry of grid.layers), the noise of the light seen: the indirect
+/// light's standard deviation over direct plus indirect, the floor a tenth
+/// of the mean of their sum; meanLuminance stays the indirect light's.
+NoiseSummary summarizeNoise(const VdlGrid& grid, const std::vector<float>* direct = nullptr);
 
 }  // namespace lo

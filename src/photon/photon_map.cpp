@@ -95,6 +95,7 @@ struct Context {
   int maxBounces = 0;
   bool includeDirect = false;
   bool segments = false;  ///< PhotonParams::segments
+  bool countDirect = false;  ///< PhotonParams::countDirect
   uint64_t seed = 0;
 };
 
@@ -105,6 +106,8 @@ struct ChunkResult {
   std::vector<uint32_t> pathRays;     ///< rays per path
   std::vector<uint8_t> pathMissed;    ///< 1: the path's first ray hit nothing
   std::vector<uint32_t> pathLight;    ///< the emitter each path started from
+  std::vector<Photon> direct;         ///< with countDirect: unstored direct first hits
+  std::vector<uint8_t> pathDirect;    ///< direct first hits per path (0 or 1)
   std::vector<PhotonSegment> segments;   ///< with PhotonParams::segments
   std::vector<uint32_t> pathSegments;    ///< segments per path
 };
@@ -334,9 +337,11 @@ inline bool roulette(Rng& rng, const Vec3& tint, Vec3& power) {
 /// stored photon would carry (PhotonSegment), and counts them in segmentCount.
 inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon>& out,
                       uint32_t& photonCount, uint32_t& rayCount, bool& missed, uint32_t& light,
-                      std::vector<PhotonSegment>& segments, uint32_t& segmentCount) {
+                      std::vector<PhotonSegment>& segments, uint32_t& segmentCount,
+                      std::vector<Photon>& direct, uint8_t& directCount) {
   Rng rng(ctx.seed, pathIndex);
   segmentCount = 0;
+  directCount = 0;
   photonCount = 0;
   rayCount = 0;
   missed = false;
@@ -386,10 +391,12 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     Vec3 n = frontFace ? normal : -normal;  // faces the incoming side
     Vec3 wo = -dir;
 
-    if (mat.storesPhotons && (bounce > 0 || ctx.includeDirect || start.storeFirstHit) &&
-        (ctx.region.empty() || (p.x >= ctx.region.lower.x && p.y >= ctx.region.lower.y &&
-                                p.z >= ctx.region.lower.z && p.x <= ctx.region.upper.x &&
-                                p.y <= ctx.region.upper.y && p.z <= ctx.region.upper.z))) {
+    const bool inRegion =
+        ctx.region.empty() || (p.x >= ctx.region.lower.x && p.y >= ctx.region.lower.y &&
+                               p.z >= ctx.region.lower.z && p.x <= ctx.region.upper.x &&
+                               p.y <= ctx.region.upper.y && p.z <= ctx.region.upper.z);
+    const bool stored = bounce > 0 || ctx.includeDirect || start.storeFirstHit;
+    if (mat.storesPhotons && inRegion && (stored || ctx.countDirect)) {
       Photon ph;
       ph.position = p;
       ph.direction = wo;
@@ -397,8 +404,13 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
       ph.normal = n;
       ph.bounce = uint16_t(std::min<uint32_t>(bounce, 0xffffu));
       ph.caustic = bounce > 0 && specularChain ? 1 : 0;
-      out.push_back(ph);
-      ++photonCount;
+      if (stored) {
+        out.push_back(ph);
+        ++photonCount;
+      } else {
+        direct.push_back(ph);  // counted, not stored (PhotonParams::countDirect)
+        directCount = 1;
+      }
     }
     if (int(bounce) >= ctx.maxBounces || rayCount > kMaxPathRays) return;
 
@@ -525,14 +537,18 @@ struct TraceChunks {
       out.pathRays.clear();
       out.pathMissed.clear();
       out.pathLight.clear();
+      out.direct.clear();
+      out.pathDirect.clear();
       out.segments.clear();
       out.pathSegments.clear();
       size_t begin = c * kChunkPaths, end = std::min(batchPaths, begin + kChunkPaths);
       for (size_t i = begin; i < end; ++i) {
         uint32_t photons = 0, rays = 0, segments = 0, light = 0;
+        uint8_t direct = 0;
         bool missed = false;
         tracePath(*ctx, firstPath + i, out.photons, photons, rays, missed, light, out.segments,
-                  segments);
+                  segments, out.direct, direct);
+        if (ctx->countDirect) out.pathDirect.push_back(direct);
         if (ctx->segments) out.pathSegments.push_back(segments);
         out.pathPhotons.push_back(photons);
         out.pathRays.push_back(rays);
@@ -647,6 +663,7 @@ PhotonTracer::PhotonTracer(const Scene& scene, const PhotonParams& params)
   ctx.maxBounces = params.maxBounces;
   ctx.includeDirect = params.includeDirect;
   ctx.segments = params.segments;
+  ctx.countDirect = params.countDirect;
   ctx.seed = params.seed;
 
   ctx.triangles.resize(traced.triangleCount());
@@ -704,7 +721,7 @@ void PhotonTracer::leaveOut(const std::vector<uint32_t>& lights) {
 }
 
 void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath,
-                         const SegmentSink& onSegments) const {
+                         const SegmentSink& onSegments, const DirectSink& onDirect) const {
   using namespace photon_internal;
   if (count == 0) return;
   if (!state_->tracer) {
@@ -723,6 +740,7 @@ void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath,
     ChunkResult& chunk = chunks[c];
     if (origin != Vec3{0, 0, 0}) {
       for (Photon& photon : chunk.photons) photon.position += origin;
+      for (Photon& photon : chunk.direct) photon.position += origin;
       for (PhotonSegment& segment : chunk.segments) {
         segment.from += origin;
         segment.to += origin;
@@ -730,7 +748,12 @@ void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath,
     }
     const Photon* photons = chunk.photons.data();
     const PhotonSegment* segments = chunk.segments.data();
+    const Photon* direct = chunk.direct.data();
     for (size_t i = 0; i < chunk.pathPhotons.size(); ++i) {
+      if (!chunk.pathDirect.empty()) {
+        if (onDirect) onDirect(direct, chunk.pathDirect[i]);
+        direct += chunk.pathDirect[i];
+      }
       if (onSegments && !chunk.pathSegments.empty()) {
         onSegments(segments, chunk.pathSegments[i]);
         segments += chunk.pathSegments[i];

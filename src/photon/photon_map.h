@@ -39,6 +39,10 @@ struct PhotonParams {
   /// footprint (a disc of its bounding sphere) instead of the whole scene's,
   /// starting outside the scene so that occluders beyond the region still cast.
   Bounds3 region;
+  /// Hand each path's first hit, when it is direct light the map does not
+  /// store, to PhotonTracer::trace's DirectSink: what a target bake weighs
+  /// the indirect light's noise against (the light a viewer sees there).
+  bool countDirect = false;
 };
 
 struct PhotonMap {
@@ -110,8 +114,11 @@ class PhotonTracer {
   /// With PhotonParams::segments, `onSegments` gets each path's segments
   /// just before `onPath` gets its photons.
   using SegmentSink = std::function<void(const PhotonSegment* segments, uint32_t count)>;
+  /// With PhotonParams::countDirect: each path's unstored direct first hit
+  /// (count 0 or 1; world space, power not yet scaled), just before its photons.
+  using DirectSink = std::function<void(const Photon* hits, uint32_t count)>;
   void trace(uint64_t first, size_t count, const PathSink& onPath,
-             const SegmentSink& onSegments = {}) const;
+             const SegmentSink& onSegments = {}, const DirectSink& onDirect = {}) const;
   /// The same, appending the photons to `photons` and each path's photon
   /// count to `pathPhotons`.
   void trace(uint64_t first, size_t count, std::vector<Photon>& photons,

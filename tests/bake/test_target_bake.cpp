@@ -61,6 +61,7 @@ TEST(TargetBake, ReachesItsTargetAndSaysHow) {
   BakeParams p;
   p.depth = 5;
   p.targetError = 0.08;
+  p.targetSeenLight = false;  // the indirect light's figure: the grid's own (checked below)
   const BakeResult r = bake(cornellBox(), p);
   const BakeStats& s = r.stats;
   ASSERT_GE(s.passes.size(), 2u) << "a pilot, then the photons it asks for";
@@ -141,6 +142,28 @@ TEST(TargetBake, RefusesATargetOutsideItsRange) {
     p.targetError = bad;
     EXPECT_THROW(bake(cornellBox(), p), InputError) << bad;
   }
+}
+
+
+// The default figure weighs the indirect noise against the light a viewer
+// sees: in the Cornell box, lit directly almost everywhere, it reaches the
+// same target with fewer photons, and its grid's indirect figure is then
+// above the target it would have traced to.
+TEST(TargetBake, TheLightSeenReachesItsTargetWithFewerPhotons) {
+  BakeParams p;
+  p.depth = 4;
+  p.targetError = 0.08;
+  p.targetSeenLight = false;
+  const BakeResult indirect = bake(cornellBox(), p);
+  p.targetSeenLight = true;
+  const BakeResult seen = bake(cornellBox(), p);
+  EXPECT_EQ(indirect.stats.targetStop, "target reached");
+  EXPECT_EQ(seen.stats.targetStop, "target reached");
+  EXPECT_FALSE(indirect.stats.noise.seen);
+  EXPECT_TRUE(seen.stats.noise.seen);
+  EXPECT_LE(seen.stats.noise.quantile, 0.08);
+  EXPECT_LT(seen.stats.storedPhotons, indirect.stats.storedPhotons);
+  EXPECT_GT(summarizeNoise(seen.grid).quantile, summarizeNoise(indirect.grid).quantile);
 }
 
 }  // namespace

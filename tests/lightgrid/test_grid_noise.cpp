@@ -60,5 +60,34 @@ TEST(GridNoise, AGridWithoutNoiseSaysSo) {
   EXPECT_EQ(summarizeNoise(g).ToString(), "noise not recorded");
 }
 
+
+TEST(GridNoise, TheLightSeenWeighsTheIndirectNoiseAgainstDirectPlusIndirect) {
+  // Ten voxels of indirect light 1 and noise 1%..10%. Direct light 3 on the
+  // first five, none on the rest: the first five count a quarter of their
+  // noise (0.25%..1.25%), the rest in full, so the 90% quantile stays the
+  // 9th voxel's 9% and the median becomes the 5th's 1.25%, not 5%.
+  std::vector<float> y(10, 1.0f), n, a(10, 1.0f);
+  for (int i = 1; i <= 10; ++i) n.push_back(0.01f * float(i));
+  const VdlGrid g = gridOf(y, n, a);
+  std::vector<float> direct(10, 0.0f);
+  for (int i = 0; i < 5; ++i) direct[size_t(i)] = 3.0f;
+  NoiseSummary s = summarizeNoise(g, &direct);
+  EXPECT_TRUE(s.seen);
+  EXPECT_NEAR(s.quantile, 0.09, 1e-6);
+  EXPECT_NEAR(s.median, 0.0125, 1e-6);
+  EXPECT_NEAR(s.meanLuminance, 1.0, 1e-6) << "the mean stays the indirect light's";
+  EXPECT_NE(s.ToString().find("of the light seen"), std::string::npos) << s.ToString();
+  // Direct light 9 everywhere: every voxel a tenth of its noise.
+  direct.assign(10, 9.0f);
+  s = summarizeNoise(g, &direct);
+  EXPECT_NEAR(s.quantile, 0.009, 1e-6);
+  // No direct light: the indirect figure; a list of the wrong size is ignored.
+  direct.assign(10, 0.0f);
+  EXPECT_NEAR(summarizeNoise(g, &direct).quantile, summarizeNoise(g).quantile, 1e-12);
+  direct.assign(3, 9.0f);
+  EXPECT_FALSE(summarizeNoise(g, &direct).seen);
+  EXPECT_FALSE(summarizeNoise(g).seen);
+}
+
 }  // namespace
 }  // namespace lo
