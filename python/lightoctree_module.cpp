@@ -84,7 +84,10 @@ class CallbackProgress : public ProgressSink {
 
 GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, double targetError,
                   uint64_t seed, int knn, const std::string& vdls, bool includeDirect,
-                  const py::object& progress) {
+                  const std::string& targetLight, const py::object& progress) {
+  if (targetLight != "seen" && targetLight != "indirect") {
+    throw InputError("target_light must be 'seen' or 'indirect', got '" + targetLight + "'");
+  }
   Scene scene = loadScene(scenePath);
   BakeParams params;
   params.depth = depth;
@@ -93,6 +96,7 @@ GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, doubl
   params.knn = knn;
   params.vdls = parseVdlCount(vdls);
   params.includeDirect = includeDirect;
+  params.targetSeenLight = targetLight == "seen";
   auto out = std::make_shared<Grid>();
   {
     std::unique_ptr<CallbackProgress> sink;
@@ -315,9 +319,11 @@ PYBIND11_MODULE(lightoctree, m) {
 
   m.def("bake", &bakeScene, py::arg("scene"), py::arg("depth") = 6, py::arg("photons") = 0,
         py::arg("target_error") = 0.0, py::arg("seed") = 1, py::arg("knn") = BakeParams{}.knn,
-        py::arg("vdls") = "4", py::arg("include_direct") = false, py::arg("progress") = py::none(),
+        py::arg("vdls") = "4", py::arg("include_direct") = false, py::arg("target_light") = "seen",
+        py::arg("progress") = py::none(),
         "Bakes a scene (.gltf, .glb, .obj) as `lightoctree bake` does: photons until the noise "
-        "figure reaches target_error (default 0.07), or a fixed number of photons. "
+        "figure reaches target_error (default 0.07), or a fixed number of photons; target_light "
+        "'seen' (the noise of the light a viewer sees) or 'indirect' (of the indirect light). "
         "progress(task, done, total) is called as the bake goes.");
   m.def("read", &readGrid, py::arg("path"), "Reads a .vdb written by bake or convert.");
   m.def("write", [](const std::string& path, const Grid& g) { writeVdlGrid(path, g.grid, g.meta); },

@@ -101,6 +101,18 @@ def test_errors_are_python_exceptions(tmp_path):
     assert issubclass(lightoctree.InputError, ValueError)
     with pytest.raises(ValueError):
         lightoctree.bake(SCENE, photons=1000, target_error=0.1)
+    with pytest.raises(lightoctree.InputError, match="target_light"):
+        lightoctree.bake(SCENE, target_error=0.1, target_light="direct")
+
+
+def test_target_light_chooses_the_noise_figure():
+    """The default target weighs the indirect noise against the light seen
+    (direct plus indirect): in the Cornell box it stops with fewer photons."""
+    seen = lightoctree.bake(SCENE, depth=4, target_error=0.1)
+    indirect = lightoctree.bake(SCENE, depth=4, target_error=0.1, target_light="indirect")
+    assert "of the light seen" in seen.stats["noise"]
+    assert "of the light seen" not in indirect.stats["noise"]
+    assert seen.stats["stored_photons"] < indirect.stats["stored_photons"]
 
 
 def test_render_equals_the_command(grid, tmp_path):
