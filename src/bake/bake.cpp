@@ -368,8 +368,9 @@ std::string darkLightsWarning(const BakeStats& st) {
   std::string names;
   for (const std::string& name : st.darkLights) names += (names.empty() ? "" : "; ") + name;
   return "no photon was stored from " + names +
-         ": the light reaches no surface of the grid (under or behind geometry, aimed away, "
-         "or outside --bounds)";
+         ": its light reaches no surface of the grid (under or behind geometry, aimed away, "
+         "outside --bounds), or only as direct light (which the renderer draws) that bounces "
+         "nowhere the grid holds";
 }
 
 void checkPhotonsStored(const BakeParams& params, const BakeStats& st) {

@@ -310,10 +310,13 @@ TEST(Photons, StoresExactCount) {
 }
 
 TEST(Photons, MaxEmittedCapsPathsWhenLightMissesGeometry) {
-  // A small floor far from a point light: most paths leave the scene.
+  // A small floor far from a point light: most paths leave the scene. A
+  // second small quad as far above keeps the light inside the scene's
+  // bounding sphere, where it is not aimed at the scene (PhotonAim).
   Scene scene;
   int floor = addMaterial(scene, {0.5f, 0.5f, 0.5f});
   addQuad(scene, {-0.1f, 0, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, {0, 1, 0}, floor);
+  addQuad(scene, {-0.1f, 20, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, {0, 1, 0}, floor);
   scene.lights.push_back(pointLight({0, 10, 0}, 1));
   PhotonParams params = withDirect(1000);
   params.maxEmitted = 5000;
@@ -825,6 +828,50 @@ TEST(SegmentCollector, TracePhotonsKeepsAtMostTheCap) {
   ASSERT_FALSE(map.segments.empty());
   EXPECT_EQ(map.segments[0].from, all.segments[0].from);
   EXPECT_GT(map.segments[0].power.x, all.segments[0].power.x);
+}
+
+
+// A point light and a spot 10 units above a 0.2 x 0.2 floor, outside the
+// scene's bounding sphere, are aimed at it: every path is drawn in the cone
+// the sphere subtends and carries the intensity times that cone's solid
+// angle. The direct flux on the floor must stay I x (the floor's solid angle
+// seen from the light; for the spot, inside its inner cone, the same), now
+// with a photon from almost every path where the whole sphere gave one in
+// 30,000.
+TEST(PhotonAim, ALightFarFromASmallSceneIsAimedAtItWithTheSameFlux) {
+  const float half = 0.1f, height = 10.0f;
+  // The solid angle of a rectangle of half-sides a, b at distance d on its
+  // axis: 4 asin(a b / sqrt((a^2 + d^2)(b^2 + d^2))).
+  const double omega = 4.0 * std::asin(double(half * half) / (double(half * half) + height * height));
+  for (Light::Type type : {Light::Type::Point, Light::Type::Spot}) {
+    SCOPED_TRACE(type == Light::Type::Point ? "point" : "spot");
+    Scene scene;
+    int floor = addMaterial(scene, {0.5f, 0.5f, 0.5f});
+    addQuad(scene, {-half, 0, -half}, {2 * half, 0, 0}, {0, 0, 2 * half}, {0, 1, 0}, floor);
+    Light light = pointLight({0, height, 0}, 2.0f);
+    if (type == Light::Type::Spot) {
+      light.type = Light::Type::Spot;
+      light.direction = {0, -1, 0};
+      light.innerConeAngle = 0.05f;  // the floor spans 0.01 rad: inside it
+      light.outerConeAngle = 0.5f;
+    }
+    scene.lights.push_back(light);
+    PhotonParams params = withDirect(20000);
+    const PhotonMap map = tracePhotons(scene, params);
+    ASSERT_EQ(map.photons.size(), params.storedPhotons);
+    // The sphere round the square subtends pi/2 times its solid angle.
+    EXPECT_LT(double(map.emittedPaths), 1.7 * double(map.photons.size()));
+    double direct = 0;
+    for (const Photon& p : map.photons) direct += p.bounce == 0 ? double(p.power.x) : 0.0;
+    const double expected = double(light.intensity) * omega;
+    // Each direct photon carries I x (the aimed cone's solid angle) / paths;
+    // the hits are binomial over the paths.
+    const double cone = 2.0 * M_PI * (1.0 - std::sqrt(1.0 - std::pow(0.5 * std::sqrt(2.0) * 0.2 * 1.01 / height, 2.0)));
+    const double perPhoton = double(light.intensity) * cone / double(map.emittedPaths);
+    const double hit = expected / (perPhoton * double(map.emittedPaths));
+    const double stdErr = perPhoton * std::sqrt(double(map.emittedPaths) * hit * (1.0 - hit));
+    EXPECT_NEAR(direct, expected, 4.0 * stdErr + 0.01 * expected);
+  }
 }
 
 }  // namespace
