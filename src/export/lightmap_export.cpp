@@ -35,6 +35,15 @@ float rgbmRangeFor(const std::vector<RgbImage>& pages) {
 }
 
 /// D/OUT<suffix> for output D/OUT.glb or .gltf.
+/// A page as it is written: the stitch's least-squares fit leaves small
+/// negative values in gutter texels (dilated, not covered; clamping them in
+/// the atlas would open its seams again), which no irradiance is; the files
+/// hold them as 0 (the RGBM encoding clamps them too, and GL's RGB9_E5).
+RgbImage nonNegative(RgbImage page) {
+  for (float& v : page.rgb) v = v > 0 ? v : 0.0f;  // NaN to 0 as well
+  return page;
+}
+
 std::string besideOutput(const std::string& output, const std::string& suffix) {
   const fs::path out(output);
   return (out.parent_path() / (out.stem().string() + suffix)).string();
@@ -209,7 +218,7 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
     if (params.rgbm) {
       set.addText(path, rgbmPages[size_t(p)]);
     } else {
-      writeExr(path, atlas.irradiance[size_t(p)], &set);
+      writeExr(path, nonNegative(atlas.irradiance[size_t(p)]), &set);
     }
     result.pageFileBytes += size_t(set.bytesOf(path));
   }
