@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# `pip install .` into a virtual environment (docs/python.md, "Install into
+# any Python"): setup.py builds the module with CMake for the interpreter
+# that runs pip, here reusing this build tree (LIGHTOCTREE_BUILD_DIR, made
+# for the same Python), offline; the venv's `import lightoctree` is then the
+# installed copy, of the project's version.
+# Usage: python_pip_install.sh SOURCE_DIR BUILD_DIR WORK_DIR PYTHON VERSION
+set -eu
+src=$1 build=$2 work=$3 python=$4 version=$5
+rm -rf "$work" && mkdir -p "$work"
+"$python" -m venv --system-site-packages "$work/venv"
+LIGHTOCTREE_BUILD_DIR="$build" "$work/venv/bin/python" -m pip install --no-build-isolation \
+  --no-deps --no-index --quiet "$src"
+cd "$work"
+"$work/venv/bin/python" - "$work/venv" "$version" <<'PY'
+import os, sys
+import lightoctree
+venv, version = sys.argv[1], sys.argv[2]
+where = os.path.realpath(lightoctree.__file__)
+assert where.startswith(os.path.realpath(venv)), f"imported {where}, not the venv's copy"
+assert lightoctree.__version__ == version, (lightoctree.__version__, version)
+print(f"pip install: lightoctree {lightoctree.__version__} from {where}")
+PY
+"$work/venv/bin/python" -m pip show lightoctree | grep -q "^Version: $version$"
+echo "pip install: the venv's pip lists lightoctree $version"
