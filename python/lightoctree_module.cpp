@@ -17,6 +17,8 @@
 #include "bake/bake.h"
 #include "bake/convert.h"
 #include "core/error.h"
+#include "core/file.h"
+#include "core/number_range.h"
 #include "core/progress.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
@@ -82,9 +84,17 @@ class CallbackProgress : public ProgressSink {
   std::string task_;
 };
 
+/// The arguments are checked as the command's flags are, by the same ranges
+/// (bake/bake.h, core/number_range.h), and named by their Python names; 0 is
+/// "not given" for photons and target_error, as their defaults.
 GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, double targetError,
                   uint64_t seed, int knn, const std::string& vdls, bool includeDirect,
                   const std::string& targetLight, const py::object& progress) {
+  checkPathText(scenePath, "scene");
+  checkNumber(depth, kDepthRange, "depth");
+  if (photons != 0) checkNumber(double(photons), kPhotonsRange, "photons");
+  if (targetError != 0) checkNumber(targetError, kTargetErrorRange, "target_error");
+  checkNumber(knn, kKnnRange, "knn");
   if (targetLight != "seen" && targetLight != "indirect") {
     throw InputError("target_light must be 'seen' or 'indirect', got '" + targetLight + "'");
   }
@@ -116,6 +126,7 @@ GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, doubl
 }
 
 GridPtr readGrid(const std::string& path) {
+  checkPathText(path, "path");
   LoadedVdl loaded = readVdlGrid(path);
   auto out = std::make_shared<Grid>();
   out->grid = std::move(loaded.grid);
@@ -124,6 +135,7 @@ GridPtr readGrid(const std::string& path) {
 }
 
 py::dict inspectFile(const std::string& path) {
+  checkPathText(path, "path");
   const VdbReport r = inspectVdb(path);
   py::dict d;
   d["path"] = r.path;
@@ -146,6 +158,8 @@ py::dict inspectFile(const std::string& path) {
 }
 
 GridPtr convertGrid(const Grid& in, int depth, const std::string& vdls, const std::string& scenePath) {
+  if (depth != 0) checkNumber(depth, kDepthRange, "depth");  // 0: the grid's own
+  checkPathText(scenePath, "scene");
   ConvertParams params;
   params.depth = depth;
   params.vdls = vdls;
@@ -221,6 +235,7 @@ RenderSettings renderSettings(int width, int height, const std::string& mode, co
 /// RGB, shape (height, width, 3).
 py::array_t<float> renderImage(const std::string& scenePath, const Grid& g, int width, int height,
                                const std::string& mode, const py::kwargs& kw) {
+  checkPathText(scenePath, "scene");
   const RenderSettings settings = renderSettings(width, height, mode, kw);
   Scene scene = loadScene(scenePath);
   RgbImage image;
@@ -241,6 +256,7 @@ py::array_t<float> renderImage(const std::string& scenePath, const Grid& g, int 
 
 /// An EXR (linear) or PNG (sRGB decoded) image as (height, width, 3) floats.
 py::array_t<float> readImageFile(const std::string& path) {
+  checkPathText(path, "path");
   const RgbImage image = readImage(path);
   py::array_t<float> out({size_t(image.height), size_t(image.width), size_t(3)});
   std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
@@ -326,9 +342,14 @@ PYBIND11_MODULE(lightoctree, m) {
         "'seen' (the noise of the light a viewer sees) or 'indirect' (of the indirect light). "
         "progress(task, done, total) is called as the bake goes.");
   m.def("read", &readGrid, py::arg("path"), "Reads a .vdb written by bake or convert.");
-  m.def("write", [](const std::string& path, const Grid& g) { writeVdlGrid(path, g.grid, g.meta); },
-        py::arg("path"), py::arg("grid"),
-        "Writes the grid as a .vdb (atomically; a grid the readers would refuse is not written).");
+  m.def(
+      "write",
+      [](const std::string& path, const Grid& g) {
+        checkPathText(path, "path");
+        writeVdlGrid(path, g.grid, g.meta);
+      },
+      py::arg("path"), py::arg("grid"),
+      "Writes the grid as a .vdb (atomically; a grid the readers would refuse is not written).");
   m.def("inspect", &inspectFile, py::arg("path"),
         "The checks `lightoctree inspect` runs: {'ok', 'checks': [{'name', 'passed', 'detail'}], ...}.");
   m.def("convert", &convertGrid, py::arg("grid"), py::arg("depth") = 0, py::arg("vdls") = "",

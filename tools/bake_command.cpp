@@ -34,7 +34,7 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   if (!opt.statsJson.empty()) checkOutputFolder(opt.statsJson, "--stats-json");
   checkDistinctFiles(
       {{"--output", opt.output}, {"--photon-map", opt.photonMap}, {"--stats-json", opt.statsJson}},
-      sceneInputs(opt.scene));
+      sceneInputs(opt.scene, opt.sceneOptions));
 
   ThreadLimit threadLimit(opt.threads);
   ConsoleProgress progress(opt.quiet);

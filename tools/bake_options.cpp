@@ -74,14 +74,14 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
   cmd->add_option("--photons", opt.photons,
                   "A fixed photon budget: store this many photons (the paper's 600000) instead "
                   "of tracing until --target-error is reached")
-      ->check(CLI::Range(size_t(1), size_t(200000000)));
+      ->check(numberIn(kPhotonsRange));
   cmd->add_option("--target-error", opt.targetError,
                   "Trace photons in passes until the bake's noise figure is at most this (default " +
                       formatNumber(kDefaultTargetError) +
                       "): the estimated relative standard error of the irradiance that 90% of the "
                       "lit area is below (docs/accuracy.md, \"How good is a bake\"). A deeper "
                       "grid gets the photons it needs")
-      ->check(CLI::Range(1e-3, 1.0));
+      ->check(numberIn(kTargetErrorRange));
   cmd->add_option("--target-light", opt.targetLight,
                   "What --target-error measures the indirect light's noise against: 'seen', "
                   "the light a viewer sees (direct plus indirect: where direct light is bright, "
@@ -92,21 +92,21 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
   cmd->add_option("--max-photons", opt.maxPhotons,
                   "With --target-error: store at most this many photons (fewer when memory "
                   "holds fewer); the report says when the cap stopped the bake")
-      ->check(CLI::Range(size_t(1), size_t(200000000)))
+      ->check(numberIn(kPhotonsRange))
       ->capture_default_str();
   cmd->add_option("--max-seconds", opt.maxSeconds,
                   "With --target-error: start no new pass after this many seconds (0: no limit). "
                   "The one setting that makes the result depend on the machine's speed")
-      ->check(CLI::Range(0.0, 1e7))
+      ->check(numberIn({0, 1e7}))
       ->capture_default_str();
   cmd->add_option("--knn", opt.knn,
                   "Nearest photons gathered per voxel (paper: 300); a target bake raises it to "
                   "3/E^2 so that it does not hold the noise up")
-      ->check(CLI::Range(1, 100000))
+      ->check(numberIn(kKnnRange))
       ->capture_default_str();
   cmd->add_option("--radius", opt.radius,
                   "Gathering radius in scene units (default: " + formatNumber(kDefaultRadiusVoxels) + " voxel sizes)")
-      ->check(finitePositive());
+      ->check(numberIn(kPositiveNumber));
   cmd->add_option("--vdls", opt.vdls,
                   "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest (up to --auto-cap) whose "
                   "angular error is under --auto-threshold")
@@ -119,12 +119,12 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->check(CLI::IsMember(representationNames()))
       ->capture_default_str();
   cmd->add_option("--auto-cap", opt.autoCap, "With --vdls auto: at most this many VDLs per voxel")
-      ->check(CLI::Range(1, kMaxVdls))
+      ->check(wholeIn(1, kMaxVdls))
       ->capture_default_str();
   cmd->add_option("--auto-threshold", opt.autoThreshold,
                   "With --vdls auto: the fewest VDLs whose angular error (chord-length deviation, "
                   "0..2; 0.35 is about 20 degrees) is under this")
-      ->check(finitePositive())
+      ->check(numberIn({0, 2, true}))
       ->capture_default_str();
   cmd->add_option("--seed", opt.seed, "Random seed (same seed, same bytes)")
       ->check(seedValidator())->capture_default_str();
@@ -167,7 +167,7 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
   cmd->add_option("--free-space-levels", opt.freeSpaceLevels,
                   "How many levels coarser than the surface grid the free-space grid is "
                   "(2: a free-space voxel is 4 surface voxels wide; never coarser than depth 1)")
-      ->check(CLI::Range(0, 11))
+      ->check(wholeIn(0, 11))
       ->capture_default_str();
   cmd->add_option("--free-space-order", opt.freeSpaceOrder,
                   "SH order of the free-space light: 2 (9 terms, 80 bytes a voxel on the GPU) or "

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "cli_checks.h"
 #include "core/error.h"
 
 namespace lo::tool {
@@ -14,7 +15,7 @@ void addCameraOptions(CLI::App* cmd, CameraOptions& opt) {
   cmd->add_option("--target", opt.target, "Point the camera looks at, x,y,z (with --eye)");
   camera->excludes(eye);
   cmd->add_option("--fov", opt.fovDegrees, "Vertical field of view in degrees (default 45)")
-      ->check(CLI::Range(1.0f, 179.0f));
+      ->check(numberIn({1, 179}));
 }
 
 Vec3d parseVec3d(const std::string& text, const char* flag) {

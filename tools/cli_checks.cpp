@@ -14,7 +14,38 @@ CLI::Validator vdlCountValidator() {
                         "1.." + std::to_string(kMaxVdls) + "|auto", "VdlCount");
 }
 
-CLI::Validator depthValidator() { return CLI::Range(1, kMaxGridDepth); }
+CLI::Validator depthValidator() { return numberIn(kDepthRange); }
+
+CLI::Validator numberIn(const NumberRange& range) {
+  // The help's type after the option's own: "FLOAT:from 0.001 to 1", "INT:from 1 to 12".
+  const std::string description = range.boundsText();
+  return CLI::Validator(
+      [range](std::string& s) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(s.c_str(), &end);
+        if (s.empty() || end != s.c_str() + s.size() || !range.contains(v)) {
+          return "must be " + range.ToString() + ", got '" + s + "'";
+        }
+        return {};
+      },
+      description, "Number");
+}
+
+CLI::Validator wholeIn(double min, double max) {
+  return numberIn(NumberRange{min, max, false, true});
+}
+
+void requireFiniteNumbers(CLI::App& app) {
+  CLI::Validator finite = numberIn(kFiniteNumber);
+  finite.description("");  // the option's help says FLOAT already
+  for (CLI::Option* option : app.get_options()) {
+    // CLI11 names a float, a double and a vector of them FLOAT.
+    if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
+  }
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+    requireFiniteNumbers(*sub);
+  }
+}
 
 CLI::Validator seedValidator() {
   return CLI::Validator(
@@ -46,19 +77,6 @@ CLI::Validator tilesValidator() {
         return {};
       },
       "auto|1,2,4,..", "Tiles");
-}
-
-CLI::Validator finitePositive() {
-  return CLI::Validator(
-      [](std::string& s) -> std::string {
-        char* end = nullptr;
-        const double v = std::strtod(s.c_str(), &end);
-        if (end == s.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0)) {
-          return "must be a finite number > 0, got '" + s + "'";
-        }
-        return {};
-      },
-      "NUMBER > 0", "FinitePositive");
 }
 
 }  // namespace lo::tool

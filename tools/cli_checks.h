@@ -6,21 +6,34 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "core/number_range.h"
+
 namespace lo::tool {
 
 /// `--vdls`: 1..kMaxVdls or "auto" (lo::vdlCountError).
 CLI::Validator vdlCountValidator();
 
-/// `--depth`: 1..kMaxGridDepth.
+/// `--depth`: 1..kMaxGridDepth (kDepthRange, as the bake and the Python module).
 CLI::Validator depthValidator();
+
+/// A number within `range` (core/number_range.h, the check the Python module
+/// applies to its arguments): finite first, so NaN and infinities are
+/// refused where CLI::Range and CLI::PositiveNumber let NaN through.
+/// "--fov: must be a finite number from 1 to 179, got 'nan'".
+CLI::Validator numberIn(const NumberRange& range);
+/// numberIn of the whole numbers from `min` to `max`.
+CLI::Validator wholeIn(double min, double max);
+
+/// Adds the finite check (numberIn(kFiniteNumber)) to every option of `app`
+/// and its subcommands that takes floating-point numbers: a flag registered
+/// without a range still refuses NaN and infinities. Called once, after every
+/// command has registered its flags.
+void requireFiniteNumbers(CLI::App& app);
 
 /// `--seed`: decimal digits only, at most 2^64 - 1: "-1", "1e23" or a number
 /// beyond 64 bits would otherwise wrap to some other seed without a word.
 CLI::Validator seedValidator();
 /// `bake --tiles`: "auto" or a power of two up to kMaxTilesPerAxis.
 CLI::Validator tilesValidator();
-
-/// A finite number > 0 ("nan" and "inf" refused, unlike CLI::PositiveNumber).
-CLI::Validator finitePositive();
 
 }  // namespace lo::tool

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "core/error.h"
 #include "image/compare.h"
@@ -153,7 +154,7 @@ void addCompareOptions(CLI::App* cmd, CompareOptions& opt) {
                   "Average both images (and the mask) over blocks of N x N pixels first: the "
                   "error at the scale of N pixels, without the reference's per-pixel noise "
                   "(--diff is then at that resolution too)")
-      ->check(CLI::Range(1, 1024))
+      ->check(wholeIn(1, 1024))
       ->capture_default_str();
   cmd->add_option("--diff", opt.diff,
                   "Write |Y(test) - Y(reference)| in false colour (.png or .exr): black 0, blue, "
@@ -161,7 +162,7 @@ void addCompareOptions(CLI::App* cmd, CompareOptions& opt) {
   cmd->add_option("--diff-scale", opt.diffScale,
                   "Error shown red in --diff, in the images' units (default: a quarter of the "
                   "mean reference luminance)")
-      ->check(CLI::PositiveNumber);
+      ->check(numberIn(kPositiveNumber));
   cmd->add_option("--json", opt.json, "Write the figures as JSON for scripts");
   cmd->add_flag("-q,--quiet", opt.quiet, "Print nothing (use with --json)");
 }

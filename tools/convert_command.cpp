@@ -20,6 +20,7 @@
 #include "json_report.h"
 #include "report.h"
 #include "scene/scene.h"
+#include "scene_options.h"
 #include "vdb/vdb_io.h"
 
 namespace lo::tool {
@@ -79,7 +80,12 @@ void addConvertOptions(CLI::App* cmd, ConvertOptions& opt) {
 int runConvert(const ConvertOptions& opt) {
   checkOutputFolder(opt.output, "--output");
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
-  const NamedPaths inputs{{"IN", opt.input}, {"--scene", opt.scene}, {"--photon-map", opt.photonMap}};
+  NamedPaths inputs{{"IN", opt.input}};
+  if (!opt.scene.empty()) {
+    const NamedPaths scene = sceneInputs(opt.scene, "--scene");
+    inputs.insert(inputs.end(), scene.begin(), scene.end());
+  }
+  inputs.push_back({"--photon-map", opt.photonMap});
   checkDistinctFiles({{"--output", opt.output}, {"--json", opt.json}}, inputs);
   const auto& optional = droppableVdlGridNames();
   for (const std::string& name : opt.drop) {

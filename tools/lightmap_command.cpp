@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
+#include "cli_checks.h"
 #include "command_options.h"
 #include "commands.h"
 #include "core/file.h"
@@ -89,7 +90,7 @@ nlohmann::json lightmapFigures(const LightmapExportResult& r, const LightmapExpo
 }
 
 int runLightmap(const LightmapOptions& opt) {
-  NamedPaths inputs = sceneInputs(opt.scene);
+  NamedPaths inputs = sceneInputs(opt.scene, opt.sceneOptions);
   inputs.push_back({"LIGHTS", opt.lights});
   LightmapExportParams params = exportParams(opt, inputs);
   std::vector<StageReport> rows;
@@ -133,11 +134,11 @@ void addLightmapOptions(CLI::App* cmd, LightmapOptions& opt) {
   cmd->add_option("--texel-size", opt.texelSize,
                   "Scene units per lightmap texel (automatic charts only; default: a quarter of "
                   "the octree's voxel, which holds nothing finer)")
-      ->check(CLI::PositiveNumber);
+      ->check(numberIn(kPositiveNumber));
   cmd->add_option("--atlas", opt.atlas,
                   "Largest atlas page in texels (width = height): charts go on the smallest page "
                   "that holds them, up to this size, then on more pages")
-      ->check(CLI::Range(8, 16384))
+      ->check(wholeIn(8, 16384))
       ->capture_default_str();
   cmd->add_option("--uv", opt.uv,
                   "Lightmap UVs: texcoord1 (the scene's TEXCOORD_1, which must lie in [0, 1] "
@@ -152,7 +153,7 @@ void addLightmapOptions(CLI::App* cmd, LightmapOptions& opt) {
   cmd->add_option("--direct-samples", opt.directSamples,
                   "With --content full: emitter samples per texel (shadow rays; punctual lights "
                   "take one each)")
-      ->check(CLI::Range(1, 65536))
+      ->check(wholeIn(1, 65536))
       ->capture_default_str();
   cmd->add_option("--image", opt.image,
                   "Page images: exr (linear 32-bit float irradiance, W/m^2) or png (RGBM in "
@@ -164,7 +165,7 @@ void addLightmapOptions(CLI::App* cmd, LightmapOptions& opt) {
                 "radiance (albedo / pi * E + emission) as its base colour, for any glTF viewer");
   cmd->add_option("--exposure", opt.exposure,
                   "Exposure of the unlit preview in EV (radiance * 2^EV before the sRGB curve)")
-      ->check(CLI::Range(-30.0f, 30.0f))
+      ->check(numberIn({-30, 30}))
       ->capture_default_str();
   cmd->add_option("--atlas-on", opt.atlasOn,
                   "Where the octree is rendered into the atlas: cpu (the C++ lookup; the same "

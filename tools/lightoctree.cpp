@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <exception>
 
+#include "cli_checks.h"
 #include "commands.h"
 
 namespace {
@@ -29,6 +30,7 @@ int run(int argc, char** argv) {
   commands.push_back(lo::tool::addCompareCommand(app));
   commands.push_back(lo::tool::addSweepCommand(app));
   commands.push_back(lo::tool::addViewCommand(app));
+  lo::tool::requireFiniteNumbers(app);  // every float flag, those with a range or not
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -78,7 +78,7 @@ int runReference(const ReferenceOptions& opt) {
   if (!opt.stdErrorOutput.empty()) checkImageOutput(opt.stdErrorOutput, "--std-error");
   if (!opt.emitterMaskOutput.empty()) checkImageOutput(opt.emitterMaskOutput, "--emitter-mask");
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
-  const NamedPaths inputs = sceneInputs(opt.scene);
+  const NamedPaths inputs = sceneInputs(opt);
   checkDistinctFiles({{"--output", opt.output},
                       {"--std-error", opt.stdErrorOutput},
                       {"--emitter-mask", opt.emitterMaskOutput},

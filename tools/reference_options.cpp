@@ -48,12 +48,12 @@ void addReferenceOptions(CLI::App* cmd, ReferenceOptions& opt) {
   addSizeOptions(cmd, opt.width, opt.height);
   addPictureOptions(cmd, opt.picture);
   auto* spp = cmd->add_option("--spp", opt.spp, "Samples per pixel")
-                  ->check(CLI::Range(1, 1000000))
+                  ->check(wholeIn(1, 1000000))
                   ->capture_default_str();
   cmd->add_option("--time-budget", opt.timeBudget,
                   "Render passes of 1 sample per pixel until this many seconds have passed "
                   "(instead of --spp)")
-      ->check(CLI::Range(1e-3, 1e7))
+      ->check(numberIn({1e-3, 1e7}))
       ->excludes(spp);
   cmd->add_option("--part", opt.part,
                   "full | direct | indirect (what `render --mode indirect` approximates) | "
@@ -67,7 +67,7 @@ void addReferenceOptions(CLI::App* cmd, ReferenceOptions& opt) {
   cmd->add_option("--edge-distance", opt.edgeDistance,
                   "With --part edge-mask: how near an edge, in scene units (default: one voxel "
                   "of a depth-6 bake of the scene)")
-      ->check(finitePositive());
+      ->check(numberIn(kPositiveNumber));
   cmd->add_option("--seed", opt.seed, "Random seed (same seed and --spp, same bytes)")
       ->check(seedValidator())
       ->capture_default_str();
@@ -75,7 +75,7 @@ void addReferenceOptions(CLI::App* cmd, ReferenceOptions& opt) {
   cmd->add_option("--max-bounces", opt.maxBounces,
                   "Cap on scattering events after the first hit (Russian roulette ends "
                   "paths long before)")
-      ->check(CLI::Range(0, 100000))
+      ->check(wholeIn(0, 100000))
       ->capture_default_str();
   cmd->add_option("--std-error", opt.stdErrorOutput,
                   "Also write the per-pixel standard error of the mean (.exr or .png)");

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "camera_options.h"
+#include "cli_checks.h"
 #include "command_options.h"
 #include "commands.h"
 #include "core/error.h"
@@ -100,7 +101,7 @@ int runRender(const RenderOptions& opt) {
   // Everything that can be checked before the work is checked first.
   checkOutputFolder(opt.output, "--output");
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
-  NamedPaths inputs = sceneInputs(opt.scene);
+  NamedPaths inputs = sceneInputs(opt);
   inputs.push_back({"LIGHTS", opt.lights});
   checkDistinctFiles({{"--output", opt.output}, {"--json", opt.json}}, inputs);
   JsonReport report{"render", inputs, {{"mode", opt.mode}, {"width", opt.width}, {"height", opt.height}}};
@@ -178,11 +179,11 @@ void addRenderOptions(CLI::App* cmd, RenderOptions& opt) {
                   "time and memory per stage (README.md, \"Scripting\")");
   cmd->add_option("--frames", opt.frames,
                   "Also time this many frames (no read-back) and print the mean frame time")
-      ->check(CLI::Range(0, 100000));
+      ->check(wholeIn(0, 100000));
   cmd->add_option("--spp", opt.irradianceSpp,
                   "--mode irradiance: camera rays per pixel, averaged as the reference averages "
                   "its samples (pixels across an edge need many)")
-      ->check(CLI::Range(1, 4096))
+      ->check(wholeIn(1, 4096))
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", opt.quiet, "Only errors");
 }

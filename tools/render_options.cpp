@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "cli_checks.h"
 #include "core/error.h"
 #include "lightmap/lightmap_bake.h"
 
@@ -78,16 +79,16 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
     cmd->add_option("--supersample", opt.supersample,
                     "Anti-aliasing: each pixel the mean of N x N samples (the image drawn N times "
                     "larger, then box-filtered), as the path tracer integrates a pixel")
-        ->check(CLI::Range(1, kMaxSupersample))
+        ->check(wholeIn(1, kMaxSupersample))
         ->capture_default_str();
   }
   if (window) {  // `render` has --exposure auto|EV (picture_options.h)
     cmd->add_option("--exposure", opt.exposure, "Exposure in EV (radiance * 2^EV)" + key("keys , . 0"))
-        ->check(CLI::Range(-30.0f, 30.0f))
+        ->check(numberIn({-30, 30}))
         ->capture_default_str();
   }
   cmd->add_option("--vdls", opt.vdls, "VDLs used per voxel, strongest first" + key("keys [ ]"))
-      ->check(CLI::Range(1, kMaxVdls))
+      ->check(wholeIn(1, kMaxVdls))
       ->capture_default_str();
   cmd->add_option("--area-lights", opt.areaLights,
                   "Emissive triangles as area lights: exact irradiance, soft shadows (up to 8 "
@@ -97,11 +98,11 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
   cmd->add_option("--emitter-lights", opt.emitterLights,
                   "Shadowed virtual point lights sampled on emissive triangles when they are not "
                   "area lights (0: none)")
-      ->check(CLI::Range(0, kMaxEmitterLights))
+      ->check(wholeIn(0, kMaxEmitterLights))
       ->capture_default_str();
   cmd->add_option("--shadow-map-size", opt.shadowMapSize, "Shadow map resolution per face, at most: many shadowed lights (6 faces per "
                   "emitter VPL) get smaller maps, halved until all fit in 48 MiB (16-bit depth)")
-      ->check(CLI::Range(kMinShadowMapSize, kMaxShadowMapSize))
+      ->check(wholeIn(kMinShadowMapSize, kMaxShadowMapSize))
       ->capture_default_str();
   cmd->add_option("--cosine-correction", opt.cosineCorrection,
                   "Divide each VDL by the cosine to its voxel's normal on upload, so that the "
@@ -120,12 +121,12 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
                   "Adaptive leaves: siblings whose light agrees within this share of each "
                   "voxel's irradiance, at its own surface, become one coarser leaf (0 = every "
                   "leaf at the bake's depth; docs/octree.md)")
-      ->check(CLI::Range(0.0f, 1.0f))
+      ->check(numberIn({0, 1}))
       ->capture_default_str();
   cmd->add_option("--free-space-tolerance", opt.freeSpaceTolerance,
                   "The same for the free-space light the --add objects take: eight voxels whose "
                   "irradiance agrees within this share, for 14 normals, become one (0 = none)")
-      ->check(CLI::Range(0.0f, 1.0f))
+      ->check(numberIn({0, 1}))
       ->capture_default_str();
 }
 

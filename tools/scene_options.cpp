@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "camera_options.h"
+#include "cli_checks.h"
 #include "core/error.h"
 #include "scene/place_model.h"
 #include "scene/scene_files.h"
@@ -37,33 +38,51 @@ void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
                   "light), an atmosphere of this turbidity (2: very clear, 3: clear, 6: hazy; "
                   "Preetham et al. 1999), as bright beside the sun as that sky is beside the "
                   "sun through it; scaled by --sky")
-      ->check(CLI::Range(1.7, 10.0))  // kMinTurbidity, kMaxTurbidity
+      ->check(numberIn({1.7, 10.0}))  // kMinTurbidity, kMaxTurbidity (as doubles: 1.7f > 1.7)
       ->excludes("--sky-image")
       ->excludes("--sky-mesh");
 }
 
-NamedPaths sceneInputs(const std::string& scene) {
+NamedPaths sceneInputs(const std::string& scene, const std::string& role) {
   NamedPaths inputs;
   const std::string folder = std::filesystem::path(scene).parent_path().string();
   for (const std::string& file : sceneFiles(scene)) {
     if (inputs.empty()) {
-      inputs.push_back({"SCENE", file});
+      inputs.push_back({role, file});
       continue;
     }
     std::error_code ec;
     const std::string name =
         std::filesystem::relative(file, folder.empty() ? "." : folder, ec).generic_string();
-    inputs.push_back({"SCENE's file '" + (ec || name.empty() ? file : name) + "'", file});
+    inputs.push_back({role + "'s file '" + (ec || name.empty() ? file : name) + "'", file});
   }
   return inputs;
 }
 
-Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
+NamedPaths sceneInputs(const std::string& scene, const SceneOptions& opt) {
+  NamedPaths inputs = sceneInputs(scene);
+  if (!opt.skyImage.empty()) inputs.push_back({"--sky-image", opt.skyImage});
+  return inputs;
+}
+
+NamedPaths sceneInputs(const SceneFlags& opt) {
+  NamedPaths inputs = sceneInputs(opt.scene, opt.sceneOptions);
+  for (const std::string& model : opt.objects.models) {
+    const NamedPaths files = sceneInputs(model, "--add '" + model + "'");
+    inputs.insert(inputs.end(), files.begin(), files.end());
+  }
+  return inputs;
+}
+
+namespace {
+
+/// The scene at `path` with its sky replaced as the flags say (unchecked).
+Scene applySkyFlags(const std::string& path, const SceneOptions& opt) {
   Vec3 sky{0, 0, 0};
   if (!opt.sky.empty()) {
     sky = parseVec3(opt.sky, "--sky");
     for (int c = 0; c < 3; ++c) {
-      if (!std::isfinite(sky[c]) || sky[c] < 0 || sky[c] > 1e9f) {
+      if (!std::isfinite(sky[c]) || sky[c] < 0 || sky[c] > kMaxRadiance) {
         throw InputError("--sky: '" + opt.sky +
                          "' is not a radiance (three numbers from 0 to 1e9, W/(m^2 sr))");
       }
@@ -106,6 +125,20 @@ Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
     scene.sky.radiance = sky;
     scene.sky.image.reset();
   }
+  return scene;
+}
+
+}  // namespace
+
+Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
+  Scene scene = applySkyFlags(path, opt);
+  // The sky the flags made, checked as loadScene checks the file's (and a
+  // --sky-mesh's): every command, bake and reference alike, takes the same skies.
+  if (opt.sky.empty() && opt.skyImage.empty() && !(opt.physicalSky > 0)) return scene;
+  const std::string flag = !opt.skyImage.empty() ? "--sky-image '" + opt.skyImage + "'"
+                           : opt.physicalSky > 0 ? std::string("--physical-sky")
+                                                 : std::string("--sky");
+  checkSkyRadiance(scene.sky, flag + (opt.sky.empty() || flag == "--sky" ? "" : " with --sky"));
   return scene;
 }
 

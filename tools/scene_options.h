@@ -33,9 +33,12 @@ void addSceneArgument(CLI::App* cmd, std::string& scene);
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt);
 
 /// The files loading `scene` reads, named for checkDistinctFiles ("SCENE",
-/// then "SCENE's file 'tex.png'", ...; scene/scene_files.h): what no
-/// output of a command may replace.
-NamedPaths sceneInputs(const std::string& scene);
+/// then "SCENE's file 'tex.png'", ...; scene/scene_files.h; `role` for
+/// SCENE): what no output of a command may replace.
+NamedPaths sceneInputs(const std::string& scene, const std::string& role = "SCENE");
+
+/// sceneInputs(scene) and the file the flags add to it: --sky-image.
+NamedPaths sceneInputs(const std::string& scene, const SceneOptions& opt);
 
 /// loadScene(path) with the flags applied. @throws InputError naming the flag
 /// (a radiance that is negative or not a number) or the file.
@@ -64,6 +67,11 @@ struct SceneFlags {
   SceneOptions sceneOptions;  // --sky
   AddedObjects objects;       // --add, --at
 };
+
+/// Every file loadSceneWith(opt) reads: the scene's and --sky-image
+/// (sceneInputs), and each --add model's ("--add 'chair.obj'", "--add
+/// 'chair.obj''s file 'chair.mtl'", ...).
+NamedPaths sceneInputs(const SceneFlags& opt);
 
 /// Registers SCENE (addSceneArgument), the --sky flags and --add, --at on `cmd`.
 void addSceneFlags(CLI::App* cmd, SceneFlags& opt);

@@ -45,6 +45,14 @@ int runSweepCommand(const SweepOptions& opt) {
   params.progress = &progress;
   // A results folder: an existing one is reused; a new one needs its parent.
   if (!std::filesystem::is_directory(opt.out)) checkOutputFolder(opt.out, "--out");
+  // Its tables, pictures, plot data and cache take names of their own
+  // (src/sweep): a folder holding a file the scene reads is not one.
+  const NamedPaths inputs = sceneInputs(opt.scene);
+  for (const std::string& folder : {opt.out, opt.out + "/cache", opt.out + "/plot-data"}) {
+    checkFolderOutputs(
+        folder, [&](const std::string&) { return "results written to '" + folder + "'"; }, "--out",
+        inputs);
+  }
   std::filesystem::create_directories(opt.out);
   std::FILE* log = opt.quiet ? nullptr : stdout;
   std::vector<SweepResult> results = runSweep(params, log);
@@ -66,14 +74,14 @@ void addSweepOptions(CLI::App* cmd, SweepOptions& opt) {
   cmd->add_flag("--quick", opt.quick, "A reduced sweep: fewer points, smaller images");
   cmd->add_flag("--tiny", opt.tiny, "Three tiny points (a smoke test)")->group("");
   cmd->add_option("--width", opt.width, "Image width (default: 160, quick 96)")
-      ->check(CLI::Range(1, 4096));
+      ->check(wholeIn(1, 4096));
   cmd->add_option("--height", opt.height, "Image height (default: 120, quick 72)")
-      ->check(CLI::Range(1, 4096));
+      ->check(wholeIn(1, 4096));
   cmd->add_option("--spp", opt.spp, "Reference samples per pixel (default: 8192, quick 2048)")
-      ->check(CLI::Range(1, 1000000));
+      ->check(wholeIn(1, 1000000));
   cmd->add_option("--frames", opt.frames,
                   "Frames timed per point with OSMesa (0: no GL render; default 5, quick 2)")
-      ->check(CLI::Range(0, 1000));
+      ->check(wholeIn(0, 1000));
   addThreadsOption(cmd, opt.threads)->capture_default_str();
   cmd->add_option("--seed", opt.seed, "Random seed of bakes and references")
       ->check(seedValidator())

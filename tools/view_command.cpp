@@ -30,6 +30,18 @@
 namespace lo::tool {
 namespace {
 
+/// Whether the viewer may write `name` into its --save-frames folder: it
+/// writes frame_00000.png, frame_00001.png, ... (render/viewer.h), as many
+/// as it draws, six digits and more past 99,999.
+bool isSavedFrameName(const std::string& name) {
+  const std::string head = "frame_", tail = ".png";
+  if (name.size() < head.size() + 5 + tail.size() || name.compare(0, head.size(), head) != 0 ||
+      name.compare(name.size() - tail.size(), tail.size(), tail) != 0) {
+    return false;
+  }
+  return name.find_first_not_of("0123456789", head.size()) == name.size() - tail.size();
+}
+
 int runView(const ViewOptions& opt) {
   // Everything that can be checked before a window opens is checked first.
   if (opt.progressive && !opt.lights.empty()) {
@@ -44,10 +56,19 @@ int runView(const ViewOptions& opt) {
   }
   checkCameraOptions(opt.camera);
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
-  NamedPaths inputs = sceneInputs(opt.scene);
+  NamedPaths inputs = sceneInputs(opt);
   if (!opt.lights.empty()) inputs.push_back({"LIGHTS", opt.lights});
+  // The file P appends to may be the path played, and nothing else read.
+  checkDistinctFiles({{"--record", opt.view.record}}, inputs);
   if (!opt.cameraPath.empty()) inputs.push_back({"--camera-path", opt.cameraPath});
-  // The file P appends to may be the path played: only --json must differ from it.
+  if (!opt.view.saveFrames.empty()) {
+    checkFolderOutputs(
+        opt.view.saveFrames,
+        [](const std::string& name) {
+          return isSavedFrameName(name) ? "frame '" + name + "' of --save-frames" : std::string();
+        },
+        "--save-frames", inputs);
+  }
   inputs.push_back({"--record", opt.view.record});
   checkDistinctFiles({{"--json", opt.json}}, inputs);
   JsonReport report{"view", inputs,

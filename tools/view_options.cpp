@@ -62,7 +62,7 @@ void addViewOptions(CLI::App* cmd, ViewOptions& opt) {
   cmd->add_option("--speed", opt.speed,
                   "Movement speed, scene units per second (default: a quarter of the scene's "
                   "diagonal)")
-      ->check(CLI::PositiveNumber);
+      ->check(numberIn(kPositiveNumber));
   cmd->add_option("--camera-path", opt.cameraPath,
                   "Play this camera path (format below) and exit at its end")
       ->check(CLI::ExistingFile);
@@ -71,7 +71,7 @@ void addViewOptions(CLI::App* cmd, ViewOptions& opt) {
   cmd->add_option("--frames", opt.view.frames,
                   "Exit after N frames (with --camera-path: N frames evenly spaced along it; "
                   "with --progressive: N frames at the target depth)")
-      ->check(CLI::Range(0, 10000000));
+      ->check(wholeIn(0, 10000000));
   cmd->add_flag("--continuous", opt.view.continuous,
                 "Redraw every iteration, even when nothing changed (by default a still view "
                 "is not redrawn, which leaves the CPU to a --progressive bake)");
@@ -81,13 +81,13 @@ void addViewOptions(CLI::App* cmd, ViewOptions& opt) {
                 "Bake from the scene while viewing: trace photons once, show depth 4 as soon "
                 "as it is ready, refine to --depth in the background");
   cmd->add_option("--photons", opt.bake.photons.storedPhotons, "Progressive: photons to store")
-      ->check(CLI::Range(size_t(1), size_t(200000000)))
+      ->check(numberIn(kPhotonsRange))
       ->capture_default_str();
   cmd->add_option("--depth", opt.bake.targetDepth, "Progressive: target octree depth")
       ->check(depthValidator())
       ->capture_default_str();
   cmd->add_option("--knn", opt.bake.gather.k, "Progressive: nearest photons gathered per voxel")
-      ->check(CLI::Range(1, 100000))
+      ->check(numberIn(kKnnRange))
       ->capture_default_str();
   cmd->add_option("--seed", opt.bake.photons.seed, "Progressive: random seed")
       ->check(seedValidator())

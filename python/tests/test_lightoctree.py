@@ -140,3 +140,66 @@ def test_render_equals_the_command(grid, tmp_path):
         lightoctree.render(SCENE, grid, width=8, height=8, no_such_setting=1)
     with pytest.raises(lightoctree.InputError):
         lightoctree.render(SCENE, grid, width=8, height=8, texels="double")
+
+
+# The arguments are checked as the command's flags are: the same ranges, NaN
+# and the infinities refused, 0 "not given" where it is the default (NaN and
+# -1 used to become target_error's default without a word, and 1e-9 ran for
+# a minute). Each value goes to the module and to `lightoctree bake`: both
+# refuse it or both take it (the module then fails on the missing scene,
+# the command on the missing output folder: no bake runs).
+@pytest.mark.parametrize("argument, flag, value", [
+    ("target_error", "--target-error", v) for v in
+    (math.nan, math.inf, -math.inf, -1.0, 1e-9, 1e-4, 1.5, 1e-3, 0.07, 1.0)
+] + [
+    ("depth", "--depth", v) for v in (-1, 0, 13, 1, 12)
+] + [
+    ("knn", "--knn", v) for v in (0, 100001, 1, 100000)
+] + [
+    ("photons", "--photons", v) for v in (200000001, 1, 200000000)
+])
+def test_numeric_arguments_take_what_the_flags_take(argument, flag, value, tmp_path):
+    missing = str(tmp_path / "missing.gltf")
+    with pytest.raises(lightoctree.InputError) as refusal:
+        lightoctree.bake(missing, **{argument: value})
+    module_refused = str(refusal.value).startswith(argument + ": must be")
+    low, high = {"target_error": (1e-3, 1), "depth": (1, 12), "knn": (1, 100000),
+                 "photons": (1, 200000000)}[argument]
+    assert module_refused == (not low <= value <= high), str(refusal.value)
+    cli = os.environ.get("LIGHTOCTREE_CLI")
+    if not cli:
+        pytest.skip("LIGHTOCTREE_CLI not set (ctest sets it)")
+    import subprocess
+    run = subprocess.run([cli, "bake", SCENE, "-o", str(tmp_path / "no-folder" / "x.vdb"),
+                          flag, repr(value)], capture_output=True, text=True)
+    assert run.returncode in (1, 2), run.stderr
+    flag_refused = run.returncode == 2 and (flag + ": must be") in run.stderr
+    assert module_refused == flag_refused, (str(refusal.value), run.stderr)
+    assert not (tmp_path / "no-folder").exists()
+
+
+def test_convert_refuses_a_depth_it_would_have_ignored(grid):
+    with pytest.raises(lightoctree.InputError, match="depth: must be a whole number from 1 to 12, got -1"):
+        lightoctree.convert(grid, depth=-1)
+    with pytest.raises(lightoctree.InputError, match="depth"):
+        lightoctree.convert(grid, depth=13)
+    assert lightoctree.convert(grid).depth == grid.depth  # 0: the grid's own
+
+
+def test_a_path_with_a_nul_byte_names_no_file(grid, tmp_path):
+    """Python's open() refuses "\\0" in a path; the module did not, and the
+    system cut the path at it: write("a.vdb\\0.png") wrote a.vdb."""
+    target = tmp_path / "grid.vdb"
+    with pytest.raises(lightoctree.InputError, match=r"path: the path .*grid\.vdb\\0\.png' holds a NUL byte"):
+        lightoctree.write(str(target) + "\0.png", grid)
+    assert list(tmp_path.iterdir()) == []
+    lightoctree.write(str(target), grid)
+    for read in (lightoctree.read, lightoctree.inspect, lightoctree.read_image):
+        with pytest.raises(lightoctree.InputError, match="path: .*NUL byte"):
+            read(str(target) + "\0.exr")
+    with pytest.raises(lightoctree.InputError, match="scene: .*NUL byte"):
+        lightoctree.bake(SCENE + "\0.obj", depth=3, photons=1000)
+    with pytest.raises(lightoctree.InputError, match="scene: .*NUL byte"):
+        lightoctree.render(SCENE + "\0", grid, width=8, height=8)
+    with pytest.raises(lightoctree.InputError, match="scene: .*NUL byte"):
+        lightoctree.convert(grid, depth=5, scene=SCENE + "\0")

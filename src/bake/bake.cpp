@@ -216,18 +216,13 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
   return vdls;
 }
 
-void checkDepth(int depth, const std::string& what) {
-  if (depth < 1 || depth > kMaxGridDepth) {
-    throw InputError(what + " " + std::to_string(depth) + " is outside [1, " +
-                     std::to_string(kMaxGridDepth) + "]");
-  }
-}
+void checkDepth(int depth, const std::string& what) { checkNumber(depth, kDepthRange, what); }
 
 namespace {
 
 void checkParams(const BakeParams& p, int processes) {
   checkDepth(p.depth);
-  if (p.photons < 1) throw InputError("--photons must be at least 1");
+  checkNumber(double(p.photons), kPhotonsRange, "--photons");
   if (!(p.targetError >= 0) || !(p.targetError <= 1)) {
     throw InputError("--target-error " + formatNumber(p.targetError) +
                      " is outside (0, 1] (a relative error: 0.05 is 5%)");
@@ -251,7 +246,7 @@ void checkParams(const BakeParams& p, int processes) {
                      " bytes per stored photon), more than the " + formatBytes(available) +
                      " of memory available: store fewer photons");
   }
-  if (p.knn < 1) throw InputError("--knn " + std::to_string(p.knn) + " must be at least 1");
+  checkNumber(p.knn, kKnnRange, "--knn");
   if (!(p.radius >= 0.0f) || !std::isfinite(p.radius)) {
     throw InputError("--radius " + std::to_string(p.radius) + " must be a finite positive length");
   }
@@ -289,7 +284,9 @@ double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bo
 }
 
 void setPhotonBudget(BakeParams& params, size_t photons, double targetError) {
-  if (photons > 0 && targetError > 0) {
+  // 0 is "not given"; anything else is a target, checked (NaN is not 0).
+  if (targetError != 0) checkNumber(targetError, kTargetErrorRange, "--target-error");
+  if (photons > 0 && targetError != 0) {
     throw InputError("give photons (a fixed budget, --photons) or a target error (photons until "
                      "the noise reaches it, --target-error), not both");
   }
@@ -297,7 +294,7 @@ void setPhotonBudget(BakeParams& params, size_t photons, double targetError) {
     params.photons = photons;
     params.targetError = 0;
   } else {
-    params.targetError = targetError > 0 ? targetError : kDefaultTargetError;
+    params.targetError = targetError != 0 ? targetError : kDefaultTargetError;
   }
 }
 

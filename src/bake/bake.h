@@ -14,6 +14,7 @@
 
 #include "cluster/vdl_cluster.h"
 #include "cluster/volume_light.h"
+#include "core/number_range.h"
 #include "core/progress.h"
 #include "core/resources.h"
 #include "gather/gather.h"
@@ -38,8 +39,8 @@ VdlCount parseVdlCount(const std::string& text, const char* flag = "--vdls");
 /// The same check for a CLI validator: "" when valid, else the message.
 std::string vdlCountError(const std::string& text);
 
-/// @throws InputError "<what> N is outside [1, kMaxGridDepth]" unless
-/// 1 <= depth <= kMaxGridDepth: the one depth check of the bake module.
+/// @throws InputError "<what>: must be a whole number from 1 to 12, got N"
+/// unless kDepthRange holds `depth`: the one depth check of the bake module.
 void checkDepth(int depth, const std::string& what = "--depth");
 
 /// Memory a bake needs per stored photon (the map, its bins and the gather's
@@ -64,6 +65,17 @@ struct LevelParams;
 /// masked) against the paper's 600k at 1.0 s and 3.4%; 0.05 reaches 2.7%
 /// at 3.3 s, which real textured scenes pay 5-9x for.
 constexpr double kDefaultTargetError = 0.07;
+/// The noise targets a bake takes (`--target-error`, Python's target_error):
+/// 0.1% to 100%. The photons needed grow as 1/E^2: below 0.1% a bake of any
+/// scene runs for hours.
+constexpr NumberRange kTargetErrorRange{1e-3, 1.0};
+/// The photons a bake stores (`--photons`, `--max-photons`, Python's
+/// photons): up to 200 million, 24 GB (kBakeBytesPerPhoton each).
+constexpr NumberRange kPhotonsRange{1, 2e8, false, true};
+/// The nearest photons a voxel gathers (`--knn`, Python's knn).
+constexpr NumberRange kKnnRange{1, 1e5, false, true};
+/// The grid depths a bake takes (`--depth`, Python's depth; checkDepth).
+constexpr NumberRange kDepthRange{1, kMaxGridDepth, false, true};
 /// A target bake stores at most this many photons unless told otherwise
 /// (`--max-photons`), nor more than the memory available holds.
 constexpr size_t kDefaultMaxPhotons = 20000000;
@@ -308,7 +320,9 @@ double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bo
 /// The photon budget from the two ways of asking for one: `photons` > 0 a
 /// fixed budget, else photons until the noise figure reaches `targetError`
 /// (0: kDefaultTargetError). The command line and the Python module both ask
-/// through it. @throws InputError when both are given.
+/// through it. @throws InputError when both are given, or a target error
+/// other than 0 is outside kTargetErrorRange (NaN, a negative one: never
+/// taken as "not given").
 void setPhotonBudget(BakeParams& params, size_t photons, double targetError);
 
 /// Refuses, before any work, a grid at `frame` whose voxels

@@ -17,7 +17,7 @@ double lightGridEnergy(const LightGridVoxels& g) {
 ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
                                const ConvertParams& params, ProgressSink* progress) {
   const int inDepth = in.frame.depth;
-  const int depth = params.depth > 0 ? params.depth : inDepth;
+  const int depth = params.depth != 0 ? params.depth : inDepth;  // -1 is refused, not "the input's"
   checkDepth(depth);
   if (in.shTerms > 0) {
     throw InputError(std::string("convert works on VDL files; this one holds ") +

@@ -151,7 +151,16 @@ void writeBytes(const std::string& path, const std::string& tmp, const std::stri
 
 }  // namespace file_internal
 
+void checkPathText(const std::string& path, const std::string& name) {
+  if (path.find('\0') == std::string::npos) return;
+  std::string shown;
+  for (char c : path) shown += c == '\0' ? std::string("\\0") : std::string(1, c);
+  throw InputError(name + ": the path '" + shown +
+                   "' holds a NUL byte, where the system would end it (and name another file)");
+}
+
 void requireRegularFile(const std::string& path, const std::string& what) {
+  checkPathText(path, what);
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (ec || !fs::exists(status)) throw InputError(path + ": " + what + " does not exist");
@@ -162,6 +171,7 @@ void requireRegularFile(const std::string& path, const std::string& what) {
 }
 
 std::string readFile(const std::string& path) {
+  checkPathText(path, "cannot read");
   // A FIFO or a device would block or never end: only regular files are read.
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
@@ -229,6 +239,7 @@ bool isTemporaryPathFor(const std::string& candidate, const std::string& path) {
 }
 
 void checkOutputName(const std::string& path, const char* flag) {
+  checkPathText(path, flag);
   const std::string name = fs::path(path).filename().string();
   const size_t limit = nameMaxFor(path);
   if (name.size() > limit) {
@@ -300,6 +311,7 @@ AtomicFileSet::~AtomicFileSet() {
 void AtomicFileSet::add(const std::string& path,
                         const std::function<void(const std::string& tmp)>& write) {
   using namespace file_internal;
+  checkPathText(path, "cannot write");
   requireReplaceable(path);
   for (const Entry& e : entries_) {
     if (e.path == path) throw IoError(path + ": named twice in one set of output files");
@@ -422,6 +434,20 @@ void makeOutputFolder(const std::string& path, const char* flag) {
   }
 }
 
+namespace {
+
+/// `path` absolute, links and ".." resolved as far as it exists ("" for an
+/// empty path, the working folder): how outputs and inputs are compared.
+fs::path resolvedPath(const std::string& path) {
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(path.empty() ? fs::path(".") : fs::path(path), ec);
+  if (ec) return {};
+  const fs::path resolved = fs::weakly_canonical(absolute, ec);
+  return ec ? absolute.lexically_normal() : resolved;
+}
+
+}  // namespace
+
 void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs) {
   auto same = [](const std::string& a, const std::string& b) {
     std::error_code ec1, ec2;
@@ -429,9 +455,8 @@ void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs) {
       std::error_code ec;
       if (fs::equivalent(a, b, ec)) return true;
     }
-    std::error_code ea, eb;
-    const fs::path ca = fs::weakly_canonical(a, ea), cb = fs::weakly_canonical(b, eb);
-    return !ea && !eb && ca == cb;
+    const fs::path ca = resolvedPath(a), cb = resolvedPath(b);
+    return !ca.empty() && ca == cb;
   };
   for (size_t i = 0; i < outputs.size(); ++i) {
     const auto& [flag, path] = outputs[i];
@@ -446,6 +471,27 @@ void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs) {
       if (!outputs[j].second.empty() && same(path, outputs[j].second)) {
         throw InputError(flag + " and " + outputs[j].first + " name the same file '" + path +
                          "'");
+      }
+    }
+  }
+}
+
+void checkFolderOutputs(const std::string& folder,
+                        const std::function<std::string(const std::string& name)>& kindOf,
+                        const std::string& flag, const NamedPaths& inputs) {
+  const fs::path where = resolvedPath(folder);
+  for (const auto& [role, path] : inputs) {
+    if (path.empty()) continue;
+    // The input as named (a link in the folder is what a write there would
+    // replace) and as resolved (a link elsewhere to a file in the folder).
+    const fs::path named =
+        resolvedPath(fs::path(path).parent_path().string()) / fs::path(path).filename();
+    for (const fs::path& in : {named, resolvedPath(path)}) {
+      if (in.parent_path() != where) continue;
+      const std::string kind = kindOf(in.filename().string());
+      if (!kind.empty()) {
+        throw InputError(flag + ": the " + kind + " would replace the input " + role + " ('" +
+                         path + "'); write to another name");
       }
     }
   }

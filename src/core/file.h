@@ -19,6 +19,14 @@ namespace lo {
 /// pipe (only regular files are read)", or "... does not exist".
 void requireRegularFile(const std::string& path, const std::string& what);
 
+/// @brief The rule for a path handed over as text (a flag, an argument of the
+/// Python module): it holds no NUL byte, where the system would end it and
+/// read or write another file ("out.vdb\0.png" is "out.vdb"). The readers
+/// (requireRegularFile, readFile) and writers (checkOutputName, writeOutput)
+/// apply it too. @throws InputError "<name>: the path 'out.vdb\0.png' holds
+/// a NUL byte ...".
+void checkPathText(const std::string& path, const std::string& name);
+
 /// @brief The whole content of the file at `path`, as bytes.
 /// @throws IoError naming `path` when it cannot be opened or read.
 std::string readFile(const std::string& path);
@@ -74,6 +82,19 @@ using NamedPaths = std::vector<std::pair<std::string, std::string>>;  // (flag, 
 /// (the same file, by any name) or two outputs are the same file. Empty paths
 /// are skipped. Called by commands before any work.
 void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs);
+
+/// @brief checkDistinctFiles for outputs named by a rule rather than listed
+/// (numbered pages, saved frames, a results folder): `kindOf(name)` says what
+/// the command may write under the file name `name` in `folder` ("lightmap
+/// pages of 'out.glb'"; "" = nothing). Folders and inputs are compared as
+/// absolute paths with links resolved, so a bare name ("out.glb" in the
+/// scene's folder) is caught as surely as a full one.
+/// @throws InputError "<flag>: the <kind> would replace the input <role>
+/// ('<path>'); write to another name" when an input lies in `folder` under
+/// such a name. Called by commands before any work.
+void checkFolderOutputs(const std::string& folder,
+                        const std::function<std::string(const std::string& name)>& kindOf,
+                        const std::string& flag, const NamedPaths& inputs);
 
 /// @brief True when `path` ends in `extension` (".png"), ignoring ASCII case.
 bool hasExtension(const std::string& path, const char* extension);

@@ -295,23 +295,17 @@ void checkLightmapOutputs(const std::string& output, bool preview, const NamedPa
   // The longest name the set writes (up to 1,000 pages) must fit the file
   // system's limit, found now and not after the bake.
   checkOutputName(besideOutput(output, "-direction999.png"), "--output");
-  // The numbered outputs: pages, direction pages, chart images.
-  std::error_code ec;
-  const fs::path folder = fs::weakly_canonical(fs::absolute(fs::path(output).parent_path(), ec), ec);
+  // The numbered outputs: pages, direction pages, chart images. Every
+  // numbered name, whatever this export writes: it replaces them, or removes
+  // those an earlier export left (removeStaleSiblings).
   const std::string stem = fs::path(output).stem().string();
-  for (const auto& [what, path] : inputs) {
-    if (path.empty()) continue;
-    std::error_code e;
-    const fs::path in = fs::weakly_canonical(fs::absolute(path, e), e);
-    if (e || in.parent_path() != folder) continue;
-    // Every numbered name, whatever this export writes: it replaces them, or
-    // removes those an earlier export left (removeStaleSiblings).
-    if (const char* kind = lightmap_export_internal::numberedOutputKind(in.filename().string(), stem)) {
-      throw InputError("--output: the " + std::string(kind) +
-                       " of '" + output + "' would replace the input " + what + " ('" + path +
-                       "'); write to another name");
-    }
-  }
+  checkFolderOutputs(
+      fs::path(output).parent_path().string(),
+      [&](const std::string& name) -> std::string {
+        const char* kind = lightmap_export_internal::numberedOutputKind(name, stem);
+        return kind ? std::string(kind) + " of '" + output + "'" : std::string();
+      },
+      "--output", inputs);
 }
 
 std::string lightmapPagePath(const std::string& output, int page, bool rgbm) {

@@ -43,8 +43,6 @@ constexpr size_t kChunkPaths = 256;
 /// A path ends after this many rays whatever its bounce count (passes
 /// through thin walls do not count as bounces).
 constexpr uint32_t kMaxPathRays = 1024;
-constexpr size_t kMinBatchPaths = 4096;
-constexpr size_t kMaxBatchPaths = size_t(1) << 19;
 
 /// Per-triangle data read at every hit.
 struct TriangleInfo {
@@ -824,54 +822,6 @@ void PhotonTracer::trace(uint64_t first, size_t count, std::vector<Photon>& phot
   });
 }
 
-size_t photonBatchPaths(size_t target, size_t stored, size_t emitted, size_t maxEmitted) {
-  using namespace photon_internal;
-  if (emitted >= maxEmitted) return 0;
-  if (emitted == 0) return std::min(maxEmitted, std::clamp(target, kMinBatchPaths, size_t(65536)));
-  // Lights that reach (almost) nothing: the rate so far would store under
-  // 1% of the target by the last path a map may trace.
-  if (emitted >= kReachProbePaths &&
-      double(stored) * double(maxEmitted) < 0.01 * double(target) * double(emitted)) {
-    return 0;
-  }
-  // The paths the photons-per-path ratio so far says are still needed, plus
-  // a margin. Only the amount of wasted work depends on it.
-  double need = stored > 0 ? double(target - stored) * double(emitted) / double(stored) * 1.03 + 1024
-                           : 4.0 * double(emitted);
-  need = std::clamp(need, double(kMinBatchPaths), double(kMaxBatchPaths));
-  return std::min(maxEmitted - emitted, size_t(need));
-}
-
-void LightReach::add(uint32_t light, uint32_t stored) {
-  if (light >= paths.size()) {
-    paths.resize(light + 1, 0);
-    photons.resize(light + 1, 0);
-  }
-  ++paths[light];
-  photons[light] += stored;
-}
-
-std::vector<uint32_t> LightReach::darkLights(size_t minPaths) const {
-  std::vector<uint32_t> out;
-  for (size_t k = 0; k < paths.size(); ++k) {
-    if (paths[k] >= minPaths && photons[k] == 0) out.push_back(uint32_t(k));
-  }
-  return out;
-}
-
-std::vector<std::string> LightReach::dark(const std::vector<std::string>& names,
-                                          size_t minPaths) const {
-  std::vector<std::string> out;
-  for (uint32_t k : darkLights(minPaths)) {
-    if (k < names.size()) out.push_back(names[k] + ", " + formatCount(paths[k]) + " paths");
-  }
-  return out;
-}
-
-size_t maxEmittedPaths(const PhotonParams& params) {
-  return params.maxEmitted ? params.maxEmitted : 64 * params.storedPhotons;
-}
-
 PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressSink* progress) {
   PhotonTracer tracer(scene, params);
   PhotonMap map;
@@ -923,30 +873,6 @@ PhotonMap tracePhotons(const Scene& scene, const PhotonParams& params, ProgressS
   scalePhotonPower(map.photons, emitted);
   map.segments = collector.take();
   return map;
-}
-
-void scalePhotonPower(std::vector<Photon>& photons, size_t emittedPaths) {
-  const float invPaths = emittedPaths > 0 ? float(1.0 / double(emittedPaths)) : 0.0f;
-  for (Photon& ph : photons) ph.power *= invPaths;
-}
-
-bool SegmentCollector::addPath(const PhotonSegment* segments, uint32_t count) {
-  if (full_) return false;
-  if (segments_.size() + count > cap_) {
-    full_ = true;
-    return false;
-  }
-  segments_.insert(segments_.end(), segments, segments + count);
-  ++paths_;
-  return true;
-}
-
-std::vector<PhotonSegment> SegmentCollector::take() {
-  const float invPaths = paths_ > 0 ? float(1.0 / double(paths_)) : 0.0f;
-  for (PhotonSegment& segment : segments_) segment.power *= invPaths;
-  std::vector<PhotonSegment> out = std::move(segments_);
-  segments_ = std::vector<PhotonSegment>();
-  return out;
 }
 
 }  // namespace lo

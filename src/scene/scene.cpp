@@ -722,6 +722,7 @@ void checkCameras(const Scene& scene) {
 
 void validateScene(Scene& scene) {
   if (scene.triangleCount() == 0) fail(scene.sourcePath, "no triangles in the scene");
+  checkSkyRadiance(scene.sky, scene.sourcePath);
   checkSceneIndices(scene);
   // Coordinates the tracers can hold: Embree and the bake work in single
   // precision, in a frame centred on the scene; beyond kMaxCoordinate a
@@ -760,6 +761,31 @@ void validateScene(Scene& scene) {
 }
 
 }  // namespace scene_internal
+
+void checkSkyRadiance(const Sky& sky, const std::string& what) {
+  // The brightest texel above the horizon (the rows Sky::power sums), per channel.
+  Vec3 brightest{1, 1, 1};
+  if (sky.image) {
+    brightest = Vec3{0, 0, 0};
+    const int w = sky.image->width, h = sky.image->height;
+    for (int y = 0; y < h && skyPixelSolidAngle(y, w, h) > 0; ++y) {
+      for (int x = 0; x < w; ++x) brightest = max(brightest, sky.image->texel(x, y));
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    const double radiance = double(sky.radiance[c]) * double(brightest[c]);
+    if (!(radiance >= 0 && radiance <= double(kMaxRadiance))) {
+      throw InputError(what + ": the sky's radiance reaches " +
+                       scene_internal::formatLimit(radiance) + " W/(m^2 sr) in channel " +
+                       std::to_string(c) +
+                       (sky.image ? " (its scale " + scene_internal::formatLimit(sky.radiance[c]) +
+                                        " times its brightest texel above the horizon, " +
+                                        scene_internal::formatLimit(brightest[c]) + ")"
+                                  : "") +
+                       ", outside [0, " + scene_internal::formatLimit(kMaxRadiance) + "]");
+    }
+  }
+}
 
 void checkSceneIndices(const Scene& scene) {
   const std::string where = scene.sourcePath.empty() ? "scene" : scene.sourcePath;

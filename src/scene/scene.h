@@ -240,6 +240,14 @@ struct Sky {
 /// 2 x 2 or larger than 16384 x 8192, or holds a negative or non-finite value.
 std::shared_ptr<const Texture> loadSkyImage(const std::string& path);
 
+/// The one check of a sky's brightness, whatever made it (the scene file,
+/// --sky, --sky-image, --physical-sky, --sky-mesh), so that every command and
+/// the bake take the same skies: the radiance it gives in any direction above
+/// the horizon (Sky::radiance times the image's texel) is finite and at most
+/// kMaxRadiance, as emission is. Beyond it the bake's sky power overflows
+/// while the path tracer would still draw it. @throws InputError naming `what`.
+void checkSkyRadiance(const Sky& sky, const std::string& what);
+
 /// The texel (x, y) of a w x h sky image that direction `towards` looks at.
 void skyPixelOf(const Vec3& towards, int w, int h, int& x, int& y);
 /// The direction at (x + fx, y + fy) of a w x h sky image (fx, fy in [0, 1]).

@@ -236,5 +236,48 @@ TEST(SkySampler, DensityIntegratesToOneAndMatchesItsDraws) {
   EXPECT_TRUE(SkySampler(Sky{}).empty());
 }
 
+// The one check of a sky's brightness (checkSkyRadiance), which loadScene and
+// every command's sky flags apply, so that the path tracer and the bake take
+// the same skies: what it lets through has a finite power over the largest
+// scene (the bake's emitter), and the bright sky it refuses is one whose
+// power overflows (the bake refused that one late, the reference drew it).
+TEST(SkyRadiance, TheSkiesEveryCommandTakesHaveAFinitePower) {
+  Bounds3 largest;
+  largest.extend(Vec3(-kMaxCoordinate));
+  largest.extend(Vec3(kMaxCoordinate));
+  Sky uniform;
+  uniform.radiance = Vec3(kMaxRadiance);
+  EXPECT_NO_THROW(checkSkyRadiance(uniform, "--sky"));
+  EXPECT_TRUE(isFinite(uniform.power(largest)));
+  std::vector<Vec3> texels(8 * 4, Vec3(1.0f));
+  Sky image;
+  image.radiance = Vec3(kMaxRadiance);
+  image.image = std::make_shared<Texture>(Texture::fromLinear(8, 4, texels));
+  EXPECT_NO_THROW(checkSkyRadiance(image, "--sky-image"));
+  EXPECT_TRUE(isFinite(image.power(largest)));
+  // One texel of an HDR sun at 1e30 (finite, as loadSkyImage requires):
+  // its power over the largest scene overflows.
+  texels[1 * 8 + 3] = Vec3(1e30f);
+  image.radiance = {1, 1, 1};
+  image.image = std::make_shared<Texture>(Texture::fromLinear(8, 4, texels));
+  EXPECT_FALSE(isFinite(image.power(largest)));
+  test::expectRefusal(
+      [&] { checkSkyRadiance(image, "--sky-image 'sun.hdr'"); },
+      {"--sky-image 'sun.hdr': the sky's radiance reaches 1e+30", "brightest texel"});
+  // The same texel below the horizon is never seen: the sky is taken.
+  texels[1 * 8 + 3] = Vec3(1.0f);
+  texels[3 * 8 + 3] = Vec3(1e30f);
+  image.image = std::make_shared<Texture>(Texture::fromLinear(8, 4, texels));
+  EXPECT_NO_THROW(checkSkyRadiance(image, "--sky-image"));
+  // A scale times a texel beyond kMaxRadiance, each within it; a negative scale.
+  texels[3 * 8 + 3] = Vec3(3.0f);
+  texels[0] = Vec3(3.0f);
+  image.image = std::make_shared<Texture>(Texture::fromLinear(8, 4, texels));
+  image.radiance = Vec3(0.5f * kMaxRadiance);
+  EXPECT_THROW(checkSkyRadiance(image, "--sky"), InputError);
+  uniform.radiance = {1, -1, 1};
+  EXPECT_THROW(checkSkyRadiance(uniform, "--sky"), InputError);
+}
+
 }  // namespace
 }  // namespace lo
