@@ -149,7 +149,8 @@ void addCompareOptions(CLI::App* cmd, CompareOptions& opt) {
                   "error, and warns when the error measured is not above it")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--ignore-background", opt.ignoreBackground,
-                "Leave out pixels where the reference is exactly black");
+                "Leave out pixels where the reference is exactly black (by value: `reference "
+                "--geometry-mask` with --mask leaves out the background by what it shows)");
   cmd->add_option("--bin", opt.bin,
                   "Average both images (and the mask) over blocks of N x N pixels first: the "
                   "error at the scale of N pixels, without the reference's per-pixel noise "

@@ -77,11 +77,13 @@ int runReference(const ReferenceOptions& opt) {
   checkImageOutput(opt.output, "--output");
   if (!opt.stdErrorOutput.empty()) checkImageOutput(opt.stdErrorOutput, "--std-error");
   if (!opt.emitterMaskOutput.empty()) checkImageOutput(opt.emitterMaskOutput, "--emitter-mask");
+  if (!opt.geometryMaskOutput.empty()) checkImageOutput(opt.geometryMaskOutput, "--geometry-mask");
   if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
   const NamedPaths inputs = sceneInputs(opt);
   checkDistinctFiles({{"--output", opt.output},
                       {"--std-error", opt.stdErrorOutput},
                       {"--emitter-mask", opt.emitterMaskOutput},
+                      {"--geometry-mask", opt.geometryMaskOutput},
                       {"--json", opt.json}},
                      inputs);
   JsonReport report{"reference", inputs, {{"part", opt.part}, {"width", opt.width}, {"height", opt.height}}};
@@ -108,8 +110,9 @@ int runReference(const ReferenceOptions& opt) {
   ToneReport tone;
   writeTonedImage(opt.output, result.image, opt.picture.toneParams(), &outputs, &tone);
   if (!opt.stdErrorOutput.empty()) writeImage(opt.stdErrorOutput, result.stdError, 0.0f, &outputs);
-  if (!opt.emitterMaskOutput.empty()) {
-    writeImage(opt.emitterMaskOutput, result.emitterMask, 0.0f, &outputs);
+  if (!opt.emitterMaskOutput.empty()) writeImage(opt.emitterMaskOutput, result.emitterMask, 0.0f, &outputs);
+  if (!opt.geometryMaskOutput.empty()) {
+    writeImage(opt.geometryMaskOutput, result.geometryMask, 0.0f, &outputs);
   }
   if (!opt.json.empty()) {
     report.figures["samples_per_pixel"] = result.samplesPerPixel;

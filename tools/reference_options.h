@@ -24,6 +24,7 @@ struct ReferenceOptions : SceneFlags {
   std::string output;
   std::string stdErrorOutput;
   std::string emitterMaskOutput;
+  std::string geometryMaskOutput;
   CameraOptions camera;
   int width = 800, height = 600;  // as `render`, so that the images compare pixel for pixel
   int spp = 64;

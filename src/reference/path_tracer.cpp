@@ -514,6 +514,7 @@ ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
     }
   }
   result.emitterMask = RgbImage(params.width, params.height);
+  result.geometryMask = RgbImage(params.width, params.height);
   for (int y = 0; y < params.height; ++y) {
     for (int x = 0; x < params.width; ++x) {
       const float sx = (2.0f * (float(x) + 0.5f) / float(params.width) - 1.0f) * body.tanHalf *
@@ -521,11 +522,14 @@ ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
       const float sy = (1.0f - 2.0f * (float(y) + 0.5f) / float(params.height)) * body.tanHalf;
       const Vec3 dir = normalize(camera.forward + body.right * sx + camera.up * sy);
       Hit seen;
+      const bool surface = tracer.intersectFromCamera(camera.eye, dir, seen);
       const bool emitter =
-          tracer.intersectFromCamera(camera.eye, dir, seen) &&
-          scene.materials[size_t(scene.triangleMaterial[seen.triangle])].isEmissive();
+          surface && scene.materials[size_t(scene.triangleMaterial[seen.triangle])].isEmissive();
       const size_t i = size_t(y) * size_t(params.width) + size_t(x);
-      for (int c = 0; c < 3; ++c) result.emitterMask.rgb[3 * i + c] = emitter ? 0.0f : 1.0f;
+      for (int c = 0; c < 3; ++c) {
+        result.emitterMask.rgb[3 * i + c] = emitter ? 0.0f : 1.0f;
+        result.geometryMask.rgb[3 * i + c] = surface && !emitter ? 1.0f : 0.0f;
+      }
     }
   }
   result.raysTraced = rays.load();

@@ -74,6 +74,11 @@ struct ReferenceImage {
   /// octree and the path tracer define irradiance differently on a light
   /// fixture's own pixels, docs/accuracy.md).
   RgbImage emitterMask;
+  /// 1 where the ray through the pixel's centre meets a surface that does
+  /// not emit, 0 on the background (sky, nothing) and on emitters
+  /// (`reference --geometry-mask`): the pixels `compare --mask` judges, left
+  /// out by what the pixel sees, never by its value.
+  RgbImage geometryMask;
   int samplesPerPixel = 0;
   double seconds = 0;      ///< wall-clock rendering time
   uint64_t raysTraced = 0; ///< closest-hit plus shadow rays

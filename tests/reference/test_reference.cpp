@@ -479,5 +479,56 @@ TEST(Reference, UnlitIsSeenByTheCameraAloneAsItsColour) {
   EXPECT_NEAR(a.image.at(8 * 16 + 11).x, lit, 0.02f * lit);
 }
 
+
+// The geometry mask is what the pixel's centre sees, never its value: 1 on a
+// surface that does not emit, 0 on the background and on an emitter, checked
+// per pixel against the rays cast here (a grey quad on the left, a small
+// emitter in front on the right, nothing elsewhere).
+TEST(Reference, GeometryMaskIsWhatThePixelCentreSees) {
+  Scene scene;
+  Material grey;
+  grey.baseColor = {0.5f, 0.5f, 0.5f};
+  scene.materials.push_back(grey);
+  Material lamp;
+  lamp.emission = {4, 4, 4};
+  scene.materials.push_back(lamp);
+  test::addQuad(scene, {-1, -1, 0}, {1, 0, 0}, {0, 2, 0}, {0, 0, 1}, 0);
+  test::addQuad(scene, {0.2f, -0.1f, 0.5f}, {0.2f, 0, 0}, {0, 0.2f, 0}, {0, 0, 1}, 1);
+  const PinholeCamera camera = PinholeCamera::lookAt({0, 0, 2}, {0, 0, 0}, 1.0f);
+  ReferenceParams params = imageParams(40, 30, 1);
+  params.part = ReferencePart::Direct;
+  const ReferenceImage r = renderReference(scene, camera, params);
+  ASSERT_EQ(r.geometryMask.width, params.width);
+  const float tanHalf = std::tan(0.5f * camera.yfov), aspect = 40.0f / 30.0f;
+  size_t surface = 0, emitter = 0, background = 0;
+  for (int y = 0; y < params.height; ++y) {
+    for (int x = 0; x < params.width; ++x) {
+      const float sx = (2.0f * (float(x) + 0.5f) / float(params.width) - 1.0f) * tanHalf * aspect;
+      const float sy = (1.0f - 2.0f * (float(y) + 0.5f) / float(params.height)) * tanHalf;
+      // The ray (sx, sy, -1) from (0, 0, 2) meets z = c at t = 2 - c.
+      const float ex = sx * 1.5f, ey = sy * 1.5f;  // at the emitter's plane z = 0.5
+      const float qx = sx * 2.0f, qy = sy * 2.0f;  // at the quad's plane z = 0
+      float expected = 0;
+      if (ex > 0.2f && ex < 0.4f && ey > -0.1f && ey < 0.1f) {
+        ++emitter;
+      } else if (qx > -1 && qx < 0 && qy > -1 && qy < 1) {
+        expected = 1;
+        ++surface;
+      } else {
+        ++background;
+      }
+      const bool edge = std::fabs(ex - 0.2f) < 0.02f || std::fabs(ex - 0.4f) < 0.02f ||
+                        std::fabs(std::fabs(ey) - 0.1f) < 0.02f || std::fabs(qx) < 0.02f ||
+                        std::fabs(qx + 1) < 0.02f || std::fabs(std::fabs(qy) - 1) < 0.02f;
+      if (edge) continue;  // a centre on a border: either answer
+      EXPECT_EQ(r.geometryMask.rgb[3 * (size_t(y) * size_t(params.width) + size_t(x))], expected)
+          << x << ", " << y;
+    }
+  }
+  EXPECT_GT(surface, 100u);
+  EXPECT_GT(emitter, 2u);
+  EXPECT_GT(background, 100u);
+}
+
 }  // namespace
 }  // namespace lo
