@@ -51,6 +51,19 @@ inline float length(const Vec3& v) { return std::sqrt(dot(v, v)); }
 constexpr float lengthSquared(const Vec3& v) { return dot(v, v); }
 /// Unit vector along v; the zero vector stays zero (no NaN).
 inline Vec3 normalize(const Vec3& v) {
+  // Vectors whose squared length leaves float's normal range (sums of photon
+  // powers of 1e-20 W; or 1e20) are scaled by their largest component
+  // first: their squares would be denormal, or flushed to zero on threads
+  // that run with denormals off (as a ray tracer's worker may leave them),
+  // and the result would depend on the thread (a "unit" vector of length
+  // 1.005). Inside the range: the plain quotient, bit for bit as ever.
+  const float l2 = dot(v, v);
+  if (!(l2 > 1e-30f && l2 < 1e30f)) {
+    const float m = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
+    if (!(m > 0) || !std::isfinite(m)) return l2 > 0 && std::isfinite(l2) ? v / std::sqrt(l2) : Vec3{};
+    const Vec3 w = v / m;
+    return w / std::sqrt(dot(w, w));
+  }
   float l = length(v);
   return l > 0 ? v / l : Vec3{};
 }
