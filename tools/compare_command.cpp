@@ -22,6 +22,7 @@ struct CompareOptions {
   std::string referenceError;
   bool ignoreBackground = false;
   int bin = 1;
+  float clipPercentile = 100;
   std::string diff;
   float diffScale = 0;
   std::string json;
@@ -75,6 +76,14 @@ int runCompare(const CompareOptions& opt) {
                        std::to_string(reference.height));
     }
   }
+  // Black holes are judged per pixel against the reference as it is.
+  const DarkHoles holes = darkHoles(test, reference, params);
+  Vec3 clip(0.0f);
+  if (opt.clipPercentile < 100) {
+    clip = channelPercentiles(reference, opt.clipPercentile, params);
+    clipChannels(test, clip);
+    clipChannels(reference, clip);
+  }
   if (opt.bin > 1) {
     test = binImage(test, opt.bin);
     reference = binImage(reference, opt.bin);
@@ -89,6 +98,13 @@ int runCompare(const CompareOptions& opt) {
                                std::to_string(opt.bin)).c_str()
                             : "",
                 result.ToString().c_str());
+    std::printf("black holes: %zu of %zu pixels (%.3f%%) below 2%% of the reference's mean Y "
+                "where the reference is above 20%% of it\n",
+                holes.pixels, holes.compared, 100.0 * holes.share());
+    if (opt.clipPercentile < 100) {
+      std::printf("clipped first at the reference's %g-th percentile: R %.4g, G %.4g, B %.4g\n",
+                  double(opt.clipPercentile), double(clip.x), double(clip.y), double(clip.z));
+    }
     if (noise >= 0) {
       std::printf("reference noise: %.3g relative RMS standard error of Y over the same pixels%s\n",
                   noise, opt.bin > 1 ? " and bins" : "");
@@ -116,7 +132,12 @@ int runCompare(const CompareOptions& opt) {
     j["channels"] = {{"R", toJson(result.channel[0])},
                      {"G", toJson(result.channel[1])},
                      {"B", toJson(result.channel[2])},
-                     {"Y", toJson(result.luminance)}};
+                     {"Y", toJson(result.luminance)},
+                     {"RGB", toJson(result.rgb)}};
+    j["clip_percentile"] = opt.clipPercentile;
+    if (opt.clipPercentile < 100) j["clip"] = {clip.x, clip.y, clip.z};
+    j["black_hole_pixels"] = holes.pixels;
+    j["black_hole_share"] = holes.share();
     j["compared_pixels"] = result.comparedPixels;
     j["ignored_pixels"] = result.ignoredPixels;
     j["non_finite_pixels"] = result.nonFinitePixels;
@@ -156,6 +177,12 @@ void addCompareOptions(CLI::App* cmd, CompareOptions& opt) {
                   "error at the scale of N pixels, without the reference's per-pixel noise "
                   "(--diff is then at that resolution too)")
       ->check(wholeIn(1, 1024))
+      ->capture_default_str();
+  cmd->add_option("--clip-percentile", opt.clipPercentile,
+                  "Clip each channel of both images at the reference's P-th percentile (over the "
+                  "compared pixels) before binning and comparing, so that a few visible lamps do "
+                  "not rule the error (99 is the figure docs/accuracy.md quotes); 100 = off")
+      ->check(numberIn({0, 100, true}))
       ->capture_default_str();
   cmd->add_option("--diff", opt.diff,
                   "Write |Y(test) - Y(reference)| in false colour (.png or .exr): black 0, blue, "

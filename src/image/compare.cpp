@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 #include "core/error.h"
 
@@ -160,11 +161,56 @@ ImageNoise imageNoise(const RgbImage& image, const RgbImage& stdError) {
   return noise;
 }
 
+Vec3 channelPercentiles(const RgbImage& image, double p, const CompareParams& params) {
+  checkSizes(image, image, params);
+  if (!(p > 0 && p <= 100)) {
+    throw InputError("percentile " + std::to_string(p) + " is not in (0, 100]");
+  }
+  std::vector<float> values[3];
+  for (size_t i = 0; i < image.pixelCount(); ++i) {
+    if (pixelUse(image, image, params, i) != PixelUse::Compare) continue;
+    const Vec3 v = image.at(i);
+    for (int c = 0; c < 3; ++c) values[c].push_back(v[c]);
+  }
+  Vec3 out(0.0f);
+  if (values[0].empty()) return out;
+  // Nearest rank: the smallest value with at least p% of the values at or below it.
+  const size_t n = values[0].size();
+  const size_t rank = std::min(n, size_t(std::max(1.0, std::ceil(p / 100.0 * double(n))))) - 1;
+  for (int c = 0; c < 3; ++c) {
+    std::nth_element(values[c].begin(), values[c].begin() + std::ptrdiff_t(rank), values[c].end());
+    out[c] = values[c][rank];
+  }
+  return out;
+}
+
+void clipChannels(RgbImage& image, const Vec3& limit) {
+  for (size_t i = 0; i < image.rgb.size(); ++i) {
+    image.rgb[i] = std::min(image.rgb[i], limit[int(i % 3)]);
+  }
+}
+
+DarkHoles darkHoles(const RgbImage& test, const RgbImage& reference, const CompareParams& params,
+                    double darkFraction, double litFraction) {
+  checkSizes(test, reference, params);
+  const double mean = compareImages(test, reference, params).meanReferenceLuminance;
+  DarkHoles holes;
+  for (size_t i = 0; i < reference.pixelCount(); ++i) {
+    if (pixelUse(test, reference, params, i) != PixelUse::Compare) continue;
+    ++holes.compared;
+    if (luminance(test.at(i)) < darkFraction * mean &&
+        luminance(reference.at(i)) > litFraction * mean) {
+      ++holes.pixels;
+    }
+  }
+  return holes;
+}
+
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
                             const CompareParams& params) {
   checkSizes(test, reference, params);
   CompareResult r;
-  Accumulator acc[4];
+  Accumulator acc[4], pooled;
   double maxLum = -1, sumLum = 0, sumTestLum = 0;
   for (size_t i = 0; i < reference.pixelCount(); ++i) {
     PixelUse use = pixelUse(test, reference, params, i);
@@ -178,7 +224,10 @@ CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
     }
     ++r.comparedPixels;
     Vec3 a = test.at(i), b = reference.at(i);
-    for (int c = 0; c < 3; ++c) acc[c].add(a[c], b[c]);
+    for (int c = 0; c < 3; ++c) {
+      acc[c].add(a[c], b[c]);
+      pooled.add(a[c], b[c]);
+    }
     double ya = luminance(a), yb = luminance(b);
     acc[3].add(ya, yb);
     sumLum += yb;
@@ -191,6 +240,7 @@ CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
   }
   for (int c = 0; c < 3; ++c) r.channel[c] = acc[c].result();
   r.luminance = acc[3].result();
+  r.rgb = pooled.result();
   r.meanReferenceLuminance = r.comparedPixels ? sumLum / double(r.comparedPixels) : 0.0;
   r.meanTestLuminance = r.comparedPixels ? sumTestLum / double(r.comparedPixels) : 0.0;
   return r;
@@ -200,9 +250,9 @@ std::string CompareResult::ToString() const {
   std::ostringstream os;
   char line[160];
   os << "channel    rel.RMSE    rel.MAE     max.abs\n";
-  const char* names[4] = {"R", "G", "B", "Y"};
-  for (int c = 0; c < 4; ++c) {
-    const ChannelError& e = c < 3 ? channel[c] : luminance;
+  const char* names[5] = {"R", "G", "B", "Y", "RGB"};
+  for (int c = 0; c < 5; ++c) {
+    const ChannelError& e = c < 3 ? channel[c] : c == 3 ? luminance : rgb;
     std::snprintf(line, sizeof line, "%-8s %10.5f %10.5f %11.5g\n", names[c], e.relRmse, e.relMae,
                   e.maxAbs);
     os << line;

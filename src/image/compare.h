@@ -37,6 +37,10 @@ struct ChannelError {
 struct CompareResult {
   ChannelError channel[3];  ///< R, G, B
   ChannelError luminance;   ///< Rec. 709 Y of each pixel
+  /// R, G and B pooled: sqrt(sum over pixels and channels (a - b)^2 / sum b^2)
+  /// (and likewise the MAE): one figure for colour errors that luminance
+  /// averages away (a brown table drawn mauve-grey).
+  ChannelError rgb;
   size_t comparedPixels = 0;
   size_t ignoredPixels = 0;            ///< by the mask or as background
   size_t nonFinitePixels = 0;          ///< NaN/inf in either image: left out and counted
@@ -82,6 +86,31 @@ struct ImageNoise {
 };
 /// @throws InputError naming both sizes if they differ, or if the image is empty.
 ImageNoise imageNoise(const RgbImage& image, const RgbImage& stdError);
+
+/// The p-th percentile (0 < p <= 100, nearest rank) of each channel of
+/// `image` over the pixels `params` compares (against `image` itself).
+/// 0 when no pixel is compared.
+Vec3 channelPercentiles(const RgbImage& image, double p, const CompareParams& params = {});
+
+/// Every value of channel c clamped to at most limit[c]: the test and the
+/// reference clipped at the reference's 99th percentile compare the picture
+/// without letting a few visible lamps (thousands of times brighter than the
+/// walls) rule the RMSE.
+void clipChannels(RgbImage& image, const Vec3& limit);
+
+/// Black holes: compared pixels where the test's luminance is below
+/// `darkFraction` of the reference's mean while the reference's own is above
+/// `litFraction` of that mean: surfaces the reference lights that the test
+/// draws (nearly) black. Counted per pixel, before any binning.
+struct DarkHoles {
+  size_t pixels = 0;    ///< black holes
+  size_t compared = 0;  ///< pixels judged
+  double share() const { return compared ? double(pixels) / double(compared) : 0.0; }
+};
+/// @throws InputError if the sizes (or the mask's) differ or an image is empty.
+DarkHoles darkHoles(const RgbImage& test, const RgbImage& reference,
+                    const CompareParams& params = {}, double darkFraction = 0.02,
+                    double litFraction = 0.2);
 
 /// @throws InputError if the sizes (or the mask's) differ or an image is empty.
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,

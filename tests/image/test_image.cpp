@@ -84,6 +84,59 @@ TEST(Compare, MaskAndBackgroundAreIgnored) {
   EXPECT_EQ(diff.at(0), Vec3(0.0f));  // no error: black
 }
 
+TEST(Compare, PooledRgbErrorWeighsEveryChannel) {
+  // Reference grey 1; test (1.3, 1, 0.7): luminance nearly unchanged, the
+  // colour wrong: pooled RGB rel. RMSE = sqrt((0.09 + 0 + 0.09) / 3).
+  RgbImage ref(3, 2), test(3, 2);
+  std::fill(ref.rgb.begin(), ref.rgb.end(), 1.0f);
+  for (size_t i = 0; i < test.pixelCount(); ++i) test.set(i, Vec3(1.3f, 1.0f, 0.7f));
+  CompareResult r = compareImages(test, ref);
+  EXPECT_NEAR(r.rgb.relRmse, std::sqrt(0.18 / 3), 1e-6);
+  EXPECT_NEAR(r.rgb.relMae, 0.6 / 3, 1e-6);
+  EXPECT_LT(r.luminance.relRmse, 0.05);
+}
+
+TEST(Compare, PercentilesAreNearestRankOverTheComparedPixels) {
+  // Channel R holds 1..100 over 100 pixels, G 100..1, B 5: the 99th
+  // percentile is 99, the 50th 50 (nearest rank), the 100th the largest.
+  RgbImage img(10, 10);
+  for (size_t i = 0; i < 100; ++i) img.set(i, Vec3(float(i + 1), float(100 - i), 5.0f));
+  EXPECT_EQ(channelPercentiles(img, 99), Vec3(99, 99, 5));
+  EXPECT_EQ(channelPercentiles(img, 50), Vec3(50, 50, 5));
+  EXPECT_EQ(channelPercentiles(img, 100), Vec3(100, 100, 5));
+  EXPECT_EQ(channelPercentiles(img, 0.5), Vec3(1, 1, 5));
+  // A mask leaves the brightest pixels out of the count.
+  RgbImage mask(10, 10);
+  for (size_t i = 0; i < 50; ++i) mask.set(i, Vec3(1.0f));
+  CompareParams masked;
+  masked.mask = &mask;
+  EXPECT_EQ(channelPercentiles(img, 100, masked).x, 50.0f);
+  EXPECT_THROW(channelPercentiles(img, 0), InputError);
+  EXPECT_THROW(channelPercentiles(img, std::nan("")), InputError);
+  clipChannels(img, Vec3(10, 20, 1));
+  EXPECT_EQ(img.at(99), Vec3(10, 1, 1));
+  EXPECT_EQ(img.at(0), Vec3(1, 20, 1));
+}
+
+TEST(Compare, BlackHolesAreLitReferencePixelsTheTestDrawsBlack) {
+  // Reference: 90 pixels at 1, 10 at 0 (a corner no light reaches); mean 0.9.
+  // Test: 3 of the lit pixels black (holes), 2 at 0.01 (< 0.018: holes),
+  // 1 at 0.02 (not), the unlit 10 black (agreeing: not holes).
+  RgbImage ref(10, 10);
+  for (size_t i = 0; i < 90; ++i) ref.set(i, Vec3(1.0f));
+  RgbImage test = ref;
+  for (size_t i = 0; i < 3; ++i) test.set(i, Vec3(0.0f));
+  for (size_t i = 3; i < 5; ++i) test.set(i, Vec3(0.01f));
+  test.set(5, Vec3(0.02f));
+  DarkHoles holes = darkHoles(test, ref);
+  EXPECT_EQ(holes.pixels, size_t(5));
+  EXPECT_EQ(holes.compared, size_t(100));
+  EXPECT_NEAR(holes.share(), 0.05, 1e-12);
+  // Pixels the reference barely lights (below 20% of its mean) are not holes.
+  ref.set(0, Vec3(0.1f));
+  EXPECT_EQ(darkHoles(test, ref).pixels, size_t(4));
+}
+
 TEST(Compare, RejectsSizeMismatch) {
   EXPECT_THROW(compareImages(RgbImage(2, 2), RgbImage(2, 3)), InputError);
   RgbImage mask(1, 1);
