@@ -28,9 +28,12 @@ const int LO_LIGHT_DIRECTIONAL = 2;
 const int LO_LIGHT_EMITTER = 3; /* a virtual point light on an emissive triangle */
 const int LO_LIGHT_AREA = 4;    /* an emissive triangle: exact unshadowed irradiance, soft shadows */
 
-/* Emissive triangles drawn as area lights at most (each takes a cube of 6
- * shadow layers); a scene with more gets virtual point lights instead. */
+/* Emissive triangles drawn as area lights: at most LO_MAX_AREA_TRIANGLES
+ * one-sided triangles (a double-sided one counts twice), integrated exactly
+ * one by one, in at most LO_MAX_AREA_LIGHTS groups, each shadowed from one
+ * cube of 6 shadow layers; a scene with more gets virtual point lights. */
 const int LO_MAX_AREA_LIGHTS = 8;
+const int LO_MAX_AREA_TRIANGLES = 128;
 
 /* Cascaded shadow maps per directional light (layers of the shadow array;
  * the cascade uniforms are vec4s: at most 4). */

@@ -29,17 +29,20 @@ static_assert(sizeof(vec4) == 16 && sizeof(ivec4) == 16 && sizeof(mat4) == 64 &&
 
 /* One light. Render space: world minus the scene's centre. */
 struct GpuLight {
-  vec4 positionType;   /* xyz position, w type (LO_LIGHT_*) */
+  vec4 positionType;   /* xyz position (an area light's shadow cube), w type (LO_LIGHT_*) */
   vec4 directionRange; /* xyz unit direction light travels (spot, directional, emitter
-                          normal), w range (0 = none) */
+                          normal; a flat area light's front, else 0), w range (0 = none) */
   vec4 colorFar;       /* rgb: W/sr (point, spot, emitter at normal incidence), W/m^2
-                          (directional), W/(m^2 sr) (area); w shadow far */
+                          (directional), 0 (area: its triangles hold their radiance);
+                          w shadow far */
   vec4 params;         /* x cos outer, y cos inner, z first shadow layer (-1 = none),
                           w near-field area (m^2) */
-  vec4 corner0;        /* area light: the triangle's corners; corner0.w = sqrt(area) */
-  vec4 corner1;        /* w: the shadow map's tangent per texel (a texel's size at
+  vec4 corner0;        /* area light: xyz its box's lower corner (what lies in the box
+                          casts no shadow on it), w its size (the penumbra's light) */
+  vec4 corner1;        /* area light: xyz the box's upper corner; w (every shadowed
+                          light): the shadow map's tangent per texel (a texel's size at
                           distance 1 from the light) */
-  vec4 corner2;
+  vec4 corner2;        /* area light: x its first triangle in uAreaTriangles, y how many */
 };
 
 /* In GLSL the members are globals (uLights[i], ...); in C++ fields. */
@@ -48,6 +51,9 @@ LO_STD140_BLOCK(LightBlock) {
   mat4 uShadowMatrices[LO_MAX_SHADOW_LAYERS]; /* render space -> clip, per shadow layer */
   ivec4 uLightCount;  /* x lights, y of them area lights (the last y) */
   vec4 uShadowParams; /* x the least depth bias (fraction of far: two 16-bit steps), yzw 0 */
+  /* The area lights' one-sided triangles, three vec4 each: corners in xyz
+   * (wound to face where they emit), the radiance's R, G, B in the w's. */
+  vec4 uAreaTriangles[3 * LO_MAX_AREA_TRIANGLES];
 };
 
 #undef LO_STD140_BLOCK
@@ -67,8 +73,13 @@ static_assert(offsetof(LightBlock, uLightCount) ==
               "std140 LightBlock.uLightCount");
 static_assert(offsetof(LightBlock, uShadowParams) == offsetof(LightBlock, uLightCount) + 16,
               "std140 LightBlock.uShadowParams");
-static_assert(sizeof(LightBlock) == offsetof(LightBlock, uShadowParams) + 16,
+static_assert(offsetof(LightBlock, uAreaTriangles) == offsetof(LightBlock, uShadowParams) + 16,
+              "std140 LightBlock.uAreaTriangles");
+static_assert(sizeof(LightBlock) ==
+                  offsetof(LightBlock, uAreaTriangles) + 3 * LO_MAX_AREA_TRIANGLES * 16,
               "std140 LightBlock size");
+static_assert(sizeof(LightBlock) <= 16384,
+              "the light block within the least GL_MAX_UNIFORM_BLOCK_SIZE a GL 3.3 driver has");
 }  // namespace shader
 }  // namespace lo
 #endif

@@ -130,10 +130,13 @@ vec3 behindAlong(vec3 q, vec3 d) {
   if (uMode == LO_MODE_FULL || uMode == LO_MODE_DIRECT) {
     float nearest = tBox;
     vec3 emitted = vec3(-1.0);
-    for (int i = uLightCount.x - uLightCount.y; i < uLightCount.x; ++i) {
-      vec3 a = uLights[i].corner0.xyz, e1 = uLights[i].corner1.xyz - a,
-           e2 = uLights[i].corner2.xyz - a;
-      if (dot(d, uLights[i].directionRange.xyz) >= 0.0) continue;  // its back
+    // The area lights' triangles: the last light's range ends them.
+    int last = uLightCount.x - 1;
+    int triangles = uLightCount.y > 0 ? int(uLights[last].corner2.x + uLights[last].corner2.y) : 0;
+    for (int k = 0; k < triangles; ++k) {
+      vec3 a = uAreaTriangles[3 * k].xyz, e1 = uAreaTriangles[3 * k + 1].xyz - a,
+           e2 = uAreaTriangles[3 * k + 2].xyz - a;
+      if (dot(d, cross(e1, e2)) >= 0.0) continue;  // its back
       vec3 pv = cross(d, e2);
       float det = dot(e1, pv);
       if (abs(det) < 1e-12) continue;
@@ -144,7 +147,8 @@ vec3 behindAlong(vec3 q, vec3 d) {
       float t = dot(e2, qv) / det;
       if (b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 && t > 0.0 && t <= nearest) {
         nearest = t;
-        emitted = uLights[i].colorFar.rgb;
+        emitted = vec3(uAreaTriangles[3 * k].w, uAreaTriangles[3 * k + 1].w,
+                       uAreaTriangles[3 * k + 2].w);
       }
     }
     if (emitted.x >= 0.0) return emitted;

@@ -62,53 +62,67 @@ vec3 closestOnTriangle(vec3 p, vec3 a, vec3 b, vec3 c) {
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
-// Light reflected towards v from area light i: the exact irradiance of its
-// triangle, softly shadowed (areaShadow), through the BRDF.
+// Light reflected towards v from area light i: the exact irradiance of each
+// of its triangles through the BRDF, shadowed once for the group
+// (areaShadow, towards the irradiance-weighted centre of what p sees of it).
 vec3 areaLight(int i, vec3 p, vec3 n, vec3 v, vec3 baseColor, float metallic, float roughness) {
 #define L uLights[i]
-  // One-sided Lambertian emitter: nothing behind its plane is lit, and
-  // a point in the plane (the ceiling around a ceiling light) sees it at
-  // grazing incidence: nothing either (the clipped edge sum would be
-  // all rounding there).
-  if (dot(p - L.corner0.xyz, L.directionRange.xyz) <= 1e-3 * L.corner0.w) return vec3(0.0);
-  vec3 lightCentre;
-  float solid = polygonIrradiance(p, n, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz, lightCentre);
-  if (solid <= 0.0) return vec3(0.0);
-  vec3 la = normalize(lightCentre - p);
-  float visible = areaShadow(i, p, gGeometricNormal, la);
-  if (visible <= 0.0) return vec3(0.0);
-  // Diffuse: the lobe in the direction of the light's visible part times
-  // the exact projected solid angle.
-  vec3 diffuse, specular;
+  const vec3 kLuminance = vec3(0.2126, 0.7152, 0.0722);
+  int first = int(L.corner2.x);
+  int end = first + int(L.corner2.y);
   float a = loBrdfAlpha(roughness);
-  loBrdfLobes(n, v, la, baseColor, metallic, a, uTransmission, uDielectric, diffuse, specular);
-  if (!uSpecular) diffuse = loBrdfDiffuseOnly(baseColor, metallic, uTransmission);
-  vec3 f = diffuse * solid;
-  if (uSpecular) {
-    // Specular: a representative point (Karis 2013): the point of the
-    // triangle nearest the reflected ray, the GGX lobe evaluated towards
-    // it with its own alpha and scaled by (alpha / alpha')^2, alpha'
-    // widened by the light's angular radius: a glossy surface shows the
-    // light's shape, not a highlight of the lobe's size at its centre.
-    vec3 r = reflect(-v, n);
-    vec3 nE = L.directionRange.xyz;
-    float towards = dot(r, nE);
-    vec3 q = lightCentre;
-    if (towards < -1e-4) q = p + r * max(dot(L.corner0.xyz - p, nE) / towards, 0.0);
-    q = closestOnTriangle(q, L.corner0.xyz, L.corner1.xyz, L.corner2.xyz);
-    vec3 ls = normalize(q - p);
-    float nls = dot(n, ls);
-    if (nls > 0.0) {
-      float distance = length(lightCentre - p);
-      float radius = L.corner0.w * 0.5641896;  // sqrt(area / pi)
-      float wide = clamp(a + radius / (2.0 * distance), a, 1.0);
-      vec3 dRep, sRep;
-      loBrdfLobes(n, v, ls, baseColor, metallic, a, uTransmission, uDielectric, dRep, sRep);
-      float omega = solid / max(dot(n, la), 1e-4);  // the light's solid angle
-      f += sRep * (a * a / (wide * wide)) * nls * omega;
+  vec3 r = reflect(-v, n);
+  vec3 f = vec3(0.0);
+  vec3 towards = vec3(0.0);
+  for (int k = first; k < end; ++k) {
+    vec4 t0 = uAreaTriangles[3 * k], t1 = uAreaTriangles[3 * k + 1], t2 = uAreaTriangles[3 * k + 2];
+    vec3 cr = cross(t1.xyz - t0.xyz, t2.xyz - t0.xyz);
+    float twiceArea = length(cr);
+    vec3 nE = cr / twiceArea;
+    // One-sided Lambertian emitter: nothing behind its plane is lit, and a
+    // point in the plane (the ceiling around a ceiling light) sees it at
+    // grazing incidence: nothing either (the clipped edge sum would be all
+    // rounding there).
+    float side = sqrt(0.5 * twiceArea);
+    if (dot(p - t0.xyz, nE) <= 1e-3 * side) continue;
+    vec3 lightCentre;
+    float solid = polygonIrradiance(p, n, t0.xyz, t1.xyz, t2.xyz, lightCentre);
+    if (solid <= 0.0) continue;
+    vec3 radiance = vec3(t0.w, t1.w, t2.w);
+    vec3 la = normalize(lightCentre - p);
+    towards += la * (solid * dot(radiance, kLuminance));
+    // Diffuse: the lobe in the direction of the triangle's visible part
+    // times its exact projected solid angle.
+    vec3 diffuse, specular;
+    loBrdfLobes(n, v, la, baseColor, metallic, a, uTransmission, uDielectric, diffuse, specular);
+    if (!uSpecular) diffuse = loBrdfDiffuseOnly(baseColor, metallic, uTransmission);
+    vec3 c = diffuse * solid;
+    if (uSpecular) {
+      // Specular: a representative point (Karis 2013): the point of the
+      // triangle nearest the reflected ray, the GGX lobe evaluated towards
+      // it with its own alpha and scaled by (alpha / alpha')^2, alpha'
+      // widened by the triangle's angular radius: a glossy surface shows
+      // the light's shape, not a highlight of the lobe's size at its centre.
+      float facing = dot(r, nE);
+      vec3 q = lightCentre;
+      if (facing < -1e-4) q = p + r * max(dot(t0.xyz - p, nE) / facing, 0.0);
+      q = closestOnTriangle(q, t0.xyz, t1.xyz, t2.xyz);
+      vec3 ls = normalize(q - p);
+      float nls = dot(n, ls);
+      if (nls > 0.0) {
+        float distance = length(lightCentre - p);
+        float radius = side * 0.5641896;  // sqrt(area / pi)
+        float wide = clamp(a + radius / (2.0 * distance), a, 1.0);
+        vec3 dRep, sRep;
+        loBrdfLobes(n, v, ls, baseColor, metallic, a, uTransmission, uDielectric, dRep, sRep);
+        float omega = solid / max(dot(n, la), 1e-4);  // the triangle's solid angle
+        c += sRep * (a * a / (wide * wide)) * nls * omega;
+      }
     }
+    f += c * radiance;
   }
-  return f * L.colorFar.rgb * visible;
+  if (dot(towards, towards) <= 0.0) return vec3(0.0);
+  return f * areaShadow(i, p, gGeometricNormal, normalize(towards));
 #undef L
 }
 

@@ -43,11 +43,12 @@ float shadowBias(float texel, float far) { return max(0.5 * texel / far, uShadow
 // blocks nothing.
 // Distance / far of the receiver's tangent plane (through the light centre
 // lc's offset `plane` = (ps - lc).n) along the shadow-map direction of uv t,
-// or a negative value for directions behind the emitter (normal nE).
+// or a negative value for directions behind the emitter (normal nE; 0 for
+// a light that faces every way: a glowing cube).
 float receiverDepth(mat4 clipToRender, vec2 t, vec3 lc, vec3 n, vec3 nE, float plane, float far) {
   vec4 w = clipToRender * vec4(t * 2.0 - 1.0, 0.0, 1.0);
   vec3 dir = normalize(w.xyz / w.w - lc);
-  if (dot(dir, nE) <= 0.0) return -1.0;
+  if (dot(nE, nE) > 0.0 && dot(dir, nE) <= 0.0) return -1.0;  // nE = 0: a light facing every way
   float dn = dot(dir, n);
   float receiver = dn < -1e-4 || dn > 1e-4 ? plane / dn : far;
   return receiver > 0.0 ? min(receiver / far, 1.0) : 1.0;

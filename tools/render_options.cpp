@@ -91,8 +91,9 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
       ->check(wholeIn(1, kMaxVdls))
       ->capture_default_str();
   cmd->add_option("--area-lights", opt.areaLights,
-                  "Emissive triangles as area lights: exact irradiance, soft shadows (up to 8 "
-                  "triangles; more, or off: --emitter-lights point lights)")
+                  "Emissive triangles as area lights: exact irradiance of each, soft shadows "
+                  "(up to 128 one-sided triangles, a double-sided one counting twice; more, or "
+                  "off: --emitter-lights point lights)")
       ->check(onOff())
       ->capture_default_str();
   cmd->add_option("--emitter-lights", opt.emitterLights,

@@ -4,7 +4,10 @@
 #include "render/light_list.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <map>
 
 #include "scene/emitter_sampler.h"
 
@@ -26,30 +29,118 @@ float radicalInverse(uint32_t i) {
 
 }  // namespace
 
-std::vector<GpuLight> areaLights(const Scene& scene, const RenderSpace& space) {
-  std::vector<GpuLight> out;
+AreaLightSet areaLights(const Scene& scene, const RenderSpace& space) {
+  // The emissive triangles, a double-sided one as two one-sided ones.
+  struct Emitter {
+    Vec3 p[3];
+    Vec3 emission;
+    size_t triangle;
+  };
+  std::vector<Emitter> emitters;
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
     int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
     if (m < 0 || size_t(m) >= scene.materials.size()) continue;
     const Vec3 emission = scene.triangleEmission(t);
-    const float area = scene.triangleArea(t);
-    if (!(maxComponent(emission) > 0) || !(area > 0)) continue;
-    if (out.size() == size_t(shader::LO_MAX_AREA_LIGHTS)) return {};
-    const Vec3 p0 = space.toRender(scene.positions[scene.indices[t * 3]]);
-    const Vec3 p1 = space.toRender(scene.positions[scene.indices[t * 3 + 1]]);
-    const Vec3 p2 = space.toRender(scene.positions[scene.indices[t * 3 + 2]]);
-    const Vec3 n = scene.faceNormal(t);
+    if (!(maxComponent(emission) > 0) || !(scene.triangleArea(t) > 0)) continue;
+    Emitter e{{space.toRender(scene.positions[scene.indices[t * 3]]),
+               space.toRender(scene.positions[scene.indices[t * 3 + 1]]),
+               space.toRender(scene.positions[scene.indices[t * 3 + 2]])},
+              emission, t};
+    emitters.push_back(e);
+    if (scene.materials[size_t(m)].doubleSided) {
+      std::swap(e.p[1], e.p[2]);
+      emitters.push_back(e);
+    }
+    if (emitters.size() > size_t(shader::LO_MAX_AREA_TRIANGLES)) return {};
+  }
+  if (emitters.empty()) return {};
+
+  // Groups: triangles that share a corner (by position: a cube's faces
+  // have their own vertices) are one light; then the two groups whose
+  // merged box is smallest merge until LO_MAX_AREA_LIGHTS are left.
+  std::vector<size_t> parent(emitters.size());
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  auto root = [&parent](size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::map<std::array<float, 3>, size_t> corners;
+  for (size_t i = 0; i < emitters.size(); ++i) {
+    for (const Vec3& c : emitters[i].p) {
+      auto [it, inserted] = corners.emplace(std::array<float, 3>{c.x, c.y, c.z}, i);
+      if (!inserted) parent[root(i)] = root(it->second);
+    }
+  }
+  struct Group {
+    std::vector<size_t> members;
+    Bounds3 box;
+  };
+  std::map<size_t, Group> byRoot;
+  for (size_t i = 0; i < emitters.size(); ++i) {
+    Group& g = byRoot[root(i)];
+    g.members.push_back(i);
+    for (const Vec3& c : emitters[i].p) g.box.extend(c);
+  }
+  std::vector<Group> groups;
+  for (auto& [r, g] : byRoot) groups.push_back(std::move(g));
+  std::sort(groups.begin(), groups.end(),
+            [](const Group& a, const Group& b) { return a.members[0] < b.members[0]; });
+  while (groups.size() > size_t(shader::LO_MAX_AREA_LIGHTS)) {
+    size_t bestA = 0, bestB = 1;
+    float best = std::numeric_limits<float>::max();
+    for (size_t a = 0; a < groups.size(); ++a) {
+      for (size_t b = a + 1; b < groups.size(); ++b) {
+        Bounds3 merged = groups[a].box;
+        merged.extend(groups[b].box);
+        const float size = length(merged.upper - merged.lower);
+        if (size < best) best = size, bestA = a, bestB = b;
+      }
+    }
+    groups[bestA].box.extend(groups[bestB].box);
+    groups[bestA].members.insert(groups[bestA].members.end(), groups[bestB].members.begin(),
+                                 groups[bestB].members.end());
+    groups.erase(groups.begin() + std::ptrdiff_t(bestB));
+  }
+
+  AreaLightSet out;
+  const float eps = 1e-3f * space.sceneSize;
+  for (Group& g : groups) {
+    std::sort(g.members.begin(), g.members.end());
     GpuLight l{};
-    // The shadow cube sits at the triangle's centroid, just in front of it.
-    l.positionType =
-        toVec4((p0 + p1 + p2) / 3.0f + n * (1e-3f * space.sceneSize), float(shader::LO_LIGHT_AREA));
-    l.directionRange = toVec4(n, 0);
-    l.colorFar = toVec4(emission, 0);  // the mean radiance of a textured emitter
-    l.params = toVec4(Vec3(-1, 1, -1), area);
-    l.corner0 = toVec4(p0, std::sqrt(area));
-    l.corner1 = toVec4(p1, 0);
-    l.corner2 = toVec4(p2, 0);
-    out.push_back(l);
+    double area = 0;
+    Vec3 centroid(0.0f), facing(0.0f);
+    const int first = int(out.triangles.size() / 3);
+    for (size_t i : g.members) {
+      const Emitter& e = emitters[i];
+      const Vec3 c = cross(e.p[1] - e.p[0], e.p[2] - e.p[0]);
+      const float a = 0.5f * length(c);
+      area += a;
+      centroid += (e.p[0] + e.p[1] + e.p[2]) * (a / 3.0f);
+      facing += c * 0.5f;  // the normal times the area
+      out.triangles.push_back(toVec4(e.p[0], e.emission.x));
+      out.triangles.push_back(toVec4(e.p[1], e.emission.y));
+      out.triangles.push_back(toVec4(e.p[2], e.emission.z));
+    }
+    centroid /= float(area);
+    // A flat light (a quad, a panel) is seen from one side: its shadow
+    // cube sits just in front of it; a light that faces every way (a
+    // cube, a sphere, a double-sided sheet) has it at its centre. Its
+    // size for the shadow's penumbra: the side of a square of its
+    // silhouette's area (a convex body's mean silhouette is a quarter of
+    // its surface).
+    const float facingArea = length(facing);
+    const bool flat = facingArea > 0.5f * float(area);
+    const Vec3 front = flat ? facing / facingArea : Vec3(0.0f);
+    l.positionType = toVec4(centroid + front * eps, float(shader::LO_LIGHT_AREA));
+    l.directionRange = toVec4(front, 0);
+    l.colorFar = toVec4(Vec3(0.0f), 0);
+    l.params = toVec4(Vec3(-1, 1, -1), 0);
+    // The light's own box: what lies in it casts no shadow on its light
+    // (a cube's faces around its shadow cube's centre).
+    l.corner0 = toVec4(g.box.lower - Vec3(eps), std::sqrt(std::max(facingArea, float(area) / 4)));
+    l.corner1 = toVec4(g.box.upper + Vec3(eps), 0);
+    l.corner2 = toVec4(Vec3(float(first), float(g.members.size()), 0), 0);
+    out.lights.push_back(l);
   }
   return out;
 }

@@ -15,11 +15,23 @@ namespace lo::render_internal {
 using shader::GpuLight;
 using shader::LightBlock;
 
-/// Emissive triangles -> area lights (LO_LIGHT_AREA, render space), when
-/// there are at most LO_MAX_AREA_LIGHTS of them; else empty (they become
-/// VPLs). The shader integrates each exactly (unshadowed, Lambertian) and
-/// softens its shadow by the light's size (PCSS, see docs/render.md).
-std::vector<GpuLight> areaLights(const Scene& scene, const RenderSpace& space);
+/// The emissive triangles as area lights: `lights` (LO_LIGHT_AREA, render
+/// space), each a group of triangles that share corners (a quad, a cube, a
+/// neon tube), groups merged by proximity down to LO_MAX_AREA_LIGHTS; and
+/// `triangles`, the light block's uAreaTriangles: three vec4 per one-sided
+/// triangle, its corners in xyz (wound to face where it emits: a
+/// double-sided emitter is two triangles) and its mean radiance's R, G, B
+/// in their w. A light's triangles are corner2.x to corner2.x + corner2.y.
+/// The shader integrates each triangle exactly (unshadowed, Lambertian)
+/// and shadows the group once from one cube map at its centre, softened
+/// by its size (PCSS, see docs/render.md). Empty when the scene has none or
+/// more than LO_MAX_AREA_TRIANGLES of them (they become VPLs).
+struct AreaLightSet {
+  std::vector<GpuLight> lights;
+  std::vector<glm::vec4> triangles;
+  size_t triangleCount() const { return triangles.size() / 3; }
+};
+AreaLightSet areaLights(const Scene& scene, const RenderSpace& space);
 
 /// Emissive triangles -> `count` virtual point lights (LO_LIGHT_EMITTER,
 /// render space), chosen in proportion to emitted power by the tracers'

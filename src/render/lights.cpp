@@ -78,13 +78,15 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
   shadowMapSize = params.shadowMapSize;
   std::vector<GpuLight> lights;
   for (const Light& light : scene.lights) lights.push_back(punctualLight(light, space));
-  std::vector<GpuLight> emitters =
-      params.areaLights ? areaLights(scene, space) : std::vector<GpuLight>{};
+  AreaLightSet area = params.areaLights ? areaLights(scene, space) : AreaLightSet{};
+  std::vector<GpuLight> emitters = area.lights;
   if (emitters.empty()) {
     emitters = emitterVpls(scene, space, params.emitterLights);
     emitterLights = int(emitters.size());
   } else {
     areaLightCount = int(emitters.size());
+    areaTriangleCount = int(area.triangleCount());
+    std::copy(area.triangles.begin(), area.triangles.end(), block.uAreaTriangles);
   }
   lights.insert(lights.end(), emitters.begin(), emitters.end());
   if (lights.size() > size_t(kMaxLights)) {

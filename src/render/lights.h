@@ -25,7 +25,8 @@ struct SceneLights {
   GlProgram shadowProgram;
   int shadowMapSize = 1;
   int emitterLights = 0;   ///< VPLs in the block
-  int areaLightCount = 0;  ///< area lights in the block (the last ones)
+  int areaLightCount = 0;  ///< area lights in the block (the last ones): groups of triangles
+  int areaTriangleCount = 0;  ///< their triangles (uAreaTriangles)
   /// Directional lights with cascaded shadow maps (indices into the light
   /// block), their cascades refitted when the camera moves.
   std::vector<int> sunLights;
@@ -82,6 +83,14 @@ struct SceneLights {
   /// Points the shadow framebuffer at `layer` and clears it; the program's
   /// view-projection is that layer's matrix.
   void beginLayer(int layer, bool checkComplete);
+  /// The shadow program leaves out fragments inside [lower, upper] (empty
+  /// when lower > upper).
+  void setIgnoredBox(const glm::vec3& lower, const glm::vec3& upper) {
+    glUniform3fv(glGetUniformLocation(shadowProgram.get(), "uIgnoreLower"), 1,
+                 glm::value_ptr(lower));
+    glUniform3fv(glGetUniformLocation(shadowProgram.get(), "uIgnoreUpper"), 1,
+                 glm::value_ptr(upper));
+  }
   void fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
                           float yfov, float aspect, float znear, float zfar);
 
@@ -94,6 +103,11 @@ struct SceneLights {
       glUniform3fv(glGetUniformLocation(shadowProgram.get(), "uLightPosition"), 1,
                    glm::value_ptr(l.positionType));
       glUniform1f(glGetUniformLocation(shadowProgram.get(), "uFar"), l.colorFar[3]);
+      // An area light's own box casts no shadow on it (its centre may lie
+      // inside its triangles: a glowing cube); other lights ignore nothing.
+      const bool area = int(l.positionType[3]) == shader::LO_LIGHT_AREA;
+      setIgnoredBox(area ? glm::vec3(l.corner0) : glm::vec3(1.0f),
+                    area ? glm::vec3(l.corner1) : glm::vec3(0.0f));
       const int layers = shadowLayersOf(int(l.positionType[3]));
       for (int f = 0; f < layers; ++f) {
         beginLayer(int(l.params[2]) + f, true);
@@ -108,6 +122,7 @@ struct SceneLights {
   void renderCascades(GLuint vao, const DrawDepthOnly& draw) {
     const GLint previous = beginShadowPass(vao);
     glUniform1f(glGetUniformLocation(shadowProgram.get(), "uFar"), 0.0f);
+    setIgnoredBox(glm::vec3(1.0f), glm::vec3(0.0f));
     for (int light : sunLights) {
       const GpuLight& l = block.uLights[light];
       for (int c = 0; c < shader::LO_SUN_CASCADES; ++c) {

@@ -221,7 +221,8 @@ Renderer::~Renderer() = default;
 
 int Renderer::emitterLightCount() const { return impl_->lights.emitterLights; }
 
-int Renderer::areaLightCount() const { return impl_->lights.areaLightCount; }
+int Renderer::areaLightCount() const { return impl_->lights.areaTriangleCount; }
+int Renderer::areaLightGroups() const { return impl_->lights.areaLightCount; }
 
 void Renderer::setOctree(const GpuOctree& octree) {
   impl_->uploadOctree(octree);

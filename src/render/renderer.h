@@ -73,9 +73,10 @@ struct RendererParams {
   /// take hundreds of megabytes.
   int shadowMapSize = 1024;
   /// Emissive triangles are drawn as area lights (exact unshadowed irradiance
-  /// of each triangle, soft shadows by its size) when the scene has at most
-  /// LO_MAX_AREA_LIGHTS (shaders/render_constants.h) of them; else, or when
-  /// off, as `emitterLights` shadowed virtual point lights.
+  /// of each triangle; triangles that share corners, a quad or a glowing
+  /// cube, shadowed together, softly by their size) when the scene has at
+  /// most LO_MAX_AREA_TRIANGLES (shaders/render_constants.h) of them; else,
+  /// or when off, as `emitterLights` shadowed virtual point lights.
   bool areaLights = true;
   /// Emissive triangles become this many shadowed virtual point lights for the
   /// direct pass when they are not area lights (0 = none: then bake with
@@ -160,7 +161,8 @@ class Renderer {
   /// by factor or map, below the probe's cut-off, shaders/render_constants.h).
   bool hasReflectionProbe() const;
   int emitterLightCount() const;  ///< virtual point lights on emissive triangles
-  int areaLightCount() const;     ///< emissive triangles drawn as area lights
+  int areaLightCount() const;     ///< emissive triangles drawn as area lights (one-sided)
+  int areaLightGroups() const;    ///< their groups, each shadowed from one cube map
 
  private:
   struct Impl;

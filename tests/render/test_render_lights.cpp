@@ -180,6 +180,70 @@ TEST_F(RenderImage, AreaLightGivesTheExactIrradianceOfTheRectangle) {
   }
 }
 
+// An emissive mesh is an area light too: a glowing cube of 12 triangles
+// (more than a handful of points could stand for) lights the quad below it
+// with the exact irradiance of its faces, E = sum over the faces p sees of
+// L integral cos(theta) cos(theta') / r^2 dA, here integrated by brute force
+// over a fine grid of each face (a convex emitter: p sees exactly the faces
+// whose planes it is in front of), so each pixel is albedo E / pi. The
+// cube's own faces surround its shadow cube's centre and must cast no
+// shadow on it.
+TEST_F(RenderImage, AGlowingCubeLightsLikeTheIntegralOfItsFaces) {
+  QuadSetup s;
+  Material e;
+  e.baseColor = Vec3(0.0f);
+  const Vec3 radiance{2.0f, 1.0f, 3.0f};
+  e.emission = radiance;
+  s.scene.materials.push_back(e);
+  const int material = int(s.scene.materials.size()) - 1;
+  const Vec3 lo{0.0f, -0.15f, 0.05f};  // just above the quad: its faces are near
+  const float side = 0.2f;
+  const Vec3 ex{side, 0, 0}, ey{0, side, 0}, ez{0, 0, side};
+  struct Face {
+    Vec3 corner, u, v, normal;
+  };
+  const Face faces[6] = {{lo, ex, ey, {0, 0, -1}},      {lo + ez, ex, ey, {0, 0, 1}},
+                         {lo, ey, ez, {-1, 0, 0}},      {lo + ex, ey, ez, {1, 0, 0}},
+                         {lo, ex, ez, {0, -1, 0}},      {lo + ey, ex, ez, {0, 1, 0}}};
+  for (const Face& f : faces) test::addQuad(s.scene, f.corner, f.u, f.v, f.normal, material);
+  Renderer renderer(s.scene, test::emptyOctree());
+  ASSERT_EQ(renderer.areaLightCount(), 12);
+  ASSERT_EQ(renderer.areaLightGroups(), 1);
+  const RenderParams p = QuadSetup::directParams();
+  const RgbImage image = renderer.render(s.camera, p);
+  const float worldPerPixel = s.worldPerPixel(p, 2.0f);
+  // Columns beside the cube's image (it hides x in about [-0.02, 0.22]).
+  for (int offset : {-20, -12, -6, 6, 9, 14, 22}) {
+    const int px = p.width / 2 + offset, py = p.height / 2 + 3;
+    const double x = 0.1 + (px + 0.5 - 0.5 * p.width) * worldPerPixel;
+    const double y = -0.05 - (py + 0.5 - 0.5 * p.height) * worldPerPixel;
+    double E = 0;  // per unit radiance
+    const int n = 400;
+    for (const Face& f : faces) {
+      const double front = (x - f.corner.x) * f.normal.x + (y - f.corner.y) * f.normal.y +
+                           (0.0 - f.corner.z) * f.normal.z;
+      if (front <= 0) continue;
+      const double dA = double(side) * side / (double(n) * n);
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+          const Vec3 q = f.corner + f.u * float((i + 0.5) / n) + f.v * float((j + 0.5) / n);
+          const double dx = q.x - x, dy = q.y - y, dz = q.z;
+          const double r2 = dx * dx + dy * dy + dz * dz;
+          const double cosReceiver = dz / std::sqrt(r2);
+          const double cosEmitter = -(dx * f.normal.x + dy * f.normal.y + dz * f.normal.z) /
+                                    std::sqrt(r2);
+          if (cosReceiver > 0 && cosEmitter > 0) E += cosReceiver * cosEmitter / r2 * dA;
+        }
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double expected = s.albedo[c] * radiance[c] * E / kPi;
+      EXPECT_NEAR(image.pixel(px, py)[c], expected, 5e-3 * expected)
+          << "pixel " << px << ", channel " << c;
+    }
+  }
+}
+
 // Soft shadows: a straight blocker edge under the square light casts a
 // penumbra in which the visible fraction of the light (the image over the
 // image without the blocker) rises without steps (no bands) from the umbra

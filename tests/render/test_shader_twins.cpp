@@ -150,6 +150,7 @@ TEST(RenderLightBlock, GlLayoutMatchesCpp) {
   members.push_back({"uShadowMatrices[0]", offsetof(LightBlock, uShadowMatrices)});
   members.push_back({"uLightCount", offsetof(LightBlock, uLightCount)});
   members.push_back({"uShadowParams", offsetof(LightBlock, uShadowParams)});
+  members.push_back({"uAreaTriangles[0]", offsetof(LightBlock, uAreaTriangles)});
   std::vector<std::string> names;
   for (const Member& m : members) names.push_back(m.name);
   const std::vector<UniformLayout> layout = lightBlockLayout(names);
@@ -158,7 +159,8 @@ TEST(RenderLightBlock, GlLayoutMatchesCpp) {
     SCOPED_TRACE(members[i].name);
     EXPECT_EQ(layout[i].offset, int(members[i].offset));
   }
-  const UniformLayout& matrices = layout[layout.size() - 3];
+  const UniformLayout& matrices = layout[layout.size() - 4];
+  EXPECT_EQ(layout.back().arrayStride, 16);
   EXPECT_EQ(matrices.arrayStride, int(sizeof(glm::mat4)));
   EXPECT_EQ(matrices.matrixStride, 16);
 }
