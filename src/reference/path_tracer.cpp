@@ -252,7 +252,10 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng,
                                         hit.triangle, hit.b1, hit.b2);
     Vec3 albedo = ctx.scene->albedo(hit.triangle, hit.b1, hit.b2);
     if (lobes.hasSmoothLobe()) {
-      Vec3 l = sampleLights(ctx, p, normal, n, wo, lobes, albedo, rng, out.rays);
+      // The geometric normal on the side the path arrives from: the sky is
+      // sampled above it (a back face's sky lies below its winding).
+      Vec3 l = sampleLights(ctx, p, frontFace ? normal : -normal, n, wo, lobes, albedo, rng,
+                            out.rays);
       (depth == 1 ? out.direct : out.indirect) += beta * l;
     }
     BsdfSample sample;

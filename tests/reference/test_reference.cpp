@@ -105,13 +105,17 @@ TEST(Reference, FurnaceFullIsEmissionOverOneMinusAlbedo) {
   EXPECT_EQ(far, 0u);
 }
 
-TEST(Reference, SkyOverAnOpenFloorGivesAlbedoTimesL) {
+class ReferenceWinding : public ::testing::TestWithParam<float> {};
+
+TEST_P(ReferenceWinding, SkyOverAnOpenFloorGivesAlbedoTimesL) {
   // A Lambert floor of albedo a under a uniform sky of radiance L: the
   // irradiance is pi L, so the floor's radiance is a L, all of it direct
-  // light of vertex 1; looking up, the camera sees the sky itself.
+  // light of vertex 1; looking up, the camera sees the sky itself. Whichever
+  // way the floor is wound (a file's winding need not face the light: the
+  // sky is sampled above the side the path arrives from).
   Scene scene;
   const int floor = addMaterial(scene, Vec3(0.5f));
-  addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, 1, 0}, floor);
+  addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, GetParam(), 0}, floor);
   scene.sky.radiance = {0.4f, 0.8f, 1.6f};
   ReferenceParams params = imageParams(8, 8, 256);
   params.seed = 5;
@@ -134,6 +138,7 @@ TEST(Reference, SkyOverAnOpenFloorGivesAlbedoTimesL) {
       renderReference(scene, PinholeCamera::lookAt({0, 1, 0}, {0.01f, 2, 0}, 0.5f), params);
   for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(up.image.rgb[size_t(c)], scene.sky.radiance[c]);
 }
+INSTANTIATE_TEST_SUITE_P(UpAndDown, ReferenceWinding, ::testing::Values(1.0f, -1.0f));
 
 TEST(Reference, SkyImageOverAnOpenFloorGivesAlbedoTimesItsIrradiance) {
   // The image of Photons.SkyImageLightsAnOpenFloorWithItsCosineIntegral:
