@@ -237,7 +237,7 @@ DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat,
   range.specular = mat.specular;
   range.alphaMode = alphaModeOf(mat);
   range.alphaCutoff = mat.alphaCutoff;
-  range.doubleSided = mat.doubleSided;
+  range.doubleSided = mat.doubleSided || !mat.backFaceCulling;
   range.unlit = mat.unlit;
   if (usable(scene, mat.emissiveTexture, mat.emissiveTexCoord) && mat.isEmissive()) {
     range.emissiveTexture = useTexture(scene, mat.emissiveTexture, uploads);
@@ -348,7 +348,27 @@ void SceneGeometry::uploadVertices(const std::vector<Vertex>& vertices) {
 void SceneGeometry::drawDepthOnly(GLuint program, bool shadows) const {
   const GLint alphaTest = glGetUniformLocation(program, "uAlphaTest");
   glUniform1i(alphaTest, 0);
-  glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
+  // The camera's pre-pass culls what the colour pass culls (else a culled
+  // back face would keep its depth and show the background: a black hole);
+  // shadow maps see both sides.
+  auto cull = [shadows](const DrawRange& range) {
+    if (!shadows && !range.doubleSided) {
+      glEnable(GL_CULL_FACE);
+    } else {
+      glDisable(GL_CULL_FACE);
+    }
+  };
+  glFrontFace(GL_CCW);
+  glCullFace(GL_BACK);
+  if (shadows) {
+    glDrawArrays(GL_TRIANGLES, 0, opaqueCount);
+  } else {
+    for (size_t i = 0; i < ranges.size(); ++i) {
+      if (rangeCategory[i] != kSolid) continue;
+      cull(ranges[i]);
+      glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].count);
+    }
+  }
   glUniform1i(glGetUniformLocation(program, "uBaseColorTexture"), 4);
   const GLint hasTexture = glGetUniformLocation(program, "uHasBaseColorTexture");
   const GLint cutoff = glGetUniformLocation(program, "uAlphaCutoff");
@@ -363,8 +383,10 @@ void SceneGeometry::drawDepthOnly(GLuint program, bool shadows) const {
     glUniform1f(cutoff, rangeCategory[i] == kMasked ? (masked ? range.alphaCutoff : 0.0f) : 0.5f);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D, texture(range.texture));
+    cull(range);
     glDrawArrays(GL_TRIANGLES, range.first, range.count);
   }
+  glDisable(GL_CULL_FACE);
   if (shadows) {
     glUniform1i(alphaTest, 0);
     for (size_t i = 0; i < ranges.size(); ++i) {

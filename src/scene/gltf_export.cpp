@@ -591,7 +591,9 @@ class Exporter {
     } else if (m.alphaMode == AlphaMode::Blend) {
       g["alphaMode"] = "BLEND";
     }
-    if (m.doubleSided) g["doubleSided"] = true;
+    // A surface drawn from both sides (an OBJ face) stays so in glTF, unless
+    // it emits: glTF's doubleSided would make it emit from both sides too.
+    if (m.doubleSided || (!m.backFaceCulling && !m.isEmissive())) g["doubleSided"] = true;
     g["extras"]["lightmap"] = lightmapExtras(page);
     json pbr;
     if (lm_.unlit) {

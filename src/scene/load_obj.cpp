@@ -176,6 +176,7 @@ Scene loadObj(const std::string& path) {
     const tinyobj::material_t& o = objMaterials[i];
     Material m;
     m.name = o.name;
+    m.backFaceCulling = false;  // OBJ has no single-sided faces
     m.baseColor = rgb(o.diffuse);
     m.emission = rgb(o.emission);
     m.metallic = float(o.metallic);
@@ -315,6 +316,7 @@ Scene loadObj(const std::string& path) {
         defaultMaterial = int(scene.materials.size());
         Material m;
         m.name = "default";
+        m.backFaceCulling = false;
         scene.materials.push_back(m);
       }
       material = defaultMaterial;

@@ -164,6 +164,11 @@ struct Material {
   /// path tracer, shadows) treats every surface as two-sided except emission,
   /// which leaves one-sided emitters on their front only.
   bool doubleSided = false;
+  /// Whether the rasterisers may cull the back of a surface that is not
+  /// doubleSided: glTF's rule. An OBJ file has no such flag and DCC tools
+  /// and path tracers draw both sides of its faces, whatever their winding
+  /// (load_obj sets false): then every side of the surface is drawn.
+  bool backFaceCulling = true;
   /// KHR_materials_specular specularFactor: the weight of the dielectric's
   /// specular layer (its F0 comes from `ior`). 0: a pure Lambert base, in
   /// every renderer (scenes whose answers are analytic only for Lambert).

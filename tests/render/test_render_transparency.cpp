@@ -143,21 +143,35 @@ TEST_F(RenderImage, BlendedPaneCoversItsAlphaOfWhatIsBehind) {
 // glTF doubleSided false: a surface seen from behind is culled (the quad
 // behind it shows); doubleSided true: it is drawn.
 TEST_F(RenderImage, SingleSidedSurfaceIsCulledFromBehind) {
-  QuadSetup s;
-  Material pane;
-  pane.baseColor = {1, 1, 1};
-  s.scene.materials.push_back(pane);
-  // Its winding faces -z, away from the camera.
-  test::addQuad(s.scene, {-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, 1);
-  const RenderParams p = QuadSetup::params(false);
-  const GpuOctree octree = test::constantOctree();
-  const RgbImage culled = s.render(octree, p);
-  const float* c = culled.pixel(p.width / 2, p.height / 2);
-  EXPECT_NEAR(c[0] / c[2], s.albedo.x / s.albedo.z, 0.02f) << "the quad behind shows";
-  s.scene.materials[1].doubleSided = true;
-  const RgbImage drawn = s.render(octree, p);
-  const float* d = drawn.pixel(p.width / 2, p.height / 2);
-  EXPECT_NEAR(d[0] / d[2], 1.0f, 0.02f) << "the pane shows";
+  // With and without the depth pre-pass (interpolation or direct light on):
+  // the pre-pass culls what the colour pass culls, so the culled pane's
+  // depth never hides the quad behind it (a black hole).
+  for (bool prePass : {false, true}) {
+    SCOPED_TRACE(prePass ? "with the depth pre-pass" : "without it");
+    QuadSetup s;
+    Material pane;
+    pane.baseColor = {1, 1, 1};
+    s.scene.materials.push_back(pane);
+    // Its winding faces -z, away from the camera.
+    test::addQuad(s.scene, {-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, 1);
+    const RenderParams p = QuadSetup::params(prePass);
+    const GpuOctree octree = test::constantOctree();
+    const RgbImage culled = s.render(octree, p);
+    const float* c = culled.pixel(p.width / 2, p.height / 2);
+    EXPECT_GT(c[2], 0.0f) << "not the background";
+    EXPECT_NEAR(c[0] / c[2], s.albedo.x / s.albedo.z, 0.02f) << "the quad behind shows";
+    s.scene.materials[1].doubleSided = true;
+    const RgbImage drawn = s.render(octree, p);
+    const float* d = drawn.pixel(p.width / 2, p.height / 2);
+    EXPECT_NEAR(d[0] / d[2], 1.0f, 0.02f) << "the pane shows";
+    // A face of a format without single-sided faces (OBJ) shows from both
+    // sides too.
+    s.scene.materials[1].doubleSided = false;
+    s.scene.materials[1].backFaceCulling = false;
+    const RgbImage obj = s.render(octree, p);
+    const float* o = obj.pixel(p.width / 2, p.height / 2);
+    EXPECT_NEAR(o[0] / o[2], 1.0f, 0.02f) << "the OBJ pane shows";
+  }
 }
 
 }  // namespace

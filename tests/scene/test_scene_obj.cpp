@@ -45,6 +45,12 @@ TEST_F(SceneObj, MaterialMappingAndGrouping) {
   ASSERT_EQ(s.normals.size(), s.positions.size());
   for (const Vec3& n : s.normals) expectNear(n, {0, 0, 1}, 1e-6f, "normal");
   ASSERT_EQ(s.texcoords0.size(), 2 * s.positions.size());
+  // OBJ has no single-sided faces: both sides are drawn, whatever the
+  // winding; emission stays on the winding's side (not doubleSided).
+  for (const Material& m : s.materials) {
+    EXPECT_FALSE(m.backFaceCulling) << m.name;
+    EXPECT_FALSE(m.doubleSided) << m.name;
+  }
 }
 
 TEST_F(SceneObj, UndefinedMaterialIsWarnedOnceByName) {
