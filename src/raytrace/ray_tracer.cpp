@@ -6,6 +6,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -18,6 +19,9 @@ struct RayTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::vector<Vec3> faceNormals;
+  /// Per triangle: whether the rasteriser culls its back (a glTF material
+  /// not doubleSided): camera rays pass through it from behind.
+  std::vector<uint8_t> cullsBack;
   /// A copy of the scene when some material has alpha (Mask or Blend): the
   /// filter below reads its coverage; null otherwise (no filter installed).
   std::unique_ptr<Scene> alphaScene;
@@ -113,6 +117,14 @@ RayTracer::RayTracer(const Scene& scene, Objects objects) : impl_(std::make_uniq
   }
   impl_->faceNormals.resize(scene.triangleCount());
   for (size_t t = 0; t < scene.triangleCount(); ++t) impl_->faceNormals[t] = scene.faceNormal(t);
+  impl_->cullsBack.resize(scene.triangleCount());
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const int m = scene.triangleMaterial[t];
+    const bool culls = m >= 0 && size_t(m) < scene.materials.size() &&
+                       scene.materials[size_t(m)].backFaceCulling &&
+                       !scene.materials[size_t(m)].doubleSided;
+    impl_->cullsBack[t] = culls ? 1 : 0;
+  }
 
   impl_->device = rtcNewDevice(nullptr);
   if (!impl_->device) throw InternalError("rtcNewDevice failed (error " + errorCode(nullptr) + ")");
@@ -162,14 +174,22 @@ RayTracer::RayTracer(const Scene& scene, Objects objects) : impl_(std::make_uniq
 RayTracer::~RayTracer() = default;
 
 bool RayTracer::intersect(const Vec3& org, const Vec3& dir, Hit& hit, float tmax) const {
-  return trace(org, dir, hit, tmax, false);
+  return trace(org, dir, hit, 0.0f, tmax, false);
 }
 
 bool RayTracer::intersectFromCamera(const Vec3& org, const Vec3& dir, Hit& hit) const {
-  return trace(org, dir, hit, std::numeric_limits<float>::infinity(), true);
+  // Past the backs of culled faces, as the rasteriser draws them (a bounded
+  // number: a ray through a stack of culled sheets ends at the last).
+  float from = 0.0f;
+  for (int skipped = 0; skipped < 64; ++skipped) {
+    if (!trace(org, dir, hit, from, std::numeric_limits<float>::infinity(), true)) return false;
+    if (!impl_->cullsBack[hit.triangle] || dot(dir, hit.geometricNormal) < 0) return true;
+    from = std::nextafter(hit.t, std::numeric_limits<float>::infinity());
+  }
+  return true;
 }
 
-bool RayTracer::trace(const Vec3& org, const Vec3& dir, Hit& hit, float tmax,
+bool RayTracer::trace(const Vec3& org, const Vec3& dir, Hit& hit, float tmin, float tmax,
                       bool fromCamera) const {
   TracingContext context;
   rtcInitIntersectContext(&context.embree);
@@ -178,7 +198,7 @@ bool RayTracer::trace(const Vec3& org, const Vec3& dir, Hit& hit, float tmax,
   rh.ray.org_x = org.x;
   rh.ray.org_y = org.y;
   rh.ray.org_z = org.z;
-  rh.ray.tnear = 0.0f;
+  rh.ray.tnear = tmin;
   rh.ray.dir_x = dir.x;
   rh.ray.dir_y = dir.y;
   rh.ray.dir_z = dir.z;

@@ -47,12 +47,16 @@ class RayTracer {
                  float tmax = std::numeric_limits<float>::infinity()) const;
   /// True if anything lies along the ray with t in [0, tmax].
   bool occluded(const Vec3& org, const Vec3& dir, float tmax) const;
-  /// intersect for a ray from the camera: the only rays that see unlit
-  /// surfaces (Material::unlit); every other query passes through them.
+  /// intersect for a ray from the camera: what the rasteriser shows. The
+  /// only rays that see unlit surfaces (Material::unlit; every other query
+  /// passes through them), and rays that pass through the back of a face
+  /// whose material the rasteriser culls (glTF's doubleSided false); light
+  /// meets both sides of every surface.
   bool intersectFromCamera(const Vec3& org, const Vec3& dir, Hit& hit) const;
 
  private:
-  bool trace(const Vec3& org, const Vec3& dir, Hit& hit, float tmax, bool fromCamera) const;
+  bool trace(const Vec3& org, const Vec3& dir, Hit& hit, float tmin, float tmax,
+             bool fromCamera) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

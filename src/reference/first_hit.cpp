@@ -46,7 +46,7 @@ RgbImage renderFirstHits(const Scene& scene, const PinholeCamera& camera,
               const float sy = (1.0f - 2.0f * (float(y) + v) / float(params.height)) * tanHalf;
               const Vec3 dir = normalize(camera.forward + right * sx + camera.up * sy);
               Hit hit;
-              if (!tracer.intersect(camera.eye, dir, hit)) continue;
+              if (!tracer.intersectFromCamera(camera.eye, dir, hit)) continue;
               FirstHit first;
               first.position = camera.eye + dir * hit.t;
               first.normal =

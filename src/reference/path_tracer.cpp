@@ -211,8 +211,10 @@ inline PathRadiance tracePath(const Context& ctx, Vec3 org, Vec3 dir, Rng& rng,
   Hit hit;
   for (int depth = 1;; ++depth) {
     ++out.rays;
-    const RayTracer& tracer = depth == 1 && fromCamera ? *ctx.cameraTracer : *ctx.tracer;
-    if (!tracer.intersect(org, dir, hit)) {
+    const bool seen = depth == 1 && fromCamera
+                          ? ctx.cameraTracer->intersectFromCamera(org, dir, hit)
+                          : ctx.tracer->intersect(org, dir, hit);
+    if (!seen) {
       // Escaped: the sky's light, MIS-weighted against the sky's light
       // sample at the previous vertex (none after a mirror or glass). Seen by
       // the camera it is the background; at vertex 2 it is direct light of
@@ -315,7 +317,7 @@ inline Vec3 samplePixel(const Context& ctx, const PinholeCamera& cam, const Vec3
   // radiance arriving along it minus the emission of the surface it hits.
   Hit hit;
   ++rays;
-  if (!ctx.cameraTracer->intersect(cam.eye, dir, hit)) return Vec3{0, 0, 0};
+  if (!ctx.cameraTracer->intersectFromCamera(cam.eye, dir, hit)) return Vec3{0, 0, 0};
   Vec3 p = cam.eye + dir * hit.t;
   const Vec3& normal = hit.geometricNormal;
   Vec3 n = dot(dir, normal) < 0 ? normal : -normal;

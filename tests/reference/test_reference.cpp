@@ -116,6 +116,7 @@ TEST_P(ReferenceWinding, SkyOverAnOpenFloorGivesAlbedoTimesL) {
   Scene scene;
   const int floor = addMaterial(scene, Vec3(0.5f));
   addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, GetParam(), 0}, floor);
+  scene.materials[size_t(floor)].backFaceCulling = false;  // seen from either side (OBJ)
   scene.sky.radiance = {0.4f, 0.8f, 1.6f};
   ReferenceParams params = imageParams(8, 8, 256);
   params.seed = 5;
@@ -139,6 +140,35 @@ TEST_P(ReferenceWinding, SkyOverAnOpenFloorGivesAlbedoTimesL) {
   for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(up.image.rgb[size_t(c)], scene.sky.radiance[c]);
 }
 INSTANTIATE_TEST_SUITE_P(UpAndDown, ReferenceWinding, ::testing::Values(1.0f, -1.0f));
+
+TEST(Reference, TheCameraSeesWhatTheRasteriserShowsOfSingleSidedFaces) {
+  // A red pane between the camera and a grey floor under a white sky, its
+  // winding facing away from the camera: glTF's single-sided face is culled
+  // from behind, so the camera sees the grey floor (lit by the sky, which
+  // the pane still shadows a little: light meets both sides); double-sided,
+  // or an OBJ face, it sees the red pane.
+  Scene scene;
+  const int floor = addMaterial(scene, Vec3(0.5f));
+  const int pane = addMaterial(scene, Vec3(0.8f, 0.0f, 0.0f));
+  addQuad(scene, {-4, 0, -4}, {8, 0, 0}, {0, 0, 8}, {0, 1, 0}, floor);
+  addQuad(scene, {-0.1f, 0.9f, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, {0, -1, 0}, pane);
+  scene.sky.radiance = {1.0f, 1.0f, 1.0f};
+  ReferenceParams params = imageParams(4, 4, 64);
+  const PinholeCamera down = PinholeCamera::lookAt({0.001f, 1, 0}, {0, 0, 0}, 0.3f);
+  auto redOverBlue = [&]() {
+    const ReferenceImage r = renderReference(scene, down, params);
+    double red = 0, blue = 0, se = 0;
+    imageMean(r, 0, red, se);
+    imageMean(r, 2, blue, se);
+    return red / std::max(blue, 1e-9);
+  };
+  EXPECT_NEAR(redOverBlue(), 1.0, 0.05) << "culled: the grey floor";
+  scene.materials[size_t(pane)].doubleSided = true;
+  EXPECT_GT(redOverBlue(), 100.0) << "double-sided: the red pane";
+  scene.materials[size_t(pane)].doubleSided = false;
+  scene.materials[size_t(pane)].backFaceCulling = false;
+  EXPECT_GT(redOverBlue(), 100.0) << "never culled (OBJ): the red pane";
+}
 
 TEST(Reference, SkyImageOverAnOpenFloorGivesAlbedoTimesItsIrradiance) {
   // The image of Photons.SkyImageLightsAnOpenFloorWithItsCosineIntegral:
