@@ -257,6 +257,9 @@ void main() {
   float coverage = uAlphaMode == LO_ALPHA_BLEND ? clamp(alpha, 0.0, 1.0) : 1.0;
   vec3 emission = vEmission;
   if (uHasEmissiveTexture) emission *= texture(uEmissiveTexture, vEmissiveUv).rgb;
+  // A one-sided emitter shows its light on its front (the winding's side,
+  // where every tracer emits it) and none from behind.
+  if (!gl_FrontFacing && !uEmitsBothSides) emission = vec3(0.0);
   float metallic = vMetallicRoughness.x;
   float roughness = vMetallicRoughness.y;
   if (uHasMetallicRoughnessTexture) {

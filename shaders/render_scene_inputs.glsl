@@ -49,6 +49,7 @@ uniform float uOcclusionStrength;
 uniform sampler2D uEmissiveTexture;  // linear RGB emission map (sRGB decoded at load)
 uniform bool uHasEmissiveTexture;
 uniform float uEmissionScale;  // 1; 0 while the probe is captured if emitters are lights
+uniform bool uEmitsBothSides;  // glTF doubleSided: else emission shows on the winding's front only
 uniform int uAlphaMode;      // LO_ALPHA_OPAQUE, LO_ALPHA_MASK or LO_ALPHA_BLEND (glTF alphaMode)
 uniform float uAlphaCutoff;  // glTF alphaCutoff (mask)
 uniform float uTransmission;  // KHR_materials_transmission of this draw; 0 = opaque

@@ -63,6 +63,10 @@ struct DrawRange {
   int alphaMode = shader::LO_ALPHA_OPAQUE;
   float alphaCutoff = 0.5f;
   bool doubleSided = true;  ///< false: back faces culled from the camera's view (glTF)
+  /// Material::doubleSided: emission shows from both sides (else from the
+  /// winding's front only, as every tracer emits it; an OBJ face, never
+  /// culled, shows none from behind).
+  bool emitsBothSides = false;
   GLint first = 0;
   GLsizei count = 0;
   float transmission = 0;  ///< > 0: drawn after the opaque scene, see-through

@@ -238,6 +238,7 @@ DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat,
   range.alphaMode = alphaModeOf(mat);
   range.alphaCutoff = mat.alphaCutoff;
   range.doubleSided = mat.doubleSided || !mat.backFaceCulling;
+  range.emitsBothSides = mat.doubleSided;
   range.unlit = mat.unlit;
   if (usable(scene, mat.emissiveTexture, mat.emissiveTexCoord) && mat.isEmissive()) {
     range.emissiveTexture = useTexture(scene, mat.emissiveTexture, uploads);

@@ -205,7 +205,8 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
   GLuint p = 0;
   GLint hasTexture = -1, hasNormal = -1, normalScale = -1, hasMr = -1, hasOcclusion = -1,
         occlusionStrength = -1, transmission = -1, hasEmissive = -1, alphaMode = -1,
-        alphaCutoff = -1, thickness = -1, ior = -1, dielectric = -1, unlit = -1;
+        alphaCutoff = -1, thickness = -1, ior = -1, dielectric = -1, unlit = -1,
+        emitsBothSides = -1;
   // The program of a range, in use with its octree's textures bound.
   auto use = [&](GLuint program) {
     if (program == p) return;
@@ -231,6 +232,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
     ior = loc("uIor");
     dielectric = loc("uDielectric");
     unlit = loc("uUnlit");
+    emitsBothSides = loc("uEmitsBothSides");
   };
   // glTF: single-sided materials are culled from behind (counter-clockwise
   // winding in front, as the loader keeps it).
@@ -282,6 +284,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
     glUniform1f(ior, range.ior);
     glUniform2f(dielectric, range.dielectricF0, range.specular);
     glUniform1i(unlit, range.unlit ? 1 : 0);
+    glUniform1i(emitsBothSides, range.emitsBothSides ? 1 : 0);
     bind(GL_TEXTURE10, range.emissiveTexture);
     glActiveTexture(GL_TEXTURE0);
     glUniform1i(hasEmissive, range.emissiveTexture >= 0 ? 1 : 0);

@@ -174,5 +174,26 @@ TEST_F(RenderImage, SingleSidedSurfaceIsCulledFromBehind) {
   }
 }
 
+// Emission shows on an emitter's front only (its winding's side, where the
+// tracers emit it) unless it is double-sided: an OBJ lamp seen from behind
+// (never culled) is its dark base colour, not a glowing square.
+TEST_F(RenderImage, AOneSidedEmitterShowsNoLightFromBehind) {
+  QuadSetup s;
+  Material lamp;
+  lamp.baseColor = {0, 0, 0};
+  lamp.emission = {5, 5, 5};
+  lamp.backFaceCulling = false;
+  s.scene.materials.push_back(lamp);
+  // Its winding faces -z, away from the camera, towards the quad.
+  test::addQuad(s.scene, {-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, 1);
+  const RenderParams p = QuadSetup::directParams();
+  const GpuOctree octree = test::emptyOctree();
+  const float* back = s.render(octree, p).pixel(p.width / 2, p.height / 2);
+  EXPECT_LT(back[0], 0.05f) << "its back: no emission";
+  s.scene.materials[1].doubleSided = true;
+  const float* both = s.render(octree, p).pixel(p.width / 2, p.height / 2);
+  EXPECT_NEAR(both[0], 5.0f, 0.05f) << "double-sided: its emission";
+}
+
 }  // namespace
 }  // namespace lo
