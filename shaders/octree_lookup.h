@@ -267,6 +267,22 @@ LO_LOOKUP_FN bool loNearestLeaf(LO_TEX_PARAM vec3 q, vec3 n, int depth, float no
   return loLookupLeaf(LO_TEX voxel, depth, leaf);
 }
 
+/* Whether the light of a leaf's VDLs (the first maxVdls of `count` at
+ * `first`) reaches a surface facing ng at all: some of it arrives from above
+ * the surface's horizon, or the leaf holds none (a dark voxel is dark for
+ * every surface). A voxel all of whose light arrives from behind the surface
+ * lights another surface (the far side of a wall thinner than a voxel, the
+ * other face of an edge that no layer split off): in an interpolation it
+ * would count as darkness. */
+LO_LOOKUP_FN bool loLeafFaces(LO_TEX_PARAM uint first, int count, int maxVdls, vec3 ng) {
+  if (LO_SH_TERMS > 0 || count <= 0) return true;
+  int n = min(count, maxVdls);
+  for (int i = 0; i < n; ++i) {
+    if (dot(ng, loVdlDirection(loFetchVdl(LO_TEX first + uint(i)).a)) > 0.0f) return true;
+  }
+  return false;
+}
+
 /* The VDLs of voxel c that serve a surface point at q facing ng: its leaf
  * (loLookupLeaf), then the leaf's layer for the point (loLeafVdls). */
 LO_LOOKUP_FN bool loServingLeaf(LO_TEX_PARAM ivec3 c, vec3 q, vec3 ng, int depth,
@@ -318,10 +334,11 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
   int count;
   if (interpolation) {
     /* Trilinear over the 8 voxels around q (paper §4.2.1); empty neighbours,
-     * and layered ones without a layer for this surface (loLeafVdls), are
-     * left out and the remaining weights renormalized, so light never leaks
-     * in from empty space, through a thin wall or fades at the edge of the
-     * geometry. */
+     * layered ones without a layer for this surface (loLeafVdls) and those
+     * whose light all comes from behind it (loLeafFaces) are left out and
+     * the remaining weights renormalized, so light never leaks in from empty
+     * space or through a thin wall, and neither fades at the edge of the
+     * geometry nor darkens beside the far side of a thin wall. */
     vec3 f;
     ivec3 base = loTrilinearCell(q, f);
     vec3 sum = vec3(0.0f);
@@ -330,7 +347,8 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
       ivec3 o = loCellCorner(k);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      if (loServingLeaf(LO_TEX base + o, q, s.ng, depth, first, count)) {
+      if (loServingLeaf(LO_TEX base + o, q, s.ng, depth, first, count) &&
+          loLeafFaces(LO_TEX first, count, maxVdls, s.ng)) {
         sum += w * loShadeVdls(LO_TEX first, count, maxVdls, s);
         weightSum += w;
       }
@@ -393,7 +411,8 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
       ivec3 o = loCellCorner(k);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      if (loServingLeaf(LO_TEX base + o, q, n, depth, first, count)) {
+      if (loServingLeaf(LO_TEX base + o, q, n, depth, first, count) &&
+          loLeafFaces(LO_TEX first, count, maxVdls, n)) {
         e = loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, d);
         sum += w * e;
         directionSum += w * d;

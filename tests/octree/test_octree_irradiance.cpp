@@ -58,6 +58,13 @@ Vec3 decodedDirection(const GpuOctree& o, int k) {
   return s.vdls[k].direction;
 }
 
+/// The x of the decoded direction of the first VDL of the voxel at p.
+Vec3 decodedDirectionAt(const GpuOctree& o, const Vec3& p) {
+  OctreeSample s = lookupOctree(o, p);
+  EXPECT_TRUE(s.found);
+  return s.vdls[0].direction;
+}
+
 TEST(OctreeIrradiance, ConstantVdlGivesTheCosineLawEverywhereOnTheSlab) {
   const Vec3 c{2.0f, 1.0f, 0.5f};
   const Vec3 d = normalize(Vec3{0.3f, -0.2f, 1.0f});
@@ -106,6 +113,40 @@ TEST(OctreeIrradiance, InterpolationBlendsNeighboursTrilinearly) {
   p.interpolation = false;
   EXPECT_NEAR(octreeIrradiance(o, Vec3{3.5f, 3.5f, 0.75f} * kVoxel, {0, 0, 1}, p).x, 1.0f, 1e-6f);
   EXPECT_NEAR(octreeIrradiance(o, Vec3{3.5f, 3.5f, 1.25f} * kVoxel, {0, 0, 1}, p).x, 3.0f, 1e-6f);
+}
+
+TEST(OctreeIrradiance, ANeighbourLitOnlyFromBehindLendsNoDarkness) {
+  // A wall thinner than a voxel: the voxels x = 2 hold its inside face, lit
+  // from +x (irradiance 2); the voxels x = 1 its outside face, lit from -x
+  // only (5). A point of the inside face (normal +x) between the two columns'
+  // centres interpolates over both; the outside column's light all arrives
+  // from behind it, so it is left out: 2, not 2 x 0.6 (its weight counted as
+  // darkness), and never any of the outside's 5.
+  VdlGrid g;
+  g.frame.origin = {0, 0, 0};
+  g.frame.voxelSize = kVoxel;
+  g.frame.depth = 3;
+  g.maxVdls = kMaxVdls;
+  for (int x = 1; x <= 2; ++x)
+    for (int y = 0; y < 8; ++y)
+      for (int z = 0; z < 8; ++z) {
+        g.coords.push_back({x, y, z});
+        g.normals.push_back({x == 2 ? 1.0f : -1.0f, 0, 0});
+        g.vdlCount.push_back(1);
+        g.vdls.push_back(x == 2 ? vdl({2, 2, 2}, {1, 0, 0}) : vdl({5, 5, 5}, {-1, 0, 0}));
+        for (int i = 1; i < kMaxVdls; ++i) g.vdls.push_back(Vdl{});
+      }
+  const GpuOctree o = buildGpuOctree(g, test::paperCosine());
+  OctreeShadeParams p;
+  p.normalOffset = 0;
+  const float c = decodedDirectionAt(o, Vec3{2.5f, 3.5f, 3.5f} * kVoxel).x;
+  for (float x : {2.1f, 2.3f, 2.5f}) {
+    const Vec3 e = octreeIrradiance(o, Vec3{x, 3.5f, 3.5f} * kVoxel, {1, 0, 0}, p);
+    EXPECT_NEAR(e.x, 2.0f * c, 1e-4f) << "x = " << x;
+  }
+  // The outside face likewise sees only the outside's light.
+  const Vec3 out = octreeIrradiance(o, Vec3{1.9f, 3.5f, 3.5f} * kVoxel, {-1, 0, 0}, p);
+  EXPECT_NEAR(out.x, 5.0f * c, 1e-4f);
 }
 
 TEST(OctreeIrradiance, MaxVdlsAndHalfFloatTexels) {
@@ -191,9 +232,12 @@ TEST(OctreeIrradiance, FirstHitImageOfALitPlaneIsTheAnalyticValueAtEveryPixel) {
   for (size_t i = 0; i < image.pixelCount(); ++i)
     for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(image.at(i)[ch], expected[ch], 1e-5f) << i;
 
-  // The same plane turned over (normal -z): the camera still sees the side
-  // facing it, and the VDL from above lights it.
+  // The same plane turned over (normal -z), of a material never culled (an
+  // OBJ face; a glTF single-sided one the camera would not see from
+  // behind): the camera still sees the side facing it, and the VDL from
+  // above lights it.
   Scene flipped;
+  m.backFaceCulling = false;
   flipped.materials.push_back(m);
   test::addQuad(flipped, {0, 0, 0.3f * kVoxel}, {0, 8 * kVoxel, 0}, {8 * kVoxel, 0, 0}, {0, 0, -1},
                 0);
