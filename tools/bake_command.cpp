@@ -98,7 +98,7 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   if (!opt.photonMap.empty()) {
     StageTimer pointsTimer(rows, "write photon map");
     writePhotonPoints(opt.photonMap, baked.photons.photons, baked.grid.frame.voxelSize,
-                      scene.origin, &outputs);
+                      scene.origin, &outputs, baked.metadata.sourceSceneHash);
     pointsTimer.finish(opt.photonMap);
   }
 

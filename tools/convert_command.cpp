@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/bake.h"
 #include "bake/convert.h"
 #include "cli_checks.h"
 #include "command_options.h"
@@ -20,6 +21,7 @@
 #include "json_report.h"
 #include "report.h"
 #include "scene/scene.h"
+#include "scene/scene_files.h"
 #include "scene_options.h"
 #include "vdb/vdb_io.h"
 
@@ -123,12 +125,26 @@ int runConvert(const ConvertOptions& opt) {
     params.scene = &scene;
     loadTimer.finish(formatCount(scene.triangleCount()) + " triangles");
   }
+  // Every input made from a scene is checked against the scene given with it
+  // (the hashes of bake's metadata): a photon map of another scene was taken
+  // without a word, and lost 29% of the light.
+  const std::string sceneHash = opt.scene.empty() ? "" : sceneContentHash(opt.scene);
+  auto warn = [](const std::string& warning) {
+    if (!warning.empty()) std::fprintf(stderr, "warning: %s\n", warning.c_str());
+  };
+  if (!opt.scene.empty()) {
+    warn(sceneMismatchWarning("IN '" + opt.input + "'", in.meta.sourceSceneHash, opt.scene,
+                              sceneHash));
+  }
   std::vector<Photon> photons;
   if (!opt.photonMap.empty()) {
     StageTimer readTimer(rows, "read photon map");
-    photons = readPhotonPoints(opt.photonMap, in.grid.frame.offset);
+    std::string photonHash;
+    photons = readPhotonPoints(opt.photonMap, in.grid.frame.offset, &photonHash);
     params.photons = &photons;
     readTimer.finish(formatCount(photons.size()) + " photons");
+    const std::string what = "--photon-map '" + opt.photonMap + "'";
+    if (!opt.scene.empty()) warn(sceneMismatchWarning(what, photonHash, opt.scene, sceneHash));
   }
   ConvertResult out = convertLightGrid(in.grid, in.meta, params, &progress);
   rows.insert(rows.end(), out.stages.begin(), out.stages.end());

@@ -474,6 +474,15 @@ std::string staleBakeWarning(const BakeMetadata& meta, const std::string& sceneP
          "): bake again if the scene changed";
 }
 
+std::string sceneMismatchWarning(const std::string& what, const std::string& recordedHash,
+                                 const std::string& scenePath, const std::string& sceneHash) {
+  if (recordedHash.empty() || recordedHash == sceneHash) return "";
+  return what + " was made from a scene with content hash " + recordedHash + "; '" + scenePath +
+         "' and the files it reads have " + sceneHash +
+         ": it belongs to another scene, or to this one before it changed (its light may not "
+         "fit; bake again with this scene)";
+}
+
 LevelParams BakeParams::levelParams() const {
   LevelParams level;
   level.grid = gridParams();

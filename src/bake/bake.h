@@ -360,6 +360,14 @@ void recordSourceScene(BakeMetadata& meta, const std::string& scenePath);
 /// files have changed since (its light may no longer fit the scene).
 std::string staleBakeWarning(const BakeMetadata& meta, const std::string& scenePath);
 
+/// The same rule for any input made from a scene (a photon map, a `.vdb`
+/// given to `convert --scene`): "" when `recordedHash` is empty (not
+/// recorded) or equals `sceneHash` (sceneContentHash of the scene given
+/// with it); else a warning naming `what` and both hashes: the input was
+/// made from another scene, or from this one before it changed.
+std::string sceneMismatchWarning(const std::string& what, const std::string& recordedHash,
+                                 const std::string& scenePath, const std::string& sceneHash);
+
 
 /// @brief Bakes `scene` with `params` (paper §3.1). Deterministic. Without
 /// params.region, the scene's marked region (Scene::region) is the region.

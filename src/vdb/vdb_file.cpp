@@ -288,6 +288,39 @@ T metaValue(const std::string& path, const openvdb::MetaMap& meta, const std::st
         }
       }
     }
+    // Floats of the other width: pyopenvdb writes every Python float as a
+    // double and every tuple of them as a vec3d, so a file read and written
+    // back unchanged in Python holds doubles where we wrote floats; a file
+    // another tool wrote may hold floats where we wrote doubles.
+    auto narrowed = [&](double v) {
+      if (std::isfinite(v) && std::fabs(v) > double(std::numeric_limits<float>::max())) {
+        throw InputError(path + ": file metadata '" + key + "' = " + std::to_string(v) +
+                         " is beyond the range of a float");
+      }
+      return float(v);
+    };
+    if constexpr (std::is_same_v<T, float>) {
+      if (auto wide = openvdb::DynamicPtrCast<const openvdb::DoubleMetadata>(m)) {
+        return narrowed(wide->value());
+      }
+    }
+    if constexpr (std::is_same_v<T, double>) {
+      if (auto narrow = openvdb::DynamicPtrCast<const openvdb::FloatMetadata>(m)) {
+        return double(narrow->value());
+      }
+    }
+    if constexpr (std::is_same_v<T, openvdb::Vec3s>) {
+      if (auto wide = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>(m)) {
+        const openvdb::Vec3d v = wide->value();
+        return openvdb::Vec3s(narrowed(v.x()), narrowed(v.y()), narrowed(v.z()));
+      }
+    }
+    if constexpr (std::is_same_v<T, openvdb::Vec3d>) {
+      if (auto narrow = openvdb::DynamicPtrCast<const openvdb::Vec3SMetadata>(m)) {
+        const openvdb::Vec3s v = narrow->value();
+        return openvdb::Vec3d(double(v.x()), double(v.y()), double(v.z()));
+      }
+    }
     throw InputError(path + ": file metadata '" + key + "' has type " + m->typeName() +
                      ", expected " + openvdb::typeNameAsString<T>());
   }

@@ -21,6 +21,14 @@ struct Damage {
   /// Write this int32 as the file's format_version instead of kVdlFormatVersion
   /// (0 = leave the key out, as files written before it existed).
   int formatVersion = kVdlFormatVersion;
+  /// Every grid on a transform of this scale instead of the frame's voxel
+  /// size (0 = the frame's; negative mirrors the grid).
+  double scale = 0;
+  /// Write this as the file's depth metadata (0 = the grid's depth).
+  int metadataDepth = 0;
+  /// Every float metadata written as a double and every vec3s as a vec3d, as
+  /// pyopenvdb writes a file back.
+  bool doubleMetadata = false;
 };
 
 /// writeVdlGrid with damage applied (same metadata, same temp + rename).

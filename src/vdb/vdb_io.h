@@ -107,14 +107,22 @@ LoadedVdl readVdlGrid(const std::string& path,
 /// Cd (RGB power, W), direction (wi), normal, bounce. Temp name + rename.
 /// `offset`: Scene::origin of the photons' scene; the file's positions are
 /// world positions (offset + position, in double).
+/// `sourceSceneHash`: the content hash of the scene the photons were traced
+/// in (BakeMetadata::sourceSceneHash), written as file metadata
+/// "source_scene_hash" so that a reader can tell a photon map of another
+/// scene; "" writes none.
 void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
-                       const Vec3d& offset = Vec3d(), AtomicFileSet* into = nullptr);
+                       const Vec3d& offset = Vec3d(), AtomicFileSet* into = nullptr,
+                       const std::string& sourceSceneHash = "");
 
 /// Reads a photon file written by writePhotonPoints. Photons come back in the
 /// file's (leaf) order, which is deterministic but not the order written.
 /// @throws InputError naming the file when it cannot be read, holds no
 /// "photons" point grid or lacks one of the attributes.
 /// Positions come back relative to `origin` (computed in double).
-std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origin = Vec3d());
+/// `sourceSceneHash`, when given, receives the file's "source_scene_hash"
+/// ("" when the file carries none).
+std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origin = Vec3d(),
+                                     std::string* sourceSceneHash = nullptr);
 
 }  // namespace lo

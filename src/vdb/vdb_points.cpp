@@ -25,7 +25,7 @@ namespace {
 using openvdb::math::Transform;
 
 void writePoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
-                 const Vec3d& offset, AtomicFileSet* into) {
+                 const Vec3d& offset, AtomicFileSet* into, const std::string& sourceSceneHash) {
   if (!(voxelSize > 0) || !std::isfinite(voxelSize)) {
     throw InputError(path + ": photon point voxel size must be positive, got " +
                      std::to_string(voxelSize));
@@ -76,12 +76,22 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   meta.insertMeta("generator", openvdb::StringMetadata("lightoctree"));
   meta.insertMeta("version", openvdb::StringMetadata(LO_VERSION));
   meta.insertMeta("photons", openvdb::Int64Metadata(int64_t(n)));
+  // The scene the photons were traced in, as the .vdb records it: a reader
+  // given another scene can say so (convert --photon-map --scene).
+  if (!sourceSceneHash.empty()) {
+    meta.insertMeta("source_scene_hash", openvdb::StringMetadata(sourceSceneHash));
+  }
   writeVdbFile(path, {{"photons", [&grid] { return openvdb::GridBase::Ptr(grid); }}}, meta, into);
 }
 
-std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin) {
+std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin,
+                               std::string* sourceSceneHash) {
   namespace pts = openvdb::points;
   OpenedFile f = openFile(path);
+  if (sourceSceneHash) {
+    auto hash = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f.meta)["source_scene_hash"]);
+    *sourceSceneHash = hash ? hash->value() : "";
+  }
   if (!findGrid(f, "photons") && findGrid(f, gridNameOf(&VdlGrid::irradiance))) {
     throw InputError(path + ": is a VDL file (written by `lightoctree bake -o`), not a photon "
                      "file (`bake --photon-map`)");
@@ -165,13 +175,14 @@ PointFileInfo inspectPointFile(const std::string& path) {
 
 }  // namespace vdb_internal
 
-std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origin) {
-  return vdb_internal::readPoints(path, origin);
+std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origin,
+                                     std::string* sourceSceneHash) {
+  return vdb_internal::readPoints(path, origin, sourceSceneHash);
 }
 
 void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
-                       const Vec3d& offset, AtomicFileSet* into) {
-  vdb_internal::writePoints(path, photons, voxelSize, offset, into);
+                       const Vec3d& offset, AtomicFileSet* into, const std::string& sourceSceneHash) {
+  vdb_internal::writePoints(path, photons, voxelSize, offset, into, sourceSceneHash);
 }
 
 }  // namespace lo

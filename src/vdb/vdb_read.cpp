@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -42,8 +44,19 @@ GridFrame readFrame(const std::string& path, const Transform& xform, int depth,
     throw InputError(path + ": transform is " + xform.mapType() +
                      ", expected a uniform scale and translation");
   }
-  const double h = xform.voxelSize()[0];
+  // The size a voxel has, from the map itself (one index step along x), not
+  // the voxel size a file states beside it: a negative scale (a mirror), a
+  // NaN or a size the map does not have would place every voxel wrongly.
   const openvdb::Vec3d centre0 = xform.indexToWorld(openvdb::Vec3d(0.0));
+  const double h = (xform.indexToWorld(openvdb::Vec3d(1, 0, 0)) - centre0).x();
+  const openvdb::Vec3d stated = xform.voxelSize();
+  if (!(h > 0) || !std::isfinite(h) || !(float(h) >= std::numeric_limits<float>::min()) ||
+      !(std::fabs(stated[0] - h) <= 1e-6 * h)) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.6g (the file states %.6g)", h, stated[0]);
+    throw InputError(path + ": transform has voxel size " + text +
+                     ", expected a finite size > 0 (a uniform scale and translation)");
+  }
   GridFrame frame;
   frame.voxelSize = float(h);
   frame.origin = Vec3(float(centre0.x() - 0.5 * h - offset.x), float(centre0.y() - 0.5 * h - offset.y),
@@ -57,6 +70,32 @@ GridFrame readFrame(const std::string& path, const Transform& xform, int depth,
 template <typename T>
 using GridOf =
     std::conditional_t<std::is_same_v<T, Vec3> || std::is_same_v<T, Vdl>, Vec3SGrid, FloatGrid>;
+
+/// The depth the metadata states against the voxels: 2^depth voxels of the
+/// file's size span the cube the bake made around the scene's bounds (or its
+/// region), which the metadata records. A depth that is not the voxels' (a
+/// file edited to claim depth 6 over depth-4 voxels) makes that cube 2^k
+/// times too large or small, and `convert` would resample into a wrongly
+/// sized grid. Files without recorded bounds are taken as they are.
+void checkDepthAgainstBounds(const std::string& path, const BakeMetadata& meta,
+                             const GridFrame& frame) {
+  const Bounds3& bounds = meta.region.empty() ? meta.sceneBounds : meta.region;
+  if (bounds.empty() || !isFinite(bounds.lower) || !isFinite(bounds.upper)) return;
+  const double extent = double(maxComponent(bounds.upper - bounds.lower));
+  if (!(extent > 0)) return;
+  const double cube = double(frame.voxelSize) * double(1 << frame.depth);
+  const double ratio = cube / extent;
+  // Padding is 1% each side; a depth off by one level is a factor of 2.
+  if (ratio > 0.7 && ratio < 1.42) return;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "file metadata depth = %d over voxels of %.6g spans a cube of %.6g, where the "
+                "recorded %s is %.6g across: the voxels are of depth %.3g",
+                frame.depth, double(frame.voxelSize), cube,
+                meta.region.empty() ? "scene_bounds" : "region", extent,
+                std::log2(extent * 1.02 / double(frame.voxelSize)));
+  throw InputError(path + ": " + text + "; the file is inconsistent");
+}
 
 void checkTransform(const std::string& path, const openvdb::GridBase& grid, const Transform& xform) {
   if (!(grid.transform() == xform)) {
@@ -358,6 +397,9 @@ LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& 
 
   VdlGrid& g = out.grid;
   g.frame = readFrame(path, xform, out.meta.depth, origin.value_or(out.meta.sceneOrigin));
+  if (out.meta.depth >= 1 && out.meta.depth <= kMaxGridDepth) {
+    checkDepthAgainstBounds(path, out.meta, g.frame);
+  }
   if (origin) {
     // The metadata's bounds too, from the baked scene's origin to `origin`.
     const Vec3d from = out.meta.sceneOrigin;

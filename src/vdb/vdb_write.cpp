@@ -243,6 +243,11 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
                      std::to_string(grid.frame.voxelSize));
   }
   Transform::Ptr xform = frameTransform(grid.frame);
+  if (damage && damage->scale != 0) {
+    const openvdb::Vec3d centre0 = xform->indexToWorld(openvdb::Vec3d(0.0));
+    xform = Transform::createLinearTransform(damage->scale);
+    xform->postTranslate(centre0);
+  }
   if (damage && damage->rotateTransform) xform->postRotate(0.3, openvdb::math::Z_AXIS);
   std::vector<GridSource> sources;
   for (GridSource& source : vdlGridSources(grid, xform)) {
@@ -281,6 +286,24 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
     if (damage->formatVersion != 0) {
       fileMeta.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(damage->formatVersion));
     }
+  }
+  if (damage && damage->metadataDepth != 0) {
+    fileMeta.removeMeta(kMetaDepth);
+    fileMeta.insertMeta(kMetaDepth, openvdb::Int32Metadata(damage->metadataDepth));
+  }
+  if (damage && damage->doubleMetadata) {
+    openvdb::MetaMap wide;
+    for (auto it = fileMeta.beginMeta(); it != fileMeta.endMeta(); ++it) {
+      if (auto f = openvdb::DynamicPtrCast<openvdb::FloatMetadata>(it->second)) {
+        wide.insertMeta(it->first, openvdb::DoubleMetadata(double(f->value())));
+      } else if (auto v = openvdb::DynamicPtrCast<openvdb::Vec3SMetadata>(it->second)) {
+        const openvdb::Vec3s x = v->value();
+        wide.insertMeta(it->first, openvdb::Vec3DMetadata(openvdb::Vec3d(x.x(), x.y(), x.z())));
+      } else {
+        wide.insertMeta(it->first, *it->second);
+      }
+    }
+    fileMeta = wide;
   }
   writeVdbFile(path, sources, fileMeta, into);
 }

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/bake.h"
 #include "cluster/resample.h"
 #include "core/error.h"
 #include "core/rng.h"
@@ -449,6 +450,113 @@ TEST(Inspect, FreeSpaceGridsRoundTripAndTheirDamageIsRefused) {
   const std::string nan = damaged("nan", [](VolumeLight& v) { v.sh[5].x = std::nanf(""); });
   EXPECT_FALSE(inspectVdb(nan).ok());
   EXPECT_NE(readError(nan).find("volume_sh1"), std::string::npos) << readError(nan);
+}
+
+}  // namespace
+}  // namespace lo
+
+// Issue 43, family 7: mismatched inputs.
+namespace lo {
+namespace {
+
+/// meta() with the scene bounds the floor grid's cube was made from (depth 4,
+/// voxels of 0.0625: a cube of 1 = the bounds' extent and 1% each side).
+BakeMetadata metaWithBounds() {
+  BakeMetadata m = meta();
+  const float extent = 1.0f / 1.02f;
+  m.sceneBounds.lower = Vec3(-0.49f, -0.24f, 0.135f);
+  m.sceneBounds.upper = m.sceneBounds.lower + Vec3(extent, 0.1f, extent);
+  return m;
+}
+
+// A transform of negative (or no) size passed `inspect` and was refused by
+// `render` (the GPU octree); every reader now refuses it, with one message,
+// the one inspect's "readable" check shows.
+TEST(Inspect, AVoxelSizeTheReadersRefuseFailsInspectWithTheirMessage) {
+  const std::string dir = test::outputDir("Inspect.VoxelSize");
+  vdb_internal::Damage mirrored;
+  mirrored.scale = -0.0625;
+  vdb_internal::writeVdlGridDamaged(dir + "/negative.vdb", floorGrid(), meta(), mirrored);
+  const std::string refused = readError(dir + "/negative.vdb");
+  EXPECT_NE(refused.find("transform has voxel size -0.0625"), std::string::npos) << refused;
+  const VdbReport report = inspectVdb(dir + "/negative.vdb");
+  const VdbCheck* readable = findCheck(report, "readable");
+  ASSERT_NE(readable, nullptr);
+  EXPECT_FALSE(readable->passed);
+  EXPECT_EQ(readable->detail, refused);
+  EXPECT_FALSE(report.ok());
+}
+
+// Metadata claiming depth 6 over depth-4 voxels passed `inspect`, and
+// `convert` wrote a grid 4x too large. The voxels' size against the cube the
+// recorded bounds make tells: refused by every reader, named by inspect.
+TEST(Inspect, ADepthTheVoxelsDoNotHaveIsRefusedByEveryReader) {
+  const std::string dir = test::outputDir("Inspect.DepthLie");
+  // The honest file, with its bounds, passes: the check has no false alarm.
+  writeVdlGrid(dir + "/good.vdb", floorGrid(), metaWithBounds());
+  EXPECT_NO_THROW(readVdlGrid(dir + "/good.vdb"));
+  EXPECT_TRUE(inspectVdb(dir + "/good.vdb").ok());
+  for (int claimed : {6, 3}) {
+    vdb_internal::Damage lie;
+    lie.metadataDepth = claimed;
+    const std::string path = dir + "/depth" + std::to_string(claimed) + ".vdb";
+    vdb_internal::writeVdlGridDamaged(path, floorGrid(), metaWithBounds(), lie);
+    const std::string refused = readError(path);
+    EXPECT_NE(refused.find("file metadata depth = " + std::to_string(claimed)), std::string::npos)
+        << refused;
+    EXPECT_NE(refused.find("the voxels are of depth 4"), std::string::npos) << refused;
+    const VdbReport report = inspectVdb(path);
+    const VdbCheck* readable = findCheck(report, "readable");
+    ASSERT_NE(readable, nullptr);
+    EXPECT_FALSE(readable->passed);
+    EXPECT_EQ(readable->detail, refused);
+    EXPECT_FALSE(report.ok());
+  }
+}
+
+// A light .vdb read and written back unchanged by pyopenvdb holds doubles
+// (and vec3d) where the bake wrote floats (and vec3s): it was refused.
+TEST(VdbIo, FloatMetadataOfEitherWidthIsRead) {
+  const std::string dir = test::outputDir("VdbIo.DoubleMetadata");
+  BakeMetadata m = metaWithBounds();
+  m.radius = 0.15f;
+  m.region = m.sceneBounds;
+  vdb_internal::Damage python;
+  python.doubleMetadata = true;
+  vdb_internal::writeVdlGridDamaged(dir + "/python.vdb", floorGrid(), m, python);
+  LoadedVdl back;
+  ASSERT_NO_THROW(back = readVdlGrid(dir + "/python.vdb"));
+  EXPECT_EQ(back.meta.radius, 0.15f);
+  EXPECT_EQ(back.meta.sceneBounds.lower.x, m.sceneBounds.lower.x);
+  EXPECT_EQ(back.meta.region.upper.z, m.region.upper.z);
+  EXPECT_TRUE(inspectVdb(dir + "/python.vdb").ok());
+}
+
+// A photon map carries the hash of the scene it was traced in; a reader
+// given another scene is told (convert --photon-map --scene).
+TEST(PhotonPoints, CarryTheirScenesHash) {
+  const std::string dir = test::outputDir("PhotonPoints.SceneHash");
+  std::vector<Photon> photons(3);
+  for (size_t i = 0; i < photons.size(); ++i) {
+    photons[i].position = Vec3(float(i), 0, 0);
+    photons[i].power = Vec3(1.0f);
+    photons[i].direction = photons[i].normal = Vec3(0, 1, 0);
+  }
+  writePhotonPoints(dir + "/hashed.vdb", photons, 0.05f, Vec3d(), nullptr, "0123456789abcdef");
+  writePhotonPoints(dir + "/plain.vdb", photons, 0.05f);
+  std::string hash = "x";
+  EXPECT_EQ(readPhotonPoints(dir + "/hashed.vdb", Vec3d(), &hash).size(), 3u);
+  EXPECT_EQ(hash, "0123456789abcdef");
+  readPhotonPoints(dir + "/plain.vdb", Vec3d(), &hash);
+  EXPECT_EQ(hash, "");
+  // The warning: none when the hashes agree or none was recorded.
+  EXPECT_EQ(sceneMismatchWarning("--photon-map 'p.vdb'", "", "s.gltf", "1"), "");
+  EXPECT_EQ(sceneMismatchWarning("--photon-map 'p.vdb'", "1", "s.gltf", "1"), "");
+  const std::string warning = sceneMismatchWarning("--photon-map 'p.vdb'", "1", "s.gltf", "2");
+  EXPECT_NE(warning.find("--photon-map 'p.vdb' was made from a scene with content hash 1"),
+            std::string::npos)
+      << warning;
+  EXPECT_NE(warning.find("'s.gltf' and the files it reads have 2"), std::string::npos) << warning;
 }
 
 }  // namespace
