@@ -1,16 +1,93 @@
 // lightoctree: the command-line front end. Parses, calls the stages, reports.
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
+#include <iostream>
+#include <memory>
+#include <new>
+#include <string>
 
 #include "cli_checks.h"
 #include "commands.h"
+#include "core/file.h"
+#include "core/resources.h"
 
 namespace {
 
 /// Exit status of a command line the parser refuses (docs: README, "Exit status").
 constexpr int kUsageError = 2;
+
+/// The command being run ("bake"), for the messages of the last resort.
+std::string commandName;
+
+std::string program() { return commandName.empty() ? "lightoctree" : "lightoctree " + commandName; }
+
+/// What to lower when `command` ran out of memory.
+std::string memoryAdvice() {
+  if (commandName == "bake") {
+    return "use a smaller --depth, fewer --photons or --max-photons, or only the part that "
+           "matters (--bounds)";
+  }
+  if (commandName == "convert") return "use a smaller --depth";
+  if (commandName == "lightmap") return "use a larger --texel-size or a smaller --atlas";
+  if (commandName == "render" || commandName == "reference" || commandName == "view") {
+    return "use a smaller --width and --height, or a smaller scene";
+  }
+  if (commandName == "sweep") return "sweep smaller depths and photon counts";
+  return "give the process more memory";
+}
+
+/// A closed standard stream (a script's `>&-`) would be taken by the next file
+/// opened, and a report printed into a `.vdb`. Each one closed gets /dev/null
+/// opened for reading: nothing else can take it, and a write to it fails
+/// (EBADF) as it would on the closed stream, which finishOutput reports.
+void holdClosedStandardStreams() {
+  for (int fd = 0; fd <= 2; ++fd) {
+    if (::fcntl(fd, F_GETFD) != -1 || errno != EBADF) continue;
+    const int held = ::open("/dev/null", O_RDONLY);
+    if (held >= 0 && held != fd) {
+      ::dup2(held, fd);
+      ::close(held);
+    }
+  }
+}
+
+/// A report that did not reach standard output (a full disk, /dev/full, a
+/// closed stream) is a failure: a script reading it would get nothing, or
+/// half, with exit status 0. @returns `rc`, or 1 with a message.
+int finishOutput(int rc) {
+  std::cout.flush();
+  errno = 0;
+  const bool flushed = std::fflush(stdout) == 0;
+  const int error = errno;
+  if (flushed && !std::ferror(stdout) && !std::cout.fail()) return rc;
+  std::fprintf(stderr, "%s: error: cannot write to standard output%s%s: the report is lost\n",
+               program().c_str(), error ? ": " : "", error ? std::strerror(error) : "");
+  return rc == 0 ? 1 : rc;
+}
+
+/// Stops the process when its resident memory grows past
+/// LIGHTOCTREE_MEMORY_LIMIT: the estimates checked before the work (photons,
+/// voxels, pages) do not see everything that grows. Runs on the watch's
+/// thread, so it removes the temporary outputs itself and ends at once.
+void onMemoryLimit(size_t rss, size_t limit) {
+  std::fprintf(stderr,
+               "%s: error: out of memory: the process grew to %s, past "
+               "LIGHTOCTREE_MEMORY_LIMIT=%s (%s); stopped, nothing written: %s\n",
+               program().c_str(), lo::formatBytes(rss).c_str(),
+               std::getenv("LIGHTOCTREE_MEMORY_LIMIT"), lo::formatBytes(limit).c_str(),
+               memoryAdvice().c_str());
+  lo::removeLiveTemporaries();
+  std::fflush(stderr);
+  std::_Exit(1);
+}
 
 int run(int argc, char** argv) {
   CLI::App app{
@@ -38,6 +115,9 @@ int run(int argc, char** argv) {
     // tools do (the parser's own codes, 105-109, say nothing to a script).
     return app.exit(e) == 0 ? 0 : kUsageError;
   }
+  for (const CLI::App* sub : app.get_subcommands()) commandName = sub->get_name();
+  const size_t limit = lo::memoryLimitSetting();
+  const lo::MemoryWatch watch(limit, [limit](size_t rss) { onMemoryLimit(rss, limit); });
   for (auto& command : commands) {
     int rc = command();
     if (rc >= 0) return rc;
@@ -48,10 +128,23 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  holdClosedStandardStreams();
   try {
-    return run(argc, argv);
+    return finishOutput(run(argc, argv));
+  } catch (const std::bad_alloc&) {
+    // The checks before the work compare estimates with the memory available
+    // (the machine's, the cgroup's, ulimit -v, LIGHTOCTREE_MEMORY_LIMIT);
+    // what they missed ends here, said plainly.
+    std::fprintf(stderr,
+                 "%s: error: out of memory (an allocation failed): the machine or the "
+                 "process's limits (ulimit -v, the container's, LIGHTOCTREE_MEMORY_LIMIT) "
+                 "hold less than this run needs: %s\n",
+                 program().c_str(), memoryAdvice().c_str());
+    finishOutput(1);
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "lightoctree: error: %s\n", e.what());
+    finishOutput(1);
     return 1;
   }
 }

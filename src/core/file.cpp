@@ -11,6 +11,7 @@
 #include <array>
 #include <atomic>
 #include <cctype>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -19,6 +20,7 @@
 #include <mutex>
 #include <random>
 #include <system_error>
+#include <thread>
 
 #include "core/error.h"
 
@@ -150,6 +152,18 @@ void writeBytes(const std::string& path, const std::string& tmp, const std::stri
 }
 
 }  // namespace file_internal
+
+void removeLiveTemporaries() {
+  using namespace file_internal;
+  // A set being renamed ends its renames first (a few system calls), as a
+  // signal waits for them: the set is then whole.
+  for (int i = 0; i < 1000 && committing.load() != 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  for (Slot& s : slots) {
+    if (s.state.load() == 2) ::unlink(s.path);
+  }
+}
 
 void checkPathText(const std::string& path, const std::string& name) {
   if (path.find('\0') == std::string::npos) return;

@@ -96,6 +96,11 @@ void checkFolderOutputs(const std::string& folder,
                         const std::function<std::string(const std::string& name)>& kindOf,
                         const std::string& flag, const NamedPaths& inputs);
 
+/// @brief Removes every temporary output file this process has open now (those
+/// a signal would remove), for a process about to end at once (_exit) from a
+/// thread that cannot unwind the writers: the memory watch of the CLI.
+void removeLiveTemporaries();
+
 /// @brief True when `path` ends in `extension` (".png"), ignoring ASCII case.
 bool hasExtension(const std::string& path, const char* extension);
 

@@ -15,6 +15,10 @@
 #include <sstream>
 #include <string>
 #include <utility>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <cstdint>
 
 #include "core/error.h"
 
@@ -98,6 +102,47 @@ std::string formatCount(size_t n) {
   return s;
 }
 
+size_t memoryLimitSetting() {
+  // LIGHTOCTREE_MEMORY_LIMIT: a budget of one's own, or a smaller machine's
+  // in tests: bytes, or a number with K, M, G or T (binary: 2G = 2 GiB, an
+  // optional "iB" or "B" after it). Anything else is refused, not ignored.
+  const char* limit = std::getenv("LIGHTOCTREE_MEMORY_LIMIT");
+  if (!limit) return 0;
+  char* end = nullptr;
+  const double number = std::strtod(limit, &end);
+  double scale = 1;
+  std::string unit = end ? end : "";
+  if (!unit.empty()) {
+    const char prefix = char(std::toupper(static_cast<unsigned char>(unit[0])));
+    const std::string rest = unit.substr(1);
+    const size_t power = std::string("KMGT").find(prefix);
+    if (power != std::string::npos && (rest.empty() || rest == "B" || rest == "iB")) {
+      scale = std::ldexp(1.0, 10 * int(power + 1));
+    } else if (unit != "B") {
+      scale = 0;
+    }
+  }
+  const double bytes = number * scale;
+  if (end == limit || !(bytes >= 1) || !std::isfinite(bytes) || bytes > 1e18) {
+    throw InputError(std::string("LIGHTOCTREE_MEMORY_LIMIT='") + limit +
+                     "': expected a size in bytes, or a number with K, M, G or T (2G: 2 GiB)");
+  }
+  return size_t(bytes);
+}
+
+size_t addressSpaceRoomBytes() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return SIZE_MAX;
+  size_t used = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    unsigned long long pages = 0;
+    if (std::fscanf(f, "%llu", &pages) == 1) used = size_t(pages) * size_t(sysconf(_SC_PAGESIZE));
+    std::fclose(f);
+  }
+  const size_t cap = size_t(limit.rlim_cur);
+  return cap > used ? cap - used : 0;
+}
+
 size_t availableMemoryBytes() {
   size_t available = 0;
   if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
@@ -125,32 +170,50 @@ size_t availableMemoryBytes() {
       break;
     }
   }
-  // LIGHTOCTREE_MEMORY_LIMIT: a budget of one's own, or a smaller machine's
-  // in tests: bytes, or a number with K, M, G or T (binary: 2G = 2 GiB, an
-  // optional "iB" or "B" after it). Anything else is refused, not ignored.
-  if (const char* limit = std::getenv("LIGHTOCTREE_MEMORY_LIMIT")) {
-    char* end = nullptr;
-    const double number = std::strtod(limit, &end);
-    double scale = 1;
-    std::string unit = end ? end : "";
-    if (!unit.empty()) {
-      const char prefix = char(std::toupper(static_cast<unsigned char>(unit[0])));
-      const std::string rest = unit.substr(1);
-      const size_t power = std::string("KMGT").find(prefix);
-      if (power != std::string::npos && (rest.empty() || rest == "B" || rest == "iB")) {
-        scale = std::ldexp(1.0, 10 * int(power + 1));
-      } else if (unit != "B") {
-        scale = 0;
-      }
-    }
-    const double bytes = number * scale;
-    if (end == limit || !(bytes >= 1) || !std::isfinite(bytes) || bytes > 1e18) {
-      throw InputError(std::string("LIGHTOCTREE_MEMORY_LIMIT='") + limit +
-                       "': expected a size in bytes, or a number with K, M, G or T (2G: 2 GiB)");
-    }
-    available = available ? std::min(available, size_t(bytes)) : size_t(bytes);
+  // An address-space limit (ulimit -v): allocations beyond it fail however
+  // much memory the machine has (a bare std::bad_alloc before this cap).
+  const size_t room = addressSpaceRoomBytes();
+  if (room != SIZE_MAX) available = available ? std::min(available, room) : std::max<size_t>(room, 1);
+  if (const size_t limit = memoryLimitSetting()) {
+    available = available ? std::min(available, limit) : limit;
   }
   return available;
+}
+
+struct MemoryWatch::State {
+  std::mutex mutex;
+  std::condition_variable wake;
+  bool stop = false;
+  std::thread thread;
+};
+
+MemoryWatch::MemoryWatch(size_t limitBytes, std::function<void(size_t)> onExceeded,
+                         double intervalSeconds)
+    : state_(std::make_unique<State>()) {
+  if (limitBytes == 0) return;
+  const auto interval = std::chrono::duration<double>(std::max(intervalSeconds, 1e-3));
+  State* s = state_.get();
+  s->thread = std::thread([s, limitBytes, onExceeded = std::move(onExceeded), interval] {
+    std::unique_lock<std::mutex> lock(s->mutex);
+    while (!s->wake.wait_for(lock, interval, [s] { return s->stop; })) {
+      const size_t rss = currentRssBytes();
+      if (rss > limitBytes) {
+        lock.unlock();
+        onExceeded(rss);
+        return;
+      }
+    }
+  });
+}
+
+MemoryWatch::~MemoryWatch() {
+  if (!state_ || !state_->thread.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(state_->mutex);
+    state_->stop = true;
+  }
+  state_->wake.notify_all();
+  state_->thread.join();
 }
 
 }  // namespace lo

@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <cstddef>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -41,6 +43,35 @@ size_t peakRssSinceResetBytes();
 /// bytes, or a number with K, M, G or T, binary: 2G = 2 GiB), bytes; 0 if
 /// unknown. @throws InputError when LIGHTOCTREE_MEMORY_LIMIT is not a size.
 size_t availableMemoryBytes();
+
+/// LIGHTOCTREE_MEMORY_LIMIT in bytes (see availableMemoryBytes); 0 when the
+/// variable is not set. @throws InputError when it is not a size.
+size_t memoryLimitSetting();
+
+/// What the process's address-space limit (setrlimit RLIMIT_AS, `ulimit -v`)
+/// leaves: its soft limit less the address space in use now (VmSize), bytes;
+/// SIZE_MAX when there is no limit. Every allocation counts against it,
+/// resident or not, so availableMemoryBytes takes it as a cap too.
+size_t addressSpaceRoomBytes();
+
+/// @brief Watches the process's resident memory from a thread of its own
+/// (every `intervalSeconds`) and calls `onExceeded(rss)` once, from that
+/// thread, when it grows past `limitBytes`: the estimates made before the
+/// work (photons, voxels, atlas pages) cannot see everything that grows, and
+/// a limit the user set (LIGHTOCTREE_MEMORY_LIMIT) must hold whatever grew.
+/// The destructor stops the thread. A limit of 0 watches nothing.
+class MemoryWatch {
+ public:
+  MemoryWatch(size_t limitBytes, std::function<void(size_t rssBytes)> onExceeded,
+              double intervalSeconds = 0.02);
+  ~MemoryWatch();
+  MemoryWatch(const MemoryWatch&) = delete;
+  MemoryWatch& operator=(const MemoryWatch&) = delete;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// One stage's row in a report.
 struct StageReport {

@@ -1,4 +1,11 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <thread>
 
 #include <algorithm>
 #include <cmath>
@@ -169,6 +176,67 @@ TEST(DiscreteDistribution, DrawsEachEntryInProportionToItsWeight) {
   // The ends of [0, 1) land on the first and the last entry of positive weight.
   EXPECT_EQ(d.sample(0.0), 0u);
   EXPECT_EQ(d.sample(std::nextafter(1.0, 0.0)), 4u);
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+// Issue 43, family 2: under `ulimit -v` the memory checks did not see the
+// limit, and the tools died of a bare std::bad_alloc.
+TEST(Resources, AvailableMemorySeesTheAddressSpaceLimit) {
+  rlimit saved{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
+  if (saved.rlim_cur == RLIM_INFINITY) EXPECT_EQ(addressSpaceRoomBytes(), SIZE_MAX);
+  // What the process maps now, and a limit 256 MiB above it.
+  size_t mapped = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    unsigned long long pages = 0;
+    if (std::fscanf(f, "%llu", &pages) == 1) mapped = size_t(pages) * size_t(sysconf(_SC_PAGESIZE));
+    std::fclose(f);
+  }
+  ASSERT_GT(mapped, 0u);
+  const size_t room = size_t(256) << 20;
+  if (saved.rlim_cur != RLIM_INFINITY && saved.rlim_cur < mapped + room) GTEST_SKIP() << "limit already lower";
+  rlimit lower = saved;
+  lower.rlim_cur = rlim_t(mapped + room);
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &lower), 0);
+  const size_t seen = addressSpaceRoomBytes();
+  const size_t available = availableMemoryBytes();
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &saved), 0);
+  EXPECT_LE(seen, room);
+  EXPECT_GT(seen, room / 2);  // a few pages mapped since, not the whole room
+  EXPECT_LE(available, room) << "availableMemoryBytes ignores ulimit -v";
+}
+
+// LIGHTOCTREE_MEMORY_LIMIT alone did not stop a run that grew to 24 GB: the
+// estimates before the work cannot see all that grows; the watch does.
+TEST(Resources, MemoryWatchCallsBackWhenTheProcessGrowsPastItsLimit) {
+  const size_t rss = currentRssBytes();
+  ASSERT_GT(rss, 0u);
+  std::atomic<size_t> seen{0};
+  std::atomic<int> calls{0};
+  {
+    MemoryWatch far(rss + (size_t(8) << 30), [&](size_t) { ++calls; });
+    MemoryWatch near(rss + (size_t(32) << 20), [&](size_t now) {
+      seen = now;
+      ++calls;
+    });
+    std::vector<char> grown(size_t(96) << 20);
+    for (size_t i = 0; i < grown.size(); i += 4096) grown[i] = char(i);
+    for (int i = 0; i < 200 && calls.load() == 0; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    volatile char keep = grown[grown.size() / 2];  // the pages stay in use until here
+    (void)keep;
+  }
+  EXPECT_EQ(calls.load(), 1) << "the near limit once, the far one never";
+  EXPECT_GT(seen.load(), rss + (size_t(32) << 20));
+  // No limit, no watch.
+  MemoryWatch none(0, [&](size_t) { ++calls; });
+  EXPECT_EQ(calls.load(), 1);
 }
 
 }  // namespace

@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Hostile environments (issue 43, family 2; docs/robustness.md, "The
+# environment"): a report that cannot reach standard output (/dev/full, a
+# closed stream) is a failure, not exit 0; an address-space limit (ulimit -v)
+# is seen by the memory checks before any work; LIGHTOCTREE_MEMORY_LIMIT
+# stops a run that grows past it, whatever grew, and nothing is written.
+# Usage: environment.sh CLI SCENE OUT_DIR
+set -u
+cli=$1 scene=$2 out=$3
+rm -rf "$out"
+mkdir -p "$out"
+failed=0
+fail() { echo "FAILED: $*"; failed=1; }
+
+# A small bake to report on.
+"$cli" bake "$scene" -o "$out/small.vdb" --depth 3 --photons 3000 --knn 20 --quiet ||
+  fail "the small bake failed"
+
+# 1. Standard output full or closed: exit non-zero, saying so.
+for cmd in "inspect $out/small.vdb" "inspect --json $out/small.vdb" "--help" "bake --help"; do
+  err=$($cli $cmd 2>&1 >/dev/full)
+  rc=$?
+  if [ "$rc" -eq 0 ] || ! grep -q "cannot write to standard output" <<<"$err"; then
+    fail "'$cmd >/dev/full': exit $rc: $err"
+  fi
+  err=$($cli $cmd 2>&1 >&-)
+  rc=$?
+  if [ "$rc" -eq 0 ] || ! grep -q "cannot write to standard output" <<<"$err"; then
+    fail "'$cmd >&-': exit $rc: $err"
+  fi
+done
+# A bake whose report is lost still exits non-zero; its file, complete, is
+# the bake's (the report is printed before the set is committed).
+err=$("$cli" bake "$scene" -o "$out/full.vdb" --depth 3 --photons 3000 --knn 20 2>&1 >/dev/full)
+rc=$?
+if [ "$rc" -eq 0 ] || ! grep -q "cannot write to standard output" <<<"$err"; then
+  fail "bake >/dev/full: exit $rc: $err"
+fi
+# A closed stdout is never taken by a file opened later: the .vdb holds no report.
+"$cli" bake "$scene" -o "$out/closed.vdb" --depth 3 --photons 3000 --knn 20 >&- 2>/dev/null
+if [ -f "$out/closed.vdb" ] && grep -q "wrote " "$out/closed.vdb"; then
+  fail "bake >&-: the report went into the .vdb"
+fi
+# Nothing printed, nothing lost: --quiet to a full stdout is fine.
+"$cli" bake "$scene" -o "$out/quiet.vdb" --depth 3 --photons 3000 --knn 20 --quiet >/dev/full ||
+  fail "bake --quiet >/dev/full failed though it prints nothing"
+
+# 2. An address-space limit is memory the checks see: 100M photons (11 GiB,
+# less than many machines have) under ulimit -v 4 GiB are refused before
+# tracing, naming --photons (they were traced until std::bad_alloc).
+err=$(bash -c "ulimit -v 4194304; exec '$cli' bake '$scene' -o '$out/as.vdb' --photons 100000000" 2>&1)
+rc=$?
+if [ "$rc" -ne 1 ] || ! grep -q -- "--photons 100000000 needs about .* of memory available" <<<"$err" ||
+   [ -e "$out/as.vdb" ]; then
+  fail "ulimit -v: exit $rc: $err"
+fi
+
+# 3. LIGHTOCTREE_MEMORY_LIMIT holds whatever grew: a bake whose estimate fits
+# (100,000 photons, 12 MB) in a process that needs more than the limit.
+err=$(LIGHTOCTREE_MEMORY_LIMIT=48M "$cli" bake "$scene" -o "$out/limit.vdb" --depth 5 --photons 100000 2>&1)
+rc=$?
+if [ "$rc" -ne 1 ] || ! grep -q "out of memory: the process grew to .* past LIGHTOCTREE_MEMORY_LIMIT=48M" <<<"$err"; then
+  fail "LIGHTOCTREE_MEMORY_LIMIT=48M: exit $rc: $err"
+fi
+if [ -e "$out/limit.vdb" ] || ls -a "$out" | grep -q "^\.limit\.vdb\..*\.tmp$"; then
+  fail "LIGHTOCTREE_MEMORY_LIMIT=48M: a file was left: $(ls -a "$out")"
+fi
+# The same bake within a generous limit runs.
+LIGHTOCTREE_MEMORY_LIMIT=8G "$cli" bake "$scene" -o "$out/ok.vdb" --depth 5 --photons 100000 --quiet ||
+  fail "LIGHTOCTREE_MEMORY_LIMIT=8G: the bake failed"
+
+[ "$failed" -eq 0 ] && echo "environment: every case refused or reported"
