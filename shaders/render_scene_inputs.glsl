@@ -68,6 +68,7 @@ uniform vec3 uProbeBoxMin;     // the scene's bounds (render space): the paralla
 uniform vec3 uProbeBoxMax;
 uniform float uProbeMaxLod;
 uniform vec3 uProbeIrradiance[9];  // the probe's irradiance at its centre: SH terms E_i (octree_layout.h)
+uniform vec2 uBehindScale;     // the share of uBehind's texels this frame fills (it only grows)
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 uniform float uThickness;     // KHR_materials_volume thickness; 0 = thin-walled
 uniform float uIor;           // KHR_materials_ior

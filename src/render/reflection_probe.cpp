@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -49,19 +50,31 @@ glm::vec3 cubeTexelDirection(int face, int x, int y, int n) {
 void Renderer::Impl::captureProbe(const RenderParams& rp) {
   const int size = params.probeSize;
   if (!probe.texture) {
-    probe.texture = GlTexture::create();
-    glBindTexture(GL_TEXTURE_CUBE_MAP, probe.texture.get());
+    // Two cube maps alike: the faces are drawn into one while the other is
+    // bound to the scene shader's probe unit. The software rasteriser
+    // compiles a shader variant per set of bound texture and target formats
+    // (seconds each for the scene shader): drawn into the render target's
+    // format (RGBA32F) with the same textures bound as the frame after it,
+    // the six faces compile the variants the frame then uses, instead of a
+    // set of their own (docs/render.md, "The first frame").
     probe.levels = 1;
     while ((size >> probe.levels) > 0) ++probe.levels;
-    for (int f = 0; f < 6; ++f) {
-      glTexImage2D(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), 0, GL_RGBA16F, size, size, 0,
-                   GL_RGBA, GL_FLOAT, nullptr);
+    for (GlTexture* t : {&probe.texture, &probe.spare}) {
+      *t = GlTexture::create();
+      glBindTexture(GL_TEXTURE_CUBE_MAP, t->get());
+      for (int level = 0; level < probe.levels; ++level) {
+        for (int f = 0; f < 6; ++f) {
+          glTexImage2D(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), level, GL_RGBA32F,
+                       std::max(1, size >> level), std::max(1, size >> level), 0, GL_RGBA,
+                       GL_FLOAT, nullptr);
+        }
+      }
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
     }
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     probe.fbo = GlFramebuffer::create();
     probe.depth = GlRenderbuffer::create();
@@ -82,7 +95,7 @@ void Renderer::Impl::captureProbe(const RenderParams& rp) {
   probe.capturing = true;
   for (int f = 0; f < 6; ++f) {
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
-                           GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), probe.texture.get(), 0);
+                           GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), probe.spare.get(), 0);
     GLenum drawBuffer = GL_COLOR_ATTACHMENT0;
     glDrawBuffers(1, &drawBuffer);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
@@ -99,6 +112,8 @@ void Renderer::Impl::captureProbe(const RenderParams& rp) {
     draw(camera, face, size, size, 1.0f, false);
   }
   probe.capturing = false;
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X, 0, 0);
+  std::swap(probe.texture, probe.spare);
   glBindTexture(GL_TEXTURE_CUBE_MAP, probe.texture.get());
   glGenerateMipmap(GL_TEXTURE_CUBE_MAP);
   projectProbeIrradiance();

@@ -149,7 +149,8 @@ struct ReflectionProbe {
   bool wanted = false;
   bool valid = false;
   bool capturing = false;
-  GlTexture texture;
+  GlTexture texture;  ///< the probe the scene shader reads
+  GlTexture spare;    ///< the next capture's target (RGBA32F as the frame's)
   GlFramebuffer fbo;
   GlRenderbuffer depth;
   int levels = 1;
@@ -214,6 +215,7 @@ struct Renderer::Impl {
 
   // scene_pass.cpp
   void ensureTarget(int width, int height);
+  void ensureBehind(int width, int height, bool floatTarget);
   void copyBehind(int width, int height, bool floatTarget);
   /// One frame into the bound framebuffer: depth pre-pass, then the scene
   /// pass (opaque, masked, blended back to front, transmissive).

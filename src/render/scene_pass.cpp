@@ -88,21 +88,37 @@ void Renderer::Impl::ensureTarget(int width, int height) {
   targetHeight = height;
 }
 
-/// Copies the bound framebuffer's colour into behindTexture (float for
-/// the offscreen RGBA32F target, 8-bit for a window's back buffer).
-void Renderer::Impl::copyBehind(int width, int height, bool floatTarget) {
-  if (!behindTexture || behindWidth != width || behindHeight != height ||
+/// Makes behindTexture (float for the offscreen RGBA32F target, 8-bit for a
+/// window's back buffer) hold at least width x height texels, and binds it to
+/// its unit. It only grows, and never to a power of two on either side: the
+/// software rasteriser compiles a shader variant per set of bound texture
+/// states, whether a side is a power of two among them, so the reflection
+/// probe's 128-texel faces and a 320 x 240 frame, both drawn with it bound
+/// (from the first draw: before, nothing was bound until the first
+/// transmissive surface), share their variants.
+void Renderer::Impl::ensureBehind(int width, int height, bool floatTarget) {
+  auto notPowerOfTwo = [](int n) { return (n & (n - 1)) == 0 ? n + 1 : n; };
+  if (!behindTexture || behindWidth < width || behindHeight < height ||
       behindFloat != floatTarget) {
     if (!behindTexture) behindTexture = GlTexture::create();
+    behindWidth = notPowerOfTwo(std::max(width, behindWidth));
+    behindHeight = notPowerOfTwo(std::max(height, behindHeight));
     glBindTexture(GL_TEXTURE_2D, behindTexture.get());
-    glTexImage2D(GL_TEXTURE_2D, 0, floatTarget ? GL_RGBA32F : GL_RGBA8, width, height, 0, GL_RGBA,
-                 floatTarget ? GL_FLOAT : GL_UNSIGNED_BYTE, nullptr);
+    glTexImage2D(GL_TEXTURE_2D, 0, floatTarget ? GL_RGBA32F : GL_RGBA8, behindWidth, behindHeight,
+                 0, GL_RGBA, floatTarget ? GL_FLOAT : GL_UNSIGNED_BYTE, nullptr);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    behindWidth = width;
-    behindHeight = height;
     behindFloat = floatTarget;
   }
+  glActiveTexture(GL_TEXTURE6);
+  glBindTexture(GL_TEXTURE_2D, behindTexture.get());
+  glActiveTexture(GL_TEXTURE0);
+}
+
+/// Copies the bound framebuffer's colour (width x height) into the corner
+/// of behindTexture.
+void Renderer::Impl::copyBehind(int width, int height, bool floatTarget) {
+  ensureBehind(width, height, floatTarget);
   glBindTexture(GL_TEXTURE_2D, behindTexture.get());
   glCopyTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 0, 0, width, height);
   checkGl("copying the opaque image for transmissive surfaces");
@@ -166,7 +182,10 @@ void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, con
   glUniform1f(loc("uProbeMaxLod"), float(probe.levels - 1));
   glUniform3fv(loc("uProbeIrradiance"), 9, glm::value_ptr(probe.irradiance[0]));
   glActiveTexture(GL_TEXTURE11);
-  glBindTexture(GL_TEXTURE_CUBE_MAP, reflect ? probe.texture.get() : 0);
+  // Bound whenever it exists, read only where uHasProbe says: the probe's
+  // capture draws with the same textures bound as the frames after it
+  // (one set of shader variants on the software rasteriser).
+  glBindTexture(GL_TEXTURE_CUBE_MAP, probe.texture ? probe.texture.get() : 0);
   glActiveTexture(GL_TEXTURE0);
   glUniform1i(loc("uInterpolation"), rp.interpolation ? 1 : 0);
   glUniform1i(loc("uSpecular"), rp.specular ? 1 : 0);
@@ -391,6 +410,12 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
   const GLuint p = sceneProgramFor(rp, withDirect);
   glUseProgram(p);
   setFrameUniforms(p, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
+  // The opaque image's copy for transmissive surfaces: bound from the first
+  // draw, its share that this frame fills.
+  ensureBehind(width, height, !encodeSrgb);
+  const glm::vec2 behindScale(float(width) / float(behindWidth),
+                              float(height) / float(behindHeight));
+  glUniform2fv(glGetUniformLocation(p, "uBehindScale"), 1, glm::value_ptr(behindScale));
   // Added objects: the free-space light's program, its frame uniforms, and
   // the free-space octree's frame in place of the surfaces'.
   GLuint moving = 0;
@@ -399,6 +424,7 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
     moving = withDirect ? sceneMovingProgram.get() : sceneIndirectMovingProgram.get();
     glUseProgram(moving);
     setFrameUniforms(moving, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
+    glUniform2fv(glGetUniformLocation(moving, "uBehindScale"), 1, glm::value_ptr(behindScale));
     glUniform3f(glGetUniformLocation(moving, "uOctreeOrigin"), volumeOrigin.x, volumeOrigin.y,
                 volumeOrigin.z);
     glUniform1f(glGetUniformLocation(moving, "uVoxelSize"), volumeTextures.voxelSize);
