@@ -26,6 +26,7 @@
 #include "cluster/volume_light.h"
 #include "core/error.h"
 #include "core/resources.h"
+#include "distributed/rank_agreement.h"
 #include "distributed/vdl_grid_parts.h"
 #include "photon/photon_map.h"
 
@@ -648,6 +649,7 @@ BakeResult distributedBake(const Scene& scene, const BakeParams& requested, cons
     throw InputError("--target-error: the distributed bake (mpirun) traces a fixed photon "
                      "budget; give --photons");
   }
+  checkRanksAgree(scene, requested, tiles, comm);
   const BakeParams params = checkedBakeParams(scene, requested, comm.size());
   if (params.keepPhotons) {
     throw InputError(

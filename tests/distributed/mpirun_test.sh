@@ -2,7 +2,8 @@
 # The distributed bake under mpirun (localhost, oversubscribed): the .vdb
 # bytes of `mpirun -np N lightoctree bake` equal those of the one-process
 # bake for N = 1, 2, 3, 4, on the Cornell box and the dragon; a rank killed
-# mid-bake makes mpirun exit non-zero and leaves no output file.
+# mid-bake makes mpirun exit non-zero and leaves no output file; ranks started
+# with different settings refuse together.
 # Usage: mpirun_test.sh MPIEXEC LIGHTOCTREE SHARED_SCENES OUTPUT_DIR
 set -euo pipefail
 MPIEXEC=$1 CLI=$2 SCENES=$3 OUT=$4
@@ -45,6 +46,23 @@ if [ $rc -ne 0 ] && [ ! -e "$OUT/killed.vdb" ] && [ "$leftovers" -eq 0 ]; then
 else
   echo "FAIL: a killed rank: mpirun exited $rc; output file present: $([ -e "$OUT/killed.vdb" ] && echo yes || echo no), temporary files: $leftovers"
   cat "$OUT/killed.log"
+  failures=$((failures + 1))
+fi
+# Ranks started with different settings (one mpirun, two command lines):
+# every rank refuses before any work, naming the rank; nothing is written
+# (they hung in a collective of unequal sizes, or failed in OpenMPI).
+set +e
+"${MPI[@]}" -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" -o "$OUT/disagree.vdb" -q \
+  --depth 4 --photons 3000 : -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" \
+  -o "$OUT/disagree.vdb" -q --depth 4 --photons 4000 >"$OUT/disagree.log" 2>&1
+rc=$?
+set -e
+if [ $rc -ne 0 ] && [ ! -e "$OUT/disagree.vdb" ] &&
+   grep -q "the settings of rank(s) 1 differ from rank 0's" "$OUT/disagree.log"; then
+  echo "ok: ranks with different settings: mpirun exits $rc, the rank named, no output file"
+else
+  echo "FAIL: ranks with different settings: mpirun exited $rc"
+  cat "$OUT/disagree.log"
   failures=$((failures + 1))
 fi
 exit $failures

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <mutex>
+#include <string>
 #include <random>
 #include <set>
 
@@ -230,6 +231,57 @@ TEST(TiledBake, RefusesAPhotonMapAndBadTileCounts) {
       EXPECT_NE(std::string(e.what()).find("--tiles"), std::string::npos) << e.what();
     }
   }
+}
+
+// Ranks that were started with different settings, or read different
+// copies of the scene, refuse before any work, every one with the same
+// message naming what differs and which ranks (they hung in a collective of
+// unequal sizes, or baked a grid mixed from both scenes).
+TEST(TiledBake, RanksThatDisagreeRefuseTogether) {
+  const Scene scene = test::pointLitRoom();
+  Scene moved = scene;
+  moved.positions[0].x += 0.01f;
+  const BakeParams params = test::smallBake(4, 2000);
+  BakeParams other = params;
+  other.photons = 3000;
+  struct Case {
+    const char* what;
+    bool otherSettings, otherScene;
+  };
+  for (const Case& c : {Case{"settings", true, false}, Case{"scene", false, true},
+                        Case{"settings and scene", true, true}}) {
+    SCOPED_TRACE(c.what);
+    std::vector<std::string> messages(3);
+    std::mutex mutex;
+    EXPECT_THROW(runThreadRanks(3,
+                                [&](Communicator& comm) {
+                                  const bool odd = comm.rank() == 2;
+                                  try {
+                                    distributedBake(odd && c.otherScene ? moved : scene,
+                                                    odd && c.otherSettings ? other : params,
+                                                    TileParams{}, comm);
+                                  } catch (const InputError& e) {
+                                    std::lock_guard<std::mutex> lock(mutex);
+                                    messages[size_t(comm.rank())] = e.what();
+                                    throw;
+                                  }
+                                }),
+                 InputError);
+    // Every rank that refused said the same (under threads, a rank whose
+    // peer threw first may end with the communicator's own error instead;
+    // under MPI each refuses on its own).
+    std::string said;
+    for (const std::string& m : messages) {
+      if (m.empty()) continue;
+      if (said.empty()) said = m;
+      EXPECT_EQ(m, said);
+    }
+    EXPECT_NE(said.find("rank(s) 2"), std::string::npos) << said;
+    EXPECT_EQ(said.find("settings") != std::string::npos, c.otherSettings) << said;
+    EXPECT_EQ(said.find("scene read") != std::string::npos, c.otherScene) << said;
+  }
+  // Agreeing ranks bake.
+  EXPECT_GT(bakeOnThreadRanks(scene, params, 3, 0).result.grid.size(), 0u);
 }
 
 TEST(TilePlan, SplitsTheWorkEvenlyAlongTheCurve) {

@@ -1,0 +1,152 @@
+/// @file distributed/rank_agreement.cpp
+/// @brief The ranks of a distributed bake agree on what they bake
+/// (distributed/rank_agreement.h).
+
+#include "distributed/rank_agreement.h"
+
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+
+namespace lo {
+namespace {
+
+/// FNV-1a over the bytes of values added one by one (never over a struct's
+/// padding).
+class Fingerprint {
+ public:
+  void bytes(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) {
+      hash_ ^= p[i];
+      hash_ *= 1099511628211ull;
+    }
+  }
+  template <typename T>
+  void add(const T& value) {
+    bytes(&value, sizeof value);
+  }
+  void add(const Vec3& v) {
+    add(v.x);
+    add(v.y);
+    add(v.z);
+  }
+  void add(const std::string& s) {
+    add(uint64_t(s.size()));
+    bytes(s.data(), s.size());
+  }
+  uint64_t value() const { return hash_; }
+
+ private:
+  uint64_t hash_ = 1469598103934665603ull;
+};
+
+/// "1, 3" for the ranks whose value differs from rank 0's.
+std::string ranksThatDiffer(const std::vector<uint64_t>& values) {
+  std::string out;
+  for (size_t r = 1; r < values.size(); ++r) {
+    if (values[r] == values[0]) continue;
+    if (!out.empty()) out += ", ";
+    out += std::to_string(r);
+  }
+  return out;
+}
+
+}  // namespace
+
+uint64_t bakeSettingsFingerprint(const BakeParams& p, const TileParams& tiles) {
+  Fingerprint f;
+  f.add(p.depth);
+  f.add(uint64_t(p.photons));
+  f.add(p.targetError);
+  f.add(p.targetSeenLight);
+  f.add(uint64_t(p.maxPhotons));
+  f.add(p.maxSeconds);
+  f.add(p.knn);
+  f.add(p.radius);
+  f.add(p.vdls.count);
+  f.add(p.vdls.automatic);
+  f.add(p.autoCap);
+  f.add(p.autoThreshold);
+  f.add(int(p.representation));
+  f.add(p.seed);
+  f.add(p.includeDirect);
+  f.add(p.keepPhotons);
+  f.add(p.layers);
+  f.add(p.occlusion);
+  f.add(p.edgeCorrection);
+  f.add(p.separateCaustics);
+  f.add(p.smoothing);
+  f.add(p.freeSpace);
+  f.add(p.freeSpaceLevels);
+  f.add(p.freeSpaceOrder);
+  f.add(uint64_t(p.freeSpaceRays));
+  f.add(p.region.lower);
+  f.add(p.region.upper);
+  f.add(tiles.tilesPerAxis);
+  f.add(uint64_t(tiles.owner.size()));
+  for (int32_t o : tiles.owner) f.add(o);
+  f.add(tiles.assumedMarginVoxels);
+  return f.value();
+}
+
+uint64_t sceneFingerprint(const Scene& scene) {
+  Fingerprint f;
+  f.add(uint64_t(scene.positions.size()));
+  for (const Vec3& p : scene.positions) f.add(p);
+  f.add(uint64_t(scene.indices.size()));
+  f.bytes(scene.indices.data(), scene.indices.size() * sizeof(scene.indices[0]));
+  f.add(uint64_t(scene.triangleMaterial.size()));
+  f.bytes(scene.triangleMaterial.data(),
+          scene.triangleMaterial.size() * sizeof(scene.triangleMaterial[0]));
+  f.add(uint64_t(scene.materials.size()));
+  for (const Material& m : scene.materials) {
+    f.add(m.baseColor);
+    f.add(m.emission);
+    f.add(m.metallic);
+    f.add(m.roughness);
+    f.add(m.transmission);
+    f.add(m.ior);
+    f.add(m.thickness);
+    f.add(m.doubleSided);
+    f.add(m.baseColorTexture);
+    f.add(m.emissiveTexture);
+  }
+  f.add(uint64_t(scene.textures.size()));
+  f.add(uint64_t(scene.lights.size()));
+  for (const Light& l : scene.lights) {
+    f.add(int(l.type));
+    f.add(l.position);
+    f.add(l.direction);
+    f.add(l.color);
+    f.add(l.intensity);
+    f.add(l.range);
+    f.add(l.innerConeAngle);
+    f.add(l.outerConeAngle);
+  }
+  f.add(scene.sky.radiance);
+  return f.value();
+}
+
+void checkRanksAgree(const Scene& scene, const BakeParams& params, const TileParams& tiles,
+                     Communicator& comm) {
+  if (comm.size() < 2) return;
+  const std::vector<uint64_t> settings = comm.allgather(bakeSettingsFingerprint(params, tiles));
+  const std::vector<uint64_t> scenes = comm.allgather(sceneFingerprint(scene));
+  const std::string settingsDiffer = ranksThatDiffer(settings);
+  const std::string scenesDiffer = ranksThatDiffer(scenes);
+  if (settingsDiffer.empty() && scenesDiffer.empty()) return;
+  std::string message = "the ranks of this bake do not agree:";
+  if (!settingsDiffer.empty()) {
+    message += " the settings of rank(s) " + settingsDiffer + " differ from rank 0's;";
+  }
+  if (!scenesDiffer.empty()) {
+    message += " the scene read by rank(s) " + scenesDiffer + " differs from rank 0's;";
+  }
+  message += " every rank must run the same command on the same scene (one mpirun command line, "
+             "the scene's files the same on every machine)";
+  throw InputError(message);
+}
+
+}  // namespace lo
