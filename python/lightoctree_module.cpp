@@ -11,8 +11,17 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cctype>
+#include <cstdio>
+#include <limits>
+#include <exception>
+#include <initializer_list>
 #include <memory>
+#include <optional>
+#include <atomic>
+#include <utility>
 #include <string>
+#include <vector>
 
 #include "bake/bake.h"
 #include "bake/convert.h"
@@ -20,20 +29,38 @@
 #include "core/file.h"
 #include "core/number_range.h"
 #include "core/progress.h"
+#include "export/lightmap_export.h"
+#include "image/compare.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
 #include "render/context.h"
+#include "reference/path_tracer.h"
 #include "render/render_session.h"
 #include "scene/pinhole_camera.h"
 #include "scene/scene.h"
 #include "vdb/vdb_inspect.h"
 #include "vdb/vdb_io.h"
 
+// The commands' own options code (tools/, lo_tool_options): the defaults of
+// `reference`, its camera choice and the scene flags, shared rather than
+// retyped, so that the module and the commands cannot drift apart.
+#include "camera_options.h"
+#include "reference_options.h"
+#include "scene_options.h"
+
 namespace py = pybind11;
 
 namespace lo::python {
 namespace {
+
+using tool::checkCameraOptions;
+using tool::chooseCamera;
+using tool::loadSceneWith;
+using tool::ReferenceOptions;
+using tool::referenceParams;
+using tool::sceneInputs;
+using tool::SceneOptions;
 
 /// A grid and its metadata, shared by the arrays that view it.
 struct Grid {
@@ -63,26 +90,68 @@ py::array vec3s(const py::object& owner, const std::vector<Vec3>& v) {
   return view<float>(owner, &v.data()->x, {v.size(), 3}, {sizeof(Vec3), sizeof(float)});
 }
 
-/// The bake's progress to a Python callable (task, done, total), called with
-/// the interpreter's lock held (the bake runs without it, on its threads).
+/// Thrown through the library's loops by CallbackProgress to stop the work.
+struct Stopped {};
+
+/// The work's progress to a Python callable (task, done, total), called with
+/// the interpreter's lock held (the work runs without it, on its threads),
+/// and its cancellation. A sink stops a stage by throwing from begin() or
+/// from update() with done < total (ProgressiveBake stops its stages so);
+/// the exception leaves the stage (TBB hands it from its worker threads to
+/// the caller) and the library call. Each report first runs the
+/// interpreter's pending signal handlers (PyErr_CheckSignals; on the main
+/// thread, which takes part in the work): Ctrl-C's KeyboardInterrupt, or an
+/// exception the callback raises, stops the work at that report, and the
+/// call raises it. Never thrown from end() or update(total, total), which
+/// Progress's destructor sends, also while the stack unwinds.
 class CallbackProgress : public ProgressSink {
  public:
   explicit CallbackProgress(py::object callback) : callback_(std::move(callback)) {}
   void begin(const std::string& task, size_t total) override {
     task_ = task;
-    call(0, total);
+    report(0, total, true);
   }
-  void update(size_t done, size_t total) override { call(done, total); }
+  void update(size_t done, size_t total) override { report(done, total, done < total); }
   void end() override {}
+  /// With the interpreter's lock: raises what stopped the work, if anything.
+  void raiseIfStopped() {
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  }
 
  private:
-  void call(size_t done, size_t total) {
-    py::gil_scoped_acquire lock;
-    callback_(task_, done, total);
+  void report(size_t done, size_t total, bool mayStop) {
+    if (!stopped_) {
+      py::gil_scoped_acquire lock;
+      try {
+        if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+        if (!callback_.is_none()) callback_(task_, done, total);
+      } catch (py::error_already_set&) {
+        if (!stopped_.exchange(true)) error_ = std::current_exception();
+      }
+    }
+    if (stopped_ && mayStop) throw Stopped{};
   }
   py::object callback_;
   std::string task_;
+  std::atomic<bool> stopped_{false};
+  std::exception_ptr error_;
 };
+
+/// work(sink) without the interpreter's lock, its progress to `progress`
+/// (a callable or None); raises what stopped it (module comment above).
+template <typename Work>
+auto withProgress(const py::object& progress, Work work) {
+  CallbackProgress sink(progress);
+  std::optional<decltype(work(&sink))> result;
+  try {
+    py::gil_scoped_release unlocked;
+    result.emplace(work(&sink));
+  } catch (const Stopped&) {
+  }
+  sink.raiseIfStopped();  // also a callback that raised at a stage's last report
+  if (!result) throw InputError("stopped");  // not reached: a stop has its error
+  return std::move(*result);
+}
 
 /// The arguments are checked as the command's flags are, by the same ranges
 /// (bake/bake.h, core/number_range.h), and named by their Python names; 0 is
@@ -108,20 +177,17 @@ GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, doubl
   params.includeDirect = includeDirect;
   params.targetSeenLight = targetLight == "seen";
   auto out = std::make_shared<Grid>();
-  {
-    std::unique_ptr<CallbackProgress> sink;
-    if (!progress.is_none()) sink = std::make_unique<CallbackProgress>(progress);
-    py::gil_scoped_release unlocked;
-    BakeResult r = bake(scene, params, sink.get());
-    out->grid = std::move(r.grid);
-    out->meta = std::move(r.metadata);
-    recordSourceScene(out->meta, scenePath);
-    py::gil_scoped_acquire lock;
-    out->stats["stored_photons"] = r.stats.storedPhotons;
-    out->stats["emitted_paths"] = r.stats.emittedPaths;
-    out->stats["noise"] = r.stats.noise.ToString();
-    out->stats["passes"] = r.stats.passes.size();
-  }
+  BakeResult r = withProgress(progress, [&](ProgressSink* sink) {
+    BakeResult result = bake(scene, params, sink);
+    recordSourceScene(result.metadata, scenePath);
+    return result;
+  });
+  out->grid = std::move(r.grid);
+  out->meta = std::move(r.metadata);
+  out->stats["stored_photons"] = r.stats.storedPhotons;
+  out->stats["emitted_paths"] = r.stats.emittedPaths;
+  out->stats["noise"] = r.stats.noise.ToString();
+  out->stats["passes"] = r.stats.passes.size();
   return out;
 }
 
@@ -263,6 +329,406 @@ py::array_t<float> readImageFile(const std::string& path) {
   return out;
 }
 
+// ---- reference, compare, lightmap: the commands' settings and defaults ----
+
+/// A message of the commands' options code (tools/) with its flags named as
+/// the Python arguments are: "--eye and --target" -> "eye and target",
+/// "--sky-image: ..." -> "sky_image: ...".
+std::string pythonNames(const std::string& message) {
+  std::string out;
+  for (size_t i = 0; i < message.size(); ++i) {
+    if (message.compare(i, 2, "--") == 0 && i + 2 < message.size() &&
+        std::islower(static_cast<unsigned char>(message[i + 2])) &&
+        (i == 0 || !std::isalnum(static_cast<unsigned char>(message[i - 1])))) {
+      size_t j = i + 2;
+      for (; j < message.size() && (std::isalnum(static_cast<unsigned char>(message[j])) ||
+                                    message[j] == '-');
+           ++j) {
+        out += message[j] == '-' ? '_' : message[j];
+      }
+      i = j - 1;
+    } else {
+      out += message[i];
+    }
+  }
+  return out;
+}
+
+/// `work()` with an InputError of the options code reworded by pythonNames.
+template <typename Work>
+auto withPythonNames(Work work) {
+  try {
+    return work();
+  } catch (const InputError& e) {
+    throw InputError(pythonNames(e.what()));
+  }
+}
+
+/// A number argument (int or float, not bool). @throws InputError naming it.
+double numberArg(const py::handle& value, const std::string& name) {
+  if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) ||
+      !PyNumber_Check(value.ptr())) {
+    throw InputError(name + ": must be a number, got " + std::string(py::repr(value)));
+  }
+  return value.cast<double>();
+}
+
+/// A whole number in `range`, refused by its Python name as checkNumber does
+/// (a float argument, NaN and 4.5 included, is refused, not truncated).
+int wholeNumber(double value, double min, double max, const std::string& name) {
+  return int(checkNumber(value, NumberRange{min, max, false, true}, name));
+}
+
+/// `value` when it is one of `choices`. @throws InputError naming `name`.
+const std::string& checkChoice(const std::string& value, std::initializer_list<const char*> choices,
+                               const std::string& name) {
+  std::string list;
+  for (const char* c : choices) {
+    if (value == c) return value;
+    list += std::string(list.empty() ? "'" : ", '") + c + "'";
+  }
+  throw InputError(name + ": must be one of " + list + ", got '" + value + "'");
+}
+
+bool boolArg(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<py::bool_>(value)) {
+    throw InputError(name + ": must be True or False, got " + std::string(py::repr(value)));
+  }
+  return value.cast<bool>();
+}
+
+std::string textArg(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<py::str>(value)) {
+    throw InputError(name + ": must be a string, got " + std::string(py::repr(value)));
+  }
+  return value.cast<std::string>();
+}
+
+/// A path argument: str or os.PathLike, checked as checkPathText.
+std::string pathArg(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<py::str>(value) && !py::hasattr(value, "__fspath__")) {
+    throw InputError(name + ": must be a path, got " + std::string(py::repr(value)));
+  }
+  const std::string path = py::str(py::module_::import("os").attr("fspath")(value));
+  checkPathText(path, name);
+  return path;
+}
+
+/// Three numbers, or their text "x,y,z", as the flags' text "x,y,z" that
+/// parseVec3d reads (%.17g gives every double back exactly).
+std::string vec3Text(const py::handle& value, const std::string& name) {
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  std::vector<double> v;
+  try {
+    v = value.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+  }
+  if (v.size() != 3) {
+    throw InputError(name + ": expected three numbers x, y, z, got " + std::string(py::repr(value)));
+  }
+  char text[96];
+  std::snprintf(text, sizeof text, "%.17g,%.17g,%.17g", v[0], v[1], v[2]);
+  return text;
+}
+
+/// The scene flags every command shares (tools/scene_options.h): sky,
+/// sky_image, sky_mesh, physical_sky; None = not given.
+SceneOptions sceneOptions(const py::object& sky, const py::object& skyImage,
+                          const py::object& skyMesh, const py::object& physicalSky) {
+  SceneOptions o;
+  if (!sky.is_none()) o.sky = vec3Text(sky, "sky");
+  if (!skyImage.is_none()) o.skyImage = pathArg(skyImage, "sky_image");
+  if (!skyMesh.is_none()) o.skyMesh = textArg(skyMesh, "sky_mesh");
+  if (!physicalSky.is_none()) {
+    // kMinTurbidity, kMaxTurbidity, as the flag's range.
+    o.physicalSky = float(checkNumber(numberArg(physicalSky, "physical_sky"), {1.7, 10.0}, "physical_sky"));
+  }
+  if (!o.skyImage.empty() && (!o.skyMesh.empty() || o.physicalSky > 0)) {
+    throw InputError(std::string(o.skyMesh.empty() ? "physical_sky" : "sky_mesh") +
+                     " and sky_image: give one of them");
+  }
+  if (!o.skyMesh.empty() && o.physicalSky > 0) {
+    throw InputError("physical_sky and sky_mesh: give one of them");
+  }
+  return o;
+}
+
+py::array_t<float> imageArray(const RgbImage& image) {
+  py::array_t<float> out({size_t(image.height), size_t(image.width), size_t(3)});
+  std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
+  return out;
+}
+
+/// `lightoctree reference`: the path tracer's picture of the scene from the
+/// camera the command chooses, with the command's defaults (ReferenceOptions).
+py::object referenceImage(const std::string& scenePath, int width, int height, int spp,
+                          const std::string& part, const py::object& seed, int maxBounces,
+                          const py::object& camera, const py::object& eye,
+                          const py::object& target, const py::object& fov,
+                          const py::object& timeBudget, bool withStdError,
+                          const py::object& progress, const py::object& sky,
+                          const py::object& skyImage, const py::object& skyMesh,
+                          const py::object& physicalSky) {
+  ReferenceOptions opt;  // the command's flags, as given
+  opt.scene = scenePath;
+  checkPathText(scenePath, "scene");
+  // The ranges of the command's flags (tools/reference_options.cpp,
+  // command_options.cpp, camera_options.cpp); python/tests check that both
+  // refuse the same values.
+  opt.width = wholeNumber(width, 1, kMaxImageSide, "width");
+  opt.height = wholeNumber(height, 1, kMaxImageSide, "height");
+  opt.spp = wholeNumber(spp, 1, 1000000, "spp");
+  opt.maxBounces = wholeNumber(maxBounces, 0, 100000, "max_bounces");
+  opt.part = checkChoice(part, {"full", "direct", "indirect", "irradiance"}, "part");
+  if (!seed.is_none()) {
+    if (!py::isinstance<py::int_>(seed) || py::isinstance<py::bool_>(seed) ||
+        seed.cast<py::int_>() < py::int_(0) ||
+        seed.cast<py::int_>() > py::int_(std::numeric_limits<uint64_t>::max())) {
+      throw InputError("seed: must be a whole number from 0 to 18446744073709551615, got " +
+                       std::string(py::repr(seed)));
+    }
+    opt.seed = seed.cast<uint64_t>();
+  }
+  if (!timeBudget.is_none()) {
+    opt.timeBudget = checkNumber(numberArg(timeBudget, "time_budget"), {1e-3, 1e7}, "time_budget");
+  }
+  if (!camera.is_none()) opt.camera.camera = textArg(camera, "camera");
+  if (!eye.is_none()) opt.camera.eye = vec3Text(eye, "eye");
+  if (!target.is_none()) opt.camera.target = vec3Text(target, "target");
+  if (!opt.camera.camera.empty() && !opt.camera.eye.empty()) {
+    throw InputError("camera and eye: give one of them");
+  }
+  if (!fov.is_none()) opt.camera.fovDegrees = float(checkNumber(numberArg(fov, "fov"), {1, 179}, "fov"));
+  opt.sceneOptions = sceneOptions(sky, skyImage, skyMesh, physicalSky);
+  withPythonNames([&] {
+    checkCameraOptions(opt.camera);
+    return 0;
+  });
+  const ReferenceParams params = referenceParams(opt);
+  const ReferenceImage r = withPythonNames([&] {
+    return withProgress(progress, [&](ProgressSink* sink) {
+      const Scene scene = loadSceneWith(opt);
+      const PinholeCamera view = chooseCamera(opt.camera, scene, opt.scene);
+      return renderReference(scene, view, params, sink);
+    });
+  });
+  py::array_t<float> image = imageArray(r.image);
+  if (!withStdError) return std::move(image);
+  return py::make_tuple(image, imageArray(r.stdError));
+}
+
+/// An image argument of compare: a path (EXR linear, PNG decoded; a mask's
+/// 8-bit values as plain numbers, as `compare --mask`) or an array of shape
+/// (height, width, 3) (a mask also (height, width)). `path` gets the path.
+RgbImage imageArg(const py::object& value, const std::string& name, bool isMask,
+                  std::string* path) {
+  if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")) {
+    *path = pathArg(value, name);
+    return readImage(*path, isMask);
+  }
+  using Floats = py::array_t<float, py::array::c_style | py::array::forcecast>;
+  Floats a;
+  try {
+    a = value.cast<Floats>();
+  } catch (const py::cast_error&) {
+  }
+  const bool plane = isMask && a && a.ndim() == 2;
+  if (!a || !((a.ndim() == 3 && a.shape(2) == 3) || plane) || a.shape(0) < 1 || a.shape(1) < 1 ||
+      a.shape(0) > kMaxImageSide || a.shape(1) > kMaxImageSide) {
+    throw InputError(name + ": must be a path or an array of shape (height, width, 3)" +
+                     std::string(isMask ? " or (height, width)" : "") + " of 1 to " +
+                     std::to_string(kMaxImageSide) + " pixels a side, got " +
+                     (a ? "shape " + std::string(py::str(py::tuple(py::cast(std::vector<py::ssize_t>(
+                                                     a.shape(), a.shape() + a.ndim())))))
+                        : std::string(py::repr(py::type::of(value)))));
+  }
+  RgbImage image(int(a.shape(1)), int(a.shape(0)));
+  const float* data = a.data();
+  if (plane) {
+    for (size_t i = 0; i < image.pixelCount(); ++i) image.set(i, Vec3(data[i]));
+  } else {
+    std::copy(data, data + image.rgb.size(), image.rgb.begin());
+  }
+  return image;
+}
+
+std::string sizeText(const std::string& name, const std::string& path, const RgbImage& image) {
+  return name + (path.empty() ? "" : " '" + path + "'") + " is " + std::to_string(image.width) +
+         " x " + std::to_string(image.height);
+}
+
+py::dict channelDict(const ChannelError& e) {
+  py::dict d;
+  d["rel_rmse"] = e.relRmse;
+  d["rel_mae"] = e.relMae;
+  d["max_abs"] = e.maxAbs;
+  return d;
+}
+
+/// `lightoctree compare`: compareReport's figures as `compare --json` writes them.
+py::dict compareImagesArg(const py::object& testArg, const py::object& referenceArg, int bin,
+                          double clipPercentile, const py::object& maskArg, bool ignoreBackground,
+                          const py::object& referenceErrorArg) {
+  CompareSettings settings;
+  settings.bin = int(checkNumber(bin, kCompareBinRange, "bin"));
+  settings.clipPercentile = float(checkNumber(clipPercentile, kClipPercentileRange, "clip_percentile"));
+  settings.ignoreBackground = ignoreBackground;
+  std::string testPath, referencePath, maskPath, errorPath;
+  const RgbImage test = imageArg(testArg, "test", false, &testPath);
+  const RgbImage reference = imageArg(referenceArg, "reference", false, &referencePath);
+  if (test.width != reference.width || test.height != reference.height) {
+    throw InputError(sizeText("test", testPath, test) + " but " +
+                     sizeText("reference", referencePath, reference));
+  }
+  std::optional<RgbImage> mask, stdError;
+  if (!maskArg.is_none()) mask = imageArg(maskArg, "mask", true, &maskPath);
+  if (!referenceErrorArg.is_none()) {
+    stdError = imageArg(referenceErrorArg, "reference_error", false, &errorPath);
+  }
+  if (mask && (mask->width != reference.width || mask->height != reference.height)) {
+    throw InputError("mask: " + sizeText("the mask", maskPath, *mask) + ", the images are " +
+                     std::to_string(reference.width) + " x " + std::to_string(reference.height));
+  }
+  if (stdError && (stdError->width != reference.width || stdError->height != reference.height)) {
+    throw InputError("reference_error: " + sizeText("the standard error", errorPath, *stdError) +
+                     ", the images are " + std::to_string(reference.width) + " x " +
+                     std::to_string(reference.height));
+  }
+  CompareReport r;
+  {
+    py::gil_scoped_release unlocked;
+    r = compareReport(test, reference, settings, mask ? &*mask : nullptr,
+                      stdError ? &*stdError : nullptr);
+  }
+  const CompareResult& m = r.result;
+  py::dict d;  // the keys and values of `compare --json`
+  d["test"] = testPath.empty() ? py::object(py::none()) : py::object(py::str(testPath));
+  d["reference"] = referencePath.empty() ? py::object(py::none()) : py::object(py::str(referencePath));
+  d["bin"] = settings.bin;
+  d["width"] = r.reference.width;
+  d["height"] = r.reference.height;
+  py::dict channels;
+  channels["R"] = channelDict(m.channel[0]);
+  channels["G"] = channelDict(m.channel[1]);
+  channels["B"] = channelDict(m.channel[2]);
+  channels["Y"] = channelDict(m.luminance);
+  channels["RGB"] = channelDict(m.rgb);
+  d["channels"] = channels;
+  d["clip_percentile"] = double(settings.clipPercentile);
+  if (settings.clipPercentile < 100) {
+    d["clip"] = std::vector<double>{r.clip.x, r.clip.y, r.clip.z};
+  }
+  d["black_hole_pixels"] = r.holes.pixels;
+  d["black_hole_share"] = r.holes.share();
+  d["compared_pixels"] = m.comparedPixels;
+  d["ignored_pixels"] = m.ignoredPixels;
+  d["non_finite_pixels"] = m.nonFinitePixels;
+  d["max_error_pixel"] = std::vector<int>{m.maxErrorX, m.maxErrorY};
+  d["mean_reference_luminance"] = m.meanReferenceLuminance;
+  d["mean_test_luminance"] = m.meanTestLuminance;
+  d["reference_noise"] = r.referenceNoise >= 0 ? py::object(py::float_(r.referenceNoise))
+                                               : py::object(py::none());
+  return d;
+}
+
+/// `lightoctree lightmap`: the export with the command's settings by their
+/// flag names (snake_case), defaults those of LightmapExportParams (the
+/// command's), checked before any work as the command checks them.
+py::dict lightmapExport(const std::string& scenePath, const std::string& lightsPath,
+                        const std::string& output, const py::kwargs& kw) {
+  checkPathText(scenePath, "scene");
+  checkPathText(lightsPath, "lights");
+  checkPathText(output, "output");
+  LightmapExportParams p;
+  p.output = output;
+  py::object sky = py::none(), skyImage = py::none(), skyMesh = py::none(), physicalSky = py::none();
+  for (const auto& [key, value] : kw) {
+    const std::string name = py::str(key);
+    // The ranges and words of the command's flags (tools/lightmap_command.cpp).
+    if (name == "texel_size") {
+      p.lightmap.uv.texelSize = float(checkNumber(numberArg(value, name), kPositiveNumber, name));
+    } else if (name == "atlas") {
+      p.lightmap.uv.atlasSize = wholeNumber(numberArg(value, name), 8, 16384, name);
+    } else if (name == "uv") {
+      p.lightmap.uvSource = parseUvSource(checkChoice(textArg(value, name), {"auto", "texcoord1"}, name));
+    } else if (name == "content") {
+      p.content = parseAtlasContent(checkChoice(textArg(value, name), {"indirect", "full"}, name));
+    } else if (name == "direct_samples") {
+      p.directSamples = wholeNumber(numberArg(value, name), 1, 65536, name);
+    } else if (name == "image") {
+      p.rgbm = checkChoice(textArg(value, name), {"exr", "png"}, name) == "png";
+    } else if (name == "preview_unlit") {
+      p.preview = boolArg(value, name);
+    } else if (name == "exposure") {
+      p.previewExposureEv = float(checkNumber(numberArg(value, name), {-30, 30}, name));
+    } else if (name == "atlas_on") {
+      const std::string on = checkChoice(textArg(value, name), {"cpu", "osmesa", "egl"}, name);
+      if (on == "cpu") p.atlasGl.reset();
+      else p.atlasGl = parseGlBackend(on);
+    } else if (name == "directions") {
+      p.directionPages = checkChoice(textArg(value, name), {"on", "off"}, name) == "on";
+    } else if (name == "chart_image") {
+      p.chartImages = boolArg(value, name);
+    } else if (name == "sky") {
+      sky = py::reinterpret_borrow<py::object>(value);
+    } else if (name == "sky_image") {
+      skyImage = py::reinterpret_borrow<py::object>(value);
+    } else if (name == "sky_mesh") {
+      skyMesh = py::reinterpret_borrow<py::object>(value);
+    } else if (name == "physical_sky") {
+      physicalSky = py::reinterpret_borrow<py::object>(value);
+    } else {
+      throw InputError("lightmap: unknown setting '" + name + "'");
+    }
+  }
+  const SceneOptions scene = sceneOptions(sky, skyImage, skyMesh, physicalSky);
+  // What the command checks before any work: the folder, the name, and that
+  // no file written (or removed as an earlier export's) replaces an input.
+  checkOutputFolder(output, "output");
+  checkLightmapExportPath(output, "output");
+  NamedPaths inputs = sceneInputs(scenePath, "scene");
+  if (!scene.skyImage.empty()) inputs.push_back({"sky_image", scene.skyImage});
+  inputs.push_back({"lights", lightsPath});
+  withPythonNames([&] {  // it names the output "--output"
+    checkLightmapOutputs(output, p.preview, inputs);
+    return 0;
+  });
+  LightmapExportResult r;
+  withPythonNames([&] {
+    py::gil_scoped_release unlocked;
+    r = exportLightmap(loadSceneWith(scenePath, scene), lightsPath, p);
+    return 0;
+  });
+  const LightmapUvs& uvs = r.lightmap.uvs;
+  const LightmapAtlas& atlas = r.lightmap.atlas;
+  py::dict d;  // the figures of `lightmap --json`, and the files' sizes
+  d["uvs"] = r.lightmap.fromTexcoord1 ? "texcoord1" : "charts";
+  d["charts"] = uvs.chartCount;
+  d["pages"] = atlas.pageCount;
+  d["page_size"] = std::vector<int>{atlas.width, atlas.height};
+  d["texel_size"] = uvs.texelSize;
+  d["utilisation"] = uvs.utilisation;
+  d["covered_texels"] = atlas.coveredTexels;
+  d["dilated_texels"] = atlas.dilatedTexels;
+  py::dict seams;
+  seams["before"] = atlas.seamMismatchBefore;
+  seams["after"] = atlas.seamMismatchAfter;
+  d["seam_mismatch"] = seams;
+  d["content"] = toString(p.content);
+  d["encoding"] = p.rgbm ? "rgbm-png" : "linear-exr";
+  d["rgbm_range"] = p.rgbm ? py::object(py::float_(r.rgbmRange)) : py::object(py::none());
+  d["page_files"] = r.pagePaths;
+  d["direction_files"] = r.directionPaths;
+  d["chart_files"] = r.chartPaths;
+  d["gltf"] = r.output;
+  d["preview"] = r.previewPath.empty() ? py::object(py::none()) : py::object(py::str(r.previewPath));
+  d["octree_bytes"] = r.octreePoolBytes + r.octreeVdlBytes;
+  d["page_file_bytes"] = r.pageFileBytes;
+  d["output_bytes"] = r.outputBytes;
+  d["preview_bytes"] = r.previewBytes;
+  return d;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(lightoctree, m) {
@@ -340,7 +806,8 @@ PYBIND11_MODULE(lightoctree, m) {
         "Bakes a scene (.gltf, .glb, .obj) as `lightoctree bake` does: photons until the noise "
         "figure reaches target_error (default 0.07), or a fixed number of photons; target_light "
         "'seen' (the noise of the light a viewer sees) or 'indirect' (of the indirect light). "
-        "progress(task, done, total) is called as the bake goes.");
+        "progress(task, done, total) is called as the bake goes; an exception it raises, or "
+        "Ctrl-C, stops the bake and is raised.");
   m.def("read", &readGrid, py::arg("path"), "Reads a .vdb written by bake or convert.");
   m.def(
       "write",
@@ -365,6 +832,42 @@ PYBIND11_MODULE(lightoctree, m) {
         "same: interpolation, specular, reflections, area_lights, cosine_correction (bool); "
         "lighting ('octree' | 'atlas'), texels ('compact' | 'half' | 'float'); supersample, vdls, "
         "emitter_lights, shadow_map_size (int); tolerance, free_space_tolerance (0..1).");
+  m.def("reference", &referenceImage, py::arg("scene"), py::arg("width") = ReferenceOptions{}.width,
+        py::arg("height") = ReferenceOptions{}.height, py::arg("spp") = ReferenceOptions{}.spp,
+        py::arg("part") = ReferenceOptions{}.part, py::arg("seed") = ReferenceOptions{}.seed,
+        py::arg("max_bounces") = ReferenceOptions{}.maxBounces, py::arg("camera") = py::none(),
+        py::arg("eye") = py::none(), py::arg("target") = py::none(), py::arg("fov") = py::none(),
+        py::arg("time_budget") = py::none(), py::arg("std_error") = false,
+        py::arg("progress") = py::none(), py::arg("sky") = py::none(),
+        py::arg("sky_image") = py::none(), py::arg("sky_mesh") = py::none(),
+        py::arg("physical_sky") = py::none(),
+        "The path-traced ground truth, as `lightoctree reference` renders it (the same flags, "
+        "defaults and camera: the scene's first camera or `camera` by name, else the scene "
+        "framed; eye and target as x, y, z; fov in degrees): linear RGB, shape (height, width, "
+        "3); with std_error=True (image, per-pixel standard error). part 'full' | 'direct' | "
+        "'indirect' | 'irradiance'; time_budget (seconds) renders passes of 1 spp instead of "
+        "spp. progress(task, done, total) is called as it goes; an exception it raises, or "
+        "Ctrl-C, stops the work and is raised.");
+  m.def("compare", &compareImagesArg, py::arg("test"), py::arg("reference"),
+        py::arg("bin") = CompareSettings{}.bin,
+        py::arg("clip_percentile") = double(CompareSettings{}.clipPercentile),
+        py::arg("mask") = py::none(), py::arg("ignore_background") = CompareSettings{}.ignoreBackground,
+        py::arg("reference_error") = py::none(),
+        "The error of a test image against a reference, as `lightoctree compare --json` reports "
+        "it (the same keys and values): images, mask and reference_error (the reference's "
+        "standard error) as paths or arrays of shape (height, width, 3). Black holes are "
+        "judged first, then both images clipped at the reference's clip_percentile, then "
+        "binned (mask and standard error alike) over bin x bin blocks.");
+  m.def("lightmap", &lightmapExport, py::arg("scene"), py::arg("lights"), py::arg("output"),
+        "Lightmaps from a baked grid file, as `lightoctree lightmap SCENE LIGHTS -o OUTPUT` "
+        "writes them (the same files; an output that would replace an input is refused): "
+        "OUTPUT .glb or .gltf, the pages beside it. Keywords as the command's flags, defaults "
+        "the same: texel_size (0 = a quarter voxel), atlas (1024), uv ('auto' | 'texcoord1'; "
+        "default TEXCOORD_1 when the scene has one), content ('indirect' | 'full'), "
+        "direct_samples (64), image ('exr' | 'png'), preview_unlit (False), exposure (0), "
+        "atlas_on ('cpu' | 'osmesa' | 'egl'), directions ('on' | 'off'), chart_image (False), "
+        "sky, sky_image, sky_mesh, physical_sky. Returns what it wrote: the figures of "
+        "`lightmap --json` (page_files, gltf, pages, texel_size, ...) and the files' bytes.");
   m.def("read_image", &readImageFile, py::arg("path"),
         "An image file: EXR as linear floats, PNG decoded from sRGB; shape (height, width, 3).");
 }

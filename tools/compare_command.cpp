@@ -76,22 +76,17 @@ int runCompare(const CompareOptions& opt) {
                        std::to_string(reference.height));
     }
   }
-  // Black holes are judged per pixel against the reference as it is.
-  const DarkHoles holes = darkHoles(test, reference, params);
-  Vec3 clip(0.0f);
-  if (opt.clipPercentile < 100) {
-    clip = channelPercentiles(reference, opt.clipPercentile, params);
-    clipChannels(test, clip);
-    clipChannels(reference, clip);
-  }
-  if (opt.bin > 1) {
-    test = binImage(test, opt.bin);
-    reference = binImage(reference, opt.bin);
-    if (params.mask) mask = binMask(mask, opt.bin);
-    if (!stdError.rgb.empty()) stdError = binStdError(stdError, opt.bin);
-  }
-  CompareResult result = compareImages(test, reference, params);
-  const double noise = stdError.rgb.empty() ? -1.0 : referenceNoise(reference, stdError, params);
+  CompareSettings settings;
+  settings.bin = opt.bin;
+  settings.clipPercentile = opt.clipPercentile;
+  settings.ignoreBackground = opt.ignoreBackground;
+  const CompareReport report =
+      compareReport(std::move(test), std::move(reference), settings, params.mask,
+                    opt.referenceError.empty() ? nullptr : &stdError);
+  const CompareResult& result = report.result;
+  const DarkHoles& holes = report.holes;
+  const Vec3 clip = report.clip;
+  const double noise = report.referenceNoise;
   if (!opt.quiet) {
     std::printf("%s against %s%s\n%s\n", opt.test.c_str(), opt.reference.c_str(),
                 opt.bin > 1 ? (", binned " + std::to_string(opt.bin) + "x" +
@@ -119,7 +114,7 @@ int runCompare(const CompareOptions& opt) {
   }
   if (!opt.diff.empty()) {
     // Linear float values in an EXR; PNG keeps the false colour as it is.
-    writeImage(opt.diff, differenceImage(test, reference, params, opt.diffScale));
+    writeImage(opt.diff, differenceImage(report.test, report.reference, report.params(), opt.diffScale));
     if (!opt.quiet) std::printf("wrote %s\n", opt.diff.c_str());
   }
   if (!opt.json.empty()) {
@@ -127,8 +122,8 @@ int runCompare(const CompareOptions& opt) {
     j["test"] = opt.test;
     j["reference"] = opt.reference;
     j["bin"] = opt.bin;
-    j["width"] = reference.width;
-    j["height"] = reference.height;
+    j["width"] = report.reference.width;
+    j["height"] = report.reference.height;
     j["channels"] = {{"R", toJson(result.channel[0])},
                      {"G", toJson(result.channel[1])},
                      {"B", toJson(result.channel[2])},
@@ -176,13 +171,13 @@ void addCompareOptions(CLI::App* cmd, CompareOptions& opt) {
                   "Average both images (and the mask) over blocks of N x N pixels first: the "
                   "error at the scale of N pixels, without the reference's per-pixel noise "
                   "(--diff is then at that resolution too)")
-      ->check(wholeIn(1, 1024))
+      ->check(numberIn(kCompareBinRange))
       ->capture_default_str();
   cmd->add_option("--clip-percentile", opt.clipPercentile,
                   "Clip each channel of both images at the reference's P-th percentile (over the "
                   "compared pixels) before binning and comparing, so that a few visible lamps do "
                   "not rule the error (99 is the figure docs/accuracy.md quotes); 100 = off")
-      ->check(numberIn({0, 100, true}))
+      ->check(numberIn(kClipPercentileRange))
       ->capture_default_str();
   cmd->add_option("--diff", opt.diff,
                   "Write |Y(test) - Y(reference)| in false colour (.png or .exr): black 0, blue, "

@@ -203,3 +203,268 @@ def test_a_path_with_a_nul_byte_names_no_file(grid, tmp_path):
         lightoctree.render(SCENE + "\0", grid, width=8, height=8)
     with pytest.raises(lightoctree.InputError, match="scene: .*NUL byte"):
         lightoctree.convert(grid, depth=5, scene=SCENE + "\0")
+
+
+# reference, compare and lightmap: the commands from Python (issue 44, part 2),
+# with the commands' settings and defaults, so each equals its command's output.
+
+def _cli():
+    cli = os.environ.get("LIGHTOCTREE_CLI")
+    if not cli:
+        pytest.skip("LIGHTOCTREE_CLI not set (ctest sets it)")
+    return cli
+
+
+def _run(*args):
+    import subprocess
+    return subprocess.run([_cli(), *map(str, args)], check=True, capture_output=True, text=True)
+
+
+def test_reference_equals_the_command(tmp_path):
+    """The same seed and settings give the command's floats, with the scene's
+    camera and with --eye/--target/--fov; the standard error alike."""
+    calls = []
+    image, error = lightoctree.reference(SCENE, width=16, height=12, spp=4, std_error=True,
+                                         progress=lambda *report: calls.append(report))
+    assert image.shape == error.shape == (12, 16, 3) and image.dtype == np.float32
+    assert image.mean() > 0 and error.mean() > 0
+    assert calls and all(task == "Path tracing" and 0 <= done <= total for task, done, total in calls)
+    _run("reference", SCENE, "-o", tmp_path / "ref.exr", "--std-error", tmp_path / "se.exr",
+         "--width", 16, "--height", 12, "--spp", 4, "--quiet")
+    assert np.array_equal(lightoctree.read_image(str(tmp_path / "ref.exr")), image)
+    assert np.array_equal(lightoctree.read_image(str(tmp_path / "se.exr")), error)
+    view = dict(eye=(0.1, 0.3, 1.2), target=(0.0, 0.25, 0.0), fov=50)
+    moved = lightoctree.reference(SCENE, width=16, height=12, spp=4, part="indirect", seed=7,
+                                  max_bounces=5, **view)
+    _run("reference", SCENE, "-o", tmp_path / "moved.exr", "--width", 16, "--height", 12,
+         "--spp", 4, "--part", "indirect", "--seed", 7, "--max-bounces", 5,
+         "--eye", "0.1,0.3,1.2", "--target", "0,0.25,0", "--fov", 50, "--quiet")
+    assert np.array_equal(lightoctree.read_image(str(tmp_path / "moved.exr")), moved)
+    assert not np.array_equal(moved[..., :], image)
+
+
+def test_reference_defaults_are_the_commands():
+    text = lightoctree.reference.__doc__
+    for default in ("width: int = 800", "height: int = 600", "spp: int = 64", "part: str = 'full'",
+                    "seed: object = 1", "max_bounces: int = 256"):
+        assert default in text, default
+
+
+@pytest.mark.parametrize("argument, value, message", [
+    ("spp", -1, "spp: must be a whole number from 1 to 1000000, got -1"),
+    ("spp", 0, "spp: must be"),
+    ("width", 0, "width: must be"),
+    ("max_bounces", -1, "max_bounces: must be"),
+    ("fov", math.nan, "fov: must be a finite number from 1 to 179, got nan"),
+    ("fov", 180, "fov: must be"),
+    ("time_budget", math.nan, "time_budget: must be"),
+    ("time_budget", -1.0, "time_budget: must be"),
+    ("part", "edges", "part: must be one of 'full', 'direct', 'indirect', 'irradiance', got 'edges'"),
+    ("seed", -1, "seed: must be a whole number from 0"),
+    ("eye", (1, 2), "eye: expected three numbers"),
+    ("eye", (1, 2, math.nan), "eye: expected three numbers"),
+    ("eye", (0, 1, 2), "eye and target must be given together"),
+    ("camera", "nowhere", "camera: no camera named 'nowhere'"),
+    ("sky", (1, -1, 1), "sky: .* is not a radiance"),
+])
+def test_reference_refuses_bad_arguments_by_name(argument, value, message):
+    with pytest.raises(ValueError, match=message):
+        settings = dict(width=8, height=8, spp=1)
+        if argument == "eye" and "together" not in message:
+            settings["target"] = (0, 0, 0)
+        lightoctree.reference(SCENE, **dict(settings, **{argument: value}))
+
+
+@pytest.mark.parametrize("argument, flag, value", [
+    ("spp", "--spp", v) for v in (0, 1, 1000000, 1000001)
+] + [
+    ("max_bounces", "--max-bounces", v) for v in (-1, 0, 100000, 100001)
+] + [
+    ("width", "--width", v) for v in (0, 1, 16384, 16385)
+] + [
+    ("fov", "--fov", v) for v in (math.nan, math.inf, 0.5, 1.0, 179.0, 179.5)
+] + [
+    ("time_budget", "--time-budget", v) for v in (math.nan, 0.0, 1e-4, 1e-3, 1e7, 2e7)
+])
+def test_reference_takes_what_the_flags_take(argument, flag, value, tmp_path):
+    """Each value goes to the module and to `lightoctree reference`: both
+    refuse it or both take it (then both fail on the missing scene)."""
+    import subprocess
+    missing = str(tmp_path / "missing.gltf")
+    with pytest.raises(ValueError) as refusal:
+        lightoctree.reference(missing, **{argument: value})
+    module_refused = str(refusal.value).startswith(argument + ": must be")
+    run = subprocess.run([_cli(), "reference", SCENE, "-o", str(tmp_path / "no-folder" / "x.exr"),
+                          flag, repr(value)], capture_output=True, text=True)
+    assert run.returncode in (1, 2), run.stderr
+    flag_refused = run.returncode == 2 and (flag + ": must be") in run.stderr
+    assert module_refused == flag_refused, (str(refusal.value), run.stderr)
+
+
+class Stop(Exception):
+    pass
+
+
+def test_a_progress_callback_that_raises_stops_the_work():
+    calls = []
+
+    def progress(task, done, total):
+        calls.append((task, done, total))
+        if done > 0:
+            raise Stop("enough")
+
+    import time
+    start = time.monotonic()
+    with pytest.raises(Stop, match="enough"):
+        lightoctree.reference(SCENE, width=160, height=120, spp=4096, progress=progress)
+    # 160 x 120 at 4096 spp takes minutes; stopped at the first report after
+    # the start, with no report after the one that raised.
+    assert time.monotonic() - start < 20
+    assert calls[-1][1] > 0 and sum(1 for _, done, _ in calls if done > 0) == 1
+    calls.clear()
+    with pytest.raises(Stop):
+        lightoctree.bake(SCENE, depth=4, photons=2000000, progress=progress)
+    assert sum(1 for _, done, _ in calls if done > 0) == 1
+
+
+def test_ctrl_c_stops_the_work():
+    """SIGINT during the work: the next progress report on the main thread
+    runs Python's handler (PyErr_CheckSignals) and the call raises
+    KeyboardInterrupt, with or without a callback."""
+    import signal
+    import threading
+    import time
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            lightoctree.reference(SCENE, width=160, height=120, spp=4096)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 20
+
+
+def test_compare_measures_what_the_command_measures(tmp_path):
+    image = lightoctree.reference(SCENE, width=16, height=12, spp=4)
+    same = lightoctree.compare(image, image)
+    assert same["compared_pixels"] == 16 * 12 and same["reference_noise"] is None
+    for channel in ("R", "G", "B", "Y", "RGB"):
+        assert same["channels"][channel] == {"rel_rmse": 0.0, "rel_mae": 0.0, "max_abs": 0.0}
+    scaled = lightoctree.compare(image * 1.1, image)
+    for channel in ("R", "G", "B", "Y", "RGB"):
+        assert scaled["channels"][channel]["rel_rmse"] == pytest.approx(0.1, rel=1e-5)
+        assert scaled["channels"][channel]["rel_mae"] == pytest.approx(0.1, rel=1e-5)
+    assert scaled["mean_test_luminance"] == pytest.approx(1.1 * scaled["mean_reference_luminance"])
+
+    # The command's --json on the same files: the same keys and values, with
+    # every step (mask, black holes, clip, bin, the reference's noise).
+    import json
+    test, ref, se, mask = (str(tmp_path / name) for name in
+                           ("test.exr", "ref.exr", "se.exr", "mask.png"))
+    _run("reference", SCENE, "-o", test, "--width", 16, "--height", 12, "--spp", 2, "--seed", 2,
+         "--quiet")
+    _run("reference", SCENE, "-o", ref, "--std-error", se, "--geometry-mask", mask,
+         "--width", 16, "--height", 12, "--spp", 4, "--quiet")
+    for flags, settings in [
+        ([], {}),
+        (["--bin", "3", "--clip-percentile", "99", "--mask", mask, "--reference-error", se],
+         dict(bin=3, clip_percentile=99, mask=mask, reference_error=se)),
+        (["--ignore-background", "--bin", "2", "--clip-percentile", "90.5"],
+         dict(ignore_background=True, bin=2, clip_percentile=90.5)),
+    ]:
+        report = str(tmp_path / "report.json")
+        _run("compare", test, ref, "--json", report, "--quiet", *flags)
+        with open(report) as f:
+            expected = json.load(f)
+        assert lightoctree.compare(test, ref, **settings) == expected, flags
+        # Arrays give the same figures as the files they hold.
+        arrays = {key: (lightoctree.read_image(value) if key == "reference_error" else value)
+                  for key, value in settings.items()}
+        from_arrays = lightoctree.compare(lightoctree.read_image(test), lightoctree.read_image(ref),
+                                          **arrays)
+        assert from_arrays == dict(expected, test=None, reference=None), flags
+
+
+def test_compare_refuses_bad_arguments_by_name():
+    image = np.ones((12, 16, 3), dtype=np.float32)
+    with pytest.raises(ValueError, match="bin: must be a whole number from 1 to 1024, got 0"):
+        lightoctree.compare(image, image, bin=0)
+    with pytest.raises(ValueError, match="clip_percentile: must be .*got nan"):
+        lightoctree.compare(image, image, clip_percentile=math.nan)
+    with pytest.raises(ValueError, match="clip_percentile: must be"):
+        lightoctree.compare(image, image, clip_percentile=0)
+    with pytest.raises(ValueError, match="test is 16 x 8 but reference is 16 x 12"):
+        lightoctree.compare(image[:8], image)
+    with pytest.raises(ValueError, match=r"reference: must be a path or an array of shape \(height, width, 3\)"):
+        lightoctree.compare(image, image[..., 0])
+    with pytest.raises(ValueError, match="mask: the mask is 8 x 12, the images are 16 x 12"):
+        lightoctree.compare(image, image, mask=image[:, :8])
+    with pytest.raises(ValueError, match="reference_error: "):
+        lightoctree.compare(image, image, reference_error=image[:4])
+
+
+@pytest.fixture(scope="module")
+def grid_file(grid, tmp_path_factory):
+    path = str(tmp_path_factory.mktemp("grid") / "grid.vdb")
+    lightoctree.write(path, grid)
+    return path
+
+
+def test_lightmap_writes_what_the_command_writes(grid_file, tmp_path):
+    """Defaults and a few settings: the same files, byte for byte (the atlas
+    on the CPU is the same bytes on every run)."""
+    for settings, flags in [({}, []),
+                            (dict(atlas=256, image="png", directions="off", preview_unlit=True,
+                                  texel_size=0.02, chart_image=True),
+                             ["--atlas", "256", "--image", "png", "--directions", "off",
+                              "--preview-unlit", "--texel-size", "0.02", "--chart-image"])]:
+        module_dir, command_dir = tmp_path / "module", tmp_path / "command"
+        for d in (module_dir, command_dir):
+            d.mkdir(exist_ok=True)
+            for f in d.iterdir():
+                f.unlink()
+        result = lightoctree.lightmap(SCENE, grid_file, str(module_dir / "lit.glb"), **settings)
+        _run("lightmap", SCENE, grid_file, "-o", command_dir / "lit.glb", "--quiet", *flags)
+        written = sorted(f.name for f in module_dir.iterdir())
+        assert written == sorted(f.name for f in command_dir.iterdir()), settings
+        for name in written:
+            assert (module_dir / name).read_bytes() == (command_dir / name).read_bytes(), name
+        assert result["gltf"] == str(module_dir / "lit.glb")
+        assert result["pages"] == len(result["page_files"]) >= 1
+        assert all(os.path.exists(p) for p in result["page_files"] + result["direction_files"])
+        assert result["texel_size"] > 0 and result["output_bytes"] == os.path.getsize(result["gltf"])
+        if settings:
+            assert result["encoding"] == "rgbm-png" and result["direction_files"] == []
+            assert result["preview"] == str(module_dir / "lit-preview.glb")
+            assert result["texel_size"] == pytest.approx(0.02)
+            assert len(result["chart_files"]) == result["pages"]
+        else:
+            assert result["encoding"] == "linear-exr" and result["preview"] is None
+            assert len(result["direction_files"]) == result["pages"]
+
+
+def test_lightmap_refuses_as_the_command_does(grid_file, tmp_path):
+    import shutil
+    scene = str(tmp_path / "scene.gltf")
+    shutil.copy(SCENE, scene)
+    before = open(scene, "rb").read()
+    with pytest.raises(ValueError, match="output: .*scene.gltf' is the input scene"):
+        lightoctree.lightmap(scene, grid_file, scene)
+    copy = str(tmp_path / "lit-lightmap0.exr")  # an input named like a page of the output
+    shutil.copy(grid_file, copy)
+    with pytest.raises(ValueError, match="output: the lightmap pages of .* would replace the input lights"):
+        lightoctree.lightmap(scene, copy, str(tmp_path / "lit.glb"))
+    os.remove(copy)
+    assert open(scene, "rb").read() == before
+    with pytest.raises(ValueError, match="output: .*must end in"):
+        lightoctree.lightmap(scene, grid_file, str(tmp_path / "lit.obj"))
+    with pytest.raises(ValueError, match="lightmap: unknown setting 'atlas_size'"):
+        lightoctree.lightmap(scene, grid_file, str(tmp_path / "lit.glb"), atlas_size=256)
+    with pytest.raises(ValueError, match="atlas: must be a whole number from 8 to 16384, got 4"):
+        lightoctree.lightmap(scene, grid_file, str(tmp_path / "lit.glb"), atlas=4)
+    with pytest.raises(ValueError, match="texel_size: must be .*got nan"):
+        lightoctree.lightmap(scene, grid_file, str(tmp_path / "lit.glb"), texel_size=math.nan)
+    with pytest.raises(ValueError, match="content: must be one of 'indirect', 'full', got 'direct'"):
+        lightoctree.lightmap(scene, grid_file, str(tmp_path / "lit.glb"), content="direct")
+    assert sorted(os.listdir(tmp_path)) == ["scene.gltf"]

@@ -297,4 +297,37 @@ RgbImage differenceImage(const RgbImage& test, const RgbImage& reference,
   return out;
 }
 
+CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSettings& settings,
+                            const RgbImage* mask, const RgbImage* stdError) {
+  CompareReport r;
+  r.ignoreBackground = settings.ignoreBackground;
+  if (mask) r.mask = *mask;
+  RgbImage error;
+  if (stdError) {
+    if (stdError->width != reference.width || stdError->height != reference.height)
+      throw InputError("compare: standard error is " + std::to_string(stdError->width) + " x " +
+                       std::to_string(stdError->height) + ", images are " +
+                       std::to_string(reference.width) + " x " + std::to_string(reference.height));
+    error = *stdError;
+  }
+  // Black holes are judged per pixel against the reference as it is.
+  r.holes = darkHoles(test, reference, r.params());
+  if (settings.clipPercentile < 100) {
+    r.clip = channelPercentiles(reference, settings.clipPercentile, r.params());
+    clipChannels(test, r.clip);
+    clipChannels(reference, r.clip);
+  }
+  if (settings.bin > 1) {
+    test = binImage(test, settings.bin);
+    reference = binImage(reference, settings.bin);
+    if (mask) r.mask = binMask(r.mask, settings.bin);
+    if (stdError) error = binStdError(error, settings.bin);
+  }
+  r.result = compareImages(test, reference, r.params());
+  if (stdError) r.referenceNoise = referenceNoise(reference, error, r.params());
+  r.test = std::move(test);
+  r.reference = std::move(reference);
+  return r;
+}
+
 }  // namespace lo

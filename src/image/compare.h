@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <string>
 
+#include "core/number_range.h"
 #include "image/image.h"
 
 namespace lo {
@@ -115,6 +116,48 @@ DarkHoles darkHoles(const RgbImage& test, const RgbImage& reference,
 /// @throws InputError if the sizes (or the mask's) differ or an image is empty.
 CompareResult compareImages(const RgbImage& test, const RgbImage& reference,
                             const CompareParams& params = {});
+
+/// `compare --bin` and the Python module's bin: blocks of 1 to 1024 pixels.
+constexpr NumberRange kCompareBinRange{1, 1024, false, true};
+/// `compare --clip-percentile` and clip_percentile: (0, 100], 100 = off.
+constexpr NumberRange kClipPercentileRange{0, 100, true};
+
+/// What `lightoctree compare` and the Python module's compare choose.
+struct CompareSettings {
+  int bin = 1;                 ///< average over bin x bin blocks first (kCompareBinRange)
+  float clipPercentile = 100;  ///< clip at the reference's percentile first; 100 = off
+  bool ignoreBackground = false;  ///< CompareParams::ignoreBackground
+};
+
+/// Everything `compare` measures, in the images the figures are of.
+struct CompareReport {
+  CompareResult result;  ///< of the clipped and binned images
+  DarkHoles holes;       ///< per pixel, before clipping and binning
+  Vec3 clip{0, 0, 0};    ///< clipPercentile < 100: the limit of each channel, else 0
+  /// The reference's relative RMS standard error of Y over the compared
+  /// pixels (and bins), referenceNoise(); < 0 when no standard error was given.
+  double referenceNoise = -1;
+  /// The images as compared (clipped, binned), for differenceImage; `mask`
+  /// empty when none was given.
+  RgbImage test, reference, mask;
+  /// The parameters the figures were measured with, over this report's mask.
+  CompareParams params() const {
+    CompareParams p;
+    p.mask = mask.rgb.empty() ? nullptr : &mask;
+    p.ignoreBackground = ignoreBackground;
+    return p;
+  }
+  bool ignoreBackground = false;
+};
+
+/// @brief `compare`'s measurement in its order: black holes judged per pixel
+/// against the reference as it is; then both images clipped at the
+/// reference's clipPercentile (over the compared pixels); then the images, the
+/// mask (binMask) and the standard error (binStdError) binned; then
+/// compareImages and referenceNoise. `mask` and `stdError` may be null.
+/// @throws InputError if the sizes differ, an image is empty or bin < 1.
+CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSettings& settings,
+                            const RgbImage* mask = nullptr, const RgbImage* stdError = nullptr);
 
 /// False colour of |Y(test) - Y(reference)| / scale: black 0, blue 0.25,
 /// green 0.5, yellow 0.75, red >= 1; ignored pixels mid grey. scale <= 0
