@@ -125,6 +125,27 @@ GatherOcclusion::GatherOcclusion(const Scene& scene) : origin_(scene.tracingOrig
 
 GatherOcclusion::~GatherOcclusion() = default;
 
+SurfaceProbe GatherOcclusion::surfaceProbe() const {
+  const RayTracer* tracer = tracer_.get();
+  const Vec3 origin = origin_;
+  return [tracer, origin](const Vec3& p, const Vec3& n, float h) {
+    // Down the segment from p + n h, past surfaces that face another way
+    // (a few at most: the first facing one answers).
+    const Vec3 down = -n;
+    Vec3 from = p + n * h - origin;
+    float left = 2.0f * h;
+    for (int crossed = 0; crossed < 8 && left > 0; ++crossed) {
+      Hit hit;
+      if (!tracer->intersect(from, down, hit, left)) return false;
+      if (std::fabs(dot(hit.geometricNormal, n)) > 0.5f) return true;
+      const float step = hit.t + 1e-4f * h;
+      from = from + down * step;
+      left -= step;
+    }
+    return false;
+  };
+}
+
 SegmentBlocked GatherOcclusion::test() const {
   const RayTracer* tracer = tracer_.get();
   const Vec3 origin = origin_;
@@ -185,6 +206,7 @@ VdlGrid gatherLevel(const Scene& scene, SurfaceGrid& grid, const std::vector<Pho
   if (params.occlusion && !gather.blocked && scene.triangleCount() > 0) {
     occlusion = std::make_unique<GatherOcclusion>(scene);
     gather.blocked = occlusion->test();
+    if (gather.edgeCorrection) gather.surfaceAt = occlusion->surfaceProbe();
   }
   const LayerParams layerParams;
   VdlGrid vdls = buildVdlGrid(grid, photons, gather, params.cluster, progress, &s.threadSeconds,

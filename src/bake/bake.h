@@ -180,6 +180,8 @@ class GatherOcclusion {
   GatherOcclusion(const GatherOcclusion&) = delete;
   GatherOcclusion& operator=(const GatherOcclusion&) = delete;
   SegmentBlocked test() const;
+  /// GatherParams::surfaceAt through the same ray tracer.
+  SurfaceProbe surfaceProbe() const;
 
  private:
   std::unique_ptr<RayTracer> tracer_;

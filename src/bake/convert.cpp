@@ -83,6 +83,7 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
       // The bake's defaults: surface layers and gather occlusion.
       const GatherOcclusion occlusion(*params.scene);
       gather.blocked = occlusion.test();
+      gather.surfaceAt = occlusion.surfaceProbe();
       const LayerParams layers;
       r.grid = buildVdlGrid(grid, photons, gather, cluster, progress, nullptr, &layers);
       r.metadata.knn = gather.k;

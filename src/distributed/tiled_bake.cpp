@@ -559,6 +559,7 @@ class RankBake {
     if (level_.occlusion && scene_.triangleCount() > 0) {
       occlusion = std::make_unique<GatherOcclusion>(scene_);
       gather.blocked = occlusion->test();
+      if (gather.edgeCorrection) gather.surfaceAt = occlusion->surfaceProbe();
     }
     const LayerParams layerParams;
     local_ = buildVdlGrid(grid_, held_, gather, level_.cluster, progress_, &st_.level.threadSeconds,

@@ -192,8 +192,11 @@ inline void selectPhoton(const Vec3& position, const Vec3& normal, uint32_t inde
 /// the winding need not face the light). A density estimate divides the
 /// photons' power by this share of pi r^2: near an edge, where the disc
 /// reaches past the surface, the photons cover only part of it.
+/// With GatherParams::surfaceAt, each point asks the scene instead: is
+/// there such surface along the normal within the gather's ellipsoid there.
 /// GatherParams::edgeCorrection; 1 for the sphere metric or r = 0.
-double surfaceCoverage(const SurfaceGrid& grid, const Vec3& q, const Vec3& n, float r) {
+double surfaceCoverage(const SurfaceGrid& grid, const Vec3& q, const Vec3& n, float r,
+                       float squash, const SurfaceProbe& surfaceAt) {
   if (n == Vec3{} || !(r > 0) || grid.size() == 0) return 1.0;
   const Vec3 a = std::fabs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
   const Vec3 t1 = normalize(cross(n, a)), t2 = cross(n, t1);
@@ -246,6 +249,14 @@ double surfaceCoverage(const SurfaceGrid& grid, const Vec3& q, const Vec3& n, fl
       // Rings turned by half a step against each other.
       const float phi = (float(k) + 0.5f * float(ring & 1)) * (2.0f * kPi / float(kAngles));
       const Vec3 p = q + (t1 * std::cos(phi) + t2 * std::sin(phi)) * rr;
+      if (surfaceAt) {
+        // The ellipsoid's half thickness at this distance from q (at least
+        // a tenth of a voxel: a surface that curves away).
+        const float h = std::max(std::sqrt(std::max(r * r - rr * rr, 0.0f)) / std::max(squash, 1e-3f),
+                                 0.1f * grid.frame.voxelSize);
+        covered += surfaceAt(p, n, h);
+        continue;
+      }
       const Coord c = grid.frame.coordOf(p);
       bool hit = facesLikeN(grid.find(c), p);
       if (!hit) {
@@ -318,7 +329,10 @@ void gatherWith(const SurfaceGrid& grid, const std::vector<Photon>& photons,
   // Edge correction: the disc's share on the surface (at least a quarter,
   // so that a stray estimate cannot blow up).
   const double coverage =
-      params.edgeCorrection ? std::max(0.25, surfaceCoverage(grid, query.point, n, rk)) : 1.0;
+      params.edgeCorrection
+          ? std::max(0.25, surfaceCoverage(grid, query.point, n, rk, params.normalSquash,
+                                           params.surfaceAt))
+          : 1.0;
   const double invArea = 1.0 / (double(kPi) * double(rk) * double(rk) * coverage);
   out.radius = rk;
   out.coverage = float(coverage);

@@ -20,6 +20,11 @@ namespace lo {
 /// gather uses it to leave out photons behind a wall.
 using SegmentBlocked = std::function<bool(const Vec3& from, const Vec3& to)>;
 
+/// Whether a surface facing within 60 degrees of n (either way) crosses the
+/// segment from p - n h to p + n h: the edge correction's look at the
+/// scene itself, where the grid only knows which voxels hold such geometry.
+using SurfaceProbe = std::function<bool(const Vec3& p, const Vec3& n, float h)>;
+
 struct GatherParams {
   int k = 300;  ///< nearest neighbours (paper: 300)
   /// Gathering radius in world units; 0 = kDefaultRadiusVoxels * voxel size.
@@ -44,6 +49,12 @@ struct GatherParams {
   /// the whole disc: next to an edge, where the disc reaches past the
   /// surface, the plain estimate is too dark by up to half.
   bool edgeCorrection = true;
+  /// Set: the edge correction asks the scene (a ray along the normal through
+  /// each of its disc points, as long as the gather's ellipsoid is thick
+  /// there) whether surface lies there; unset: whether the point's voxel
+  /// holds such geometry (a railing or a stair's edge in a voxel counts its
+  /// whole voxel as floor: the estimate divides by too much and is dark).
+  SurfaceProbe surfaceAt;
   /// Caustics apart (the classic caustic map): photons that reached their
   /// surface through mirrors and glass alone (Photon::caustic) are not
   /// gathered with the smooth light but by Gatherer::gatherCaustics, within

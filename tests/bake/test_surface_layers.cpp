@@ -78,10 +78,12 @@ TEST(SurfaceLayers, EachFaceOfAnEdgeKeepsItsOwnLight) {
   const EdgeError on = edgeError(true);
   const EdgeError off = edgeError(false);
   // Photon noise of a k = 300 estimate is ~6%; the edge voxels without
-  // layers mix the two faces' photons.
+  // layers mix the two faces' photons. (Since the edge correction asks the
+  // scene where its surfaces end, layers off measure 0.057 and 0.084 against
+  // 0.029 and 0.042 on: half, where the grid's coverage left off at 2.5x.)
   EXPECT_LT(on.floor, 0.08);
   EXPECT_LT(on.wall, 0.08);
-  EXPECT_GT(off.floor + off.wall, 2.0 * (on.floor + on.wall));
+  EXPECT_GT(off.floor + off.wall, 1.5 * (on.floor + on.wall));
 }
 
 // The same edge with the SH representation: each layer's SH, scaled to its

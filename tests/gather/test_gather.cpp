@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "bake/bake.h"
 #include "core/rng.h"
 #include "gather/gather.h"
 #include "gather/gather_fixture.h"
@@ -455,6 +456,45 @@ TEST_F(Gather, EdgeCorrectionKeepsTheBorderOfAPlaneLit) {
       EXPECT_LT(ratio, 0.8);
     }
   }
+}
+
+// The edge correction asking the scene (GatherParams::surfaceAt, the bake's
+// default): a free border's place inside its voxel is then known, and the
+// border's estimate is the interior's, where the grid's answer (the voxel
+// holds floor) left it partial.
+TEST_F(Gather, EdgeCorrectionThatAsksTheSceneFindsAFreeBorder) {
+  scene = unitFloor();
+  spreadPhotons(200000, 11, 4);
+  const GatherOcclusion occlusion(scene);
+  double ratios[2] = {0, 0};
+  for (int asks = 0; asks < 2; ++asks) {
+    GatherParams params;
+    params.k = 2000;  // the radius, not k, bounds the disc: r_k = r everywhere
+    if (asks) params.surfaceAt = occlusion.surfaceProbe();
+    Gatherer g(grid, photons, params);
+    GatherResult res;
+    double border = 0, interior = 0;
+    int nb = 0, ni = 0;
+    for (size_t v = 0; v < grid.size(); ++v) {
+      g.gather(v, res);
+      const Vec3 q = grid.centroids[v];
+      if (q.x < 0.05f && q.z > 0.3f && q.z < 0.7f) {
+        border += res.irradiance.x;
+        ++nb;
+      }
+      if (q.x > 0.3f && q.x < 0.7f && q.z > 0.3f && q.z < 0.7f) {
+        interior += res.irradiance.x;
+        ++ni;
+      }
+    }
+    ASSERT_GT(nb, 0);
+    ASSERT_GT(ni, 0);
+    ratios[asks] = (border / nb) / (interior / ni);
+  }
+  std::printf("border / interior irradiance: the grid's coverage %.3f, the scene's %.3f (exact: 1)\n",
+              ratios[0], ratios[1]);
+  EXPECT_NEAR(ratios[1], 1.0, 0.06);
+  EXPECT_GT(std::fabs(ratios[0] - 1.0), std::fabs(ratios[1] - 1.0));
 }
 
 // Deterministic: the same result whatever the thread count.
