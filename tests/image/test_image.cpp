@@ -137,6 +137,40 @@ TEST(Compare, BlackHolesAreLitReferencePixelsTheTestDrawsBlack) {
   EXPECT_EQ(darkHoles(test, ref).pixels, size_t(4));
 }
 
+TEST(Compare, TheReportJudgesHolesFirstThenClipsThenBins) {
+  // A 4 x 4 reference of 1 with one lamp pixel of 1000; the test equal but
+  // one lit pixel black. Black holes are judged first, per pixel, against
+  // the unclipped reference; then the images are clipped, then binned.
+  RgbImage ref(4, 4), test(4, 4);
+  std::fill(ref.rgb.begin(), ref.rgb.end(), 1.0f);
+  ref.set(0, Vec3(1000.0f));
+  test = ref;
+  test.set(5, Vec3(0.0f));
+  CompareSettings settings;
+  settings.clipPercentile = 90;  // nearest rank: 1 (the lamp is the 16th of 16)
+  settings.bin = 2;
+  const CompareReport r = compareReport(test, ref, settings);
+  EXPECT_EQ(r.holes.compared, size_t(16));
+  // The unclipped mean is (15 + 1000) / 16 = 63.4: 2% of it is 1.27, so
+  // every pixel of 1 counts as dark and none is above 20% of the mean but
+  // the lamp: no hole is found there, as the reference's own lamp rules the
+  // mean (the reason the bench clips the figures, not the holes).
+  EXPECT_EQ(r.holes.pixels, size_t(0));
+  EXPECT_EQ(r.clip, Vec3(1.0f));
+  // Clipped, then binned 2 x 2: the block holding the black pixel averages
+  // 0.75 against 1; the others agree. Rel. RMSE over 4 blocks of 3 channels:
+  // sqrt(3 * 0.25^2 / (12 * 1)).
+  EXPECT_EQ(r.test.width, 2);
+  EXPECT_NEAR(r.result.rgb.relRmse, std::sqrt(3 * 0.0625 / 12.0), 1e-6);
+  EXPECT_LT(r.referenceNoise, 0.0);  // no standard error given
+  // Without the lamp the hole is found: 2% of a mean of 15/16 is 0.019.
+  RgbImage plain(4, 4), holed(4, 4);
+  std::fill(plain.rgb.begin(), plain.rgb.end(), 1.0f);
+  holed = plain;
+  holed.set(5, Vec3(0.0f));
+  EXPECT_EQ(compareReport(holed, plain, CompareSettings{}).holes.pixels, size_t(1));
+}
+
 TEST(Compare, RejectsSizeMismatch) {
   EXPECT_THROW(compareImages(RgbImage(2, 2), RgbImage(2, 3)), InputError);
   RgbImage mask(1, 1);
