@@ -107,10 +107,7 @@ struct Stopped {};
 class CallbackProgress : public ProgressSink {
  public:
   explicit CallbackProgress(py::object callback) : callback_(std::move(callback)) {}
-  void begin(const std::string& task, size_t total) override {
-    task_ = task;
-    report(0, total, true);
-  }
+  void begin(const std::string& task, size_t total) override { report(0, total, true, &task); }
   void update(size_t done, size_t total) override { report(done, total, done < total); }
   void end() override {}
   /// With the interpreter's lock: raises what stopped the work, if anything.
@@ -119,9 +116,10 @@ class CallbackProgress : public ProgressSink {
   }
 
  private:
-  void report(size_t done, size_t total, bool mayStop) {
+  void report(size_t done, size_t total, bool mayStop, const std::string* task = nullptr) {
     if (!stopped_) {
       py::gil_scoped_acquire lock;
+      if (task) task_ = *task;  // read by other threads' reports, under the same lock
       try {
         if (PyErr_CheckSignals() != 0) throw py::error_already_set();
         if (!callback_.is_none()) callback_(task_, done, total);

@@ -160,7 +160,9 @@ vec3 behindAlong(vec3 q, vec3 d) {
   bool onScreen = clip.w > 0.0 && all(greaterThanEqual(uv, vec2(0.0))) &&
                   all(lessThanEqual(uv, vec2(1.0)));
   if (!onScreen && uHasProbe) return textureLod(uProbe, hit, 0.0).rgb;
-  vec3 behind = textureLod(uBehind, clamp(uv, vec2(0.0), vec2(1.0)) * uBehindScale, 0.0).rgb;
+  // Within the texels this frame wrote (the copy may be larger: it only grows).
+  vec2 written = uBehindScale - 0.5 / vec2(textureSize(uBehind, 0));
+  vec3 behind = textureLod(uBehind, min(clamp(uv, vec2(0.0), vec2(1.0)) * uBehindScale, written), 0.0).rgb;
   if (uEncodeSrgb) behind = srgbDecode(behind);
   return behind / uExposureScale;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -132,15 +133,13 @@ SurfaceProbe GatherOcclusion::surfaceProbe() const {
     // Down the segment from p + n h, past surfaces that face another way
     // (a few at most: the first facing one answers).
     const Vec3 down = -n;
-    Vec3 from = p + n * h - origin;
-    float left = 2.0f * h;
-    for (int crossed = 0; crossed < 8 && left > 0; ++crossed) {
+    const Vec3 from = p + n * h - origin;
+    float tmin = 0;
+    for (int crossed = 0; crossed < 8; ++crossed) {
       Hit hit;
-      if (!tracer->intersect(from, down, hit, left)) return false;
+      if (!tracer->intersectBetween(from, down, hit, tmin, 2.0f * h)) return false;
       if (std::fabs(dot(hit.geometricNormal, n)) > 0.5f) return true;
-      const float step = hit.t + 1e-4f * h;
-      from = from + down * step;
-      left -= step;
+      tmin = std::nextafter(hit.t, std::numeric_limits<float>::infinity());
     }
     return false;
   };

@@ -100,20 +100,68 @@ uint64_t sceneFingerprint(const Scene& scene) {
   f.add(uint64_t(scene.triangleMaterial.size()));
   f.bytes(scene.triangleMaterial.data(),
           scene.triangleMaterial.size() * sizeof(scene.triangleMaterial[0]));
+  // What the photons read at a hit: shading normals, UVs, vertex colours.
+  auto floats = [&f](const std::vector<float>& v) {
+    f.add(uint64_t(v.size()));
+    f.bytes(v.data(), v.size() * sizeof(float));
+  };
+  f.add(uint64_t(scene.normals.size()));
+  for (const Vec3& n : scene.normals) f.add(n);
+  floats(scene.texcoords0);
+  floats(scene.texcoords1);
+  floats(scene.colors);
   f.add(uint64_t(scene.materials.size()));
+  auto transform = [&f](const TextureTransform& t) {
+    f.add(t.offset[0]);
+    f.add(t.offset[1]);
+    f.add(t.rotation);
+    f.add(t.scale[0]);
+    f.add(t.scale[1]);
+  };
   for (const Material& m : scene.materials) {
     f.add(m.baseColor);
+    f.add(m.baseAlpha);
+    f.add(int(m.alphaMode));
+    f.add(m.alphaCutoff);
     f.add(m.emission);
     f.add(m.metallic);
     f.add(m.roughness);
     f.add(m.transmission);
     f.add(m.ior);
     f.add(m.thickness);
+    f.add(m.specular);
     f.add(m.doubleSided);
-    f.add(m.baseColorTexture);
-    f.add(m.emissiveTexture);
+    f.add(m.backFaceCulling);
+    f.add(m.unlit);
+    for (int t : {m.baseColorTexture, m.baseColorTexCoord, m.normalTexture, m.normalTexCoord,
+                  m.metallicRoughnessTexture, m.metallicRoughnessTexCoord, m.occlusionTexture,
+                  m.occlusionTexCoord, m.emissiveTexture, m.emissiveTexCoord}) {
+      f.add(t);
+    }
+    f.add(m.normalScale);
+    f.add(m.occlusionStrength);
+    for (const TextureTransform* t : {&m.baseColorTransform, &m.normalTransform,
+                                      &m.metallicRoughnessTransform, &m.occlusionTransform,
+                                      &m.emissiveTransform}) {
+      transform(*t);
+    }
   }
+  // Every texel: another albedo.png under the same name is another scene.
+  auto texels = [&f](const Texture& t) {
+    f.add(t.width);
+    f.add(t.height);
+    f.add(t.channels);
+    f.add(int(t.format));
+    f.add(t.srgb);
+    f.add(uint64_t(t.unorm8.size()));
+    f.bytes(t.unorm8.data(), t.unorm8.size());
+    f.add(uint64_t(t.unorm16.size()));
+    f.bytes(t.unorm16.data(), t.unorm16.size() * sizeof(uint16_t));
+    f.add(uint64_t(t.floats.size()));
+    f.bytes(t.floats.data(), t.floats.size() * sizeof(float));
+  };
   f.add(uint64_t(scene.textures.size()));
+  for (const Texture& t : scene.textures) texels(t);
   f.add(uint64_t(scene.lights.size()));
   for (const Light& l : scene.lights) {
     f.add(int(l.type));
@@ -126,6 +174,8 @@ uint64_t sceneFingerprint(const Scene& scene) {
     f.add(l.outerConeAngle);
   }
   f.add(scene.sky.radiance);
+  f.add(bool(scene.sky.image));
+  if (scene.sky.image) texels(*scene.sky.image);
   return f.value();
 }
 

@@ -646,11 +646,13 @@ class RankBake {
 
 BakeResult distributedBake(const Scene& scene, const BakeParams& requested, const TileParams& tiles,
                            Communicator& comm, ProgressSink* progress, DistributedStats* stats) {
+  // First, so that a rank whose own settings would be refused below does not
+  // refuse alone while the others wait for it.
+  checkRanksAgree(scene, requested, tiles, comm);
   if (requested.targetError > 0) {
     throw InputError("--target-error: the distributed bake (mpirun) traces a fixed photon "
                      "budget; give --photons");
   }
-  checkRanksAgree(scene, requested, tiles, comm);
   const BakeParams params = checkedBakeParams(scene, requested, comm.size());
   if (params.keepPhotons) {
     throw InputError(

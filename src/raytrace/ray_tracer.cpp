@@ -177,6 +177,11 @@ bool RayTracer::intersect(const Vec3& org, const Vec3& dir, Hit& hit, float tmax
   return trace(org, dir, hit, 0.0f, tmax, false);
 }
 
+bool RayTracer::intersectBetween(const Vec3& org, const Vec3& dir, Hit& hit, float tmin,
+                                 float tmax) const {
+  return trace(org, dir, hit, tmin, tmax, false);
+}
+
 bool RayTracer::intersectFromCamera(const Vec3& org, const Vec3& dir, Hit& hit) const {
   // Past the backs of culled faces, as the rasteriser draws them (a bounded
   // number: a ray through a stack of culled sheets ends at the last).

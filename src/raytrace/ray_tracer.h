@@ -45,6 +45,9 @@ class RayTracer {
   /// Closest hit with t in [0, tmax]. Returns false (hit untouched) on a miss.
   bool intersect(const Vec3& org, const Vec3& dir, Hit& hit,
                  float tmax = std::numeric_limits<float>::infinity()) const;
+  /// Closest hit with t in [tmin, tmax]: the next surface along a ray
+  /// already stopped at tmin, from the same origin (no new origin to round).
+  bool intersectBetween(const Vec3& org, const Vec3& dir, Hit& hit, float tmin, float tmax) const;
   /// True if anything lies along the ray with t in [0, tmax].
   bool occluded(const Vec3& org, const Vec3& dir, float tmax) const;
   /// intersect for a ray from the camera: what the rasteriser shows. The

@@ -74,6 +74,7 @@ AreaLightSet areaLights(const Scene& scene, const RenderSpace& space) {
   struct Group {
     std::vector<size_t> members;
     Bounds3 box;
+    bool merged = false;  ///< of separate parts (their box holds space between them)
   };
   std::map<size_t, Group> byRoot;
   for (size_t i = 0; i < emitters.size(); ++i) {
@@ -97,6 +98,7 @@ AreaLightSet areaLights(const Scene& scene, const RenderSpace& space) {
       }
     }
     groups[bestA].box.extend(groups[bestB].box);
+    groups[bestA].merged = true;
     groups[bestA].members.insert(groups[bestA].members.end(), groups[bestB].members.begin(),
                                  groups[bestB].members.end());
     groups.erase(groups.begin() + std::ptrdiff_t(bestB));
@@ -168,10 +170,15 @@ AreaLightSet areaLights(const Scene& scene, const RenderSpace& space) {
     l.directionRange = toVec4(front, 0);
     l.colorFar = toVec4(Vec3(0.0f), 0);
     l.params = toVec4(Vec3(-1, 1, -1), 0);
-    // The light's own box: what lies in it casts no shadow on its light
-    // (a cube's faces around its shadow cube's centre).
-    l.corner0 = toVec4(g.box.lower - Vec3(eps), std::sqrt(std::max(facingArea, float(area) / 4)));
-    l.corner1 = toVec4(g.box.upper + Vec3(eps), 0);
+    // The light's own box, for one connected light that faces every way (a
+    // glowing cube around its shadow cube's centre): what lies in it casts no
+    // shadow on its light. None (lower > upper) for a flat light, whose cube
+    // sits in front of it (its box would hold the space in front of a tilted
+    // panel), nor for separate parts merged (the space between them).
+    const bool ownBox = !flat && !g.merged;
+    l.corner0 = toVec4(ownBox ? g.box.lower - Vec3(eps) : Vec3(1.0f),
+                       std::sqrt(std::max(facingArea, float(area) / 4)));
+    l.corner1 = toVec4(ownBox ? g.box.upper + Vec3(eps) : Vec3(0.0f), 0);
     l.corner2 = toVec4(Vec3(float(first), float(g.members.size()), 0), 0);
     out.lights.push_back(l);
   }

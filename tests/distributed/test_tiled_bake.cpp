@@ -9,6 +9,8 @@
 #include <atomic>
 #include <fstream>
 #include <iterator>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <random>
@@ -18,6 +20,7 @@
 #include "bake/bake_fixture.h"
 #include "core/error.h"
 #include "distributed/communicator.h"
+#include "distributed/rank_agreement.h"
 #include "distributed/tiled_bake.h"
 #include "distributed/vdl_grid_parts.h"
 #include "scene/scene.h"
@@ -282,6 +285,41 @@ TEST(TiledBake, RanksThatDisagreeRefuseTogether) {
   }
   // Agreeing ranks bake.
   EXPECT_GT(bakeOnThreadRanks(scene, params, 3, 0).result.grid.size(), 0u);
+}
+
+// What a rank reads of its scene is all in the fingerprint: a texel, a
+// shading normal, a UV, a material's alpha mode, the sky image.
+TEST(RankAgreement, TheSceneFingerprintSeesEveryInputOfTheBake) {
+  Scene base = test::pointLitRoom();
+  Texture t;
+  t.width = t.height = 2;
+  t.channels = 3;
+  t.format = TexelFormat::Unorm8;
+  t.unorm8.assign(12, 100);
+  base.textures.push_back(t);
+  base.materials[0].baseColorTexture = 0;
+  base.texcoords0.assign(2 * base.positions.size(), 0.5f);
+  base.normals.assign(base.positions.size(), Vec3(0, 1, 0));
+  const uint64_t h = sceneFingerprint(base);
+  EXPECT_EQ(sceneFingerprint(base), h);
+  std::vector<std::function<void(Scene&)>> changes = {
+      [](Scene& s) { s.textures[0].unorm8[7] = 101; },
+      [](Scene& s) { s.normals[3] = Vec3(0, 0, 1); },
+      [](Scene& s) { s.texcoords0[5] = 0.25f; },
+      [](Scene& s) { s.materials[0].alphaMode = AlphaMode::Mask; },
+      [](Scene& s) { s.positions[2].y += 1e-3f; },
+      [](Scene& s) { s.lights[0].intensity *= 2; },
+      [t](Scene& s) { s.sky.image = std::make_shared<const Texture>(t); },
+  };
+  for (size_t i = 0; i < changes.size(); ++i) {
+    Scene changed = base;
+    changes[i](changed);
+    EXPECT_NE(sceneFingerprint(changed), h) << "change " << i;
+  }
+  BakeParams a = test::smallBake(4, 2000), b = a;
+  b.seed = 2;
+  EXPECT_NE(bakeSettingsFingerprint(a, TileParams{}), bakeSettingsFingerprint(b, TileParams{}));
+  EXPECT_EQ(bakeSettingsFingerprint(a, TileParams{}), bakeSettingsFingerprint(a, TileParams{}));
 }
 
 TEST(TilePlan, SplitsTheWorkEvenlyAlongTheCurve) {
