@@ -188,11 +188,11 @@ TEST_F(RenderImage, AOneSidedEmitterShowsNoLightFromBehind) {
   test::addQuad(s.scene, {-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, {0, 0, -1}, 1);
   const RenderParams p = QuadSetup::directParams();
   const GpuOctree octree = test::emptyOctree();
-  const float* back = s.render(octree, p).pixel(p.width / 2, p.height / 2);
-  EXPECT_LT(back[0], 0.05f) << "its back: no emission";
+  const RgbImage back = s.render(octree, p);
+  EXPECT_LT(back.pixel(p.width / 2, p.height / 2)[0], 0.05f) << "its back: no emission";
   s.scene.materials[1].doubleSided = true;
-  const float* both = s.render(octree, p).pixel(p.width / 2, p.height / 2);
-  EXPECT_NEAR(both[0], 5.0f, 0.05f) << "double-sided: its emission";
+  const RgbImage both = s.render(octree, p);
+  EXPECT_NEAR(both.pixel(p.width / 2, p.height / 2)[0], 5.0f, 0.05f) << "double-sided: its emission";
 }
 
 }  // namespace
