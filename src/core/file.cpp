@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "core/error.h"
+#include "core/fnv.h"
 
 namespace lo {
 
@@ -220,10 +221,10 @@ std::string temporaryHeadFor(const std::string& path) {
   const std::string name = fs::path(path).filename().string();
   const size_t limit = nameMaxFor(path);
   if (1 + name.size() + kTemporaryTagBytes <= limit) return "." + name;
-  uint64_t hash = 1469598103934665603ull;  // FNV-1a
-  for (unsigned char c : name) hash = (hash ^ c) * 1099511628211ull;
+  Fnv1a64 hash;
+  hash.bytes(name.data(), name.size());
   char tail[24];
-  std::snprintf(tail, sizeof tail, "~%016llx", static_cast<unsigned long long>(hash));
+  std::snprintf(tail, sizeof tail, "~%016llx", static_cast<unsigned long long>(hash.value()));
   const size_t keep = limit > 1 + 17 + kTemporaryTagBytes + 8 ? limit - 1 - 17 - kTemporaryTagBytes : 8;
   return "." + name.substr(0, std::min(keep, name.size())) + tail;
 }

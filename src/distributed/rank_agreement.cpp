@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/fnv.h"
 
 namespace lo {
 namespace {
@@ -16,13 +17,7 @@ namespace {
 /// padding).
 class Fingerprint {
  public:
-  void bytes(const void* data, size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) {
-      hash_ ^= p[i];
-      hash_ *= 1099511628211ull;
-    }
-  }
+  void bytes(const void* data, size_t n) { hash_.bytes(data, n); }
   template <typename T>
   void add(const T& value) {
     bytes(&value, sizeof value);
@@ -32,14 +27,10 @@ class Fingerprint {
     add(v.y);
     add(v.z);
   }
-  void add(const std::string& s) {
-    add(uint64_t(s.size()));
-    bytes(s.data(), s.size());
-  }
-  uint64_t value() const { return hash_; }
+  uint64_t value() const { return hash_.value(); }
 
  private:
-  uint64_t hash_ = 1469598103934665603ull;
+  Fnv1a64 hash_;
 };
 
 /// "1, 3" for the ranks whose value differs from rank 0's.

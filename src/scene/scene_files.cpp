@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/fnv.h"
 #include "scene/gltf_prevalidate.h"
 #include "scene/scene_internal.h"
 
@@ -146,11 +147,8 @@ std::vector<std::string> sceneFiles(const std::string& path) {
 }
 
 std::string sceneContentHash(const std::string& path) {
-  uint64_t hash = 1469598103934665603ull;
-  auto add = [&hash](const void* data, size_t size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < size; ++i) hash = (hash ^ p[i]) * 1099511628211ull;
-  };
+  Fnv1a64 hash;
+  auto add = [&hash](const void* data, size_t size) { hash.bytes(data, size); };
   const fs::path folder = fs::path(path).parent_path();
   std::vector<char> buffer(1 << 16);
   bool first = true;
@@ -178,7 +176,7 @@ std::string sceneContentHash(const std::string& path) {
     add(&size, sizeof size);
   }
   char text[32];
-  std::snprintf(text, sizeof text, "fnv1a64:%016llx", static_cast<unsigned long long>(hash));
+  std::snprintf(text, sizeof text, "fnv1a64:%016llx", static_cast<unsigned long long>(hash.value()));
   return text;
 }
 

@@ -415,6 +415,33 @@ TEST_F(Gather, FewerThanKUsesTheSearchRadius) {
   }
 }
 
+/// The mean estimate of the unit floor's voxels along its x = 0 border
+/// (away from the corners) and of its interior, with their counts.
+struct BorderAndInterior {
+  double borderSum = 0, interiorSum = 0;
+  int border = 0, interior = 0;
+  double ratio() const { return (borderSum / border) / (interiorSum / interior); }
+};
+BorderAndInterior borderAndInterior(const SurfaceGrid& grid, const std::vector<Photon>& photons,
+                                    const GatherParams& params) {
+  Gatherer g(grid, photons, params);
+  GatherResult res;
+  BorderAndInterior e;
+  for (size_t v = 0; v < grid.size(); ++v) {
+    g.gather(v, res);
+    const Vec3 q = grid.centroids[v];
+    if (q.x < 0.05f && q.z > 0.3f && q.z < 0.7f) {
+      e.borderSum += res.irradiance.x;
+      ++e.border;
+    }
+    if (q.x > 0.3f && q.x < 0.7f && q.z > 0.3f && q.z < 0.7f) {
+      e.interiorSum += res.irradiance.x;
+      ++e.interior;
+    }
+  }
+  return e;
+}
+
 // Edge correction: on a uniformly lit plane the estimate next to its border
 // (where half the disc reaches past it) is the interior's, not half of it.
 TEST_F(Gather, EdgeCorrectionKeepsTheBorderOfAPlaneLit) {
@@ -424,27 +451,10 @@ TEST_F(Gather, EdgeCorrectionKeepsTheBorderOfAPlaneLit) {
     GatherParams params;
     params.k = 2000;  // the radius, not k, bounds the disc: r_k = r everywhere
     params.edgeCorrection = correct;
-    Gatherer g(grid, photons, params);
-    GatherResult res;
-    double border = 0, interior = 0;
-    int nb = 0, ni = 0;
-    for (size_t v = 0; v < grid.size(); ++v) {
-      g.gather(v, res);
-      const Vec3 q = grid.centroids[v];
-      const bool atBorder = q.x < 0.05f && q.z > 0.3f && q.z < 0.7f;
-      const bool inside = q.x > 0.3f && q.x < 0.7f && q.z > 0.3f && q.z < 0.7f;
-      if (atBorder) {
-        border += res.irradiance.x;
-        ++nb;
-      }
-      if (inside) {
-        interior += res.irradiance.x;
-        ++ni;
-      }
-    }
-    ASSERT_GT(nb, 0);
-    ASSERT_GT(ni, 0);
-    const double ratio = (border / nb) / (interior / ni);
+    const BorderAndInterior e = borderAndInterior(grid, photons, params);
+    ASSERT_GT(e.border, 0);
+    ASSERT_GT(e.interior, 0);
+    const double ratio = e.ratio();
     std::printf("edge correction %s: border / interior irradiance %.3f (exact: 1)\n",
                 correct ? "on" : "off", ratio);
     // The coverage test sees geometry per voxel: a free border's place
@@ -471,25 +481,10 @@ TEST_F(Gather, EdgeCorrectionThatAsksTheSceneFindsAFreeBorder) {
     GatherParams params;
     params.k = 2000;  // the radius, not k, bounds the disc: r_k = r everywhere
     if (asks) params.surfaceAt = occlusion.surfaceProbe();
-    Gatherer g(grid, photons, params);
-    GatherResult res;
-    double border = 0, interior = 0;
-    int nb = 0, ni = 0;
-    for (size_t v = 0; v < grid.size(); ++v) {
-      g.gather(v, res);
-      const Vec3 q = grid.centroids[v];
-      if (q.x < 0.05f && q.z > 0.3f && q.z < 0.7f) {
-        border += res.irradiance.x;
-        ++nb;
-      }
-      if (q.x > 0.3f && q.x < 0.7f && q.z > 0.3f && q.z < 0.7f) {
-        interior += res.irradiance.x;
-        ++ni;
-      }
-    }
-    ASSERT_GT(nb, 0);
-    ASSERT_GT(ni, 0);
-    ratios[asks] = (border / nb) / (interior / ni);
+    const BorderAndInterior e = borderAndInterior(grid, photons, params);
+    ASSERT_GT(e.border, 0);
+    ASSERT_GT(e.interior, 0);
+    ratios[asks] = e.ratio();
   }
   std::printf("border / interior irradiance: the grid's coverage %.3f, the scene's %.3f (exact: 1)\n",
               ratios[0], ratios[1]);
