@@ -18,13 +18,22 @@
 
 // Sanitizer runtimes (AddressSanitizer, libFuzzer's) call a death callback
 // when they report an error; a fuzzer's dumps the current input as a finding.
-// In the child an error is the refusal the caller expects, so it is unset
-// there. Weak: absent without a sanitizer.
+// In the child an error is the refusal the caller expects: the child's
+// callback ends it by SIGABRT, a crash, as it would end without a sanitizer
+// (the runtime's own exit code, 1, would read as a reader's ordinary
+// refusal). Weak: absent without a sanitizer.
 extern "C" void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
 
 namespace lo {
 
 namespace {
+
+/// The child's sanitizer death callback: a report is a crash of the reader.
+void dieAsACrash() {
+  signal(SIGABRT, SIG_DFL);
+  raise(SIGABRT);
+  _exit(134);
+}
 
 /// Virtual memory of this process now (VmSize), bytes; 0 if unknown. Plain
 /// system calls: it runs in the forked child, where only async-signal-safe
@@ -82,7 +91,7 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
     // (a sanitizer's or fuzzer's handler would turn them into exit codes).
     close(channel[0]);
     for (int fatal : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) signal(fatal, SIG_DFL);
-    if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
+    if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(dieAsACrash);
 #if !defined(__SANITIZE_ADDRESS__)
     const size_t base = virtualBytes();
     if (base > 0) {
