@@ -14,6 +14,12 @@ GpuOctreeParams renderOctreeDefaults() {
   return p;
 }
 
+RenderParams renderFrameDefaults() {
+  RenderParams p;
+  p.supersample = 2;
+  return p;
+}
+
 GpuOctreeParams RenderSettings::octreeParams(const GlInfo* limits) const {
   GpuOctreeParams p = octree;
   if (limits) {

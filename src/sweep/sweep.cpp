@@ -140,13 +140,15 @@ BakeFigures bakeAndWrite(const Scene& scene, const std::string& scenePath, const
 
 /// The render settings of a sweep point: the octree stage's lossless
 /// texels (the point chooses half floats, the cosine correction and the
-/// adaptive leaves), the point's interpolation, indirect light alone.
+/// adaptive leaves), the point's interpolation, indirect light alone, one
+/// sample per pixel.
 RenderSettings renderSettingsOf(const SweepPoint& point, int width, int height) {
   RenderSettings s;
   s.frame.width = width;
   s.frame.height = height;
   s.frame.mode = RenderMode::Indirect;
   s.frame.interpolation = point.interpolation;
+  s.frame.supersample = 1;  // the sweep's published figures: one sample per pixel
   s.octree = GpuOctreeParams{};
   s.octree.halfFloat = point.halfFloat;
   s.octree.cosineCorrection = point.cosineCorrection;
