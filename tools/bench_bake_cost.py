@@ -6,13 +6,19 @@ indirect`, the default before it); writes docs/results/bake-cost.md.
 
 Scenes: the Cornell box (closed); the courtyard under a sun and a sky
 (data/, open); the truck under its spots (../shared/scenes/real, a small
-object under spot lights); the Cornell box lit only by a spot under its
-floor (made here: a light that reaches nothing); the enclosed game level
-(../shared) at depth 6 and 8. Per scene and figure, one `lightoctree bake`
-at the defaults: wall time and peak memory (the process's maximum resident
-set, from wait4), stored photons, paths per stored photon, the noise figure
-and why the bake stopped (`--stats-json`). The machine is shared: compare
-rows of one run, not runs.
+object under spot lights); data/emissive-cubes.gltf's three glowing cubes and
+block with no floor or walls (made here: an object lit only by its own
+emission, most of it leaving into the void); the Cornell box, and the shared
+lamp room, each lit only by a spot under its floor (made here: a light that
+reaches nothing); the enclosed game level (../shared) at depth 6 and 8. Per
+scene and figure, one `lightoctree bake` at the defaults: wall time and peak
+memory (the process's maximum resident set, from wait4), stored photons,
+paths per stored photon, the noise figure and why the bake stopped
+(`--stats-json`); then the picture: `render` 320 x 240 at the defaults
+against `reference --part full` (tools/bench_public_scenes.py's cached
+512-spp reference where there is one, else 256 spp made here), `compare
+--bin 4 --clip-percentile 99`, RGB relative RMSE. The machine is shared:
+compare rows of one run, not runs.
 
 Usage: python3 tools/bench_bake_cost.py [--out docs/results/bake-cost.md]
 """
@@ -21,6 +27,7 @@ import argparse
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -35,6 +42,13 @@ def run(cmd):
     err = proc.stderr.read().decode(errors="replace")
     _, status, usage = os.wait4(proc.pid, 0)
     return os.waitstatus_to_exitcode(status), time.monotonic() - start, usage.ru_maxrss / 1024.0, err
+
+
+def must(cmd):
+    """Runs cmd and stops the benchmark, saying why, when it fails."""
+    code, _, _, err = run(cmd)
+    if code != 0:
+        sys.exit(f"failed ({code}): {' '.join(cmd)}\n{err[-2000:]}")
 
 
 def cellar_scene(work):
@@ -62,6 +76,69 @@ def cellar_scene(work):
     return path
 
 
+def lone_cubes_scene(work):
+    """data/emissive-cubes.gltf without its floor and walls: the glowing
+    cubes and the grey block between them, alone in the void."""
+    with open(os.path.join(ROOT, "data/emissive-cubes.gltf")) as f:
+        doc = json.load(f)
+    keep = {"block", "warm", "red", "blue", "camera"}
+    doc["scenes"][0]["nodes"] = [i for i, n in enumerate(doc["nodes"]) if n.get("name") in keep]
+    path = os.path.join(work, "lone-cubes.gltf")
+    with open(path, "w") as f:
+        json.dump(doc, f)
+    return path
+
+
+def lamp_cellar_scene(shared, work):
+    """The shared lamp room with its five lights and its bulb's glow off and a
+    spot under its floor (y = 0), aimed down."""
+    folder = os.path.join(shared, "real/lights-punctual-lamp")
+    with open(os.path.join(folder, "LightsPunctualLamp-room.gltf")) as f:
+        doc = json.load(f)
+    lit = {i for i, n in enumerate(doc["nodes"]) if "KHR_lights_punctual" in n.get("extensions", {})}
+    doc["scenes"][0]["nodes"] = [i for i in doc["scenes"][0]["nodes"] if i not in lit]
+    for m in doc["materials"]:  # the bulb's glow off too
+        m.pop("emissiveTexture", None)
+        m.pop("emissiveFactor", None)
+    # The scene's files beside the new one (a scene may not reach outside
+    # its own folder).
+    work = os.path.join(work, "lamp-cellar")
+    os.makedirs(work, exist_ok=True)
+    for item in doc.get("buffers", []) + doc.get("images", []):
+        if "uri" in item and not item["uri"].startswith("data:"):
+            shutil.copyfile(os.path.join(folder, item["uri"]), os.path.join(work, item["uri"]))
+    lights = doc["extensions"]["KHR_lights_punctual"]["lights"]
+    lights.append({"name": "cellar", "type": "spot", "intensity": 200.0, "spot": {"outerConeAngle": 0.5}})
+    turn = math.sqrt(0.5)
+    doc["nodes"].append({"name": "cellar", "translation": [0.0, -0.5, 0.0],
+                         "rotation": [-turn, 0, 0, turn],  # -Z (a spot's axis) to -Y
+                         "extensions": {"KHR_lights_punctual": {"light": len(lights) - 1}}})
+    doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
+    path = os.path.join(work, "lamp-cellar.gltf")
+    with open(path, "w") as f:
+        json.dump(doc, f)
+    return path
+
+
+def picture_error(cli, scene, grid, key, work):
+    """The bake's picture against the path tracer: RGB relative RMSE of
+    `render` 320 x 240 against a full reference (bench_public_scenes.py's
+    cached one for `key` when present), 4x4 bins, clipped at the 99th
+    percentile."""
+    size = ["--width", "320", "--height", "240"]
+    ref = os.path.join(ROOT, "out/bench-public", key or "-", "ref-512.exr")
+    if not key or not os.path.exists(ref):
+        ref = os.path.join(work, os.path.basename(scene) + "-ref-256.exr")
+        if not os.path.exists(ref):
+            must([cli, "reference", scene, "-o", ref, "--part", "full", "--spp", "256"] + size)
+    image = os.path.join(work, "picture.exr")
+    must([cli, "render", scene, grid, "-o", image] + size)
+    figures = os.path.join(work, "compare.json")
+    must([cli, "compare", image, ref, "--bin", "4", "--clip-percentile", "99", "--json", figures, "-q"])
+    with open(figures) as f:
+        return json.load(f)["channels"]["RGB"]["rel_rmse"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cli", default=os.path.join(ROOT, "build/tools/lightoctree"))
@@ -71,16 +148,20 @@ def main():
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     real = os.path.join(args.shared, "real")
+    # name, file, depth, the key of bench_public_scenes.py's cached reference
     scenes = [
-        ("Cornell box (closed)", os.path.join(ROOT, "data/cornell-box.gltf"), 6),
-        ("courtyard, sun and sky (open)", os.path.join(ROOT, "data/courtyard.gltf"), 6),
-        ("truck under spots (small object)", os.path.join(real, "milk-truck-spots/truck-under-spots.gltf"), 6),
-        ("Cornell box, only a spot under the floor", cellar_scene(args.work), 6),
-        ("game level (enclosed)", os.path.join(real, "zdm2-sauerbraten/zdm2-godot-lights.glb"), 6),
-        ("game level (enclosed)", os.path.join(real, "zdm2-sauerbraten/zdm2-godot-lights.glb"), 8),
+        ("Cornell box (closed)", os.path.join(ROOT, "data/cornell-box.gltf"), 6, "cornell-box"),
+        ("courtyard, sun and sky (open)", os.path.join(ROOT, "data/courtyard.gltf"), 6, "courtyard"),
+        ("truck under spots (small object)", os.path.join(real, "milk-truck-spots/truck-under-spots.gltf"), 6,
+         "truck-spots"),
+        ("emissive cubes alone, no walls (open, lit by its own emission)", lone_cubes_scene(args.work), 6, None),
+        ("Cornell box, only a spot under the floor", cellar_scene(args.work), 6, None),
+        ("shared lamp room, only a spot under the floor", lamp_cellar_scene(args.shared, args.work), 6, None),
+        ("game level (enclosed)", os.path.join(real, "zdm2-sauerbraten/zdm2-godot-lights.glb"), 6, "game-level"),
+        ("game level (enclosed)", os.path.join(real, "zdm2-sauerbraten/zdm2-godot-lights.glb"), 8, "game-level"),
     ]
     rows = []
-    for name, path, depth in scenes:
+    for name, path, depth, key in scenes:
         for light in ("seen", "indirect"):
             stats = os.path.join(args.work, "stats.json")
             if os.path.exists(stats):
@@ -95,7 +176,9 @@ def main():
                 c = s["counts"]
                 row.update(photons=c["stored_photons"], paths=c["emitted_paths"],
                            noise=s["noise"]["quantile"], stop=s["target"]["stop"],
-                           warning=err.strip().splitlines()[-1] if err.strip() else "")
+                           warning=err.strip().splitlines()[-1] if err.strip() else "",
+                           picture=picture_error(args.cli, path, os.path.join(args.work, "grid.vdb"), key,
+                                                 args.work))
             else:
                 row.update(error=err.strip().splitlines()[-1] if err.strip() else f"exit {code}")
             rows.append(row)
@@ -110,21 +193,24 @@ def main():
         "every other setting at its default (`--target-error 0.07`). *Seen* is the default: the noise",
         "figure divides each voxel's indirect noise by its direct plus indirect light; *indirect* divides",
         "by the indirect light alone, the figure before `--target-light` (docs/accuracy.md). Time and",
-        "peak memory are the whole command's; paths per photon = paths traced / photons stored.",
+        "peak memory are the whole command's; paths per photon = paths traced / photons stored;",
+        "picture = `render` 320 x 240 at the defaults against `reference --part full` (512 spp where",
+        "tools/bench_public_scenes.py cached one, else 256 spp), 4x4-binned RGB relative RMSE, each",
+        "channel clipped at the reference's 99th percentile, all pixels.",
         "",
-        "| scene | depth | figure | time | vs Cornell | peak memory | photons | paths per photon | noise | stop |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| scene | depth | figure | time | vs Cornell | peak memory | photons | paths per photon | noise | stop | picture |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         if "error" in r:
             stop = "refused: " + r["error"].replace("|", "/")
             lines.append(f"| {r['scene']} | {r['depth']} | {r['light']} | {r['seconds']:.2f} s | "
-                         f"{r['seconds'] / base:.1f}x | {r['peak']:.0f} MB | - | - | - | {stop} |")
+                         f"{r['seconds'] / base:.1f}x | {r['peak']:.0f} MB | - | - | - | {stop} | - |")
             continue
         ppp = r["paths"] / max(r["photons"], 1)
         lines.append(f"| {r['scene']} | {r['depth']} | {r['light']} | {r['seconds']:.2f} s | "
                      f"{r['seconds'] / base:.1f}x | {r['peak']:.0f} MB | {r['photons']:,} | {ppp:.1f} | "
-                     f"{100 * r['noise']:.1f}% | {r['stop']} |")
+                     f"{100 * r['noise']:.1f}% | {r['stop']} | {100 * r['picture']:.1f}% |")
     lines += ["", f"CPU: {os.cpu_count()} threads. Command line: `{' '.join(sys.argv)}`.", ""]
     with open(args.out, "w") as f:
         f.write("\n".join(lines))
