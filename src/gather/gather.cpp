@@ -717,11 +717,13 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
   auto significant = [&](double w, uint32_t n) {
     return n >= params.minPhotons && w >= double(params.minShare) * total && w > 0;
   };
+  const float minArea = params.minArea * grid_.frame.voxelSize * grid_.frame.voxelSize;
   int layers = 0;
   for (int c = 0; c < count && layers < params.maxLayers; ++c) {
     const Candidate& k = candidates[c];
     const bool f = significant(front[c], frontCount[c]),
                b = significant(back[c], backCount[c]) || (k.twoSided && f);
+    if (c > 0 && !f && !b && k.area < minArea) continue;  // a sliver: no layer (LayerParams::minArea)
     auto mean = [&](const double* at, double w) {
       return w > 0 ? Vec3{float(at[0] / w), float(at[1] / w), float(at[2] / w)} : k.point;
     };

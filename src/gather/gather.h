@@ -89,6 +89,13 @@ struct LayerParams {
   float splitCosine = 0.5f;   ///< a photon is on a surface's side within this cosine (60 deg)
   float minShare = 0.1f;      ///< a lit side holds at least this share of the voxel's photon weight
   uint32_t minPhotons = 4;    ///< and at least this many photons
+  /// A surface of the voxel other than its largest whose clipped area is
+  /// below this share of a voxel face (voxel size^2), and on neither side
+  /// of which light landed (minShare, minPhotons), is no layer: a step's
+  /// few-centimetre riser or a tile's edge would otherwise split its voxel
+  /// with its plane, and the floor beyond it, on the far side of that plane
+  /// from where the floor's photons landed, would find no layer at all.
+  float minArea = 0.1f;
 };
 
 /// Fills grid.binStart / grid.binPhotons / grid.binMargin: the photons whose

@@ -171,6 +171,55 @@ TEST(SurfaceLayers, NoBrightLineWhereAThinWallMeetsTheFloor) {
   EXPECT_EQ(brightestDark, 0.0) << "light across the joint";
 }
 
+/// A floor of two levels a sliver apart: y = 0 for x < 0.515 and y = -0.0015
+/// beyond, joined by a riser facing +x (a twentieth of a voxel at depth 5),
+/// black, lit straight down by a sun of 1 W/m^2 and baked with the direct
+/// light: E = 1 on both levels. The riser's plane crossed its voxels as a
+/// layer of its own, and the lower level's fragments there lay across it
+/// from the floor layer's photons: no layer served them, and where every
+/// voxel of the interpolation had the riser, neither did the interpolation
+/// (a game level's steps and tiles: black patches on the floor).
+TEST(SurfaceLayers, ASliverOfAStepDoesNotSplitTheFloor) {
+  Scene scene = blackScene();
+  const float step = 0.0015f, at = 0.515f;
+  test::addQuad(scene, {0, 0, 0}, {at, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);                  // upper level
+  test::addQuad(scene, {at, -step, 0}, {1 - at, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0);        // lower level
+  test::addQuad(scene, {at, -step, 0}, {0, step, 0}, {0, 0, 1}, {1, 0, 0}, 0);          // the riser
+  // A post in a corner, so that the grid's rows do not split the two levels.
+  test::addQuad(scene, {0, 0, 0}, {0.01f, 0, 0}, {0, 0.37f, 0}, {0, 0, -1}, 0);
+  scene.lights.push_back(sun({0, -1, 0}, 1.0f));
+  BakeParams p = test::smallBake(5, 300000);
+  p.includeDirect = true;
+  const BakeResult baked = bake(scene, p);
+  const GpuOctree octree = buildGpuOctree(baked.grid);
+  const GridFrame& frame = baked.grid.frame;
+  const float voxel = frame.voxelSize;
+  ASSERT_LT(step, 0.1f * voxel) << "the riser must be a sliver of its voxels";
+  ASSERT_EQ(frame.coordOf({at, 0, 0.5f}).y, frame.coordOf({at, -step, 0.5f}).y)
+      << "both levels must share their voxels";
+  const float across = (at - frame.origin.x) / voxel - std::floor((at - frame.origin.x) / voxel);
+  ASSERT_GT(across, 0.2f) << "the riser must cross its voxels, not lie on their faces";
+  ASSERT_LT(across, 0.8f);
+  double worst = 1e30;
+  for (bool interpolation : {false, true}) {
+    OctreeShadeParams shade;
+    shade.interpolation = interpolation;
+    for (int i = 0; i < 24; ++i) {
+      for (int j = 0; j < 8; ++j) {
+        // Both levels, within one and a half voxels of the step.
+        const float d = voxel * (0.02f + 1.5f * float(i % 12) / 11.0f);
+        const Vec3 point = i < 12 ? Vec3{at + d, -step, 0} : Vec3{at - d, 0, 0};
+        const float z = 0.2f + 0.6f * float(j) / 7.0f;
+        worst = std::min(worst, double(luminance(octreeIrradiance(
+                                    octree, {point.x, point.y, z}, {0, 1, 0}, shade))));
+      }
+    }
+  }
+  std::printf("two-level floor: %zu voxels with 2+ layers, voxel %.4g; darkest point near the step %.4g W/m^2 (exact 1)\n",
+              baked.stats.level.layeredVoxels, voxel, worst);
+  EXPECT_GT(worst, 0.8);
+}
+
 }  // namespace
 }  // namespace lo
 
