@@ -658,6 +658,11 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
     Vec3 normal, point;
     float area;
     bool twoSided;  ///< a thin wall: faces of the voxel's geometry look both ways
+    /// A point of the faces looking the other way (their centroid), where the
+    /// back layer gathers: a slab thicker than the gather's ellipsoid (a
+    /// ledge's underside half a metre below its top) holds its photons
+    /// there, not on the front face.
+    Vec3 backPoint;
   };
   Candidate candidates[SurfaceGrid::kMaxOrientations];
   int count = 0;
@@ -670,15 +675,17 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
       for (int c = 0; c < count; ++c) {
         if (-dot(candidates[c].normal, g.normal) > params.splitCosine) {
           opposite = true;
+          if (!candidates[c].twoSided) candidates[c].backPoint = g.centroid;  // the largest
           candidates[c].twoSided = true;
         }
       }
-      if (!opposite) candidates[count++] = {g.normal, g.centroid, g.area, false};
+      if (!opposite) candidates[count++] = {g.normal, g.centroid, g.area, false, g.centroid};
     }
   }
   if (count == 0) {
     if (!(lengthSquared(grid_.normals[voxel]) > 0.5f)) return 0;
-    candidates[count++] = {grid_.normals[voxel], grid_.centroids[voxel], grid_.areas[voxel], false};
+    candidates[count++] = {grid_.normals[voxel], grid_.centroids[voxel], grid_.areas[voxel], false,
+                           grid_.centroids[voxel]};
   }
   // Which side of each surface its photons arrived on: the photons of the
   // voxel's own bin within params.splitCosine of the front or the back.
@@ -724,14 +731,15 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
     const bool f = significant(front[c], frontCount[c]),
                b = significant(back[c], backCount[c]) || (k.twoSided && f);
     if (c > 0 && !f && !b && k.area < minArea) continue;  // a sliver: no layer (LayerParams::minArea)
-    auto mean = [&](const double* at, double w) {
-      return w > 0 ? Vec3{float(at[0] / w), float(at[1] / w), float(at[2] / w)} : k.point;
+    auto mean = [&](const double* at, double w, const Vec3& point) {
+      return w > 0 ? Vec3{float(at[0] / w), float(at[1] / w), float(at[2] / w)} : point;
     };
     if (f || !b) {
-      out[layers++] = {k.normal, k.point, front[c], frontCount[c], mean(frontAt[c], front[c])};
+      out[layers++] = {k.normal, k.point, front[c], frontCount[c], mean(frontAt[c], front[c], k.point)};
     }
     if (b && layers < params.maxLayers) {
-      out[layers++] = {-k.normal, k.point, back[c], backCount[c], mean(backAt[c], back[c])};
+      out[layers++] = {-k.normal, k.backPoint, back[c], backCount[c],
+                       mean(backAt[c], back[c], k.backPoint)};
     }
   }
   return layers;

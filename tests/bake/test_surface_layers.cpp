@@ -171,6 +171,49 @@ TEST(SurfaceLayers, NoBrightLineWhereAThinWallMeetsTheFloor) {
   EXPECT_EQ(brightestDark, 0.0) << "light across the joint";
 }
 
+/// A slab half a voxel thick whose two faces share their voxels: its top
+/// (y = t, facing up) lit straight down by a sun of 2 W/m^2, its underside
+/// (y = 0, facing down) straight up by one of 1 W/m^2, black, baked with
+/// the direct light. The underside's layer gathered around the top's
+/// centroid, half a voxel off its own surface along the normal (where the
+/// gather's ellipsoid, four times thinner than wide, reaches 0.4 voxel):
+/// it held no photon, and a game level's ledges were black underneath.
+TEST(SurfaceLayers, EachFaceOfAThickSlabGathersOnItsOwnSurface) {
+  Scene scene = blackScene();
+  const float t = 0.016f;  // half a voxel at depth 5
+  test::addQuad(scene, {0, t, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, 0);   // top
+  test::addQuad(scene, {0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, -1, 0}, 0);  // underside
+  // A post in a corner, so that the grid's rows do not split the two faces.
+  test::addQuad(scene, {0, 0, 0}, {0.01f, 0, 0}, {0, 0.37f, 0}, {0, 0, -1}, 0);
+  scene.lights.push_back(sun({0, -1, 0}, 2.0f));
+  scene.lights.push_back(sun({0, 1, 0}, 1.0f));
+  BakeParams p = test::smallBake(5, 300000);
+  p.includeDirect = true;
+  const BakeResult baked = bake(scene, p);
+  const GpuOctree octree = buildGpuOctree(baked.grid);
+  const GridFrame& frame = baked.grid.frame;
+  ASSERT_GT(t, 0.4f * frame.voxelSize);
+  ASSERT_EQ(frame.coordOf({0.5f, 0, 0.5f}).y, frame.coordOf({0.5f, t, 0.5f}).y)
+      << "both faces must share their voxels";
+  double top = 0, under = 0, worstUnder = 1e30;
+  int n = 0;
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 8; ++j) {
+      const float x = 0.2f + 0.6f * float(i) / 7.0f, z = 0.2f + 0.6f * float(j) / 7.0f;
+      top += luminance(octreeIrradiance(octree, {x, t, z}, {0, 1, 0}));
+      const double e = luminance(octreeIrradiance(octree, {x, 0, z}, {0, -1, 0}));
+      under += e;
+      worstUnder = std::min(worstUnder, e);
+      ++n;
+    }
+  }
+  std::printf("thick slab: top %.4g W/m^2 (exact 2), underside %.4g (exact 1), darkest underside "
+              "point %.4g\n", top / n, under / n, worstUnder);
+  EXPECT_NEAR(top / n, 2.0, 0.15);
+  EXPECT_NEAR(under / n, 1.0, 0.08);
+  EXPECT_GT(worstUnder, 0.8);
+}
+
 /// A floor of two levels a sliver apart: y = 0 for x < 0.515 and y = -0.0015
 /// beyond, joined by a riser facing +x (a twentieth of a voxel at depth 5),
 /// black, lit straight down by a sun of 1 W/m^2 and baked with the direct
