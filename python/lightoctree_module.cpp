@@ -151,44 +151,6 @@ auto withProgress(const py::object& progress, Work work) {
   return std::move(*result);
 }
 
-/// The arguments are checked as the command's flags are, by the same ranges
-/// (bake/bake.h, core/number_range.h), and named by their Python names; 0 is
-/// "not given" for photons and target_error, as their defaults.
-GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, double targetError,
-                  uint64_t seed, int knn, const std::string& vdls, bool includeDirect,
-                  const std::string& targetLight, const py::object& progress) {
-  checkPathText(scenePath, "scene");
-  checkNumber(depth, kDepthRange, "depth");
-  if (photons != 0) checkNumber(double(photons), kPhotonsRange, "photons");
-  if (targetError != 0) checkNumber(targetError, kTargetErrorRange, "target_error");
-  checkNumber(knn, kKnnRange, "knn");
-  if (targetLight != "seen" && targetLight != "indirect") {
-    throw InputError("target_light must be 'seen' or 'indirect', got '" + targetLight + "'");
-  }
-  Scene scene = loadScene(scenePath);
-  BakeParams params;
-  params.depth = depth;
-  setPhotonBudget(params, photons, targetError);
-  params.seed = seed;
-  params.knn = knn;
-  params.vdls = parseVdlCount(vdls);
-  params.includeDirect = includeDirect;
-  params.targetSeenLight = targetLight == "seen";
-  auto out = std::make_shared<Grid>();
-  BakeResult r = withProgress(progress, [&](ProgressSink* sink) {
-    BakeResult result = bake(scene, params, sink);
-    recordSourceScene(result.metadata, scenePath);
-    return result;
-  });
-  out->grid = std::move(r.grid);
-  out->meta = std::move(r.metadata);
-  out->stats["stored_photons"] = r.stats.storedPhotons;
-  out->stats["emitted_paths"] = r.stats.emittedPaths;
-  out->stats["noise"] = r.stats.noise.ToString();
-  out->stats["passes"] = r.stats.passes.size();
-  return out;
-}
-
 GridPtr readGrid(const std::string& path) {
   checkPathText(path, "path");
   LoadedVdl loaded = readVdlGrid(path);
@@ -449,6 +411,54 @@ SceneOptions sceneOptions(const py::object& sky, const py::object& skyImage,
     throw InputError("physical_sky and sky_mesh: give one of them");
   }
   return o;
+}
+
+/// `lightoctree bake`: the arguments are checked as the command's flags are,
+/// by the same ranges (bake/bake.h, core/number_range.h), and named by their
+/// Python names; 0 is "not given" for photons and target_error, as their
+/// defaults. The sky keywords light the scene as the flags do (None: the
+/// file's own sky); `lightmap` needs the same ones for the same light.
+GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, double targetError,
+                  uint64_t seed, int knn, const std::string& vdls, bool includeDirect,
+                  const std::string& targetLight, const py::object& progress,
+                  const std::string& representation, const py::object& sky,
+                  const py::object& skyImage, const py::object& skyMesh,
+                  const py::object& physicalSky) {
+  checkPathText(scenePath, "scene");
+  checkNumber(depth, kDepthRange, "depth");
+  if (photons != 0) checkNumber(double(photons), kPhotonsRange, "photons");
+  if (targetError != 0) checkNumber(targetError, kTargetErrorRange, "target_error");
+  checkNumber(knn, kKnnRange, "knn");
+  if (targetLight != "seen" && targetLight != "indirect") {
+    throw InputError("target_light must be 'seen' or 'indirect', got '" + targetLight + "'");
+  }
+  BakeParams params;
+  if (!parseRepresentation(representation, &params.representation)) {
+    throw InputError("representation: must be " + representationChoices() + ", got '" +
+                     representation + "'");
+  }
+  const SceneOptions lighting = sceneOptions(sky, skyImage, skyMesh, physicalSky);
+  Scene scene = withPythonNames([&] { return loadSceneWith(scenePath, lighting); });
+  params.depth = depth;
+  setPhotonBudget(params, photons, targetError);
+  params.seed = seed;
+  params.knn = knn;
+  params.vdls = parseVdlCount(vdls);
+  params.includeDirect = includeDirect;
+  params.targetSeenLight = targetLight == "seen";
+  auto out = std::make_shared<Grid>();
+  BakeResult r = withProgress(progress, [&](ProgressSink* sink) {
+    BakeResult result = bake(scene, params, sink);
+    recordSourceScene(result.metadata, scenePath);
+    return result;
+  });
+  out->grid = std::move(r.grid);
+  out->meta = std::move(r.metadata);
+  out->stats["stored_photons"] = r.stats.storedPhotons;
+  out->stats["emitted_paths"] = r.stats.emittedPaths;
+  out->stats["noise"] = r.stats.noise.ToString();
+  out->stats["passes"] = r.stats.passes.size();
+  return out;
 }
 
 py::array_t<float> imageArray(const RgbImage& image) {
@@ -800,12 +810,15 @@ PYBIND11_MODULE(lightoctree, m) {
   m.def("bake", &bakeScene, py::arg("scene"), py::arg("depth") = 6, py::arg("photons") = 0,
         py::arg("target_error") = 0.0, py::arg("seed") = 1, py::arg("knn") = BakeParams{}.knn,
         py::arg("vdls") = "4", py::arg("include_direct") = false, py::arg("target_light") = "seen",
-        py::arg("progress") = py::none(),
+        py::arg("progress") = py::none(), py::arg("representation") = "vdl",
+        py::arg("sky") = py::none(), py::arg("sky_image") = py::none(),
+        py::arg("sky_mesh") = py::none(), py::arg("physical_sky") = py::none(),
         "Bakes a scene (.gltf, .glb, .obj) as `lightoctree bake` does: photons until the noise "
         "figure reaches target_error (default 0.07), or a fixed number of photons; target_light "
-        "'seen' (the noise of the light a viewer sees) or 'indirect' (of the indirect light). "
-        "progress(task, done, total) is called as the bake goes; an exception it raises, or "
-        "Ctrl-C, stops the bake and is raised.");
+        "'seen' (the noise of the light a viewer sees) or 'indirect' (of the indirect light); "
+        "representation 'vdl', 'sh1' or 'sh2'; sky, sky_image, sky_mesh, physical_sky as the "
+        "--sky flags (give lightmap the same). progress(task, done, total) is called as the "
+        "bake goes; an exception it raises, or Ctrl-C, stops the bake and is raised.");
   m.def("read", &readGrid, py::arg("path"), "Reads a .vdb written by bake or convert.");
   m.def(
       "write",

@@ -1,4 +1,8 @@
-# Light Octree for Blender (3.4 or later; Python only): File > Import >
+# Light Octree for Blender (3.4 or later; Python only). The 3D viewport's
+# sidebar, tab "Light Octree": a Bake panel that exports the scene, bakes it
+# with the project's Python module (`import lightoctree`) in the background
+# and lights the scene's own materials with the lightmaps (panel.py).
+# File > Import >
 #   "Light Octree bake (.vdb)": the grid as a Volume object in the scene's
 #     frame (glTF's Y up turned to Blender's Z up) with a material that shows
 #     the baked irradiance as emission, and optionally each voxel's strongest
@@ -8,23 +12,25 @@
 #     names a lightmap page in its extras gets the page wired in: the outgoing
 #     radiance baseColor / pi * E added as emission, without losing the
 #     material's own emission, alpha, metal or glass.
-# docs/blender.md shows both; tests/blender/test_addon.py runs them headless.
+# docs/blender.md shows them; tests/blender/ runs them headless (test_addon.py
+# the imports, test_bake_panel.py and test_light_units.py the Bake panel).
 
 bl_info = {
     "name": "Light Octree",
     "author": "Light Octree",
     "version": (0, 1, 0),
     "blender": (3, 4, 0),
-    "location": "File > Import",
-    "description": "Import Light Octree bakes (.vdb) and lightmapped glTF files",
-    "category": "Import-Export",
+    "location": "View3D > Sidebar > Light Octree; File > Import",
+    "description": "Bake the scene's light with Light Octree; import its bakes (.vdb) and "
+                   "lightmapped glTF files",
+    "category": "Lighting",
 }
 
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
-from . import lightmap, volume
+from . import lightmap, panel, volume
 
 
 class LIGHTOCTREE_OT_import_vdb(bpy.types.Operator, ImportHelper):
@@ -102,9 +108,11 @@ def register():
     for cls in classes:
         bpy.utils.register_class(cls)
     bpy.types.TOPBAR_MT_file_import.append(menu_import)
+    panel.register()
 
 
 def unregister():
+    panel.unregister()
     bpy.types.TOPBAR_MT_file_import.remove(menu_import)
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)

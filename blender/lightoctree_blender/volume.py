@@ -4,9 +4,22 @@ import os
 
 import bpy
 
+from . import module
+
 
 def grid_names(obj):
     return [g.name for g in obj.data.grids]
+
+
+def replace_bake(context, path, arrows=False, max_arrows=20000):
+    """import_bake of `path`, removing first what an earlier import of the
+    same file made (the panel's re-bake)."""
+    for obj in [o for o in bpy.data.objects if o.get("lightoctree", {}).get("source") == path]:
+        data = obj.data
+        bpy.data.objects.remove(obj)
+        if data is not None and data.users == 0:
+            (bpy.data.volumes if isinstance(data, bpy.types.Volume) else bpy.data.meshes).remove(data)
+    return import_bake(context, path, arrows=arrows, max_arrows=max_arrows)
 
 
 def import_bake(context, path, strength=1.0, arrows=False, max_arrows=20000):
@@ -41,13 +54,10 @@ def add_vdl_arrows(context, path, volume_obj, max_arrows=20000):
     evenly picked) with `direction` and `irradiance` attributes, instanced as
     cones by a geometry nodes modifier. Reading the VDLs needs the project's
     Python module (docs/python.md): Blender 3.4 reads no voxel values."""
-    try:
-        import lightoctree
-        import numpy as np
-    except ImportError as e:
-        raise RuntimeError(f"VDL arrows need the lightoctree Python module (docs/python.md): {e}")
+    import numpy as np
+    lightoctree = module.load()  # ModuleMissing (a RuntimeError) says what to do
     grid = lightoctree.read(path)
-    if grid.max_vdls == 0:
+    if grid.sh_terms > 0:
         raise ValueError(f"{path}: holds spherical harmonics, not VDLs: no arrows to draw")
     keep = np.nonzero(np.asarray(grid.vdl_count) > 0)[0]
     if len(keep) > max_arrows:

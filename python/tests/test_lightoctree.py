@@ -115,6 +115,25 @@ def test_target_light_chooses_the_noise_figure():
     assert seen.stats["stored_photons"] < indirect.stats["stored_photons"]
 
 
+def test_bake_takes_the_sky_and_the_representation():
+    """The sky keywords light the bake as the --sky flags do (the Cornell
+    box's open front lets the sky in; none given is the file's own, black),
+    representation picks the payload, and bad values are refused by name."""
+    settings = dict(depth=4, photons=30000, knn=40)
+    dark = lightoctree.bake(SCENE, **settings)
+    unlit_sky = lightoctree.bake(SCENE, sky=(0, 0, 0), **settings)
+    np.testing.assert_array_equal(unlit_sky.irradiance, dark.irradiance)
+    lit = lightoctree.bake(SCENE, sky=(5, 5, 5), **settings)
+    assert lit.irradiance.mean() > 2 * dark.irradiance.mean()
+    assert dark.sh_terms == 0
+    sh = lightoctree.bake(SCENE, representation="sh1", **settings)
+    assert sh.sh_terms == 4 and not np.any(sh.vdl_count)
+    with pytest.raises(lightoctree.InputError, match="representation: must be vdl, sh1 or sh2"):
+        lightoctree.bake(SCENE, representation="vdls", **settings)
+    with pytest.raises(lightoctree.InputError, match="^sky: "):
+        lightoctree.bake(SCENE, sky=(-1, 0, 0), **settings)
+
+
 def test_render_equals_the_command(grid, tmp_path):
     """lightoctree.render and `lightoctree render` go through one render
     session: the same grid file at the same size gives the same floats."""
