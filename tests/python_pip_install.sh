@@ -21,7 +21,7 @@ assert where.startswith(os.path.realpath(venv)), f"imported {where}, not the ven
 assert lightoctree.__version__ == version, (lightoctree.__version__, version)
 print(f"pip install: lightoctree {lightoctree.__version__} from {where}")
 PY
-"$work/venv/bin/python" -m pip show lightoctree | grep -q "^Version: $version$"
+"$work/venv/bin/python" -m pip show lightoctree | grep "^Version: $version$" >/dev/null
 # The module's tests with the venv's copy (no PYTHONPATH: what the venv imports).
 env -u PYTHONPATH LIGHTOCTREE_CLI="$cli" "$work/venv/bin/python" -m pytest -q -p no:cacheprovider \
   "$src/python/tests" | tail -n 3
