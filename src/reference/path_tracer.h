@@ -92,7 +92,8 @@ ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
                                const ReferenceParams& params, ProgressSink* progress = nullptr);
 
 /// @brief Direct irradiance E(p, n) (W/m^2) from every light, with shadow
-/// rays, by the path tracer's own light sampling: punctual lights exactly,
+/// rays, by the path tracer's own light sampling: punctual lights exactly
+/// (more of them than samples by `samples` draws from their light tree),
 /// emissive triangles by `samples` samples, each an emitter picked by power
 /// (mean emission x area) and a uniform point on it (emissive textures and
 /// one-sided emission as the path tracer reads them). Not the sky's: the
@@ -108,9 +109,14 @@ class DirectIrradiance {
 
   /// E at surface point `p` of triangle `triangle` (its geometric normal
   /// offsets the shadow rays' origins) for the unit normal `n`, on n's side.
-  /// Deterministic: the same (seed, index) give the same value.
+  /// Deterministic: the same (seed, index) give the same value. Punctual
+  /// lights cost at most max(8, samples) shadow rays: each light once when
+  /// there are no more, else one drawn from the light tree per sample
+  /// (reference/light_tree.h; the draws stratified over the samples); each
+  /// sample traces one to an emitter. `shadowRays`, when given, has the rays
+  /// traced added to it.
   Vec3 at(const Vec3& p, uint32_t triangle, const Vec3& n, int samples, uint64_t seed,
-          uint64_t index) const;
+          uint64_t index, uint64_t* shadowRays = nullptr) const;
 
   /// A surface point: position, triangle (for the ray offset), unit normal.
   struct Point {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "image/image.h"
 #include "reference/path_tracer.h"
 #include "test_util.h"
@@ -336,6 +337,57 @@ TEST(Reference, PointLightOverDiffusePlane) {
   for (float v : ind.image.rgb) ASSERT_EQ(v, 0.0f);
 }
 
+/// `count` point lights 0.5 to 2 above the floor around the origin, 1 W/sr
+/// over `count` each (the same total power whatever the count).
+std::vector<Light> pointLights(int count) {
+  std::vector<Light> lights;
+  Rng rng(5, 0);
+  for (int i = 0; i < count; ++i) {
+    Light l;
+    l.position = {rng.uniform() * 4 - 2, 0.5f + 1.5f * rng.uniform(), rng.uniform() * 4 - 2};
+    l.intensity = 1.0f / float(count);
+    lights.push_back(l);
+  }
+  return lights;
+}
+
+// Many point lights: a sample costs what it costs with a few (at most 8
+// shadow rays to punctual lights per shading point: 4096 lights traced 4096
+// each, 28 s for 16 x 16 pixels at 4 spp with 10^5 lights), and the image is
+// still the analytic one.
+TEST(Reference, ManyPointLightsCostWhatAFewDo) {
+  PinholeCamera cam = PinholeCamera::lookAt({0, 3, 1}, {0, 0, 0}, 0.3f);
+  ReferenceParams params = imageParams(8, 8, 64);
+  params.part = ReferencePart::Direct;
+  uint64_t rays[2] = {0, 0};
+  const int counts[2] = {8, 4096};
+  for (int k = 0; k < 2; ++k) {
+    Scene scene = floorScene();
+    scene.lights = pointLights(counts[k]);
+    ReferenceImage r = renderReference(scene, cam, params);
+    rays[k] = r.raysTraced;
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        const double expected = expectedPixel(cam, x, y, 8, 8, [&](const Vec3& p) {
+          double sum = 0;
+          for (const Light& light : scene.lights) {
+            const Vec3 d = light.position - p;
+            const float dist = length(d);
+            sum += 0.5 / kPi * light.intensity * (d.y / dist) / (dist * dist);
+          }
+          return sum;
+        });
+        const size_t i = size_t(y) * 8 + x;
+        EXPECT_NEAR(r.image.rgb[3 * i], expected, 5.0 * r.stdError.rgb[3 * i] + 2e-3 * expected)
+            << counts[k] << " lights, pixel " << x << "," << y;
+      }
+  }
+  // 8 lights: each traced at every hit; 4096: 8 drawn (the paths after the
+  // first hit differ by their random numbers alone).
+  EXPECT_LE(double(rays[1]), 1.1 * double(rays[0]))
+      << "rays with 8 lights " << rays[0] << ", with 4096 " << rays[1];
+}
+
 /// Irradiance under the centre of a parallel square emitter of half-side s at
 /// height h: four corner rectangles, each pi L F with the differential
 /// form factor F = 1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + (X <-> Y)].
@@ -442,6 +494,33 @@ TEST(DirectIrradiance, SquareEmitterAndPointLightAnalytic) {
   addQuad(lit, {0.2f, 1.0f, -0.1f}, {0.2f, 0, 0}, {0, 0, 0.2f}, {0, -1, 0}, 0);
   DirectIrradiance blocked(lit);
   EXPECT_EQ(blocked.at(q, 0, n, 1, 1, 0).x, 0.0f);
+}
+
+// The lightmap's direct light with many point lights: each light once
+// while they are no more than the samples, else one drawn per sample (it
+// traced every light for every sample: 64 x 10^5 rays per texel, `lightmap
+// --content full` ran for minutes), and the analytic irradiance either way.
+TEST(DirectIrradiance, ManyPointLightsCostAtMostOneShadowRayPerSample) {
+  Scene scene = floorScene();
+  scene.lights = pointLights(2000);
+  DirectIrradiance direct(scene);
+  const Vec3 n{0, 1, 0};
+  for (const Vec3& p : {Vec3{0, 0, 0}, Vec3{1.5f, 0, -0.5f}, Vec3{-3, 0, 2}}) {
+    double exact = 0;
+    for (const Light& light : scene.lights) {
+      const Vec3 d = light.position - p;
+      const float dist = length(d);
+      exact += light.intensity * (d.y / dist) / (dist * dist);
+    }
+    uint64_t rays = 0;
+    const Vec3 drawn = direct.at(p, 0, n, 1024, 1, 0, &rays);
+    EXPECT_LE(rays, 1024u);
+    EXPECT_NEAR(drawn.x, exact, 0.02 * exact) << "1024 draws at " << p.ToString();
+    rays = 0;
+    const Vec3 each = direct.at(p, 0, n, 4096, 1, 0, &rays);
+    EXPECT_EQ(rays, 2000u);  // every light once, not once per sample
+    EXPECT_NEAR(each.x, exact, 1e-4 * exact) << "every light at " << p.ToString();
+  }
 }
 
 // Irradiance at the origin (normal n) from a uniform Lambertian polygon of
