@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -170,7 +171,7 @@ class SceneBuilder {
                                                           int mode);
 
   void appendNormals(const std::vector<double>& nrm, const Mat4& normalMatrix, size_t nverts,
-                     uint32_t base, const std::vector<std::array<uint32_t, 3>>& tris, bool flip);
+                     uint32_t base);
 
   void appendUv(std::vector<float>& dst, bool& has, const std::vector<double>& uv, size_t nverts,
                 uint32_t base);
@@ -194,7 +195,19 @@ class SceneBuilder {
   void appendColors(const std::vector<double>& color, size_t nverts, uint32_t base,
                     const std::string& what);
 
+  /// Normals of the vertices that have none in the file (`normalFromFaces_`):
+  /// the normalised sum of the face normals (area-weighted) of every
+  /// triangle that uses them, whichever primitive it belongs to.
   void finishVertexAttributes();
+
+  /// Refuses a primitive whose `nverts` vertices of its own (not shared)
+  /// would take the scene's vertices beyond half the memory available.
+  void checkVertexBudget(size_t nverts);
+
+  /// The accessor that reads the same values as accessor `index` (the first
+  /// of those with its bufferView, byteOffset, componentType, normalized,
+  /// type and count, none sparse), `index` itself otherwise; -1 for -1.
+  int sameValues(int index);
 
   // The finished scene (load_gltf.cpp).
 
@@ -224,6 +237,26 @@ class SceneBuilder {
     }
   };
   std::map<TextureKey, int> imageToTexture_;
+  /// The vertices already in scene_ per (world transform, the accessors of
+  /// POSITION, NORMAL, TANGENT, TEXCOORD_0, TEXCOORD_1, COLOR_0 by
+  /// sameValues): their first vertex. Primitives that share a vertex buffer
+  /// share its vertices once converted, so the scene's vertices follow the
+  /// file and not primitives x buffer (issue 43: 10,000 primitives of one
+  /// 4 MB buffer took gigabytes).
+  struct VertexBlockKey {
+    std::array<double, 16> world;
+    std::array<int, 6> accessors;
+    bool operator<(const VertexBlockKey& o) const {
+      return world != o.world ? world < o.world : accessors < o.accessors;
+    }
+  };
+  std::map<VertexBlockKey, uint32_t> vertexBlocks_;
+  std::map<std::array<size_t, 6>, int> accessorValues_;  ///< sameValues' first accessors
+  std::vector<int> sameValues_;  ///< per accessor: sameValues, -2 = not yet known
+  /// Per vertex of scene_ (once some primitive has normals): 1 where the
+  /// file gives no normal, which finishVertexAttributes computes.
+  std::vector<uint8_t> normalFromFaces_;
+  std::optional<size_t> availableMemory_;  ///< availableMemoryBytes, asked once
   std::string skyMeshFlag_;  ///< the command line's sky mesh (loadScene's skyMesh)
   std::string skyMesh_;    ///< extras.lightoctree_sky_mesh, or the flag's: a material to take as the sky
   bool skyScale_ = false;  ///< extras.lightoctree_sky was given

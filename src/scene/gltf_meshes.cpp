@@ -15,6 +15,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/resources.h"
+
 namespace lo::scene_internal::gltf_internal {
 
 void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
@@ -40,37 +42,48 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
     };
     int posAcc = attr("POSITION");
     if (posAcc < 0) fail(path_, what + " has no POSITION attribute");
-    std::vector<double> pos = reader_.read(posAcc, TINYGLTF_TYPE_VEC3, what + " POSITION");
-    size_t nverts = pos.size() / 3;
-    auto readSameCount = [&](int acc, int type, const char* key) {
-      std::vector<double> v = reader_.read(acc, type, what + " " + key);
-      if (reader_.count(acc) != nverts) {
-        fail(path_, what + ": " + key + " has " + std::to_string(reader_.count(acc)) +
-                        " elements, POSITION has " + std::to_string(nverts));
+    // Vertices this node's primitives already converted from the same
+    // accessors are used again, not copied (vertexBlocks_).
+    const VertexBlockKey key{world.m,
+                             {sameValues(posAcc), sameValues(attr("NORMAL")),
+                              sameValues(attr("TANGENT")), sameValues(attr("TEXCOORD_0")),
+                              sameValues(attr("TEXCOORD_1")), sameValues(attr("COLOR_0"))}};
+    const auto converted = vertexBlocks_.find(key);
+    const bool shared = converted != vertexBlocks_.end();
+    std::vector<double> pos, nrm, uv0, uv1, tan, color;
+    size_t nverts = reader_.count(posAcc);
+    if (!shared) {
+      pos = reader_.read(posAcc, TINYGLTF_TYPE_VEC3, what + " POSITION");
+      nverts = pos.size() / 3;
+      auto readSameCount = [&](int acc, int type, const char* key) {
+        std::vector<double> v = reader_.read(acc, type, what + " " + key);
+        if (reader_.count(acc) != nverts) {
+          fail(path_, what + ": " + key + " has " + std::to_string(reader_.count(acc)) +
+                          " elements, POSITION has " + std::to_string(nverts));
+        }
+        return v;
+      };
+      if (attr("NORMAL") >= 0) nrm = readSameCount(attr("NORMAL"), TINYGLTF_TYPE_VEC3, "NORMAL");
+      if (attr("TANGENT") >= 0) tan = readSameCount(attr("TANGENT"), TINYGLTF_TYPE_VEC4, "TANGENT");
+      if (attr("TEXCOORD_0") >= 0)
+        uv0 = readSameCount(attr("TEXCOORD_0"), TINYGLTF_TYPE_VEC2, "TEXCOORD_0");
+      if (attr("TEXCOORD_1") >= 0)
+        uv1 = readSameCount(attr("TEXCOORD_1"), TINYGLTF_TYPE_VEC2, "TEXCOORD_1");
+      if (attr("COLOR_0") >= 0) {
+        // VEC3 or VEC4; floats, or normalized unsigned bytes or shorts (the
+        // reader scales those to [0, 1]).
+        const size_t acc = size_t(attr("COLOR_0"));
+        if (acc < model_.accessors.size() &&
+            model_.accessors[acc].componentType != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+            !model_.accessors[acc].normalized) {
+          fail(path_, what + ": COLOR_0 of integers must be normalized (glTF 2.0, meshes)");
+        }
+        const int type =
+            acc < model_.accessors.size() && model_.accessors[acc].type == TINYGLTF_TYPE_VEC3
+                ? TINYGLTF_TYPE_VEC3
+                : TINYGLTF_TYPE_VEC4;
+        color = readSameCount(attr("COLOR_0"), type, "COLOR_0");
       }
-      return v;
-    };
-    std::vector<double> nrm, uv0, uv1, tan, color;
-    if (attr("NORMAL") >= 0) nrm = readSameCount(attr("NORMAL"), TINYGLTF_TYPE_VEC3, "NORMAL");
-    if (attr("TANGENT") >= 0) tan = readSameCount(attr("TANGENT"), TINYGLTF_TYPE_VEC4, "TANGENT");
-    if (attr("TEXCOORD_0") >= 0)
-      uv0 = readSameCount(attr("TEXCOORD_0"), TINYGLTF_TYPE_VEC2, "TEXCOORD_0");
-    if (attr("TEXCOORD_1") >= 0)
-      uv1 = readSameCount(attr("TEXCOORD_1"), TINYGLTF_TYPE_VEC2, "TEXCOORD_1");
-    if (attr("COLOR_0") >= 0) {
-      // VEC3 or VEC4; floats, or normalized unsigned bytes or shorts (the
-      // reader scales those to [0, 1]).
-      const size_t acc = size_t(attr("COLOR_0"));
-      if (acc < model_.accessors.size() &&
-          model_.accessors[acc].componentType != TINYGLTF_COMPONENT_TYPE_FLOAT &&
-          !model_.accessors[acc].normalized) {
-        fail(path_, what + ": COLOR_0 of integers must be normalized (glTF 2.0, meshes)");
-      }
-      const int type = acc < model_.accessors.size() &&
-                               model_.accessors[acc].type == TINYGLTF_TYPE_VEC3
-                           ? TINYGLTF_TYPE_VEC3
-                           : TINYGLTF_TYPE_VEC4;
-      color = readSameCount(attr("COLOR_0"), type, "COLOR_0");
     }
 
     std::vector<uint32_t> idx;
@@ -93,26 +106,30 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
     else if (size_t(material) >= model_.materials.size())
       fail(path_, what + ": material index " + std::to_string(material) + " out of range");
 
-    uint32_t base = uint32_t(scene_.positions.size());
-    if (uint64_t(base) + nverts > std::numeric_limits<uint32_t>::max()) {
-      fail(path_, "too many vertices for 32-bit indices");
-    }
-    for (size_t v = 0; v < nverts; ++v) {
-      const Vec3d pd =
-          world.pointInDouble({float(pos[3 * v]), float(pos[3 * v + 1]), float(pos[3 * v + 2])});
-      const Vec3 pw = pd.toVec3();
-      if (!isFinite(pw)) {
-        fail(path_, what + ": non-finite vertex position (vertex " + std::to_string(v) + ")");
+    uint32_t base = shared ? converted->second : uint32_t(scene_.positions.size());
+    if (!shared) {
+      if (uint64_t(base) + nverts > std::numeric_limits<uint32_t>::max()) {
+        fail(path_, "too many vertices for 32-bit indices");
       }
-      scene_.positions.push_back(pw);
-      world_.vertices.push_back(pd);
+      checkVertexBudget(nverts);
+      for (size_t v = 0; v < nverts; ++v) {
+        const Vec3d pd =
+            world.pointInDouble({float(pos[3 * v]), float(pos[3 * v + 1]), float(pos[3 * v + 2])});
+        const Vec3 pw = pd.toVec3();
+        if (!isFinite(pw)) {
+          fail(path_, what + ": non-finite vertex position (vertex " + std::to_string(v) + ")");
+        }
+        scene_.positions.push_back(pw);
+        world_.vertices.push_back(pd);
+      }
+      // Normals / UV sets present on some primitives only: fill the others.
+      appendNormals(nrm, normalMatrix, nverts, base);
+      appendUv(scene_.texcoords0, hasUv0_, uv0, nverts, base);
+      appendUv(scene_.texcoords1, hasUv1_, uv1, nverts, base);
+      appendTangents(tan, world, nverts, base, flip);
+      appendColors(color, nverts, base, what);
+      vertexBlocks_.emplace(key, base);
     }
-    // Normals / UV sets present on some primitives only: fill the others.
-    appendNormals(nrm, normalMatrix, nverts, base, tris, flip);
-    appendUv(scene_.texcoords0, hasUv0_, uv0, nverts, base);
-    appendUv(scene_.texcoords1, hasUv1_, uv1, nverts, base);
-    appendTangents(tan, world, nverts, base, flip);
-    appendColors(color, nverts, base, what);
 
     for (auto& t : tris) {
       if (flip) std::swap(t[1], t[2]);
@@ -146,8 +163,7 @@ std::vector<std::array<uint32_t, 3>> SceneBuilder::triangulate(const std::vector
 }
 
 void SceneBuilder::appendNormals(const std::vector<double>& nrm, const Mat4& normalMatrix,
-                                 size_t nverts, uint32_t base,
-                                 const std::vector<std::array<uint32_t, 3>>& tris, bool flip) {
+                                 size_t nverts, uint32_t base) {
   if (nrm.empty() && !hasNormals_) {
     return;  // still no normals anywhere: Scene::normals stays empty
   }
@@ -156,13 +172,7 @@ void SceneBuilder::appendNormals(const std::vector<double>& nrm, const Mat4& nor
     // (area-weighted) vertex normals from their faces.
     hasNormals_ = true;
     scene_.normals.assign(base, Vec3{});
-    for (size_t t = 0; t < scene_.triangleCount(); ++t) {
-      Vec3 n = cross(
-          scene_.positions[scene_.indices[3 * t + 1]] - scene_.positions[scene_.indices[3 * t]],
-          scene_.positions[scene_.indices[3 * t + 2]] - scene_.positions[scene_.indices[3 * t]]);
-      for (int k = 0; k < 3; ++k) scene_.normals[scene_.indices[3 * t + size_t(k)]] += n;
-    }
-    for (Vec3& n : scene_.normals) n = normalize(n);
+    normalFromFaces_.assign(base, 1);
   }
   if (!nrm.empty()) {
     for (size_t v = 0; v < nverts; ++v) {
@@ -171,15 +181,10 @@ void SceneBuilder::appendNormals(const std::vector<double>& nrm, const Mat4& nor
       if (!isFinite(n)) fail(path_, "non-finite vertex normal");
       scene_.normals.push_back(n);
     }
+    normalFromFaces_.resize(normalFromFaces_.size() + nverts, 0);
   } else {
-    std::vector<Vec3> acc(nverts, Vec3{});
-    for (const auto& t : tris) {
-      const Vec3& a = scene_.positions[base + t[0]];
-      Vec3 n = cross(scene_.positions[base + t[1]] - a, scene_.positions[base + t[2]] - a);
-      if (flip) n = -n;
-      for (uint32_t i : t) acc[i] += n;
-    }
-    for (const Vec3& n : acc) scene_.normals.push_back(normalize(n));
+    scene_.normals.resize(scene_.normals.size() + nverts, Vec3{});
+    normalFromFaces_.resize(normalFromFaces_.size() + nverts, 1);
   }
 }
 
@@ -244,6 +249,51 @@ void SceneBuilder::appendColors(const std::vector<double>& color, size_t nverts,
 
 void SceneBuilder::finishVertexAttributes() {
   LO_CHECK(!hasNormals_ || scene_.normals.size() == scene_.positions.size());
+  if (!hasNormals_) return;
+  LO_CHECK_EQ(normalFromFaces_.size(), scene_.positions.size());
+  // The triangles' windings are final here (mirrored nodes flipped): their
+  // cross products point to the front.
+  for (size_t t = 0; t < scene_.triangleCount(); ++t) {
+    const uint32_t* corner = &scene_.indices[3 * t];
+    if (!normalFromFaces_[corner[0]] && !normalFromFaces_[corner[1]] &&
+        !normalFromFaces_[corner[2]]) {
+      continue;
+    }
+    const Vec3& a = scene_.positions[corner[0]];
+    const Vec3 n = cross(scene_.positions[corner[1]] - a, scene_.positions[corner[2]] - a);
+    for (int k = 0; k < 3; ++k)
+      if (normalFromFaces_[corner[k]]) scene_.normals[corner[k]] += n;
+  }
+  for (size_t v = 0; v < normalFromFaces_.size(); ++v)
+    if (normalFromFaces_[v]) scene_.normals[v] = normalize(scene_.normals[v]);
+}
+
+void SceneBuilder::checkVertexBudget(size_t nverts) {
+  // What a vertex holds at most (position, normal, two UV sets, tangent,
+  // colour: 72 bytes; the double position kept for the rebase: 24), as the
+  // triangle budget counts (gltf_nodes.cpp).
+  constexpr double kVertexBytes = 72 + 24;
+  if (!availableMemory_) availableMemory_ = availableMemoryBytes();
+  const double vertices = double(scene_.positions.size()) + double(nverts);
+  if (*availableMemory_ > 0 && vertices * kVertexBytes > 0.5 * double(*availableMemory_)) {
+    fail(path_, "the primitives make " + std::to_string(uint64_t(vertices)) +
+                    " vertices of their own (" + formatBytes(size_t(vertices * kVertexBytes)) +
+                    " to hold), beyond half the " + formatBytes(*availableMemory_) +
+                    " of memory available (primitives that share a vertex buffer through the "
+                    "same accessors share its vertices)");
+  }
+}
+
+int SceneBuilder::sameValues(int index) {
+  if (index < 0 || size_t(index) >= model_.accessors.size()) return index;
+  if (sameValues_.empty()) sameValues_.assign(model_.accessors.size(), -2);
+  int& known = sameValues_[size_t(index)];
+  if (known != -2) return known;
+  const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+  if (a.sparse.isSparse || a.bufferView < 0) return known = index;
+  const std::array<size_t, 6> values{size_t(a.bufferView), a.byteOffset,   size_t(a.componentType),
+                                     size_t(a.normalized), size_t(a.type), a.count};
+  return known = accessorValues_.emplace(values, index).first->second;
 }
 
 }  // namespace lo::scene_internal::gltf_internal

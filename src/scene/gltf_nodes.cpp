@@ -146,11 +146,16 @@ void SceneBuilder::addRegion(const tinygltf::Node& node, int nodeIndex, const Ma
   const size_t positions = sc.positions.size(), normals = sc.normals.size(),
                uv0 = sc.texcoords0.size(), uv1 = sc.texcoords1.size(),
                tangents = sc.tangents.size(), colors = sc.colors.size(),
-               indices = sc.indices.size(),
-               materials = sc.triangleMaterial.size();
+               indices = sc.indices.size(), materials = sc.triangleMaterial.size(),
+               fromFaces = normalFromFaces_.size();
   const bool hadNormals = hasNormals_, hadUv0 = hasUv0_, hadUv1 = hasUv1_,
              hadTangents = hasTangents_, hadColors = hasColors_;
+  // The marker's vertices are its own: none shared with the geometry's,
+  // none left for the geometry to share.
+  std::map<VertexBlockKey, uint32_t> blocks;
+  blocks.swap(vertexBlocks_);
   addMesh(node.mesh, world);
+  blocks.swap(vertexBlocks_);
   for (size_t i = positions; i < sc.positions.size(); ++i) sc.region.extend(sc.positions[i]);
   world_.region.insert(world_.region.end(), world_.vertices.begin() + ptrdiff_t(positions),
                        world_.vertices.end());
@@ -161,6 +166,7 @@ void SceneBuilder::addRegion(const tinygltf::Node& node, int nodeIndex, const Ma
   sc.texcoords1.resize(uv1);
   sc.tangents.resize(tangents);
   sc.colors.resize(colors);
+  normalFromFaces_.resize(fromFaces);
   hasNormals_ = hadNormals;
   hasUv0_ = hadUv0;
   hasUv1_ = hadUv1;

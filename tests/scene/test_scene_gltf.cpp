@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "scene/scene.h"
 #include "scene/scene_fixture.h"
@@ -145,6 +147,120 @@ TEST_F(SceneGltf, SparseAccessorOfImplicitZerosIsBounded) {
             "{\"count\": 1, \"indices\": {\"bufferView\": 2, \"componentType\": 5125}, "
             "\"values\": {\"bufferView\": 1}}}");
   expectInputError(write("huge.gltf", j), "implicit zero elements");
+}
+
+/// A strip of `columns` x 2 vertices along x in y = 0 (POSITION accessor 0,
+/// NORMAL 1), and `primitives` primitives of one mesh, each two triangles of
+/// it by its own index accessor; a copy of the POSITION accessor (2: the same
+/// view and offset) serves every other primitive. NORMAL on every primitive
+/// (`normals` "all") or on the first only ("first"). `nodes` and the
+/// scene's roots as given.
+std::string sharedBufferGltf(int columns, int primitives, const std::string& normals,
+                             const std::string& nodes, const std::string& roots) {
+  std::vector<float> pos, nrm;
+  for (int c = 0; c < columns; ++c)
+    for (int r = 0; r < 2; ++r) {
+      pos.insert(pos.end(), {float(c), 0.0f, float(r)});
+      nrm.insert(nrm.end(), {0.0f, 1.0f, 0.0f});
+    }
+  std::vector<uint32_t> idx;
+  for (int p = 0; p < primitives; ++p) {
+    const uint32_t a = uint32_t(2 * (p % (columns - 1)));
+    idx.insert(idx.end(), {a, a + 1, a + 2, a + 2, a + 1, a + 3});  // facing +y
+  }
+  std::string blob;
+  test::append(blob, pos);
+  const size_t nrmOffset = blob.size();
+  test::append(blob, nrm);
+  const size_t idxOffset = blob.size();
+  test::append(blob, idx);
+  std::ostringstream os;
+  os << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" << roots
+     << R"(}], "nodes": )" << nodes << R"(, "meshes": [{"primitives": [)";
+  for (int p = 0; p < primitives; ++p) {
+    os << (p ? ", " : "") << R"({"attributes": {"POSITION": )" << (p % 2 ? 2 : 0)
+       << (normals == "all" || p == 0 ? R"(, "NORMAL": 1)" : "") << R"(}, "indices": )" << 3 + p
+       << "}";
+  }
+  os << R"(]}], "accessors": [)";
+  const int vertices = 2 * columns;
+  os << R"({"bufferView": 0, "componentType": 5126, "count": )" << vertices
+     << R"(, "type": "VEC3"}, )";
+  os << R"({"bufferView": 1, "componentType": 5126, "count": )" << vertices
+     << R"(, "type": "VEC3"}, )";
+  os << R"({"bufferView": 0, "componentType": 5126, "count": )" << vertices
+     << R"(, "type": "VEC3"})";
+  for (int p = 0; p < primitives; ++p) {
+    os << R"(, {"bufferView": 2, "byteOffset": )" << 24 * p
+       << R"(, "componentType": 5125, "count": 6, "type": "SCALAR"})";
+  }
+  os << R"(], "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": )" << nrmOffset
+     << R"(}, {"buffer": 0, "byteOffset": )" << nrmOffset << R"(, "byteLength": )"
+     << idxOffset - nrmOffset << R"(}, {"buffer": 0, "byteOffset": )" << idxOffset
+     << R"(, "byteLength": )" << blob.size() - idxOffset << R"(}], "buffers": [{"byteLength": )"
+     << blob.size() << R"(, "uri": "data:application/octet-stream;base64,)" << test::base64(blob)
+     << R"("}]})";
+  return os.str();
+}
+
+// Primitives that share a vertex buffer through the same accessors (or
+// accessors that read the same bytes the same way) share its vertices in
+// the scene: the scene's vertices follow the file, not primitives x buffer
+// (10,000 primitives of one 4 MB buffer took gigabytes, issue 43). Each
+// node instance still has its own; a region marker's are its own.
+TEST_F(SceneGltf, PrimitivesThatShareAVertexBufferShareItsVertices) {
+  const int columns = 500, primitives = 2000;
+  Scene s = loadScene(write(
+      "shared.gltf", sharedBufferGltf(columns, primitives, "all", R"([{"mesh": 0}])", "[0]")));
+  ASSERT_EQ(s.triangleCount(), size_t(2 * primitives));
+  EXPECT_EQ(s.positions.size(), size_t(2 * columns));  // was 2 * columns * primitives
+  EXPECT_EQ(s.normals.size(), s.positions.size());
+  for (int p = 0; p < primitives; ++p) {
+    const float x = float(p % (columns - 1));
+    expectNear(s.positions[s.indices[6 * size_t(p)]], {x, 0, 0}, 0, "first corner");
+    expectNear(s.positions[s.indices[6 * size_t(p) + 5]], {x + 1, 0, 1}, 0, "last corner");
+  }
+
+  // Two nodes: two instances, each with its vertices; a region marker over
+  // the same mesh keeps its own and leaves the geometry's alone.
+  Scene two = loadScene(
+      write("two.gltf", sharedBufferGltf(columns, 8, "all",
+                                         R"([{"mesh": 0}, {"mesh": 0, "translation": [0, 5, 0]},
+          {"mesh": 0, "extras": {"lightoctree_region": true}}])",
+                                         "[0, 1, 2]")));
+  EXPECT_EQ(two.triangleCount(), 32u);
+  EXPECT_EQ(two.positions.size(), size_t(4 * columns));
+  ASSERT_FALSE(two.region.empty());
+  expectNear(two.region.lower, {0, 0, 0}, 0, "region lower");
+  expectNear(two.region.upper, {float(columns - 1), 0, 1}, 0, "region upper");
+
+  // Without NORMAL (all but the first primitive, which has its own copy),
+  // the shared vertices' normals come from the faces of every primitive that
+  // uses them: all face +y, also the vertices the second primitive, which
+  // made the copy, does not use.
+  Scene faceted = loadScene(
+      write("faceted.gltf", sharedBufferGltf(columns, 50, "first", R"([{"mesh": 0}])", "[0]")));
+  EXPECT_EQ(faceted.positions.size(), size_t(4 * columns));
+  ASSERT_EQ(faceted.normals.size(), faceted.positions.size());
+  for (size_t t = 0; t < faceted.triangleCount(); ++t)
+    for (int k = 0; k < 3; ++k)
+      expectNear(faceted.normals[faceted.indices[3 * t + size_t(k)]], {0, 1, 0}, 1e-6f, "normal");
+}
+
+// Vertices that are no primitive's to share (another node's instance, or
+// accessors over other bytes) are counted before they are built: beyond
+// half the memory available, refused by name rather than built to a bare
+// out-of-memory.
+TEST_F(SceneGltf, VerticesBeyondMemoryAreRefusedBeforeBuilt) {
+  const std::string path =
+      write("instances.gltf",
+            sharedBufferGltf(1500, 4, "all",
+                             R"([{"mesh": 0}, {"mesh": 0, "translation": [0, 5, 0]}])", "[0, 1]"));
+  // 1 MiB: half of it holds 5,461 vertices of 96 bytes; each instance has 3,000.
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "1M", 1);
+  expectInputError(path, "vertices of their own");
+  unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+  EXPECT_EQ(loadScene(path).positions.size(), 6000u);
 }
 
 TEST_F(SceneGltf, GlbAndDefaultMaterial) {
