@@ -28,24 +28,43 @@ void stableSortRects(void* base, size_t count, size_t size,
 namespace lo::lightmap_internal {
 
 int packRects(const std::vector<RectSize>& rects, int pageSize, int maxPages,
-              std::vector<RectPlacement>& placement) {
+              std::vector<RectPlacement>& placement, size_t* offered) {
   placement.assign(rects.size(), RectPlacement{});
+  // The packer's own order (stb_rect_pack sorts each batch so, stably), once.
   std::vector<int> remaining(rects.size());
   for (size_t i = 0; i < rects.size(); ++i) remaining[i] = int(i);
+  std::stable_sort(remaining.begin(), remaining.end(), [&](int a, int b) {
+    const RectSize& p = rects[size_t(a)];
+    const RectSize& q = rects[size_t(b)];
+    return p.h != q.h ? p.h > q.h : p.w > q.w;
+  });
   // Enough skyline nodes (one per texel column) for the unquantised packer.
   std::vector<stbrp_node> nodes(size_t(std::max(pageSize, 1)));
+  const double offer = kPackOfferPages * double(pageSize) * double(pageSize);
   int pages = 0;
+  std::vector<stbrp_rect> batch;
+  std::vector<int> left;
   while (!remaining.empty()) {
     if (pages == maxPages) return -1;
-    std::vector<stbrp_rect> batch(remaining.size());
-    for (size_t i = 0; i < remaining.size(); ++i) {
+    size_t take = 0;
+    double area = 0;
+    while (take < remaining.size()) {
+      const RectSize& r = rects[size_t(remaining[take])];
+      const double a = double(r.w) * double(r.h);
+      if (take > 0 && area + a > offer) break;
+      area += a;
+      ++take;
+    }
+    batch.resize(take);
+    for (size_t i = 0; i < take; ++i) {
       const RectSize& r = rects[size_t(remaining[i])];
       batch[i] = stbrp_rect{remaining[i], r.w, r.h, 0, 0, 0};
     }
+    if (offered) *offered += take;
     stbrp_context context;
     stbrp_init_target(&context, pageSize, pageSize, nodes.data(), int(nodes.size()));
     stbrp_pack_rects(&context, batch.data(), int(batch.size()));
-    std::vector<int> left;
+    left.clear();
     for (const stbrp_rect& r : batch) {
       if (r.was_packed) {
         placement[size_t(r.id)] = RectPlacement{pages, r.x, r.y};
@@ -53,7 +72,8 @@ int packRects(const std::vector<RectSize>& rects, int pageSize, int maxPages,
         left.push_back(r.id);
       }
     }
-    if (left.size() == remaining.size()) return -1;  // a rectangle larger than a page
+    if (left.size() == take) return -1;  // a rectangle larger than a page
+    left.insert(left.end(), remaining.begin() + ptrdiff_t(take), remaining.end());
     remaining.swap(left);
     ++pages;
   }

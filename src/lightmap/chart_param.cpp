@@ -124,40 +124,46 @@ ChartTopology buildChartTopology(const Scene& scene) {
     topo.weld[size_t(order[i])] = ids;
   }
 
-  // Triangles around each welded vertex (CSR, in triangle order); an edge's
-  // users are the triangles around one end point that hold the other.
+  // An edge's users: the non-degenerate triangles' half-edges keyed by their
+  // welded end points, sorted so that an edge's users lie side by side
+  // (O(n log n) whatever the valence; scanning the triangles around an end
+  // point for the other was quadratic in the valence: a fan of 10^5
+  // triangles around one vertex took minutes).
   auto weldOf = [&](size_t t, int k) { return topo.weld[scene.indices[3 * t + size_t(k)]]; };
-  std::vector<int32_t> start(size_t(ids + 1) + 2, 0);
-  for (size_t t = 0; t < nt; ++t) {
-    if (topo.geometry.degenerate[t]) continue;
-    for (int k = 0; k < 3; ++k) ++start[size_t(weldOf(t, k)) + 2];
-  }
-  for (size_t i = 2; i < start.size(); ++i) start[i] += start[i - 1];
-  std::vector<int32_t> around(size_t(start.back()));
-  for (size_t t = 0; t < nt; ++t) {
-    if (topo.geometry.degenerate[t]) continue;
-    for (int k = 0; k < 3; ++k) around[size_t(start[size_t(weldOf(t, k)) + 1]++)] = int32_t(t);
-  }
-  topo.neighbour.assign(3 * nt, -1);
+  struct HalfEdge {
+    uint64_t key;  ///< the smaller welded end point, then the larger
+    int32_t triangle;
+    int32_t corner;  ///< the edge runs from this corner to the next
+    bool forward;    ///< it runs from the smaller end point to the larger
+  };
+  std::vector<HalfEdge> halfEdges;
+  halfEdges.reserve(3 * nt);
   for (size_t t = 0; t < nt; ++t) {
     if (topo.geometry.degenerate[t]) continue;
     for (int k = 0; k < 3; ++k) {
-      const int32_t a = weldOf(t, k), b = weldOf(t, (k + 1) % 3);
-      int32_t other = -1, users = 0;
-      bool opposite = false;
-      for (int32_t i = start[size_t(a)]; i < start[size_t(a) + 1]; ++i) {
-        const size_t g = size_t(around[size_t(i)]);
-        if (g == t) continue;
-        for (int c = 0; c < 3; ++c) {
-          if (weldOf(g, c) != b) continue;
-          ++users;
-          other = int32_t(g);
-          // g runs b -> a when a follows b in its winding.
-          opposite = weldOf(g, (c + 1) % 3) == a;
-        }
-      }
-      if (users == 1 && opposite) topo.neighbour[3 * t + size_t(k)] = other;
+      const uint32_t a = uint32_t(weldOf(t, k)), b = uint32_t(weldOf(t, (k + 1) % 3));
+      const uint64_t key = a < b ? (uint64_t(a) << 32 | b) : (uint64_t(b) << 32 | a);
+      halfEdges.push_back({key, int32_t(t), k, a < b});
     }
+  }
+  std::sort(halfEdges.begin(), halfEdges.end(), [](const HalfEdge& x, const HalfEdge& y) {
+    return x.key != y.key
+               ? x.key < y.key
+               : (x.triangle != y.triangle ? x.triangle < y.triangle : x.corner < y.corner);
+  });
+  // Neighbours across an edge that exactly two triangles use, in opposite
+  // directions (manifold and consistently oriented); any other edge is a seam.
+  topo.neighbour.assign(3 * nt, -1);
+  for (size_t i = 0; i < halfEdges.size();) {
+    size_t j = i + 1;
+    while (j < halfEdges.size() && halfEdges[j].key == halfEdges[i].key) ++j;
+    const HalfEdge& e = halfEdges[i];
+    const HalfEdge& f = halfEdges[i + 1 < j ? i + 1 : i];
+    if (j - i == 2 && e.forward != f.forward) {
+      topo.neighbour[3 * size_t(e.triangle) + size_t(e.corner)] = f.triangle;
+      topo.neighbour[3 * size_t(f.triangle) + size_t(f.corner)] = e.triangle;
+    }
+    i = j;
   }
 
   for (size_t t = 0; t < nt; ++t) {
@@ -445,10 +451,9 @@ bool solveLscm(const std::vector<D3>& position, const std::vector<int32_t>& corn
   return true;
 }
 
-// Rotates the chart into its minimal-area bounding rectangle (one side along
-// an edge of the convex hull, Freeman & Shapira 1975), wider than tall, with
-// its lower-left corner at the origin. Rotations keep the orientation.
-void orient(std::vector<double>& xy, double& width, double& height) {
+}  // namespace
+
+void orientChart(std::vector<double>& xy, double& width, double& height, size_t* projections) {
   const size_t nv = xy.size() / 2;
   std::vector<size_t> order(nv);
   std::iota(order.begin(), order.end(), 0);
@@ -474,55 +479,81 @@ void orient(std::vector<double>& xy, double& width, double& height) {
   }
   hull.resize(k > 1 ? k - 1 : k);
 
+  // Rotating calipers (Toussaint 1983): the hull is counter-clockwise, so as
+  // the edge turns, the points farthest along it (max u), against it (min u)
+  // and from it (max v) move forward around the hull, each once in all:
+  // O(hull) projections. The scan of every hull point for every edge made
+  // hull^2, hours for a chart whose outline has 10^6 vertices.
+  const size_t h = hull.size();
+  size_t count = 0;
+  auto along = [&](size_t i, double dx, double dy) {
+    ++count;
+    const size_t q = hull[i % h];
+    return dx * xy[2 * q] + dy * xy[2 * q + 1];
+  };
+  auto across = [&](size_t i, double dx, double dy) {
+    ++count;
+    const size_t q = hull[i % h];
+    return -dy * xy[2 * q] + dx * xy[2 * q + 1];
+  };
   double bestArea = std::numeric_limits<double>::infinity();
   double bestC = 1, bestS = 0;
-  for (size_t i = 0; i < hull.size(); ++i) {
-    const size_t a = hull[i], b = hull[(i + 1) % hull.size()];
+  size_t maxU = 0, minU = 0, maxV = 0;
+  bool started = false;
+  for (size_t i = 0; i < h; ++i) {
+    const size_t a = hull[i], b = hull[(i + 1) % h];
     double dx = xy[2 * b] - xy[2 * a], dy = xy[2 * b + 1] - xy[2 * a + 1];
     const double len = std::sqrt(dx * dx + dy * dy);
     if (!(len > 0)) continue;
     dx /= len;
     dy /= len;
-    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY;
-    for (size_t h : hull) {
-      const double u = dx * xy[2 * h] + dy * xy[2 * h + 1];
-      const double v = -dy * xy[2 * h] + dx * xy[2 * h + 1];
-      minU = std::min(minU, u);
-      maxU = std::max(maxU, u);
-      minV = std::min(minV, v);
-      maxV = std::max(maxV, v);
+    if (!started) {
+      // The first edge's extremes by a scan; later edges move them on.
+      for (size_t j = 1; j < h; ++j) {
+        if (along(j, dx, dy) > along(maxU, dx, dy)) maxU = j;
+        if (along(j, dx, dy) < along(minU, dx, dy)) minU = j;
+        if (across(j, dx, dy) > across(maxV, dx, dy)) maxV = j;
+      }
+      started = true;
     }
-    const double area = (maxU - minU) * (maxV - minV);
+    for (size_t step = 0; step < h && along(maxU + 1, dx, dy) >= along(maxU, dx, dy); ++step)
+      maxU = (maxU + 1) % h;
+    for (size_t step = 0; step < h && along(minU + 1, dx, dy) <= along(minU, dx, dy); ++step)
+      minU = (minU + 1) % h;
+    for (size_t step = 0; step < h && across(maxV + 1, dx, dy) >= across(maxV, dx, dy); ++step)
+      maxV = (maxV + 1) % h;
+    // The edge itself is the side the hull lies left of: least v at its ends.
+    const double lowV = std::min(across(i, dx, dy), across(i + 1, dx, dy));
+    const double area = (along(maxU, dx, dy) - along(minU, dx, dy)) * (across(maxV, dx, dy) - lowV);
     if (area < bestArea * (1 - 1e-9)) {
       bestArea = area;
       bestC = dx;
       bestS = dy;
     }
   }
-  double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY;
+  if (projections) *projections += count;
+  double minX = INFINITY, maxX = -INFINITY, minY = INFINITY, maxY = -INFINITY;
   for (size_t v = 0; v < nv; ++v) {
     const double u = bestC * xy[2 * v] + bestS * xy[2 * v + 1];
     const double w = -bestS * xy[2 * v] + bestC * xy[2 * v + 1];
     xy[2 * v] = u;
     xy[2 * v + 1] = w;
-    minU = std::min(minU, u);
-    maxU = std::max(maxU, u);
-    minV = std::min(minV, w);
-    maxV = std::max(maxV, w);
+    minX = std::min(minX, u);
+    maxX = std::max(maxX, u);
+    minY = std::min(minY, w);
+    maxY = std::max(maxY, w);
   }
-  width = maxU - minU;
-  height = maxV - minV;
+  width = maxX - minX;
+  height = maxY - minY;
   const bool turn90 = height > width;
   for (size_t v = 0; v < nv; ++v) {
-    const double u = xy[2 * v] - minU, w = xy[2 * v + 1] - minV;
+    const double u = xy[2 * v] - minX, w = xy[2 * v + 1] - minY;
     // A quarter turn, (u, w) -> (height - w, u), keeps the orientation.
     xy[2 * v] = turn90 ? height - w : u;
     xy[2 * v + 1] = turn90 ? u : w;
   }
   if (turn90) std::swap(width, height);
 }
-
-}  // namespace
 
 void ChartFlattener::flatten(const std::vector<int32_t>& faces, double coneDegrees,
                              std::vector<FlatChart>& out) {
@@ -563,7 +594,7 @@ void ChartFlattener::flatten(const std::vector<int32_t>& faces, double coneDegre
   }
   FlatChart chart;
   chart.triangles = faces;
-  orient(chosen.xy, chart.width, chart.height);
+  orientChart(chosen.xy, chart.width, chart.height);
   chart.uv.resize(6 * faces.size());
   for (size_t i = 0; i < faces.size(); ++i)
     cornerXY(chosen.xy, mesh.cornerVertex, i, &chart.uv[6 * i]);

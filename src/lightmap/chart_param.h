@@ -9,6 +9,7 @@
 /// checks do not depend on the order of float operations.
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -63,6 +64,16 @@ struct FlatChart {
 /// with its 2D area scaled to the 3D one. Mirrored triangles count as their
 /// mirror image. The 2D triangle must have non-zero area.
 double triangleStretchSquared(const D3 q[3], const double p[6]);
+
+/// Rotates a flattened chart (x, y per vertex) into its minimal-area
+/// bounding rectangle (one side along an edge of the convex hull, Freeman &
+/// Shapira 1975) [0, width] x [0, height], width >= height; rotations keep
+/// the orientation. The rectangle is found by rotating calipers: O(hull)
+/// point projections, added to `projections` when given (each hull point
+/// projected for each hull edge was hull^2: hours for a chart outlined by
+/// 10^6 vertices).
+void orientChart(std::vector<double>& xy, double& width, double& height,
+                 size_t* projections = nullptr);
 
 /// Grows, flattens and (where needed) splits charts. Holds scratch arrays the
 /// size of the scene; not thread-safe.

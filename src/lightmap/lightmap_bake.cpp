@@ -83,9 +83,14 @@ LightmapBake bakeLightmap(const Scene& scene, const GpuOctree& octree,
     auto grow = [](int s) { return (s + s / 4 + 15) / 16 * 16; };
     int size = 64;
     while (size < params.uv.atlasSize && double(size) * size < texels) size = grow(size);
+    // The charts are cut and flattened once; each size only packs them.
+    LightmapCharts charts(scene, uv);
     for (;; size = grow(size)) {
       uv.atlasSize = std::min(size, params.uv.atlasSize);
-      out.uvs = buildLightmapUvs(scene, uv);
+      // A size whose page cannot hold the charts' area is passed over: its
+      // packing would only say so.
+      if (uv.atlasSize < params.uv.atlasSize && charts.exceedsOnePage(uv)) continue;
+      out.uvs = charts.pack(uv);
       if (out.uvs.pageCount <= 1 || uv.atlasSize >= params.uv.atlasSize) break;
     }
   }

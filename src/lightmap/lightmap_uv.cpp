@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <sstream>
 #include <tuple>
@@ -47,34 +49,41 @@ void checkParams(const LightmapUvParams& p) {
 // Texels a chart of the given world extent occupies at texel size t: its
 // extent plus a margin on both sides, so that float rounding of the UVs
 // (2^-24 of the page) never pushes a corner into the next texel column.
+// The margin of chartTexels for pages of `size` texels.
+double uvMargin(int size) { return 1e-3 + double(size) * 1e-6; }
+
 int chartTexels(double extent, double t, double margin) {
   // Saturated: a texel size of 1e-15 must not overflow the int (it did).
   return int(std::clamp(std::ceil(extent / t + 2 * margin), 1.0, double(1 << 30)));
 }
 
-std::vector<RectSize> rectSizes(const std::vector<FlatChart>& charts, double t, int gutter,
+// A chart's rectangle in texels: each carries the gutter on its right and
+// top side; the page region starts one gutter in from the left and bottom
+// border.
+RectSize rectSize(const FlatChart& chart, double t, int gutter, double margin) {
+  return {chartTexels(chart.width, t, margin) + gutter,
+          chartTexels(chart.height, t, margin) + gutter};
+}
+
+std::vector<RectSize> rectSizes(const std::vector<const FlatChart*>& charts, double t, int gutter,
                                 double margin) {
   std::vector<RectSize> sizes(charts.size());
-  for (size_t c = 0; c < charts.size(); ++c) {
-    // Each rectangle carries the gutter on its right and top side; the page
-    // region starts one gutter in from the left and bottom border.
-    sizes[c] = {chartTexels(charts[c].width, t, margin) + gutter,
-                chartTexels(charts[c].height, t, margin) + gutter};
-  }
+  for (size_t c = 0; c < charts.size(); ++c) sizes[c] = rectSize(*charts[c], t, gutter, margin);
   return sizes;
 }
 
 // The texel size at which the charts fill about one page: the smallest that
 // still packs into it, to within 0.5% (a geometric search from the size at
 // which the rectangles' total area equals the page).
-double fitOnePage(const std::vector<FlatChart>& charts, int usable, int gutter, double margin) {
+double fitOnePage(const std::vector<const FlatChart*>& charts, int usable, int gutter,
+                  double margin) {
   // Rectangle area at texel size t, with ceil(x) <= x + 1:
   // sum (w x + o)(h x + o), x = 1 / t, o = 1 + 2 margin + gutter. Quadratic in x.
   const double o = 1 + 2 * margin + gutter;
   double a = 0, b = 0;
-  for (const FlatChart& c : charts) {
-    a += c.width * c.height;
-    b += (c.width + c.height) * o;
+  for (const FlatChart* c : charts) {
+    a += c->width * c->height;
+    b += (c->width + c->height) * o;
   }
   const double s2 = double(usable) * double(usable);
   const double overhead = double(charts.size()) * o * o;
@@ -135,18 +144,83 @@ std::string LightmapUvs::ToString() const {
   return os.str();
 }
 
-LightmapUvs buildLightmapUvs(const Scene& scene, const LightmapUvParams& params) {
+struct LightmapCharts::Impl {
+  Impl(const Scene& s, const LightmapUvParams& params)
+      : scene(s),
+        topology(lightmap_internal::buildChartTopology(s)),
+        flattener(s, topology, params.maxStretch),
+        charts(flattener.run(params.chartConeDegrees)),
+        coneDegrees(params.chartConeDegrees),
+        maxStretch(params.maxStretch) {}
+  const Scene& scene;
+  const lightmap_internal::ChartTopology topology;
+  lightmap_internal::ChartFlattener flattener;
+  const std::vector<FlatChart> charts;
+  const float coneDegrees, maxStretch;
+};
+
+namespace {
+
+const LightmapUvParams& checkedCharts(const Scene& scene, const LightmapUvParams& params) {
   checkParams(params);
   checkSceneIndices(scene);
+  return params;
+}
+
+}  // namespace
+
+LightmapCharts::LightmapCharts(const Scene& scene, const LightmapUvParams& params)
+    : impl_(std::make_unique<Impl>(scene, checkedCharts(scene, params))) {}
+
+LightmapCharts::~LightmapCharts() = default;
+
+LightmapUvs buildLightmapUvs(const Scene& scene, const LightmapUvParams& params) {
+  return LightmapCharts(scene, params).pack(params);
+}
+
+bool LightmapCharts::exceedsOnePage(const LightmapUvParams& params) const {
+  checkParams(params);
+  const double t = params.texelSize;
+  if (!(t > 0)) return false;  // fitted to one page
+  const int gutter = params.gutter;
+  const int usable = params.atlasSize - gutter;
+  const double margin = uvMargin(params.atlasSize), page = double(usable) * double(usable);
+  // Each chart's rectangle; a chart larger than a page is cut into pieces
+  // whose rectangles hold at least its area, and two rectangles of a texel
+  // and the gutter each.
+  double area = 0;
+  for (const FlatChart& c : impl_->charts) {
+    const RectSize r = rectSize(c, t, gutter, margin);
+    area += r.w <= usable && r.h <= usable
+                ? double(r.w) * double(r.h)
+                : std::max(c.area / (t * t), 2.0 * double(1 + gutter) * double(1 + gutter));
+    if (area > page) return true;
+  }
+  return false;
+}
+
+LightmapUvs LightmapCharts::pack(const LightmapUvParams& params) {
+  checkParams(params);
+  if (params.chartConeDegrees != impl_->coneDegrees || params.maxStretch != impl_->maxStretch) {
+    throw InputError("LightmapCharts::pack: the charts were cut with chartConeDegrees " +
+                     std::to_string(impl_->coneDegrees) + " and maxStretch " +
+                     std::to_string(impl_->maxStretch) + ", not " +
+                     std::to_string(params.chartConeDegrees) + " and " +
+                     std::to_string(params.maxStretch));
+  }
+  const Scene& scene = impl_->scene;
+  lightmap_internal::ChartFlattener& flattener = impl_->flattener;
   const size_t nt = scene.triangleCount();
   const int size = params.atlasSize;
   const int gutter = params.gutter;
   const int usable = size - gutter;
-  const double margin = 1e-3 + double(size) * 1e-6;
-
-  const lightmap_internal::ChartTopology topo = lightmap_internal::buildChartTopology(scene);
-  lightmap_internal::ChartFlattener flattener(scene, topo, params.maxStretch);
-  std::vector<FlatChart> charts = flattener.run(params.chartConeDegrees);
+  const double margin = uvMargin(size);
+  // The charts as cut, and the pieces of those split here (a deque keeps
+  // their addresses); no copy of the charts that need none.
+  std::vector<const FlatChart*> charts;
+  charts.reserve(impl_->charts.size());
+  for (const FlatChart& c : impl_->charts) charts.push_back(&c);
+  std::deque<FlatChart> pieces;
 
   LightmapUvs out;
   out.width = out.height = size;
@@ -162,23 +236,25 @@ LightmapUvs buildLightmapUvs(const Scene& scene, const LightmapUvParams& params)
     // every one fits.
     for (bool cut = true; cut;) {
       cut = false;
-      std::vector<FlatChart> next;
-      for (FlatChart& c : charts) {
-        if (chartTexels(c.width, t, margin) + gutter <= usable &&
-            chartTexels(c.height, t, margin) + gutter <= usable) {
-          next.push_back(std::move(c));
+      std::vector<const FlatChart*> next;
+      next.reserve(charts.size());
+      for (const FlatChart* c : charts) {
+        const RectSize r = rectSize(*c, t, gutter, margin);
+        if (r.w <= usable && r.h <= usable) {
+          next.push_back(c);
           continue;
         }
-        if (c.triangles.size() < 2) {
+        if (c->triangles.size() < 2) {
           std::ostringstream os;
           os << "LightmapUvParams.texelSize: " << params.texelSize << " is too small for "
-             << sceneName(scene) << ": triangle " << c.triangles[0] << " alone spans "
-             << std::ceil(c.width / t) << " texels, more than a page of " << size << " with gutter "
-             << gutter;
+             << sceneName(scene) << ": triangle " << c->triangles[0] << " alone spans "
+             << std::ceil(c->width / t) << " texels, more than a page of " << size
+             << " with gutter " << gutter;
           throw InputError(os.str());
         }
-        for (FlatChart& piece : flattener.splitInHalves(c.triangles, params.chartConeDegrees)) {
-          next.push_back(std::move(piece));
+        for (FlatChart& piece : flattener.splitInHalves(c->triangles, params.chartConeDegrees)) {
+          pieces.push_back(std::move(piece));
+          next.push_back(&pieces.back());
         }
         cut = true;
       }
@@ -199,7 +275,7 @@ LightmapUvs buildLightmapUvs(const Scene& scene, const LightmapUvParams& params)
   double coveredTexels = 0;
   int32_t chartId = 0;
   for (size_t c = 0; c < charts.size(); ++c) {
-    const FlatChart& chart = charts[c];
+    const FlatChart& chart = *charts[c];
     // Centred in its texel rectangle (which starts one gutter in from the page border).
     const double ox = gutter + placement[c].x + 0.5 * (rects[c].w - gutter - chart.width / t);
     const double oy = gutter + placement[c].y + 0.5 * (rects[c].h - gutter - chart.height / t);

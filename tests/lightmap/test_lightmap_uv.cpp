@@ -347,6 +347,38 @@ TEST(LightmapUv, Deterministic) {
   EXPECT_EQ(a.texelSize, b.texelSize);
 }
 
+// Charts cut once and packed at many sizes (bakeLightmap's search for the
+// smallest page) give buildLightmapUvs' bytes at every size; packing with
+// another cone or stretch than the charts were cut with is refused.
+TEST(LightmapUv, ChartsCutOncePackAsBuildLightmapUvsDoes) {
+  const Scene scene = mixedScene();
+  LightmapUvParams params;
+  LightmapCharts charts(scene, params);
+  for (int size : {64, 96, 256, 1024}) {
+    for (float texel : {0.0f, 0.02f}) {
+      params.atlasSize = size;
+      params.texelSize = texel;
+      const LightmapUvs a = charts.pack(params);
+      const LightmapUvs b = buildLightmapUvs(scene, params);
+      EXPECT_EQ(a.uv, b.uv) << size << " " << texel;
+      EXPECT_EQ(a.trianglePage, b.trianglePage);
+      EXPECT_EQ(a.triangleChart, b.triangleChart);
+      EXPECT_EQ(a.pageCount, b.pageCount);
+      EXPECT_EQ(a.texelSize, b.texelSize);
+      // The search for one page passes over the sizes whose pages the
+      // charts' area exceeds: they would have needed more.
+      if (charts.exceedsOnePage(params)) {
+        EXPECT_GT(a.pageCount, 1) << size << " " << texel;
+      }
+    }
+  }
+  params.atlasSize = 64;
+  params.texelSize = 0.02f;
+  EXPECT_TRUE(charts.exceedsOnePage(params));
+  params.chartConeDegrees = 30;
+  EXPECT_THROW(charts.pack(params), InputError);
+}
+
 TEST(LightmapUv, DegenerateTrianglesGetNoChart) {
   Scene scene = unitCube();
   addTriangle(scene, {0, 0, 0}, {1, 0, 0}, {2, 0, 0});  // collinear
