@@ -95,6 +95,48 @@ def test_render_draws_the_scene_lit_by_the_grid(grid):
     assert np.all(np.isfinite(image)) and image.mean() > 0
 
 
+def test_render_in_a_child_forked_after_a_render_fails_at_once(grid):
+    """A render in an os.fork child after one in the parent waited forever
+    (Mesa's threads stay in the parent). It now raises at once, naming the
+    'spawn' start method; the child is killed after 60 s so that a hang
+    fails the test instead of the suite."""
+    import signal
+    import time
+    lightoctree.render(SCENE, grid, width=16, height=12)
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        os.close(read_end)
+        outcome = b"returned"
+        try:
+            lightoctree.render(SCENE, grid, width=16, height=12)
+        except RuntimeError as e:
+            outcome = ("raised: " + str(e)).encode()
+        except BaseException as e:  # noqa: B036 - anything else is a failure, reported
+            outcome = ("raised another error: " + repr(e)).encode()
+        os.write(write_end, outcome[:4000])
+        os._exit(0)
+    os.close(write_end)
+    deadline = time.monotonic() + 60
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            break
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            os.close(read_end)
+            pytest.fail("the render in the forked child did not end within 60 s")
+        time.sleep(0.05)
+    with os.fdopen(read_end, "rb") as pipe:
+        outcome = pipe.read().decode()
+    assert os.waitstatus_to_exitcode(status) == 0, outcome
+    assert outcome.startswith("raised: "), outcome
+    assert "fork" in outcome and "spawn" in outcome, outcome
+    # The parent still renders.
+    assert lightoctree.render(SCENE, grid, width=16, height=12).mean() > 0
+
+
 def test_errors_are_python_exceptions(tmp_path):
     with pytest.raises(lightoctree.InputError):
         lightoctree.read(str(tmp_path / "missing.vdb"))

@@ -3,9 +3,12 @@
 #include "render/context.h"
 
 #include <glad/gl.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <sstream>
+#include <string>
 
 #include "core/error.h"
 #include "render/context_internal.h"
@@ -17,6 +20,27 @@ namespace {
 /// out different function pointers, so the table must follow whichever back end
 /// is current (tests create both in one process).
 const GlContext* gLoadedFor = nullptr;
+
+/// The process that made the first GL context, 0 before any. A GL driver
+/// keeps process-wide state from its first context on (Mesa's llvmpipe: its
+/// rasterising threads), which a child forked afterwards inherits without
+/// the threads: a render there waited forever (issue 43, family 1:
+/// `lightoctree.render` in an os.fork child after one in the parent).
+std::atomic<pid_t> gFirstGlProcess{0};
+
+/// Refuses GL in a child forked after its parent used GL; records the first
+/// process that uses it.
+void checkGlProcess() {
+  const pid_t self = ::getpid();
+  pid_t first = 0;
+  if (gFirstGlProcess.compare_exchange_strong(first, self) || first == self) return;
+  throw GlError("OpenGL was first used in process " + std::to_string(first) +
+                " and this is process " + std::to_string(self) +
+                ", forked from it afterwards: the GL driver's threads do not survive a fork, and "
+                "a render here would wait forever. Render in processes started afresh (Python: "
+                "multiprocessing's 'spawn' or 'forkserver' start method, "
+                "multiprocessing.get_context('spawn')), or fork before the first render");
+}
 
 void GLAD_API_PTR debugCallback(GLenum, GLenum type, GLuint, GLenum severity, GLsizei,
                                 const GLchar* message, const void*) {
@@ -58,6 +82,7 @@ std::string GlInfo::ToString() const {
 }
 
 void GlContext::makeCurrent() {
+  checkGlProcess();
   makeCurrentImpl();
   if (gLoadedFor != this) {
     if (!gladLoadGL(reinterpret_cast<GLADloadfunc>(procLoader()))) {
@@ -90,6 +115,7 @@ void GlContext::initialize(bool debugOutput) {
 }
 
 std::unique_ptr<GlContext> createGlContext(const GlContextParams& params) {
+  checkGlProcess();
   switch (params.backend) {
     case GlBackend::OSMesa:
       return render_internal::createOsMesaContext(params);

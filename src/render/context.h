@@ -108,6 +108,10 @@ class GlContext {
 /// Creates a context of the requested back end and makes it current.
 /// @throws GlError when the back end cannot give a 3.3+ core context (no
 /// display, no driver); the message names the back end and the failing call.
+/// Also, at once, in a child forked after its parent made a context (and
+/// from makeCurrent there): the driver's threads stayed in the parent, and
+/// the child would wait for them forever; the message says to start
+/// processes afresh ('spawn').
 std::unique_ptr<GlContext> createGlContext(const GlContextParams& params = {});
 
 /// An OpenGL failure: context creation, shader compilation, framebuffer setup.
