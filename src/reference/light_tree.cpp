@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "material/bsdf.h"
 
@@ -90,26 +91,31 @@ int32_t LightTree::build(std::vector<uint32_t>& order, size_t begin, size_t end,
   return index;
 }
 
-float LightTree::importance(const Light& light, const Vec3& p, const Vec3& n) {
-  const float power = lightPower(light);
-  if (!(power > 0)) return 0.0f;
+Vec3 punctualIrradiance(const Light& light, const Vec3& p, Vec3& wi, float& dist) {
+  dist = std::numeric_limits<float>::infinity();
   if (light.type == Light::Type::Directional) {
-    return power * std::max(0.0f, dot(-normalize(light.direction), n));
+    wi = -normalize(light.direction);
+    return light.color * light.intensity;
   }
-  // As the path tracer weighs the light (path_tracer.cpp, punctualLight).
   const Vec3 d = light.position - p;
-  const float dist = length(d);
-  if (!(dist > 0)) return 0.0f;
-  const Vec3 wi = d / dist;
-  const float cosine = dot(wi, n);
-  if (!(cosine > 0)) return 0.0f;
+  dist = length(d);
+  if (!(dist > 0)) return Vec3{0, 0, 0};
+  wi = d / dist;
   float scale = rangeWindow(dist, light.range) / (dist * dist);
   if (light.type == Light::Type::Spot) {
     const float cosOuter = std::cos(light.outerConeAngle);
     const float cosInner = std::max(cosOuter, std::cos(light.innerConeAngle));
     scale *= spotFalloff(dot(-wi, normalize(light.direction)), cosInner, cosOuter);
   }
-  return power * scale * cosine;
+  return light.color * (light.intensity * scale);
+}
+
+float LightTree::importance(const Light& light, const Vec3& p, const Vec3& n) {
+  if (!(lightPower(light) > 0)) return 0.0f;
+  Vec3 wi;
+  float dist = 0;
+  const Vec3 irradiance = punctualIrradiance(light, p, wi, dist);
+  return std::max(0.0f, maxComponent(irradiance)) * std::max(0.0f, dot(wi, n));
 }
 
 float LightTree::nodeImportance(int32_t index, const Vec3& p, const Vec3& n) const {

@@ -31,6 +31,14 @@
 
 namespace lo {
 
+/// What punctual light `light` sends to point p without shadows: its
+/// irradiance perpendicular to the direction (W/m^2, RGB: intensity times
+/// the spot falloff and the range window over d^2, KHR_lights_punctual), the
+/// unit direction towards it `wi` and its distance `dist` (infinite for a
+/// directional light). Zero at its own position and outside its cone or
+/// range. The path tracer's shading and the tree's importance both read it.
+Vec3 punctualIrradiance(const Light& light, const Vec3& p, Vec3& wi, float& dist);
+
 class LightTree {
  public:
   LightTree() = default;

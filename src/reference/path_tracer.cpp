@@ -115,24 +115,8 @@ inline Vec3 punctualLight(const Context& ctx, const Light& light, const Vec3& p,
                           const Vec3& n, const Vec3& wo, const BsdfLobes& lobes, const Vec3& albedo,
                           uint32_t& rays) {
   Vec3 wi;
-  float dist = std::numeric_limits<float>::infinity();
-  Vec3 irradiance;  // W/m^2 perpendicular to wi, before the cosine
-  if (light.type == Light::Type::Directional) {
-    wi = -normalize(light.direction);
-    irradiance = light.color * light.intensity;
-  } else {
-    Vec3 d = light.position - p;
-    dist = length(d);
-    if (!(dist > 0)) return Vec3{0, 0, 0};
-    wi = d / dist;
-    float scale = rangeWindow(dist, light.range) / (dist * dist);
-    if (light.type == Light::Type::Spot) {
-      float cosOuter = std::cos(light.outerConeAngle);
-      float cosInner = std::max(cosOuter, std::cos(light.innerConeAngle));
-      scale *= spotFalloff(dot(-wi, normalize(light.direction)), cosInner, cosOuter);
-    }
-    irradiance = light.color * (light.intensity * scale);
-  }
+  float dist = 0;
+  const Vec3 irradiance = punctualIrradiance(light, p, wi, dist);  // before the cosine
   if (maxComponent(irradiance) <= 0) return Vec3{0, 0, 0};
   Vec3 f = evalBsdf(lobes, albedo, wo, wi, n);
   if (maxComponent(f) <= 0) return Vec3{0, 0, 0};
