@@ -23,7 +23,7 @@ BakeParams BakeOptions::bakeParams(const Scene& scene) const {
     params.targetSeenLight = targetLight == "seen";
   }
   params.knn = knn;
-  params.radius = radius;
+  params.radius = float(radius);
   params.vdls = parseVdlCount(vdls);
   params.seed = seed;
   params.includeDirect = includeDirect;
@@ -105,8 +105,9 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->check(numberIn(kKnnRange))
       ->capture_default_str();
   cmd->add_option("--radius", opt.radius,
-                  "Gathering radius in scene units (default: " + formatNumber(kDefaultRadiusVoxels) + " voxel sizes)")
-      ->check(numberIn(kPositiveNumber));
+                  "Gathering radius in scene units (default: " + formatNumber(kDefaultRadiusVoxels) +
+                      " voxel sizes; at least " + formatNumber(kMinRadiusVoxels) + " of one)")
+      ->check(numberIn({1e-30, 1e30}));  // a float's range: 1e-300 would become 0, the default
   cmd->add_option("--vdls", opt.vdls,
                   "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest (up to --auto-cap) whose "
                   "angular error is under --auto-threshold")

@@ -27,7 +27,7 @@ struct BakeOptions {
   size_t maxPhotons = kDefaultMaxPhotons;
   double maxSeconds = 0;
   int knn = 300;
-  float radius = 0;  // 0 = auto
+  double radius = 0;  // 0 = auto
   std::string vdls = "4";
   std::string representation = "vdl";
   uint64_t seed = 1;

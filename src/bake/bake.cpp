@@ -442,6 +442,17 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
                        formatNumber(float(kMinStorableVoxel)) +
                        "): bake at a smaller --depth, or the scene in larger units");
     }
+    // A radius far below the photons' spacing gathers none: every voxel
+    // dark, and a noise figure of 0 (no photon, no variance) that would call
+    // the dark bake converged.
+    if (params.radius > 0 && !(params.radius >= kMinRadiusVoxels * float(h))) {
+      throw InputError("--radius " + formatNumber(params.radius) + " is under " +
+                       formatNumber(kMinRadiusVoxels) + " of a voxel (" + formatNumber(float(h)) +
+                       " scene units at --depth " + std::to_string(params.depth) +
+                       "): the gather would find no photon and the bake would be dark; leave "
+                       "it out (" + formatNumber(kDefaultRadiusVoxels) + " voxels) or give at least " +
+                       formatNumber(kMinRadiusVoxels * float(h)));
+    }
   }
   checkBakeMemory(scene, params, processes);
   return params;

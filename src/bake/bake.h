@@ -87,6 +87,11 @@ constexpr size_t kMinPilotPhotons = 20000;
 /// Passes of a target bake at most (the pilot included).
 constexpr int kMaxTargetPasses = 6;
 
+/// The smallest gathering radius a bake takes, in voxel sizes: below it the
+/// gather finds no photon in most voxels (a dark bake whose noise figure, of
+/// no photons, reads 0).
+constexpr float kMinRadiusVoxels = 0.1f;
+
 /// Every setting of a bake, with the defaults of `lightoctree bake`.
 struct BakeParams {
   int depth = 6;            ///< 2^depth voxels across the padded bounding cube (paper's delta)
@@ -111,7 +116,8 @@ struct BakeParams {
   /// The only setting whose result depends on the machine's speed.
   double maxSeconds = 0;
   int knn = 300;            ///< nearest photons gathered per voxel (paper: 300)
-  /// Gathering radius, world units; 0 = kDefaultRadiusVoxels voxel sizes.
+  /// Gathering radius, world units; 0 = kDefaultRadiusVoxels voxel sizes;
+  /// else at least kMinRadiusVoxels voxel sizes.
   float radius = 0.0f;
   VdlCount vdls;
   /// `--vdls auto`: at most this many VDLs per voxel (`--auto-cap`), the

@@ -324,6 +324,16 @@ CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSett
     if (stdError) error = binStdError(error, settings.bin);
   }
   r.result = compareImages(test, reference, r.params());
+  // Nothing compared is no score (its figures would read 0: a perfect one).
+  if (r.result.comparedPixels == 0) {
+    throw InputError("compare: no pixel to compare: " + std::to_string(r.result.ignoredPixels) +
+                     " left out (the mask, --ignore-background), " +
+                     std::to_string(r.result.nonFinitePixels) +
+                     " not finite (NaN or infinite in either image)" +
+                     (settings.bin > 1 ? " of the " + std::to_string(settings.bin) + " x " +
+                                             std::to_string(settings.bin) + " bins"
+                                       : std::string()));
+  }
   if (stdError) r.referenceNoise = referenceNoise(reference, error, r.params());
   r.test = std::move(test);
   r.reference = std::move(reference);

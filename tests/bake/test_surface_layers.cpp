@@ -15,6 +15,7 @@
 #include "bake/bake.h"
 #include "bake/bake_fixture.h"
 #include "core/error.h"
+#include "lightgrid/grid_frame.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
 #include "test_util.h"
@@ -281,6 +282,21 @@ TEST(BakeLimits, VoxelsTooSmallForAVdbAreRefusedFirst) {
   test::expectRefusal([&] { bake(scene, p); }, {"--depth 8", "smaller than a .vdb stores"});
   p.depth = 4;  // 16 voxels across a millimetre: storable
   p.photons = 2000;
+  EXPECT_NO_THROW(bake(scene, p));
+}
+
+// A gathering radius far below the photons' spacing found no photon: every
+// voxel dark and a noise figure of 0 (none gathered, no variance). Refused
+// below a tenth of a voxel, naming the smallest it takes.
+TEST(BakeLimits, ARadiusUnderATenthOfAVoxelIsRefused) {
+  const Scene scene = test::pointLitRoom();
+  BakeParams p = test::smallBake(4, 2000);
+  const float voxel = makeGridFrame(scene.bounds(), 4).voxelSize;
+  p.radius = 0.05f * voxel;
+  test::expectRefusal([&] { bake(scene, p); }, {"--radius", "of a voxel", "at least"});
+  p.radius = 1e-30f;
+  test::expectRefusal([&] { bake(scene, p); }, {"--radius"});
+  p.radius = 0.2f * voxel;  // small, but a radius the gather can use
   EXPECT_NO_THROW(bake(scene, p));
 }
 

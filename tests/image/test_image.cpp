@@ -2,6 +2,8 @@
 // masks, EXR round trips.
 
 #include <gtest/gtest.h>
+
+#include <limits>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -169,6 +171,29 @@ TEST(Compare, TheReportJudgesHolesFirstThenClipsThenBins) {
   holed = plain;
   holed.set(5, Vec3(0.0f));
   EXPECT_EQ(compareReport(holed, plain, CompareSettings{}).holes.pixels, size_t(1));
+}
+
+// Nothing compared is no score: an all-black mask, a reference black where
+// --ignore-background leaves it out, or a test image of NaN used to report
+// a relative RMSE of 0, a perfect one.
+TEST(Compare, NothingComparedIsRefusedNotAPerfectScore) {
+  RgbImage ref(4, 4), test(4, 4);
+  std::fill(ref.rgb.begin(), ref.rgb.end(), 1.0f);
+  test = ref;
+  EXPECT_NEAR(compareReport(test, ref, CompareSettings{}).result.rgb.relRmse, 0.0, 1e-12);
+  const RgbImage black(4, 4);  // zero everywhere
+  test::expectRefusal([&] { compareReport(test, ref, CompareSettings{}, &black); },
+                      {"no pixel to compare", "16 left out"});
+  CompareSettings background;
+  background.ignoreBackground = true;
+  test::expectRefusal([&] { compareReport(test, black, background); }, {"no pixel to compare"});
+  RgbImage nan = ref;
+  std::fill(nan.rgb.begin(), nan.rgb.end(), std::numeric_limits<float>::quiet_NaN());
+  test::expectRefusal([&] { compareReport(nan, ref, CompareSettings{}); },
+                      {"no pixel to compare", "16 not finite"});
+  CompareSettings binned;
+  binned.bin = 2;
+  test::expectRefusal([&] { compareReport(nan, ref, binned); }, {"4 not finite", "2 x 2 bins"});
 }
 
 TEST(Compare, RejectsSizeMismatch) {
