@@ -5,6 +5,7 @@
 
 #include <glad/gl.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -268,7 +269,27 @@ RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& param
     throw InputError("render: supersampling must be 1..16, got " + std::to_string(s));
   }
   const int w = params.width * s, h = params.height * s;
-  r.ensureTarget(w, h);
+  // The frame the driver draws into, checked before it is made: a side
+  // beyond its largest texture, render buffer or viewport, or a target it
+  // cannot hold, failed inside the driver ("GL error 0x0501").
+  GLint maxTexture = 0, maxRenderbuffer = 0, maxViewport[2] = {0, 0};
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxTexture);
+  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &maxRenderbuffer);
+  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, maxViewport);
+  const int maxSide = std::min({maxTexture, maxRenderbuffer, maxViewport[0], maxViewport[1]});
+  const std::string frame = std::to_string(w) + " x " + std::to_string(h) + " (--width " +
+                            std::to_string(params.width) + ", --height " +
+                            std::to_string(params.height) + ", --supersample " + std::to_string(s) + ")";
+  if (maxSide > 0 && (w > maxSide || h > maxSide)) {
+    throw InputError("render: a frame of " + frame + " has a side beyond the " +
+                     std::to_string(maxSide) + " the GL driver draws: lower them");
+  }
+  try {
+    r.ensureTarget(w, h);
+  } catch (const GlError& e) {
+    throw InputError("render: a frame of " + frame + " is more than the GL driver can draw into (" +
+                     e.what() + "): lower them");
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo.get());
   r.draw(camera, params, w, h, 1.0f, false);
   std::vector<float> raw(size_t(w) * size_t(h) * 4);

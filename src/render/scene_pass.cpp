@@ -97,7 +97,10 @@ void Renderer::Impl::ensureTarget(int width, int height) {
 /// (from the first draw: before, nothing was bound until the first
 /// transmissive surface), share their variants.
 void Renderer::Impl::ensureBehind(int width, int height, bool floatTarget) {
-  auto notPowerOfTwo = [](int n) { return (n & (n - 1)) == 0 ? n + 1 : n; };
+  GLint maxSide = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSide);
+  // A side at the driver's largest stays as it is (a power of two then).
+  auto notPowerOfTwo = [maxSide](int n) { return (n & (n - 1)) == 0 && n < maxSide ? n + 1 : n; };
   if (!behindTexture || behindWidth < width || behindHeight < height ||
       behindFloat != floatTarget) {
     if (!behindTexture) behindTexture = GlTexture::create();
