@@ -167,6 +167,98 @@ vec3 behindAlong(vec3 q, vec3 d) {
   return behind / uExposureScale;
 }
 
+// Where render-space point x falls in the frame: uv in [0, 1], window depth;
+// false when it is behind the camera or off the frame.
+bool windowPoint(vec3 x, out vec3 w) {
+  vec4 clip = uViewProj * vec4(x, 1.0);
+  w = vec3(0.0);
+  if (clip.w <= 0.0) return false;
+  w = clip.xyz / clip.w * 0.5 + 0.5;
+  return all(greaterThanEqual(w.xy, vec2(0.0))) && all(lessThanEqual(w.xy, vec2(1.0)));
+}
+
+// The copies' texel at frame position uv (within the texels this frame wrote:
+// the copies may be larger, they only grow).
+vec4 copyTexel(sampler2D copy, vec2 uv) {
+  vec2 written = uBehindScale - 0.5 / vec2(textureSize(copy, 0));
+  return textureLod(copy, min(uv * uBehindScale, written), 0.0);
+}
+
+// The opaque scene along the ray from q in direction d, met by marching the
+// ray across the frame against the opaque image's depth (24 steps, closer
+// near q, then bisection): what lies a few centimetres behind a glass block
+// is found where it is, not where the scene's bounds would put it. Off the
+// frame, or meeting nothing, behindAlong.
+vec3 behindMarched(vec3 q, vec3 d) {
+  if (!uHasOpaqueDepth) return behindAlong(q, d);
+  vec3 dd = mix(d, vec3(1e-6), equal(d, vec3(0.0)));
+  vec3 tf = max((uProbeBoxMax - q) / dd, (uProbeBoxMin - q) / dd);
+  float tBox = max(min(min(tf.x, tf.y), tf.z), 0.0);
+  const int kSteps = 24;
+  float before = 0.0;
+  for (int i = 1; i <= kSteps; ++i) {
+    float s = tBox * pow(float(i) / float(kSteps), 2.0);
+    vec3 w;
+    if (!windowPoint(q + d * s, w)) break;
+    if (w.z >= copyTexel(uOpaqueDepth, w.xy).r) {
+      float lo = before, hi = s;
+      for (int k = 0; k < 5; ++k) {
+        float mid = 0.5 * (lo + hi);
+        vec3 wm;
+        if (windowPoint(q + d * mid, wm) && wm.z >= copyTexel(uOpaqueDepth, wm.xy).r) {
+          hi = mid;
+        } else {
+          lo = mid;
+        }
+      }
+      windowPoint(q + d * hi, w);
+      vec3 behind = copyTexel(uBehind, w.xy).rgb;
+      if (uEncodeSrgb) behind = srgbDecode(behind);
+      return behind / uExposureScale;
+    }
+    before = s;
+  }
+  return behindAlong(q, d);
+}
+
+// The outward normal a back face's w holds (render_volume_back.frag).
+vec3 backFaceNormal(float code) {
+  float c = code - 1.0;
+  vec2 o = vec2(floor(c / 1024.0), mod(c, 1024.0)) / 1023.0 * 2.0 - 1.0;
+  vec3 n = vec3(o, 1.0 - abs(o.x) - abs(o.y));
+  if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+  return normalize(n);
+}
+
+// Where the ray from p inside a volume along t leaves it. The volume's back
+// faces at the pixels of points along the ray (a quarter, a half and all of
+// the material's thickness, then where the nearest exit so far lies) each
+// give a plane the ray leaves through; a convex body's exit is the nearest
+// of its faces' (a block's is found exactly once its face is among them).
+// m: the outward normal there. False when no back face is found ahead.
+bool volumeExit(vec3 p, vec3 t, out vec3 exitPoint, out vec3 m) {
+  float best = 1e30;
+  m = -t;
+  for (int k = 0; k < 5; ++k) {
+    float s = k < 3 ? uThickness * (k == 0 ? 0.25 : k == 1 ? 0.5 : 1.0) : 0.999 * best;
+    if (s >= 1e29) break;
+    vec3 w;
+    if (!windowPoint(p + t * s, w)) continue;
+    vec4 b = copyTexel(uBackFaces, w.xy);
+    if (b.w == 0.0) continue;
+    vec3 nb = backFaceNormal(b.w);
+    float along = dot(t, nb);
+    if (along <= 1e-3) continue;
+    float exitAt = dot(b.xyz - p, nb) / along;
+    if (exitAt > 0.0 && exitAt < best) {
+      best = exitAt;
+      m = nb;
+    }
+  }
+  exitPoint = p + t * min(best, 1e29);
+  return best < 1e29;
+}
+
 // Light through a transmissive surface (KHR_materials_transmission), tinted
 // by the base colour and weighted by the Fresnel transmittance of each
 // interface it crosses (Schlick, F0 from the ior).
@@ -179,6 +271,36 @@ vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
   // across the pixel (a sphere: 1 / its radius; a pane: 0).
   float curvature = max(length(dFdx(n)) / max(length(dFdx(vPosition)), 1e-9),
                         length(dFdy(n)) / max(length(dFdy(vPosition)), 1e-9));
+  vec3 exitPoint, m;
+  vec3 t = refract(-v, n, 1.0 / ior);
+  if (dot(t, t) == 0.0) t = -v;
+  if (uThickness > 0.0 && uHasVolumeBacks && curvature * uThickness < 0.25 &&
+      volumeExit(vPosition, t, exitPoint, m)) {
+    // A volume flat here (a block, a slab) whose back faces this frame drew:
+    // the ray refracts in, leaves through the back face it meets (the share
+    // the interface lets through) or is reflected inside it once (the rest:
+    // past the critical angle, a block's sides and bottom mirror what is
+    // behind), and goes on to the opaque scene it meets.
+    vec3 p = vPosition;
+    vec3 light = vec3(0.0);
+    float carried = 1.0 - fresnel;
+    for (int bounce = 0; bounce < 2 && carried > 0.0; ++bounce) {
+      if (bounce > 0 && !volumeExit(p, t, exitPoint, m)) {
+        light += carried * behindMarched(p, t);
+        break;
+      }
+      vec3 out_ = refract(t, -m, ior);
+      float through = 0.0;
+      if (dot(out_, out_) > 0.0) {
+        through = 1.0 - (f0 + (1.0 - f0) * pow(1.0 - clamp(dot(out_, m), 0.0, 1.0), 5.0));
+        light += carried * through * behindMarched(exitPoint, out_);
+      }
+      carried *= 1.0 - through;
+      t = reflect(t, -m);
+      p = exitPoint;
+    }
+    return uTransmission * baseColor * light;
+  }
   if (uThickness <= 0.0 || curvature * uThickness < 0.25) {
     // Thin-walled (glTF without KHR_materials_volume), or a volume whose
     // surface is flat on the scale of its thickness (a pane, a table top):
@@ -197,8 +319,6 @@ vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
   // far side lets through) or after one reflection inside it (the rest: a
   // light above a glass ball shows in its lower half), on to the scene
   // behind.
-  vec3 t = refract(-v, n, 1.0 / ior);
-  if (dot(t, t) == 0.0) t = -v;
   float radius = 0.5 * uThickness;
   vec3 centre = vPosition - n * radius;
   vec3 light = vec3(0.0);

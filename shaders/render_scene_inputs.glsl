@@ -71,5 +71,9 @@ uniform vec3 uProbeIrradiance[9];  // the probe's irradiance at its centre: SH t
 uniform vec2 uBehindScale;     // the share of uBehind's texels this frame fills (it only grows)
 uniform sampler2D uBehind;    // the opaque image under transmissive surfaces (as output)
 uniform float uThickness;     // KHR_materials_volume thickness; 0 = thin-walled
+uniform bool uHasVolumeBacks;  // uBackFaces holds this frame's volume back faces
+uniform sampler2D uBackFaces;  // nearest back face of a volume per pixel: render space, w its normal (0: none)
+uniform bool uHasOpaqueDepth;  // uOpaqueDepth holds the opaque image's depth
+uniform sampler2D uOpaqueDepth;   // window-space depth of the opaque image (as uBehind)
 uniform float uIor;           // KHR_materials_ior
 uniform mat4 uViewProj;       // render space -> clip (the vertex shader's)

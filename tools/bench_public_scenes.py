@@ -35,6 +35,7 @@ SCENES = [
     ("courtyard", "data:courtyard.gltf", "open courtyard under a sun and an image sky (made by the project)"),
     ("window-room", "data:window-room.gltf", "a room lit through its window by sun and sky (made by the project)"),
     ("emissive-cubes", "data:emissive-cubes.gltf", "emissive cubes as the only light (made by the project)"),
+    ("tabletop", "data:tabletop.gltf", "a 7.5 cm toy and a thick glass block under a spot (made by the project)"),
     ("living-room-day", "shared:real/godot-living-room/living_room-day.glb", "living room by day, windows"),
     ("living-room-night", "shared:real/godot-living-room/living_room-night.glb", "living room by night, two bulbs"),
     ("game-level", "shared:real/zdm2-sauerbraten/zdm2-godot-lights.glb", "enclosed game level: sun, omni lights, spot"),

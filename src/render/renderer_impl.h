@@ -120,6 +120,10 @@ struct SceneGeometry {
   void drawDepthOnly(GLuint program, bool shadows) const;
   /// Writes the blended triangles' vertex indices into blendEbo, back to front from `eye`.
   void sortBlended(const glm::vec3& eye);
+  /// Whether a transmissive range has a volume (KHR_materials_volume).
+  bool hasVolumes() const;
+  /// Draws the transmissive ranges with a volume, both sides (vao bound).
+  void drawVolumes() const;
 
  private:
   GlTexture uploadTexture(const Texture& t, unsigned read);
@@ -210,6 +214,19 @@ struct Renderer::Impl {
       behindTexture;  ///< the opaque image, seen through transmissive surfaces
   int behindWidth = 0, behindHeight = 0;
   bool behindFloat = false;
+  /// Thick glass (KHR_materials_volume), made when the scene has a volume:
+  /// the opaque image's depth (unit 14), and the nearest back face of the
+  /// volumes at each pixel (unit 15: its render-space position, and in w its
+  /// outward normal, octahedral, 10 bits a side, plus 1; 0: none), the same
+  /// size as behindTexture.
+  struct VolumeBacks {
+    render_internal::GlTexture opaqueDepth, faces;
+    render_internal::GlFramebuffer fbo;
+    render_internal::GlRenderbuffer depth;
+    render_internal::GlProgram program;
+    int width = 0, height = 0;
+    bool depthCopied = false;  ///< this frame's opaque depth is in opaqueDepth
+  } volumeBacks;
 
   void uploadOctree(const GpuOctree& octree);
 
@@ -217,6 +234,12 @@ struct Renderer::Impl {
   void ensureTarget(int width, int height);
   void ensureBehind(int width, int height, bool floatTarget);
   void copyBehind(int width, int height, bool floatTarget);
+  /// Thick glass: volumeBacks at behindTexture's size (made on first use),
+  /// bound to units 14 and 15.
+  void ensureVolumeBacks();
+  /// Copies the opaque depth and draws the volumes' back faces into
+  /// volumeBacks, the bound framebuffer then bound again.
+  void drawVolumeBacks(int width, int height, const glm::mat4& viewProj, const glm::vec3& eye);
   /// One frame into the bound framebuffer: depth pre-pass, then the scene
   /// pass (opaque, masked, blended back to front, transmissive).
   void draw(const PinholeCamera& camera, const RenderParams& rp, int width, int height,
@@ -227,8 +250,8 @@ struct Renderer::Impl {
                         bool encodeSrgb);
   /// `movingProgram` (0: none) draws the ranges of added objects, with the
   /// free-space light's textures bound in place of the octree's.
-  void drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye, GLuint program,
-                  GLuint movingProgram);
+  void drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye,
+                  const glm::mat4& viewProj, GLuint program, GLuint movingProgram);
 
   // reflection_probe.cpp
   /// Renders the probe's six faces with the full scene program, reflections

@@ -390,13 +390,25 @@ void SceneGeometry::drawDepthOnly(GLuint program, bool shadows) const {
   glDisable(GL_CULL_FACE);
   if (shadows) {
     glUniform1i(alphaTest, 0);
-    for (size_t i = 0; i < ranges.size(); ++i) {
-      if (rangeCategory[i] == kTransmissive && ranges[i].thickness > 0) {
-        glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].count);
-      }
-    }
+    drawVolumes();
   }
   glActiveTexture(GL_TEXTURE0);
+}
+
+bool SceneGeometry::hasVolumes() const {
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    if (rangeCategory[i] == kTransmissive && ranges[i].thickness > 0) return true;
+  }
+  return false;
+}
+
+void SceneGeometry::drawVolumes() const {
+  glDisable(GL_CULL_FACE);
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    if (rangeCategory[i] == kTransmissive && ranges[i].thickness > 0) {
+      glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].count);
+    }
+  }
 }
 
 /// Writes the blended triangles' vertex indices into blendEbo, each

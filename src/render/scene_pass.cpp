@@ -116,6 +116,82 @@ void Renderer::Impl::ensureBehind(int width, int height, bool floatTarget) {
   glActiveTexture(GL_TEXTURE6);
   glBindTexture(GL_TEXTURE_2D, behindTexture.get());
   glActiveTexture(GL_TEXTURE0);
+  if (geometry.hasVolumes()) ensureVolumeBacks();
+}
+
+void Renderer::Impl::ensureVolumeBacks() {
+  VolumeBacks& b = volumeBacks;
+  if (!b.program) {
+    b.program = GlProgram(buildProgram({"render_scene.vert", "render_volume_back.frag"}));
+  }
+  if (!b.fbo || b.width != behindWidth || b.height != behindHeight) {
+    if (!b.fbo) {
+      b.fbo = GlFramebuffer::create();
+      b.opaqueDepth = GlTexture::create();
+      b.faces = GlTexture::create();
+      b.depth = GlRenderbuffer::create();
+    }
+    b.width = behindWidth;
+    b.height = behindHeight;
+    glBindTexture(GL_TEXTURE_2D, b.opaqueDepth.get());
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, b.width, b.height, 0, GL_DEPTH_COMPONENT,
+                 GL_UNSIGNED_INT, nullptr);
+    for (const GlTexture* t : {&b.opaqueDepth, &b.faces}) {
+      glBindTexture(GL_TEXTURE_2D, t->get());
+      if (t != &b.opaqueDepth) {
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, b.width, b.height, 0, GL_RGBA, GL_FLOAT, nullptr);
+      }
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, b.depth.get());
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, b.width, b.height);
+    GLint bound = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
+    glBindFramebuffer(GL_FRAMEBUFFER, b.fbo.get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, b.faces.get(), 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, b.depth.get());
+    const GLenum buffer = GL_COLOR_ATTACHMENT0;
+    glDrawBuffers(1, &buffer);
+    const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(bound));
+    if (!complete) throw GlError("the volumes' back-face framebuffer is incomplete");
+  }
+  glActiveTexture(GL_TEXTURE14);
+  glBindTexture(GL_TEXTURE_2D, b.opaqueDepth.get());
+  glActiveTexture(GL_TEXTURE15);
+  glBindTexture(GL_TEXTURE_2D, b.faces.get());
+  glActiveTexture(GL_TEXTURE0);
+  checkGl("making the volumes' back-face textures");
+}
+
+void Renderer::Impl::drawVolumeBacks(int width, int height, const glm::mat4& viewProj,
+                                     const glm::vec3& eye) {
+  VolumeBacks& b = volumeBacks;
+  ensureVolumeBacks();
+  GLint bound = 0, program = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
+  glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+  // The opaque depth, for the refracted ray's march (a window's depth
+  // buffer may not copy into a texture: the march then falls back).
+  glBindTexture(GL_TEXTURE_2D, b.opaqueDepth.get());
+  glCopyTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 0, 0, width, height);
+  b.depthCopied = glGetError() == GL_NO_ERROR;
+  glBindFramebuffer(GL_FRAMEBUFFER, b.fbo.get());
+  glDepthMask(GL_TRUE);  // before the clear, which it masks
+  glDepthFunc(GL_LESS);
+  glClearColor(0, 0, 0, 0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glUseProgram(b.program.get());
+  glUniformMatrix4fv(glGetUniformLocation(b.program.get(), "uViewProj"), 1, GL_FALSE,
+                     glm::value_ptr(viewProj));
+  glUniform3fv(glGetUniformLocation(b.program.get(), "uEye"), 1, glm::value_ptr(eye));
+  geometry.drawVolumes();
+  glBindFramebuffer(GL_FRAMEBUFFER, GLuint(bound));
+  glUseProgram(GLuint(program));
+  checkGl("drawing the volumes' back faces");
 }
 
 /// Copies the bound framebuffer's colour (width x height) into the corner
@@ -212,6 +288,10 @@ void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, con
   glUniform1i(loc("uMetallicRoughnessTexture"), 8);
   glUniform1i(loc("uOcclusionTexture"), 9);
   glUniform1i(loc("uBehind"), 6);
+  glUniform1i(loc("uOpaqueDepth"), 14);
+  glUniform1i(loc("uBackFaces"), 15);
+  glUniform1i(loc("uHasVolumeBacks"), 0);  // drawVolumeBacks sets it
+  glUniform1i(loc("uHasOpaqueDepth"), 0);
   glUniform1i(loc("uEmissiveTexture"), 10);
   glUniform1f(loc("uTransmission"), 0.0f);
   glUniform2f(loc("uDielectric"), 0.04f, 1.0f);
@@ -222,7 +302,8 @@ void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, con
 /// from `eye` without depth writes; transmissive ones over a copy of what
 /// was drawn before them.
 void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye,
-                                GLuint staticProgram, GLuint movingProgram) {
+                                const glm::mat4& viewProj, GLuint staticProgram,
+                                GLuint movingProgram) {
   glBindVertexArray(geometry.vao.get());
   GLuint p = 0;
   GLint hasTexture = -1, hasNormal = -1, normalScale = -1, hasMr = -1, hasOcclusion = -1,
@@ -280,6 +361,19 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
       // The opaque scene as drawn so far, for the surfaces in front of it
       // to show (thin-walled transmission: seen straight through).
       copyBehind(width, height, !encodeSrgb);
+      // Thick glass: the opaque depth and the volumes' back faces, where
+      // the refracted rays leave them (render_scene.frag).
+      if (geometry.hasVolumes()) {
+        drawVolumeBacks(width, height, viewProj, eye);
+        for (GLuint program : {staticProgram, movingProgram}) {
+          if (!program) continue;
+          glUseProgram(program);
+          glUniform1i(glGetUniformLocation(program, "uHasVolumeBacks"), 1);
+          glUniform1i(glGetUniformLocation(program, "uHasOpaqueDepth"),
+                      volumeBacks.depthCopied ? 1 : 0);
+        }
+        glUseProgram(p);
+      }
       glActiveTexture(GL_TEXTURE6);
       glBindTexture(GL_TEXTURE_2D, behindTexture.get());
       glDepthMask(GL_TRUE);  // the nearest transmissive surface wins
@@ -433,7 +527,7 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
     glUniform1f(glGetUniformLocation(moving, "uVoxelSize"), volumeTextures.voxelSize);
     glUniform1i(glGetUniformLocation(moving, "uDepth"), volumeTextures.depth);
   }
-  drawRanges(width, height, encodeSrgb, eye, p, moving);
+  drawRanges(width, height, encodeSrgb, eye, viewProj, p, moving);
   glDisable(GL_CULL_FACE);
   glBindVertexArray(0);
   glBindSampler(5, 0);

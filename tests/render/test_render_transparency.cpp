@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "image/image.h"
 #include "render/render_fixture.h"
@@ -72,6 +74,93 @@ TEST_F(RenderImage, AFlatGlassVolumeIsSeenStraightThroughTwoInterfaces) {
     ASSERT_GT(a[0], 0.01f);
     EXPECT_NEAR(b[0] / a[0], 0.96f * 0.96f, 0.01f) << "pixel " << px;
   }
+}
+
+// Snell's law for unit `d` meeting a surface of unit normal `n` (against
+// d), eta = n_from / n_to; false past the critical angle.
+bool refracted(const Vec3& d, const Vec3& n, float eta, Vec3& t) {
+  const float c = -dot(d, n);
+  const float k = 1.0f - eta * eta * (1.0f - c * c);
+  if (k < 0.0f) return false;
+  t = d * eta + n * (eta * c - std::sqrt(k));
+  return true;
+}
+
+// Thick glass (KHR_materials_volume): a clear block 0.4 thick in front of a
+// card, red left of x = 0 and blue right of it, seen 31 degrees off its
+// normal. Each ray refracts into the front face, out of the back face and on
+// to the card, shifted sideways by 0.4 sin(theta_i - theta_t) / cos(theta_t)
+// (8 cm here, 5 pixels): the colour of every pixel of the middle row is the
+// one Snell's law gives, where a view straight through (the pane model the
+// block was drawn with) puts the edge elsewhere.
+TEST_F(RenderImage, AGlassBlockShiftsWhatIsBehindItAsSnellsLawDoes) {
+  Scene scene;
+  Material redCard, blueCard, glass;
+  redCard.unlit = blueCard.unlit = true;
+  redCard.baseColor = {0.8f, 0.05f, 0.05f};
+  blueCard.baseColor = {0.05f, 0.05f, 0.8f};
+  glass.baseColor = {1, 1, 1};
+  glass.roughness = 0.0f;
+  glass.transmission = 1.0f;
+  glass.thickness = 0.4f;
+  glass.ior = 1.5f;
+  scene.materials = {redCard, blueCard, glass};
+  test::addQuad(scene, {-2, -1, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 0);
+  test::addQuad(scene, {0, -1, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 1);
+  const Vec3 lo(-1.0f, -0.5f, 0.2f), hi(1.5f, 0.5f, 0.6f);
+  const Vec3 size = hi - lo;
+  test::addQuad(scene, {lo.x, lo.y, hi.z}, {size.x, 0, 0}, {0, size.y, 0}, {0, 0, 1}, 2);
+  test::addQuad(scene, {lo.x, lo.y, lo.z}, {0, size.y, 0}, {size.x, 0, 0}, {0, 0, -1}, 2);
+  test::addQuad(scene, {lo.x, lo.y, lo.z}, {0, 0, size.z}, {0, size.y, 0}, {-1, 0, 0}, 2);
+  test::addQuad(scene, {hi.x, lo.y, lo.z}, {0, size.y, 0}, {0, 0, size.z}, {1, 0, 0}, 2);
+  test::addQuad(scene, {lo.x, lo.y, lo.z}, {size.x, 0, 0}, {0, 0, size.z}, {0, -1, 0}, 2);
+  test::addQuad(scene, {lo.x, hi.y, lo.z}, {0, 0, size.z}, {size.x, 0, 0}, {0, 1, 0}, 2);
+  const PinholeCamera camera =
+      PinholeCamera::lookAt({1.2f, 0.0f, 2.0f}, {0.0f, 0.0f, 0.0f}, 36.0f * kPi / 180.0f);
+  RenderParams p = QuadSetup::directParams();
+  p.width = 128;
+  p.height = 96;
+  const RgbImage image = Renderer(scene, test::emptyOctree()).render(camera, p);
+  const Vec3 right = normalize(cross(camera.forward, camera.up));
+  const float tanHalf = std::tan(0.5f * camera.yfov);
+  const int row = p.height / 2;
+  // Per column of the middle row: -1 off the block, else whether the card
+  // is red where the ray lands, refracted and straight through.
+  std::vector<int> red(size_t(p.width), -1), redStraight(size_t(p.width), -1);
+  for (int x = 0; x < p.width; ++x) {
+    const float sx = (2.0f * (float(x) + 0.5f) / float(p.width) - 1.0f) * tanHalf * p.width / p.height;
+    const float sy = (1.0f - 2.0f * (float(row) + 0.5f) / float(p.height)) * tanHalf;
+    const Vec3 d = normalize(camera.forward + right * sx + camera.up * sy);
+    // Into the front face (z = 0.6), out of the back (z = 0.2), on to z = 0.
+    const Vec3 front = camera.eye + d * ((hi.z - camera.eye.z) / d.z);
+    if (front.x < lo.x || front.x > hi.x) continue;
+    Vec3 inside, out;
+    ASSERT_TRUE(refracted(d, {0, 0, 1}, 1.0f / 1.5f, inside));
+    const Vec3 back = front + inside * ((lo.z - front.z) / inside.z);
+    if (back.x < lo.x + 0.05f || back.x > hi.x - 0.05f) continue;  // it leaves by a side
+    ASSERT_TRUE(refracted(inside, {0, 0, 1}, 1.5f, out));
+    red[size_t(x)] = (back + out * (-back.z / out.z)).x < 0.0f;
+    redStraight[size_t(x)] = (front + d * (-front.z / d.z)).x < 0.0f;
+  }
+  int edge = -1, straightEdge = -1, mismatches = 0, compared = 0;
+  for (size_t x = 1; x < red.size(); ++x) {
+    if (red[x] >= 0 && red[x - 1] >= 0 && red[x] != red[x - 1]) edge = int(x);
+    if (redStraight[x] >= 0 && redStraight[x - 1] >= 0 && redStraight[x] != redStraight[x - 1]) {
+      straightEdge = int(x);
+    }
+  }
+  for (int x = 0; x < p.width; ++x) {
+    if (red[size_t(x)] < 0 || std::abs(x - edge) <= 1) continue;  // off the block; the edge
+    const float* px = image.pixel(x, row);
+    ASSERT_GT(px[0] + px[2], 0.1f) << "column " << x << " shows nothing";
+    ++compared;
+    if ((px[0] > px[2]) != (red[size_t(x)] == 1)) ++mismatches;
+  }
+  ASSERT_GT(edge, 0);
+  EXPECT_GE(std::abs(edge - straightEdge), 3) << "the test tells refraction from a straight view";
+  EXPECT_GT(compared, p.width / 2);
+  EXPECT_EQ(mismatches, 0) << "edge by Snell's law at column " << edge << ", straight through at "
+                           << straightEdge;
 }
 
 // glTF MASK: the cut-out half of a card neither hides the quad behind it nor
