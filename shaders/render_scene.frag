@@ -278,17 +278,14 @@ vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
       volumeExit(vPosition, t, exitPoint, m)) {
     // A volume flat here (a block, a slab) whose back faces this frame drew:
     // the ray refracts in, leaves through the back face it meets (the share
-    // the interface lets through) or is reflected inside it once (the rest:
-    // past the critical angle, a block's sides and bottom mirror what is
-    // behind), and goes on to the opaque scene it meets.
+    // the interface lets through) or is reflected inside it (the rest: past
+    // the critical angle, a block's sides and bottom mirror what is behind),
+    // up to four times, and goes on to the opaque scene it meets.
     vec3 p = vPosition;
     vec3 light = vec3(0.0);
     float carried = 1.0 - fresnel;
-    for (int bounce = 0; bounce < 2 && carried > 0.0; ++bounce) {
-      if (bounce > 0 && !volumeExit(p, t, exitPoint, m)) {
-        light += carried * behindMarched(p, t);
-        break;
-      }
+    for (int bounce = 0; bounce < 4 && carried > 0.0; ++bounce) {
+      if (bounce > 0 && !volumeExit(p, t, exitPoint, m)) break;
       vec3 out_ = refract(t, -m, ior);
       float through = 0.0;
       if (dot(out_, out_) > 0.0) {
@@ -299,6 +296,10 @@ vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
       t = reflect(t, -m);
       p = exitPoint;
     }
+    // What four inner reflections still hold (a block's corners reflect a
+    // ray totally from face to face), or a ray whose exit the back faces do
+    // not show: sent on from where it was last.
+    if (carried > 0.0) light += carried * behindMarched(p, t);
     return uTransmission * baseColor * light;
   }
   if (uThickness <= 0.0 || curvature * uThickness < 0.25) {
