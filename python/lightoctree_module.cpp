@@ -52,6 +52,34 @@
 namespace py = pybind11;
 
 namespace lo::python {
+
+/// An argument as Python gave it, whatever its type, checked by the function
+/// that takes it and refused by its name (numberArg, wholeArg, boolArg,
+/// textArg, pathArg below). pybind11's own conversion answered a wrong type
+/// with "incompatible function arguments" and the whole signature, and took
+/// True for 1; `T` is only the type the signature shows.
+template <typename T>
+struct Arg {
+  py::object value;
+};
+
+}  // namespace lo::python
+
+namespace pybind11::detail {
+template <typename T>
+struct type_caster<lo::python::Arg<T>> {
+  PYBIND11_TYPE_CASTER(lo::python::Arg<T>, make_caster<T>::name);
+  bool load(handle src, bool) {
+    value.value = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const lo::python::Arg<T>& arg, return_value_policy, handle) {
+    return arg.value.inc_ref();
+  }
+};
+}  // namespace pybind11::detail
+
+namespace lo::python {
 namespace {
 
 using tool::checkCameraOptions;
@@ -151,8 +179,166 @@ auto withProgress(const py::object& progress, Work work) {
   return std::move(*result);
 }
 
-GridPtr readGrid(const std::string& path) {
-  checkPathText(path, "path");
+/// A message of the commands' options code (tools/) with its flags named as
+/// the Python arguments are: "--eye and --target" -> "eye and target",
+/// "--sky-image: ..." -> "sky_image: ...".
+std::string pythonNames(const std::string& message) {
+  std::string out;
+  for (size_t i = 0; i < message.size(); ++i) {
+    if (message.compare(i, 2, "--") == 0 && i + 2 < message.size() &&
+        std::islower(static_cast<unsigned char>(message[i + 2])) &&
+        (i == 0 || !std::isalnum(static_cast<unsigned char>(message[i - 1])))) {
+      size_t j = i + 2;
+      for (; j < message.size() && (std::isalnum(static_cast<unsigned char>(message[j])) ||
+                                    message[j] == '-');
+           ++j) {
+        out += message[j] == '-' ? '_' : message[j];
+      }
+      i = j - 1;
+    } else {
+      out += message[i];
+    }
+  }
+  return out;
+}
+
+/// `work()` with an InputError of the options code reworded by pythonNames.
+template <typename Work>
+auto withPythonNames(Work work) {
+  try {
+    return work();
+  } catch (const InputError& e) {
+    throw InputError(pythonNames(e.what()));
+  }
+}
+
+// ---- arguments: each checked by its name, as the commands check their flags ----
+
+/// repr(value), cut to 60 characters (a refused argument may be large).
+std::string shortRepr(const py::handle& value) {
+  try {
+    std::string r = py::repr(value);
+    return r.size() > 60 ? r.substr(0, 57) + "..." : r;
+  } catch (const py::error_already_set&) {
+    return "a " + std::string(py::str(py::type::of(value).attr("__name__")));
+  }
+}
+
+/// True and False, NumPy's included: never a number here.
+bool isBool(const py::handle& value) {
+  if (PyBool_Check(value.ptr())) return true;
+  const py::handle type = py::type::of(value);
+  const std::string name = py::str(type.attr("__name__"));
+  return (name == "bool_" || name == "bool") &&
+         std::string(py::str(type.attr("__module__"))) == "numpy";
+}
+
+[[noreturn]] void refuse(const std::string& name, const std::string& what,
+                         const py::handle& value) {
+  throw InputError(name + ": must be " + what + ", got " + shortRepr(value));
+}
+
+/// The number `value` holds (int, float, a NumPy number; not a bool, not a
+/// string), else nullopt.
+std::optional<double> numberOf(const py::handle& value) {
+  if (isBool(value) || !PyNumber_Check(value.ptr())) return std::nullopt;
+  const double v = PyFloat_AsDouble(value.ptr());  // int beyond a double: OverflowError
+  if (v == -1.0 && PyErr_Occurred()) {
+    PyErr_Clear();
+    return std::nullopt;
+  }
+  return v;
+}
+
+/// The one check of a number argument: a number within `range` (the range of
+/// the command's flag, core/number_range.h), else InputError naming it:
+/// "tolerance: must be a finite number from 0 to 1, got '0.1'".
+double numberArg(const py::handle& value, const NumberRange& range, const std::string& name) {
+  const std::optional<double> v = numberOf(value);
+  if (!v || !range.contains(*v)) refuse(name, range.ToString(), value);
+  return *v;
+}
+
+/// numberArg for a setting whose 0 means "not given" (`unset` says what 0 is).
+double numberOrZeroArg(const py::handle& value, const NumberRange& range, const std::string& name,
+                       const std::string& unset) {
+  const std::optional<double> v = numberOf(value);
+  if (v && *v == 0) return 0;
+  if (!v || !range.contains(*v)) refuse(name, "0 (" + unset + ") or " + range.ToString(), value);
+  return *v;
+}
+
+/// A whole number from `min` to `max` (4.0 taken, as the flags take "4.0";
+/// 4.5, NaN and True refused).
+int wholeArg(const py::handle& value, double min, double max, const std::string& name) {
+  return int(numberArg(value, NumberRange{min, max, false, true}, name));
+}
+
+/// A seed: a whole number from 0 to 2^64 - 1, exactly (as --seed).
+uint64_t seedArg(const py::handle& value, const std::string& name) {
+  const char* what = "a whole number from 0 to 18446744073709551615";
+  if (isBool(value) || !PyIndex_Check(value.ptr())) refuse(name, what, value);
+  const py::int_ seed = py::reinterpret_steal<py::int_>(PyNumber_Index(value.ptr()));
+  if (!seed) throw py::error_already_set();
+  if (seed < py::int_(0) || seed > py::int_(std::numeric_limits<uint64_t>::max())) {
+    refuse(name, what, value);
+  }
+  return seed.cast<uint64_t>();
+}
+
+/// `value` when it is one of `choices`. @throws InputError naming `name`.
+const std::string& checkChoice(const std::string& value, std::initializer_list<const char*> choices,
+                               const std::string& name) {
+  std::string list;
+  for (const char* c : choices) {
+    if (value == c) return value;
+    list += std::string(list.empty() ? "'" : ", '") + c + "'";
+  }
+  throw InputError(name + ": must be one of " + list + ", got '" + value + "'");
+}
+
+bool boolArg(const py::handle& value, const std::string& name) {
+  if (!isBool(value)) refuse(name, "True or False", value);
+  return PyObject_IsTrue(value.ptr()) == 1;
+}
+
+std::string textArg(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<py::str>(value)) refuse(name, "a string", value);
+  return value.cast<std::string>();
+}
+
+/// A number of VDLs as --vdls takes it: 1 to kMaxVdls or "auto", as a
+/// number or as text ("" where `empty` says what it means).
+std::string vdlsArg(const py::handle& value, const std::string& name, const char* empty = nullptr) {
+  std::string text;
+  if (py::isinstance<py::int_>(value) && !isBool(value)) {
+    text = py::str(value);
+  } else if (py::isinstance<py::str>(value)) {
+    text = value.cast<std::string>();
+  } else {
+    text = "?";  // refused below
+  }
+  if (empty && text.empty()) return text;
+  if (!vdlCountError(text).empty()) {
+    const std::string none = empty ? "'' (" + std::string(empty) + "), " : "";
+    refuse(name, none + "a whole number from 1 to " + std::to_string(kMaxVdls) + " or 'auto'",
+           value);
+  }
+  return text;
+}
+
+/// A path argument: str or os.PathLike, checked as checkPathText.
+std::string pathArg(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<py::str>(value) && !py::hasattr(value, "__fspath__")) {
+    refuse(name, "a path", value);
+  }
+  const std::string path = py::str(py::module_::import("os").attr("fspath")(value));
+  checkPathText(path, name);
+  return path;
+}
+
+GridPtr readGrid(const Arg<std::string>& pathArgument) {
+  const std::string path = pathArg(pathArgument.value, "path");
   LoadedVdl loaded = readVdlGrid(path);
   auto out = std::make_shared<Grid>();
   out->grid = std::move(loaded.grid);
@@ -160,8 +346,8 @@ GridPtr readGrid(const std::string& path) {
   return out;
 }
 
-py::dict inspectFile(const std::string& path) {
-  checkPathText(path, "path");
+py::dict inspectFile(const Arg<std::string>& pathArgument) {
+  const std::string path = pathArg(pathArgument.value, "path");
   const VdbReport r = inspectVdb(path);
   py::dict d;
   d["path"] = r.path;
@@ -183,9 +369,11 @@ py::dict inspectFile(const std::string& path) {
   return d;
 }
 
-GridPtr convertGrid(const Grid& in, int depth, const std::string& vdls, const std::string& scenePath) {
-  if (depth != 0) checkNumber(depth, kDepthRange, "depth");  // 0: the grid's own
-  checkPathText(scenePath, "scene");
+GridPtr convertGrid(const Grid& in, const Arg<int>& depthArg, const Arg<std::string>& vdlsValue,
+                    const Arg<std::string>& sceneArg) {
+  const int depth = int(numberOrZeroArg(depthArg.value, kDepthRange, "depth", "the grid's own"));
+  const std::string vdls = vdlsArg(vdlsValue.value, "vdls", "the grid's own");
+  const std::string scenePath = pathArg(sceneArg.value, "scene");
   ConvertParams params;
   params.depth = depth;
   params.vdls = vdls;
@@ -230,27 +418,46 @@ py::array_t<float> lookup(Grid& g, py::array_t<float, py::array::c_style | py::a
 /// The render settings the keywords select: the command line's flags by
 /// their Python names, defaults the library's (RenderSettings{}), so that
 /// `lightoctree.render` draws what `lightoctree render` draws.
-RenderSettings renderSettings(int width, int height, const std::string& mode, const py::kwargs& kw) {
+RenderSettings renderSettings(const Arg<int>& width, const Arg<int>& height,
+                              const Arg<std::string>& mode, const py::kwargs& kw) {
+  // The ranges and words of the command's flags (tools/render_options.cpp).
   RenderSettings s;
-  s.frame.width = width;
-  s.frame.height = height;
-  s.frame.mode = parseRenderMode(mode);
+  s.frame.width = wholeArg(width.value, 1, kMaxImageSide, "width");
+  s.frame.height = wholeArg(height.value, 1, kMaxImageSide, "height");
+  s.frame.mode = parseRenderMode(
+      checkChoice(textArg(mode.value, "mode"), {"full", "direct", "indirect", "voxels"}, "mode"));
   for (const auto& [key, value] : kw) {
     const std::string name = py::str(key);
-    if (name == "interpolation") s.frame.interpolation = value.cast<bool>();
-    else if (name == "specular") s.frame.specular = value.cast<bool>();
-    else if (name == "reflections") s.frame.reflections = value.cast<bool>();
-    else if (name == "lighting") s.frame.lighting = parseLighting(value.cast<std::string>());
-    else if (name == "supersample") s.frame.supersample = value.cast<int>();
-    else if (name == "vdls") s.frame.maxVdls = value.cast<int>();
-    else if (name == "area_lights") s.renderer.areaLights = value.cast<bool>();
-    else if (name == "emitter_lights") s.renderer.emitterLights = value.cast<int>();
-    else if (name == "shadow_map_size") s.renderer.shadowMapSize = value.cast<int>();
-    else if (name == "cosine_correction") s.octree.cosineCorrection = value.cast<bool>();
-    else if (name == "tolerance") s.octree.tolerance = value.cast<float>();
-    else if (name == "free_space_tolerance") s.octree.volumeTolerance = value.cast<float>();
-    else if (name == "texels") setTexels(s.octree, value.cast<std::string>());
-    else throw InputError("render: unknown setting '" + name + "'");
+    if (name == "interpolation") {
+      s.frame.interpolation = boolArg(value, name);
+    } else if (name == "specular") {
+      s.frame.specular = boolArg(value, name);
+    } else if (name == "reflections") {
+      s.frame.reflections = boolArg(value, name);
+    } else if (name == "lighting") {
+      const std::string lighting = checkChoice(textArg(value, name), {"octree", "atlas"}, name);
+      s.frame.lighting = parseLighting(lighting);
+    } else if (name == "supersample") {
+      s.frame.supersample = wholeArg(value, 1, kMaxSupersample, name);
+    } else if (name == "vdls") {
+      s.frame.maxVdls = wholeArg(value, 1, kMaxVdls, name);
+    } else if (name == "area_lights") {
+      s.renderer.areaLights = boolArg(value, name);
+    } else if (name == "emitter_lights") {
+      s.renderer.emitterLights = wholeArg(value, 0, kMaxEmitterLights, name);
+    } else if (name == "shadow_map_size") {
+      s.renderer.shadowMapSize = wholeArg(value, kMinShadowMapSize, kMaxShadowMapSize, name);
+    } else if (name == "cosine_correction") {
+      s.octree.cosineCorrection = boolArg(value, name);
+    } else if (name == "tolerance") {
+      s.octree.tolerance = float(numberArg(value, {0, 1}, name));
+    } else if (name == "free_space_tolerance") {
+      s.octree.volumeTolerance = float(numberArg(value, {0, 1}, name));
+    } else if (name == "texels") {
+      setTexels(s.octree, checkChoice(textArg(value, name), {"float", "half", "compact"}, name));
+    } else {
+      throw InputError("render: unknown setting '" + name + "'");
+    }
   }
   s.check();
   return s;
@@ -259,13 +466,14 @@ RenderSettings renderSettings(int width, int height, const std::string& mode, co
 /// The scene lit by the grid, drawn by the GL renderer (OSMesa, headless)
 /// from the scene's camera through the library's render session: linear
 /// RGB, shape (height, width, 3).
-py::array_t<float> renderImage(const std::string& scenePath, const Grid& g, int width, int height,
-                               const std::string& mode, const py::kwargs& kw) {
-  checkPathText(scenePath, "scene");
+py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Grid& g,
+                               const Arg<int>& width, const Arg<int>& height,
+                               const Arg<std::string>& mode, const py::kwargs& kw) {
+  const std::string scenePath = pathArg(sceneArg.value, "scene");
   const RenderSettings settings = renderSettings(width, height, mode, kw);
   Scene scene = loadScene(scenePath);
   RgbImage image;
-  {
+  withPythonNames([&] {  // the renderer's refusals name the flags ("--emitter-lights")
     py::gil_scoped_release unlocked;
     GlContextParams contextParams;
     contextParams.backend = GlBackend::OSMesa;
@@ -274,15 +482,16 @@ py::array_t<float> renderImage(const std::string& scenePath, const Grid& g, int 
     // The scene's first camera, else one framing its bounds from the side its
     // surfaces face (as `render`).
     image = session.render(PinholeCamera::ofScene(scene), settings.frame.mode);
-  }
-  py::array_t<float> out({size_t(height), size_t(width), size_t(3)});
+    return 0;
+  });
+  py::array_t<float> out({size_t(settings.frame.height), size_t(settings.frame.width), size_t(3)});
   std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
   return out;
 }
 
 /// An EXR (linear) or PNG (sRGB decoded) image as (height, width, 3) floats.
-py::array_t<float> readImageFile(const std::string& path) {
-  checkPathText(path, "path");
+py::array_t<float> readImageFile(const Arg<std::string>& pathArgument) {
+  const std::string path = pathArg(pathArgument.value, "path");
   const RgbImage image = readImage(path);
   py::array_t<float> out({size_t(image.height), size_t(image.width), size_t(3)});
   std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
@@ -290,89 +499,6 @@ py::array_t<float> readImageFile(const std::string& path) {
 }
 
 // ---- reference, compare, lightmap: the commands' settings and defaults ----
-
-/// A message of the commands' options code (tools/) with its flags named as
-/// the Python arguments are: "--eye and --target" -> "eye and target",
-/// "--sky-image: ..." -> "sky_image: ...".
-std::string pythonNames(const std::string& message) {
-  std::string out;
-  for (size_t i = 0; i < message.size(); ++i) {
-    if (message.compare(i, 2, "--") == 0 && i + 2 < message.size() &&
-        std::islower(static_cast<unsigned char>(message[i + 2])) &&
-        (i == 0 || !std::isalnum(static_cast<unsigned char>(message[i - 1])))) {
-      size_t j = i + 2;
-      for (; j < message.size() && (std::isalnum(static_cast<unsigned char>(message[j])) ||
-                                    message[j] == '-');
-           ++j) {
-        out += message[j] == '-' ? '_' : message[j];
-      }
-      i = j - 1;
-    } else {
-      out += message[i];
-    }
-  }
-  return out;
-}
-
-/// `work()` with an InputError of the options code reworded by pythonNames.
-template <typename Work>
-auto withPythonNames(Work work) {
-  try {
-    return work();
-  } catch (const InputError& e) {
-    throw InputError(pythonNames(e.what()));
-  }
-}
-
-/// A number argument (int or float, not bool). @throws InputError naming it.
-double numberArg(const py::handle& value, const std::string& name) {
-  if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) ||
-      !PyNumber_Check(value.ptr())) {
-    throw InputError(name + ": must be a number, got " + std::string(py::repr(value)));
-  }
-  return value.cast<double>();
-}
-
-/// A whole number in `range`, refused by its Python name as checkNumber does
-/// (a float argument, NaN and 4.5 included, is refused, not truncated).
-int wholeNumber(double value, double min, double max, const std::string& name) {
-  return int(checkNumber(value, NumberRange{min, max, false, true}, name));
-}
-
-/// `value` when it is one of `choices`. @throws InputError naming `name`.
-const std::string& checkChoice(const std::string& value, std::initializer_list<const char*> choices,
-                               const std::string& name) {
-  std::string list;
-  for (const char* c : choices) {
-    if (value == c) return value;
-    list += std::string(list.empty() ? "'" : ", '") + c + "'";
-  }
-  throw InputError(name + ": must be one of " + list + ", got '" + value + "'");
-}
-
-bool boolArg(const py::handle& value, const std::string& name) {
-  if (!py::isinstance<py::bool_>(value)) {
-    throw InputError(name + ": must be True or False, got " + std::string(py::repr(value)));
-  }
-  return value.cast<bool>();
-}
-
-std::string textArg(const py::handle& value, const std::string& name) {
-  if (!py::isinstance<py::str>(value)) {
-    throw InputError(name + ": must be a string, got " + std::string(py::repr(value)));
-  }
-  return value.cast<std::string>();
-}
-
-/// A path argument: str or os.PathLike, checked as checkPathText.
-std::string pathArg(const py::handle& value, const std::string& name) {
-  if (!py::isinstance<py::str>(value) && !py::hasattr(value, "__fspath__")) {
-    throw InputError(name + ": must be a path, got " + std::string(py::repr(value)));
-  }
-  const std::string path = py::str(py::module_::import("os").attr("fspath")(value));
-  checkPathText(path, name);
-  return path;
-}
 
 /// Three numbers, or their text "x,y,z", as the flags' text "x,y,z" that
 /// parseVec3d reads (%.17g gives every double back exactly).
@@ -401,7 +527,7 @@ SceneOptions sceneOptions(const py::object& sky, const py::object& skyImage,
   if (!skyMesh.is_none()) o.skyMesh = textArg(skyMesh, "sky_mesh");
   if (!physicalSky.is_none()) {
     // kMinTurbidity, kMaxTurbidity, as the flag's range.
-    o.physicalSky = float(checkNumber(numberArg(physicalSky, "physical_sky"), {1.7, 10.0}, "physical_sky"));
+    o.physicalSky = float(numberArg(physicalSky, {1.7, 10.0}, "physical_sky"));
   }
   if (!o.skyImage.empty() && (!o.skyMesh.empty() || o.physicalSky > 0)) {
     throw InputError(std::string(o.skyMesh.empty() ? "physical_sky" : "sky_mesh") +
@@ -418,20 +544,27 @@ SceneOptions sceneOptions(const py::object& sky, const py::object& skyImage,
 /// Python names; 0 is "not given" for photons and target_error, as their
 /// defaults. The sky keywords light the scene as the flags do (None: the
 /// file's own sky); `lightmap` needs the same ones for the same light.
-GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, double targetError,
-                  uint64_t seed, int knn, const std::string& vdls, bool includeDirect,
-                  const std::string& targetLight, const py::object& progress,
-                  const std::string& representation, const py::object& sky,
+GridPtr bakeScene(const Arg<std::string>& sceneArg, const Arg<int>& depthArg,
+                  const Arg<size_t>& photonsArg, const Arg<double>& targetErrorArg,
+                  const Arg<uint64_t>& seedArgument, const Arg<int>& knnArg,
+                  const Arg<std::string>& vdlsValue, const Arg<bool>& includeDirectArg,
+                  const Arg<std::string>& targetLightArg, const py::object& progress,
+                  const Arg<std::string>& representationArg, const py::object& sky,
                   const py::object& skyImage, const py::object& skyMesh,
                   const py::object& physicalSky) {
-  checkPathText(scenePath, "scene");
-  checkNumber(depth, kDepthRange, "depth");
-  if (photons != 0) checkNumber(double(photons), kPhotonsRange, "photons");
-  if (targetError != 0) checkNumber(targetError, kTargetErrorRange, "target_error");
-  checkNumber(knn, kKnnRange, "knn");
-  if (targetLight != "seen" && targetLight != "indirect") {
-    throw InputError("target_light must be 'seen' or 'indirect', got '" + targetLight + "'");
-  }
+  const std::string scenePath = pathArg(sceneArg.value, "scene");
+  const int depth = int(numberArg(depthArg.value, kDepthRange, "depth"));
+  const auto photons =
+      size_t(numberOrZeroArg(photonsArg.value, kPhotonsRange, "photons", "not given"));
+  const double targetError =
+      numberOrZeroArg(targetErrorArg.value, kTargetErrorRange, "target_error", "the default");
+  const uint64_t seed = seedArg(seedArgument.value, "seed");
+  const int knn = int(numberArg(knnArg.value, kKnnRange, "knn"));
+  const std::string vdls = vdlsArg(vdlsValue.value, "vdls");
+  const bool includeDirect = boolArg(includeDirectArg.value, "include_direct");
+  const std::string targetLight = checkChoice(textArg(targetLightArg.value, "target_light"),
+                                              {"seen", "indirect"}, "target_light");
+  const std::string representation = textArg(representationArg.value, "representation");
   BakeParams params;
   if (!parseRepresentation(representation, &params.representation)) {
     throw InputError("representation: must be " + representationChoices() + ", got '" +
@@ -443,7 +576,7 @@ GridPtr bakeScene(const std::string& scenePath, int depth, size_t photons, doubl
   setPhotonBudget(params, photons, targetError);
   params.seed = seed;
   params.knn = knn;
-  params.vdls = parseVdlCount(vdls);
+  params.vdls = parseVdlCount(vdls, "vdls");
   params.includeDirect = includeDirect;
   params.targetSeenLight = targetLight == "seen";
   auto out = std::make_shared<Grid>();
@@ -469,36 +602,30 @@ py::array_t<float> imageArray(const RgbImage& image) {
 
 /// `lightoctree reference`: the path tracer's picture of the scene from the
 /// camera the command chooses, with the command's defaults (ReferenceOptions).
-py::object referenceImage(const std::string& scenePath, int width, int height, int spp,
-                          const std::string& part, const py::object& seed, int maxBounces,
+py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& width,
+                          const Arg<int>& height, const Arg<int>& spp, const Arg<std::string>& part,
+                          const Arg<uint64_t>& seed, const Arg<int>& maxBounces,
                           const py::object& camera, const py::object& eye,
-                          const py::object& target, const py::object& fov,
-                          const py::object& timeBudget, bool withStdError,
+                          const py::object& target, const Arg<double>& fov,
+                          const Arg<double>& timeBudget, const Arg<bool>& withStdErrorArg,
                           const py::object& progress, const py::object& sky,
                           const py::object& skyImage, const py::object& skyMesh,
                           const py::object& physicalSky) {
   ReferenceOptions opt;  // the command's flags, as given
-  opt.scene = scenePath;
-  checkPathText(scenePath, "scene");
+  opt.scene = pathArg(sceneArg.value, "scene");
+  const bool withStdError = boolArg(withStdErrorArg.value, "std_error");
   // The ranges of the command's flags (tools/reference_options.cpp,
   // command_options.cpp, camera_options.cpp); python/tests check that both
   // refuse the same values.
-  opt.width = wholeNumber(width, 1, kMaxImageSide, "width");
-  opt.height = wholeNumber(height, 1, kMaxImageSide, "height");
-  opt.spp = wholeNumber(spp, 1, 1000000, "spp");
-  opt.maxBounces = wholeNumber(maxBounces, 0, 100000, "max_bounces");
-  opt.part = checkChoice(part, {"full", "direct", "indirect", "irradiance"}, "part");
-  if (!seed.is_none()) {
-    if (!py::isinstance<py::int_>(seed) || py::isinstance<py::bool_>(seed) ||
-        seed.cast<py::int_>() < py::int_(0) ||
-        seed.cast<py::int_>() > py::int_(std::numeric_limits<uint64_t>::max())) {
-      throw InputError("seed: must be a whole number from 0 to 18446744073709551615, got " +
-                       std::string(py::repr(seed)));
-    }
-    opt.seed = seed.cast<uint64_t>();
-  }
-  if (!timeBudget.is_none()) {
-    opt.timeBudget = checkNumber(numberArg(timeBudget, "time_budget"), {1e-3, 1e7}, "time_budget");
+  opt.width = wholeArg(width.value, 1, kMaxImageSide, "width");
+  opt.height = wholeArg(height.value, 1, kMaxImageSide, "height");
+  opt.spp = wholeArg(spp.value, 1, 1000000, "spp");
+  opt.maxBounces = wholeArg(maxBounces.value, 0, 100000, "max_bounces");
+  opt.part = checkChoice(textArg(part.value, "part"), {"full", "direct", "indirect", "irradiance"},
+                         "part");
+  if (!seed.value.is_none()) opt.seed = seedArg(seed.value, "seed");
+  if (!timeBudget.value.is_none()) {
+    opt.timeBudget = numberArg(timeBudget.value, {1e-3, 1e7}, "time_budget");
   }
   if (!camera.is_none()) opt.camera.camera = textArg(camera, "camera");
   if (!eye.is_none()) opt.camera.eye = vec3Text(eye, "eye");
@@ -506,7 +633,7 @@ py::object referenceImage(const std::string& scenePath, int width, int height, i
   if (!opt.camera.camera.empty() && !opt.camera.eye.empty()) {
     throw InputError("camera and eye: give one of them");
   }
-  if (!fov.is_none()) opt.camera.fovDegrees = float(checkNumber(numberArg(fov, "fov"), {1, 179}, "fov"));
+  if (!fov.value.is_none()) opt.camera.fovDegrees = float(numberArg(fov.value, {1, 179}, "fov"));
   opt.sceneOptions = sceneOptions(sky, skyImage, skyMesh, physicalSky);
   withPythonNames([&] {
     checkCameraOptions(opt.camera);
@@ -574,13 +701,15 @@ py::dict channelDict(const ChannelError& e) {
 }
 
 /// `lightoctree compare`: compareReport's figures as `compare --json` writes them.
-py::dict compareImagesArg(const py::object& testArg, const py::object& referenceArg, int bin,
-                          double clipPercentile, const py::object& maskArg, bool ignoreBackground,
+py::dict compareImagesArg(const py::object& testArg, const py::object& referenceArg,
+                          const Arg<int>& bin, const Arg<double>& clipPercentile,
+                          const py::object& maskArg, const Arg<bool>& ignoreBackground,
                           const py::object& referenceErrorArg) {
   CompareSettings settings;
-  settings.bin = int(checkNumber(bin, kCompareBinRange, "bin"));
-  settings.clipPercentile = float(checkNumber(clipPercentile, kClipPercentileRange, "clip_percentile"));
-  settings.ignoreBackground = ignoreBackground;
+  settings.bin = int(numberArg(bin.value, kCompareBinRange, "bin"));
+  settings.clipPercentile =
+      float(numberArg(clipPercentile.value, kClipPercentileRange, "clip_percentile"));
+  settings.ignoreBackground = boolArg(ignoreBackground.value, "ignore_background");
   std::string testPath, referencePath, maskPath, errorPath;
   const RgbImage test = imageArg(testArg, "test", false, &testPath);
   const RgbImage reference = imageArg(referenceArg, "reference", false, &referencePath);
@@ -642,11 +771,11 @@ py::dict compareImagesArg(const py::object& testArg, const py::object& reference
 /// `lightoctree lightmap`: the export with the command's settings by their
 /// flag names (snake_case), defaults those of LightmapExportParams (the
 /// command's), checked before any work as the command checks them.
-py::dict lightmapExport(const std::string& scenePath, const std::string& lightsPath,
-                        const std::string& output, const py::kwargs& kw) {
-  checkPathText(scenePath, "scene");
-  checkPathText(lightsPath, "lights");
-  checkPathText(output, "output");
+py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>& lightsArg,
+                        const Arg<std::string>& outputArg, const py::kwargs& kw) {
+  const std::string scenePath = pathArg(sceneArg.value, "scene");
+  const std::string lightsPath = pathArg(lightsArg.value, "lights");
+  const std::string output = pathArg(outputArg.value, "output");
   LightmapExportParams p;
   p.output = output;
   py::object sky = py::none(), skyImage = py::none(), skyMesh = py::none(), physicalSky = py::none();
@@ -654,21 +783,21 @@ py::dict lightmapExport(const std::string& scenePath, const std::string& lightsP
     const std::string name = py::str(key);
     // The ranges and words of the command's flags (tools/lightmap_command.cpp).
     if (name == "texel_size") {
-      p.lightmap.uv.texelSize = float(checkNumber(numberArg(value, name), kPositiveNumber, name));
+      p.lightmap.uv.texelSize = float(numberArg(value, kPositiveNumber, name));
     } else if (name == "atlas") {
-      p.lightmap.uv.atlasSize = wholeNumber(numberArg(value, name), 8, 16384, name);
+      p.lightmap.uv.atlasSize = wholeArg(value, 8, kMaxImageSide, name);
     } else if (name == "uv") {
       p.lightmap.uvSource = parseUvSource(checkChoice(textArg(value, name), {"auto", "texcoord1"}, name));
     } else if (name == "content") {
       p.content = parseAtlasContent(checkChoice(textArg(value, name), {"indirect", "full"}, name));
     } else if (name == "direct_samples") {
-      p.directSamples = wholeNumber(numberArg(value, name), 1, 65536, name);
+      p.directSamples = wholeArg(value, 1, 65536, name);
     } else if (name == "image") {
       p.rgbm = checkChoice(textArg(value, name), {"exr", "png"}, name) == "png";
     } else if (name == "preview_unlit") {
       p.preview = boolArg(value, name);
     } else if (name == "exposure") {
-      p.previewExposureEv = float(checkNumber(numberArg(value, name), {-30, 30}, name));
+      p.previewExposureEv = float(numberArg(value, {-30, 30}, name));
     } else if (name == "atlas_on") {
       const std::string on = checkChoice(textArg(value, name), {"cpu", "osmesa", "egl"}, name);
       if (on == "cpu") p.atlasGl.reset();
@@ -822,9 +951,8 @@ PYBIND11_MODULE(lightoctree, m) {
   m.def("read", &readGrid, py::arg("path"), "Reads a .vdb written by bake or convert.");
   m.def(
       "write",
-      [](const std::string& path, const Grid& g) {
-        checkPathText(path, "path");
-        writeVdlGrid(path, g.grid, g.meta);
+      [](const Arg<std::string>& path, const Grid& g) {
+        writeVdlGrid(pathArg(path.value, "path"), g.grid, g.meta);
       },
       py::arg("path"), py::arg("grid"),
       "Writes the grid as a .vdb (atomically; a grid the readers would refuse is not written).");

@@ -240,11 +240,67 @@ def test_numeric_arguments_take_what_the_flags_take(argument, flag, value, tmp_p
 
 
 def test_convert_refuses_a_depth_it_would_have_ignored(grid):
-    with pytest.raises(lightoctree.InputError, match="depth: must be a whole number from 1 to 12, got -1"):
+    with pytest.raises(lightoctree.InputError,
+                       match=r"depth: must be 0 \(the grid's own\) or a whole number from 1 to 12, got -1"):
         lightoctree.convert(grid, depth=-1)
     with pytest.raises(lightoctree.InputError, match="depth"):
         lightoctree.convert(grid, depth=13)
     assert lightoctree.convert(grid).depth == grid.depth  # 0: the grid's own
+
+
+# Every argument is checked by the module and refused by its name, whatever
+# its type: pybind11's own conversion answered a negative photons, a NaN
+# supersample or a tolerance "0.1" with a TypeError naming no argument
+# ("incompatible function arguments" and the whole signature), and took
+# True for 1. The refusal comes before any work (the scene is missing).
+@pytest.mark.parametrize("call, argument, value", [
+    ("bake", "photons", -5), ("bake", "photons", 2.5), ("bake", "photons", "1000"),
+    ("bake", "depth", True), ("bake", "depth", "4"), ("bake", "depth", 4.5),
+    ("bake", "knn", math.nan), ("bake", "knn", None), ("bake", "seed", -1), ("bake", "seed", 1.0),
+    ("bake", "seed", True), ("bake", "target_error", "0.1"), ("bake", "target_error", 1j),
+    ("bake", "include_direct", 1), ("bake", "vdls", 9), ("bake", "vdls", True),
+    ("bake", "target_light", 0), ("bake", "depth", 10 ** 400), ("bake", "scene", 3),
+    ("render", "supersample", math.nan), ("render", "supersample", True),
+    ("render", "tolerance", "0.1"), ("render", "tolerance", 1.5), ("render", "width", -1),
+    ("render", "height", 2.5), ("render", "interpolation", 1), ("render", "emitter_lights", 17),
+    ("render", "shadow_map_size", np.True_), ("render", "mode", None), ("render", "texels", 16),
+    ("reference", "spp", 2.5), ("reference", "width", True), ("reference", "std_error", "yes"),
+    ("reference", "seed", 2 ** 64), ("reference", "fov", "45"),
+    ("compare", "bin", True), ("compare", "clip_percentile", "99"),
+    ("compare", "ignore_background", 0),
+    ("convert", "depth", False), ("convert", "depth", -1.0), ("convert", "vdls", 4.0),
+    ("convert", "vdls", 9), ("convert", "vdls", "four"),
+    ("lightmap", "atlas", True), ("lightmap", "texel_size", "0.1"), ("lightmap", "chart_image", 1),
+    ("read", "path", 3), ("write", "path", None),
+])
+def test_every_argument_is_refused_by_its_name(grid, call, argument, value, tmp_path):
+    missing = str(tmp_path / "missing.gltf")
+    image = np.ones((4, 4, 3), dtype=np.float32)
+    calls = {
+        "bake": lambda **kw: lightoctree.bake(**dict(dict(scene=missing), **kw)),
+        "render": lambda **kw: lightoctree.render(missing, grid, **kw),
+        "reference": lambda **kw: lightoctree.reference(missing, **kw),
+        "compare": lambda **kw: lightoctree.compare(image, image, **kw),
+        "convert": lambda **kw: lightoctree.convert(grid, **kw),
+        "lightmap": lambda **kw: lightoctree.lightmap(missing, missing, str(tmp_path / "lit.glb"), **kw),
+        "read": lambda **kw: lightoctree.read(**kw),
+        "write": lambda **kw: lightoctree.write(grid=grid, **kw),
+    }
+    with pytest.raises(lightoctree.InputError) as refusal:
+        calls[call](**{argument: value})
+    assert str(refusal.value).startswith(argument + ": must be "), str(refusal.value)
+    assert len(str(refusal.value)) < 200, str(refusal.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_numbers_of_any_numeric_type_are_taken():
+    """What the checks take: NumPy integers and whole floats where a whole
+    number is expected (as the flags take "4.0"), a NumPy bool where a bool
+    is, the number of VDLs as a number; the bake runs with them."""
+    g = lightoctree.bake(SCENE, depth=np.int64(3), photons=2000.0, knn=np.int32(20), seed=np.uint64(3),
+                         vdls=2, include_direct=np.False_, target_error=0)
+    assert g.depth == 3 and g.max_vdls == 2 and g.stats["stored_photons"] == 2000
+    assert lightoctree.convert(g, depth=np.int8(2)).depth == 2
 
 
 def test_a_path_with_a_nul_byte_names_no_file(grid, tmp_path):
@@ -307,7 +363,7 @@ def test_reference_equals_the_command(tmp_path):
 def test_reference_defaults_are_the_commands():
     text = lightoctree.reference.__doc__
     for default in ("width: int = 800", "height: int = 600", "spp: int = 64", "part: str = 'full'",
-                    "seed: object = 1", "max_bounces: int = 256"):
+                    "seed: int = 1", "max_bounces: int = 256"):
         assert default in text, default
 
 
