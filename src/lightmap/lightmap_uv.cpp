@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "core/error.h"
+#include "image/image.h"
 #include "lightmap/atlas_pack.h"
 #include "lightmap/chart_param.h"
 
@@ -116,6 +117,47 @@ double fitOnePage(const std::vector<const FlatChart*>& charts, int usable, int g
     (fits(mid) ? hi : lo) = mid;
   }
   return hi;
+}
+
+/// The smallest value >= v with 3 significant digits: a size that, printed,
+/// still does what the message says it does.
+double roundUp3(double v) {
+  const double unit = std::pow(10.0, std::floor(std::log10(v)) - 2);
+  return std::ceil(v / unit * (1 - 1e-12)) * unit;
+}
+
+/// A triangle larger than a page at texel size t (chart of one triangle, so
+/// cutting cannot help): the flags named, with values that hold every
+/// triangle of the scene (a triangle's rectangle is no wider than its
+/// longest edge).
+InputError triangleBeyondAPage(const Scene& scene, const FlatChart& chart, double t, int size,
+                               int gutter) {
+  double extent = std::max(chart.width, chart.height);
+  for (size_t i = 0; i < scene.triangleCount(); ++i) {
+    const D3 p[3] = {D3(scene.positions[scene.indices[3 * i]]),
+                     D3(scene.positions[scene.indices[3 * i + 1]]),
+                     D3(scene.positions[scene.indices[3 * i + 2]])};
+    for (int k = 0; k < 3; ++k) extent = std::max(extent, length(p[k] - p[(k + 1) % 3]));
+  }
+  // A page of `s` holds a rectangle of chartTexels + gutter <= s - gutter.
+  auto fits = [&](double texel, int s) {
+    return chartTexels(extent, texel, uvMargin(s)) + 2 * gutter <= s;
+  };
+  double texel = roundUp3(extent / (size - 2 * gutter - 2 * uvMargin(size)));
+  while (!fits(texel, size)) texel = roundUp3(texel * 1.001);
+  std::ostringstream os;
+  os << "triangle " << chart.triangles[0] << " of " << sceneName(scene) << " alone spans "
+     << std::ceil(std::max(chart.width, chart.height) / t) << " texels at a texel size of " << t
+     << " scene units (--texel-size; the default is a quarter voxel), more than a page of --atlas "
+     << size << " holds with its gutter of " << gutter << " texels: use --texel-size " << texel
+     << " or larger";
+  const double side = std::ceil(extent / t + 2 * uvMargin(size)) + 2 * gutter;
+  if (side <= double(kMaxImageSide)) {  // --atlas takes up to the largest texture side
+    int atlas = int(side);
+    while (!fits(t, atlas)) ++atlas;
+    os << ", or --atlas " << atlas << " or larger";
+  }
+  return InputError(os.str());
 }
 
 // Squared L2 stretch sum and areas of one triangle's UVs (scaled by `scale`).
@@ -244,14 +286,7 @@ LightmapUvs LightmapCharts::pack(const LightmapUvParams& params) {
           next.push_back(c);
           continue;
         }
-        if (c->triangles.size() < 2) {
-          std::ostringstream os;
-          os << "LightmapUvParams.texelSize: " << params.texelSize << " is too small for "
-             << sceneName(scene) << ": triangle " << c->triangles[0] << " alone spans "
-             << std::ceil(c->width / t) << " texels, more than a page of " << size
-             << " with gutter " << gutter;
-          throw InputError(os.str());
-        }
+        if (c->triangles.size() < 2) throw triangleBeyondAPage(scene, *c, t, size, gutter);
         for (FlatChart& piece : flattener.splitInHalves(c->triangles, params.chartConeDegrees)) {
           pieces.push_back(std::move(piece));
           next.push_back(&pieces.back());

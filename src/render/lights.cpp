@@ -54,6 +54,30 @@ GpuLight punctualLight(const Light& light, const RenderSpace& space) {
   return l;
 }
 
+/// Why the lights do not fit in the shader's LO_MAX_LIGHTS, and what helps:
+/// a flag where one lowers the count, the scene itself where its punctual
+/// lights alone exceed it (no flag of `render` or `view` drops them).
+InputError tooManyLights(const Scene& scene, size_t emitters, bool areaLights) {
+  const std::string sceneSource = scene.sourcePath.empty() ? "the scene" : scene.sourcePath;
+  const size_t punctual = scene.lights.size();
+  const std::string most = std::to_string(kMaxLights);
+  if (punctual > size_t(kMaxLights)) {
+    return InputError(sceneSource + " has " + std::to_string(punctual) +
+                      " punctual lights; the GL renderer draws at most " + most +
+                      " lights: keep at most " + most +
+                      " in the scene file (bake and reference take any number)");
+  }
+  const size_t left = size_t(kMaxLights) - punctual;
+  const std::string room = std::to_string(left) + (left > 0 ? " or fewer" : "");
+  const std::string what = std::to_string(punctual) + " punctual lights and " +
+                           std::to_string(emitters) +
+                           (areaLights ? " area lights (emissive triangles)" : " emitter lights");
+  return InputError(sceneSource + " has " + what + ", more than the " + most +
+                    " lights the GL renderer draws: " +
+                    (areaLights ? "use --area-lights off with --emitter-lights " + room
+                                : "use --emitter-lights " + room));
+}
+
 }  // namespace
 
 int SceneLights::shadowLayersOf(int type) {
@@ -90,9 +114,7 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
   }
   lights.insert(lights.end(), emitters.begin(), emitters.end());
   if (lights.size() > size_t(kMaxLights)) {
-    throw InputError("scene has " + std::to_string(lights.size()) +
-                     " punctual + emitter lights; the renderer draws at most " +
-                     std::to_string(kMaxLights) + " (lower --emitter-lights)");
+    throw tooManyLights(scene, emitters.size(), !area.lights.empty());
   }
 
   // Shadow map layers: 6 per point light / emitter VPL (cube faces), 1 per

@@ -417,10 +417,35 @@ TEST(LightmapUv, BadParametersNameTheField) {
   p = {};
   p.maxStretch = 0.5f;
   expectError(p, "maxStretch");
-  p = {};
+}
+
+// A triangle larger than a page at the texel size: the command's flags are
+// named (it named LightmapUvParams.texelSize), and each value the message
+// advises holds every triangle.
+TEST(LightmapUv, ATriangleBeyondAPageNamesTheFlagsAndValuesThatHold) {
+  const Scene scene = unitCube();
+  LightmapUvParams p;
   p.atlasSize = 64;
   p.texelSize = 0.001f;  // one triangle of the unit cube spans 1000 texels
-  expectError(p, "texelSize");
+  std::string what;
+  try {
+    buildLightmapUvs(scene, p);
+    ADD_FAILURE() << "built";
+  } catch (const InputError& e) {
+    what = e.what();
+  }
+  EXPECT_NE(what.find("at a texel size of 0.001 scene units (--texel-size"), std::string::npos)
+      << what;
+  EXPECT_NE(what.find("more than a page of --atlas 64"), std::string::npos) << what;
+  const size_t texelAt = what.find("use --texel-size "), atlasAt = what.find("or --atlas ");
+  ASSERT_NE(texelAt, std::string::npos) << what;
+  ASSERT_NE(atlasAt, std::string::npos) << what;
+  LightmapUvParams texel = p;
+  texel.texelSize = std::stof(what.substr(texelAt + 17));
+  EXPECT_GE(buildLightmapUvs(scene, texel).pageCount, 1);
+  LightmapUvParams atlas = p;
+  atlas.atlasSize = std::stoi(what.substr(atlasAt + 11));
+  EXPECT_GE(buildLightmapUvs(scene, atlas).pageCount, 1);
 }
 
 // ---------------------------------------------------------------------------
