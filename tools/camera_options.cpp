@@ -18,18 +18,22 @@ void addCameraOptions(CLI::App* cmd, CameraOptions& opt) {
       ->check(numberIn({1, 179}));
 }
 
-Vec3d parseVec3d(const std::string& text, const char* flag) {
+Vec3d parseThreeNumbers(const std::string& text, const char* flag) {
   Vec3d v;
   char c1 = 0, c2 = 0;
   std::istringstream is(text);
   if (!(is >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !is.eof() ||
-      !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) ||
-      !isFinite(v.toVec3())) {
+      !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
     throw InputError(std::string(flag) + ": expected three numbers x,y,z, got '" + text + "'");
   }
+  return v;
+}
+
+Vec3d parseVec3d(const std::string& text, const char* flag) {
+  const Vec3d v = parseThreeNumbers(text, flag);
   if (std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) > double(kMaxCoordinate)) {
-    throw InputError(std::string(flag) + ": '" + text + "' lies beyond 1e12 scene units from "
-                     "the origin (kMaxCoordinate), where no scene reaches");
+    throw InputError(std::string(flag) + ": '" + text +
+                     "' lies beyond 1e12 scene units from the origin, where no scene reaches");
   }
   return v;
 }

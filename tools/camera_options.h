@@ -29,7 +29,11 @@ void addCameraOptions(CLI::App* cmd, CameraOptions& opt);
 /// pairing and syntax). @throws InputError naming the flag.
 void checkCameraOptions(const CameraOptions& opt);
 
-/// "x,y,z" -> Vec3. @throws InputError naming `flag`.
+/// "x,y,z" -> three finite numbers, any size (a radiance, a scale).
+/// @throws InputError naming `flag`.
+Vec3d parseThreeNumbers(const std::string& text, const char* flag);
+/// "x,y,z" -> a position within kMaxCoordinate of the origin.
+/// @throws InputError naming `flag`.
 Vec3 parseVec3(const std::string& text, const char* flag);
 /// The same in double (world positions, before Scene::toLocal).
 Vec3d parseVec3d(const std::string& text, const char* flag);

@@ -80,13 +80,16 @@ namespace {
 Scene applySkyFlags(const std::string& path, const SceneOptions& opt) {
   Vec3 sky{0, 0, 0};
   if (!opt.sky.empty()) {
-    sky = parseVec3(opt.sky, "--sky");
-    for (int c = 0; c < 3; ++c) {
-      if (!std::isfinite(sky[c]) || sky[c] < 0 || sky[c] > kMaxRadiance) {
+    // A radiance, not a position: its range is kMaxRadiance's, in double
+    // before it becomes a float (3.5e38 would be one's infinity).
+    const Vec3d given = parseThreeNumbers(opt.sky, "--sky");
+    for (const double c : {given.x, given.y, given.z}) {
+      if (!(c >= 0 && c <= double(kMaxRadiance))) {
         throw InputError("--sky: '" + opt.sky +
                          "' is not a radiance (three numbers from 0 to 1e9, W/(m^2 sr))");
       }
     }
+    sky = given.toVec3();
   }
   std::shared_ptr<const Texture> image;
   if (!opt.skyImage.empty()) {
