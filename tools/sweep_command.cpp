@@ -44,7 +44,7 @@ int runSweepCommand(const SweepOptions& opt) {
   ConsoleProgress progress(opt.quiet);
   params.progress = &progress;
   // A results folder: an existing one is reused; a new one needs its parent.
-  if (!std::filesystem::is_directory(opt.out)) checkOutputFolder(opt.out, "--out");
+  checkResultsFolder(opt.out, "--out");
   // Its tables, pictures, plot data and cache take names of their own
   // (src/sweep): a folder holding a file the scene reads is not one.
   const NamedPaths inputs = sceneInputs(opt.scene);

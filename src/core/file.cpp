@@ -440,7 +440,34 @@ void checkOutputFolder(const std::string& path, const char* flag) {
   }
 }
 
+namespace {
+
+/// @throws InputError when `path` exists as anything but a folder (or a link to one).
+void requireFolderIfPresent(const std::string& path, const char* flag) {
+  std::error_code ec;
+  const fs::file_status s = fs::status(path, ec);  // through links
+  if (ec || s.type() == fs::file_type::not_found || s.type() == fs::file_type::directory) return;
+  throw InputError(std::string(flag) + ": '" + path + "' is " +
+                   (s.type() == fs::file_type::regular ? std::string("a regular file")
+                                                       : file_internal::describe(s)) +
+                   ", not a folder: " + flag +
+                   " names the folder the files are written into (give a new name or a folder)");
+}
+
+}  // namespace
+
+void checkResultsFolder(const std::string& path, const char* flag) {
+  requireFolderIfPresent(path, flag);
+  if (!fs::is_directory(path)) {
+    checkOutputFolder(path, flag);  // a new folder: its parent exists and takes it
+  } else if (::access(path.c_str(), W_OK | X_OK) != 0) {
+    throw InputError(std::string(flag) + ": folder '" + path +
+                     "' is not writable: " + std::strerror(errno));
+  }
+}
+
 void makeOutputFolder(const std::string& path, const char* flag) {
+  requireFolderIfPresent(path, flag);
   std::error_code ec;
   fs::create_directories(path, ec);
   if (!fs::is_directory(path)) {

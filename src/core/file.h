@@ -69,10 +69,19 @@ void checkOutputName(const std::string& path, const char* flag);
 /// anything but a regular file. Called by commands before any long work.
 void checkOutputFolder(const std::string& path, const char* flag);
 
+/// @brief A folder a command writes its files into (`sweep --out`): one that
+/// exists is written into, a new one is made in a folder that exists.
+/// @throws InputError naming `flag` when `path` exists as anything but a
+/// folder (or a link to one), "--out: 'r.md' is a regular file, not a folder:
+/// --out names the folder the files are written into", when the folder is
+/// not writable, or when a new one cannot be made (checkOutputFolder).
+void checkResultsFolder(const std::string& path, const char* flag);
+
 /// @brief Creates the folder `path` (and its parents) when missing.
 /// @throws InputError naming `flag` and the cause when it cannot be created
-/// or `path` is something other than a folder. Called by commands that
-/// write many files into one folder, before any long work.
+/// or `path` is something other than a folder (named as checkResultsFolder
+/// names it). Called by commands that write many files into one folder,
+/// before any long work.
 void makeOutputFolder(const std::string& path, const char* flag);
 
 /// @brief A command's files, each with the flag that named it.
