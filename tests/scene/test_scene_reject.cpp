@@ -50,6 +50,36 @@ TEST_F(SceneReject, MissingExternalBuffer) {
   expectInputError(path, "holds 67108864 bytes where its byteLength says");
 }
 
+// A data: URI buffer whose bytes are not its byteLength: tinygltf's refusal
+// quoted the URI (megabytes of base64 in a real file); now the buffer is
+// named with both sizes, and the URI is not in the message.
+TEST_F(SceneReject, ADataUriOfAnotherLengthIsNamedNotQuoted) {
+  const MiniGltf g = oneTriangle();
+  const std::string good = g.json();
+  EXPECT_EQ(loadScene(write("good.gltf", good)).triangleCount(), 1u);
+  const std::string length = "\"byteLength\": " + std::to_string(g.blob().size()) + ", \"uri\"";
+  const size_t at = good.find(length);
+  ASSERT_NE(at, std::string::npos) << good;
+  for (const uint64_t claimed : {uint64_t(1) << 62, uint64_t(g.blob().size() + 3)}) {
+    SCOPED_TRACE(claimed);
+    std::string json = good;
+    json.replace(at, length.size(), "\"byteLength\": " + std::to_string(claimed) + ", \"uri\"");
+    const std::string path = write("lying.gltf", json);
+    try {
+      loadScene(path);
+      ADD_FAILURE() << "loaded";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("buffer 0: its data URI holds " + std::to_string(g.blob().size()) +
+                          " bytes where its byteLength says " + std::to_string(claimed)),
+                std::string::npos)
+          << what;
+      EXPECT_EQ(what.find("base64,"), std::string::npos) << what;
+      EXPECT_LT(what.size(), 400u) << what;
+    }
+  }
+}
+
 TEST_F(SceneReject, TrianglesBeyondMemoryAreCountedBeforeBuilt) {
   // Twenty nodes instancing a mesh of 1e8 triangles (an accessor without a
   // buffer view: zeros, as glTF allows): 2e9 triangles, refused from the
