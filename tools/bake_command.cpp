@@ -79,8 +79,11 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   DistributedStats distributed;
   TileParams tiles;
   tiles.tilesPerAxis = opt.tiles == "auto" ? 0 : std::stoi(opt.tiles);
-  BakeResult baked = comm ? distributedBake(scene, params, tiles, *comm, &progress, &distributed)
-                          : bake(scene, params, &progress);
+  // The names as given (machines may differ in their working folders).
+  const std::string outputNames = opt.output + '\n' + opt.statsJson;
+  BakeResult baked =
+      comm ? distributedBake(scene, params, tiles, *comm, &progress, &distributed, outputNames)
+           : bake(scene, params, &progress);
   if (rank != 0) return 0;
   rows.insert(rows.end(), baked.stats.stages.begin(), baked.stats.stages.end());
   const std::string missed = photonBudgetWarning(params, baked.stats);

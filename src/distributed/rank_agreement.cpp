@@ -171,19 +171,27 @@ uint64_t sceneFingerprint(const Scene& scene) {
 }
 
 void checkRanksAgree(const Scene& scene, const BakeParams& params, const TileParams& tiles,
-                     Communicator& comm) {
+                     Communicator& comm, const std::string& outputs) {
   if (comm.size() < 2) return;
   const std::vector<uint64_t> settings = comm.allgather(bakeSettingsFingerprint(params, tiles));
   const std::vector<uint64_t> scenes = comm.allgather(sceneFingerprint(scene));
+  Fingerprint outputNames;
+  outputNames.bytes(outputs.data(), outputs.size());
+  const std::vector<uint64_t> written = comm.allgather(outputNames.value());
   const std::string settingsDiffer = ranksThatDiffer(settings);
   const std::string scenesDiffer = ranksThatDiffer(scenes);
-  if (settingsDiffer.empty() && scenesDiffer.empty()) return;
+  const std::string outputsDiffer = ranksThatDiffer(written);
+  if (settingsDiffer.empty() && scenesDiffer.empty() && outputsDiffer.empty()) return;
   std::string message = "the ranks of this bake do not agree:";
   if (!settingsDiffer.empty()) {
     message += " the settings of rank(s) " + settingsDiffer + " differ from rank 0's;";
   }
   if (!scenesDiffer.empty()) {
     message += " the scene read by rank(s) " + scenesDiffer + " differs from rank 0's;";
+  }
+  if (!outputsDiffer.empty()) {
+    message += " the output files (-o, --stats-json) given to rank(s) " + outputsDiffer +
+               " differ from rank 0's, which rank 0 alone writes;";
   }
   message += " every rank must run the same command on the same scene (one mpirun command line, "
              "the scene's files the same on every machine)";

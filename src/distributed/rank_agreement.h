@@ -8,6 +8,8 @@
 /// gave exit 0 and a grid mixed from both. Now every rank refuses, with one
 /// message naming what differs and which ranks.
 
+#include <string>
+
 #include "bake/bake.h"
 #include "distributed/communicator.h"
 #include "distributed/tiled_bake.h"
@@ -23,10 +25,12 @@ uint64_t bakeSettingsFingerprint(const BakeParams& params, const TileParams& til
 /// triangles, their materials, the lights and the sky.
 uint64_t sceneFingerprint(const Scene& scene);
 
-/// Every rank calls it with its own settings and scene; returns when all
-/// agree. @throws InputError on every rank (the same message) when a rank's
-/// settings or scene differ from rank 0's.
+/// Every rank calls it with its own settings, scene and `outputs` (the
+/// files rank 0 writes, as this rank was told: ranks given another -o saw
+/// rank 0's written without a word); returns when all agree.
+/// @throws InputError on every rank (the same message) when a rank's
+/// settings, scene or outputs differ from rank 0's.
 void checkRanksAgree(const Scene& scene, const BakeParams& params, const TileParams& tiles,
-                     Communicator& comm);
+                     Communicator& comm, const std::string& outputs = {});
 
 }  // namespace lo

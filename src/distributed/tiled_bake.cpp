@@ -645,10 +645,11 @@ class RankBake {
 }  // namespace distributed_internal
 
 BakeResult distributedBake(const Scene& scene, const BakeParams& requested, const TileParams& tiles,
-                           Communicator& comm, ProgressSink* progress, DistributedStats* stats) {
+                           Communicator& comm, ProgressSink* progress, DistributedStats* stats,
+                           const std::string& outputs) {
   // First, so that a rank whose own settings would be refused below does not
   // refuse alone while the others wait for it.
-  checkRanksAgree(scene, requested, tiles, comm);
+  checkRanksAgree(scene, requested, tiles, comm, outputs);
   if (requested.targetError > 0) {
     throw InputError("--target-error: the distributed bake (mpirun) traces a fixed photon "
                      "budget; give --photons");

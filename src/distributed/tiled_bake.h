@@ -136,10 +136,12 @@ struct DistributedStats {
 /// metadata, stats); the other ranks return an empty grid. The grid is the
 /// one bake() returns, value for value. @throws InputError as bake() does,
 /// and for BakeParams::keepPhotons (the map is spread over the ranks) or a
-/// bad tile count.
+/// bad tile count. `outputs` names what rank 0 will write, as this rank was
+/// told (the command's -o and side files): the ranks compare it with their
+/// settings and scene (checkRanksAgree) before any work.
 BakeResult distributedBake(const Scene& scene, const BakeParams& params, const TileParams& tiles,
                            Communicator& comm, ProgressSink* progress = nullptr,
-                           DistributedStats* stats = nullptr);
+                           DistributedStats* stats = nullptr, const std::string& outputs = {});
 
 // ---------------------------------------------------------------------------
 

@@ -3,7 +3,7 @@
 # bytes of `mpirun -np N lightoctree bake` equal those of the one-process
 # bake for N = 1, 2, 3, 4, on the Cornell box and the dragon; a rank killed
 # mid-bake makes mpirun exit non-zero and leaves no output file; ranks started
-# with different settings refuse together.
+# with different settings or output names refuse together.
 # Usage: mpirun_test.sh MPIEXEC LIGHTOCTREE SHARED_SCENES OUTPUT_DIR
 set -euo pipefail
 MPIEXEC=$1 CLI=$2 SCENES=$3 OUT=$4
@@ -63,6 +63,22 @@ if [ $rc -ne 0 ] && [ ! -e "$OUT/disagree.vdb" ] &&
 else
   echo "FAIL: ranks with different settings: mpirun exited $rc"
   cat "$OUT/disagree.log"
+  failures=$((failures + 1))
+fi
+# Ranks given different output names: rank 0 alone writes, so the other's
+# name was dropped without a word; now every rank refuses, neither written.
+set +e
+"${MPI[@]}" -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" -o "$OUT/rank0.vdb" -q \
+  --depth 4 --photons 3000 : -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" \
+  -o "$OUT/rank1.vdb" -q --depth 4 --photons 3000 >"$OUT/outputs.log" 2>&1
+rc=$?
+set -e
+if [ $rc -ne 0 ] && [ ! -e "$OUT/rank0.vdb" ] && [ ! -e "$OUT/rank1.vdb" ] &&
+   grep -q "the output files (-o, --stats-json) given to rank(s) 1 differ" "$OUT/outputs.log"; then
+  echo "ok: ranks given different -o: mpirun exits $rc, the rank named, no output file"
+else
+  echo "FAIL: ranks given different -o: mpirun exited $rc"
+  cat "$OUT/outputs.log"
   failures=$((failures + 1))
 fi
 exit $failures

@@ -249,10 +249,13 @@ TEST(TiledBake, RanksThatDisagreeRefuseTogether) {
   other.photons = 3000;
   struct Case {
     const char* what;
-    bool otherSettings, otherScene;
+    bool otherSettings, otherScene, otherOutput;
   };
-  for (const Case& c : {Case{"settings", true, false}, Case{"scene", false, true},
-                        Case{"settings and scene", true, true}}) {
+  // An output name is what rank 0 alone writes: a rank given another saw
+  // rank 0's written without a word.
+  for (const Case& c : {Case{"settings", true, false, false}, Case{"scene", false, true, false},
+                        Case{"settings and scene", true, true, false},
+                        Case{"output", false, false, true}}) {
     SCOPED_TRACE(c.what);
     std::vector<std::string> messages(3);
     std::mutex mutex;
@@ -262,7 +265,8 @@ TEST(TiledBake, RanksThatDisagreeRefuseTogether) {
                                   try {
                                     distributedBake(odd && c.otherScene ? moved : scene,
                                                     odd && c.otherSettings ? other : params,
-                                                    TileParams{}, comm);
+                                                    TileParams{}, comm, nullptr, nullptr,
+                                                    odd && c.otherOutput ? "b.vdb" : "a.vdb");
                                   } catch (const InputError& e) {
                                     std::lock_guard<std::mutex> lock(mutex);
                                     messages[size_t(comm.rank())] = e.what();
@@ -282,6 +286,7 @@ TEST(TiledBake, RanksThatDisagreeRefuseTogether) {
     EXPECT_NE(said.find("rank(s) 2"), std::string::npos) << said;
     EXPECT_EQ(said.find("settings") != std::string::npos, c.otherSettings) << said;
     EXPECT_EQ(said.find("scene read") != std::string::npos, c.otherScene) << said;
+    EXPECT_EQ(said.find("output files") != std::string::npos, c.otherOutput) << said;
   }
   // Agreeing ranks bake.
   EXPECT_GT(bakeOnThreadRanks(scene, params, 3, 0).result.grid.size(), 0u);
