@@ -159,36 +159,52 @@ def embedded_buffer(data):
             "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}
 
 
-def write_sunlit_scene(out, generator, materials, quads, sun, camera, scene_extras):
-    """Writes a glTF of the quads (one mesh per material, buffer embedded),
-    a 3 W/m^2 directional sun at (elevation, azimuth) degrees (sun_rotation),
-    a camera (eye, target, yfov, znear) and the scene's extras."""
-    data, views, accessors, meshes, nodes = mesh_nodes(materials, quads)
-    nodes.append({"name": "sun", "rotation": sun_rotation(*sun),
-                  "extensions": {"KHR_lights_punctual": {"light": 0}}})
+def write_gltf(out, generator, parts, materials, camera, extensions_used, lights=None,
+               scene_extras=None):
+    """Writes a glTF of mesh_nodes' parts (buffer embedded), its materials
+    (glTF material objects), a camera node (eye, target, yfov, znear) after
+    the parts' nodes, and KHR_lights_punctual `lights` (their nodes already
+    among the parts')."""
+    data, views, accessors, meshes, nodes = parts
     eye, target, yfov, znear = camera
     nodes.append({"name": "camera", "camera": 0, "translation": list(eye),
                   "rotation": camera_rotation(eye, target)})
-    gltf = {
-        "asset": {"version": "2.0", "generator": generator},
-        "extensionsUsed": ["KHR_lights_punctual"],
-        "extensions": {"KHR_lights_punctual": {"lights": [
-            {"type": "directional", "name": "sun", "color": [1.0, 0.95, 0.85], "intensity": 3.0}]}},
+    gltf = {"asset": {"version": "2.0", "generator": generator},
+            "extensionsUsed": list(extensions_used)}
+    if lights:
+        gltf["extensions"] = {"KHR_lights_punctual": {"lights": lights}}
+    scene = {"nodes": list(range(len(nodes)))}
+    if scene_extras is not None:
+        scene["extras"] = scene_extras
+    gltf.update({
         "scene": 0,
-        "scenes": [{"nodes": list(range(len(nodes))), "extras": scene_extras}],
+        "scenes": [scene],
         "nodes": nodes,
         "meshes": meshes,
-        "materials": [{"name": name, "pbrMetallicRoughness": {
-            "baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}
-            for name, color in materials],
+        "materials": materials,
         "cameras": [{"type": "perspective", "perspective": {"yfov": yfov, "znear": znear}}],
         "buffers": [embedded_buffer(data)],
         "bufferViews": views,
         "accessors": accessors,
-    }
+    })
     with open(out, "w") as f:
         json.dump(gltf, f, indent=1)
         f.write("\n")
+
+
+def write_sunlit_scene(out, generator, materials, quads, sun, camera, scene_extras):
+    """Writes a glTF of the quads (one mesh per material, buffer embedded),
+    a 3 W/m^2 directional sun at (elevation, azimuth) degrees (sun_rotation),
+    a camera (eye, target, yfov, znear) and the scene's extras."""
+    parts = mesh_nodes(materials, quads)
+    parts[4].append({"name": "sun", "rotation": sun_rotation(*sun),
+                     "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    gltf_materials = [{"name": name, "pbrMetallicRoughness": {
+        "baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}
+        for name, color in materials]
+    sun_light = {"type": "directional", "name": "sun", "color": [1.0, 0.95, 0.85], "intensity": 3.0}
+    write_gltf(out, generator, parts, gltf_materials, camera, ["KHR_lights_punctual"],
+               lights=[sun_light], scene_extras=scene_extras)
 
 
 def main():

@@ -22,11 +22,10 @@ The file stands alone (base64 data: URI); stdlib only.
 Usage: python3 tools/make_emissive_cubes.py [output.gltf]
 """
 
-import json
 import os
 import sys
 
-from make_courtyard import box_faces, camera_rotation, embedded_buffer, mesh_nodes
+from make_courtyard import box_faces, mesh_nodes, write_gltf
 
 
 def main():
@@ -51,10 +50,7 @@ def main():
     for material, (x, z) in ((3, (-1.0, -0.6)), (4, (0.7, -0.9)), (5, (-0.2, 0.5))):
         for face in box_faces((x - 0.15, 0, z - 0.15), (x + 0.15, 0.3, z + 0.15)):
             quads.append((material, face))
-    data, views, accessors, meshes, nodes = mesh_nodes([(m[0], m[1]) for m in materials], quads)
-    eye, target = (0.6, 1.6, 3.2), (-0.1, 0.3, -0.6)
-    nodes.append({"name": "camera", "camera": 0, "translation": list(eye),
-                  "rotation": camera_rotation(eye, target)})
+    parts = mesh_nodes([(m[0], m[1]) for m in materials], quads)
     gltf_materials = []
     for name, color, emission in materials:
         m = {"name": name, "pbrMetallicRoughness": {
@@ -63,23 +59,8 @@ def main():
             m["emissiveFactor"] = list(emission[0])
             m["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": emission[1]}}
         gltf_materials.append(m)
-    gltf = {
-        "asset": {"version": "2.0", "generator": "tools/make_emissive_cubes.py"},
-        "extensionsUsed": ["KHR_materials_emissive_strength"],
-        "scene": 0,
-        "scenes": [{"nodes": list(range(len(nodes)))}],
-        "nodes": nodes,
-        "meshes": meshes,
-        "materials": gltf_materials,
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.05}}],
-        "buffers": [embedded_buffer(data)],
-        "bufferViews": views,
-        "accessors": accessors,
-    }
-    with open(out, "w") as f:
-        json.dump(gltf, f, indent=1)
-        f.write("\n")
-
+    write_gltf(out, "tools/make_emissive_cubes.py", parts, gltf_materials,
+               ((0.6, 1.6, 3.2), (-0.1, 0.3, -0.6), 0.8, 0.05), ["KHR_materials_emissive_strength"])
 
 if __name__ == "__main__":
     main()

@@ -24,11 +24,10 @@ data: URI); stdlib only.
 Usage: python3 tools/make_tabletop.py [output.gltf]
 """
 
-import json
 import os
 import sys
 
-from make_courtyard import box_faces, camera_rotation, embedded_buffer, mesh_nodes
+from make_courtyard import box_faces, camera_rotation, mesh_nodes, write_gltf
 
 
 def main():
@@ -69,13 +68,11 @@ def main():
     for i, material in enumerate((7, 8, 9)):
         x0 = 0.0 + 0.04 * i
         quads.append((material, ((x0, mat_top, -0.07), (0.04, 0, 0), (0, 0.1, 0))))
-    data, views, accessors, meshes, nodes = mesh_nodes([(m[0], m[1]) for m in materials], quads)
+    parts = mesh_nodes([(m[0], m[1]) for m in materials], quads)
     spot, aim = (0.05, 0.6, 0.25), (0.0, 0.0, -0.02)
-    nodes.append({"name": "spot", "translation": list(spot), "rotation": camera_rotation(spot, aim),
-                  "extensions": {"KHR_lights_punctual": {"light": 0}}})
-    eye, target = (0.14, 0.17, 0.3), (0.0, 0.025, -0.02)
-    nodes.append({"name": "camera", "camera": 0, "translation": list(eye),
-                  "rotation": camera_rotation(eye, target)})
+    parts[4].append({"name": "spot", "translation": list(spot),
+                     "rotation": camera_rotation(spot, aim),
+                     "extensions": {"KHR_lights_punctual": {"light": 0}}})
     gltf_materials = []
     for name, color, extra in materials:
         m = {"name": name, "pbrMetallicRoughness": {
@@ -84,27 +81,12 @@ def main():
         if "extensions" in extra:
             m["extensions"] = extra["extensions"]
         gltf_materials.append(m)
-    gltf = {
-        "asset": {"version": "2.0", "generator": "tools/make_tabletop.py"},
-        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_transmission",
-                           "KHR_materials_volume", "KHR_materials_ior"],
-        "extensions": {"KHR_lights_punctual": {"lights": [{
-            "type": "spot", "name": "spot", "color": [1.0, 0.95, 0.88], "intensity": 3.0,
-            "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.4}}]}},
-        "scene": 0,
-        "scenes": [{"nodes": list(range(len(nodes)))}],
-        "nodes": nodes,
-        "meshes": meshes,
-        "materials": gltf_materials,
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}],
-        "buffers": [embedded_buffer(data)],
-        "bufferViews": views,
-        "accessors": accessors,
-    }
-    with open(out, "w") as f:
-        json.dump(gltf, f, indent=1)
-        f.write("\n")
-
+    spot_light = {"type": "spot", "name": "spot", "color": [1.0, 0.95, 0.88], "intensity": 3.0,
+                  "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.4}}
+    write_gltf(out, "tools/make_tabletop.py", parts, gltf_materials,
+               ((0.14, 0.17, 0.3), (0.0, 0.025, -0.02), 0.6, 0.01),
+               ["KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_volume",
+                "KHR_materials_ior"], lights=[spot_light])
 
 if __name__ == "__main__":
     main()
