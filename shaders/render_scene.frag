@@ -167,6 +167,9 @@ vec3 behindAlong(vec3 q, vec3 d) {
   return behind / uExposureScale;
 }
 
+// Thick glass followed through the solid: compiled into the programs of a
+// scene that has a volume (LO_VOLUMES, Renderer::Impl::buildSceneProgram).
+#ifdef LO_VOLUMES
 // Where render-space point x falls in the frame: uv in [0, 1], window depth;
 // false when it is behind the camera or off the frame.
 bool windowPoint(vec3 x, out vec3 w) {
@@ -258,6 +261,7 @@ bool volumeExit(vec3 p, vec3 t, out vec3 exitPoint, out vec3 m) {
   exitPoint = p + t * min(best, 1e29);
   return best < 1e29;
 }
+#endif  // LO_VOLUMES
 
 // Light through a transmissive surface (KHR_materials_transmission), tinted
 // by the base colour and weighted by the Fresnel transmittance of each
@@ -271,9 +275,10 @@ vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
   // across the pixel (a sphere: 1 / its radius; a pane: 0).
   float curvature = max(length(dFdx(n)) / max(length(dFdx(vPosition)), 1e-9),
                         length(dFdy(n)) / max(length(dFdy(vPosition)), 1e-9));
-  vec3 exitPoint, m;
   vec3 t = refract(-v, n, 1.0 / ior);
   if (dot(t, t) == 0.0) t = -v;
+#ifdef LO_VOLUMES
+  vec3 exitPoint, m;
   if (uThickness > 0.0 && uHasVolumeBacks && curvature * uThickness < 0.25 &&
       volumeExit(vPosition, t, exitPoint, m)) {
     // A volume flat here (a block, a slab) whose back faces this frame drew:
@@ -302,6 +307,7 @@ vec3 transmittedLight(vec3 n, vec3 v, vec3 baseColor) {
     if (carried > 0.0) light += carried * behindMarched(p, t);
     return uTransmission * baseColor * light;
   }
+#endif  // LO_VOLUMES
   if (uThickness <= 0.0 || curvature * uThickness < 0.25) {
     // Thin-walled (glTF without KHR_materials_volume), or a volume whose
     // surface is flat on the scale of its thickness (a pane, a table top):

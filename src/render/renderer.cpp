@@ -79,11 +79,11 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.space.bounds.extend(r.space.toRender(world.upper));
   r.space.sceneSize = std::max(length(r.space.bounds.extent()), 1e-3f);
   r.sky = scene.sky.radiance;
-  r.sceneProgram =
-      GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT"}));
+  for (const Material& m : scene.materials) r.volumes |= m.transmission > 0 && m.thickness > 0;
+  r.sceneProgram = GlProgram(r.buildSceneProgram({"LO_DIRECT_LIGHT"}));
   glUniformBlockBinding(r.sceneProgram.get(),
                         glGetUniformBlockIndex(r.sceneProgram.get(), "LightBlock"), 0);
-  r.sceneIndirectProgram = GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}));
+  r.sceneIndirectProgram = GlProgram(r.buildSceneProgram({}));
   r.depthProgram = GlProgram(buildProgram({"render_depth.vert", "render_depth.frag"}));
   if (maxComponent(r.sky) > 0) {
     r.skyProgram = GlProgram(buildProgram({"render_fullscreen.vert", "render_sky.frag"}));
@@ -234,12 +234,11 @@ void Renderer::setFreeSpaceLight(const GpuOctree& volume) {
   Impl& r = *impl_;
   OctreeTextures::checkLimits(volume, r.params.max3DTextureSize, r.params.max2DTextureSize);
   if (!r.sceneMovingProgram) {
-    r.sceneMovingProgram = GlProgram(
-        buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_DIRECT_LIGHT", "LO_FREE_SPACE"}));
+    r.sceneMovingProgram = GlProgram(r.buildSceneProgram({"LO_DIRECT_LIGHT", "LO_FREE_SPACE"}));
     glUniformBlockBinding(r.sceneMovingProgram.get(),
                           glGetUniformBlockIndex(r.sceneMovingProgram.get(), "LightBlock"), 0);
     r.sceneIndirectMovingProgram =
-        GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_FREE_SPACE"}));
+        GlProgram(r.buildSceneProgram({"LO_FREE_SPACE"}));
   }
   r.volumeTextures.upload(volume);
   r.volumeOrigin = r.space.toRender(volume.origin);
@@ -347,7 +346,9 @@ void compileAllShaders() {
            {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"},
            {"LO_ATLAS_LIGHTING"},
            {"LO_DIRECT_LIGHT", "LO_FREE_SPACE"},
-           {"LO_FREE_SPACE"}}) {
+           {"LO_FREE_SPACE"},
+           {"LO_DIRECT_LIGHT", "LO_VOLUMES"},
+           {"LO_VOLUMES"}}) {
     const GlProgram program(buildProgram({"render_scene.vert", "render_scene.frag"}, defines));
   }
 }

@@ -181,6 +181,14 @@ struct Renderer::Impl {
   /// The scene pass in two variants: with the direct light compiled in (full,
   /// direct) and without it (indirect, voxels), so the octree-only modes do
   /// not pay for the lights' code on a software rasterizer.
+  /// The scene has a volume (KHR_materials_volume with transmission): its
+  /// programs are built with LO_VOLUMES, the glass followed through the
+  /// solid (render_scene.frag); without, that code is left out (the software
+  /// rasteriser's compile time follows the shader's size).
+  bool volumes = false;
+  /// The scene program's files built with `defines`, plus LO_VOLUMES where
+  /// the scene has a volume.
+  GLuint buildSceneProgram(std::vector<std::string> defines) const;
   render_internal::GlProgram sceneProgram, sceneIndirectProgram;
   /// The same two with the atlas lookup compiled in place of the octree's
   /// (LO_ATLAS_LIGHTING), built on the first atlas frame.

@@ -203,18 +203,22 @@ void Renderer::Impl::copyBehind(int width, int height, bool floatTarget) {
   checkGl("copying the opaque image for transmissive surfaces");
 }
 
+GLuint Renderer::Impl::buildSceneProgram(std::vector<std::string> defines) const {
+  if (volumes) defines.push_back("LO_VOLUMES");
+  return buildProgram({"render_scene.vert", "render_scene.frag"}, defines);
+}
+
 /// The scene program for a frame: with or without the direct light, with
 /// the octree's lookup or the atlas's (built on first use).
 GLuint Renderer::Impl::sceneProgramFor(const RenderParams& rp, bool withDirect) {
   const bool atlasProgram = rp.lighting == Lighting::Atlas && !probe.capturing &&
                             rp.mode != RenderMode::Voxels && atlasVbo;
   if (atlasProgram && !sceneAtlasProgram) {
-    sceneAtlasProgram = GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"},
-                                               {"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"}));
+    sceneAtlasProgram = GlProgram(buildSceneProgram({"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"}));
     glUniformBlockBinding(sceneAtlasProgram.get(),
                           glGetUniformBlockIndex(sceneAtlasProgram.get(), "LightBlock"), 0);
     sceneIndirectAtlasProgram =
-        GlProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, {"LO_ATLAS_LIGHTING"}));
+        GlProgram(buildSceneProgram({"LO_ATLAS_LIGHTING"}));
   }
   const GlProgram& p = atlasProgram ? (withDirect ? sceneAtlasProgram : sceneIndirectAtlasProgram)
                                     : (withDirect ? sceneProgram : sceneIndirectProgram);
