@@ -453,6 +453,17 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
                        "it out (" + formatNumber(kDefaultRadiusVoxels) + " voxels) or give at least " +
                        formatNumber(kMinRadiusVoxels * float(h)));
     }
+    // A radius beyond the grid's cube gathers every photon for every voxel
+    // (and 1e19 scene units made rays Embree aborts on).
+    const double cube = double(h) * double(1 << params.depth);
+    if (params.radius > 0 && !(double(params.radius) <= cube)) {
+      throw InputError("--radius " + formatNumber(params.radius) + " exceeds the grid's cube (" +
+                       formatNumber(float(cube)) + " scene units at --depth " +
+                       std::to_string(params.depth) +
+                       "): the gather would read every photon for every voxel; leave it out (" +
+                       formatNumber(kDefaultRadiusVoxels) + " voxels) or give at most " +
+                       formatNumber(float(cube)));
+    }
   }
   checkBakeMemory(scene, params, processes);
   return params;

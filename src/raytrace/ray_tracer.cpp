@@ -194,8 +194,25 @@ bool RayTracer::intersectFromCamera(const Vec3& org, const Vec3& dir, Hit& hit) 
   return true;
 }
 
+namespace {
+
+/// Embree asserts on a ray whose origin or direction has a coordinate beyond
+/// +-1.844e18 (its FLT_LARGE) or not finite (RayK::valid; Debian builds it
+/// with assertions): such a ray, which extreme settings can make (a gather
+/// radius of 1e19 scene units), meets nothing here instead of aborting.
+bool traceable(const Vec3& org, const Vec3& dir, float tmin, float tmax) {
+  constexpr float kLargest = 1.8e18f;
+  const auto within = [](const Vec3& v) {
+    return std::fabs(v.x) <= kLargest && std::fabs(v.y) <= kLargest && std::fabs(v.z) <= kLargest;
+  };
+  return within(org) && within(dir) && tmin <= tmax;
+}
+
+}  // namespace
+
 bool RayTracer::trace(const Vec3& org, const Vec3& dir, Hit& hit, float tmin, float tmax,
                       bool fromCamera) const {
+  if (!traceable(org, dir, tmin, tmax)) return false;
   TracingContext context;
   rtcInitIntersectContext(&context.embree);
   context.fromCamera = fromCamera;
@@ -225,6 +242,7 @@ bool RayTracer::trace(const Vec3& org, const Vec3& dir, Hit& hit, float tmin, fl
 }
 
 bool RayTracer::occluded(const Vec3& org, const Vec3& dir, float tmax) const {
+  if (!traceable(org, dir, 0.0f, tmax)) return false;
   TracingContext context;
   rtcInitIntersectContext(&context.embree);
   RTCRay ray;

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -68,6 +69,10 @@ RgbImage renderEdgeMask(const Scene& scene, const PinholeCamera& camera,
     throw InputError("edge mask: distance " + std::to_string(distance) +
                      " must be finite and positive");
   }
+  // Beyond the scene's diagonal every hit lies within the distance of every
+  // edge: the mask is the same, and the probes stay where rays can go.
+  const Bounds3 bounds = scene.bounds();
+  if (!bounds.empty()) distance = std::min(distance, 2.0f * length(bounds.extent()) + 1e-30f);
   RayTracer tracer(scene);
   constexpr int kDirections = 16;
   const float lift = distance / 50.0f, dropLift = distance / 20.0f;

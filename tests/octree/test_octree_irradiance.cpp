@@ -358,6 +358,10 @@ TEST(FirstHit, EdgeMaskMarksTheHitsNearAnEdge) {
   EXPECT_GT(near, 40);
   EXPECT_GT(far, 800);
   EXPECT_THROW(renderEdgeMask(scene, camera, params, 0.0f), InputError);
+  // Beyond the scene's size every hit is near an edge: all ones, where 1e19
+  // scene units made probes Embree aborted on.
+  const RgbImage all = renderEdgeMask(scene, camera, params, 1e19f);
+  for (size_t i = 0; i < all.pixelCount(); ++i) ASSERT_EQ(all.at(i).x, 1.0f) << "pixel " << i;
 }
 
 }  // namespace

@@ -73,5 +73,25 @@ TEST(RayTracerAlpha, BlendStopsAlphaOfTheRays) {
   EXPECT_EQ(hits, occluded) << "closest-hit and shadow rays agree ray by ray";
 }
 
+// Rays Embree cannot take (a coordinate of the origin or the direction
+// beyond its +-1.8e18, or not finite) meet nothing; they aborted the process
+// inside Embree (a gather radius of 1e19). A ray within them still hits.
+TEST(RayTracer, RaysBeyondWhatEmbreeTakesMeetNothing) {
+  Scene scene = test::oneMaterialScene();
+  test::addQuad(scene, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 0);
+  const RayTracer tracer(scene);
+  Hit hit;
+  ASSERT_TRUE(tracer.intersect({0, 0, 1}, {0, 0, -1}, hit, 10.0f));
+  ASSERT_TRUE(tracer.occluded({0, 0, 1}, {0, 0, -1}, 10.0f));
+  const float huge = 1e19f, nan = std::nanf("");
+  for (const Vec3& org : {Vec3{0, 0, huge}, Vec3{nan, 0, 1}, Vec3{0, 0, INFINITY}}) {
+    EXPECT_FALSE(tracer.intersect(org, {0, 0, -1}, hit, INFINITY));
+    EXPECT_FALSE(tracer.occluded(org, {0, 0, -1}, INFINITY));
+  }
+  EXPECT_FALSE(tracer.intersect({0, 0, 1}, {0, 0, -huge}, hit, INFINITY));
+  EXPECT_FALSE(tracer.occluded({0, 0, 1}, {0, 0, -huge}, INFINITY));
+  EXPECT_FALSE(tracer.occluded({0, 0, 1}, {nan, 0, -1}, 10.0f));
+}
+
 }  // namespace
 }  // namespace lo
