@@ -952,7 +952,9 @@ PYBIND11_MODULE(lightoctree, m) {
   m.def(
       "write",
       [](const Arg<std::string>& path, const Grid& g) {
-        writeVdlGrid(pathArg(path.value, "path"), g.grid, g.meta);
+        const std::string file = pathArg(path.value, "path");
+        checkOutputFile(file, "path", ".vdb");
+        writeVdlGrid(file, g.grid, g.meta);
       },
       py::arg("path"), py::arg("grid"),
       "Writes the grid as a .vdb (atomically; a grid the readers would refuse is not written).");

@@ -29,9 +29,9 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   BakeOptions opt = options;
   // Only rank 0 reports and writes; the others bake their tiles in silence.
   opt.quiet = opt.quiet || rank != 0;
-  checkOutputFolder(opt.output, "--output");
-  if (!opt.photonMap.empty()) checkOutputFolder(opt.photonMap, "--photon-map");
-  if (!opt.statsJson.empty()) checkOutputFolder(opt.statsJson, "--stats-json");
+  checkOutputFile(opt.output, "--output", ".vdb");
+  if (!opt.photonMap.empty()) checkOutputFile(opt.photonMap, "--photon-map", ".vdb");
+  if (!opt.statsJson.empty()) checkOutputFile(opt.statsJson, "--stats-json", ".json");
   checkDistinctFiles(
       {{"--output", opt.output}, {"--photon-map", opt.photonMap}, {"--stats-json", opt.statsJson}},
       sceneInputs(opt.scene, opt.sceneOptions));

@@ -40,7 +40,7 @@ int runCompare(const CompareOptions& opt) {
       throw InputError("--diff: '" + opt.diff + "' must end in .png or .exr");
     }
   }
-  if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
+  if (!opt.json.empty()) checkOutputFile(opt.json, "--json", ".json");
   checkDistinctFiles({{"--diff", opt.diff}, {"--json", opt.json}},
                      {{"TEST", opt.test},
                       {"REFERENCE", opt.reference},

@@ -80,8 +80,8 @@ void addConvertOptions(CLI::App* cmd, ConvertOptions& opt) {
 }
 
 int runConvert(const ConvertOptions& opt) {
-  checkOutputFolder(opt.output, "--output");
-  if (!opt.json.empty()) checkOutputFolder(opt.json, "--json");
+  checkOutputFile(opt.output, "--output", ".vdb");
+  if (!opt.json.empty()) checkOutputFile(opt.json, "--json", ".json");
   NamedPaths inputs{{"IN", opt.input}};
   if (!opt.scene.empty()) {
     const NamedPaths scene = sceneInputs(opt.scene, "--scene");

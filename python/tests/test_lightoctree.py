@@ -64,6 +64,15 @@ def test_write_read_and_inspect_round_trip(grid, tmp_path):
     assert {"vdl_sum", "unit_directions", "readable"} <= {c["name"] for c in report["checks"]}
 
 
+def test_write_refuses_a_name_that_is_not_a_vdb(grid, tmp_path):
+    # A scene named as the output was replaced by a grid without a word.
+    scene = tmp_path / "scene.gltf"
+    scene.write_text("{}")
+    with pytest.raises(lightoctree.InputError, match=r"^path: '.*scene.gltf' must end in .vdb"):
+        lightoctree.write(str(scene), grid)
+    assert scene.read_text() == "{}"
+
+
 def test_convert_to_a_coarser_depth_keeps_the_light(grid):
     coarse = lightoctree.convert(grid, depth=3)
     assert coarse.depth == 3 and 0 < coarse.size < grid.size

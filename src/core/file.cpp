@@ -546,6 +546,13 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
+void checkOutputFile(const std::string& path, const char* flag, const char* extension) {
+  if (!hasExtension(path, extension)) {
+    throw InputError(std::string(flag) + ": '" + path + "' must end in " + extension);
+  }
+  checkOutputFolder(path, flag);
+}
+
 bool hasExtension(const std::string& path, const char* extension) {
   std::string want(extension);
   std::transform(want.begin(), want.end(), want.begin(),

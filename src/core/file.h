@@ -69,6 +69,12 @@ void checkOutputName(const std::string& path, const char* flag);
 /// anything but a regular file. Called by commands before any long work.
 void checkOutputFolder(const std::string& path, const char* flag);
 
+/// @brief checkOutputFolder, and that `path` ends in `extension` (".vdb",
+/// any case): a scene, texture or buffer named as an output was replaced by
+/// a grid or a report without a word.
+/// @throws InputError naming `flag`: "--output: 'scene.gltf' must end in .vdb".
+void checkOutputFile(const std::string& path, const char* flag, const char* extension);
+
 /// @brief A folder a command writes its files into (`sweep --out`): one that
 /// exists is written into, a new one is made in a folder that exists.
 /// @throws InputError naming `flag` when `path` exists as anything but a
