@@ -75,4 +75,19 @@ fi
 LIGHTOCTREE_MEMORY_LIMIT=8G "$cli" bake "$scene" -o "$out/ok.vdb" --depth 5 --photons 100000 --quiet ||
   fail "LIGHTOCTREE_MEMORY_LIMIT=8G: the bake failed"
 
+# 4. A file-size limit (ulimit -f) smaller than the output: the write fails
+#    with its cause and exit 1, the earlier file kept, no temporary left (the
+#    signal ended the bake and left its temporary file).
+cp "$out/small.vdb" "$out/keep.vdb"
+before=$(cksum <"$out/keep.vdb")
+err=$(bash -c "ulimit -f 16; exec '$cli' bake '$scene' -o '$out/keep.vdb' --depth 4 --photons 20000 --quiet" 2>&1)
+rc=$?
+if [ "$rc" -ne 1 ] || ! grep -q "File too large" <<<"$err"; then
+  fail "ulimit -f: exit $rc: $err"
+fi
+[ "$(cksum <"$out/keep.vdb")" = "$before" ] || fail "ulimit -f: the earlier file changed"
+if ls -a "$out" | grep -q "^\.keep\.vdb\..*\.tmp$"; then
+  fail "ulimit -f: a temporary file was left: $(ls -a "$out")"
+fi
+
 [ "$failed" -eq 0 ] && echo "environment: every case refused or reported"

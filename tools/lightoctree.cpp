@@ -1,5 +1,6 @@
 // lightoctree: the command-line front end. Parses, calls the stages, reports.
 
+#include <csignal>
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -129,6 +130,10 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   holdClosedStandardStreams();
+  // Past the file-size limit (ulimit -f) a write fails with EFBIG, reported
+  // as any failed write with its temporary file removed, instead of the
+  // signal ending the process and leaving the temporary behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     return finishOutput(run(argc, argv));
   } catch (const std::bad_alloc&) {
