@@ -369,6 +369,30 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
       metaValue<openvdb::Vec3s>(path, m, "region_min", false, openvdb::Vec3s(INFINITY)));
   meta.region.upper = fromVdb(
       metaValue<openvdb::Vec3s>(path, m, "region_max", false, openvdb::Vec3s(-INFINITY)));
+  // Values the commands rely on, refused when another tool left them out of
+  // range: a NaN bound let a depth the voxels do not have through (convert
+  // then wrote a grid of the wrong size), a NaN radius was copied on.
+  if (!(meta.radius >= 0) || !std::isfinite(meta.radius)) {
+    throw InputError(path + ": file metadata 'radius' = " + std::to_string(meta.radius) +
+                     " is not a finite radius >= 0");
+  }
+  if (meta.photons < 0 || meta.emittedPaths < 0) {
+    throw InputError(path + ": file metadata 'photons' or 'emitted_paths' is negative");
+  }
+  for (const auto& [bounds, name] : {std::pair<const Bounds3*, const char*>{&meta.sceneBounds,
+                                                                             "scene_bounds"},
+                                     {&meta.region, "region"}}) {
+    const Vec3 &lo = bounds->lower, &hi = bounds->upper;
+    const bool empty = lo.x == INFINITY && lo.y == INFINITY && lo.z == INFINITY &&
+                       hi.x == -INFINITY && hi.y == -INFINITY && hi.z == -INFINITY;
+    const bool ordered = std::isfinite(lo.x) && std::isfinite(lo.y) && std::isfinite(lo.z) &&
+                         std::isfinite(hi.x) && std::isfinite(hi.y) && std::isfinite(hi.z) &&
+                         lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z;
+    if (!empty && !ordered) {
+      throw InputError(path + ": file metadata '" + name + "_min' and '" + name +
+                       "_max' are not finite bounds with min <= max");
+    }
+  }
   return meta;
 }
 

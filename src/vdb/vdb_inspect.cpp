@@ -159,11 +159,21 @@ class VdlChecker {
     return parseRepresentation(typed->value(), &r) ? shTermsOf(r) : -1;
   }
 
-  int readMaxVdls() const {
-    auto m = (*f_.meta)[vdb_internal::kMetaMaxVdls];
-    auto typed = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m);
-    return typed ? typed->value() : -1;
+  /// An integer of the file metadata, of either width (as the readers take
+  /// it: pyopenvdb writes Python ints as int64); -1 when missing or not an
+  /// integer.
+  int readInt(const char* key) const {
+    auto m = (*f_.meta)[key];
+    if (auto narrow = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m)) return narrow->value();
+    if (auto wide = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(m)) {
+      return wide->value() >= 0 && wide->value() <= std::numeric_limits<int32_t>::max()
+                 ? int(wide->value())
+                 : -1;
+    }
+    return -1;
   }
+
+  int readMaxVdls() const { return readInt(vdb_internal::kMetaMaxVdls); }
 
   bool checkContract(int maxVdls) {
     std::string problems;
@@ -181,7 +191,7 @@ class VdlChecker {
     const bool maxVdlsValid = maxVdls >= 1 && maxVdls <= kMaxVdls;
     if (!maxVdlsValid) {
       problems = "file metadata max_vdls is " +
-                 (maxVdls < 0 ? std::string("missing or not int32") : std::to_string(maxVdls)) +
+                 (maxVdls < 0 ? std::string("missing or not an integer") : std::to_string(maxVdls)) +
                  ", expected 1.." + std::to_string(kMaxVdls);
     }
     const int shTerms = readShTerms();
@@ -218,12 +228,11 @@ class VdlChecker {
       add("format_version", true, "absent: a file written before format_version 1 (read as 1)");
       return;
     }
-    auto typed = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m);
-    if (!typed) {
-      add("format_version", false, "has type " + m->typeName() + ", expected int32");
+    const int v = readInt(vdb_internal::kMetaFormatVersion);
+    if (v < 0) {
+      add("format_version", false, "has type " + m->typeName() + ", expected an integer");
       return;
     }
-    const int v = typed->value();
     add("format_version", v >= 1 && v <= kVdlFormatVersion,
         std::to_string(v) + " (this lightoctree reads 1.." + std::to_string(kVdlFormatVersion) +
             ")");

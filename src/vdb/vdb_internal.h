@@ -29,6 +29,8 @@ struct Damage {
   /// Every float metadata written as a double and every vec3s as a vec3d, as
   /// pyopenvdb writes a file back.
   bool doubleMetadata = false;
+  /// Every int32 metadata written as an int64, as pyopenvdb writes Python ints.
+  bool wideIntegers = false;
 };
 
 /// writeVdlGrid with damage applied (same metadata, same temp + rename).

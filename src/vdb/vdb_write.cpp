@@ -291,12 +291,18 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
     fileMeta.removeMeta(kMetaDepth);
     fileMeta.insertMeta(kMetaDepth, openvdb::Int32Metadata(damage->metadataDepth));
   }
-  if (damage && damage->doubleMetadata) {
+  if (damage && (damage->doubleMetadata || damage->wideIntegers)) {
     openvdb::MetaMap wide;
     for (auto it = fileMeta.beginMeta(); it != fileMeta.endMeta(); ++it) {
-      if (auto f = openvdb::DynamicPtrCast<openvdb::FloatMetadata>(it->second)) {
+      auto f = openvdb::DynamicPtrCast<openvdb::FloatMetadata>(it->second);
+      auto v = openvdb::DynamicPtrCast<openvdb::Vec3SMetadata>(it->second);
+      if (!damage->doubleMetadata) f = nullptr, v = nullptr;
+      if (f) {
         wide.insertMeta(it->first, openvdb::DoubleMetadata(double(f->value())));
-      } else if (auto v = openvdb::DynamicPtrCast<openvdb::Vec3SMetadata>(it->second)) {
+      } else if (auto i = openvdb::DynamicPtrCast<openvdb::Int32Metadata>(it->second);
+                 i && damage->wideIntegers) {
+        wide.insertMeta(it->first, openvdb::Int64Metadata(int64_t(i->value())));
+      } else if (v) {
         const openvdb::Vec3s x = v->value();
         wide.insertMeta(it->first, openvdb::Vec3DMetadata(openvdb::Vec3d(x.x(), x.y(), x.z())));
       } else {

@@ -532,6 +532,52 @@ TEST(VdbIo, FloatMetadataOfEitherWidthIsRead) {
   EXPECT_TRUE(inspectVdb(dir + "/python.vdb").ok());
 }
 
+// pyopenvdb writes every Python int as an int64: such a file is read by
+// every reader and passes inspect (inspect failed it, "expected int32",
+// while render and convert took it).
+TEST(VdbIo, IntegerMetadataOfEitherWidthPassesInspect) {
+  const std::string dir = test::outputDir("VdbIo.WideIntegers");
+  vdb_internal::Damage python;
+  python.wideIntegers = true;
+  vdb_internal::writeVdlGridDamaged(dir + "/python.vdb", floorGrid(), metaWithBounds(), python);
+  LoadedVdl back;
+  ASSERT_NO_THROW(back = readVdlGrid(dir + "/python.vdb"));
+  EXPECT_EQ(back.grid.maxVdls, floorGrid().maxVdls);
+  const VdbReport report = inspectVdb(dir + "/python.vdb");
+  for (const VdbCheck& c : report.checks) EXPECT_TRUE(c.passed) << c.name << ": " << c.detail;
+}
+
+// Metadata another tool left out of range are refused by every reader and
+// failed by inspect, naming the key: a NaN bound let a depth the voxels do
+// not have through (convert then wrote a grid of the wrong size), a NaN or
+// negative radius was copied on by convert.
+TEST(Inspect, MetadataOutOfRangeAreRefusedNamingTheKey) {
+  const std::string dir = test::outputDir("Inspect.MetadataRange");
+  struct Case {
+    const char* name;
+    const char* key;
+    void (*edit)(BakeMetadata&);
+  };
+  const Case cases[] = {
+      {"radius-nan", "'radius'", [](BakeMetadata& m) { m.radius = std::nanf(""); }},
+      {"radius-negative", "'radius'", [](BakeMetadata& m) { m.radius = -1.0f; }},
+      {"bounds-nan", "'scene_bounds_min'",
+       [](BakeMetadata& m) { m.sceneBounds.upper = Vec3(std::nanf("")); }},
+      {"bounds-reversed", "'scene_bounds_min'",
+       [](BakeMetadata& m) { std::swap(m.sceneBounds.lower, m.sceneBounds.upper); }},
+      {"photons-negative", "'photons'", [](BakeMetadata& m) { m.photons = -5; }},
+  };
+  for (const Case& c : cases) {
+    BakeMetadata m = metaWithBounds();
+    c.edit(m);
+    const std::string path = dir + "/" + c.name + ".vdb";
+    vdb_internal::writeVdlGridDamaged(path, floorGrid(), m, {});
+    const std::string refused = readError(path);
+    EXPECT_NE(refused.find(c.key), std::string::npos) << c.name << ": " << refused;
+    EXPECT_FALSE(inspectVdb(path).ok()) << c.name;
+  }
+}
+
 // A photon map carries the hash of the scene it was traced in; a reader
 // given another scene is told (convert --photon-map --scene).
 TEST(PhotonPoints, CarryTheirScenesHash) {
