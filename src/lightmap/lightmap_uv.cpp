@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "core/error.h"
+#include "core/resources.h"
 #include "image/image.h"
 #include "lightmap/atlas_pack.h"
 #include "lightmap/chart_param.h"
@@ -273,6 +274,15 @@ LightmapUvs LightmapCharts::pack(const LightmapUvParams& params) {
   out.texelSize = params.texelSize;
 
   double t = params.texelSize;
+  const Bounds3 bounds = scene.bounds();
+  const double diagonal = bounds.empty() ? 0.0 : double(length(bounds.extent()));
+  if (t > 0 && diagonal > 0 && t > diagonal) {
+    // Every triangle would fall between texel centres: an all-black page.
+    throw InputError("a texel size of " + formatNumber(t) + " scene units (--texel-size) exceeds " +
+                     sceneName(scene) + " (its bounds' diagonal is " + formatNumber(diagonal) +
+                     "): no texel would cover a triangle; leave it out (a quarter voxel) or give "
+                     "a size well under the scene's");
+  }
   if (t > 0) {
     // A given texel size: charts larger than a page are cut in halves until
     // every one fits.
