@@ -90,6 +90,29 @@ void onMemoryLimit(size_t rss, size_t limit) {
   std::_Exit(1);
 }
 
+/// "--photons: '1e5' is not a whole number in digits (100000, not 1e5): see
+/// `lightoctree bake --help`" for the parser's "Could not convert: --photons
+/// = 1e5"; its own text where it is not of that form.
+std::string conversionMessage(const CLI::App& app, const std::string& parserText) {
+  const std::string prefix = "Could not convert: ";
+  const size_t equals = parserText.find(" = ");
+  if (parserText.rfind(prefix, 0) != 0 || equals == std::string::npos) return parserText;
+  const std::string flag = parserText.substr(prefix.size(), equals - prefix.size());
+  const std::string value = parserText.substr(equals + 3);
+  std::string kind = "a number", command = "lightoctree";
+  for (const CLI::App* sub : app.get_subcommands()) {
+    command = "lightoctree " + sub->get_name();
+    for (const CLI::Option* option : sub->get_options()) {
+      if (!option->check_name(flag)) continue;
+      const std::string type = option->get_type_name();
+      if (type.find("INT") != std::string::npos) {
+        kind = "a whole number in digits (100000, not 1e5 or 1.0)";
+      }
+    }
+  }
+  return flag + ": '" + value + "' is not " + kind + ": see `" + command + " --help`";
+}
+
 int run(int argc, char** argv) {
   CLI::App app{
       "Light Octree " LO_VERSION
@@ -111,6 +134,11 @@ int run(int argc, char** argv) {
   lo::tool::requireFiniteNumbers(app);  // every float flag, those with a range or not
   try {
     app.parse(argc, argv);
+  } catch (const CLI::ConversionError& e) {
+    // The parser's "Could not convert: --photons = 1e5" says neither what
+    // the flag takes nor how to write it.
+    std::fprintf(stderr, "lightoctree: error: %s\n", conversionMessage(app, e.what()).c_str());
+    return kUsageError;
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; a usage error exits 2, as command-line
     // tools do (the parser's own codes, 105-109, say nothing to a script).
