@@ -276,7 +276,7 @@ void checkParams(const BakeParams& p, int processes) {
                      std::to_string(kMaxVdls) + "]");
   }
   if (p.vdls.automatic && !(p.autoThreshold > 0 && p.autoThreshold <= 2)) {
-    throw InputError("--auto-threshold " + std::to_string(p.autoThreshold) +
+    throw InputError("--auto-threshold " + formatNumber(p.autoThreshold) +
                      " is outside (0, 2] (a chord length)");
   }
   if (!p.vdls.automatic && (p.vdls.count < 1 || p.vdls.count > kMaxVdls)) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 namespace lo {
 namespace {
@@ -164,7 +165,8 @@ ImageNoise imageNoise(const RgbImage& image, const RgbImage& stdError) {
 Vec3 channelPercentiles(const RgbImage& image, double p, const CompareParams& params) {
   checkSizes(image, image, params);
   if (!(p > 0 && p <= 100)) {
-    throw InputError("percentile " + std::to_string(p) + " is not in (0, 100]");
+    throw InputError("the clip percentile (--clip-percentile, clip_percentile) " + formatNumber(p) +
+                     " is not in (0, 100]");
   }
   std::vector<float> values[3];
   for (size_t i = 0; i < image.pixelCount(); ++i) {
