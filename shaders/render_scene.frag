@@ -115,6 +115,21 @@ vec3 indirectLight(vec3 n, vec3 v, vec3 ng, vec3 baseColor, float metallic, floa
   return indirect;
 }
 
+// A copy's texel at frame position uv (uBehind, and with glass the opaque
+// depth and the back faces), within the texels this frame wrote: the copies
+// may be larger, they only grow.
+vec4 copyTexel(sampler2D copy, vec2 uv) {
+  vec2 written = uBehindScale - 0.5 / vec2(textureSize(copy, 0));
+  return textureLod(copy, min(uv * uBehindScale, written), 0.0);
+}
+
+// The opaque image's radiance at frame position uv.
+vec3 behindAt(vec2 uv) {
+  vec3 behind = copyTexel(uBehind, uv).rgb;
+  if (uEncodeSrgb) behind = srgbDecode(behind);
+  return behind / uExposureScale;
+}
+
 // The opaque scene's radiance behind a transmissive surface along the ray
 // from q in direction d: the ray is taken to the scene's bounds (the walls
 // of a room, the probe's parallax box) and that point read from the opaque
@@ -160,11 +175,7 @@ vec3 behindAlong(vec3 q, vec3 d) {
   bool onScreen = clip.w > 0.0 && all(greaterThanEqual(uv, vec2(0.0))) &&
                   all(lessThanEqual(uv, vec2(1.0)));
   if (!onScreen && uHasProbe) return textureLod(uProbe, hit, 0.0).rgb;
-  // Within the texels this frame wrote (the copy may be larger: it only grows).
-  vec2 written = uBehindScale - 0.5 / vec2(textureSize(uBehind, 0));
-  vec3 behind = textureLod(uBehind, min(clamp(uv, vec2(0.0), vec2(1.0)) * uBehindScale, written), 0.0).rgb;
-  if (uEncodeSrgb) behind = srgbDecode(behind);
-  return behind / uExposureScale;
+  return behindAt(clamp(uv, vec2(0.0), vec2(1.0)));
 }
 
 // Thick glass followed through the solid: compiled into the programs of a
@@ -178,13 +189,6 @@ bool windowPoint(vec3 x, out vec3 w) {
   if (clip.w <= 0.0) return false;
   w = clip.xyz / clip.w * 0.5 + 0.5;
   return all(greaterThanEqual(w.xy, vec2(0.0))) && all(lessThanEqual(w.xy, vec2(1.0)));
-}
-
-// The copies' texel at frame position uv (within the texels this frame wrote:
-// the copies may be larger, they only grow).
-vec4 copyTexel(sampler2D copy, vec2 uv) {
-  vec2 written = uBehindScale - 0.5 / vec2(textureSize(copy, 0));
-  return textureLod(copy, min(uv * uBehindScale, written), 0.0);
 }
 
 // The opaque scene along the ray from q in direction d, met by marching the
@@ -215,9 +219,7 @@ vec3 behindMarched(vec3 q, vec3 d) {
         }
       }
       windowPoint(q + d * hi, w);
-      vec3 behind = copyTexel(uBehind, w.xy).rgb;
-      if (uEncodeSrgb) behind = srgbDecode(behind);
-      return behind / uExposureScale;
+      return behindAt(w.xy);
     }
     before = s;
   }

@@ -120,8 +120,6 @@ struct SceneGeometry {
   void drawDepthOnly(GLuint program, bool shadows) const;
   /// Writes the blended triangles' vertex indices into blendEbo, back to front from `eye`.
   void sortBlended(const glm::vec3& eye);
-  /// Whether a transmissive range has a volume (KHR_materials_volume).
-  bool hasVolumes() const;
   /// Draws the transmissive ranges with a volume, both sides (vao bound).
   void drawVolumes() const;
 
@@ -178,17 +176,18 @@ struct Renderer::Impl {
   /// reaches the surfaces through the octree only.
   Vec3 sky{0, 0, 0};
 
-  /// The scene pass in two variants: with the direct light compiled in (full,
-  /// direct) and without it (indirect, voxels), so the octree-only modes do
-  /// not pay for the lights' code on a software rasterizer.
   /// The scene has a volume (KHR_materials_volume with transmission): its
   /// programs are built with LO_VOLUMES, the glass followed through the
-  /// solid (render_scene.frag); without, that code is left out (the software
+  /// solid (render_scene.frag), and its frames draw the volumes' back faces
+  /// (volumeBacks); without, that code is left out (the software
   /// rasteriser's compile time follows the shader's size).
   bool volumes = false;
   /// The scene program's files built with `defines`, plus LO_VOLUMES where
   /// the scene has a volume.
   GLuint buildSceneProgram(std::vector<std::string> defines) const;
+  /// The scene pass in two variants: with the direct light compiled in (full,
+  /// direct) and without it (indirect, voxels), so the octree-only modes do
+  /// not pay for the lights' code on a software rasterizer.
   render_internal::GlProgram sceneProgram, sceneIndirectProgram;
   /// The same two with the atlas lookup compiled in place of the octree's
   /// (LO_ATLAS_LIGHTING), built on the first atlas frame.
@@ -243,10 +242,11 @@ struct Renderer::Impl {
   void ensureBehind(int width, int height, bool floatTarget);
   void copyBehind(int width, int height, bool floatTarget);
   /// Thick glass: volumeBacks at behindTexture's size (made on first use),
-  /// bound to units 14 and 15.
+  /// bound to units 14 and 15 (ensureBehind calls it).
   void ensureVolumeBacks();
   /// Copies the opaque depth and draws the volumes' back faces into
-  /// volumeBacks, the bound framebuffer then bound again.
+  /// volumeBacks (made by the ensureBehind of copyBehind just before), the
+  /// bound framebuffer then bound again.
   void drawVolumeBacks(int width, int height, const glm::mat4& viewProj, const glm::vec3& eye);
   /// One frame into the bound framebuffer: depth pre-pass, then the scene
   /// pass (opaque, masked, blended back to front, transmissive).

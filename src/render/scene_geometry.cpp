@@ -395,13 +395,6 @@ void SceneGeometry::drawDepthOnly(GLuint program, bool shadows) const {
   glActiveTexture(GL_TEXTURE0);
 }
 
-bool SceneGeometry::hasVolumes() const {
-  for (size_t i = 0; i < ranges.size(); ++i) {
-    if (rangeCategory[i] == kTransmissive && ranges[i].thickness > 0) return true;
-  }
-  return false;
-}
-
 void SceneGeometry::drawVolumes() const {
   glDisable(GL_CULL_FACE);
   for (size_t i = 0; i < ranges.size(); ++i) {

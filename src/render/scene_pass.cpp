@@ -116,7 +116,7 @@ void Renderer::Impl::ensureBehind(int width, int height, bool floatTarget) {
   glActiveTexture(GL_TEXTURE6);
   glBindTexture(GL_TEXTURE_2D, behindTexture.get());
   glActiveTexture(GL_TEXTURE0);
-  if (geometry.hasVolumes()) ensureVolumeBacks();
+  if (volumes) ensureVolumeBacks();
 }
 
 void Renderer::Impl::ensureVolumeBacks() {
@@ -170,15 +170,16 @@ void Renderer::Impl::ensureVolumeBacks() {
 void Renderer::Impl::drawVolumeBacks(int width, int height, const glm::mat4& viewProj,
                                      const glm::vec3& eye) {
   VolumeBacks& b = volumeBacks;
-  ensureVolumeBacks();
   GLint bound = 0, program = 0;
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
   glGetIntegerv(GL_CURRENT_PROGRAM, &program);
-  // The opaque depth, for the refracted ray's march (a window's depth
-  // buffer may not copy into a texture: the march then falls back).
-  glBindTexture(GL_TEXTURE_2D, b.opaqueDepth.get());
+  // The opaque depth, for the refracted ray's march, into the texture on
+  // its unit (a window's depth buffer may not copy into a texture: the
+  // march then falls back).
+  glActiveTexture(GL_TEXTURE14);
   glCopyTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 0, 0, width, height);
   b.depthCopied = glGetError() == GL_NO_ERROR;
+  glActiveTexture(GL_TEXTURE0);
   glBindFramebuffer(GL_FRAMEBUFFER, b.fbo.get());
   glDepthMask(GL_TRUE);  // before the clear, which it masks
   glDepthFunc(GL_LESS);
@@ -367,7 +368,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
       copyBehind(width, height, !encodeSrgb);
       // Thick glass: the opaque depth and the volumes' back faces, where
       // the refracted rays leave them (render_scene.frag).
-      if (geometry.hasVolumes()) {
+      if (volumes) {
         drawVolumeBacks(width, height, viewProj, eye);
         for (GLuint program : {staticProgram, movingProgram}) {
           if (!program) continue;

@@ -382,13 +382,10 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   for (const auto& [bounds, name] : {std::pair<const Bounds3*, const char*>{&meta.sceneBounds,
                                                                              "scene_bounds"},
                                      {&meta.region, "region"}}) {
-    const Vec3 &lo = bounds->lower, &hi = bounds->upper;
-    const bool empty = lo.x == INFINITY && lo.y == INFINITY && lo.z == INFINITY &&
-                       hi.x == -INFINITY && hi.y == -INFINITY && hi.z == -INFINITY;
-    const bool ordered = std::isfinite(lo.x) && std::isfinite(lo.y) && std::isfinite(lo.z) &&
-                         std::isfinite(hi.x) && std::isfinite(hi.y) && std::isfinite(hi.z) &&
-                         lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z;
-    if (!empty && !ordered) {
+    // The empty bounds a bake without bounds writes (+inf, -inf), or finite ones.
+    const bool none = bounds->lower == Vec3(INFINITY) && bounds->upper == Vec3(-INFINITY);
+    const bool ordered = isFinite(bounds->lower) && isFinite(bounds->upper) && !bounds->empty();
+    if (!none && !ordered) {
       throw InputError(path + ": file metadata '" + name + "_min' and '" + name +
                        "_max' are not finite bounds with min <= max");
     }

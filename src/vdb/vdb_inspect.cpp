@@ -159,18 +159,15 @@ class VdlChecker {
     return parseRepresentation(typed->value(), &r) ? shTermsOf(r) : -1;
   }
 
-  /// An integer of the file metadata, of either width (as the readers take
-  /// it: pyopenvdb writes Python ints as int64); -1 when missing or not an
-  /// integer.
+  /// An integer of the file metadata as the readers take it (metaInt: of
+  /// either width, pyopenvdb writes Python ints as int64); -1 when missing
+  /// or not such an integer.
   int readInt(const char* key) const {
-    auto m = (*f_.meta)[key];
-    if (auto narrow = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(m)) return narrow->value();
-    if (auto wide = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(m)) {
-      return wide->value() >= 0 && wide->value() <= std::numeric_limits<int32_t>::max()
-                 ? int(wide->value())
-                 : -1;
+    try {
+      return vdb_internal::metaInt("", *f_.meta, key, false, -1);
+    } catch (const InputError&) {
+      return -1;
     }
-    return -1;
   }
 
   int readMaxVdls() const { return readInt(vdb_internal::kMetaMaxVdls); }

@@ -294,15 +294,14 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
   if (damage && (damage->doubleMetadata || damage->wideIntegers)) {
     openvdb::MetaMap wide;
     for (auto it = fileMeta.beginMeta(); it != fileMeta.endMeta(); ++it) {
-      auto f = openvdb::DynamicPtrCast<openvdb::FloatMetadata>(it->second);
-      auto v = openvdb::DynamicPtrCast<openvdb::Vec3SMetadata>(it->second);
-      if (!damage->doubleMetadata) f = nullptr, v = nullptr;
-      if (f) {
+      const bool floats = damage->doubleMetadata, integers = damage->wideIntegers;
+      if (auto f = openvdb::DynamicPtrCast<openvdb::FloatMetadata>(it->second); f && floats) {
         wide.insertMeta(it->first, openvdb::DoubleMetadata(double(f->value())));
       } else if (auto i = openvdb::DynamicPtrCast<openvdb::Int32Metadata>(it->second);
-                 i && damage->wideIntegers) {
+                 i && integers) {
         wide.insertMeta(it->first, openvdb::Int64Metadata(int64_t(i->value())));
-      } else if (v) {
+      } else if (auto v = openvdb::DynamicPtrCast<openvdb::Vec3SMetadata>(it->second);
+                 v && floats) {
         const openvdb::Vec3s x = v->value();
         wide.insertMeta(it->first, openvdb::Vec3DMetadata(openvdb::Vec3d(x.x(), x.y(), x.z())));
       } else {
