@@ -106,7 +106,8 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->capture_default_str();
   cmd->add_option("--radius", opt.radius,
                   "Gathering radius in scene units (default: " + formatNumber(kDefaultRadiusVoxels) +
-                      " voxel sizes; at least " + formatNumber(kMinRadiusVoxels) + " of one)")
+                      " voxel sizes; at least " + formatNumber(kMinRadiusVoxels) +
+                      " of one, at most the grid's cube)")
       ->check(numberIn({1e-30, 1e30}));  // a float's range: 1e-300 would become 0, the default
   cmd->add_option("--vdls", opt.vdls,
                   "VDLs per voxel, 1-" + std::to_string(kMaxVdls) + ", or 'auto' for the fewest (up to --auto-cap) whose "
@@ -182,9 +183,9 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       ->expected(6)
       ->delimiter(',');
   cmd->add_option("--photon-map", opt.photonMap,
-                  "Also write the photons as an OpenVDB point grid for inspection");
+                  "Also write the photons as an OpenVDB point grid (a .vdb) for inspection");
   cmd->add_option("--stats-json,--json", opt.statsJson,
-                  "Write the per-stage figures as JSON (under mpirun, per rank too: time, "
+                  "Write the per-stage figures as JSON, a .json file (under mpirun, per rank too: time, "
                   "bytes sent, peak memory)");
   cmd->add_option("--tiles", opt.tiles,
                   "Under mpirun (mpirun -np N lightoctree bake ...): tiles per axis the grid is "

@@ -186,7 +186,7 @@ void addCompareOptions(CLI::App* cmd, CompareOptions& opt) {
                   "Error shown red in --diff, in the images' units (default: a quarter of the "
                   "mean reference luminance)")
       ->check(numberIn(kPositiveNumber));
-  cmd->add_option("--json", opt.json, "Write the figures as JSON for scripts");
+  cmd->add_option("--json", opt.json, "Write the figures as JSON for scripts (a .json file)");
   cmd->add_flag("-q,--quiet", opt.quiet, "Print nothing (use with --json)");
 }
 

@@ -74,7 +74,7 @@ void addConvertOptions(CLI::App* cmd, ConvertOptions& opt) {
       ->capture_default_str();
   addThreadsOption(cmd, opt.threads);
   cmd->add_option("--json", opt.json,
-                  "Also write a JSON report: the files read and written, depths, voxels, method, "
+                  "Also write a JSON report (a .json file): the files read and written, depths, voxels, method, "
                   "energy in and out (README.md, \"Scripting\")");
   cmd->add_flag("-q,--quiet", opt.quiet, "No progress or summary, only errors");
 }
