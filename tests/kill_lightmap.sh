@@ -31,6 +31,10 @@ for sig in INT TERM KILL; do
     rm -rf "$out" && cp -r "$dir/old" "$out"
     pause=$moment
     [ "$moment" = trace ] && pause=none
+    # Emptied here, not only by the child's redirection: the loop below may
+    # read the file before the child has opened it, and must not find the
+    # previous run's pause there.
+    : > "$dir/stderr"
     LIGHTOCTREE_PAUSE_SET=$pause "$cli" lightmap "$scene" "$dir/grid.vdb" -o "$out/lm.gltf" "${new[@]}" \
       2> "$dir/stderr" &
     pid=$!
