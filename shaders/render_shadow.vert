@@ -1,15 +1,14 @@
 #version 330 core
-// Shadow-map pass: world-space triangles into one layer of the shadow array.
+// Shadow-map pass: world-space triangles into one layer of the shadow array
+// (projected by render_shadow.geom, which leaves out edge-on triangles).
 layout(location = 0) in vec3 aPosition;
 layout(location = 2) in vec4 aBaseColor;  // its alpha: factor x COLOR_0 (the alpha test)
 layout(location = 5) in vec2 aUv;  // base colour UV: the alpha test of masked materials
-uniform mat4 uViewProj;
-out vec3 vWorld;
-out vec2 vUv;
-out float vBaseAlpha;
+out vec3 gWorld;
+out vec2 gUv;
+out float gBaseAlpha;
 void main() {
-  vWorld = aPosition;
-  vUv = aUv;
-  vBaseAlpha = aBaseColor.a;
-  gl_Position = uViewProj * vec4(aPosition, 1.0);
+  gWorld = aPosition;
+  gUv = aUv;
+  gBaseAlpha = aBaseColor.a;
 }

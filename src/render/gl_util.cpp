@@ -119,7 +119,7 @@ GLuint buildProgram(const std::vector<std::string>& files,
 
 std::vector<std::vector<std::string>> allPrograms() {
   return {{"render_scene.vert", "render_scene.frag"},
-          {"render_shadow.vert", "render_shadow.frag"},
+          {"render_shadow.vert", "render_shadow.geom", "render_shadow.frag"},
           {"render_depth.vert", "render_depth.frag"},
           {"render_fullscreen.vert", "render_layout_probe.frag"},
           {"render_fullscreen.vert", "render_brdf_probe.frag"},

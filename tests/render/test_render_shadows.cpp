@@ -1,6 +1,6 @@
-// The sun's shadow maps under OSMesa: no sunlight leaks into a closed room of
-// zero-thickness walls, and cascades fitted to the view resolve a small
-// shadow on a large ground.
+// Shadow maps under OSMesa: no sunlight leaks into a closed room of
+// zero-thickness walls, cascades fitted to the view resolve a small shadow on
+// a large ground, and a wall beside a lamp keeps its shadow.
 
 #include <gtest/gtest.h>
 
@@ -91,6 +91,44 @@ TEST_F(RenderImage, SunCascadesResolveASmallShadowOnALargeGround) {
   const double share = double(dark) / double(image.pixelCount());
   EXPECT_NEAR(share, 0.30, 0.04) << dark << " dark pixels";
   EXPECT_LT(between, 3 * 281) << "a penumbra wider than 3 pixels on average";
+}
+
+// A lamp 1 cm in front of a 2 m wall (one quad, its plane 1 cm from the
+// light, its corners a metre away): the floor behind the wall is dark, the
+// floor in front lit. The shadow pass leaves out triangles the light sees
+// edge-on (render_shadow.geom), judged by the triangle's nearest point, not
+// its corners: judged by its corners this wall was edge-on and let the light
+// through.
+TEST_F(RenderImage, AWallBesideALampKeepsItsShadow) {
+  Scene scene;
+  Material m;
+  m.baseColor = {0.8f, 0.8f, 0.8f};
+  scene.materials.push_back(m);
+  scene.lights.push_back(test::pointLight({0.01f, 0.5f, 0.0f}, 1.0f));
+  test::addQuad(scene, {-1, 0, -1}, {0, 0, 2}, {2, 0, 0}, {0, 1, 0}, 0);      // floor
+  test::addQuad(scene, {0, 0, -1}, {0, 1, 0}, {0, 0, 2}, {1, 0, 0}, 0);       // wall, x = 0
+  RenderParams p;
+  p.width = p.height = 64;
+  p.mode = RenderMode::Direct;
+  p.specular = false;
+  Renderer renderer(scene, test::constantOctree());
+  const std::string dir = test::outputDir("render_wall_beside_lamp");
+  // Straight down on the floor 0.3 m behind the wall and 0.3 m in front.
+  auto meanOf = [&](float x, const char* name) {
+    const PinholeCamera camera =
+        PinholeCamera::lookAt({x, 0.4f, 0.0f}, {x, 0.0f, 0.01f}, 20.0f * kPi / 180.0f);
+    const RgbImage image = renderer.render(camera, p);
+    writePng(dir + "/" + name + ".png", image, 0.0f);
+    double sum = 0;
+    for (size_t i = 0; i < image.pixelCount(); ++i) sum += image.rgb[3 * i];
+    return sum / double(image.pixelCount());
+  };
+  const double behind = meanOf(-0.3f, "behind"), front = meanOf(0.3f, "front");
+  // In front: 0.8 / pi x 1 W/sr x cos / d^2 at (0.3, 0, 0) from (0.01, 0.5, 0):
+  // d^2 = 0.334, cos = 0.5 / 0.578: about 0.66 (measured 0.655). Judged by its
+  // corners, the wall let 0.62 through behind it.
+  EXPECT_NEAR(front, 0.66, 0.05) << dir;
+  EXPECT_LT(behind, 0.01 * front) << "the lamp's light passes through the wall (" << dir << ")";
 }
 
 }  // namespace
