@@ -10,7 +10,9 @@ object under spot lights); data/emissive-cubes.gltf's three glowing cubes and
 block with no floor or walls (made here: an object lit only by its own
 emission, most of it leaving into the void); the Cornell box, and the shared
 lamp room, each lit only by a spot under its floor (made here: a light that
-reaches nothing); the enclosed game level (../shared) at depth 6 and 8. Per
+reaches nothing); the enclosed game level (../shared) at depth 6 and 8; with
+--helmet DIR, the Khronos sample DamagedHelmet alone (DIR/DamagedHelmet.gltf,
+CC BY-NC, so not in this repository), lit only by its emissive texture. Per
 scene and figure, one `lightoctree bake` at the defaults: wall time and peak
 memory (the process's maximum resident set, from wait4), stored photons,
 paths per stored photon, the noise figure and why the bake stopped
@@ -20,7 +22,7 @@ against `reference --part full` (tools/bench_public_scenes.py's cached
 --bin 4 --clip-percentile 99`, RGB relative RMSE. The machine is shared:
 compare rows of one run, not runs.
 
-Usage: python3 tools/bench_bake_cost.py [--out docs/results/bake-cost.md]
+Usage: python3 tools/bench_bake_cost.py [--helmet DIR] [--out docs/results/bake-cost.md]
 """
 
 import argparse
@@ -145,6 +147,7 @@ def main():
     ap.add_argument("--shared", default=os.path.join(ROOT, "../shared/scenes"))
     ap.add_argument("--work", default=os.path.join(ROOT, "out/bench-bake-cost"))
     ap.add_argument("--out", default=os.path.join(ROOT, "docs/results/bake-cost.md"))
+    ap.add_argument("--helmet", help="folder with the Khronos sample DamagedHelmet.gltf and its files")
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     real = os.path.join(args.shared, "real")
@@ -160,6 +163,11 @@ def main():
         ("game level (enclosed)", os.path.join(real, "zdm2-sauerbraten/zdm2-godot-lights.glb"), 6, "game-level"),
         ("game level (enclosed)", os.path.join(real, "zdm2-sauerbraten/zdm2-godot-lights.glb"), 8, "game-level"),
     ]
+    if args.helmet:
+        helmet = os.path.join(args.helmet, "DamagedHelmet.gltf")
+        if not os.path.exists(helmet):
+            sys.exit(f"--helmet: no DamagedHelmet.gltf in {args.helmet}")
+        scenes.insert(4, ("DamagedHelmet alone (open, lit by its own emissive texture)", helmet, 6, None))
     rows = []
     for name, path, depth, key in scenes:
         for light in ("seen", "indirect"):

@@ -634,6 +634,7 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
   LightReach reach;  // paths and photons per light
   uint64_t firstPath = 0;  // the path index `emitted` counts from
   size_t goal = std::min(cap, std::max(kMinPilotPhotons, kPilotPhotonsPerVoxel * grid.size()));
+  double previousLit = 0;  // the light over the lit surface of the pass before (kLitSettledGrowth)
   for (int pass = 1;; ++pass) {
     const double passStart = elapsed();
     StageTimer trace(s.stages, "trace photons");
@@ -692,7 +693,10 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
       s.noise = summarizeNoise(r.grid);
     }
     s.passes.push_back({raw.size(), emitted, s.noise, elapsed() - passStart});
-    if (s.noise.quantile <= target) {
+    const bool litSettled =
+        previousLit > 0 && s.noise.litLight <= (1.0 + kLitSettledGrowth) * previousLit;
+    previousLit = s.noise.litLight;
+    if (s.noise.quantile <= target && litSettled) {
       s.targetStop = "target reached";
     } else if (raw.size() >= cap) {
       s.targetStop = "photon cap";
@@ -716,6 +720,7 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
       rawPower.clear();
       rawSegments = SegmentCollector(photonParams.maxSegments);
       emitted = empty = missed = 0;
+      previousLit = 0;
       std::fill(directFront.begin(), directFront.end(), 0.0);
       std::fill(directBack.begin(), directBack.end(), 0.0);
     }

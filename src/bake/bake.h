@@ -80,10 +80,22 @@ constexpr NumberRange kDepthRange{1, kMaxGridDepth, false, true};
 /// (`--max-photons`), nor more than the memory available holds.
 constexpr size_t kDefaultMaxPhotons = 20000000;
 /// A target bake's first pass stores this many photons per active voxel
-/// (at least kMinPilotPhotons): enough for each voxel's noise to say how
-/// many the target needs.
-constexpr size_t kPilotPhotonsPerVoxel = 8;
+/// (at least kMinPilotPhotons): enough for the noise figure to say how many
+/// the target needs. One, not the eight it was: where direct light is bright
+/// (an emissive object alone, a sunlit street) the figure of the light seen
+/// was 15-200 times below the target after eight, which open scenes paid for
+/// with hundreds of paths per photon (docs/results/bake-cost.md).
+constexpr size_t kPilotPhotonsPerVoxel = 1;
 constexpr size_t kMinPilotPhotons = 20000;
+/// A target bake stops at its target only once the light over the lit
+/// surface has settled: its pass found at most this share more indirect light
+/// there (NoiseSummary::litLight) than the pass before. A small pilot leaves
+/// voxels its few photons missed unlit, which the figure does not count: a
+/// pass whose photons still light surface that holds light has not yet
+/// measured all of it. (The voxels lit at the far edge of an emissive
+/// object's reach hold little light: counting them, the lit voxels of the
+/// emissive helmet grew by more than 2% in every pass.)
+constexpr double kLitSettledGrowth = 0.05;
 /// Passes of a target bake at most (the pilot included).
 constexpr int kMaxTargetPasses = 6;
 

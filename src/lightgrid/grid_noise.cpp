@@ -57,6 +57,7 @@ NoiseSummary summarizeNoise(const VdlGrid& g, const std::vector<float>* direct) 
     weightedSeen += e.area * e.seen;
   }
   s.meanLuminance = weighted / area;
+  s.litLight = weighted;
   const double floor = kNoiseFloorShare * weightedSeen / area;
   std::vector<std::pair<double, double>> counted;  // (noise, area)
   counted.reserve(entries.size());

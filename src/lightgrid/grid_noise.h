@@ -32,6 +32,7 @@ struct NoiseSummary {
   size_t lit = 0;            ///< voxels and layers with light
   size_t unlit = 0;          ///< active voxels and layers without light
   double meanLuminance = 0;  ///< area-weighted, over the lit ones, W/m^2
+  double litLight = 0;       ///< luminance of the indirect light over the lit surface, W (area x W/m^2)
   double median = 0;         ///< area-weighted median of the counted noise
   double quantile = 0;       ///< area-weighted kNoiseQuantile quantile: the bake's noise figure
   std::string ToString() const;  ///< "noise 4.1% (90% of the lit area below), median 2.3%"

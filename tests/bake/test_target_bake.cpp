@@ -80,6 +80,26 @@ TEST(TargetBake, ReachesItsTargetAndSaysHow) {
   EXPECT_EQ(again.quantile, s.noise.quantile);
 }
 
+// The pilot stores one photon per active voxel (at least kMinPilotPhotons),
+// and the bake stops at its target only in a pass whose light over the lit
+// surface is within kLitSettledGrowth of the pass before: a pilot too small to
+// have lit every surface that holds light does not end the bake.
+TEST(TargetBake, StopsOnlyOnceTheLitLightHasSettled) {
+  BakeParams p;
+  p.depth = 5;
+  p.targetError = 0.25;  // met by the pilot's own figure (21% at depth 5)
+  const BakeResult r = bake(cornellBox(), p);
+  const BakeStats& s = r.stats;
+  ASSERT_EQ(s.targetStop, "target reached");
+  ASSERT_GE(s.passes.size(), 2u) << "the pilot alone never ends a bake";
+  EXPECT_LE(s.passes.front().noise.quantile, 0.25) << "a target the pilot met";
+  EXPECT_LT(s.passes.front().photons, size_t(kMinPilotPhotons) + 64u);
+  const double last = s.passes.back().noise.litLight;
+  const double before = s.passes[s.passes.size() - 2].noise.litLight;
+  EXPECT_GT(before, 0);
+  EXPECT_LE(last, (1 + kLitSettledGrowth) * before);
+}
+
 // The photons a target needs grow with the depth (a deeper voxel holds
 // fewer photons): what makes a deeper grid no noisier.
 TEST(TargetBake, ADeeperGridGetsMorePhotonsAtTheSameNoise) {
