@@ -24,6 +24,7 @@
 #include "core/resources.h"
 #include "core/rng.h"
 #include "material/bsdf.h"
+#include "photon/emission_guide.h"
 #include "photon/light_footprint.h"
 #include "raytrace/ray_tracer.h"
 #include "scene/emitter_sampler.h"
@@ -69,6 +70,9 @@ struct Emitter {
   /// paths past every surface (aimAtScene). cosAim = -2: not aimed.
   Vec3 aimAxis{0, 0, 1};
   float cosAim = -2;
+  /// Its pick weight is average(samplePower) times this: an emissive
+  /// triangle's EmissionGuide::pickFactor, 1 for every other emitter.
+  float pickFactor = 1;
 };
 
 /// How far around a region of interest the sun and the sky send photons, in
@@ -84,6 +88,7 @@ struct Context {
   /// Which emitter a path starts from: by average(samplePower), across kinds.
   DiscreteDistribution emitterPick;
   EmitterSampler triangleEmitters;  ///< the emissive triangles (where on them light starts)
+  EmissionGuide emissionGuide;      ///< which way their light goes (PhotonParams::guideEmission)
   std::vector<LightFootprint> footprints;  ///< of the directional lights
   /// The sky's directions: an image's texels weighted by the covered box's
   /// silhouette seen from them; a uniform sky's hemisphere.
@@ -324,11 +329,24 @@ inline bool emit(const Context& ctx, Rng& rng, EmittedRay& out) {
       }
       // One-sided emitters emit on the side of the winding normal;
       // double-sided ones pick a side (their power counts both).
-      if (ctx.scene->materials[ctx.triangles[tri].material].doubleSided && rng.uniform() < 0.5f)
-        n = -n;
+      const bool back =
+          ctx.scene->materials[ctx.triangles[tri].material].doubleSided && rng.uniform() < 0.5f;
+      if (back) n = -n;
       Vec3 t, b;
       orthonormalBasis(n, t, b);
-      float u1 = rng.uniform(), u2 = rng.uniform();
+      float u1 = 0, u2 = 0;
+      if (ctx.emissionGuide.guided(e.entry, back)) {
+        // Toward the cells whose probes met the scene (EmissionGuide).
+        const float u0 = rng.uniform();
+        u1 = rng.uniform();
+        u2 = rng.uniform();
+        float weight = 1;
+        ctx.emissionGuide.sample(e.entry, back, u0, u1, u2, weight);
+        out.power *= weight;
+      } else {
+        u1 = rng.uniform();
+        u2 = rng.uniform();
+      }
       out.direction = normalize(fromLocal(cosineHemisphere(u1, u2), t, b, n));
       out.origin = p + n * ctx.epsilon;
       return true;
@@ -486,6 +504,11 @@ inline void aimAtScene(const Light& light, const Bounds3& bounds, Emitter& e) {
   e.samplePower = light.color * (light.intensity * aimSolidAngle);
 }
 
+/// Which emitter a path starts from: by average(samplePower) times its
+/// pickFactor, never the emitters `leftOut` (by index; empty: none); a path
+/// starts with its emitter's sample power over that probability.
+void pickEmitters(Context& ctx, const std::vector<bool>& leftOut);
+
 /// Fills the emitter table; throws if the scene emits nothing.
 inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
   totalPower = Vec3{0, 0, 0};
@@ -547,12 +570,12 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
     e.samplePower = e.power;
     ctx.emitters.push_back(e);
   }
-  ctx.emitterPick.reserve(ctx.emitters.size());
+  double pickable = 0;
   for (const Emitter& e : ctx.emitters) {
-    ctx.emitterPick.add(double(average(e.samplePower)));
+    pickable += double(average(e.samplePower));
     totalPower += e.power;
   }
-  if (ctx.emitters.empty() || !(ctx.emitterPick.total() > 0)) {
+  if (ctx.emitters.empty() || !(pickable > 0)) {
     std::ostringstream os;
     os << "scene has no light with positive power (" << scene.lights.size()
        << " punctual lights, no emissive triangle with positive emission, no sky) in '"
@@ -560,9 +583,22 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
        << "'";
     throw InputError(os.str());
   }
+  pickEmitters(ctx, {});
+}
+
+void pickEmitters(Context& ctx, const std::vector<bool>& leftOut) {
+  DiscreteDistribution pick;
+  pick.reserve(ctx.emitters.size());
+  for (size_t k = 0; k < ctx.emitters.size(); ++k) {
+    const Emitter& e = ctx.emitters[k];
+    const bool out = !leftOut.empty() && leftOut[k];
+    pick.add(out ? 0.0 : double(average(e.samplePower)) * double(e.pickFactor));
+  }
+  ctx.emitterPick = std::move(pick);
   for (size_t k = 0; k < ctx.emitters.size(); ++k) {
     Emitter& e = ctx.emitters[k];
-    e.pathPower = e.samplePower * float(1.0 / ctx.emitterPick.pmf(k));
+    const double pmf = ctx.emitterPick.pmf(k);
+    e.pathPower = pmf > 0 ? e.samplePower * float(1.0 / pmf) : Vec3{0, 0, 0};
   }
 }
 
@@ -730,6 +766,14 @@ PhotonTracer::PhotonTracer(const Scene& scene, const PhotonParams& params)
   ctx.farDistance = 2.0f * std::max(scale, 1e-6f);
   st.tracer = std::make_unique<RayTracer>(traced);
   ctx.tracer = st.tracer.get();
+  if (params.guideEmission && !ctx.triangleEmitters.empty()) {
+    ctx.emissionGuide =
+        EmissionGuide(traced, ctx.triangleEmitters, *st.tracer, ctx.epsilon, ctx.farDistance);
+    for (Emitter& e : ctx.emitters) {
+      if (e.kind == Emitter::Kind::Triangle) e.pickFactor = ctx.emissionGuide.pickFactor(e.entry);
+    }
+    pickEmitters(ctx, {});
+  }
 }
 
 PhotonTracer::~PhotonTracer() = default;
@@ -748,20 +792,14 @@ void PhotonTracer::leaveOut(const std::vector<uint32_t>& lights) {
     if (k < out.size()) out[k] = true;
   }
   Context& ctx = st.ctx;
-  DiscreteDistribution pick;
-  pick.reserve(ctx.emitters.size());
+  std::vector<bool> leftOut(ctx.emitters.size(), false);
+  bool any = false;
   for (size_t k = 0; k < ctx.emitters.size(); ++k) {
-    pick.add(out[st.lightGroup[k]] ? 0.0 : double(average(ctx.emitters[k].samplePower)));
+    leftOut[k] = out[st.lightGroup[k]];
+    any = any || (!leftOut[k] && average(ctx.emitters[k].samplePower) > 0);
   }
-  if (!(pick.total() > 0)) {
-    throw InputError("PhotonTracer::leaveOut: every light would be left out");
-  }
-  ctx.emitterPick = std::move(pick);
-  for (size_t k = 0; k < ctx.emitters.size(); ++k) {
-    Emitter& e = ctx.emitters[k];
-    const double pmf = ctx.emitterPick.pmf(k);
-    e.pathPower = pmf > 0 ? e.samplePower * float(1.0 / pmf) : Vec3{0, 0, 0};
-  }
+  if (!any) throw InputError("PhotonTracer::leaveOut: every light would be left out");
+  pickEmitters(ctx, leftOut);
 }
 
 void PhotonTracer::trace(uint64_t first, size_t count, const PathSink& onPath,

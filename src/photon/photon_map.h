@@ -43,6 +43,11 @@ struct PhotonParams {
   /// store, to PhotonTracer::trace's DirectSink: what a target bake weighs
   /// the indirect light's noise against (the light a viewer sees there).
   bool countDirect = false;
+  /// Send emissive triangles' light preferably the ways that meet the scene
+  /// (photon/emission_guide.h): the same expected light, far fewer paths for
+  /// an emissive object in the open; off, every direction as often as the
+  /// cosine says (what the guide is tested against).
+  bool guideEmission = true;
 };
 
 struct PhotonMap {
