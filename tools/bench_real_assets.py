@@ -5,7 +5,8 @@ textured assets others made, command by command as a user runs them
 docs/results/real-assets.md.
 
 Scenes: the Cornell box (data/, untextured: the baseline), the textured OBJ
-room and the truck under spot lights (../shared/scenes/real), and, when
+room, the truck under spot lights and the lamp room of five point lights and
+an emissive texture (../shared/scenes/real), and, when
 --helmet names a folder holding the Khronos sample DamagedHelmet
 (DamagedHelmet.gltf, its .bin and five 2048^2 JPEGs; CC BY-NC, so it is not
 in this repository), that helmet in a room under a spot light and lit by its
@@ -69,7 +70,9 @@ def main():
     scenes = [("Cornell box (no textures)", os.path.join(ROOT, "data/cornell-box.gltf"), None)]
     real = os.path.join(args.shared, "real")
     for label, path in [("Viking room (OBJ, 1024² PNG)", "viking-room/viking_room_lit.obj"),
-                        ("Milk truck under spots (2048² PNG)", "milk-truck-spots/truck-under-spots.gltf")]:
+                        ("Milk truck under spots (2048² PNG)", "milk-truck-spots/truck-under-spots.gltf"),
+                        ("Lamp room, five point lights and an emissive texture",
+                         "lights-punctual-lamp/LightsPunctualLamp-room.gltf")]:
         if os.path.isfile(os.path.join(real, path)):
             scenes.append((label, os.path.join(real, path), None))
     if args.helmet:

@@ -8,8 +8,8 @@
 /// square of each emissive triangle's side into kRings x kSectors cells and
 /// weighs each cell by the share of probe rays from the triangle's centre
 /// through it that meet the scene; a path picks its cell by that weight
-/// three times in four and evenly the fourth (every direction stays
-/// possible, no photon weighs more than 4 times its share), then a point
+/// half the time and evenly the other half (every direction stays
+/// possible, no photon weighs more than twice its share), then a point
 /// uniform in the cell, and its power is multiplied by (1 / cells) / the
 /// cell's probability: the expected power in every direction is unchanged
 /// (PhotonGuide.* against the analytic form factor). A side whose probes all
@@ -41,7 +41,7 @@ class EmissionGuide {
   /// triangle's pick weight kept whatever its probes met: every direction
   /// and triangle stays possible, no photon weighs more than 1 / kSpread
   /// times its share (as EmitterSampler::samplePoint's texture cells).
-  static constexpr float kSpread = 0.25f;
+  static constexpr float kSpread = 0.5f;
 
   EmissionGuide() = default;
   /// Probes each side that emits of each entry of `emitters` (a
@@ -63,9 +63,8 @@ class EmissionGuide {
   /// How much more often than by its power entry `entry` starts a path:
   /// kSpread, plus the rest times the share of its probes that met the
   /// scene (1 when it was not probed). A triangle whose every probe leaves
-  /// into the open (the outside of a lone glowing object) starts a quarter
-  /// of the paths its power would give it, each carrying four times the
-  /// power: the emissive helmet's paths per stored photon 232 -> 88.
+  /// into the open (the outside of a lone glowing object) starts half the
+  /// paths its power would give it, each carrying twice the power.
   float pickFactor(uint32_t entry) const {
     return size_t(entry) < pick_.size() ? pick_[entry] : 1.0f;
   }
