@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Every numeric flag of every command refuses NaN and the infinities before
-# any work, naming the flag, exit 2 and nothing written (docs/robustness.md,
-# "Numbers at the flags"). The flags are read from each command's --help, so
+# Every numeric flag of every command refuses NaN, the infinities and numbers
+# single precision cannot hold (1e-300 became 0, 1e300 infinity, after the
+# parse) before any work, naming the flag, exit 2 and nothing written
+# (docs/robustness.md, "Numbers at the flags"). The flags are read from each command's --help, so
 # a flag added later is tried too: a floating-point one must say "must be a
 # finite number"; a whole-number one must refuse as well.
 # Usage: numeric_flags.sh CLI SCENE OUT_DIR
@@ -28,7 +29,7 @@ for cmd in bake render lightmap convert inspect reference compare sweep view; do
   # the flag's long name, its type and how many numbers it takes.
   while read -r flag type count; do
     flags=$((flags + 1))
-    for value in nan inf -inf; do
+    for value in nan inf -inf 1e-300 1e300; do
       joined=$value
       for ((i = 1; i < count; ++i)); do joined="$joined,1"; done
       err=$("$cli" "$cmd" "${args[@]}" "$flag=$joined" 2>&1 >/dev/null)
@@ -77,5 +78,5 @@ if [ "$flags" -lt 40 ]; then
   echo "FAILED: only $flags numeric flags found in the commands' --help (its format changed?)"
   failed=$((failed + 1))
 fi
-[ "$failed" -eq 0 ] && echo "numeric flags: $flags flags of 9 commands refuse nan, inf and -inf ($tried runs)"
+[ "$failed" -eq 0 ] && echo "numeric flags: $flags flags of 9 commands refuse nan, inf, -inf, 1e-300 and 1e300 ($tried runs)"
 exit "$failed"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 #include "bake/bake.h"
 #include "distributed/tiled_bake.h"
@@ -25,6 +26,14 @@ CLI::Validator numberIn(const NumberRange& range) {
         const double v = std::strtod(s.c_str(), &end);
         if (s.empty() || end != s.c_str() + s.size() || !range.contains(v)) {
           return "must be " + range.ToString() + ", got '" + s + "'";
+        }
+        // The tools compute in single precision: 1e-308 became 0 and 1e308
+        // infinity after the parse, refused later quoting a value never typed.
+        const double size = std::fabs(v);
+        if (v != 0 && !(size >= double(std::numeric_limits<float>::min()) &&
+                        size <= double(std::numeric_limits<float>::max()))) {
+          return "must be " + range.ToString() + " and 0 or of a size single precision holds " +
+                 "(1.2e-38 to 3.4e38), got '" + s + "'";
         }
         return {};
       },

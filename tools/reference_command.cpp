@@ -100,11 +100,21 @@ int runReference(const ReferenceOptions& opt) {
   if (opt.part == "added-mask" || opt.part == "edge-mask") {
     return renderMask(opt, scene, camera, report, rows);
   }
+  // One sample per pixel says nothing of its spread: a standard error of it
+  // was written as 0, and `compare --reference-error` took it for no noise.
+  if (!opt.stdErrorOutput.empty() && !(opt.timeBudget > 0) && opt.spp < 2) {
+    throw InputError("--std-error needs --spp 2 or more: one sample per pixel says nothing of "
+                     "its spread");
+  }
   const ReferenceParams params = referenceParams(opt);
   ConsoleProgress progress(opt.quiet);
   StageTimer traceTimer(rows, "path trace");
   ReferenceImage result = renderReference(scene, camera, params, &progress);
   traceTimer.finish(std::to_string(result.samplesPerPixel) + " spp");
+  if (!opt.stdErrorOutput.empty() && result.samplesPerPixel < 2) {
+    throw InputError("--std-error: the --time-budget allowed one sample per pixel, which says "
+                     "nothing of its spread: raise --time-budget (nothing was written)");
+  }
   // The image and its side images (and the report) appear together.
   AtomicFileSet outputs;
   ToneReport tone;
@@ -127,11 +137,15 @@ int runReference(const ReferenceOptions& opt) {
     // How far the reference itself is from converged, to weigh errors
     // measured against it.
     const ImageNoise noise = imageNoise(result.image, result.stdError);
-    std::printf(
-        "%s %s: %d x %d, %d spp, %.2f s, %s rays, mean %.5g, RMS std. error %.5g (%.2f%%)\n",
-        toString(params.part).c_str(), opt.scene.c_str(), opt.width, opt.height,
-        result.samplesPerPixel, result.seconds, formatCount(result.raysTraced).c_str(), noise.mean,
-        noise.rmsStdError, noise.percent());
+    char spread[96] = "std. error unknown (one sample per pixel)";
+    if (result.samplesPerPixel >= 2) {
+      std::snprintf(spread, sizeof spread, "RMS std. error %.5g (%.2f%%)", noise.rmsStdError,
+                    noise.percent());
+    }
+    std::printf("%s %s: %d x %d, %d spp, %.2f s, %s rays, mean %.5g, %s\n",
+                toString(params.part).c_str(), opt.scene.c_str(), opt.width, opt.height,
+                result.samplesPerPixel, result.seconds, formatCount(result.raysTraced).c_str(),
+                noise.mean, spread);
     std::printf("wrote %s%s%s\n", opt.output.c_str(), opt.stdErrorOutput.empty() ? "" : " and ",
                 opt.stdErrorOutput.c_str());
   }
