@@ -389,24 +389,50 @@ GridPtr convertGrid(const Grid& in, const Arg<int>& depthArg, const Arg<std::str
   return out;
 }
 
-/// E(p, n) through the CPU copy of the renderer's octree lookup.
-py::array_t<float> lookup(Grid& g, py::array_t<float, py::array::c_style | py::array::forcecast> points,
-                          py::array_t<float, py::array::c_style | py::array::forcecast> normals) {
+/// Row `i` of an (N, 3) array as "(x, y, z)", for a refusal.
+std::string rowText(const double* v, size_t i) {
+  char text[96];
+  std::snprintf(text, sizeof text, "(%.9g, %.9g, %.9g)", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+  return text;
+}
+
+/// E(p, n) through the CPU copy of the renderer's octree lookup. A point or
+/// normal that is not finite is refused by its argument and row, as every
+/// other argument of the module is by its name: the lookup has no answer
+/// there (it gave 0, a value a caller cannot tell from darkness), and NaN in
+/// the result would spread silently through the caller's sums.
+py::array_t<float> lookup(Grid& g,
+                          py::array_t<double, py::array::c_style | py::array::forcecast> points,
+                          py::array_t<double, py::array::c_style | py::array::forcecast> normals) {
   if (points.ndim() != 2 || points.shape(1) != 3 || normals.ndim() != 2 || normals.shape(1) != 3 ||
       normals.shape(0) != points.shape(0)) {
     throw InputError("lookup: points and normals must both be arrays of shape (N, 3)");
   }
   const size_t n = size_t(points.shape(0));
+  const double* p = points.data();
+  const double* nn = normals.data();
+  // Checked as the lookup takes them, in single precision: 1e39 is inf there.
+  auto vec = [](const double* v, size_t i) {
+    return Vec3(float(v[3 * i]), float(v[3 * i + 1]), float(v[3 * i + 2]));
+  };
+  for (size_t i = 0; i < n; ++i) {
+    if (!isFinite(vec(p, i))) {
+      throw InputError("points: row " + std::to_string(i) + " is " + rowText(p, i) +
+                       ": every point must be finite (within a float's range)");
+    }
+    const Vec3 normal = vec(nn, i);
+    if (!isFinite(normal) || (normal.x == 0 && normal.y == 0 && normal.z == 0)) {
+      throw InputError("normals: row " + std::to_string(i) + " is " + rowText(nn, i) +
+                       ": every normal must be a finite direction of non-zero length");
+    }
+  }
   const GpuOctree& octree = g.lookupOctree();
   py::array_t<float> out({n, size_t(3)});
-  const float* p = points.data();
-  const float* nn = normals.data();
   float* e = out.mutable_data();
   {
     py::gil_scoped_release unlocked;
     for (size_t i = 0; i < n; ++i) {
-      const Vec3 v = octreeIrradiance(octree, Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]),
-                                      normalize(Vec3(nn[3 * i], nn[3 * i + 1], nn[3 * i + 2])));
+      const Vec3 v = octreeIrradiance(octree, vec(p, i), normalize(vec(nn, i)));
       e[3 * i] = v.x;
       e[3 * i + 1] = v.y;
       e[3 * i + 2] = v.z;

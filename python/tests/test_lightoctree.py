@@ -98,6 +98,23 @@ def test_lookup_sees_the_light_from_the_front_and_none_from_behind(grid):
         lightoctree.lookup(grid, np.zeros((3, 2)), np.zeros((3, 2)))
 
 
+@pytest.mark.parametrize("argument, bad", [
+    ("points", [math.nan, 0.5, 0.5]), ("points", [0.5, math.inf, 0.5]),
+    ("points", [0.5, 0.5, -math.inf]), ("points", [1e39, 0.5, 0.5]),  # inf as a float
+    ("normals", [math.nan, 1.0, 0.0]), ("normals", [0.0, -math.inf, 0.0]),
+    ("normals", [0.0, 0.0, 0.0])])
+def test_lookup_refuses_points_and_normals_it_has_no_answer_for(grid, argument, bad):
+    """A NaN or infinite point gave 0, dark light a caller cannot tell from
+    a real answer: refused by the argument's name and the row, as the
+    module's other arguments are, and no answer for any row."""
+    points = np.tile(np.asarray(grid.positions)[0], (4, 1))
+    normals = np.tile([0.0, 1.0, 0.0], (4, 1))
+    assert np.all(np.isfinite(lightoctree.lookup(grid, points, normals)))
+    (points if argument == "points" else normals)[2] = bad
+    with pytest.raises(lightoctree.InputError, match=argument + r": row 2 is \("):
+        lightoctree.lookup(grid, points, normals)
+
+
 def test_render_draws_the_scene_lit_by_the_grid(grid):
     image = lightoctree.render(SCENE, grid, width=64, height=48, mode="indirect")
     assert image.shape == (48, 64, 3) and image.dtype == np.float32
