@@ -212,6 +212,14 @@ auto withPythonNames(Work work) {
   }
 }
 
+/// The commands' "warning: ..." on stderr, as Python's warnings.warn(text)
+/// (a UserWarning, shown once per place by default, or raised where the
+/// caller made warnings errors); nothing for "".
+void warn(const std::string& text) {
+  if (text.empty()) return;
+  if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+}
+
 // ---- arguments: each checked by its name, as the commands check their flags ----
 
 /// repr(value), cut to 60 characters (a refused argument may be large).
@@ -763,6 +771,7 @@ py::dict compareImagesArg(const py::object& testArg, const py::object& reference
     r = compareReport(test, reference, settings, mask ? &*mask : nullptr,
                       stdError ? &*stdError : nullptr);
   }
+  warn(r.nonFiniteWarning());  // as the command's "warning: ..." on stderr
   const CompareResult& m = r.result;
   py::dict d;  // the keys and values of `compare --json`
   d["test"] = testPath.empty() ? py::object(py::none()) : py::object(py::str(testPath));
@@ -786,6 +795,7 @@ py::dict compareImagesArg(const py::object& testArg, const py::object& reference
   d["compared_pixels"] = m.comparedPixels;
   d["ignored_pixels"] = m.ignoredPixels;
   d["non_finite_pixels"] = m.nonFinitePixels;
+  d["non_finite_image_pixels"] = r.nonFiniteImagePixels;
   d["max_error_pixel"] = std::vector<int>{m.maxErrorX, m.maxErrorY};
   d["mean_reference_luminance"] = m.meanReferenceLuminance;
   d["mean_test_luminance"] = m.meanTestLuminance;

@@ -112,6 +112,10 @@ int runCompare(const CompareOptions& opt) {
                  "render it with more samples or compare over larger --bin blocks\n",
                  noise, result.luminance.relRmse);
   }
+  // Pixels left out for NaN or inf: the figures are of the rest, which a
+  // reader of the figures alone would not know (--quiet too, as above).
+  const std::string nonFinite = report.nonFiniteWarning();
+  if (!nonFinite.empty()) std::fprintf(stderr, "warning: %s\n", nonFinite.c_str());
   if (!opt.diff.empty()) {
     // Linear float values in an EXR; PNG keeps the false colour as it is.
     writeImage(opt.diff, differenceImage(report.test, report.reference, report.params(), opt.diffScale));
@@ -136,6 +140,7 @@ int runCompare(const CompareOptions& opt) {
     j["compared_pixels"] = result.comparedPixels;
     j["ignored_pixels"] = result.ignoredPixels;
     j["non_finite_pixels"] = result.nonFinitePixels;
+    j["non_finite_image_pixels"] = report.nonFiniteImagePixels;
     j["max_error_pixel"] = {result.maxErrorX, result.maxErrorY};
     j["mean_reference_luminance"] = result.meanReferenceLuminance;
     j["mean_test_luminance"] = result.meanTestLuminance;

@@ -529,6 +529,77 @@ def test_compare_measures_what_the_command_measures(tmp_path):
         assert from_arrays == dict(expected, test=None, reference=None), flags
 
 
+def _write_exr(path, image):
+    """An uncompressed scanline EXR of 32-bit float B, G, R (the format's
+    plainest form), so that a test can hand the command NaN pixels."""
+    import struct
+    height, width = image.shape[:2]
+
+    def attribute(name, kind, value):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
+
+    channels = b"".join(c + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in (b"B", b"G", b"R"))
+    window = struct.pack("<iiii", 0, 0, width - 1, height - 1)
+    header = (b"\x76\x2f\x31\x01" + struct.pack("<i", 2) +
+              attribute("channels", "chlist", channels + b"\0") +
+              attribute("compression", "compression", b"\0") +
+              attribute("dataWindow", "box2i", window) +
+              attribute("displayWindow", "box2i", window) +
+              attribute("lineOrder", "lineOrder", b"\0") +
+              attribute("pixelAspectRatio", "float", struct.pack("<f", 1)) +
+              attribute("screenWindowCenter", "v2f", struct.pack("<ff", 0, 0)) +
+              attribute("screenWindowWidth", "float", struct.pack("<f", 1)) + b"\0")
+    rows = []
+    for y in range(height):
+        data = b"".join(np.ascontiguousarray(image[y, :, c], dtype="<f4").tobytes() for c in (2, 1, 0))
+        rows.append(struct.pack("<ii", y, len(data)) + data)
+    offset = len(header) + 8 * height
+    table = b""
+    for row in rows:
+        table += struct.pack("<Q", offset)
+        offset += len(row)
+    with open(path, "wb") as f:
+        f.write(header + table + b"".join(rows))
+
+
+def test_compare_warns_of_the_pixels_it_leaves_out(tmp_path):
+    """A test image half NaN was scored over its other half without a word:
+    the command warns on stderr and its --json counts them, the module warns
+    through Python's warnings with the same sentence and the same figures."""
+    import json
+    import subprocess
+    reference = lightoctree.reference(SCENE, width=16, height=12, spp=4)
+    test = reference * 1.1
+    test[:6] = np.nan  # the top half: 96 of 192 pixels
+    test_file, reference_file = str(tmp_path / "half-nan.exr"), str(tmp_path / "reference.exr")
+    _write_exr(test_file, test)
+    _write_exr(reference_file, reference)
+    assert np.array_equal(lightoctree.read_image(test_file), test, equal_nan=True)
+    report = str(tmp_path / "report.json")
+    run = subprocess.run([_cli(), "compare", test_file, reference_file, "--json", report, "--quiet"],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    sentence = ("96 pixels are not finite (NaN or infinite in the test image or the reference) "
+                "and left out: the figures are of the 96 pixels compared")
+    assert run.stderr == "warning: " + sentence + "\n"
+    with open(report) as f:
+        figures = json.load(f)
+    assert figures["non_finite_image_pixels"] == 96 and figures["compared_pixels"] == 96
+    assert figures["channels"]["Y"]["rel_rmse"] == pytest.approx(0.1, rel=1e-5)
+    with pytest.warns(UserWarning) as caught:
+        from_arrays = lightoctree.compare(test, reference)
+    assert [str(w.message) for w in caught] == [sentence]
+    assert from_arrays == dict(figures, test=None, reference=None)
+    # Binned: the bins holding them are left out whole, and said so.
+    with pytest.warns(UserWarning, match="96 pixels are not finite .*: the 8 bins of 4 x 4"):
+        lightoctree.compare(test, reference, bin=4)
+    # A finite image: no warning.
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert lightoctree.compare(reference, reference)["non_finite_image_pixels"] == 0
+
+
 def test_compare_refuses_bad_arguments_by_name():
     image = np.ones((12, 16, 3), dtype=np.float32)
     with pytest.raises(ValueError, match="bin: must be a whole number from 1 to 1024, got 0"):

@@ -299,6 +299,20 @@ RgbImage differenceImage(const RgbImage& test, const RgbImage& reference,
   return out;
 }
 
+std::string CompareReport::nonFiniteWarning() const {
+  if (nonFiniteImagePixels == 0) return "";
+  const std::string count = std::to_string(nonFiniteImagePixels) +
+                            (nonFiniteImagePixels == 1 ? " pixel is" : " pixels are") +
+                            " not finite (NaN or infinite in the test image or the reference)";
+  const std::string compared = std::to_string(result.comparedPixels);
+  if (bin <= 1) {
+    return count + " and left out: the figures are of the " + compared + " pixels compared";
+  }
+  const std::string bins = std::to_string(bin) + " x " + std::to_string(bin);
+  return count + ": the " + std::to_string(result.nonFinitePixels) + " bins of " + bins +
+         " that hold them are left out, the figures are of the " + compared + " bins compared";
+}
+
 CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSettings& settings,
                             const RgbImage* mask, const RgbImage* stdError) {
   CompareReport r;
@@ -319,6 +333,11 @@ CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSett
     clipChannels(test, r.clip);
     clipChannels(reference, r.clip);
   }
+  // Per pixel, as clipped and before binning, over the mask as given.
+  for (size_t i = 0; i < reference.pixelCount(); ++i) {
+    if (pixelUse(test, reference, r.params(), i) == PixelUse::NonFinite) ++r.nonFiniteImagePixels;
+  }
+  r.bin = settings.bin;
   if (settings.bin > 1) {
     test = binImage(test, settings.bin);
     reference = binImage(reference, settings.bin);

@@ -148,6 +148,16 @@ struct CompareReport {
     return p;
   }
   bool ignoreBackground = false;
+  int bin = 1;  ///< CompareSettings::bin: result counts bins of bin x bin pixels
+  /// Pixels the mask and ignoreBackground select that are NaN or infinite in
+  /// either image (after clipping, which takes an infinite value to its
+  /// limit), counted per pixel before binning: left out of the figures, and
+  /// with bin > 1 so is every bin holding one (result.nonFinitePixels).
+  size_t nonFiniteImagePixels = 0;
+  /// "" when no pixel was left out for not being finite; else a sentence
+  /// for a warning saying how many were, and what the figures are of: a
+  /// test image half NaN scored its other half without a word.
+  std::string nonFiniteWarning() const;
 };
 
 /// @brief `compare`'s measurement in its order: black holes judged per pixel

@@ -196,6 +196,46 @@ TEST(Compare, NothingComparedIsRefusedNotAPerfectScore) {
   test::expectRefusal([&] { compareReport(nan, ref, binned); }, {"4 not finite", "2 x 2 bins"});
 }
 
+// A test image half NaN was scored over its other half without a word:
+// the report counts the pixels left out, per pixel before binning, and says
+// so in a warning the command and the Python module give.
+TEST(Compare, NonFinitePixelsLeftOutAreCountedAndWarned) {
+  RgbImage ref(4, 4), test(4, 4);
+  std::fill(ref.rgb.begin(), ref.rgb.end(), 1.0f);
+  test = ref;
+  const CompareReport clean = compareReport(test, ref, CompareSettings{});
+  EXPECT_EQ(clean.nonFiniteImagePixels, 0u);
+  EXPECT_EQ(clean.nonFiniteWarning(), "");
+  // The top row NaN and one pixel of the second infinite: 5 of 16.
+  for (int x = 0; x < 4; ++x) test.set(size_t(x), Vec3(std::numeric_limits<float>::quiet_NaN()));
+  ref.set(5, Vec3(std::numeric_limits<float>::infinity()));
+  const CompareReport half = compareReport(test, ref, CompareSettings{});
+  EXPECT_EQ(half.nonFiniteImagePixels, 5u);
+  EXPECT_EQ(half.result.nonFinitePixels, 5u);
+  EXPECT_EQ(half.result.comparedPixels, 11u);
+  EXPECT_EQ(half.nonFiniteWarning(),
+            "5 pixels are not finite (NaN or infinite in the test image or the reference) and "
+            "left out: the figures are of the 11 pixels compared");
+  // Binned 2 x 2: the two top bins hold them; 2 of 4 bins compared.
+  CompareSettings binned;
+  binned.bin = 2;
+  const CompareReport bins = compareReport(test, ref, binned);
+  EXPECT_EQ(bins.nonFiniteImagePixels, 5u);
+  EXPECT_EQ(bins.result.nonFinitePixels, 2u);
+  EXPECT_EQ(bins.result.comparedPixels, 2u);
+  EXPECT_NE(bins.nonFiniteWarning().find("5 pixels are not finite"), std::string::npos);
+  EXPECT_NE(bins.nonFiniteWarning().find("the 2 bins of 2 x 2 that hold them are left out, the "
+                                         "figures are of the 2 bins compared"),
+            std::string::npos)
+      << bins.nonFiniteWarning();
+  // Pixels the mask leaves out are not counted, finite or not.
+  RgbImage mask(4, 4);
+  for (size_t i = 4; i < 16; ++i) mask.set(i, Vec3(1.0f));
+  const CompareReport masked = compareReport(test, ref, CompareSettings{}, &mask);
+  EXPECT_EQ(masked.nonFiniteImagePixels, 1u);
+  EXPECT_EQ(masked.result.comparedPixels, 11u);
+}
+
 TEST(Compare, RejectsSizeMismatch) {
   EXPECT_THROW(compareImages(RgbImage(2, 2), RgbImage(2, 3)), InputError);
   RgbImage mask(1, 1);
