@@ -106,11 +106,16 @@ void checkVolume(const std::string& path, const VolumeLight& v, int depth) {
   }
 }
 
-void checkReadableValues(const std::string& path, const VdlGrid& g) {
-  if (g.frame.depth < 1 || g.frame.depth > kMaxGridDepth) {
-    throw InputError(path + ": file metadata depth = " + std::to_string(g.frame.depth) +
-                     " is outside [1, " + std::to_string(kMaxGridDepth) + "]");
+void checkDepthInRange(const std::string& path, int depth) {
+  if (depth < 1 || depth > kMaxGridDepth) {
+    throw InputError(path + ": depth " + std::to_string(depth) +
+                     " in the file's metadata: a light grid's depth is 1 to " +
+                     std::to_string(kMaxGridDepth));
   }
+}
+
+void checkReadableValues(const std::string& path, const VdlGrid& g) {
+  checkDepthInRange(path, g.frame.depth);
   checkVolume(path, g.volume, g.frame.depth);
   for (size_t v = 0; v < g.size(); ++v) {
     forEachField([&](const auto& row) { checkFinite(path, g, row, 0, v, g.coords[v]); });

@@ -112,6 +112,10 @@ bool isRequiredVoxelGrid(const std::string& name);
 /// bytes. @throws std::runtime_error when the header is not OpenVDB's.
 void makeUuidDeterministic(const std::string& file);
 
+/// @throws InputError naming `path`, `depth` and the range when the depth a
+/// file's metadata states is not a light grid's (1 to kMaxGridDepth).
+void checkDepthInRange(const std::string& path, int depth);
+
 /// What no reader of the file may draw or convert, refused at reading:
 /// non-finite values (NaN, Inf) in any field and a depth outside the
 /// octree's range. @throws InputError naming `path`, the grid and the voxel.

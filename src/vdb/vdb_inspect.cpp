@@ -294,8 +294,9 @@ class VdlChecker {
     const bool depthOk = depth >= 1 && depth <= kMaxGridDepth;
     add("depth", depthOk,
         depthOk ? std::to_string(depth) + " (2^" + std::to_string(depth) + " voxels per axis)"
-                : "file metadata depth is " + (m ? m->str() : std::string("missing")) +
-                      ", expected an int32 in [1, " + std::to_string(kMaxGridDepth) + "]");
+                : (m ? "depth " + m->str() + " in the file's metadata"
+                     : std::string("no depth in the file's metadata")) +
+                      ": a light grid's depth is 1 to " + std::to_string(kMaxGridDepth));
     std::string transform;
     for (const auto& g : *f_.grids) {
       if (!g || !transform.empty()) continue;

@@ -320,8 +320,19 @@ void readVolume(const std::string& path, const OpenedFile& f, VdlGrid& g) {
 
 LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& origin) {
   OpenedFile f = openFile(path);
+  // The other .vdb a bake writes: said so, where its missing metadata
+  // ("missing file metadata 'depth'") told nothing of what it is.
+  if (findGrid(f, "photons") && !findGrid(f, gridNameOf(&VdlGrid::irradiance))) {
+    throw InputError(path +
+                     ": this is a photon map (a .vdb of photons, written by `bake "
+                     "--photon-map`), not a light grid (the .vdb `bake -o` and `convert` write): "
+                     "a photon map is read only beside its grid, by `convert --photon-map`");
+  }
   LoadedVdl out;
   out.meta = readMetadata(path, *f.meta);
+  // Before anything sizes or places a voxel by it: a depth out of range was
+  // refused late, or blamed on another check.
+  checkDepthInRange(path, out.meta.depth);
   if (out.meta.formatVersion == 0) {
     // Files baked before the key existed follow version 1 of the contract.
     out.meta.formatVersion = 1;

@@ -514,6 +514,57 @@ TEST(Inspect, ADepthTheVoxelsDoNotHaveIsRefusedByEveryReader) {
   }
 }
 
+// Depth -1 or 13 in a file's metadata was refused late, by a check that
+// blamed something else; now by every reader first, with what is allowed,
+// and by inspect's depth check in the same words.
+TEST(Inspect, ADepthOutOfRangeIsNamedWithWhatIsAllowed) {
+  const std::string dir = test::outputDir("Inspect.DepthRange");
+  // Also with free-space grids, whose own depth was checked against it first.
+  for (const auto& [claimed, volume] :
+       {std::pair{-1, false}, std::pair{13, false}, std::pair{31, false}, std::pair{-1, true},
+        std::pair{13, true}}) {
+    vdb_internal::Damage out;
+    out.metadataDepth = claimed;
+    const std::string path =
+        dir + "/depth" + std::to_string(claimed) + (volume ? "-volume" : "") + ".vdb";
+    vdb_internal::writeVdlGridDamaged(path, volume ? floorWithVolume() : floorGrid(),
+                                      metaWithBounds(), out);
+    const std::string expected = path + ": depth " + std::to_string(claimed) +
+                                 " in the file's metadata: a light grid's depth is 1 to 12";
+    EXPECT_EQ(readError(path), expected);
+    const VdbReport report = inspectVdb(path);
+    EXPECT_FALSE(report.ok());
+    const VdbCheck* depth = findCheck(report, "depth");
+    ASSERT_NE(depth, nullptr);
+    EXPECT_FALSE(depth->passed);
+    EXPECT_EQ(depth->detail, "depth " + std::to_string(claimed) +
+                                 " in the file's metadata: a light grid's depth is 1 to 12");
+    const VdbCheck* readable = findCheck(report, "readable");
+    ASSERT_NE(readable, nullptr);
+    EXPECT_EQ(readable->detail, expected);
+  }
+}
+
+// A photon map given where a light grid is read (convert IN, render, Python
+// read) said "missing file metadata 'depth'": now what it is and where it goes.
+TEST(VdbIo, APhotonMapWhereALightGridIsReadIsNamed) {
+  const std::string dir = test::outputDir("VdbIo.PhotonMapAsGrid");
+  std::vector<Photon> photons(3);
+  for (size_t i = 0; i < photons.size(); ++i) {
+    photons[i].position = Vec3(float(i), 0, 0);
+    photons[i].power = Vec3(1.0f);
+    photons[i].direction = photons[i].normal = Vec3(0, 1, 0);
+  }
+  writePhotonPoints(dir + "/photons.vdb", photons, 0.05f);
+  const std::string refused = readError(dir + "/photons.vdb");
+  EXPECT_EQ(refused.rfind(dir + "/photons.vdb: this is a photon map (a .vdb of photons", 0), 0u)
+      << refused;
+  EXPECT_NE(refused.find("not a light grid"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("`convert --photon-map`"), std::string::npos) << refused;
+  // inspect still tells it for what it is.
+  EXPECT_EQ(inspectVdb(dir + "/photons.vdb").kind, "photons");
+}
+
 // A light .vdb read and written back unchanged by pyopenvdb holds doubles
 // (and vec3d) where the bake wrote floats (and vec3s): it was refused.
 TEST(VdbIo, FloatMetadataOfEitherWidthIsRead) {
