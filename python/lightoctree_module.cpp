@@ -220,6 +220,14 @@ void warn(const std::string& text) {
   if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
 }
 
+/// The commands' warning of a grid baked from another version of the scene
+/// (tools/render_stages.h warnIfStale), "`what`: the light was baked from
+/// ...", through warn().
+void warnIfStale(const BakeMetadata& meta, const std::string& scenePath, const std::string& what) {
+  const std::string stale = staleBakeWarning(meta, scenePath);
+  if (!stale.empty()) warn(what + ": " + stale);
+}
+
 // ---- arguments: each checked by its name, as the commands check their flags ----
 
 /// repr(value), cut to 60 characters (a refused argument may be large).
@@ -506,6 +514,7 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Grid& g,
   const std::string scenePath = pathArg(sceneArg.value, "scene");
   const RenderSettings settings = renderSettings(width, height, mode, kw);
   Scene scene = loadScene(scenePath);
+  warnIfStale(g.meta, scenePath, "grid");  // before the frame, as `render` warns
   RgbImage image;
   withPythonNames([&] {  // the renderer's refusals name the flags ("--emitter-lights")
     py::gil_scoped_release unlocked;
@@ -872,6 +881,7 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
     r = exportLightmap(loadSceneWith(scenePath, scene), lightsPath, p);
     return 0;
   });
+  warnIfStale(r.gridMetadata, scenePath, lightsPath);
   const LightmapUvs& uvs = r.lightmap.uvs;
   const LightmapAtlas& atlas = r.lightmap.atlas;
   py::dict d;  // the figures of `lightmap --json`, and the files' sizes

@@ -2,6 +2,7 @@
 octree lookup and render, from Python (ctest python.module runs these)."""
 import math
 import os
+import re
 
 import numpy as np
 import pytest
@@ -682,3 +683,31 @@ def test_lightmap_refuses_as_the_command_does(grid_file, tmp_path):
     with pytest.raises(ValueError, match="content: must be one of 'indirect', 'full', got 'direct'"):
         lightoctree.lightmap(scene, grid_file, str(tmp_path / "lit.glb"), content="direct")
     assert sorted(os.listdir(tmp_path)) == ["scene.gltf"]
+
+
+def test_render_and_lightmap_warn_of_a_grid_baked_from_another_scene(grid, grid_file, tmp_path):
+    """The commands warn when the scene's content hash is not the one the
+    grid records (tools/render_stages.h warnIfStale); the module's render and
+    lightmap said nothing. Now the same sentence, through Python's warnings,
+    and only then: a renamed copy of the same bytes is the same scene."""
+    import shutil
+    import warnings
+    same, changed = str(tmp_path / "same.gltf"), str(tmp_path / "changed.gltf")
+    shutil.copy(SCENE, same)
+    shutil.copy(SCENE, changed)
+    with open(changed, "a") as f:
+        f.write(" ")  # one byte more: another scene as far as anyone can tell
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lightoctree.render(same, grid, width=16, height=12)
+    stale = r": the light was baked from .*cornell-box.gltf \(fnv1a64:[0-9a-f]{16}\); '" + \
+        re.escape(changed) + r"' and the files it reads differ \(fnv1a64:[0-9a-f]{16}\): " \
+        r"bake again if the scene changed$"
+    with pytest.warns(UserWarning, match="^grid" + stale):
+        image = lightoctree.render(changed, grid, width=16, height=12)
+    assert image.shape == (12, 16, 3)  # still drawn, as the command draws it
+    out = tmp_path / "out"
+    out.mkdir()
+    with pytest.warns(UserWarning, match="^" + re.escape(grid_file) + stale):
+        lightoctree.lightmap(changed, grid_file, str(out / "lit.glb"), directions="off")
+    assert os.path.exists(out / "lit.glb")
