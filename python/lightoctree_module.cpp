@@ -398,7 +398,10 @@ GridPtr convertGrid(const Grid& in, const Arg<int>& depthArg, const Arg<std::str
     scene = loadScene(scenePath);
     params.scene = &scene;
   }
-  ConvertResult r = convertLightGrid(in.grid, in.meta, params, nullptr);
+  // No callback (convert takes none), but Ctrl-C stops it.
+  ConvertResult r = withProgress(py::none(), [&](ProgressSink* sink) {
+    return convertLightGrid(in.grid, in.meta, params, sink);
+  });
   auto out = std::make_shared<Grid>();
   out->grid = std::move(r.grid);
   out->meta = std::move(r.metadata);
@@ -824,10 +827,16 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
   LightmapExportParams p;
   p.output = output;
   py::object sky = py::none(), skyImage = py::none(), skyMesh = py::none(), physicalSky = py::none();
+  py::object progress = py::none();
   for (const auto& [key, value] : kw) {
     const std::string name = py::str(key);
     // The ranges and words of the command's flags (tools/lightmap_command.cpp).
-    if (name == "texel_size") {
+    if (name == "progress") {
+      if (!value.is_none() && !PyCallable_Check(value.ptr())) {
+        refuse(name, "a callable (task, done, total) or None", value);
+      }
+      progress = py::reinterpret_borrow<py::object>(value);
+    } else if (name == "texel_size") {
       p.lightmap.uv.texelSize = float(numberArg(value, kPositiveNumber, name));
     } else if (name == "atlas") {
       p.lightmap.uv.atlasSize = wholeArg(value, 8, kMaxImageSide, name);
@@ -875,11 +884,13 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
     checkLightmapOutputs(output, p.preview, inputs);
     return 0;
   });
-  LightmapExportResult r;
-  withPythonNames([&] {
-    py::gil_scoped_release unlocked;
-    r = exportLightmap(loadSceneWith(scenePath, scene), lightsPath, p);
-    return 0;
+  // Its steps to `progress`, and Ctrl-C at each: a stop before the commit
+  // leaves no file of this export (an earlier export's set as it was).
+  const LightmapExportResult r = withPythonNames([&] {
+    return withProgress(progress, [&](ProgressSink* sink) {
+      p.progress = sink;
+      return exportLightmap(loadSceneWith(scenePath, scene), lightsPath, p);
+    });
   });
   warnIfStale(r.gridMetadata, scenePath, lightsPath);
   const LightmapUvs& uvs = r.lightmap.uvs;
@@ -1053,8 +1064,11 @@ PYBIND11_MODULE(lightoctree, m) {
         "default TEXCOORD_1 when the scene has one), content ('indirect' | 'full'), "
         "direct_samples (64), image ('exr' | 'png'), preview_unlit (False), exposure (0), "
         "atlas_on ('cpu' | 'osmesa' | 'egl'), directions ('on' | 'off'), chart_image (False), "
-        "sky, sky_image, sky_mesh, physical_sky. Returns what it wrote: the figures of "
-        "`lightmap --json` (page_files, gltf, pages, texel_size, ...) and the files' bytes.");
+        "sky, sky_image, sky_mesh, physical_sky. progress(task, done, total) is called at each "
+        "step; an exception it raises, or Ctrl-C, stops the export and is raised, and no file "
+        "of it is left (an earlier export's files stay as they were). Returns what it wrote: "
+        "the figures of `lightmap --json` (page_files, gltf, pages, texel_size, ...) and the "
+        "files' bytes.");
   m.def("read_image", &readImageFile, py::arg("path"),
         "An image file: EXR as linear floats, PNG decoded from sRGB; shape (height, width, 3).");
 }

@@ -711,3 +711,45 @@ def test_render_and_lightmap_warn_of_a_grid_baked_from_another_scene(grid, grid_
     with pytest.warns(UserWarning, match="^" + re.escape(grid_file) + stale):
         lightoctree.lightmap(changed, grid_file, str(out / "lit.glb"), directions="off")
     assert os.path.exists(out / "lit.glb")
+
+
+def test_ctrl_c_during_lightmap_leaves_no_file_of_it(grid_file, tmp_path):
+    """Ctrl-C during the export was raised only when it ended, its files
+    written. Now each step reports (to `progress`, and to the interpreter's
+    signal handlers), the last one after the last file and before the
+    renames: a SIGINT there stops the export, its temporary files removed,
+    and an earlier export's files stay as they were."""
+    import signal
+    out = tmp_path / "out"
+    out.mkdir()
+    output = str(out / "lit.glb")
+    tasks = []
+
+    def interrupt(task, done, total):
+        tasks.append((task, done, total))
+        if task == "lightmap: write" and done == total - 1:  # every file written, none renamed
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt):
+        lightoctree.lightmap(SCENE, grid_file, output, progress=interrupt)
+    assert [t for t, done, _ in tasks if done == 0] == ["lightmap: octree", "lightmap: atlas",
+                                                  "lightmap: encode", "lightmap: write"]
+    assert os.listdir(out) == []  # not a file, not a temporary one
+    # An earlier export (one page, no direction page) stays as it was, whole.
+    lightoctree.lightmap(SCENE, grid_file, output, directions="off", image="png")
+    before = {name: (out / name).read_bytes() for name in os.listdir(out)}
+    assert sorted(before) == ["lit-lightmap0.png", "lit.glb"]
+    with pytest.raises(KeyboardInterrupt):
+        lightoctree.lightmap(SCENE, grid_file, output, progress=interrupt)
+    assert {name: (out / name).read_bytes() for name in os.listdir(out)} == before
+
+    # A callback that raises stops it at any step, the same way.
+    for step in ("lightmap: octree", "lightmap: atlas", "lightmap: encode", "lightmap: write"):
+        def stop(task, done, total, step=step):
+            if task == step:
+                raise Stop(step)
+        with pytest.raises(Stop, match=step):
+            lightoctree.lightmap(SCENE, grid_file, output, progress=stop)
+        assert {name: (out / name).read_bytes() for name in os.listdir(out)} == before, step
+    with pytest.raises(ValueError, match="progress: must be a callable"):
+        lightoctree.lightmap(SCENE, grid_file, output, progress=3)

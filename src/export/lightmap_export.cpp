@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "core/error.h"
 #include "core/file_set.h"
@@ -106,6 +107,9 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
   result.output = params.output;
   std::vector<StageReport>& rows = result.stages;
 
+  // One task per step, so that a sink may stop the export between them
+  // (LightmapExportParams::progress); replaced by the next step's.
+  std::optional<Progress> step(std::in_place, params.progress, "lightmap: octree", 1);
   StageTimer octreeTimer(rows, "octree");
   const GpuOctree octree = makeOctree();
   result.octreeLeaves = octree.leafCount;
@@ -143,6 +147,7 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
     gpu = std::make_unique<GpuAtlasEvaluator>();
     bake.atlas.evaluator = gpu.get();
   }
+  step.emplace(params.progress, "lightmap: atlas", 1);
   result.lightmap = bakeLightmap(scene, octree, bake);
   const LightmapUvs& uvs = result.lightmap.uvs;
   const LightmapAtlas& atlas = result.lightmap.atlas;
@@ -162,6 +167,7 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
              formatNumber(atlas.seamMismatchAfter) + " W/m^2");
 
   // Everything is encoded in memory first; the files are written last.
+  step.emplace(params.progress, "lightmap: encode", 1);
   StageTimer encodeTimer(rows, "encode");
   LightmapExport ex;
   ex.uv = uvs.uv;
@@ -211,7 +217,13 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
   StageTimer writeTimer(rows, "write");
   // The whole set appears at once, or nothing does: every file goes to its
   // temporary name first, and a failure (a link planted at the preview's
-  // name, a full disk, a signal) leaves an earlier run's set as it was.
+  // name, a full disk, a signal, a sink that stops it) leaves an earlier
+  // run's set as it was. A step per file, and the commit's: the last report
+  // that may stop the export comes after the last file, before the renames.
+  step.reset();
+  const size_t files = size_t(atlas.pageCount) + directionPngs.size() + 1 +
+                       (params.preview ? 1 : 0) + (params.chartImages ? size_t(uvs.pageCount) : 0);
+  Progress written(params.progress, "lightmap: write", files + 1);  // the glTF and its .bin: one
   AtomicFileSet set;
   for (int p = 0; p < atlas.pageCount; ++p) {
     const std::string& path = result.pagePaths[size_t(p)];
@@ -221,19 +233,26 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
       writeExr(path, nonNegative(atlas.irradiance[size_t(p)]), &set);
     }
     result.pageFileBytes += size_t(set.bytesOf(path));
+    written.advance();
   }
   for (size_t p = 0; p < directionPngs.size(); ++p) {
     const std::string& path = result.directionPaths[p];
     set.addText(path, std::string(directionPngs[p].begin(), directionPngs[p].end()));
     result.pageFileBytes += size_t(set.bytesOf(path));
+    written.advance();
   }
   writeGltfFiles(lit, params.output, &set);
-  if (params.preview) writeGltfFiles(unlit, result.previewPath, &set);
+  written.advance();
+  if (params.preview) {
+    writeGltfFiles(unlit, result.previewPath, &set);
+    written.advance();
+  }
   if (params.chartImages) {
     for (int p = 0; p < uvs.pageCount; ++p) {
       result.chartPaths.push_back(besideOutput(params.output, "-charts" + std::to_string(p) + ".png"));
       const std::vector<uint8_t> png = encodePng(chartLayoutImage(uvs, p));
       set.addText(result.chartPaths.back(), std::string(png.begin(), png.end()));
+      written.advance();
     }
   }
   // Numbered files an earlier export left beside OUT that this one does not
@@ -242,6 +261,7 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
   removeStaleSiblings(params.output, set);
   if (params.beforeCommit) params.beforeCommit(result, set);
   set.commit();
+  written.advance();
   writeTimer.finish(formatCount(size_t(atlas.pageCount) + result.directionPaths.size() + 1 +
                                 (params.preview ? 1 : 0) + result.chartPaths.size()) +
                     " files");

@@ -30,6 +30,7 @@
 
 #include "core/file.h"
 #include "core/file_set.h"
+#include "core/progress.h"
 #include <vector>
 
 #include "core/resources.h"
@@ -85,6 +86,14 @@ struct LightmapExportParams {
   /// set is renamed into place: a command adds its side files (its `--json`
   /// report) there, so that they appear with the set or not at all.
   std::function<void(const LightmapExportResult&, AtomicFileSet&)> beforeCommit;
+  /// Told of each step (core/progress.h): "lightmap: octree", "lightmap:
+  /// atlas", "lightmap: encode", then "lightmap: write", one step per file
+  /// and the last before the commit. A sink that throws from begin() or
+  /// from update() with done < total stops the export there: files not yet
+  /// committed are removed, an earlier export's set stays as it was (the
+  /// Python module's Ctrl-C; the command ends by the signal itself). Null:
+  /// nothing told.
+  ProgressSink* progress = nullptr;
 };
 
 struct LightmapExportResult {
