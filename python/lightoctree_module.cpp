@@ -13,6 +13,7 @@
 
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <exception>
 #include <initializer_list>
@@ -29,6 +30,7 @@
 #include "core/file.h"
 #include "core/number_range.h"
 #include "core/progress.h"
+#include "core/resources.h"
 #include "export/lightmap_export.h"
 #include "image/compare.h"
 #include "image/image.h"
@@ -138,9 +140,28 @@ class CallbackProgress : public ProgressSink {
   void begin(const std::string& task, size_t total) override { report(0, total, true, &task); }
   void update(size_t done, size_t total) override { report(done, total, done < total); }
   void end() override {}
-  /// With the interpreter's lock: raises what stopped the work, if anything.
-  void raiseIfStopped() {
+  /// From MemoryWatch's thread (no lock): the process grew to `rss` bytes,
+  /// past the limit; the next report that may stop the work stops it.
+  void stopForMemory(size_t rss) {
+    memoryRss_ = rss;
+    stopped_ = true;
+  }
+  /// With the interpreter's lock: raises what stopped the work, if anything:
+  /// a callback's exception or Ctrl-C's KeyboardInterrupt (also one raised at
+  /// a stage's last report, after which the work ended), or, when the work
+  /// did not end, MemoryError naming `call` and LIGHTOCTREE_MEMORY_LIMIT.
+  void raiseIfStopped(const char* call, size_t limit, bool workEnded) {
     if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+    const size_t rss = memoryRss_.exchange(0);
+    if (rss && !workEnded) {
+      const char* setting = std::getenv("LIGHTOCTREE_MEMORY_LIMIT");
+      const std::string text =
+          std::string(call) + ": out of memory: the process grew to " + formatBytes(rss) +
+          ", past LIGHTOCTREE_MEMORY_LIMIT=" + (setting ? setting : "") + " (" +
+          formatBytes(limit) + "); stopped, nothing returned or written";
+      PyErr_SetString(PyExc_MemoryError, text.c_str());
+      throw py::error_already_set();
+    }
   }
 
  private:
@@ -160,21 +181,30 @@ class CallbackProgress : public ProgressSink {
   py::object callback_;
   std::string task_;
   std::atomic<bool> stopped_{false};
+  std::atomic<size_t> memoryRss_{0};
   std::exception_ptr error_;
 };
 
-/// work(sink) without the interpreter's lock, its progress to `progress`
-/// (a callable or None); raises what stopped it (module comment above).
+/// work(sink) of the Python function `call` without the interpreter's lock,
+/// its progress to `progress` (a callable or None); raises what stopped it
+/// (module comment above). With LIGHTOCTREE_MEMORY_LIMIT set, the process's
+/// resident memory is watched as the command watches it (MemoryWatch,
+/// tools/lightoctree.cpp): a call that grows past it is stopped at its next
+/// progress report and raises MemoryError; the interpreter goes on, where
+/// the command ends. Work that ended before a report could stop it returns.
 template <typename Work>
-auto withProgress(const py::object& progress, Work work) {
+auto withProgress(const py::object& progress, const char* call, Work work) {
+  const size_t limit = memoryLimitSetting();
   CallbackProgress sink(progress);
   std::optional<decltype(work(&sink))> result;
   try {
+    // Declared after `sink`, so its thread ends before the sink goes.
+    const MemoryWatch watch(limit, [&sink](size_t rss) { sink.stopForMemory(rss); });
     py::gil_scoped_release unlocked;
     result.emplace(work(&sink));
   } catch (const Stopped&) {
   }
-  sink.raiseIfStopped();  // also a callback that raised at a stage's last report
+  sink.raiseIfStopped(call, limit, result.has_value());
   if (!result) throw InputError("stopped");  // not reached: a stop has its error
   return std::move(*result);
 }
@@ -398,8 +428,8 @@ GridPtr convertGrid(const Grid& in, const Arg<int>& depthArg, const Arg<std::str
     scene = loadScene(scenePath);
     params.scene = &scene;
   }
-  // No callback (convert takes none), but Ctrl-C stops it.
-  ConvertResult r = withProgress(py::none(), [&](ProgressSink* sink) {
+  // No callback (convert takes none), but Ctrl-C and the memory watch stop it.
+  ConvertResult r = withProgress(py::none(), "convert", [&](ProgressSink* sink) {
     return convertLightGrid(in.grid, in.meta, params, sink);
   });
   auto out = std::make_shared<Grid>();
@@ -626,7 +656,7 @@ GridPtr bakeScene(const Arg<std::string>& sceneArg, const Arg<int>& depthArg,
   params.includeDirect = includeDirect;
   params.targetSeenLight = targetLight == "seen";
   auto out = std::make_shared<Grid>();
-  BakeResult r = withProgress(progress, [&](ProgressSink* sink) {
+  BakeResult r = withProgress(progress, "bake", [&](ProgressSink* sink) {
     BakeResult result = bake(scene, params, sink);
     recordSourceScene(result.metadata, scenePath);
     return result;
@@ -687,7 +717,7 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
   });
   const ReferenceParams params = referenceParams(opt);
   const ReferenceImage r = withPythonNames([&] {
-    return withProgress(progress, [&](ProgressSink* sink) {
+    return withProgress(progress, "reference", [&](ProgressSink* sink) {
       const Scene scene = loadSceneWith(opt);
       const PinholeCamera view = chooseCamera(opt.camera, scene, opt.scene);
       return renderReference(scene, view, params, sink);
@@ -887,7 +917,7 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
   // Its steps to `progress`, and Ctrl-C at each: a stop before the commit
   // leaves no file of this export (an earlier export's set as it was).
   const LightmapExportResult r = withPythonNames([&] {
-    return withProgress(progress, [&](ProgressSink* sink) {
+    return withProgress(progress, "lightmap", [&](ProgressSink* sink) {
       p.progress = sink;
       return exportLightmap(loadSceneWith(scenePath, scene), lightsPath, p);
     });

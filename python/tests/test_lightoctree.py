@@ -753,3 +753,33 @@ def test_ctrl_c_during_lightmap_leaves_no_file_of_it(grid_file, tmp_path):
         assert {name: (out / name).read_bytes() for name in os.listdir(out)} == before, step
     with pytest.raises(ValueError, match="progress: must be a callable"):
         lightoctree.lightmap(SCENE, grid_file, output, progress=3)
+
+
+def test_the_memory_limit_stops_a_call_that_grows_past_it():
+    """LIGHTOCTREE_MEMORY_LIMIT held in the module's estimates only, not
+    while a call ran: a bake that grows past it now stops at its next
+    progress report with MemoryError, as the command stops (which ends the
+    process); the interpreter goes on. In a child, whose limit is its own
+    resident memory after the import plus a little."""
+    import subprocess
+    import sys
+    code = r"""
+import os, sys, lightoctree
+with open("/proc/self/statm") as f:
+    rss = int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+os.environ["LIGHTOCTREE_MEMORY_LIMIT"] = str(rss + (24 << 20))
+try:
+    lightoctree.bake(sys.argv[1], depth=5, photons=300000)
+    print("not stopped")
+except MemoryError as e:
+    print("stopped:", e)
+os.environ["LIGHTOCTREE_MEMORY_LIMIT"] = "8G"
+print("after:", lightoctree.bake(sys.argv[1], depth=3, photons=5000).size > 0)
+"""
+    run = subprocess.run([sys.executable, "-c", code, SCENE], capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert re.search(r"^stopped: bake: out of memory: the process grew to [0-9.]+ [KMG]iB, past "
+                     r"LIGHTOCTREE_MEMORY_LIMIT=[0-9]+ \([0-9.]+ [KMG]iB\); stopped, nothing returned "
+                     r"or written$", run.stdout, re.M), run.stdout
+    assert "after: True" in run.stdout, run.stdout
