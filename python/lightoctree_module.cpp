@@ -964,6 +964,12 @@ PYBIND11_MODULE(lightoctree, m) {
   py::register_exception<IoError>(m, "IoError", PyExc_OSError);
 
   py::class_<Grid, GridPtr>(m, "Grid", "A light grid: voxels with irradiance and VDLs (or SH).")
+      // Only the module makes grids: pybind11 gave Grid.__new__(Grid) an
+      // object allocated but never constructed, whose use crashed Python.
+      .def_static("__new__", [](const py::args&, const py::kwargs&) -> py::object {
+        throw py::type_error("lightoctree.Grid is made by read(), bake() and convert(), not "
+                             "directly");
+      })
       .def_property_readonly("size", [](const Grid& g) { return g.grid.size(); },
                              "Active voxels")
       .def_property_readonly("depth", [](const Grid& g) { return g.grid.frame.depth; })

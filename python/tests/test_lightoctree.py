@@ -99,6 +99,15 @@ def test_lookup_sees_the_light_from_the_front_and_none_from_behind(grid):
         lightoctree.lookup(grid, np.zeros((3, 2)), np.zeros((3, 2)))
 
 
+def test_a_grid_is_made_by_the_module_not_directly(grid):
+    """Grid.__new__(Grid) gave an object allocated but never constructed,
+    whose lookup crashed the interpreter: only the module makes grids."""
+    for make in (lambda: lightoctree.Grid.__new__(lightoctree.Grid), lambda: lightoctree.Grid()):
+        with pytest.raises(TypeError, match="made by read"):
+            make()
+    assert grid.size > 0  # the module's own grids are still made
+
+
 @pytest.mark.parametrize("argument, bad", [
     ("points", [math.nan, 0.5, 0.5]), ("points", [0.5, math.inf, 0.5]),
     ("points", [0.5, 0.5, -math.inf]), ("points", [1e39, 0.5, 0.5]),  # inf as a float
