@@ -16,10 +16,7 @@ namespace lo::tool {
 namespace {
 
 struct CompareOptions {
-  std::string test;
-  std::string reference;
-  std::string mask;
-  std::string referenceError;
+  std::string test, reference, mask, referenceError;
   bool ignoreBackground = false;
   int bin = 1;
   float clipPercentile = 100;
@@ -112,10 +109,9 @@ int runCompare(const CompareOptions& opt) {
                  "render it with more samples or compare over larger --bin blocks\n",
                  noise, result.luminance.relRmse);
   }
-  // Pixels left out for NaN or inf: the figures are of the rest, which a
-  // reader of the figures alone would not know (--quiet too, as above).
-  const std::string nonFinite = report.nonFiniteWarning();
-  if (!nonFinite.empty()) std::fprintf(stderr, "warning: %s\n", nonFinite.c_str());
+  // Pixels left out for NaN or inf, which the figures alone hide (--quiet too).
+  if (const std::string w = report.nonFiniteWarning(); !w.empty())
+    std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (!opt.diff.empty()) {
     // Linear float values in an EXR; PNG keeps the false colour as it is.
     writeImage(opt.diff, differenceImage(report.test, report.reference, report.params(), opt.diffScale));
