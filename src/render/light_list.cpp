@@ -29,7 +29,8 @@ float radicalInverse(uint32_t i) {
 
 }  // namespace
 
-AreaLightSet areaLights(const Scene& scene, const RenderSpace& space) {
+AreaLightSet areaLights(const Scene& scene, const EmitterSampler& sampler,
+                        const RenderSpace& space) {
   // The emissive triangles, a double-sided one as two one-sided ones.
   struct Emitter {
     Vec3 p[3];
@@ -37,11 +38,10 @@ AreaLightSet areaLights(const Scene& scene, const RenderSpace& space) {
     size_t triangle;
   };
   std::vector<Emitter> emitters;
-  for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    int m = t < scene.triangleMaterial.size() ? scene.triangleMaterial[t] : -1;
-    if (m < 0 || size_t(m) >= scene.materials.size()) continue;
-    const Vec3 emission = scene.triangleEmission(t);
-    if (!(maxComponent(emission) > 0) || !(scene.triangleArea(t) > 0)) continue;
+  for (size_t k = 0; k < sampler.size(); ++k) {
+    const size_t t = sampler.triangles[k];
+    const int m = scene.triangleMaterial[t];
+    const Vec3 emission = sampler.emission[k];
     Emitter e{{space.toRender(scene.positions[scene.indices[t * 3]]),
                space.toRender(scene.positions[scene.indices[t * 3 + 1]]),
                space.toRender(scene.positions[scene.indices[t * 3 + 2]])},
@@ -185,8 +185,8 @@ AreaLightSet areaLights(const Scene& scene, const RenderSpace& space) {
   return out;
 }
 
-std::vector<GpuLight> emitterVpls(const Scene& scene, const RenderSpace& space, int count) {
-  const EmitterSampler emitters = buildEmitterSampler(scene);
+std::vector<GpuLight> emitterVpls(const Scene& scene, const EmitterSampler& emitters,
+                                  const RenderSpace& space, int count) {
   std::vector<GpuLight> out;
   if (emitters.empty() || count <= 0) return out;
   const double total = emitters.total();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "render/render_space.h"
+#include "scene/emitter_sampler.h"
 #include "scene/scene.h"
 
 namespace lo::render_internal {
@@ -31,7 +32,10 @@ struct AreaLightSet {
   std::vector<glm::vec4> triangles;
   size_t triangleCount() const { return triangles.size() / 3; }
 };
-AreaLightSet areaLights(const Scene& scene, const RenderSpace& space);
+/// `sampler` is buildEmitterSampler(scene): the emissive triangles with their
+/// mean emission, read from their textures once for both kinds of lights.
+AreaLightSet areaLights(const Scene& scene, const EmitterSampler& sampler,
+                        const RenderSpace& space);
 
 /// Emissive triangles -> `count` virtual point lights (LO_LIGHT_EMITTER,
 /// render space), chosen in proportion to emitted power by the tracers'
@@ -40,6 +44,7 @@ AreaLightSet areaLights(const Scene& scene, const RenderSpace& space);
 /// I(theta) = colorFar.rgb cos(theta) (W/sr), i.e. of power pi colorFar.rgb:
 /// together they carry the sampler's total power. A double-sided emitter's
 /// samples alternate sides.
-std::vector<GpuLight> emitterVpls(const Scene& scene, const RenderSpace& space, int count);
+std::vector<GpuLight> emitterVpls(const Scene& scene, const EmitterSampler& emitters,
+                                  const RenderSpace& space, int count);
 
 }  // namespace lo::render_internal

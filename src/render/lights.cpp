@@ -102,10 +102,11 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
   shadowMapSize = params.shadowMapSize;
   std::vector<GpuLight> lights;
   for (const Light& light : scene.lights) lights.push_back(punctualLight(light, space));
-  AreaLightSet area = params.areaLights ? areaLights(scene, space) : AreaLightSet{};
+  const EmitterSampler sampler = buildEmitterSampler(scene);
+  AreaLightSet area = params.areaLights ? areaLights(scene, sampler, space) : AreaLightSet{};
   std::vector<GpuLight> emitters = area.lights;
   if (emitters.empty()) {
-    emitters = emitterVpls(scene, space, params.emitterLights);
+    emitters = emitterVpls(scene, sampler, space, params.emitterLights);
     emitterLights = int(emitters.size());
   } else {
     areaLightCount = int(emitters.size());

@@ -1,8 +1,12 @@
 #include "scene/emitter_sampler.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 
@@ -14,34 +18,66 @@ void cellSamples(int c, float b1[4], float b2[4]);
 }  // namespace emitter_sampler_internal
 
 EmitterSampler buildEmitterSampler(const Scene& scene) {
+  // Each emissive triangle's area, mean emission and texture cells, in
+  // parallel: a textured emitter reads its texture 512 times (the emissive
+  // helmet's 15,000 triangles took 0.4 s of a render's start); then the
+  // entries in triangle order, as one thread made them.
+  struct Figures {
+    bool emits = false, textured = false;
+    float area = 0;
+    Vec3 emission{0, 0, 0};
+    float cells[kEmitterCells];
+  };
+  constexpr size_t kBlock = 16384;  // triangles per parallel block: 4 MiB of figures
+  const size_t n = scene.triangleCount();
+  std::vector<Figures> block;
   EmitterSampler s;
-  for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    const Material& m = scene.materials[size_t(scene.triangleMaterial[t])];
-    if (!m.isEmissive()) continue;
-    const float area = scene.triangleArea(t);
-    if (!(area > 0)) continue;
-    const float sides = m.doubleSided ? 2.0f : 1.0f;
-    const Vec3 emission = scene.triangleEmission(t);
-    const Vec3 power = emission * (sides * kPi * area);
-    if (!isFinite(power))
-      throw InputError("material '" + m.name + "' of triangle " + std::to_string(t) +
-                       " emits non-finite power " + power.ToString());
-    if (!(average(power) > 0)) continue;
-    s.triangles.push_back(uint32_t(t));
-    s.power.push_back(power);
-    s.emission.push_back(emission);
-    s.distribution.add(double(average(power)));
-    s.cellTable.push_back(-1);
-    if (m.emissiveTexture >= 0) {
-      s.cellTable.back() = int32_t(s.cellCdf.size());
-      float sum = 0;
-      // A cell's weight: the emission at its four sub-triangles' centroids,
-      // four of the 256 points its triangle's mean averages.
-      for (int c = 0; c < kEmitterCells; ++c) {
-        float b1[4], b2[4];
-        emitter_sampler_internal::cellSamples(c, b1, b2);
-        for (int k = 0; k < 4; ++k) sum += std::max(0.0f, average(scene.emission(t, b1[k], b2[k])));
-        s.cellCdf.push_back(sum);
+  for (size_t first = 0; first < n; first += kBlock) {
+    const size_t count = std::min(kBlock, n - first);
+    block.assign(count, Figures{});
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 64),
+                      [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) {
+        const size_t t = first + i;
+        const Material& m = scene.materials[size_t(scene.triangleMaterial[t])];
+        if (!m.isEmissive()) continue;
+        Figures& f = block[i];
+        f.area = scene.triangleArea(t);
+        if (!(f.area > 0)) continue;
+        f.emits = true;
+        f.emission = scene.triangleEmission(t);
+        if (m.emissiveTexture < 0) continue;
+        f.textured = true;
+        float sum = 0;
+        // A cell's weight: the emission at its four sub-triangles' centroids,
+        // four of the 256 points its triangle's mean averages.
+        for (int c = 0; c < kEmitterCells; ++c) {
+          float b1[4], b2[4];
+          emitter_sampler_internal::cellSamples(c, b1, b2);
+          for (int k = 0; k < 4; ++k) sum += std::max(0.0f, average(scene.emission(t, b1[k], b2[k])));
+          f.cells[c] = sum;
+        }
+      }
+    });
+    for (size_t i = 0; i < count; ++i) {
+      const Figures& f = block[i];
+      if (!f.emits) continue;
+      const size_t t = first + i;
+      const Material& m = scene.materials[size_t(scene.triangleMaterial[t])];
+      const float sides = m.doubleSided ? 2.0f : 1.0f;
+      const Vec3 power = f.emission * (sides * kPi * f.area);
+      if (!isFinite(power))
+        throw InputError("material '" + m.name + "' of triangle " + std::to_string(t) +
+                         " emits non-finite power " + power.ToString());
+      if (!(average(power) > 0)) continue;
+      s.triangles.push_back(uint32_t(t));
+      s.power.push_back(power);
+      s.emission.push_back(f.emission);
+      s.distribution.add(double(average(power)));
+      s.cellTable.push_back(-1);
+      if (f.textured) {
+        s.cellTable.back() = int32_t(s.cellCdf.size());
+        s.cellCdf.insert(s.cellCdf.end(), f.cells, f.cells + kEmitterCells);
       }
     }
   }

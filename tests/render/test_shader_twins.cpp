@@ -213,7 +213,7 @@ TEST(RenderLights, VplPowerIsTheEmitterSamplersPower) {
   space.sceneSize = length(scene.bounds().extent());
   for (int count : {1, 7, 16, 64}) {
     const std::vector<render_internal::GpuLight> vpls =
-        render_internal::emitterVpls(scene, space, count);
+        render_internal::emitterVpls(scene, sampler, space, count);
     ASSERT_EQ(vpls.size(), size_t(count));
     // Each VPL is a one-sided Lambertian patch of intensity colorFar cos:
     // power pi colorFar.
