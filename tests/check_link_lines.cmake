@@ -9,7 +9,7 @@
 set(allowed_lo_core "TBB::tbb")
 set(allowed_lo_lightgrid "")
 set(allowed_lo_image "OpenEXR::OpenEXR")
-set(allowed_lo_scene "tinyobjloader::tinyobjloader;nlohmann_json::nlohmann_json")
+set(allowed_lo_scene "tinyobjloader::tinyobjloader;nlohmann_json::nlohmann_json;TBB::tbb")
 set(allowed_lo_material "")
 set(allowed_lo_raytrace "embree")
 set(allowed_lo_photon "TBB::tbb")
