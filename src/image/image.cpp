@@ -520,8 +520,12 @@ StoredImage decodeChecked(const unsigned char* bytes, size_t size) {
   stbi_uc* data = stbi_load_from_memory(bytes, n, &w, &h, &comp, 0);
   if (!data || w <= 0 || h <= 0 || comp < 1 || comp > 4) {
     if (data) stbi_image_free(data);
+    // stb names no reason for a format it was built without (a GIF, a BMP):
+    // say what is read instead of an empty reason.
     const char* reason = stbi_failure_reason();
-    throw InputError(reason ? reason : "cannot decode");
+    throw InputError(reason && *reason ? reason
+                                       : "not a PNG, JPEG or HDR image this tool decodes (glTF "
+                                         "textures are PNG or JPEG)");
   }
   finish(data, out.unorm8);
   return out;

@@ -469,5 +469,15 @@ TEST(ReadImage, AnExrThatHoldsLessThanItsHeaderIsRefusedUnread) {
   EXPECT_EQ(readImage(dir + "/small.exr").rgb, ramp(16, 8000).rgb);
 }
 
+// A GIF whose header holds no frame (14 bytes, from a glTF's data URI): stb
+// refuses it with no reason, and the message was "unreadable image ...: "
+// and nothing; it now says which formats are read.
+TEST(ReadImage, AnImageRefusedWithoutAReasonIsNamedNotLeftBlank) {
+  const std::string gif("GIF89a\x01\x00\x01\x00\x00\x00\x00;", 14);
+  test::expectRefusal(
+      [&] { decodeStoredImage(reinterpret_cast<const unsigned char*>(gif.data()), gif.size()); },
+      {"not a PNG, JPEG or HDR image"});
+}
+
 }  // namespace
 }  // namespace lo
