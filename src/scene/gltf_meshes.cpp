@@ -99,6 +99,14 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
       for (size_t i = 0; i < nverts; ++i) idx[i] = uint32_t(i);
     }
     std::vector<std::array<uint32_t, 3>> tris = triangulate(idx, mode);
+    // glTF asks triangles for a multiple of three: the loader reads the
+    // whole triangles and says what it left out (35 indices lost 2 silently).
+    if (mode == TINYGLTF_MODE_TRIANGLES && idx.size() % 3 != 0) {
+      scene_.warnings.push_back(path_ + ": " + what + ": " + std::to_string(idx.size()) +
+                                (prim.indices >= 0 ? " indices" : " vertices") +
+                                " are not a whole number of triangles: the last " +
+                                std::to_string(idx.size() % 3) + " are left out");
+    }
 
     int material = prim.material;
     if (material < 0)

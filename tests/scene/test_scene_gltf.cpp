@@ -340,6 +340,24 @@ TEST_F(SceneGltf, ASceneFarFromTheOriginKeepsItsPrecision) {
   EXPECT_EQ(near.lights[0].position, Vec3(1.5f, 2.25f, 4.0f));
 }
 
+// Triangles take a multiple of three indices: the whole triangles are read
+// and the rest named in a warning (35 indices lost 2 without a word).
+TEST_F(SceneGltf, IndicesThatAreNotWholeTrianglesAreNamed) {
+  MiniGltf g = oneTriangle();
+  g.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  g.normals = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+  g.indices = {0, 1, 2, 1, 3};
+  const Scene s = loadScene(write("five.gltf", g));
+  EXPECT_EQ(s.triangleCount(), 1u);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("5 indices are not a whole number of triangles: the last 2 are "
+                               "left out"),
+            std::string::npos)
+      << s.warnings[0];
+  const Scene whole = loadScene(write("three.gltf", oneTriangle()));
+  EXPECT_TRUE(whole.warnings.empty());
+}
+
 // Extensions: one the file requires and the loader does not read is
 // refused by name, with what to do (a Draco file failed on its accessors'
 // missing buffer views, naming neither); one it only uses is a warning;
