@@ -63,4 +63,26 @@ class DiscreteDistribution {
   std::vector<double> cdf_;  ///< inclusive running sums; back() = total
 };
 
+/// One of `count` cells whose cumulative weights are `cdf` (cdf[count - 1] >
+/// 0): evenly with probability `spread`, else by its weight, u in [0, 1)
+/// rescaled for the choice within each branch. `weight` receives (1 / count)
+/// / the cell's probability, the factor that keeps an estimate unbiased; no
+/// cell weighs more than 1 / spread. The texture cells of an emissive
+/// triangle (scene/emitter_sampler.h) and the direction cells of its light
+/// (photon/emission_guide.h) are picked so.
+inline int pickCellWithSpread(const float* cdf, int count, float spread, float u, float& weight) {
+  const float total = cdf[count - 1];
+  int cell = 0;
+  if (u < spread) {
+    cell = std::min(int(u / spread * float(count)), count - 1);
+  } else {
+    const float x = (u - spread) / (1.0f - spread) * total;
+    cell = std::min(int(std::upper_bound(cdf, cdf + count, x) - cdf), count - 1);
+  }
+  const float w = cdf[cell] - (cell > 0 ? cdf[cell - 1] : 0.0f);
+  const float p = spread / float(count) + (1.0f - spread) * w / total;
+  weight = 1.0f / (float(count) * p);
+  return cell;
+}
+
 }  // namespace lo

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <numeric>
 
+#include "core/discrete_distribution.h"
 #include "material/bsdf.h"
 #include "raytrace/ray_tracer.h"
 
@@ -35,7 +36,6 @@ EmissionGuide::EmissionGuide(const Scene& scene, const EmitterSampler& emitters,
     for (size_t side = 0; side < count; ++side) sides.push_back(2 * k + uint32_t(side));
   }
   std::sort(sides.begin(), sides.end());
-  probeRays_ = sides.size() * kSideRays;
 
   // Hits per cell of each probed side, in parallel (each side its own row).
   std::vector<uint8_t> hits(sides.size() * size_t(kCells), 0);
@@ -81,7 +81,6 @@ EmissionGuide::EmissionGuide(const Scene& scene, const EmitterSampler& emitters,
       sum += float(h[c]);
       cdf_.push_back(sum);
     }
-    ++guidedSides_;
   }
   for (size_t k = 0; k < n; ++k) {
     if (probed[k] > 0) pick_[k] = kSpread + (1.0f - kSpread) * float(met[k]) / float(probed[k]);
@@ -91,19 +90,8 @@ EmissionGuide::EmissionGuide(const Scene& scene, const EmitterSampler& emitters,
 void EmissionGuide::sample(uint32_t entry, bool back, float u0, float& u1, float& u2,
                            float& weight) const {
   const float* cdf = cdf_.data() + table_[2 * size_t(entry) + (back ? 1 : 0)];
-  const float total = cdf[kCells - 1];
-  // The cell: evenly with probability kSpread, else by its hits; u0 is
-  // rescaled for the choice within each branch.
-  int cell = 0;
-  if (u0 < kSpread) {
-    cell = std::min(int(u0 / kSpread * float(kCells)), kCells - 1);
-  } else {
-    const float x = (u0 - kSpread) / (1.0f - kSpread) * total;
-    cell = std::min(int(std::upper_bound(cdf, cdf + kCells, x) - cdf), kCells - 1);
-  }
-  const float w = cdf[cell] - (cell > 0 ? cdf[cell - 1] : 0.0f);
-  const float p = kSpread / float(kCells) + (1.0f - kSpread) * w / total;
-  weight = 1.0f / (float(kCells) * p);
+  // The cell: evenly with probability kSpread, else by its hits.
+  const int cell = pickCellWithSpread(cdf, kCells, kSpread, u0, weight);
   const int ring = cell / kSectors, sector = cell % kSectors;
   u1 = std::min((float(ring) + u1) / float(kRings), 1.0f - 1e-7f);
   u2 = std::min((float(sector) + u2) / float(kSectors), 1.0f - 1e-7f);

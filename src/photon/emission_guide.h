@@ -68,14 +68,11 @@ class EmissionGuide {
   float pickFactor(uint32_t entry) const {
     return size_t(entry) < pick_.size() ? pick_[entry] : 1.0f;
   }
-  size_t guidedSides() const { return guidedSides_; }
-  size_t probeRays() const { return probeRays_; }
 
  private:
   std::vector<int32_t> table_;  ///< per entry and side: where its kCells cumulative weights start, or -1
   std::vector<float> cdf_;
   std::vector<float> pick_;  ///< per entry: pickFactor
-  size_t guidedSides_ = 0, probeRays_ = 0;
 };
 
 }  // namespace lo

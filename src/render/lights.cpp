@@ -214,7 +214,8 @@ void SceneLights::allocateShadowMaps() {
   glDrawBuffer(GL_NONE);
   glReadBuffer(GL_NONE);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  shadowProgram = GlProgram(buildProgram({"render_shadow.vert", "render_shadow.geom", "render_shadow.frag"}));
+  shadowProgram =
+      GlProgram(buildProgram({"render_shadow.vert", "render_shadow.geom", "render_shadow.frag"}));
 }
 
 GLint SceneLights::beginShadowPass(GLuint vao) {

@@ -144,18 +144,8 @@ void EmitterSampler::samplePoint(size_t k, float u0, float u1, float u2, float& 
     // 513,516 paths and 14.3% (half evenly: 10.1%).
     constexpr float kSpread = 0.25f;
     if (total > 0) {
-      // The cell: evenly with probability kSpread, else by its emission;
-      // u0 is reused, rescaled, for the choice within each branch.
-      if (u0 < kSpread) {
-        cell = std::min(int(u0 / kSpread * float(kEmitterCells)), kEmitterCells - 1);
-      } else {
-        const float x = (u0 - kSpread) / (1.0f - kSpread) * total;
-        cell = int(std::upper_bound(cdf, cdf + kEmitterCells, x) - cdf);
-        cell = std::min(cell, kEmitterCells - 1);
-      }
-      const float w = cdf[cell] - (cell > 0 ? cdf[cell - 1] : 0.0f);
-      const float p = kSpread / float(kEmitterCells) + (1.0f - kSpread) * w / total;
-      weight = 1.0f / (float(kEmitterCells) * p);
+      // The cell: evenly with probability kSpread, else by its emission.
+      cell = pickCellWithSpread(cdf, kEmitterCells, kSpread, u0, weight);
     } else {
       cell = std::min(int(u0 * float(kEmitterCells)), kEmitterCells - 1);
     }
