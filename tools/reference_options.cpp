@@ -78,7 +78,8 @@ void addReferenceOptions(CLI::App* cmd, ReferenceOptions& opt) {
       ->check(wholeIn(0, 100000))
       ->capture_default_str();
   cmd->add_option("--std-error", opt.stdErrorOutput,
-                  "Also write the per-pixel standard error of the mean (.exr or .png)");
+                  "Also write the per-pixel standard error of the mean (.exr or .png); needs 2 or "
+                  "more samples per pixel");
   cmd->add_option("--emitter-mask", opt.emitterMaskOutput,
                   "Also write a mask for `compare --mask` (.png or .exr): white where the "
                   "pixel's centre sees no emissive surface, black on the light fixtures, whose "
