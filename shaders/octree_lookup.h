@@ -13,12 +13,14 @@
  *                    leaf that serves it)
  *   loServingLeaf    a voxel's leaf and its VDLs for a surface point, in one call
  *   loNearestServingLeaf  the voxel in front of the point, else behind, that serves it
- *   loShadeVdls      sum_i response(d_i) c_i over those VDLs (paper §4.2.2), or
- *                    the SH irradiance as one light from its dominant direction
+ *   loShadeVdlsFacing  sum_i response(d_i) c_i over those VDLs (paper §4.2.2),
+ *                    or the SH irradiance as one light from its dominant
+ *                    direction; their irradiance, and whether they face a surface
  *   loNearestLeaf    the voxel in front of a surface point, else the one behind it
  *   loOctreeIndirect the indirect light at a surface point: trilinear over the 8
  *                    voxels around it with empty ones left out and the weights
  *                    renormalized (§4.2.1), else the voxel in front, else behind
+ *                    (loOctreeIndirectIrradiance: with the irradiance beside it)
  *   loOctreeIrradiance the same lookup's irradiance and the direction it comes
  *                    from, for lightmaps (§4.2.3)
  *   loVolumeIndirect the free-space octree's light at a point of an object
@@ -234,25 +236,18 @@ LO_LOOKUP_FN vec3 loShIrradiance(LO_TEX_PARAM uint first, vec3 n, LO_OUT(vec3) d
  * the dominant direction d (the surface's normal where d lies below or
  * along its horizon): response(d) E(n) / (n . d), which is E(n) times the
  * BRDF for a diffuse surface and keeps a specular highlight along d. */
-LO_LOOKUP_FN vec3 loShadeSh(LO_TEX_PARAM uint first, LoSurface s) {
+LO_LOOKUP_FN vec3 loShadeShIrradiance(LO_TEX_PARAM uint first, LoSurface s,
+                                      LO_OUT(vec3) irradiance) {
   vec3 d;
-  vec3 e = loShIrradiance(LO_TEX first, s.n, d);
+  irradiance = loShIrradiance(LO_TEX first, s.n, d);
   if (!(dot(s.n, d) > 0.05f)) d = s.n;
-  return loVdlResponse(s, d) * e / max(dot(s.n, d), 0.05f);
+  return loVdlResponse(s, d) * irradiance / max(dot(s.n, d), 0.05f);
 }
 
-/* Paper §4.2.2: c = sum_i brdf(d_i, v, n) c_i over the first maxVdls of the
- * `count` VDLs at `first` (the strongest come first), each a directional light
- * of irradiance c_i. In an SH octree, loShadeSh. */
-LO_LOOKUP_FN vec3 loShadeVdls(LO_TEX_PARAM uint first, int count, int maxVdls, LoSurface s) {
-  if (LO_SH_TERMS > 0) return loShadeSh(LO_TEX first, s);
-  int n = min(count, maxVdls);
-  vec3 sum = vec3(0.0f);
-  for (int i = 0; i < n; ++i) {
-    vec4 t = loFetchVdl(LO_TEX first + uint(i));
-    sum += loVdlResponse(s, loVdlDirection(t.a)) * vec3(t);
-  }
-  return sum;
+/* loShadeShIrradiance without the irradiance. */
+LO_LOOKUP_FN vec3 loShadeSh(LO_TEX_PARAM uint first, LoSurface s) {
+  vec3 e;
+  return loShadeShIrradiance(LO_TEX first, s, e);
 }
 
 /* The voxel under a surface point: q is the point in voxel units, already
@@ -281,6 +276,33 @@ LO_LOOKUP_FN bool loLeafFaces(LO_TEX_PARAM uint first, int count, int maxVdls, v
     if (dot(ng, loVdlDirection(loFetchVdl(LO_TEX first + uint(i)).a)) > 0.0f) return true;
   }
   return false;
+}
+
+/* Paper §4.2.2: c = sum_i brdf(d_i, v, n) c_i over the first maxVdls of the
+ * `count` VDLs at `first` (the strongest come first), each a directional light
+ * of irradiance c_i (in an SH octree, loShadeShIrradiance); beside it, from
+ * the same fetch of each VDL, their irradiance sum_i max(0, n . d_i) c_i and
+ * whether any of them faces ng (loLeafFaces). The shader's walk thus gives
+ * the light a surface reflects and the irradiance its probe is normalised by
+ * at once (render_scene.frag). */
+LO_LOOKUP_FN vec3 loShadeVdlsFacing(LO_TEX_PARAM uint first, int count, int maxVdls, LoSurface s,
+                                    LO_OUT(vec3) irradiance, LO_OUT(bool) faces) {
+  if (LO_SH_TERMS > 0) {
+    faces = true;
+    return loShadeShIrradiance(LO_TEX first, s, irradiance);
+  }
+  faces = count <= 0;
+  irradiance = vec3(0.0f);
+  int n = min(count, maxVdls);
+  vec3 sum = vec3(0.0f);
+  for (int i = 0; i < n; ++i) {
+    vec4 t = loFetchVdl(LO_TEX first + uint(i));
+    vec3 d = loVdlDirection(t.a);
+    if (dot(s.ng, d) > 0.0f) faces = true;
+    sum += loVdlResponse(s, d) * vec3(t);
+    irradiance += vec3(max(dot(s.n, d), 0.0f)) * vec3(t);
+  }
+  return sum;
 }
 
 /* The VDLs of voxel c that serve a surface point at q facing ng: its leaf
@@ -325,13 +347,18 @@ LO_LOOKUP_FN float loTrilinearWeight(vec3 f, ivec3 o) {
          (o.z == 1 ? f.z : 1.0f - f.z);
 }
 
-/* Indirect light at world position p of surface s (paper §3.2, §4.2). */
-LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize, int depth,
-                                   float normalOffset, bool interpolation, int maxVdls,
-                                   LoSurface s) {
+/* Indirect light at world position p of surface s (paper §3.2, §4.2), and
+ * the irradiance E(p, s.n) of the same VDLs with the same weights. */
+LO_LOOKUP_FN vec3 loOctreeIndirectIrradiance(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize,
+                                             int depth, float normalOffset, bool interpolation,
+                                             int maxVdls, LoSurface s,
+                                             LO_OUT(vec3) irradiance) {
   vec3 q = loOctreePosition(p, s.n, origin, voxelSize, normalOffset);
   uint first;
   int count;
+  vec3 e;
+  bool faces;
+  irradiance = vec3(0.0f);
   if (interpolation) {
     /* Trilinear over the 8 voxels around q (paper §4.2.1); empty neighbours,
      * layered ones without a layer for this surface (loLeafVdls) and those
@@ -342,27 +369,41 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
     vec3 f;
     ivec3 base = loTrilinearCell(q, f);
     vec3 sum = vec3(0.0f);
+    vec3 irradianceSum = vec3(0.0f);
     float weightSum = 0.0f;
     for (int k = 0; k < 8; ++k) {
       ivec3 o = loCellCorner(k);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      if (loServingLeaf(LO_TEX base + o, q, s.ng, depth, first, count) &&
-          loLeafFaces(LO_TEX first, count, maxVdls, s.ng)) {
-        sum += w * loShadeVdls(LO_TEX first, count, maxVdls, s);
-        weightSum += w;
-      }
+      if (!loServingLeaf(LO_TEX base + o, q, s.ng, depth, first, count)) continue;
+      vec3 light = loShadeVdlsFacing(LO_TEX first, count, maxVdls, s, e, faces);
+      if (!faces) continue;
+      sum += w * light;
+      irradianceSum += w * e;
+      weightSum += w;
     }
-    if (weightSum > 0.0f) return sum / weightSum;
+    if (weightSum > 0.0f) {
+      irradiance = irradianceSum / weightSum;
+      return sum / weightSum;
+    }
   }
   if (loNearestServingLeaf(LO_TEX q, s.n, s.ng, depth, normalOffset, first, count)) {
-    return loShadeVdls(LO_TEX first, count, maxVdls, s);
+    return loShadeVdlsFacing(LO_TEX first, count, maxVdls, s, irradiance, faces);
   }
   return vec3(0.0f);
 }
 
+/* loOctreeIndirectIrradiance without the irradiance. */
+LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize, int depth,
+                                   float normalOffset, bool interpolation, int maxVdls,
+                                   LoSurface s) {
+  vec3 e;
+  return loOctreeIndirectIrradiance(LO_TEX p, origin, voxelSize, depth, normalOffset,
+                                    interpolation, maxVdls, s, e);
+}
+
 /* Irradiance and where it comes from, for lightmaps (paper §4.2.3: one VDL
- * per texel rebuilt for the specular term): loShadeVdls with the cosine as
+ * per texel rebuilt for the specular term): loShadeVdlsFacing with the cosine as
  * the response, E = sum_i max(0, n . d_i) c_i, and beside it the
  * luminance-weighted direction sum sum_i Y(c_i) max(0, n . d_i) d_i (Rec. 709
  * luminance, world space, towards the light). */
@@ -455,10 +496,12 @@ LO_LOOKUP_FN bool loVolumeLends(LO_TEX_PARAM uint first, ivec3 c, int size, vec3
  * the bake (an object added later): none when p's own voxel has no light
  * or p lies beyond its lit box; else trilinear over the 8 voxels of the
  * free-space octree around p, voxels without light or whose lit box p lies
- * beyond (loVolumeLends) left out and the weights renormalized. */
-LO_LOOKUP_FN vec3 loVolumeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize, int depth,
-                                   LoSurface s) {
+ * beyond (loVolumeLends) left out and the weights renormalized; and the
+ * irradiance E(p, s.n) of the same light with the same weights. */
+LO_LOOKUP_FN vec3 loVolumeIndirectIrradiance(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize,
+                                             int depth, LoSurface s, LO_OUT(vec3) irradiance) {
   vec3 q = (p - origin) / voxelSize;
+  irradiance = vec3(0.0f);
   /* The point's own voxel first: without light there (a room the light
    * never reached, where a wall lies on the voxels' face), or with its
    * light beyond a wall, the neighbours lend none either. */
@@ -471,19 +514,31 @@ LO_LOOKUP_FN vec3 loVolumeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
   vec3 f;
   ivec3 base = loTrilinearCell(q, f);
   vec3 sum = vec3(0.0f);
+  vec3 irradianceSum = vec3(0.0f);
   float weightSum = 0.0f;
   for (int k = 0; k < 8; ++k) {
     ivec3 o = loCellCorner(k);
     float w = loTrilinearWeight(f, o);
     if (w <= 0.0f) continue;
     uvec4 leaf;
+    vec3 e;
     if (!loLookupLeafSize(LO_TEX base + o, depth, leaf, size)) continue;
     uint first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
     if (!loVolumeLends(LO_TEX first, base + o, size, q)) continue;
-    sum += w * loShadeSh(LO_TEX first, s);
+    sum += w * loShadeShIrradiance(LO_TEX first, s, e);
+    irradianceSum += w * e;
     weightSum += w;
   }
-  return weightSum > 0.0f ? sum / weightSum : vec3(0.0f);
+  if (!(weightSum > 0.0f)) return vec3(0.0f);
+  irradiance = irradianceSum / weightSum;
+  return sum / weightSum;
+}
+
+/* loVolumeIndirectIrradiance without the irradiance. */
+LO_LOOKUP_FN vec3 loVolumeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxelSize, int depth,
+                                   LoSurface s) {
+  vec3 e;
+  return loVolumeIndirectIrradiance(LO_TEX p, origin, voxelSize, depth, s, e);
 }
 
 #ifdef __cplusplus

@@ -22,14 +22,12 @@
 #include "octree_lookup.h"
 
 // The VDLs light the diffuse lobe and the share of the specular one that the
-// probe does not (gVdlSpecular, set by main). With gVdlIrradiance their
-// response is the cosine alone, as in C++ (octree/octree_irradiance.cpp) and
-// the atlas bake: the same lookup then gives the irradiance E(n) that the
-// probe's light is normalised by (indirectLight).
+// probe does not (gVdlSpecular, set by main). The same walk gives, beside
+// it, the irradiance E(n) of the same light, with the cosine alone as the
+// response as in C++ (octree/octree_irradiance.cpp) and the atlas bake: the
+// probe's light is normalised by it (indirectLight).
 float gVdlSpecular = 1.0;
-bool gVdlIrradiance = false;
 vec3 loVdlResponse(LoSurface s, vec3 d) {
-  if (gVdlIrradiance) return vec3(max(dot(s.n, d), 0.0));
   return loBrdfCosWeighted(s.n, s.v, d, s.baseColor, s.metallic, s.roughness, uTransmission,
                            uDielectric, uSpecular, gVdlSpecular);
 }
@@ -84,29 +82,15 @@ vec3 indirectLight(vec3 n, vec3 v, vec3 ng, vec3 baseColor, float metallic, floa
       indirect = loVdlResponse(s, d) * E / max(dot(nb, d), 0.05);
     }
   } else {
-    // Where the probe needs the irradiance the walk runs a second time, with
-    // the cosine as the response: a loop, not a second call, so that the
-    // program holds one copy of the walk (on a software rasterizer its code
-    // alone costs).
-    int passes = known > 0.0 ? 2 : 1;
-    for (int pass = 0; pass < passes; ++pass) {
-      gVdlIrradiance = pass == 1;
-      vec3 light = vec3(0.0);
 #if defined(LO_FREE_SPACE)
-      // An object added after the bake: the free-space octree's light, bound
-      // in place of the surfaces' (scene_pass.cpp).
-      light = loVolumeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, s);
+    // An object added after the bake: the free-space octree's light, bound
+    // in place of the surfaces' (scene_pass.cpp).
+    indirect = loVolumeIndirectIrradiance(vPosition, uOctreeOrigin, uVoxelSize, uDepth, s,
+                                          irradiance);
 #elif !defined(LO_ATLAS_LIGHTING)
-      light = loOctreeIndirect(vPosition, uOctreeOrigin, uVoxelSize, uDepth, uNormalOffset,
-                               uInterpolation, uMaxVdls, s);
+    indirect = loOctreeIndirectIrradiance(vPosition, uOctreeOrigin, uVoxelSize, uDepth,
+                                          uNormalOffset, uInterpolation, uMaxVdls, s, irradiance);
 #endif
-      if (pass == 0) {
-        indirect = light;
-      } else {
-        irradiance = light;
-      }
-    }
-    gVdlIrradiance = false;
   }
   if (probe > 0.0) {
     float scale = known > 0.0 ? mix(1.0, probeNormalization(n, irradiance), known) : 1.0;
