@@ -189,16 +189,12 @@ SurfaceGrid voxelizeAndSplat(const Scene& scene, const std::vector<Photon>& phot
   return grid;
 }
 
-VdlGrid gatherLevel(const Scene& scene, SurfaceGrid& grid, const std::vector<Photon>& photons,
-                    const LevelParams& params, ProgressSink* progress, LevelStats* stats,
-                    std::vector<StageReport>* stages) {
-  std::vector<StageReport> ignored;
-  std::vector<StageReport>& rows = stages ? *stages : ignored;
-  LevelStats s;
-  if (stats) s = *stats;  // keeps the voxelize figures
-  s.activeVoxels = grid.size();
-  splat(grid, photons, s, rows);
+namespace {
 
+/// gatherLevel after its splat: the gather and clustering of every voxel.
+VdlGrid gatherSplatted(const Scene& scene, SurfaceGrid& grid, const std::vector<Photon>& photons,
+                       const LevelParams& params, ProgressSink* progress, LevelStats& s,
+                       std::vector<StageReport>& rows) {
   StageTimer cluster(rows, "gather + cluster");
   GatherParams gather = params.gather;
   std::unique_ptr<GatherOcclusion> occlusion;
@@ -222,6 +218,21 @@ VdlGrid gatherLevel(const Scene& scene, SurfaceGrid& grid, const std::vector<Pho
                 formatCount(layered).c_str(), s.threadSeconds.gatherSeconds, s.threadSeconds.clusterSeconds);
   s.gatherClusterSeconds = cluster.finish(split);
   s.radius = resolveRadius(params.gather, grid.frame);
+  return vdls;
+}
+
+}  // namespace
+
+VdlGrid gatherLevel(const Scene& scene, SurfaceGrid& grid, const std::vector<Photon>& photons,
+                    const LevelParams& params, ProgressSink* progress, LevelStats* stats,
+                    std::vector<StageReport>* stages) {
+  std::vector<StageReport> ignored;
+  std::vector<StageReport>& rows = stages ? *stages : ignored;
+  LevelStats s;
+  if (stats) s = *stats;  // keeps the voxelize figures
+  s.activeVoxels = grid.size();
+  splat(grid, photons, s, rows);
+  VdlGrid vdls = gatherSplatted(scene, grid, photons, params, progress, s, rows);
   if (stats) *stats = s;
   return vdls;
 }
@@ -678,13 +689,18 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
                                    formatCount(emitted) + " paths (pass " +
                                    std::to_string(pass) + ")");
 
-    // The gather reads powers scaled by the paths traced: the photons are
-    // scaled in place, their raw powers kept apart (12 B a photon, where a
-    // scaled copy took 52) and put back if another pass follows.
+    // The photons in the order of the grid's bins, so that the gather reads
+    // them in place rather than a copy (gather.h, sortPhotonsByBin). The
+    // gather reads powers scaled by the paths traced: the photons are scaled
+    // in place, their raw powers kept apart (12 B a photon, where a scaled
+    // copy took 52) and put back if another pass follows.
+    s.level.activeVoxels = grid.size();
+    splat(grid, raw, s.level, s.stages);
+    sortPhotonsByBin(grid, raw);
     std::vector<Vec3> rawPower(raw.size());
     for (size_t i = 0; i < raw.size(); ++i) rawPower[i] = raw[i].power;
     scalePhotonPower(raw, emitted);
-    r.grid = gatherLevel(scene, grid, raw, level, progress, &s.level, &s.stages);
+    r.grid = gatherSplatted(scene, grid, raw, level, progress, s.level, s.stages);
     if (photonParams.countDirect) {
       const std::vector<float> direct =
           directIrradiance(grid, r.grid, directFront, directBack, emitted);
@@ -764,7 +780,15 @@ BakeResult bake(const Scene& scene, const BakeParams& requested, ProgressSink* p
   s.traceSeconds = trace.finish(formatCount(photons.photons.size()) + " photons from " +
                                 formatCount(photons.emittedPaths) + " paths");
 
-  r.grid = bakeLevel(scene, photons.photons, params.levelParams(), progress, &s.level, &s.stages);
+  // bakeLevel, with the photons put in the order of the grid's bins between
+  // its splat and its gather, which then reads them in place (gather.h,
+  // sortPhotonsByBin) rather than a copy.
+  const LevelParams level = params.levelParams();
+  SurfaceGrid grid = voxelize(scene, level.grid, progress, s.level, s.stages);
+  s.level.activeVoxels = grid.size();
+  splat(grid, photons.photons, s.level, s.stages);
+  sortPhotonsByBin(grid, photons.photons);
+  r.grid = gatherSplatted(scene, grid, photons.photons, level, progress, s.level, s.stages);
   s.noise = summarizeNoise(r.grid);
   if (params.freeSpace) {
     r.grid.volume = bakeFreeSpaceLight(photons.segments, r.grid.frame, params, progress, s.stages);

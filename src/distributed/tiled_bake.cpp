@@ -526,6 +526,11 @@ class RankBake {
     }
     comm_.allreduceSum(&dropped, 1);
     st_.level.droppedPhotons = size_t(dropped);
+    // In bin order, so that the gather reads them in place (gather.h). The
+    // grid's voxels follow their canonical key on every rank, so photons keep
+    // the relative order they have in a one-process bake: the same ties, the
+    // same bytes.
+    sortPhotonsByBin(grid_, held_);
     mine_.splatSeconds = timer.finish();
     return true;
   }
@@ -631,7 +636,8 @@ class RankBake {
   BakeStats st_;
   RankStats mine_;
   TilePlan plan_;
-  std::vector<Photon> held_;  ///< this rank's tiles' and halo's photons, in map order
+  /// This rank's tiles' and halo's photons, in map order (bin order after the splat).
+  std::vector<Photon> held_;
   /// Rank 0 with BakeParams::freeSpace: the kept paths' segments, in path
   /// order, as one process collects them.
   SegmentCollector collector_{0};

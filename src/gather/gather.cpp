@@ -88,14 +88,14 @@ inline void votePhoton(const Vec3& position, const Vec3& normal, float weight, c
 /// of their votes (votePhoton), without branches (whether a photon lies within
 /// r is as unpredictable as a coin near the edge of the region) and in four
 /// partial sums, so that the additions do not wait on each other.
-inline double voteRange(const BinnedPhotons::Entry* begin, const BinnedPhotons::Entry* end,
-                        const Query& q) {
+inline double voteRange(const Photon* begin, const Photon* end, const Query& q) {
   double sum[4] = {0, 0, 0, 0};
   size_t j = 0;
-  for (const BinnedPhotons::Entry* e = begin; e != end; ++e, ++j) {
+  for (const Photon* e = begin; e != end; ++e, ++j) {
     const float d2 = ellipsoidDistance2(e->position, q.point, q.normal, q.squash2m1);
     const float c = dot(e->normal, q.normal);
-    float vote = c > 0 ? e->weight : (c < 0 ? -e->weight : 0.0f);
+    const float weight = BinnedPhotons::weight(*e);
+    float vote = c > 0 ? weight : (c < 0 ? -weight : 0.0f);
     vote = d2 <= q.radius2 ? vote : 0.0f;  // also drops NaN positions
     sum[j & 3] += double(vote);
   }
@@ -370,24 +370,33 @@ std::shared_ptr<const BinnedPhotons> binPhotonsForGather(const SurfaceGrid& grid
     throw InputError("gather: the surface grid has no photon bins (call splatPhotons first)");
   }
   auto binned = std::make_shared<BinnedPhotons>();
-  binned->entries.resize(grid.binPhotons.size());
-  for (size_t j = 0; j < grid.binPhotons.size(); ++j) {
-    const uint32_t i = grid.binPhotons[j];
-    LO_CHECK_LT(size_t(i), photons.size());
-    const Photon& p = photons[i];
-    binned->entries[j] = {p.position, p.normal, average(p.power), i, BinnedPhotons::kNoGroup,
-                          p.caustic};
-    binned->causticPhotons += p.caustic != 0;
+  const size_t slots = grid.binPhotons.size();
+  bool inOrder = true;
+  for (size_t j = 0; j < slots; ++j) {
+    LO_CHECK_LT(size_t(grid.binPhotons[j]), photons.size());
+    inOrder = inOrder && grid.binPhotons[j] == uint32_t(j);
+  }
+  if (inOrder) {
+    binned->inBinOrder = photons.data();
+  } else {
+    binned->copy.resize(slots);
+    for (size_t j = 0; j < slots; ++j) binned->copy[j] = photons[grid.binPhotons[j]];
+    binned->inBinOrder = binned->copy.data();
+  }
+  binned->indices = grid.binPhotons.data();
+  binned->group.assign(slots, BinnedPhotons::kNoGroup);
+  for (size_t j = 0; j < slots; ++j) {
+    binned->causticPhotons += binned->photon(uint32_t(j)).caustic != 0;
   }
   binned->bins.resize(grid.size());
   for (size_t v = 0; v < grid.size(); ++v) {
     BinnedPhotons::Bin& bin = binned->bins[v];
     const uint32_t b = grid.binStart[v], e = grid.binStart[v + 1];
     if (b == e) continue;
-    bin.lower = bin.upper = binned->entries[b].position;
+    bin.lower = bin.upper = binned->photon(b).position;
     bool finite = true;
     for (uint32_t j = b; j != e; ++j) {
-      const BinnedPhotons::Entry& entry = binned->entries[j];
+      const Photon& entry = binned->photon(j);
       finite = finite && isFinite(entry.position) && isFinite(entry.normal);
       for (int a = 0; a < 3; ++a) {
         bin.lower[a] = std::min(bin.lower[a], entry.position[a]);
@@ -404,18 +413,18 @@ std::shared_ptr<const BinnedPhotons> binPhotonsForGather(const SurfaceGrid& grid
         bin.normal[g] = entry.normal;
         ++bin.groups;
       }
-      bin.weight[g] += entry.weight;
+      bin.weight[g] += BinnedPhotons::weight(entry);
     }
     if (bin.groups < 0 || !finite) bin.groups = 0;
     // Where each group (or the whole bin) lies, for the occlusion test.
     double sum[BinnedPhotons::kMaxGroups][3] = {};
     uint32_t count[BinnedPhotons::kMaxGroups] = {};
     for (uint32_t j = b; j != e; ++j) {
-      BinnedPhotons::Entry& entry = binned->entries[j];
+      const Photon& entry = binned->photon(j);
       int g = 0;
       if (bin.groups > 0) {
         while (!(bin.normal[g] == entry.normal)) ++g;
-        entry.group = uint16_t(g);
+        binned->group[j] = uint16_t(g);
       } else {
         bin.normalSum += entry.normal;
       }
@@ -454,7 +463,7 @@ Gatherer::Gatherer(const SurfaceGrid& grid, const std::vector<Photon>& photons,
   gather_internal::checkParams(params);
   LO_CHECK_EQ(grid.binStart.size(), grid.size() + 1);
   if (!binned_) binned_ = binPhotonsForGather(grid, photons);
-  LO_CHECK_EQ(binned_->entries.size(), grid.binPhotons.size());
+  LO_CHECK_EQ(binned_->group.size(), grid.binPhotons.size());
   radius_ = resolveRadius(params, grid.frame);
   causticRadius_ = std::min(radius_, params.causticRadius > 0
                                          ? params.causticRadius
@@ -574,7 +583,8 @@ void Gatherer::gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, boo
   using namespace gather_internal;
   updateBlock(grid_.coords[voxel]);
   findNear(point);
-  const BinnedPhotons::Entry* entries = binned_->entries.data();
+  const BinnedPhotons& binned = *binned_;
+  const Photon* inBinOrder = binned.inBinOrder;
   // Pass 1, the orientation vote: every photon within r, in bin order.
   // A bin whose photons all lie within r (d^2 is convex, so its largest value
   // over the bin's bounds is at a corner; slack for the float rounding of the
@@ -607,10 +617,11 @@ void Gatherer::gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, boo
       }
       if (sphere) {
         for (uint32_t j = nb.begin; j != nb.end; ++j) {
-          votePhoton(entries[j].position, entries[j].normal, entries[j].weight, query, scan);
+          const Photon& p = inBinOrder[j];
+          votePhoton(p.position, p.normal, BinnedPhotons::weight(p), query, scan);
         }
       } else {
-        scan.orientation += voteRange(entries + nb.begin, entries + nb.end, query);
+        scan.orientation += voteRange(inBinOrder + nb.begin, inBinOrder + nb.end, query);
       }
     }
   };
@@ -627,15 +638,15 @@ void Gatherer::gatherAt(size_t voxel, const Vec3& point, const Vec3& normal, boo
       const Neighbour& nb = blockNeighbours_[nr.neighbour];
       if (nr.blocked == 0) {
         for (uint32_t j = nb.begin; j != nb.end; ++j) {
-          if (caustic >= 0 && entries[j].caustic != caustic) continue;
-          selectPhoton(entries[j].position, entries[j].normal, entries[j].index, query, side,
+          if (caustic >= 0 && inBinOrder[j].caustic != caustic) continue;
+          selectPhoton(inBinOrder[j].position, inBinOrder[j].normal, binned.index(j), query, side,
                        selection);
         }
-      } else if (binned_->bins[nb.voxel].groups > 0) {
+      } else if (binned.bins[nb.voxel].groups > 0) {
         for (uint32_t j = nb.begin; j != nb.end; ++j) {
-          if (nr.blocked & (1u << entries[j].group)) continue;
-          if (caustic >= 0 && entries[j].caustic != caustic) continue;
-          selectPhoton(entries[j].position, entries[j].normal, entries[j].index, query, side,
+          if (nr.blocked & (1u << binned.group[j])) continue;
+          if (caustic >= 0 && inBinOrder[j].caustic != caustic) continue;
+          selectPhoton(inBinOrder[j].position, inBinOrder[j].normal, binned.index(j), query, side,
                        selection);
         }
       }
@@ -689,7 +700,6 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
   }
   // Which side of each surface its photons arrived on: the photons of the
   // voxel's own bin within params.splitCosine of the front or the back.
-  const BinnedPhotons::Entry* entries = binned_->entries.data();
   double front[SurfaceGrid::kMaxOrientations] = {}, back[SurfaceGrid::kMaxOrientations] = {};
   // Power-weighted sums of those photons' positions.
   double frontAt[SurfaceGrid::kMaxOrientations][3] = {},
@@ -698,12 +708,13 @@ int Gatherer::findSurfaceLayers(size_t voxel, const LayerParams& params,
            backCount[SurfaceGrid::kMaxOrientations] = {};
   double total = 0;
   for (uint32_t j = grid_.binStart[voxel]; j != grid_.binStart[voxel + 1]; ++j) {
-    const BinnedPhotons::Entry& e = entries[j];
-    if (!isFinite(e.normal) || !(e.weight >= 0)) continue;
-    total += double(e.weight);
+    const Photon& e = binned_->photon(j);
+    const float weight = BinnedPhotons::weight(e);
+    if (!isFinite(e.normal) || !(weight >= 0)) continue;
+    total += double(weight);
     for (int c = 0; c < count; ++c) {
       const float d = dot(e.normal, candidates[c].normal);
-      const double w = double(e.weight);
+      const double w = double(weight);
       if (d > params.splitCosine) {
         front[c] += w;
         ++frontCount[c];

@@ -104,6 +104,13 @@ struct LayerParams {
 /// neighbourhood, or dropped (counted in the return value). Deterministic.
 size_t splatPhotons(SurfaceGrid& grid, const std::vector<Photon>& photons);
 
+/// Puts `photons` in the order of the grid's bins (those splatPhotons just
+/// filled from them; the dropped ones after them, in their order) and makes
+/// grid.binPhotons the identity, so that the gather reads the array itself
+/// front to back instead of a copy (binPhotonsForGather). Bins keep their
+/// photons' order. In place, with one bit per photon besides. Deterministic.
+void sortPhotonsByBin(SurfaceGrid& grid, std::vector<Photon>& photons);
+
 /// Default radius in voxels. Chosen from the measured sweeps (docs/accuracy.md):
 /// at the paper's settings (600k photons, depth 6, k = 300) a 1.5-voxel radius
 /// was both faster to bake and more accurate than 3 voxels on all three test
@@ -146,22 +153,26 @@ inline float relativeNoise(double sum, double sumSquares) {
   return sum > 0 ? float(std::sqrt(sumSquares) / sum) : 0.0f;
 }
 
-/// The photons of a surface grid's bins, copied contiguously in bin order
-/// (grid.binPhotons order: bin v is entries[grid.binStart[v] ..
-/// grid.binStart[v + 1])), with just what the gather reads. Built once per
-/// (grid, photons) and shared read-only by the gatherers of all threads.
+/// The photons of a surface grid's bins in bin order (grid.binPhotons order:
+/// bin v is slots grid.binStart[v] .. grid.binStart[v + 1]), with what the
+/// gather reads beside them. The photon array itself when it is already in
+/// that order (sortPhotonsByBin: no copy, which at depth 8 was a quarter of a
+/// bake's peak memory), else a copy. Built once per (grid, photons) and
+/// shared read-only by the gatherers of all threads; it points into both,
+/// which must outlive it.
 struct BinnedPhotons {
-  struct Entry {
-    Vec3 position;   ///< world space
-    Vec3 normal;     ///< the photon's normal (facing its arrival side)
-    float weight;    ///< average(power), W: the orientation vote's weight
-    uint32_t index;  ///< into the photon array
-    uint16_t group;  ///< its bin's group of equal normals, kNoGroup when the bin has none
-    uint16_t caustic;  ///< Photon::caustic
-  };
+  /// Slot j's photon, and its index in the photon array.
+  const Photon& photon(uint32_t j) const { return inBinOrder[j]; }
+  uint32_t index(uint32_t j) const { return indices[j]; }
+  /// average(power), W: the orientation vote's weight.
+  static float weight(const Photon& p) { return average(p.power); }
+  const Photon* inBinOrder = nullptr;
+  const uint32_t* indices = nullptr;  ///< grid.binPhotons
+  std::vector<Photon> copy;           ///< when the array is not in bin order
+  /// Per slot: its bin's group of equal normals, kNoGroup when the bin has none.
+  std::vector<uint16_t> group;
   static constexpr uint16_t kNoGroup = 0xffffu;
-  std::vector<Entry> entries;
-  size_t causticPhotons = 0;  ///< entries with caustic set
+  size_t causticPhotons = 0;  ///< photons with caustic set
   /// Per bin (grid voxel): the bounds of its photons' positions and, when its
   /// photons carry at most kMaxGroups distinct normals, their summed weight
   /// per normal. A bin whose bounds lie wholly within the gather radius then
@@ -235,7 +246,7 @@ class Gatherer {
   struct Neighbour {
     Coord coord;
     uint32_t voxel;       ///< grid index = bin
-    uint32_t begin, end;  ///< range in binned_->entries
+    uint32_t begin, end;  ///< range of binned_ slots
   };
   struct Near {
     double bound2;  ///< lower bound of d^2 (world units^2) of any photon in the bin

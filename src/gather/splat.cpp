@@ -90,4 +90,36 @@ size_t splatPhotons(SurfaceGrid& grid, const std::vector<Photon>& photons) {
   return dropped;
 }
 
+void sortPhotonsByBin(SurfaceGrid& grid, std::vector<Photon>& photons) {
+  const size_t n = photons.size(), binned = grid.binPhotons.size();
+  LO_CHECK_LE(binned, n);
+  bool identity = true;
+  for (size_t j = 0; j < binned && identity; ++j) identity = grid.binPhotons[j] == uint32_t(j);
+  if (identity) return;
+  // Where each photon goes: a binned one to its slot, a dropped one after
+  // the last slot in photon order. grid.binPhotons becomes the identity.
+  std::vector<uint32_t> destination(n, std::numeric_limits<uint32_t>::max());
+  for (size_t j = 0; j < binned; ++j) destination[grid.binPhotons[j]] = uint32_t(j);
+  uint32_t next = uint32_t(binned);
+  for (size_t i = 0; i < n; ++i) {
+    if (destination[i] == std::numeric_limits<uint32_t>::max()) destination[i] = next++;
+  }
+  // The permutation's cycles, each followed once: the photon carried along
+  // a cycle goes to its destination and picks up the one that stood there.
+  std::vector<bool> placed(n, false);
+  for (size_t start = 0; start < n; ++start) {
+    if (placed[start]) continue;
+    placed[start] = true;
+    Photon carried = photons[start];
+    size_t to = destination[start];
+    while (to != start) {
+      std::swap(carried, photons[to]);
+      placed[to] = true;
+      to = destination[to];
+    }
+    photons[start] = carried;
+  }
+  for (size_t j = 0; j < binned; ++j) grid.binPhotons[j] = uint32_t(j);
+}
+
 }  // namespace lo
