@@ -122,6 +122,48 @@ TEST_F(Gather, MatchesBruteForceInCornellLikeBox) {
   expectSameAsBruteForce(grid, photons, p, 7);
 }
 
+// sortPhotonsByBin: the photon array put in bin order holds the same photons
+// (each bin's in their order, the dropped ones after them in theirs), the
+// bins become the identity, and every voxel gathers what it gathered from the
+// array in trace order (through the copy binPhotonsForGather then makes):
+// the same photons, irradiance and radius.
+TEST_F(Gather, PhotonsSortedByBinGatherWhatTheTraceOrderGathers) {
+  scene = cornellLikeBox();
+  spreadPhotons(30000, 11, 4);
+  Photon lost;
+  lost.position = {NAN, 0, 0};
+  photons.insert(photons.begin() + 100, lost);  // dropped by the splat
+  splatPhotons(grid, photons);
+  const std::vector<Photon> traced = photons;
+  const std::vector<uint32_t> slots = grid.binPhotons;
+  ASSERT_LT(slots.size(), traced.size());
+  GatherParams params;
+  params.k = 50;
+  std::vector<GatherResult> before(grid.size());
+  {
+    Gatherer gatherer(grid, photons, params);
+    for (size_t v = 0; v < grid.size(); ++v) gatherer.gather(v, before[v]);
+  }
+  sortPhotonsByBin(grid, photons);
+  ASSERT_EQ(photons.size(), traced.size());
+  for (size_t j = 0; j < slots.size(); ++j) {
+    ASSERT_EQ(grid.binPhotons[j], uint32_t(j));
+    ASSERT_EQ(photons[j].position, traced[slots[j]].position);
+    ASSERT_EQ(photons[j].normal, traced[slots[j]].normal);
+  }
+  EXPECT_TRUE(std::isnan(photons[slots.size()].position.x));  // the dropped one, last
+  Gatherer gatherer(grid, photons, params);
+  for (size_t v = 0; v < grid.size(); ++v) {
+    GatherResult after;
+    gatherer.gather(v, after);
+    ASSERT_EQ(after.irradiance, before[v].irradiance) << v;
+    ASSERT_EQ(after.radius, before[v].radius) << v;
+    std::vector<uint32_t> same;
+    for (uint32_t j : after.photons) same.push_back(slots[j]);
+    ASSERT_EQ(test::sorted(same), test::sorted(before[v].photons)) << v;
+  }
+}
+
 // A floor and a wall leaning over it (its normal has an upward component, so
 // back rejection alone does not exclude it). Wall photons lie at least `h0`
 // above the floor: a sphere gathers many of them; the squashed ellipsoid,
