@@ -94,7 +94,7 @@ LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metall
   float nv = max(dot(n, v), 1e-4f);
   vec3 h = normalize(l + v);
   float nh = max(dot(n, h), 0.0f);
-  float vh = clamp(dot(v, h), 0.0f, 1.0f); /* pow(1 - vh, 5) is NaN for vh a rounding above 1 */
+  float vh = clamp(dot(v, h), 0.0f, 1.0f); /* (1 - vh)^5 < 0 for vh a rounding above 1 */
   float a2 = a * a;
   float D = loGgxD(nh, a);
   float vis =
@@ -102,7 +102,11 @@ LO_BRDF_FN void loBrdfLobes(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metall
   /* The specification's mix (glTF 2.0, Appendix B): the dielectric's
    * Fresnel (its layer's F0 and weight) weights its diffuse base and its
    * specular layer, the metal's (F0 = baseColor) its specular lobe alone. */
-  float schlick = pow(1.0f - vh, 5.0f);
+  /* (1 - v.h)^5 by multiplication: a software rasteriser's pow is a log and
+   * an exp, and this runs for every light and VDL of every fragment. */
+  float m = 1.0f - vh;
+  float m2 = m * m;
+  float schlick = m2 * m2 * m;
   float fDielectric = layer.y * (layer.x + (1.0f - layer.x) * schlick);
   vec3 fMetal = baseColor + (1.0f - baseColor) * schlick;
   diffuse *= 1.0f - fDielectric;
