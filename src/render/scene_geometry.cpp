@@ -10,6 +10,7 @@
 
 #include "render/gl_util.h"
 #include "render/renderer_impl.h"
+#include "scene/texture_mips.h"
 
 namespace lo::render_internal {
 namespace {
@@ -50,6 +51,25 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t, unsigned read) {
   GlTexture id = GlTexture::create();
   glBindTexture(GL_TEXTURE_2D, id.get());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  // The glTF sampler (its codes are OpenGL's); an undefined minFilter is
+  // trilinear, as glTF viewers draw it.
+  const TextureSampler& sampler = t.sampler;
+  const GLint minFilter = sampler.minFilter ? sampler.minFilter : GL_LINEAR_MIPMAP_LINEAR;
+  const bool mipmapped = minFilter != GL_NEAREST && minFilter != GL_LINEAR;
+  // The base level, and its mip levels built on the CPU (scene/texture_mips.h):
+  // a software rasteriser's glGenerateMipmap draws them on one thread.
+  auto upload8 = [&](const uint8_t* texels, int channels, GLint internal, GLenum format) {
+    glTexImage2D(GL_TEXTURE_2D, 0, internal, t.width, t.height, 0, format, GL_UNSIGNED_BYTE,
+                 texels);
+    if (!mipmapped) return;
+    const bool srgb = internal == GL_SRGB8_ALPHA8;
+    const std::vector<MipLevel<uint8_t>> levels =
+        mipLevels(texels, t.width, t.height, channels, srgb);
+    for (size_t l = 0; l < levels.size(); ++l) {
+      glTexImage2D(GL_TEXTURE_2D, GLint(l + 1), internal, levels[l].width, levels[l].height, 0,
+                   format, GL_UNSIGNED_BYTE, levels[l].texels.data());
+    }
+  };
   const size_t n = t.texelCount(), c = size_t(t.channels);
   size_t texelBytes = 4;
   if (t.format == TexelFormat::Unorm8) {
@@ -58,8 +78,7 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t, unsigned read) {
     if (!t.srgb && (read & ~kReadR) == 0) {
       std::vector<uint8_t> r(n);
       for (size_t i = 0; i < n; ++i) r[i] = channel(i, 0);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, t.width, t.height, 0, GL_RED, GL_UNSIGNED_BYTE,
-                   r.data());
+      upload8(r.data(), 1, GL_R8, GL_RED);
       texelBytes = 1;
     } else if (!t.srgb && (read & ~(kReadG | kReadB)) == 0) {
       std::vector<uint8_t> gb(2 * n);
@@ -67,15 +86,14 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t, unsigned read) {
         gb[2 * i] = channel(i, 1);
         gb[2 * i + 1] = channel(i, 2);
       }
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RG8, t.width, t.height, 0, GL_RG, GL_UNSIGNED_BYTE,
-                   gb.data());
+      upload8(gb.data(), 2, GL_RG8, GL_RG);
       const GLint swizzle[4] = {GL_ZERO, GL_RED, GL_GREEN, GL_ONE};
       glTexParameteriv(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_RGBA, swizzle);
       texelBytes = 2;
     } else if (c == 3 || c == 4) {
       // RGB and RGBA go up as they are (the driver adds RGB's alpha).
-      glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0,
-                   c == 3 ? GL_RGB : GL_RGBA, GL_UNSIGNED_BYTE, t.unorm8.data());
+      upload8(t.unorm8.data(), int(c), t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8,
+              c == 3 ? GL_RGB : GL_RGBA);
     } else {
       // Grey (and grey + alpha) spread to RGBA.
       std::vector<uint8_t> rgba(n * 4);
@@ -84,8 +102,7 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t, unsigned read) {
         rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = p[0];
         rgba[4 * i + 3] = t.hasAlpha() ? p[c - 1] : 255;
       }
-      glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0,
-                   GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+      upload8(rgba.data(), 4, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, GL_RGBA);
     }
   } else {
     // Half floats: linear colour with 11 bits of precision, filterable and
@@ -101,15 +118,16 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t, unsigned read) {
     }
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, t.width, t.height, 0, GL_RGBA, GL_FLOAT,
                  rgba.data());
+    if (mipmapped) {
+      const std::vector<MipLevel<float>> levels = mipLevels(rgba.data(), t.width, t.height, 4);
+      for (size_t l = 0; l < levels.size(); ++l) {
+        glTexImage2D(GL_TEXTURE_2D, GLint(l + 1), GL_RGBA16F, levels[l].width, levels[l].height,
+                     0, GL_RGBA, GL_FLOAT, levels[l].texels.data());
+      }
+    }
     texelBytes = 8;
   }
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  // The glTF sampler (its codes are OpenGL's); an undefined minFilter is
-  // trilinear, as glTF viewers draw it.
-  const TextureSampler& sampler = t.sampler;
-  const GLint minFilter = sampler.minFilter ? sampler.minFilter : GL_LINEAR_MIPMAP_LINEAR;
-  const bool mipmapped = minFilter != GL_NEAREST && minFilter != GL_LINEAR;
-  if (mipmapped) glGenerateMipmap(GL_TEXTURE_2D);
   const size_t levelBytes = t.texelCount() * texelBytes;
   textureBytes += mipmapped ? levelBytes + levelBytes / 3 : levelBytes;
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, minFilter);
