@@ -334,6 +334,29 @@ int32_t metaInt(const std::string& path, const openvdb::MetaMap& m, const std::s
   return metaValue<int32_t>(path, m, key, required, fallback);
 }
 
+FormatVersion formatVersionOf(const openvdb::MetaMap& m) {
+  FormatVersion out;
+  if (!m[kMetaFormatVersion]) {
+    out.absent = true;
+    return out;
+  }
+  try {
+    out.version = metaValue<int32_t>("", m, kMetaFormatVersion, true, 0);
+  } catch (const InputError&) {
+    out.problem = "file metadata '" + std::string(kMetaFormatVersion) + "' has type " +
+                  m[kMetaFormatVersion]->typeName() + ", expected an integer";
+    return out;
+  }
+  if (out.version < 1 || out.version > kVdlFormatVersion) {
+    out.problem = std::string(kMetaFormatVersion) + " " + std::to_string(out.version) +
+                  " is not supported: this lightoctree (" LO_VERSION
+                  ") reads VDL files of format version 1 to " +
+                  std::to_string(kVdlFormatVersion) +
+                  (out.version > kVdlFormatVersion ? "; use a newer lightoctree" : "");
+  }
+  return out;
+}
+
 BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   BakeMetadata meta;
   meta.generator = metaValue<std::string>(path, m, "generator", false, "");
@@ -359,7 +382,9 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
       metaValue<openvdb::Vec3d>(path, m, "scene_origin", false, openvdb::Vec3d(0.0));
   if (!origin.isFinite()) throw InputError(path + ": file metadata 'scene_origin' is not finite");
   meta.sceneOrigin = Vec3d(origin.x(), origin.y(), origin.z());
-  meta.formatVersion = metaValue<int32_t>(path, m, kMetaFormatVersion, false, 0);
+  const FormatVersion version = formatVersionOf(m);
+  if (!version.problem.empty()) throw InputError(path + ": " + version.problem);
+  meta.formatVersion = version.version;
   meta.convertedFrom = metaValue<std::string>(path, m, "converted_from", false, "");
   meta.surfaceLayers = metaValue<int32_t>(path, m, "surface_layers", false, -1);
   meta.gatherOcclusion = metaValue<int32_t>(path, m, "gather_occlusion", false, -1);

@@ -71,6 +71,17 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m);
 int32_t metaInt(const std::string& path, const openvdb::MetaMap& m, const std::string& key,
                 bool required, int32_t fallback);
 
+/// The file's format_version by the one rule the reader and `inspect` share
+/// (they disagreed: the reader took a stored 0 for a missing key, inspect
+/// failed it): a missing key is a file written before the key existed, read
+/// as version 1; a stored value is an integer in [1, kVdlFormatVersion].
+struct FormatVersion {
+  int version = 1;
+  bool absent = false;  ///< no key: read as version 1
+  std::string problem;  ///< why the file is refused ("" = readable), without the path
+};
+FormatVersion formatVersionOf(const openvdb::MetaMap& m);
+
 inline openvdb::Vec3s toVdb(const Vec3& v) { return {v.x, v.y, v.z}; }
 inline openvdb::Coord toVdb(const Coord& c) { return {c.x, c.y, c.z}; }
 inline Vec3 fromVdb(const openvdb::Vec3s& v) { return {v.x(), v.y(), v.z()}; }

@@ -219,20 +219,18 @@ class VdlChecker {
     return problems.empty();
   }
 
+  /// The reader's rule (formatVersionOf): inspect passes what render reads.
   void checkFormatVersion() {
-    auto m = (*f_.meta)[vdb_internal::kMetaFormatVersion];
-    if (!m) {
+    const vdb_internal::FormatVersion v = vdb_internal::formatVersionOf(*f_.meta);
+    if (!v.problem.empty()) {
+      add("format_version", false, v.problem);
+    } else if (v.absent) {
       add("format_version", true, "absent: a file written before format_version 1 (read as 1)");
-      return;
+    } else {
+      add("format_version", true,
+          std::to_string(v.version) + " (this lightoctree reads 1.." +
+              std::to_string(kVdlFormatVersion) + ")");
     }
-    const int v = readInt(vdb_internal::kMetaFormatVersion);
-    if (v < 0) {
-      add("format_version", false, "has type " + m->typeName() + ", expected an integer");
-      return;
-    }
-    add("format_version", v >= 1 && v <= kVdlFormatVersion,
-        std::to_string(v) + " (this lightoctree reads 1.." + std::to_string(kVdlFormatVersion) +
-            ")");
   }
 
   void checkFinite() {

@@ -19,8 +19,8 @@ struct Damage {
   bool rotateTransform = false;  ///< every grid gets the same transform with a rotation
   VdlWriteOptions options;       ///< half floats / dropped grids, as writeVdlGrid
   /// Write this int32 as the file's format_version instead of kVdlFormatVersion
-  /// (0 = leave the key out, as files written before it existed).
-  int formatVersion = kVdlFormatVersion;
+  /// (nullopt = leave the key out, as files written before it existed).
+  std::optional<int> formatVersion = kVdlFormatVersion;
   /// Every grid on a transform of this scale instead of the frame's voxel
   /// size (0 = the frame's; negative mirrors the grid).
   double scale = 0;

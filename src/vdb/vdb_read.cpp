@@ -333,18 +333,8 @@ LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& 
   // Before anything sizes or places a voxel by it: a depth out of range was
   // refused late, or blamed on another check.
   checkDepthInRange(path, out.meta.depth);
-  if (out.meta.formatVersion == 0) {
-    // Files baked before the key existed follow version 1 of the contract.
-    out.meta.formatVersion = 1;
+  if (formatVersionOf(*f.meta).absent) {
     out.notes.push_back("no format_version metadata: read as format version 1");
-  } else if (out.meta.formatVersion > kVdlFormatVersion || out.meta.formatVersion < 1) {
-    throw InputError(
-        path + ": format_version " + std::to_string(out.meta.formatVersion) +
-        " is not supported: this lightoctree (" LO_VERSION
-        ") reads VDL files up to "
-        "format version " +
-        std::to_string(kVdlFormatVersion) +
-        (out.meta.formatVersion > kVdlFormatVersion ? "; use a newer lightoctree" : ""));
   }
   const int maxVdls = metaInt(path, *f.meta, kMetaMaxVdls, true, 0);
   if (maxVdls < 1 || maxVdls > kMaxVdls) {

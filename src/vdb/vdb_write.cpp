@@ -283,8 +283,8 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
   }
   if (damage && damage->formatVersion != kVdlFormatVersion) {
     fileMeta.removeMeta(kMetaFormatVersion);
-    if (damage->formatVersion != 0) {
-      fileMeta.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(damage->formatVersion));
+    if (damage->formatVersion) {
+      fileMeta.insertMeta(kMetaFormatVersion, openvdb::Int32Metadata(*damage->formatVersion));
     }
   }
   if (damage && damage->metadataDepth != 0) {

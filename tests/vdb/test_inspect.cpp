@@ -124,7 +124,7 @@ TEST(FormatVersion, WrittenReadAndNewerRefused) {
 
   // A file written before the key existed: read as version 1, with a note.
   vdb_internal::Damage older;
-  older.formatVersion = 0;
+  older.formatVersion = std::nullopt;
   vdb_internal::writeVdlGridDamaged(dir + "/v0.vdb", g, meta(), older);
   LoadedVdl v0 = readVdlGrid(dir + "/v0.vdb");
   EXPECT_EQ(v0.meta.formatVersion, 1);
@@ -132,6 +132,42 @@ TEST(FormatVersion, WrittenReadAndNewerRefused) {
   EXPECT_NE(v0.notes[0].find("format version 1"), std::string::npos) << v0.notes[0];
   EXPECT_EQ(v0.grid.irradiance, g.irradiance);
   expectCheck(inspectVdb(dir + "/v0.vdb"), "format_version", true);
+}
+
+// A format_version stored as 0 (or below) is no version at all: render read
+// it as version 1, as if the key were missing, while inspect failed it. Both
+// now refuse it by one rule, and pass the same files.
+TEST(FormatVersion, ZeroOrNegativeIsRefusedByTheReaderAsByInspect) {
+  std::string dir = test::outputDir("Convert.FormatVersionZero");
+  VdlGrid g = floorGrid();
+  for (int stored : {0, -1}) {
+    vdb_internal::Damage d;
+    d.formatVersion = stored;
+    const std::string path = dir + "/v" + std::to_string(stored) + ".vdb";
+    vdb_internal::writeVdlGridDamaged(path, g, meta(), d);
+    const std::string msg = readError(path);
+    EXPECT_NE(msg.find("format_version " + std::to_string(stored) + " is not supported"),
+              std::string::npos)
+        << msg;
+    EXPECT_EQ(msg.find("newer lightoctree"), std::string::npos) << msg;
+    VdbReport r = inspectVdb(path);
+    expectCheck(r, "format_version", false);
+    const VdbCheck* c = findCheck(r, "format_version");
+    ASSERT_NE(c, nullptr);
+    EXPECT_NE(msg.find(c->detail), std::string::npos) << "reader: " << msg << "\ninspect: "
+                                                      << c->detail;
+  }
+  // Every version this lightoctree writes, stored as an int64 as pyopenvdb
+  // writes it: both read it.
+  for (int stored = 1; stored <= kVdlFormatVersionVdl; ++stored) {
+    vdb_internal::Damage d;
+    d.formatVersion = stored;
+    d.wideIntegers = true;
+    const std::string path = dir + "/ok" + std::to_string(stored) + ".vdb";
+    vdb_internal::writeVdlGridDamaged(path, g, meta(), d);
+    EXPECT_EQ(readVdlGrid(path).meta.formatVersion, stored);
+    expectCheck(inspectVdb(path), "format_version", true);
+  }
 }
 
 TEST(OptionalGrids, DroppedGridsReadAsZero) {
