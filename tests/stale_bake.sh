@@ -21,4 +21,22 @@ printf ' ' >> renamed.gltf  # one byte more: another scene as far as anyone can 
   echo "FAILED: render did not warn of a changed scene"
 [ "$(warned lightmap renamed.gltf grid.vdb -o lm.glb --quiet)" = 1 ] ||
   echo "FAILED: lightmap did not warn of a changed scene"
+# A scene path with terminal escapes, recorded as source_scene_path: inspect
+# and the warning print them escaped (\x1b), never the raw bytes that
+# recolour or retitle the terminal.
+odd=$(printf 'esc-\033[31m-\033]0;owned\007')
+mkdir "$odd" && cp "$scene" "$odd/s.gltf" || exit 1
+"$cli" bake "$odd/s.gltf" -o esc.vdb --depth 3 --photons 20000 --quiet ||
+  echo "FAILED: bake from a folder named with escapes"
+escaped='esc-\x1b[31m-\x1b]0;owned\x07/s.gltf'
+inspected=$("$cli" inspect esc.vdb 2>&1 | grep source_scene_path)
+printf ' ' >> "$odd/s.gltf"
+rendered=$("$cli" render "$odd/s.gltf" esc.vdb -o esc.png --width 16 --height 12 --quiet \
+  2>&1 >/dev/null)
+for shown in "$inspected" "$rendered"; do
+  printf '%s' "$shown" | grep -qF "$escaped" ||
+    echo "FAILED: the path with escapes is not shown escaped: $(printf '%q' "$shown")"
+  printf '%s' "$shown" | grep -q "$(printf '[\033\007]')" &&
+    echo "FAILED: a control character of the metadata was printed raw: $(printf '%q' "$shown")"
+done
 echo "stale bakes: checked"

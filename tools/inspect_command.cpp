@@ -8,6 +8,7 @@
 #include <string>
 
 #include "bake/stats_json.h"
+#include "core/printable.h"
 #include "commands.h"
 #include "report.h"
 #include "vdb/vdb_inspect.h"
@@ -68,17 +69,23 @@ nlohmann::json toJson(const VdbReport& r) {
   return j;
 }
 
+// Every name and value a file supplies goes through printable (control
+// characters escaped): the JSON report escapes them itself.
 void printText(const VdbReport& r) {
-  std::printf("%s: %s, %s file\n", r.path.c_str(), formatBytes(size_t(r.fileBytes)).c_str(),
+  std::printf("%s: %s, %s file\n", printable(r.path).c_str(),
+              formatBytes(size_t(r.fileBytes)).c_str(),
               r.kind == "vdl" ? "lightoctree VDL" : (r.kind == "photons" ? "photon" : "OpenVDB"));
   std::printf("\nmetadata\n");
-  for (const auto& [k, v] : r.metadata) std::printf("  %-18s %s\n", k.c_str(), v.c_str());
+  for (const auto& [k, v] : r.metadata) {
+    std::printf("  %-18s %s\n", printable(k).c_str(), printable(v).c_str());
+  }
   std::printf("\n  %-18s %-12s %10s %10s %4s  %s\n", "grid", "value type", "active", "memory",
               "half", "range (per component, active voxels)");
   uint64_t memory = 0;
   for (const GridSummary& g : r.grids) {
     memory += g.memoryBytes;
-    std::printf("  %-18s %-12s %10s %10s %4s  %s\n", g.name.c_str(), g.valueType.c_str(),
+    std::printf("  %-18s %-12s %10s %10s %4s  %s\n", printable(g.name).c_str(),
+                printable(g.valueType).c_str(),
                 formatCount(size_t(g.activeVoxels)).c_str(),
                 formatBytes(size_t(g.memoryBytes)).c_str(), g.halfFloat ? "yes" : "no",
                 range(g).c_str());
@@ -97,7 +104,8 @@ void printText(const VdbReport& r) {
   }
   std::printf("\nchecks\n");
   for (const VdbCheck& c : r.checks) {
-    std::printf("  %-4s %-24s %s\n", c.passed ? "ok" : "FAIL", c.name.c_str(), c.detail.c_str());
+    std::printf("  %-4s %-24s %s\n", c.passed ? "ok" : "FAIL", c.name.c_str(),
+                printable(c.detail).c_str());
   }
   std::printf("\n%s\n", r.ok() ? "all checks passed" : "some checks FAILED");
 }

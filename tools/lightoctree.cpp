@@ -18,6 +18,7 @@
 #include "cli_checks.h"
 #include "commands.h"
 #include "core/file.h"
+#include "core/printable.h"
 #include "core/resources.h"
 
 namespace {
@@ -176,7 +177,9 @@ int main(int argc, char** argv) {
     finishOutput(1);
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "lightoctree: error: %s\n", e.what());
+    // A message may quote what a file holds (a grid's name in OpenVDB's
+    // error, a scene's name): its control characters escaped, its lines kept.
+    std::fprintf(stderr, "lightoctree: error: %s\n", lo::printable(e.what(), true).c_str());
     finishOutput(1);
     return 1;
   }

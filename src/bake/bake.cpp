@@ -13,6 +13,7 @@
 
 #include "cluster/volume_light.h"
 #include "core/error.h"
+#include "core/printable.h"
 #include "scene/scene_files.h"
 #include "raytrace/ray_tracer.h"
 
@@ -522,19 +523,21 @@ std::string staleBakeWarning(const BakeMetadata& meta, const std::string& sceneP
   if (meta.sourceSceneHash.empty()) return "";
   const std::string now = sceneContentHash(scenePath);
   if (now == meta.sourceSceneHash) return "";
-  return "the light was baked from " +
-         (meta.sourceScenePath.empty() ? meta.sourceScene : meta.sourceScenePath) + " (" +
-         meta.sourceSceneHash + "); '" + scenePath + "' and the files it reads differ (" + now +
-         "): bake again if the scene changed";
+  // The path and hash are the file's metadata, whatever another tool wrote.
+  return printable("the light was baked from " +
+                   (meta.sourceScenePath.empty() ? meta.sourceScene : meta.sourceScenePath) +
+                   " (" + meta.sourceSceneHash + "); '" + scenePath +
+                   "' and the files it reads differ (" + now +
+                   "): bake again if the scene changed");
 }
 
 std::string sceneMismatchWarning(const std::string& what, const std::string& recordedHash,
                                  const std::string& scenePath, const std::string& sceneHash) {
   if (recordedHash.empty() || recordedHash == sceneHash) return "";
-  return what + " was made from a scene with content hash " + recordedHash + "; '" + scenePath +
-         "' and the files it reads have " + sceneHash +
-         ": it belongs to another scene, or to this one before it changed (its light may not "
-         "fit; bake again with this scene)";
+  return printable(what + " was made from a scene with content hash " + recordedHash + "; '" +
+                   scenePath + "' and the files it reads have " + sceneHash +
+                   ": it belongs to another scene, or to this one before it changed (its light "
+                   "may not fit; bake again with this scene)");
 }
 
 LevelParams BakeParams::levelParams() const {

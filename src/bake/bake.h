@@ -377,7 +377,8 @@ void recordSourceScene(BakeMetadata& meta, const std::string& scenePath);
 
 /// "" when `meta` records no content hash or `scenePath`'s files still have
 /// it; else a sentence for a warning: the grid was baked from a scene whose
-/// files have changed since (its light may no longer fit the scene).
+/// files have changed since (its light may no longer fit the scene). Control
+/// characters of the file's metadata escaped (core/printable.h).
 std::string staleBakeWarning(const BakeMetadata& meta, const std::string& scenePath);
 
 /// The same rule for any input made from a scene (a photon map, a `.vdb`

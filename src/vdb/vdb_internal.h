@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vdb/vdb_io.h"
@@ -31,6 +32,9 @@ struct Damage {
   bool doubleMetadata = false;
   /// Every int32 metadata written as an int64, as pyopenvdb writes Python ints.
   bool wideIntegers = false;
+  /// String file metadata (key, value) written over what the writer wrote, as
+  /// another tool may.
+  std::vector<std::pair<std::string, std::string>> stringMetadata;
 };
 
 /// writeVdlGrid with damage applied (same metadata, same temp + rename).

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/printable.h"
 #include "vdb/vdb_contract.h"
 #include "vdb/vdb_file.h"
 #include "vdb/vdb_io.h"
@@ -345,7 +346,7 @@ LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& 
   const std::string& representation = out.meta.representation;
   LightRepresentation parsed = LightRepresentation::Vdl;
   if (!parseRepresentation(representation, &parsed)) {
-    throw InputError(path + ": file metadata representation = '" + representation +
+    throw InputError(path + ": file metadata representation = '" + printable(representation) +
                      "'; expected " + representationChoices());
   }
   const int shTerms = shTermsOf(parsed);

@@ -310,6 +310,12 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
     }
     fileMeta = wide;
   }
+  if (damage) {
+    for (const auto& [key, value] : damage->stringMetadata) {
+      fileMeta.removeMeta(key);
+      fileMeta.insertMeta(key, openvdb::StringMetadata(value));
+    }
+  }
   writeVdbFile(path, sources, fileMeta, into);
 }
 

@@ -17,6 +17,7 @@
 #include "core/discrete_distribution.h"
 #include "core/error.h"
 #include "core/math.h"
+#include "core/printable.h"
 #include "core/progress.h"
 #include "core/resources.h"
 #include "core/rng.h"
@@ -237,6 +238,16 @@ TEST(Resources, MemoryWatchCallsBackWhenTheProcessGrowsPastItsLimit) {
   // No limit, no watch.
   MemoryWatch none(0, [&](size_t) { ++calls; });
   EXPECT_EQ(calls.load(), 1);
+}
+
+// Control characters of a file's strings, escaped before a terminal sees them.
+TEST(Printable, EscapesControlCharactersAndKeepsTheRest) {
+  EXPECT_EQ(printable("plain \xc3\xa9t\xc3\xa9 \xff"), "plain \xc3\xa9t\xc3\xa9 \xff");
+  EXPECT_EQ(printable(std::string("a\0b\tc\x7f", 6)), "a\\x00b\\x09c\\x7f");
+  EXPECT_EQ(printable("one\ntwo"), "one\\x0atwo");
+  EXPECT_EQ(printable("one\ntwo", true), "one\ntwo");
+  EXPECT_EQ(printable("\xc2\x85\xc2\xa0"), "\\u0085\xc2\xa0");  // NEL escaped, NBSP kept
+  EXPECT_EQ(printable(printable("\x1b[0m")), printable("\x1b[0m"));
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "core/file.h"
+#include "core/printable.h"
 #include "test_util.h"
 #include "octree/gpu_octree.h"
 #include "vdb/vdb_inspect.h"
@@ -690,6 +691,40 @@ TEST(PhotonPoints, CarryTheirScenesHash) {
             std::string::npos)
       << warning;
   EXPECT_NE(warning.find("'s.gltf' and the files it reads have 2"), std::string::npos) << warning;
+}
+
+// A .vdb's string metadata is whatever wrote it: a source_scene_path with
+// terminal escapes (a window title, a cleared screen, a recoloured line) was
+// printed raw by the stale-scene warning of render, view, lightmap and
+// Python. The warning shows them escaped, and the reader's refusal of a
+// representation it does not know quotes it escaped too.
+TEST(Inspect, ControlCharactersOfTheMetadataArePrintedEscaped) {
+  const std::string dir = test::outputDir("Inspect.ControlCharacters");
+  BakeMetadata m = meta();
+  m.sourceScenePath = "/scenes/\x1b]0;owned\x07\x1b[2Jroom\xc2\x9b" "31m.gltf";
+  m.sourceSceneHash = "fnv1a64:\x1b[31m0000000000000000";
+  writeVdlGrid(dir + "/escapes.vdb", floorGrid(), m);
+  const LoadedVdl read = readVdlGrid(dir + "/escapes.vdb");
+  EXPECT_EQ(read.meta.sourceScenePath, m.sourceScenePath);  // the value itself is kept
+  const std::string warning =
+      staleBakeWarning(read.meta, test::dataDir() + "/cornell-box.gltf");
+  ASSERT_FALSE(warning.empty());
+  for (const char control : {'\x1b', '\x07'}) {
+    EXPECT_EQ(warning.find(control), std::string::npos) << warning;
+  }
+  EXPECT_EQ(warning.find("\xc2\x9b"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("/scenes/\\x1b]0;owned\\x07\\x1b[2Jroom\\u009b31m.gltf"),
+            std::string::npos)
+      << warning;
+  EXPECT_NE(warning.find("fnv1a64:\\x1b[31m0"), std::string::npos) << warning;
+
+  vdb_internal::Damage representation;
+  representation.stringMetadata = {{"representation", "sh9\x1b[8m"}};
+  vdb_internal::writeVdlGridDamaged(dir + "/representation.vdb", floorGrid(), meta(),
+                                    representation);
+  const std::string refused = readError(dir + "/representation.vdb");
+  EXPECT_EQ(refused.find('\x1b'), std::string::npos) << refused;
+  EXPECT_NE(refused.find("'sh9\\x1b[8m'"), std::string::npos) << refused;
 }
 
 }  // namespace
