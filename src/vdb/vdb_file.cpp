@@ -386,10 +386,21 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   if (!version.problem.empty()) throw InputError(path + ": " + version.problem);
   meta.formatVersion = version.version;
   meta.convertedFrom = metaValue<std::string>(path, m, "converted_from", false, "");
-  meta.surfaceLayers = metaValue<int32_t>(path, m, "surface_layers", false, -1);
-  meta.gatherOcclusion = metaValue<int32_t>(path, m, "gather_occlusion", false, -1);
-  meta.edgeCorrection = metaValue<int32_t>(path, m, "edge_correction", false, -1);
-  meta.includeDirect = metaValue<int32_t>(path, m, "include_direct", false, -1);
+  // The bake's switches: 0 or 1, -1 when not recorded. Any other integer was
+  // read as off (include_direct = 7 hid render's warning that the direct
+  // light is counted twice).
+  auto onOff = [&](const char* key) {
+    const int32_t v = metaValue<int32_t>(path, m, key, false, -1);
+    if (m[key] && v != 0 && v != 1) {
+      throw InputError(path + ": file metadata '" + key + "' = " + std::to_string(v) +
+                       " is neither 0 (off) nor 1 (on)");
+    }
+    return v;
+  };
+  meta.surfaceLayers = onOff("surface_layers");
+  meta.gatherOcclusion = onOff("gather_occlusion");
+  meta.edgeCorrection = onOff("edge_correction");
+  meta.includeDirect = onOff("include_direct");
   meta.region.lower = fromVdb(
       metaValue<openvdb::Vec3s>(path, m, "region_min", false, openvdb::Vec3s(INFINITY)));
   meta.region.upper = fromVdb(

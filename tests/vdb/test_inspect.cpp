@@ -654,6 +654,10 @@ TEST(Inspect, MetadataOutOfRangeAreRefusedNamingTheKey) {
       {"bounds-reversed", "'scene_bounds_min'",
        [](BakeMetadata& m) { std::swap(m.sceneBounds.lower, m.sceneBounds.upper); }},
       {"photons-negative", "'photons'", [](BakeMetadata& m) { m.photons = -5; }},
+      // A switch other than 0 or 1 read as off (render did not warn that the
+      // direct light of include_direct = 7 is counted twice).
+      {"include-direct-7", "'include_direct' = 7", [](BakeMetadata& m) { m.includeDirect = 7; }},
+      {"layers-2", "'surface_layers' = 2", [](BakeMetadata& m) { m.surfaceLayers = 2; }},
   };
   for (const Case& c : cases) {
     BakeMetadata m = metaWithBounds();
