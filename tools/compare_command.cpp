@@ -33,9 +33,7 @@ nlohmann::json toJson(const ChannelError& e) {
 int runCompare(const CompareOptions& opt) {
   if (!opt.diff.empty()) {
     checkOutputFolder(opt.diff, "--diff");
-    if (!hasExtension(opt.diff, ".png") && !hasExtension(opt.diff, ".exr")) {
-      throw InputError("--diff: '" + opt.diff + "' must end in .png or .exr");
-    }
+    checkOutputExtension(opt.diff, "--diff", {".png", ".exr"});
   }
   if (!opt.json.empty()) checkOutputFile(opt.json, "--json", ".json");
   checkDistinctFiles({{"--diff", opt.diff}, {"--json", opt.json}},

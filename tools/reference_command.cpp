@@ -26,9 +26,7 @@ namespace {
 
 void checkImageOutput(const std::string& path, const char* flag) {
   checkOutputFolder(path, flag);
-  if (!hasExtension(path, ".exr") && !hasExtension(path, ".png")) {
-    throw InputError(std::string(flag) + ": '" + path + "' must end in .exr or .png");
-  }
+  checkOutputExtension(path, flag, {".exr", ".png"});
 }
 
 /// --part added-mask | edge-mask: a mask of the first hits, no paths traced;

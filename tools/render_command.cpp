@@ -106,9 +106,7 @@ int runRender(const RenderOptions& opt) {
   checkDistinctFiles({{"--output", opt.output}, {"--json", opt.json}}, inputs);
   JsonReport report{"render", inputs, {{"mode", opt.mode}, {"width", opt.width}, {"height", opt.height}}};
   std::vector<StageReport> rows;
-  if (!hasExtension(opt.output, ".png") && !hasExtension(opt.output, ".exr")) {
-    throw InputError("--output: '" + opt.output + "' must end in .png or .exr");
-  }
+  checkOutputExtension(opt.output, "--output", {".png", ".exr"});
   checkCameraOptions(opt.camera);
   (void)opt.picture.toneParams();  // a bad --exposure is refused before the work
   Scene scene = loadSceneStage(opt, rows);

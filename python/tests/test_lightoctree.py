@@ -339,6 +339,19 @@ def test_numbers_of_any_numeric_type_are_taken():
     assert lightoctree.convert(g, depth=np.int8(2)).depth == 2
 
 
+def test_a_name_that_is_only_an_extension_is_named_so(grid, grid_file, tmp_path):
+    """write('.vdb', g) said "'.vdb' must end in .vdb": to the system '.vdb' is a
+    hidden name without an extension. The refusal says what is missing."""
+    for name in (".vdb", ".VDB"):
+        with pytest.raises(lightoctree.InputError, match=r"^path: '.*/" + re.escape(name) +
+                           r"' has no name before \.vdb: name the file \(grid\.vdb\)$"):
+            lightoctree.write(str(tmp_path / name), grid)
+    with pytest.raises(lightoctree.InputError,
+                       match=r"^output: '.*/\.glb' has no name before \.glb"):
+        lightoctree.lightmap(SCENE, grid_file, str(tmp_path / ".glb"))
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_path_with_a_nul_byte_names_no_file(grid, tmp_path):
     """Python's open() refuses "\\0" in a path; the module did not, and the
     system cut the path at it: write("a.vdb\\0.png") wrote a.vdb."""

@@ -547,10 +547,30 @@ std::string lowerExtension(const std::string& path) {
 }
 
 void checkOutputFile(const std::string& path, const char* flag, const char* extension) {
-  if (!hasExtension(path, extension)) {
-    throw InputError(std::string(flag) + ": '" + path + "' must end in " + extension);
-  }
+  checkOutputExtension(path, flag, {extension});
   checkOutputFolder(path, flag);
+}
+
+void checkOutputExtension(const std::string& path, const char* flag,
+                          std::initializer_list<const char*> extensions) {
+  std::string list;
+  for (const char* extension : extensions) {
+    if (hasExtension(path, extension)) return;
+    list += (list.empty() ? "" : " or ") + std::string(extension);
+  }
+  auto lower = [](std::string text) {
+    std::transform(text.begin(), text.end(), text.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return text;
+  };
+  const std::string name = lower(fs::path(path).filename().string());
+  for (const char* extension : extensions) {
+    if (name == lower(extension)) {
+      throw InputError(std::string(flag) + ": '" + path + "' has no name before " + extension +
+                       ": name the file (grid" + extension + ")");
+    }
+  }
+  throw InputError(std::string(flag) + ": '" + path + "' must end in " + list);
 }
 
 bool hasExtension(const std::string& path, const char* extension) {

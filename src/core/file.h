@@ -7,6 +7,7 @@
 /// See docs/architecture.md, "Outputs".
 
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <utility>
 #include <vector>
@@ -74,6 +75,14 @@ void checkOutputFolder(const std::string& path, const char* flag);
 /// a grid or a report without a word.
 /// @throws InputError naming `flag`: "--output: 'scene.gltf' must end in .vdb".
 void checkOutputFile(const std::string& path, const char* flag, const char* extension);
+
+/// @brief That the file name of output `path` ends in one of `extensions`
+/// (any case) and has a name before it: ".vdb" alone is, to the system, a
+/// hidden name without an extension, and was refused as not ending in .vdb.
+/// @throws InputError naming `flag`: "--output: 'x.obj' must end in .png or
+/// .exr", "path: '.vdb' has no name before .vdb: name the file (grid.vdb)".
+void checkOutputExtension(const std::string& path, const char* flag,
+                          std::initializer_list<const char*> extensions);
 
 /// @brief A folder a command writes its files into (`sweep --out`): one that
 /// exists is written into, a new one is made in a folder that exists.

@@ -301,9 +301,7 @@ const char* toString(AtlasContent content) {
 }
 
 void checkLightmapExportPath(const std::string& output, const char* flag) {
-  if (!hasExtension(output, ".glb") && !hasExtension(output, ".gltf")) {
-    throw InputError(std::string(flag) + ": '" + output + "' must end in .glb or .gltf");
-  }
+  checkOutputExtension(output, flag, {".glb", ".gltf"});
 }
 
 void checkLightmapOutputs(const std::string& output, bool preview, const NamedPaths& inputs) {

@@ -790,9 +790,7 @@ GltfFiles encodeLightmapGltf(const Scene& scene, const LightmapExport& lightmap,
                              const std::string& path) {
   using namespace gltf_export_internal;
   const bool binary = hasExtension(path, ".glb");
-  if (!binary && !hasExtension(path, ".gltf")) {
-    throw InputError(path + ": a glTF export must end in .glb or .gltf");
-  }
+  if (!binary) checkOutputExtension(path, "a glTF export", {".glb", ".gltf"});
   checkExport(scene, lightmap);
   GltfFiles files;
   if (!binary) files.binUri = std::filesystem::path(path).stem().string() + ".bin";
