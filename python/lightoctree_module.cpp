@@ -242,12 +242,25 @@ auto withPythonNames(Work work) {
   }
 }
 
+/// `text` (a message that may quote a file name or a file's metadata) as
+/// UTF-8 Python decodes: bytes that are not UTF-8 shown as \xNN. Python's
+/// PyErr_SetString and PyErr_WarnEx decode strictly, and answered a message
+/// naming a non-UTF-8 path with a UnicodeDecodeError instead of it.
+std::string validUtf8(const std::string& text) {
+  py::object decoded = py::reinterpret_steal<py::object>(
+      PyUnicode_DecodeUTF8(text.data(), py::ssize_t(text.size()), "backslashreplace"));
+  if (!decoded) throw py::error_already_set();
+  return decoded.cast<std::string>();
+}
+
 /// The commands' "warning: ..." on stderr, as Python's warnings.warn(text)
 /// (a UserWarning, shown once per place by default, or raised where the
 /// caller made warnings errors); nothing for "".
 void warn(const std::string& text) {
   if (text.empty()) return;
-  if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+  if (PyErr_WarnEx(PyExc_UserWarning, validUtf8(text).c_str(), 1) != 0) {
+    throw py::error_already_set();
+  }
 }
 
 /// The commands' warning of a grid baked from another version of the scene
@@ -373,14 +386,35 @@ std::string vdlsArg(const py::handle& value, const std::string& name, const char
   return text;
 }
 
-/// A path argument: str or os.PathLike, checked as checkPathText.
+/// A path argument: str, bytes or os.PathLike, as Python's own open() takes
+/// them: the bytes os.fsencode gives, which are the file's name whatever its
+/// encoding (a name that is not UTF-8 comes as bytes, or as a str of
+/// os.fsdecode with its bytes as surrogate escapes; pybind11's str to UTF-8
+/// raised UnicodeEncodeError on those, bytes were refused, and a PathLike of
+/// bytes was taken as the text "b'...'"). Checked as checkPathText.
 std::string pathArg(const py::handle& value, const std::string& name) {
-  if (!py::isinstance<py::str>(value) && !py::hasattr(value, "__fspath__")) {
-    refuse(name, "a path", value);
+  if (!py::isinstance<py::str>(value) && !py::isinstance<py::bytes>(value) &&
+      !py::hasattr(value, "__fspath__")) {
+    refuse(name, "a path (str, bytes or os.PathLike)", value);
   }
-  const std::string path = py::str(py::module_::import("os").attr("fspath")(value));
+  py::object encoded;
+  try {
+    encoded = py::module_::import("os").attr("fsencode")(value);
+  } catch (py::error_already_set& e) {
+    // A str with a surrogate that is not an escaped byte, an __fspath__
+    // that returns neither str nor bytes.
+    throw InputError(name + ": " + std::string(py::repr(value)) +
+                     " is not a file name the system can take (" + e.what() + ")");
+  }
+  const std::string path = encoded.cast<std::string>();
   checkPathText(path, name);
   return path;
+}
+
+/// A path for Python, as os.fsdecode gives it: a str whatever the bytes, which
+/// open() and pathArg take back to the same bytes.
+py::object pathValue(const std::string& path) {
+  return py::module_::import("os").attr("fsdecode")(py::bytes(path));
 }
 
 GridPtr readGrid(const Arg<std::string>& pathArgument) {
@@ -396,7 +430,7 @@ py::dict inspectFile(const Arg<std::string>& pathArgument) {
   const std::string path = pathArg(pathArgument.value, "path");
   const VdbReport r = inspectVdb(path);
   py::dict d;
-  d["path"] = r.path;
+  d["path"] = pathValue(r.path);
   d["kind"] = r.kind;
   d["bytes"] = r.fileBytes;
   d["ok"] = r.ok();
@@ -405,12 +439,13 @@ py::dict inspectFile(const Arg<std::string>& pathArgument) {
     py::dict check;
     check["name"] = c.name;
     check["passed"] = c.passed;
-    check["detail"] = c.detail;
+    check["detail"] = validUtf8(c.detail);
     checks.append(check);
   }
   d["checks"] = checks;
   py::dict meta;
-  for (const auto& [key, value] : r.metadata) meta[py::str(key)] = value;
+  // Another tool's metadata need not be UTF-8 (as the CLI's JSON report).
+  for (const auto& [key, value] : r.metadata) meta[py::str(validUtf8(key))] = validUtf8(value);
   d["metadata"] = meta;
   return d;
 }
@@ -733,7 +768,8 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
 /// (height, width, 3) (a mask also (height, width)). `path` gets the path.
 RgbImage imageArg(const py::object& value, const std::string& name, bool isMask,
                   std::string* path) {
-  if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")) {
+  if (py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value) ||
+      py::hasattr(value, "__fspath__")) {
     *path = pathArg(value, name);
     return readImage(*path, isMask);
   }
@@ -816,8 +852,8 @@ py::dict compareImagesArg(const py::object& testArg, const py::object& reference
   warn(r.nonFiniteWarning());  // as the command's "warning: ..." on stderr
   const CompareResult& m = r.result;
   py::dict d;  // the keys and values of `compare --json`
-  d["test"] = testPath.empty() ? py::object(py::none()) : py::object(py::str(testPath));
-  d["reference"] = referencePath.empty() ? py::object(py::none()) : py::object(py::str(referencePath));
+  d["test"] = testPath.empty() ? py::object(py::none()) : pathValue(testPath);
+  d["reference"] = referencePath.empty() ? py::object(py::none()) : pathValue(referencePath);
   d["bin"] = settings.bin;
   d["width"] = r.reference.width;
   d["height"] = r.reference.height;
@@ -941,11 +977,16 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
   d["content"] = toString(p.content);
   d["encoding"] = p.rgbm ? "rgbm-png" : "linear-exr";
   d["rgbm_range"] = p.rgbm ? py::object(py::float_(r.rgbmRange)) : py::object(py::none());
-  d["page_files"] = r.pagePaths;
-  d["direction_files"] = r.directionPaths;
-  d["chart_files"] = r.chartPaths;
-  d["gltf"] = r.output;
-  d["preview"] = r.previewPath.empty() ? py::object(py::none()) : py::object(py::str(r.previewPath));
+  auto paths = [](const std::vector<std::string>& from) {
+    py::list out;
+    for (const std::string& path : from) out.append(pathValue(path));
+    return out;
+  };
+  d["page_files"] = paths(r.pagePaths);
+  d["direction_files"] = paths(r.directionPaths);
+  d["chart_files"] = paths(r.chartPaths);
+  d["gltf"] = pathValue(r.output);
+  d["preview"] = r.previewPath.empty() ? py::object(py::none()) : pathValue(r.previewPath);
   d["octree_bytes"] = r.octreePoolBytes + r.octreeVdlBytes;
   d["page_file_bytes"] = r.pageFileBytes;
   d["output_bytes"] = r.outputBytes;
@@ -960,8 +1001,20 @@ PYBIND11_MODULE(lightoctree, m) {
       "Light Octree: photon-mapped global illumination baked into sparse OpenVDB grids of "
       "virtual directional lights (docs/python.md).";
   m.attr("__version__") = LO_VERSION;
-  py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
-  py::register_exception<IoError>(m, "IoError", PyExc_OSError);
+  static py::handle inputError =
+      py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  static py::handle ioError = py::register_exception<IoError>(m, "IoError", PyExc_OSError);
+  // Tried before the two above (the last registered first): their messages
+  // as valid UTF-8 (validUtf8), whatever bytes a file name put in them.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      PyErr_SetString(inputError.ptr(), validUtf8(e.what()).c_str());
+    } catch (const IoError& e) {
+      PyErr_SetString(ioError.ptr(), validUtf8(e.what()).c_str());
+    }
+  });
 
   py::class_<Grid, GridPtr>(m, "Grid", "A light grid: voxels with irradiance and VDLs (or SH).")
       // Only the module makes grids: pybind11 gave Grid.__new__(Grid) an

@@ -352,6 +352,53 @@ def test_a_name_that_is_only_an_extension_is_named_so(grid, grid_file, tmp_path)
     assert list(tmp_path.iterdir()) == []
 
 
+def test_file_names_that_are_not_utf8_are_taken_as_open_takes_them(grid, tmp_path):
+    """A name that is not UTF-8 comes as bytes, as the str of os.fsdecode (its
+    bytes as surrogate escapes) or as an os.PathLike of either: bytes were
+    refused, the others raised UnicodeEncodeError, a warning naming one raised
+    UnicodeDecodeError. Every function takes them as open() does, returns
+    them as os.fsdecode does and names them with the bytes shown as \\xNN."""
+    import pathlib
+    import warnings
+
+    folder = os.fsencode(tmp_path) + b"/odd-\xff\xfe"
+    os.mkdir(folder)
+    raw = folder + b"/grid.vdb"
+    text = os.fsdecode(raw)
+
+    class BytesPath:
+        def __fspath__(self):
+            return raw
+
+    lightoctree.write(raw, grid)
+    for path in (raw, text, pathlib.Path(text), BytesPath()):
+        assert lightoctree.read(path).size == grid.size
+        report = lightoctree.inspect(path)
+        assert report["ok"] and report["path"] == text
+    scene = folder + b"/scene.gltf"
+    with open(SCENE, "rb") as source, open(scene, "wb") as copy:
+        copy.write(source.read())
+    baked = lightoctree.bake(scene, depth=3, photons=2000, knn=20)
+    lightoctree.write(text, baked)
+    with open(scene, "ab") as f:
+        f.write(b" ")  # another scene: the warnings name its folder
+    with pytest.warns(UserWarning, match=r"baked from .*/odd-\\xff\\xfe/scene\.gltf"):
+        assert lightoctree.render(os.fsdecode(scene), baked, width=8, height=8).shape == (8, 8, 3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = lightoctree.lightmap(scene, BytesPath(), folder + b"/lit.glb", directions="off")
+    assert result["gltf"] == os.fsdecode(folder + b"/lit.glb") and os.path.exists(result["gltf"])
+    assert all(os.path.exists(p) for p in result["page_files"])
+    page = result["page_files"][0]
+    assert lightoctree.compare(lightoctree.read_image(page), page)["reference"] == page
+    with pytest.raises(lightoctree.InputError, match=r"/odd-\\xff\\xfe/missing\.vdb: "):
+        lightoctree.read(folder + b"/missing.vdb")
+    # A str no file system encoding holds (a surrogate that escapes no byte).
+    with pytest.raises(lightoctree.InputError,
+                       match=r"^path: '\\ud800\.vdb' is not a file name the system can take"):
+        lightoctree.read("\ud800.vdb")
+
+
 def test_a_path_with_a_nul_byte_names_no_file(grid, tmp_path):
     """Python's open() refuses "\\0" in a path; the module did not, and the
     system cut the path at it: write("a.vdb\\0.png") wrote a.vdb."""
