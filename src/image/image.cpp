@@ -539,6 +539,16 @@ void checkBytesSize(size_t size) {
 
 }  // namespace
 
+size_t storedImageBytes(const unsigned char* bytes, size_t size) {
+  int w = 0, h = 0, comp = 0;
+  if (size == 0 || size > size_t(std::numeric_limits<int>::max()) ||
+      !stbi_info_from_memory(bytes, int(size), &w, &h, &comp) || w <= 0 || h <= 0) {
+    return 0;
+  }
+  const size_t channelBytes = stbi_is_16_bit_from_memory(bytes, int(size)) ? 2 : 1;
+  return size_t(w) * size_t(h) * size_t(std::clamp(comp, 1, 4)) * channelBytes;
+}
+
 StoredImage decodeStoredImage(const unsigned char* bytes, size_t size) {
   checkBytesSize(size);
   // The header's size first: stb's pixels and the caller's copy, at most 4

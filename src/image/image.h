@@ -63,6 +63,10 @@ struct StoredImage {
 /// @brief decodeImageBytes without the conversion to floats.
 /// @throws as decodeImageBytes.
 StoredImage decodeStoredImage(const unsigned char* bytes, size_t size);
+/// The bytes decodeStoredImage keeps of the image `bytes` hold (width x
+/// height x channels x 1 or 2 bytes), read from its header without decoding;
+/// 0 when the header names no image (decoding then says why).
+size_t storedImageBytes(const unsigned char* bytes, size_t size);
 
 /// Largest width or height of an image any stage reads (the largest 2D
 /// texture GL contexts give, 16384).

@@ -264,6 +264,7 @@ class SceneBuilder {
   std::set<int> missingImages_;  ///< images whose file is missing, warned once
   /// Each image's file bytes, kept by the textures that decode it (Texture::encoded).
   std::map<int, std::shared_ptr<const std::vector<uint8_t>>> imageBytes_;
+  std::vector<PendingTexture> pendingTextures_;  ///< textureFromImage's, for decodeTextures
   int defaultMaterial_ = -1;
   bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false,
        hasColors_ = false, warnedSpecularGlossiness_ = false;

@@ -275,12 +275,14 @@ int SceneBuilder::textureFromImage(int source, int tex, bool srgb) {
   // The file's bytes, shared by every texture decoding this image.
   std::shared_ptr<const std::vector<uint8_t>>& bytes = imageBytes_[source];
   if (!bytes) bytes = std::make_shared<const std::vector<uint8_t>>(im.image);
-  Texture t = decodeImage(path_, bytes, what, srgb);
+  // Decoded once every texture is known (decodeTextures: their total memory first).
+  Texture t;
   t.sampler = key.sampler;
   t.name =
       im.name.empty() ? (im.uri.empty() ? "image" + std::to_string(source) : im.uri) : im.name;
   int index = int(scene_.textures.size());
   scene_.textures.push_back(std::move(t));
+  pendingTextures_.push_back({index, bytes, what, srgb});
   imageToTexture_[key] = index;
   return index;
 }

@@ -101,6 +101,8 @@ Scene SceneBuilder::build() {
     }
   }
   convertMaterials();
+  decodeTextures(scene_, path_, pendingTextures_);
+  pendingTextures_.clear();
   traverse();
   readSky();
   if (!skyMeshFlag_.empty()) {  // the command line's sky mesh replaces the file's sky

@@ -172,6 +172,7 @@ Scene loadObj(const std::string& path) {
 
   // Materials, in .mtl order; a shared default for faces without usemtl.
   std::map<std::string, int> textureByFile;
+  std::vector<PendingTexture> pendingTextures;
   for (size_t i = 0; i < objMaterials.size(); ++i) {
     const tinyobj::material_t& o = objMaterials[i];
     Material m;
@@ -212,15 +213,17 @@ Scene loadObj(const std::string& path) {
         }
         auto bytes = std::make_shared<const std::vector<unsigned char>>(
             readFileBytes(path, file, "texture"));
-        Texture t = decodeImage(path, bytes, "(" + what + ")");
+        Texture t;  // decoded with the others (decodeTextures: their total memory first)
         t.name = o.diffuse_texname;
         m.baseColorTexture = int(scene.textures.size());
         textureByFile[o.diffuse_texname] = m.baseColorTexture;
         scene.textures.push_back(std::move(t));
+        pendingTextures.push_back({m.baseColorTexture, bytes, "(" + what + ")", true});
       }
     }
     scene.materials.push_back(std::move(m));
   }
+  decodeTextures(scene, path, pendingTextures);
   int defaultMaterial = -1;
 
   // Faces, grouped by material (usemtl), in file order within a material.

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/resources.h"
 #include "image/image.h"
 #include "scene/scene_internal.h"
 
@@ -625,6 +626,37 @@ Texture decodeImage(const std::string& scenePath,
     t.mimeType = d.mimeType;
   }
   return t;
+}
+
+void decodeTextures(Scene& scene, const std::string& scenePath,
+                    const std::vector<PendingTexture>& pending) {
+  // From the images' headers, before any is decoded.
+  double total = 0, largest = 0;
+  const PendingTexture* largestOne = nullptr;
+  for (const PendingTexture& p : pending) {
+    const double bytes = double(storedImageBytes(p.bytes->data(), p.bytes->size()));
+    total += bytes;
+    if (bytes > largest) {
+      largest = bytes;
+      largestOne = &p;
+    }
+  }
+  // One texture alone: decodeImage's own check, which counts its working copies too.
+  const size_t available = pending.size() > 1 ? availableMemoryBytes() : 0;
+  if (available > 0 && total > 0.5 * double(available)) {
+    fail(scenePath, "its " + std::to_string(pending.size()) + " textures would take " +
+                        formatBytes(size_t(total)) + " decoded (the largest, " +
+                        largestOne->what + ", " + formatBytes(size_t(largest)) +
+                        "), more than " + formatBytes(available / 2) + ", half the " +
+                        formatBytes(available) + " of memory available");
+  }
+  for (const PendingTexture& p : pending) {
+    Texture& t = scene.textures[size_t(p.index)];
+    Texture decoded = decodeImage(scenePath, p.bytes, p.what, p.srgb);
+    decoded.name = std::move(t.name);
+    decoded.sampler = t.sampler;
+    t = std::move(decoded);
+  }
 }
 
 std::string formatLimit(double v) {

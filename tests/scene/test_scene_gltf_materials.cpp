@@ -5,12 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
+#include "image/image.h"
 #include "scene/scene.h"
 #include "scene/scene_fixture.h"
 #include "test_util.h"
@@ -243,6 +245,41 @@ TEST_F(SceneGltf, MissingTextureFileIsWarnedOnceByName) {
   EXPECT_EQ(s.materials[0].baseColorTexture, -1);
   EXPECT_EQ(s.materials[0].normalTexture, -1);
   expectNear(s.materials[0].baseColor, {0.5f, 0.25f, 1.0f}, 1e-6f);
+}
+
+// The textures' memory is checked as a total, before any is decoded: each
+// image was checked alone as it was decoded, and 160 copies of a 4096^2 PNG
+// reached 7.4 GB before one was refused.
+TEST_F(SceneGltf, TexturesAreCheckedAgainstTheMemoryAsATotal) {
+  // 256 x 256 RGB: 192 KiB kept per texture (1 MiB by the check of one image,
+  // which counts the decoder's working copies).
+  writeFile(dir + "/big.ppm", "P6\n256 256\n255\n" + std::string(256 * 256 * 3, '\x80'));
+  auto scene = [&](int n) {
+    MiniGltf g = oneTriangle();
+    g.material = 0;
+    std::string textures, images, materials;
+    for (int i = 0; i < n; ++i) {
+      const std::string comma = i ? ", " : "", index = std::to_string(i);
+      textures += comma + R"({"source": )" + index + "}";
+      images += comma + R"({"uri": "big.ppm"})";
+      materials += comma + R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": )" +
+                   index + "}}}";
+    }
+    g.extraTop = R"("textures": [)" + textures + R"(], "images": [)" + images + "], ";
+    g.materials = "[" + materials + "]";
+    return write("textures" + std::to_string(n) + ".gltf", g);
+  };
+  // 4 MiB available: the textures may take 2 MiB, 10 of them (1.9 MiB), not 16 (3 MiB).
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "4M", 1);
+  EXPECT_EQ(loadScene(scene(10)).textures.size(), 10u);
+  expectInputError(scene(16), "its 16 textures would take 3.0 MiB decoded");
+  expectInputError(scene(16), "more than 2.0 MiB, half the 4.0 MiB of memory available");
+  unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+  const Scene s = loadScene(scene(16));
+  ASSERT_EQ(s.textures.size(), 16u);
+  EXPECT_EQ(s.textures[15].width, 256);
+  EXPECT_EQ(s.textures[15].name, "big.ppm");
+  expectNear(s.textures[15].texelAt(0), Vec3{srgbToLinear(128.0f / 255.0f)}, 1e-6f);
 }
 
 /// A 2 x 2 texture of texel values 0, 1 (top row), 2, 3 (bottom row).
