@@ -143,6 +143,22 @@ size_t addressSpaceRoomBytes() {
   return cap > used ? cap - used : 0;
 }
 
+std::string memoryShortfall() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    return "the process's address space is limited to " + formatBytes(size_t(limit.rlim_cur)) +
+           " (ulimit -v), " + formatBytes(addressSpaceRoomBytes()) +
+           " of it unused: raise or remove the limit";
+  }
+  size_t available = 0;
+  try {
+    available = availableMemoryBytes();
+  } catch (const std::exception&) {  // a LIGHTOCTREE_MEMORY_LIMIT that is not a size
+  }
+  return available ? formatBytes(available) + " of memory available: give the process more"
+                   : std::string("give the process more memory");
+}
+
 size_t availableMemoryBytes() {
   size_t available = 0;
   if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {

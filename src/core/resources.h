@@ -54,6 +54,14 @@ size_t memoryLimitSetting();
 /// resident or not, so availableMemoryBytes takes it as a cap too.
 size_t addressSpaceRoomBytes();
 
+/// @brief For the message of an allocation that failed inside a library (a
+/// shared library that could not be mapped, a device that could not be
+/// made): under an address-space limit, "the process's address space is
+/// limited to 195.3 MiB (ulimit -v), 2.1 MiB of it unused: raise or remove
+/// the limit"; else the memory available (availableMemoryBytes). Their own
+/// messages said only "error 4", or advised installing what was installed.
+std::string memoryShortfall();
+
 /// @brief Watches the process's resident memory from a thread of its own
 /// (every `intervalSeconds`) and calls `onExceeded(rss)` once, from that
 /// thread, when it grows past `limitBytes`: the estimates made before the

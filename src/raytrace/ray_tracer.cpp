@@ -7,11 +7,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 namespace lo {
 
@@ -25,6 +27,7 @@ struct RayTracer::Impl {
   /// A copy of the scene when some material has alpha (Mask or Blend): the
   /// filter below reads its coverage; null otherwise (no filter installed).
   std::unique_ptr<Scene> alphaScene;
+  std::string lastError;  ///< Embree's text of its last error (rtcSetDeviceErrorFunction)
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -34,7 +37,30 @@ struct RayTracer::Impl {
 
 namespace {
 
-std::string errorCode(RTCDevice device) { return std::to_string(int(rtcGetDeviceError(device))); }
+/// An Embree call that failed with `error` (rtcGetDeviceError, read once: it
+/// clears the error, and a second read said "error 0"). Out of memory is the
+/// machine's or the process's limit (ulimit -v), said as such, as the memory
+/// checks before the work say it: "rtcNewDevice failed (error 4)" told
+/// nothing. Anything else is a broken invariant.
+/// `text`: Embree's own words, when it gave them (a build under ulimit -v
+/// fails as RTC_ERROR_UNKNOWN, "pthread_create has failed": a thread's stack
+/// is address space too).
+[[noreturn]] void embreeFailed(const std::string& what, RTCError error,
+                               const std::string& text = "") {
+  const bool threads = text.find("pthread_create") != std::string::npos &&
+                       addressSpaceRoomBytes() != SIZE_MAX;
+  if (error == RTC_ERROR_OUT_OF_MEMORY || text.find("bad_alloc") != std::string::npos ||
+      threads) {
+    throw InputError("out of memory: the ray tracer (Embree) could not " + what +
+                     (text.empty() ? "" : " (" + text + ")") + ": " + memoryShortfall());
+  }
+  throw InternalError("Embree could not " + what + " (error " + std::to_string(int(error)) +
+                      (text.empty() ? "" : ": " + text) + ")");
+}
+
+void recordError(void* text, RTCError, const char* str) {
+  *static_cast<std::string*>(text) = str ? str : "";
+}
 
 uint32_t floatBits(float f) {
   uint32_t u;
@@ -127,8 +153,9 @@ RayTracer::RayTracer(const Scene& scene, Objects objects) : impl_(std::make_uniq
   }
 
   impl_->device = rtcNewDevice(nullptr);
-  if (!impl_->device) throw InternalError("rtcNewDevice failed (error " + errorCode(nullptr) + ")");
+  if (!impl_->device) embreeFailed("start (rtcNewDevice)", rtcGetDeviceError(nullptr));
   RTCDevice device = impl_->device;
+  rtcSetDeviceErrorFunction(device, recordError, &impl_->lastError);
   impl_->scene = rtcNewScene(device);
   // Robust traversal: the dragon has coincident opposite-winding triangles
   // and the closed test boxes must not leak rays through shared edges.
@@ -145,8 +172,9 @@ RayTracer::RayTracer(const Scene& scene, Objects objects) : impl_(std::make_uniq
         rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                 3 * sizeof(uint32_t), triangles));
     if (!vertices || !indices) {
+      const RTCError error = rtcGetDeviceError(device);
       rtcReleaseGeometry(geom);
-      throw InternalError("Embree buffer allocation failed (error " + errorCode(device) + ")");
+      embreeFailed("allocate the scene's buffers", error, impl_->lastError);
     }
     for (size_t i = 0; i < scene.positions.size(); ++i) {
       vertices[3 * i] = scene.positions[i].x;
@@ -167,8 +195,9 @@ RayTracer::RayTracer(const Scene& scene, Objects objects) : impl_(std::make_uniq
     rtcReleaseGeometry(geom);
   }
   rtcCommitScene(impl_->scene);
-  if (rtcGetDeviceError(device) != RTC_ERROR_NONE)
-    throw InternalError("Embree scene build failed (error " + errorCode(device) + ")");
+  if (const RTCError error = rtcGetDeviceError(device); error != RTC_ERROR_NONE) {
+    embreeFailed("build the scene's hierarchy", error, impl_->lastError);
+  }
 }
 
 RayTracer::~RayTracer() = default;

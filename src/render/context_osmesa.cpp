@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/resources.h"
 #include "render/context_internal.h"
 
 namespace lo::render_internal {
@@ -38,8 +39,17 @@ const OsMesaApi& osMesa() {
       if (lib) break;
     }
     if (!lib) {
-      const char* why = dlerror();
-      error = std::string("osmesa: cannot open libOSMesa.so.8 (") + (why ? why : "?") +
+      const char* reason = dlerror();
+      const std::string why = reason ? reason : "?";
+      // A library that is there but cannot be mapped (ENOMEM: "failed to map
+      // segment", under ulimit -v) is a memory limit, not a missing package;
+      // thrown, not kept, so that a later context tries again.
+      if (why.find("failed to map segment") != std::string::npos ||
+          why.find("Cannot allocate memory") != std::string::npos) {
+        throw GlError("osmesa: out of memory: cannot load libOSMesa.so.8 (" + why + "): " +
+                      memoryShortfall());
+      }
+      error = "osmesa: cannot open libOSMesa.so.8 (" + why +
               "): install libosmesa6 (tools/setup.sh does)";
       return;
     }

@@ -4,8 +4,14 @@
 #include "raytrace/ray_tracer.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "core/error.h"
 
 #include "test_util.h"
 
@@ -91,6 +97,44 @@ TEST(RayTracer, RaysBeyondWhatEmbreeTakesMeetNothing) {
   EXPECT_FALSE(tracer.intersect({0, 0, 1}, {0, 0, -huge}, hit, INFINITY));
   EXPECT_FALSE(tracer.occluded({0, 0, 1}, {0, 0, -huge}, INFINITY));
   EXPECT_FALSE(tracer.occluded({0, 0, 1}, {nan, 0, -1}, 10.0f));
+}
+
+// Under an address-space limit (ulimit -v) Embree's failure said only
+// "rtcNewDevice failed (error 4)", a broken invariant: it is memory, and the
+// message says so and names the limit. (Not under AddressSanitizer, whose
+// shadow memory is terabytes of address space already mapped.)
+TEST(RayTracer, OutOfMemoryUnderAnAddressSpaceLimitIsSaid) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer";
+#endif
+  Material m;
+  const Scene scene = alphaQuad(m, nullptr);
+  rlimit saved{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
+  size_t mapped = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    unsigned long long pages = 0;
+    if (std::fscanf(f, "%llu", &pages) == 1) mapped = size_t(pages) * size_t(sysconf(_SC_PAGESIZE));
+    std::fclose(f);
+  }
+  ASSERT_GT(mapped, 0u);
+  rlimit lower = saved;
+  lower.rlim_cur = rlim_t(mapped + (size_t(1) << 20));  // 1 MiB more than is mapped now
+  if (saved.rlim_cur != RLIM_INFINITY && saved.rlim_cur < lower.rlim_cur) GTEST_SKIP();
+  std::string message;
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &lower), 0);
+  try {
+    RayTracer tracer(scene);
+    message = "no error";
+  } catch (const InputError& e) {
+    message = e.what();
+  } catch (const std::exception& e) {
+    message = std::string("not an InputError: ") + e.what();
+  }
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &saved), 0);
+  EXPECT_NE(message.find("out of memory: the ray tracer (Embree) could not"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("(ulimit -v)"), std::string::npos) << message;
 }
 
 }  // namespace
