@@ -146,7 +146,11 @@ int main(int argc, char** argv) {
      << "and its table covers compression only (KNN gathering + K-means; its photon map came "
      << "from Yafray). Our *compression* column is voxelize + splat + gather + cluster; "
      << "photon tracing is shown apart. Each row runs in its own process; peak RSS is that "
-     << "process's whole peak (scene, photon map, grid and VDLs).\n\n"
+     << "process's whole peak (scene, photon map, grid and VDLs). Open and closed scenes "
+        "at the defaults (a noise target, not a photon count: a sunlit courtyard, an emissive "
+        "object alone, a small object under a spot, a light that reaches nothing, the game "
+        "level at depth 6 and 8), with paths per photon and peak memory, are in "
+        "[bake-cost.md](bake-cost.md) (`python3 tools/bench_bake_cost.py`).\n\n"
      << "| scene | triangles | depth | active voxels | trace 600k photons | voxelize | splat | "
         "gather + cluster | **compression** | paper (compression) | speed-up | peak RSS |\n"
      << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
