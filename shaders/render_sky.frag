@@ -6,13 +6,14 @@
 uniform vec3 uSky;                    // radiance times the exposure scale
 uniform vec3 uForward, uRight, uUp;   // view ray = forward + x right + y up, x and y in [-1, 1]
 uniform vec2 uViewport;               // pixels
+uniform vec2 uPixelOffset;            // where the pixel is sampled, in pixels from its centre
 uniform bool uEncodeSrgb;
 uniform bool uHasSkyImage;            // uSky scales an equirectangular map
 uniform sampler2D uSkyImage;          // row 0 at the zenith; u = 1/2 looks along -Z
 out vec4 fragColor;
 
 void main() {
-  vec2 ndc = gl_FragCoord.xy / uViewport * 2.0 - 1.0;
+  vec2 ndc = (gl_FragCoord.xy + uPixelOffset) / uViewport * 2.0 - 1.0;
   vec3 ray = uForward + ndc.x * uRight + ndc.y * uUp;
   vec3 c = ray.y > 0.0 ? clamp(uSky, 0.0, 1.0e30) : vec3(0.0);
   if (uHasSkyImage && ray.y > 0.0) {

@@ -77,8 +77,9 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& opt, bool window) {
       ->capture_default_str();
   if (!window) {
     cmd->add_option("--supersample", opt.supersample,
-                    "Anti-aliasing: each pixel the mean of N x N samples (the image drawn N times "
-                    "larger, then box-filtered), as the path tracer integrates a pixel")
+                    "Anti-aliasing: each pixel the mean of N x N samples, as the path tracer "
+                    "integrates a pixel (2: four frames sampling a rotated grid; more: the image "
+                    "drawn N times larger, then box-filtered)")
         ->check(wholeIn(1, kMaxSupersample))
         ->capture_default_str();
   }

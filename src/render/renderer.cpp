@@ -267,7 +267,15 @@ RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& param
   if (s < 1 || s > 16) {
     throw InputError("render: supersampling must be 1..16, got " + std::to_string(s));
   }
-  const int w = params.width * s, h = params.height * s;
+  // Two: four frames of the image's size, each sampling the pixels at one
+  // point of a rotated grid (RGSS: the four points on four distinct rows
+  // and columns, so a near-horizontal or near-vertical edge gets five
+  // levels of coverage where an ordered 2 x 2 grid gives three: the window
+  // room's edge pixels, the Cornell box's light). Otherwise one frame s
+  // times larger, each output pixel the mean of its s x s block.
+  const bool rotated = s == 2;
+  const int block = rotated ? 1 : s;
+  const int w = params.width * block, h = params.height * block;
   // The frame the driver draws into, checked before it is made: a side
   // beyond its largest texture, render buffer or viewport, or a target it
   // cannot hold, failed inside the driver ("GL error 0x0501").
@@ -289,25 +297,41 @@ RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& param
     throw InputError("render: a frame of " + frame + " is more than the GL driver can draw into (" +
                      e.what() + "): lower them");
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo.get());
-  r.draw(camera, params, w, h, 1.0f, false);
-  std::vector<float> raw(size_t(w) * size_t(h) * 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, raw.data());
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  checkGl("reading back the image");
-  // GL rows go bottom-up; image rows top-down. Alpha is dropped; each output
-  // pixel is the mean of its s x s block.
+  constexpr float kRotated[4][2] = {
+      {-0.125f, -0.375f}, {0.375f, -0.125f}, {0.125f, 0.375f}, {-0.375f, 0.125f}};
+  const int passes = rotated ? 4 : 1;
+  // The four frames' textures read a level finer, as the frame twice as
+  // large does (its samples' footprints are half a pixel wide).
+  struct LodBias {
+    const render_internal::SceneGeometry& geometry;
+    bool set;
+    ~LodBias() {
+      if (set) geometry.setLodBias(0.0f);
+    }
+  } lodBias{r.geometry, rotated};
+  if (rotated) r.geometry.setLodBias(-1.0f);
   RgbImage image(params.width, params.height);
+  std::vector<float> raw(size_t(w) * size_t(h) * 4);
   const float norm = 1.0f / float(s * s);
-  for (int y = 0; y < params.height; ++y) {
-    float* dst = image.rgb.data() + size_t(y) * size_t(params.width) * 3;
-    for (int sy = 0; sy < s; ++sy) {
-      const float* src = raw.data() + size_t(h - 1 - (y * s + sy)) * size_t(w) * 4;
-      for (int x = 0; x < params.width; ++x) {
-        for (int sx = 0; sx < s; ++sx) {
-          for (int c = 0; c < 3; ++c) dst[3 * x + c] += src[4 * (x * s + sx) + c] * norm;
+  for (int pass = 0; pass < passes; ++pass) {
+    r.pixelOffset = rotated ? glm::vec2(kRotated[pass][0], kRotated[pass][1]) : glm::vec2(0.0f);
+    glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo.get());
+    r.draw(camera, params, w, h, 1.0f, false);
+    r.pixelOffset = glm::vec2(0.0f);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, raw.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    checkGl("reading back the image");
+    // GL rows go bottom-up; image rows top-down. Alpha is dropped.
+    for (int y = 0; y < params.height; ++y) {
+      float* dst = image.rgb.data() + size_t(y) * size_t(params.width) * 3;
+      for (int sy = 0; sy < block; ++sy) {
+        const float* src = raw.data() + size_t(h - 1 - (y * block + sy)) * size_t(w) * 4;
+        for (int x = 0; x < params.width; ++x) {
+          for (int sx = 0; sx < block; ++sx) {
+            for (int c = 0; c < 3; ++c) dst[3 * x + c] += src[4 * (x * block + sx) + c] * norm;
+          }
         }
       }
     }

@@ -115,6 +115,10 @@ struct SceneGeometry {
               const std::function<void(int)>& textureUploaded = {});
   /// The GL name of Scene::textures[texture], 0 for -1.
   GLuint texture(int index) const { return index >= 0 ? textures[size_t(index)].get() : 0; }
+  /// Every texture's level-of-detail bias (GL_TEXTURE_LOD_BIAS): -log2 s
+  /// while s x s samples share a pixel in frames of the image's size, so
+  /// that each sample reads the mip level of its own footprint.
+  void setLodBias(float bias) const;
   /// The geometry of a depth-only pass (depth pre-pass or shadow map) with
   /// `program` in use and the vao bound; see scene_geometry.cpp.
   void drawDepthOnly(GLuint program, bool shadows) const;
@@ -252,6 +256,9 @@ struct Renderer::Impl {
   /// pass (opaque, masked, blended back to front, transmissive).
   void draw(const PinholeCamera& camera, const RenderParams& rp, int width, int height,
             float exposureScale, bool encodeSrgb);
+  /// Where draw samples each pixel, in pixels from its centre (Renderer::
+  /// render's rotated grid); the probe's faces are drawn at the centres.
+  glm::vec2 pixelOffset{0.0f, 0.0f};
   GLuint sceneProgramFor(const RenderParams& rp, bool withDirect);
   void setFrameUniforms(GLuint program, const PinholeCamera& camera, const RenderParams& rp,
                         const glm::mat4& viewProj, bool reflect, float exposureScale,

@@ -143,6 +143,15 @@ GlTexture SceneGeometry::uploadTexture(const Texture& t, unsigned read) {
   return id;
 }
 
+void SceneGeometry::setLodBias(float bias) const {
+  for (const GlTexture& t : textures) {
+    if (!t) continue;
+    glBindTexture(GL_TEXTURE_2D, t.get());
+    glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_LOD_BIAS, bias);
+  }
+  glBindTexture(GL_TEXTURE_2D, 0);
+}
+
 namespace {
 
 const Material& materialOf(const Scene& scene, size_t t) {

@@ -449,7 +449,12 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
                       : glm::length(eye - toGlm(space.bounds.center())) + space.sceneSize + 1e-3f;
   const float znear = nearPlane(camera, space, zfar);
   const float aspect = float(width) / float(height);
-  const glm::mat4 viewProj = glm::perspective(camera.yfov, aspect, znear, zfar) *
+  // The pixel's sample point moved by pixelOffset: the image shifted the
+  // other way, by a translation after the projection.
+  const glm::vec2 offset = probe.capturing ? glm::vec2(0.0f) : pixelOffset;
+  const glm::mat4 shift = glm::translate(
+      glm::mat4(1.0f), glm::vec3(-2.0f * offset.x / float(width), -2.0f * offset.y / float(height), 0.0f));
+  const glm::mat4 viewProj = shift * glm::perspective(camera.yfov, aspect, znear, zfar) *
                              glm::lookAt(eye, eye + toGlm(camera.forward), toGlm(camera.up));
   const bool withDirect = drawsDirectLight(rp.mode);
   if (withDirect) {
@@ -477,6 +482,7 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
     const glm::vec3 upScaled = up * tanHalf;
     glUniform3fv(glGetUniformLocation(program, "uUp"), 1, glm::value_ptr(upScaled));
     glUniform2f(glGetUniformLocation(program, "uViewport"), float(width), float(height));
+    glUniform2fv(glGetUniformLocation(program, "uPixelOffset"), 1, glm::value_ptr(offset));
     glUniform1i(glGetUniformLocation(program, "uEncodeSrgb"), encodeSrgb ? 1 : 0);
     glUniform1i(glGetUniformLocation(program, "uHasSkyImage"), skyImage ? 1 : 0);
     glUniform1i(glGetUniformLocation(program, "uSkyImage"), 11);

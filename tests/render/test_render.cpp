@@ -232,5 +232,31 @@ TEST_F(RenderImage, SupersamplingIsTheBoxFilterOfTheLargerImage) {
       InputError);
 }
 
+// Two by two samples lie on a rotated grid (x offsets -3/8, -1/8, 1/8, 3/8
+// of a pixel, one per row as well): a vertical edge 0.247 px right of a
+// pixel's centre leaves 3 of its 4 samples on the quad, where an ordered
+// 2 x 2 grid (offsets -1/4 and 1/4) would leave half.
+TEST_F(RenderImage, TwoBySupersamplingSamplesARotatedGrid) {
+  QuadSetup s;
+  s.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
+  Renderer renderer(s.scene, test::constantOctree());
+  RenderParams p = QuadSetup::directParams();
+  p.width = 40;
+  p.height = 30;
+  p.supersample = 2;
+  // The quad's right edge (x = 1), 0.1 right of the view's centre: at pixel
+  // 20 + 20 (0.1 / (1.5 tan 20 deg 4/3)) = 22.747 from the left.
+  const PinholeCamera camera =
+      PinholeCamera::lookAt({0.9f, -0.05f, 1.5f}, {0.9f, -0.05f, 0.0f}, 40.0f * kPi / 180.0f);
+  const RgbImage image = renderer.render(camera, p);
+  const float v20 = image.pixel(20, 15)[0], v21 = image.pixel(21, 15)[0];
+  ASSERT_GT(v21, 0.0f);
+  EXPECT_EQ(image.pixel(23, 15)[0], 0.0f);  // wholly right of the edge
+  // The lit light where the three covered samples are (their mean offset
+  // -1/8: 0.875 px right of pixel 21's centre), extrapolated.
+  const float lit = v21 + 0.875f * (v21 - v20);
+  EXPECT_NEAR(image.pixel(22, 15)[0] / lit, 0.75f, 0.02f);
+}
+
 }  // namespace
 }  // namespace lo
