@@ -37,28 +37,25 @@ const SrgbTables& srgbTables() {
   return tables;
 }
 
-/// The level below `above`: each texel from the 2 x 2 texels above it,
-/// `mean(four values, channel)` per channel.
+/// The level below the `width` x `height` image `above`: each texel from the
+/// 2 x 2 texels above it, `mean(four values, channel)` per channel.
 template <class T, class Mean>
-MipLevel<T> halve(const MipLevel<T>& above, int channels, const Mean& mean) {
+MipLevel<T> halve(const T* above, int width, int height, int channels, const Mean& mean) {
   MipLevel<T> level;
-  level.width = std::max(1, above.width / 2);
-  level.height = std::max(1, above.height / 2);
+  level.width = std::max(1, width / 2);
+  level.height = std::max(1, height / 2);
   level.texels.resize(size_t(level.width) * size_t(level.height) * size_t(channels));
-  const size_t c = size_t(channels);
+  const size_t c = size_t(channels), w = size_t(width);
   tbb::parallel_for(tbb::blocked_range<int>(0, level.height, 16),
                     [&](const tbb::blocked_range<int>& rows) {
                       for (int y = rows.begin(); y != rows.end(); ++y) {
-                        const size_t y0 = size_t(std::min(2 * y, above.height - 1));
-                        const size_t y1 = size_t(std::min(2 * y + 1, above.height - 1));
+                        const size_t y0 = size_t(std::min(2 * y, height - 1));
+                        const size_t y1 = size_t(std::min(2 * y + 1, height - 1));
                         for (int x = 0; x < level.width; ++x) {
-                          const size_t x0 = size_t(std::min(2 * x, above.width - 1));
-                          const size_t x1 = size_t(std::min(2 * x + 1, above.width - 1));
-                          const size_t w = size_t(above.width);
-                          const T* t[4] = {&above.texels[(y0 * w + x0) * c],
-                                           &above.texels[(y0 * w + x1) * c],
-                                           &above.texels[(y1 * w + x0) * c],
-                                           &above.texels[(y1 * w + x1) * c]};
+                          const size_t x0 = size_t(std::min(2 * x, width - 1));
+                          const size_t x1 = size_t(std::min(2 * x + 1, width - 1));
+                          const T* t[4] = {above + (y0 * w + x0) * c, above + (y0 * w + x1) * c,
+                                           above + (y1 * w + x0) * c, above + (y1 * w + x1) * c};
                           T* out = &level.texels[(size_t(y) * size_t(level.width) + size_t(x)) * c];
                           for (size_t k = 0; k < c; ++k) {
                             out[k] = mean(t[0][k], t[1][k], t[2][k], t[3][k], int(k));
@@ -69,19 +66,18 @@ MipLevel<T> halve(const MipLevel<T>& above, int channels, const Mean& mean) {
   return level;
 }
 
+/// Levels 1, 2, ... of `base`, each halved from the one above (the base
+/// itself read in place).
 template <class T, class Mean>
 std::vector<MipLevel<T>> chain(const T* base, int width, int height, int channels,
                                const Mean& mean) {
   std::vector<MipLevel<T>> levels;
   if (width < 1 || height < 1 || channels < 1) return levels;
-  MipLevel<T> top;
-  top.width = width;
-  top.height = height;
-  top.texels.assign(base, base + size_t(width) * size_t(height) * size_t(channels));
-  const MipLevel<T>* above = &top;
-  while (above->width > 1 || above->height > 1) {
-    levels.push_back(halve(*above, channels, mean));
-    above = &levels.back();
+  while (width > 1 || height > 1) {
+    const T* above = levels.empty() ? base : levels.back().texels.data();
+    levels.push_back(halve(above, width, height, channels, mean));
+    width = levels.back().width;
+    height = levels.back().height;
   }
   return levels;
 }
