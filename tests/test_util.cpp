@@ -1,6 +1,7 @@
 #include "test_util.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <memory>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 namespace lo::test {
 
@@ -97,6 +99,28 @@ void forCosineGrid(int steps, const std::function<void(const Vec3& l, float z)>&
       at(Vec3(r * std::cos(phi), r * std::sin(phi), z), z);
     }
   }
+}
+
+std::optional<std::string> messageUnderAddressSpaceLimit(size_t headroom,
+                                                         const std::function<void()>& run) {
+  rlimit saved{};
+  if (getrlimit(RLIMIT_AS, &saved) != 0) return std::nullopt;
+  const size_t mapped = mappedBytes();
+  if (mapped == 0) return std::nullopt;
+  rlimit lower = saved;
+  lower.rlim_cur = rlim_t(mapped + headroom);
+  if (saved.rlim_cur != RLIM_INFINITY && saved.rlim_cur < lower.rlim_cur) return std::nullopt;
+  if (setrlimit(RLIMIT_AS, &lower) != 0) return std::nullopt;
+  std::string message = "no error";
+  try {
+    run();
+  } catch (const InputError& e) {
+    message = e.what();
+  } catch (const std::exception& e) {
+    message = std::string("not an InputError: ") + e.what();
+  }
+  setrlimit(RLIMIT_AS, &saved);
+  return message;
 }
 
 std::string runCommand(const std::string& command) {

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,14 @@ void forCosineGrid(int steps, const std::function<void(const Vec3& l, float z)>&
 
 /// Runs `command` through the shell; its standard output ("" if it cannot start).
 std::string runCommand(const std::string& command);
+
+/// Runs `run` with the process's address space limited (ulimit -v) to what it
+/// maps now plus `headroom` bytes, the limit put back after: the message of
+/// what it threw ("no error" when nothing; an exception other than
+/// InputError's prefixed "not an InputError: "), or nullopt when the limit
+/// already in force is lower (`run` is not run).
+std::optional<std::string> messageUnderAddressSpaceLimit(size_t headroom,
+                                                         const std::function<void()>& run);
 
 /// The unit room (albedo 0.6) with a block on the floor, lit by a point light
 /// of intensity 1 at (0.5, 0.8, 0.5): a small scene for whole-bake tests.

@@ -130,15 +130,20 @@ size_t memoryLimitSetting() {
   return size_t(bytes);
 }
 
-size_t addressSpaceRoomBytes() {
-  rlimit limit{};
-  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return SIZE_MAX;
+size_t mappedBytes() {
   size_t used = 0;
   if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
     unsigned long long pages = 0;
     if (std::fscanf(f, "%llu", &pages) == 1) used = size_t(pages) * size_t(sysconf(_SC_PAGESIZE));
     std::fclose(f);
   }
+  return used;
+}
+
+size_t addressSpaceRoomBytes() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return SIZE_MAX;
+  const size_t used = mappedBytes();
   const size_t cap = size_t(limit.rlim_cur);
   return cap > used ? cap - used : 0;
 }

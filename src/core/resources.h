@@ -28,6 +28,9 @@ class Stopwatch {
 size_t peakRssBytes();
 /// Current resident set size, bytes (/proc/self/statm); 0 if unavailable.
 size_t currentRssBytes();
+/// Address space this process maps now, bytes (/proc/self/statm's first
+/// field: what an address-space limit, ulimit -v, counts); 0 if unavailable.
+size_t mappedBytes();
 /// Resets the kernel's peak resident set size of this process to the current
 /// one (Linux >= 4.0, /proc/self/clear_refs), so that peakRssSinceResetBytes
 /// measures one piece of work in a process that did others before. False when

@@ -192,12 +192,7 @@ TEST(Resources, AvailableMemorySeesTheAddressSpaceLimit) {
   ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
   if (saved.rlim_cur == RLIM_INFINITY) EXPECT_EQ(addressSpaceRoomBytes(), SIZE_MAX);
   // What the process maps now, and a limit 256 MiB above it.
-  size_t mapped = 0;
-  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
-    unsigned long long pages = 0;
-    if (std::fscanf(f, "%llu", &pages) == 1) mapped = size_t(pages) * size_t(sysconf(_SC_PAGESIZE));
-    std::fclose(f);
-  }
+  const size_t mapped = mappedBytes();
   ASSERT_GT(mapped, 0u);
   const size_t room = size_t(256) << 20;
   if (saved.rlim_cur != RLIM_INFINITY && saved.rlim_cur < mapped + room) GTEST_SKIP() << "limit already lower";

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 #include "test_util.h"
 
@@ -109,29 +110,11 @@ TEST(RayTracer, OutOfMemoryUnderAnAddressSpaceLimitIsSaid) {
 #endif
   Material m;
   const Scene scene = alphaQuad(m, nullptr);
-  rlimit saved{};
-  ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
-  size_t mapped = 0;
-  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
-    unsigned long long pages = 0;
-    if (std::fscanf(f, "%llu", &pages) == 1) mapped = size_t(pages) * size_t(sysconf(_SC_PAGESIZE));
-    std::fclose(f);
-  }
-  ASSERT_GT(mapped, 0u);
-  rlimit lower = saved;
-  lower.rlim_cur = rlim_t(mapped + (size_t(1) << 20));  // 1 MiB more than is mapped now
-  if (saved.rlim_cur != RLIM_INFINITY && saved.rlim_cur < lower.rlim_cur) GTEST_SKIP();
-  std::string message;
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &lower), 0);
-  try {
-    RayTracer tracer(scene);
-    message = "no error";
-  } catch (const InputError& e) {
-    message = e.what();
-  } catch (const std::exception& e) {
-    message = std::string("not an InputError: ") + e.what();
-  }
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &saved), 0);
+  // 1 MiB more than is mapped now.
+  const std::optional<std::string> limited =
+      test::messageUnderAddressSpaceLimit(size_t(1) << 20, [&] { RayTracer tracer(scene); });
+  if (!limited) GTEST_SKIP() << "the address space is limited already";
+  const std::string& message = *limited;
   EXPECT_NE(message.find("out of memory: the ray tracer (Embree) could not"), std::string::npos)
       << message;
   EXPECT_NE(message.find("(ulimit -v)"), std::string::npos) << message;

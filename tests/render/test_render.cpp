@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/resources.h"
 #include "image/compare.h"
 #include "image/image.h"
 #include "render/context.h"
@@ -53,26 +54,11 @@ TEST(Render, ContextUnderAnAddressSpaceLimitSaysMemory) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "AddressSanitizer";
 #endif
-  rlimit saved{};
-  ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
-  size_t mapped = 0;
-  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
-    unsigned long long pages = 0;
-    if (std::fscanf(f, "%llu", &pages) == 1) mapped = size_t(pages) * size_t(sysconf(_SC_PAGESIZE));
-    std::fclose(f);
-  }
-  ASSERT_GT(mapped, 0u);
-  rlimit lower = saved;
-  lower.rlim_cur = rlim_t(mapped + (size_t(1) << 20));  // 1 MiB more than is mapped now
-  if (saved.rlim_cur != RLIM_INFINITY && saved.rlim_cur < lower.rlim_cur) GTEST_SKIP();
-  std::string message = "no error";
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &lower), 0);
-  try {
-    createGlContext();
-  } catch (const std::exception& e) {
-    message = e.what();
-  }
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &saved), 0);
+  // 1 MiB more than is mapped now.
+  const std::optional<std::string> limited =
+      test::messageUnderAddressSpaceLimit(size_t(1) << 20, [] { createGlContext(); });
+  if (!limited) GTEST_SKIP() << "the address space is limited already";
+  const std::string& message = *limited;
   if (message.find("cannot open shared object file") != std::string::npos) {
     GTEST_SKIP() << "libOSMesa is not installed: " << message;
   }
@@ -197,16 +183,25 @@ TEST(RenderImageIo, WritesPngAndExrAtomicallyAndRejectsOtherExtensions) {
 // Supersampling: an image drawn with supersample s is the s x s box filter of
 // the same image drawn s times larger (a brute-force cross-check), and it
 // anti-aliases: a quad's edge crossing a pixel gives it a fractional value.
+// The supersampling tests' view of the quad under a point light: 40 x 30,
+// its right edge (x = 1) 0.1 right of the view's centre, at pixel 20 + 20
+// (0.1 / (1.5 tan 20 deg 4/3)) = 22.747 from the left.
+RenderParams edgeParams() {
+  RenderParams p = QuadSetup::directParams();
+  p.width = 40;
+  p.height = 30;
+  return p;
+}
+PinholeCamera edgeCamera() {
+  return PinholeCamera::lookAt({0.9f, -0.05f, 1.5f}, {0.9f, -0.05f, 0.0f}, 40.0f * kPi / 180.0f);
+}
+
 TEST_F(RenderImage, SupersamplingIsTheBoxFilterOfTheLargerImage) {
   QuadSetup s;
   s.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
   Renderer renderer(s.scene, test::constantOctree());
-  RenderParams p = QuadSetup::directParams();
-  p.width = 40;
-  p.height = 30;
-  // Wide enough to see the quad's right edge (x = 1).
-  const PinholeCamera camera =
-      PinholeCamera::lookAt({0.9f, -0.05f, 1.5f}, {0.9f, -0.05f, 0.0f}, 40.0f * kPi / 180.0f);
+  RenderParams p = edgeParams();
+  const PinholeCamera camera = edgeCamera();
   p.supersample = 3;
   const RgbImage small = renderer.render(camera, p);
   RenderParams big = p;
@@ -240,15 +235,9 @@ TEST_F(RenderImage, TwoBySupersamplingSamplesARotatedGrid) {
   QuadSetup s;
   s.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
   Renderer renderer(s.scene, test::constantOctree());
-  RenderParams p = QuadSetup::directParams();
-  p.width = 40;
-  p.height = 30;
+  RenderParams p = edgeParams();
   p.supersample = 2;
-  // The quad's right edge (x = 1), 0.1 right of the view's centre: at pixel
-  // 20 + 20 (0.1 / (1.5 tan 20 deg 4/3)) = 22.747 from the left.
-  const PinholeCamera camera =
-      PinholeCamera::lookAt({0.9f, -0.05f, 1.5f}, {0.9f, -0.05f, 0.0f}, 40.0f * kPi / 180.0f);
-  const RgbImage image = renderer.render(camera, p);
+  const RgbImage image = renderer.render(edgeCamera(), p);
   const float v20 = image.pixel(20, 15)[0], v21 = image.pixel(21, 15)[0];
   ASSERT_GT(v21, 0.0f);
   EXPECT_EQ(image.pixel(23, 15)[0], 0.0f);  // wholly right of the edge
