@@ -748,6 +748,7 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
   opt.sceneOptions = sceneOptions(sky, skyImage, skyMesh, physicalSky);
   withPythonNames([&] {
     checkCameraOptions(opt.camera);
+    checkStdErrorSamples(opt, withStdError);
     return 0;
   });
   const ReferenceParams params = referenceParams(opt);
@@ -757,6 +758,10 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
       const PinholeCamera view = chooseCamera(opt.camera, scene, opt.scene);
       return renderReference(scene, view, params, sink);
     });
+  });
+  withPythonNames([&] {
+    checkStdErrorSamples(opt, withStdError, r.samplesPerPixel);
+    return 0;
   });
   py::array_t<float> image = imageArray(r.image);
   if (!withStdError) return std::move(image);

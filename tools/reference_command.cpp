@@ -98,21 +98,13 @@ int runReference(const ReferenceOptions& opt) {
   if (opt.part == "added-mask" || opt.part == "edge-mask") {
     return renderMask(opt, scene, camera, report, rows);
   }
-  // One sample per pixel says nothing of its spread: a standard error of it
-  // was written as 0, and `compare --reference-error` took it for no noise.
-  if (!opt.stdErrorOutput.empty() && !(opt.timeBudget > 0) && opt.spp < 2) {
-    throw InputError("--std-error needs --spp 2 or more: one sample per pixel says nothing of "
-                     "its spread");
-  }
+  checkStdErrorSamples(opt, !opt.stdErrorOutput.empty());
   const ReferenceParams params = referenceParams(opt);
   ConsoleProgress progress(opt.quiet);
   StageTimer traceTimer(rows, "path trace");
   ReferenceImage result = renderReference(scene, camera, params, &progress);
   traceTimer.finish(std::to_string(result.samplesPerPixel) + " spp");
-  if (!opt.stdErrorOutput.empty() && result.samplesPerPixel < 2) {
-    throw InputError("--std-error: the --time-budget allowed one sample per pixel, which says "
-                     "nothing of its spread: raise --time-budget (nothing was written)");
-  }
+  checkStdErrorSamples(opt, !opt.stdErrorOutput.empty(), result.samplesPerPixel);
   // The image and its side images (and the report) appear together.
   AtomicFileSet outputs;
   ToneReport tone;

@@ -6,6 +6,7 @@
 
 #include "cli_checks.h"
 #include "command_options.h"
+#include "core/error.h"
 
 namespace lo::tool {
 
@@ -20,6 +21,18 @@ ReferenceParams referenceParams(const ReferenceOptions& opt) {
   params.addedOnlyReceive = opt.addedOnlyReceive;
   params.seed = opt.seed;
   return params;
+}
+
+void checkStdErrorSamples(const ReferenceOptions& opt, bool wanted, int samplesMade) {
+  if (!wanted) return;
+  if (samplesMade < 0 && !(opt.timeBudget > 0) && opt.spp < 2) {
+    throw InputError("--std-error needs --spp 2 or more: one sample per pixel says nothing of "
+                     "its spread");
+  }
+  if (samplesMade >= 0 && samplesMade < 2) {
+    throw InputError("--std-error: the --time-budget allowed one sample per pixel, which says "
+                     "nothing of its spread: raise --time-budget (nothing was written)");
+  }
 }
 
 FirstHitParams firstHitParams(const ReferenceOptions& opt) {

@@ -44,6 +44,13 @@ struct ReferenceOptions : SceneFlags {
 /// irradiance. @throws InputError naming another part.
 ReferenceParams referenceParams(const ReferenceOptions& opt);
 
+/// A standard error of one sample per pixel says nothing of the spread: it
+/// came out all zeros, which `compare --reference-error` took for no noise.
+/// `wanted`: --std-error (Python's std_error). Before the trace
+/// (`samplesMade` < 0) --spp decides; after it, the samples a --time-budget
+/// allowed. The command and Python share it. @throws InputError when too few.
+void checkStdErrorSamples(const ReferenceOptions& opt, bool wanted, int samplesMade = -1);
+
 /// The first hits of --part added-mask | edge-mask: at most 64 rays per
 /// pixel, however many --spp asks for.
 FirstHitParams firstHitParams(const ReferenceOptions& opt);

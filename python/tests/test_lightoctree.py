@@ -456,6 +456,18 @@ def test_reference_equals_the_command(tmp_path):
     assert not np.array_equal(moved[..., :], image)
 
 
+def test_reference_std_error_of_one_sample_is_refused_as_by_the_command():
+    """One sample per pixel says nothing of its spread: the command refuses
+    --std-error with --spp 1, and Python returned an all-zero standard error
+    that compare(reference_error=) took for a noiseless reference."""
+    with pytest.raises(ValueError, match=r"^std_error needs spp 2 or more"):
+        lightoctree.reference(SCENE, width=8, height=6, spp=1, std_error=True)
+    # A time budget that allowed one pass (256 x 256 paths take longer than 1 ms).
+    with pytest.raises(ValueError, match="time_budget allowed one sample per pixel"):
+        lightoctree.reference(SCENE, width=256, height=256, time_budget=1e-3, std_error=True)
+    assert lightoctree.reference(SCENE, width=8, height=6, spp=1).shape == (6, 8, 3)
+
+
 def test_reference_defaults_are_the_commands():
     text = lightoctree.reference.__doc__
     for default in ("width: int = 800", "height: int = 600", "spp: int = 64", "part: str = 'full'",
