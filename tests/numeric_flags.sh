@@ -29,15 +29,23 @@ for cmd in bake render lightmap convert inspect reference compare sweep view; do
   # the flag's long name, its type and how many numbers it takes.
   while read -r flag type count; do
     flags=$((flags + 1))
-    for value in nan inf -inf 1e-300 1e300; do
+    # Hexadecimal (strtod and the parser's strtoll(s, 0) read it) and the
+    # empty value are refused too, on every flag alike.
+    for value in nan inf -inf 1e-300 1e300 0x10 ''; do
       joined=$value
       for ((i = 1; i < count; ++i)); do joined="$joined,1"; done
-      err=$("$cli" "$cmd" "${args[@]}" "$flag=$joined" 2>&1 >/dev/null)
+      given=("$flag=$joined")  # "--flag=-inf": not taken for a flag
+      [ -z "$value" ] && given=("$flag" "$joined")  # "--flag=" is a missing value
+      err=$("$cli" "$cmd" "${args[@]}" "${given[@]}" 2>&1 >/dev/null)
       rc=$?
       tried=$((tried + 1))
       expect="$flag"
-      [ "$type" = FLOAT ] && expect="$flag: must be a finite number"
-      if [ "$rc" -ne 2 ] || ! grep -qF -- "$expect" <<<"$err"; then
+      [ "$type" = FLOAT ] && [ -n "$value" ] && expect="$flag: must be a finite number"
+      [ "$value" = 0x10 ] && expect="$flag: must be"
+      if [ "$value" = 0x10 ] && ! grep -qF -- "decimal digits" <<<"$err"; then
+        rc="$rc, no 'decimal'"
+      fi
+      if [ "$rc" != 2 ] || ! grep -qF -- "$expect" <<<"$err"; then
         echo "FAILED: $cmd $flag=$joined: exit $rc, expected 2 and '$expect': $err"
         failed=$((failed + 1))
       fi
@@ -51,6 +59,23 @@ for cmd in bake render lightmap convert inspect reference compare sweep view; do
     's/^ +(-[A-Za-z],)?(--[a-z0-9-]+)(,--[a-z0-9-]+)* (FLOAT|INT|UINT)( x ([0-9]+))?.*/\2 \4 \6/p' |
     awk '{ print $1, $2, ($3 == "" ? 1 : $3) }')
 done
+# Leading zeros are decimal on every whole-number flag (the parser read "010"
+# as octal 8 and refused "08"): the report records what was taken.
+"$cli" reference "$scene" -o "$out/x.exr" --width 010 --height 08 --spp 01 --seed 017 \
+  --json "$out/zeros.json" -q
+if ! python3 -c 'import json, sys; f = json.load(open(sys.argv[1]))["figures"]
+sys.exit((f["width"], f["height"], f["samples_per_pixel"]) != (10, 8, 1))' "$out/zeros.json"; then
+  echo "FAILED: --width 010 --height 08 --spp 01 not 10 x 8 at 1 spp: $(cat "$out/zeros.json")"
+  failed=$((failed + 1))
+fi
+rm -f "$out/x.exr" "$out/zeros.json"
+"$cli" reference "$scene" -o "$out/a.exr" --width 4 --height 4 --spp 2 --seed 017 -q
+"$cli" reference "$scene" -o "$out/b.exr" --width 4 --height 4 --spp 2 --seed 17 -q
+if ! cmp -s "$out/a.exr" "$out/b.exr"; then
+  echo "FAILED: --seed 017 is not --seed 17"
+  failed=$((failed + 1))
+fi
+rm -f "$out/a.exr" "$out/b.exr"
 # A sky image whose brightest texel above the horizon is 1e30 W/(m^2 sr)
 # (finite, as sky images must be): the bake's sky power overflowed and it
 # refused late, while reference drew it. Both refuse it now, alike.
@@ -78,5 +103,5 @@ if [ "$flags" -lt 40 ]; then
   echo "FAILED: only $flags numeric flags found in the commands' --help (its format changed?)"
   failed=$((failed + 1))
 fi
-[ "$failed" -eq 0 ] && echo "numeric flags: $flags flags of 9 commands refuse nan, inf, -inf, 1e-300 and 1e300 ($tried runs)"
+[ "$failed" -eq 0 ] && echo "numeric flags: $flags flags of 9 commands refuse nan, inf, -inf, 1e-300, 1e300, 0x10 and '' ($tried runs)"
 exit "$failed"

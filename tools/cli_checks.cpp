@@ -22,6 +22,11 @@ CLI::Validator numberIn(const NumberRange& range) {
   const std::string description = range.boundsText();
   return CLI::Validator(
       [range](std::string& s) -> std::string {
+        // strtod reads hexadecimal ("0x10", "0x1p3"), which no flag's help
+        // or document offers: numbers are written in decimal, on every flag.
+        if (s.find_first_of("xX") != std::string::npos) {
+          return "must be " + range.ToString() + ", in decimal digits, got '" + s + "'";
+        }
         char* end = nullptr;
         const double v = std::strtod(s.c_str(), &end);
         if (s.empty() || end != s.c_str() + s.size() || !range.contains(v)) {
@@ -44,15 +49,34 @@ CLI::Validator wholeIn(double min, double max) {
   return numberIn(NumberRange{min, max, false, true});
 }
 
-void requireFiniteNumbers(CLI::App& app) {
+std::string decimalWholeError(std::string& s) {
+  const size_t sign = !s.empty() && (s[0] == '-' || s[0] == '+') ? 1 : 0;
+  if (s.size() == sign || s.find_first_not_of("0123456789", sign) != std::string::npos) {
+    return "must be a whole number in decimal digits (100000, not 1e5, 1.0 or 0x10), got '" + s +
+           "'";
+  }
+  // The parser converts with strtoll(s, 0): "010" was octal 8 and "08" no
+  // number at all. Without its leading zeros, "010" is read as ten.
+  const size_t first = std::min(s.find_first_not_of('0', sign), s.size() - 1);
+  s = s.substr(0, sign) + s.substr(first);
+  return {};
+}
+
+void requireNumberRules(CLI::App& app) {
   CLI::Validator finite = numberIn(kFiniteNumber);
   finite.description("");  // the option's help says FLOAT already
+  CLI::Validator decimal(decimalWholeError, "", "DecimalWhole");
   for (CLI::Option* option : app.get_options()) {
-    // CLI11 names a float, a double and a vector of them FLOAT.
-    if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
+    // CLI11 names a float, a double and a vector of them FLOAT; a signed
+    // integer INT, an unsigned one UINT. The decimal rule goes first, as a
+    // transform (a check may not change the value): the option's own checks
+    // (a range, a set) and the conversion then see "010" as "10".
+    const std::string type = option->get_type_name();
+    if (type.rfind("FLOAT", 0) == 0) option->check(finite);
+    if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0) option->transform(decimal);
   }
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
-    requireFiniteNumbers(*sub);
+    requireNumberRules(*sub);
   }
 }
 

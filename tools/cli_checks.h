@@ -24,11 +24,17 @@ CLI::Validator numberIn(const NumberRange& range);
 /// numberIn of the whole numbers from `min` to `max`.
 CLI::Validator wholeIn(double min, double max);
 
-/// Adds the finite check (numberIn(kFiniteNumber)) to every option of `app`
-/// and its subcommands that takes floating-point numbers: a flag registered
-/// without a range still refuses NaN and infinities. Called once, after every
-/// command has registered its flags.
-void requireFiniteNumbers(CLI::App& app);
+/// The rule of every numeric flag of `app` and its subcommands, whatever its
+/// own check: a floating-point one gets the finite check
+/// (numberIn(kFiniteNumber)), so a flag registered without a range still
+/// refuses NaN and infinities; a whole-number one (INT, UINT) takes decimal
+/// digits alone, leading zeros read as decimal ("010" is ten, not octal 8;
+/// "0x10" refused; decimalWholeError). Called once, after every command has
+/// registered its flags.
+void requireNumberRules(CLI::App& app);
+/// "" when `s` is an optional sign and decimal digits, which it rewrites
+/// without their leading zeros; else why not.
+std::string decimalWholeError(std::string& s);
 
 /// `--seed`: decimal digits only, at most 2^64 - 1: "-1", "1e23" or a number
 /// beyond 64 bits would otherwise wrap to some other seed without a word.

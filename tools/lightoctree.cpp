@@ -132,7 +132,7 @@ int run(int argc, char** argv) {
   commands.push_back(lo::tool::addCompareCommand(app));
   commands.push_back(lo::tool::addSweepCommand(app));
   commands.push_back(lo::tool::addViewCommand(app));
-  lo::tool::requireFiniteNumbers(app);  // every float flag, those with a range or not
+  lo::tool::requireNumberRules(app);  // every numeric flag, those with a range or not
   try {
     app.parse(argc, argv);
   } catch (const CLI::ConversionError& e) {

@@ -20,8 +20,9 @@ ToneParams PictureOptions::toneParams() const {
   }
   char* end = nullptr;
   const double ev = std::strtod(exposure.c_str(), &end);
+  // strtod reads hexadecimal too ("0x1"), which no flag takes (cli_checks.h).
   if (exposure.empty() || end != exposure.c_str() + exposure.size() || !std::isfinite(ev) ||
-      ev < -30.0 || ev > 30.0) {
+      ev < -30.0 || ev > 30.0 || exposure.find_first_of("xX") != std::string::npos) {
     throw InputError("--exposure: '" + exposure + "' is neither auto nor a number of EV in -30..30");
   }
   p.autoExposure = false;
