@@ -313,7 +313,10 @@ double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bo
     area += double(scene.triangleArea(t));
   }
   const double h = double(frame.voxelSize);
-  return h > 0 ? area / (h * h) : 0.0;
+  // Coincident surfaces (instances at one place, shared-buffer primitives)
+  // add area but no voxels: the grid has resolution^3 at most.
+  const double cells = std::pow(double(frame.resolution()), 3.0);
+  return h > 0 ? std::min(area / (h * h), cells) : 0.0;
 }
 
 void setPhotonBudget(BakeParams& params, size_t photons, double targetError) {

@@ -334,7 +334,8 @@ void checkPhotonsStored(const BakeParams& params, const BakeStats& stats);
 /// Active voxels a bake at `frame` will have, from the area of the scene's
 /// surfaces (inside `region` when it is set): area / h^2, what a surface
 /// lying along the grid crosses (1.04x that was measured on the Cornell box;
-/// slanted surfaces cross up to sqrt(3)x more, so this rather underestimates).
+/// slanted surfaces cross up to sqrt(3)x more, so this rather underestimates),
+/// and never more than the grid's resolution^3 voxels (coincident surfaces).
 double estimateActiveVoxels(const Scene& scene, const GridFrame& frame, const Bounds3& region);
 
 /// The photon budget from the two ways of asking for one: `photons` > 0 a

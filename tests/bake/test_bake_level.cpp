@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <cstdlib>
 #include <cstring>
 
 #include "bake/bake.h"
@@ -81,6 +82,33 @@ TEST(BakeLevel, SameBytesWhateverTheThreadCount) {
   tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
   VdlGrid single = bakeLevel(scene, map.photons, params);
   expectSameGrid(many, single);
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+// 2,000 coincident unit quads (20,000 instanced nodes of a glTF, G06 of the
+// seventh hostile list) have the area of 2,000 quads but cross only the
+// voxels of one: the estimate from their area, uncapped, gave a depth-4 grid
+// of 4,096 voxels "about 29,527,106 voxels ... 27.51 GiB" and refused it.
+TEST(BakeMemory, TheVoxelEstimateIsAtMostTheGridsVoxels) {
+  Scene scene = test::oneMaterialScene();
+  for (int i = 0; i < 2000; ++i) {
+    test::addQuad(scene, Vec3(0.0f), Vec3(1, 0, 0), Vec3(0, 0, 1), Vec3(0, 1, 0), 0);
+  }
+  const GridFrame frame = makeGridFrame(scene.bounds(), 2);
+  const double cells = 4.0 * 4.0 * 4.0;
+  EXPECT_LE(estimateActiveVoxels(scene, frame, Bounds3()), cells);
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "1M", 1);  // 64 voxels x 1000 B fit in 1 MiB
+  EXPECT_NO_THROW(checkVoxelMemory(scene, frame, Bounds3(), 0));
+  unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+  // One quad is still estimated from its area: about 16 voxels of a quarter.
+  Scene one = test::oneMaterialScene();
+  test::addQuad(one, Vec3(0.0f), Vec3(1, 0, 0), Vec3(0, 0, 1), Vec3(0, 1, 0), 0);
+  EXPECT_NEAR(estimateActiveVoxels(one, frame, Bounds3()), 16.0, 2.0);
 }
 
 }  // namespace
