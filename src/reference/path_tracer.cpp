@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/resources.h"
 #include "core/rng.h"
 #include "material/bsdf.h"
 #include "raytrace/ray_tracer.h"
@@ -454,8 +455,29 @@ struct RenderTiles {
 
 }  // namespace reference_internal
 
+size_t referenceBytesPerPixel() {
+  using reference_internal::PixelSums;
+  // 4 images of 3 floats; the file writer's copy at most 4 floats (EXR).
+  return sizeof(Rng) + sizeof(PixelSums) + 4 * 3 * sizeof(float) + 4 * sizeof(float);
+}
+
+void checkReferenceMemory(const ReferenceParams& params) {
+  const size_t available = availableMemoryBytes();
+  const double needed = double(params.width) * double(params.height) *
+                        double(referenceBytesPerPixel());
+  if (available > 0 && needed > double(available)) {
+    throw InputError("an image of " + std::to_string(params.width) + " x " +
+                     std::to_string(params.height) + " pixels needs about " +
+                     formatBytes(size_t(needed)) + " to path-trace (" +
+                     std::to_string(referenceBytesPerPixel()) + " bytes per pixel), more than " +
+                     "the " + formatBytes(available) + " of memory available: use a smaller " +
+                     "--width and --height");
+  }
+}
+
 ReferenceImage renderReference(const Scene& scene, const PinholeCamera& camera,
                                const ReferenceParams& params, ProgressSink* progress) {
+  checkReferenceMemory(params);
   // Far from the origin, render in a frame centred on the scene (see
   // Scene::tracingOrigin); a translation changes no radiance.
   const Vec3 origin = scene.tracingOrigin();

@@ -84,6 +84,18 @@ struct ReferenceImage {
   uint64_t raysTraced = 0; ///< closest-hit plus shadow rays
 };
 
+/// Bytes renderReference holds per pixel of `params`' image: each pixel's
+/// random stream and sums (two doubles per channel), its four images (the
+/// mean, the standard error, the two masks) and the file writer's copy.
+size_t referenceBytesPerPixel();
+
+/// @brief Refuses, before any work, an image whose pixels
+/// (referenceBytesPerPixel each) need more than the memory available
+/// (availableMemoryBytes): 16384 x 16384 grew to the whole machine and was
+/// killed by the kernel, without a word. renderReference calls it.
+/// @throws InputError naming the size, the figure and the memory.
+void checkReferenceMemory(const ReferenceParams& params);
+
 /// Renders `part` of `scene` seen by `camera`. Parallel over tiles (TBB);
 /// pixel i draws its random numbers from Rng(seed, i), so the result is the
 /// same bytes for any thread count (spp mode).

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <vector>
@@ -642,6 +643,33 @@ TEST(Reference, GeometryMaskIsWhatThePixelCentreSees) {
   EXPECT_GT(surface, 100u);
   EXPECT_GT(emitter, 2u);
   EXPECT_GT(background, 100u);
+}
+
+// 16384 x 16384 at --spp 1 grew to the whole machine (24 GB) and was killed
+// by the kernel without a word (G14 of the seventh hostile list): the
+// image's memory is checked before the trace, with the figure and the limit.
+TEST(Reference, AnImageLargerThanTheMemoryIsRefusedBeforeTheTrace) {
+  Scene scene = test::oneMaterialScene();
+  test::addQuad(scene, Vec3(-1, 0, -1), Vec3(2, 0, 0), Vec3(0, 0, 2), Vec3(0, 1, 0), 0);
+  scene.lights.push_back(test::pointLight({0, 1, 0}, 1.0f));
+  const PinholeCamera down = PinholeCamera::lookAt({0.01f, 1, 0}, {0, 0, 0}, 0.5f);
+  ReferenceParams params;
+  params.samplesPerPixel = 1;
+  params.maxBounces = 0;
+  params.width = params.height = 2048;  // 4 Mi pixels, well over 64 MiB at ~100 B each
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "64M", 1);
+  try {
+    renderReference(scene, down, params);
+    ADD_FAILURE() << "a 2048 x 2048 reference under a 64 MiB limit was not refused";
+  } catch (const InputError& e) {
+    const std::string text = e.what();
+    EXPECT_NE(text.find("2048 x 2048 pixels needs about"), std::string::npos) << text;
+    EXPECT_NE(text.find("64.0 MiB of memory available"), std::string::npos) << text;
+  }
+  params.width = params.height = 32;
+  EXPECT_NO_THROW(renderReference(scene, down, params));
+  unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+  EXPECT_GE(referenceBytesPerPixel(), 100u);  // measured: 2048^2 took 503 MB, ~120 B a pixel
 }
 
 }  // namespace
