@@ -580,7 +580,9 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Grid& g,
                                const Arg<int>& width, const Arg<int>& height,
                                const Arg<std::string>& mode, const py::kwargs& kw) {
   const std::string scenePath = pathArg(sceneArg.value, "scene");
-  const RenderSettings settings = renderSettings(width, height, mode, kw);
+  // Its checks (the frame's memory among them) name the flags.
+  const RenderSettings settings =
+      withPythonNames([&] { return renderSettings(width, height, mode, kw); });
   Scene scene = loadScene(scenePath);
   warnIfStale(g.meta, scenePath, "grid");  // before the frame, as `render` warns
   RgbImage image;

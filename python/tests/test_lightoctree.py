@@ -836,6 +836,16 @@ def test_ctrl_c_during_lightmap_leaves_no_file_of_it(grid_file, tmp_path):
         lightoctree.lightmap(SCENE, grid_file, output, progress=3)
 
 
+def test_render_checks_its_frame_against_the_memory_limit(grid, monkeypatch):
+    """render ran 94 s to 3.5 GB under LIGHTOCTREE_MEMORY_LIMIT=200M (no
+    watch stops it); its frame's memory is checked first, as the command's."""
+    monkeypatch.setenv("LIGHTOCTREE_MEMORY_LIMIT", "50M")
+    with pytest.raises(ValueError, match=r"^render: a frame of width 1000, height 1000, "
+                       r"supersample 4 needs about [0-9.]+ MiB \(16,000,000 pixels drawn, 64 "
+                       r"bytes each\), more than the 50.0 MiB of memory available"):
+        lightoctree.render(SCENE, grid, width=1000, height=1000, supersample=4)
+
+
 def test_the_memory_limit_stops_a_call_that_grows_past_it():
     """LIGHTOCTREE_MEMORY_LIMIT held in the module's estimates only, not
     while a call ran: a bake that grows past it now stops at its next

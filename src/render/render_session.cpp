@@ -62,6 +62,7 @@ void RenderSettings::check() const {
   range("shadow map size", renderer.shadowMapSize, kMinShadowMapSize, kMaxShadowMapSize);
   range("tolerance", octree.tolerance, 0, 1);
   range("free-space tolerance", octree.volumeTolerance, 0, 1);
+  checkRenderMemory(frame);
 }
 
 GpuOctree buildRenderOctree(const VdlGrid& grid, const RenderSettings& settings) {

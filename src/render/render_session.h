@@ -78,7 +78,8 @@ struct RenderSettings {
   /// The atlas settings, with the frames' lookup (shadeParamsOf(frame)).
   LightingParams lightingParams() const;
   /// @throws InputError naming the setting that is out of its range (the
-  /// constants above; VDLs 1..kMaxVdls; tolerances 0..1, NaN refused).
+  /// constants above; VDLs 1..kMaxVdls; tolerances 0..1, NaN refused), and a
+  /// frame that the memory available cannot hold (checkRenderMemory).
   void check() const;
 };
 

@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/resources.h"
 #include "render/context.h"
 #include "render/gl_util.h"
 #include "render/renderer_impl.h"
@@ -259,6 +260,27 @@ void Renderer::moveAddedObjects(const Vec3& offset) {
     r.geometry.drawDepthOnly(program, shadows);
   });
   r.probe.valid = false;
+}
+
+double renderFramePixels(const RenderParams& params) {
+  // As Renderer::render draws it.
+  const double block = params.supersample == 2 ? 1.0 : double(params.supersample);
+  return double(params.width) * double(params.height) * block * block;
+}
+
+void checkRenderMemory(const RenderParams& params) {
+  const size_t available = availableMemoryBytes();
+  const double needed = renderFramePixels(params) * kRenderBytesPerFramePixel;
+  if (available > 0 && needed > double(available)) {
+    throw InputError("render: a frame of --width " + std::to_string(params.width) +
+                     ", --height " + std::to_string(params.height) + ", --supersample " +
+                     std::to_string(params.supersample) + " needs about " +
+                     formatBytes(size_t(needed)) + " (" +
+                     formatCount(size_t(renderFramePixels(params))) + " pixels drawn, " +
+                     formatNumber(kRenderBytesPerFramePixel) +
+                     " bytes each), more than the " + formatBytes(available) +
+                     " of memory available: lower them");
+  }
 }
 
 RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& params) {

@@ -65,6 +65,24 @@ struct RenderParams {
   int supersample = 1;
 };
 
+/// Pixels of the frame the renderer draws for `params`: width x height, times
+/// supersample^2 unless it is 2 (rotated-grid supersampling draws frames of
+/// the image's size, one after another).
+double renderFramePixels(const RenderParams& params);
+
+/// Bytes the renderer holds per pixel of that frame: 52 to 66 were measured
+/// (peak resident memory of `render` on the Cornell box, 800 x 600 to
+/// 1600 x 1200, --supersample 1, 2, 4): its render targets, the read-back, the
+/// image and the file writer's copy.
+constexpr double kRenderBytesPerFramePixel = 64;
+
+/// @brief Refuses, before any work, a frame whose pixels
+/// (kRenderBytesPerFramePixel each) need more than the memory available
+/// (availableMemoryBytes, LIGHTOCTREE_MEMORY_LIMIT included): Python's
+/// render, which no memory watch stops, grew to 3.5 GB under a 200 MiB limit.
+/// @throws InputError naming the sizes, the figure and the memory.
+void checkRenderMemory(const RenderParams& params);
+
 /// Set once: resources built for the scene.
 struct RendererParams {
   /// Texels per side of every shadow map layer, at most: with many shadowed
