@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "core/printable.h"
 #include "image/image.h"
 #include "scene/scene_internal.h"
 
@@ -78,22 +79,35 @@ struct VertexKey {
 Vec3 rgb(const tinyobj::real_t c[3]) { return {float(c[0]), float(c[1]), float(c[2])}; }
 
 /// The `v` lines of an OBJ in double (tinyobjloader parses them as float,
-/// 2^-7 m apart at 1e5 m): x, y, z per vertex in file order.
+/// 2^-7 m apart at 1e5 m): x, y, z per vertex in file order. tinyobjloader
+/// also reads what is not a number ("nan") and a coordinate that is missing
+/// ("v 1 2") as 0, without a word: those are refused here, naming the line.
+/// @throws InputError.
 std::vector<double> readVerticesInDouble(const std::string& path) {
   std::vector<double> out;
   std::ifstream in(path);
   std::string line;
+  size_t lineNumber = 0;
   while (std::getline(in, line)) {
+    ++lineNumber;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     size_t i = line.find_first_not_of(" \t");
     if (i == std::string::npos || line[i] != 'v' || i + 1 >= line.size() ||
         (line[i + 1] != ' ' && line[i + 1] != '\t')) {
       continue;
     }
+    const std::string where = "line " + std::to_string(lineNumber) + ": vertex " +
+                              std::to_string(out.size() / 3 + 1) + " '" +
+                              printable(line.substr(i, 60)) + "'";
     const char* c = line.c_str() + i + 1;
     for (int k = 0; k < 3; ++k) {
       char* end = nullptr;
       const double x = std::strtod(c, &end);
-      if (end == c) return {};  // not what tinyobjloader read: keep its floats
+      if (end == c) {
+        fail(path, where + " has " + std::to_string(k) + " coordinate" + (k == 1 ? "" : "s") +
+                       ", not 3 numbers (x y z)");
+      }
+      if (!std::isfinite(x)) fail(path, where + " has a non-finite coordinate");
       out.push_back(x);
       c = end;
     }
@@ -156,15 +170,12 @@ Scene loadObj(const std::string& path) {
   const std::vector<tinyobj::real_t>& v = attrib.vertices;
   // A scene far from the origin is stored relative to its centre
   // (Scene::origin), its vertices read again in double for it.
-  std::vector<double> far;
+  std::vector<double> far = readVerticesInDouble(path);  // checks every `v` line
   scene.origin = originOf(v);
-  if (scene.rebased()) {
-    far = readVerticesInDouble(path);
-    if (far.size() == v.size()) {
-      scene.origin = originOf(far);
-    } else {
-      far.clear();
-    }
+  if (scene.rebased() && far.size() == v.size()) {
+    scene.origin = originOf(far);
+  } else {
+    far.clear();
   }
   const std::vector<tinyobj::real_t>& vn = attrib.normals;
   const std::vector<tinyobj::real_t>& vt = attrib.texcoords;

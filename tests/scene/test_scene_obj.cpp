@@ -123,6 +123,25 @@ TEST_F(SceneObj, Rejects) {
                    "unreadable image");
 }
 
+// tinyobjloader read "v nan 0 0" and the coordinates missing from "v 1 2"
+// as 0: the bake ran on a vertex at the origin without a word (D17 of the
+// seventh hostile list). Both are refused, naming the line and the vertex.
+TEST_F(SceneObj, AVertexThatIsNotThreeFiniteNumbersIsRefusedNamingItsLine) {
+  const std::string rest = "v 0 1 0\nf 1 2 3\n";
+  expectInputError(write("nan.obj", "v 0 0 0\nv nan 0 0\n" + rest),
+                   "line 2: vertex 2 'v nan 0 0' has a non-finite coordinate");
+  expectInputError(write("inf.obj", "v 0 0 0\r\nv 1 -inf 0\r\n" + rest),
+                   "line 2: vertex 2 'v 1 -inf 0' has a non-finite coordinate");
+  expectInputError(write("short.obj", "# two numbers\nv 0 0 0\nv 1 2\n" + rest),
+                   "line 3: vertex 2 'v 1 2' has 2 coordinates, not 3 numbers (x y z)");
+  expectInputError(write("one.obj", "v 1\nv 1 0 0\n" + rest),
+                   "line 1: vertex 1 'v 1' has 1 coordinate, not 3");
+  expectInputError(write("word.obj", "v 0 0 0\nv 1 zero 0\n" + rest), "has 1 coordinate");
+  EXPECT_EQ(loadScene(write("fine.obj", "v 0 0 0 # a comment\nv\t1 0 0 0.5 0.5 0.5\n" + rest))
+                .triangleCount(),
+            1u);
+}
+
 TEST_F(SceneObj, ASceneFarFromTheOriginKeepsItsPrecision) {
   // The OBJ's own numbers, read again in double (its parser reads float).
   write("far.obj",
