@@ -4,15 +4,18 @@
 #include "scene/place_model.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 namespace lo {
 
 Placement parsePlacement(const std::string& text) {
   std::vector<double> values;
+  std::vector<std::string> parts;
   std::stringstream in(text);
   std::string part;
   while (std::getline(in, part, ',')) {
@@ -22,17 +25,36 @@ Placement parsePlacement(const std::string& text) {
       throw InputError("--at '" + text + "': '" + part + "' is not a finite number");
     }
     values.push_back(v);
+    parts.push_back(part);
   }
   if (values.size() < 3 || values.size() > 5) {
     throw InputError("--at '" + text + "': expected x,y,z[,yaw[,scale]], got " +
                      std::to_string(values.size()) + " numbers");
   }
+  // Each part checked by itself and named: a yaw of 1e300 degrees became
+  // infinity in single precision and was reported as a vertex at NaN; a
+  // scale of 1e-300 became 0, a model of no size.
+  const char* names[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    if (std::fabs(values[size_t(k)]) > double(kMaxCoordinate)) {
+      throw InputError("--at '" + text + "': " + names[k] + " " + parts[size_t(k)] +
+                       " lies beyond " + formatNumber(double(kMaxCoordinate)) + " scene units");
+    }
+  }
   Placement p;
   p.at = Vec3d{values[0], values[1], values[2]};
-  if (values.size() > 3) p.yawDegrees = float(values[3]);
+  if (values.size() > 3) {
+    if (std::fabs(values[3]) > kMaxYawDegrees) {
+      throw InputError("--at '" + text + "': the yaw " + parts[3] + " must lie from -" +
+                       formatNumber(kMaxYawDegrees) + " to " + formatNumber(kMaxYawDegrees) +
+                       " degrees");
+    }
+    p.yawDegrees = float(values[3]);
+  }
   if (values.size() > 4) {
-    if (!(values[4] > 0) || values[4] > 1e6) {
-      throw InputError("--at '" + text + "': the scale must lie in (0, 1e6]");
+    if (!(values[4] >= double(std::numeric_limits<float>::min())) || values[4] > 1e6) {
+      throw InputError("--at '" + text + "': the scale " + parts[4] +
+                       " must lie in (0, 1e6], at least 1.2e-38 (what single precision holds)");
     }
     p.scale = float(values[4]);
   }

@@ -22,9 +22,15 @@ struct Placement {
   float scale = 1;
 };
 
+/// The largest yaw `--at` takes, either way, degrees: a turn covers every
+/// orientation, and single precision turns a larger angle less exactly.
+constexpr double kMaxYawDegrees = 360;
+
 /// Parses "x,y,z[,yaw[,scale]]" (scene units, degrees). @throws InputError
-/// naming the value when it is not 3 to 5 finite numbers, or the scale is
-/// not positive.
+/// naming the value when it is not 3 to 5 finite numbers, and naming the
+/// part when x, y or z lies beyond kMaxCoordinate, the yaw beyond
+/// kMaxYawDegrees, or the scale outside (0, 1e6] or below what single
+/// precision holds (1.2e-38: a smaller one became 0).
 Placement parsePlacement(const std::string& text);
 
 /// Joins `model` to `scene` at `placement`: its vertices (positions, normals,

@@ -85,6 +85,27 @@ TEST(AddedObjects, PlacementJoinsTheModelAndMarksItsMaterials) {
   EXPECT_NEAR(parsePlacement("1,2,3,90,2").yawDegrees, 90.0f, 0.0f);
 }
 
+// Each part of --at is checked by itself, and named (N12, N13 of the seventh
+// hostile list): a scale of 1e-300 was taken (0 in single precision, a model
+// of no size), and a yaw of 1e300 was refused as "a vertex at [-nan, 0, -nan]".
+TEST(AddedObjects, EachPartOfThePlacementIsCheckedByName) {
+  auto refusal = [](const std::string& text) -> std::string {
+    try {
+      parsePlacement(text);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "taken";
+  };
+  EXPECT_EQ(refusal("0,0,0,0,1e-300"), "--at '0,0,0,0,1e-300': the scale 1e-300 must lie in "
+                                        "(0, 1e6], at least 1.2e-38 (what single precision holds)");
+  EXPECT_EQ(refusal("0,0,0,1e300"),
+            "--at '0,0,0,1e300': the yaw 1e300 must lie from -360 to 360 degrees");
+  EXPECT_EQ(refusal("0,-2e12,0"), "--at '0,-2e12,0': y -2e12 lies beyond 1e+12 scene units");
+  EXPECT_EQ(refusal("1,2,3,-360,1e-30"), "taken");
+  EXPECT_EQ(parsePlacement("1,2,3,-360,1e-30").scale, 1e-30f);
+}
+
 TEST(AddedObjects, MovedObjectsDrawAsIfPlacedThere) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
   const BakedOctrees b = bakeOctrees(test::pointLitRoom(), 4, 30000);
