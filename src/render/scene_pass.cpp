@@ -452,8 +452,8 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
   // The pixel's sample point moved by pixelOffset: the image shifted the
   // other way, by a translation after the projection.
   const glm::vec2 offset = probe.capturing ? glm::vec2(0.0f) : pixelOffset;
-  const glm::mat4 shift = glm::translate(
-      glm::mat4(1.0f), glm::vec3(-2.0f * offset.x / float(width), -2.0f * offset.y / float(height), 0.0f));
+  const glm::vec3 shiftNdc(-2.0f * offset.x / float(width), -2.0f * offset.y / float(height), 0.0f);
+  const glm::mat4 shift = glm::translate(glm::mat4(1.0f), shiftNdc);
   const glm::mat4 viewProj = shift * glm::perspective(camera.yfov, aspect, znear, zfar) *
                              glm::lookAt(eye, eye + toGlm(camera.forward), toGlm(camera.up));
   const bool withDirect = drawsDirectLight(rp.mode);
