@@ -262,9 +262,16 @@ void Renderer::moveAddedObjects(const Vec3& offset) {
   r.probe.valid = false;
 }
 
+namespace {
+
+/// The drawn frame's side per image side for `supersample` samples a side:
+/// 1 for two (the rotated grid's frames are the image's size), else itself.
+int frameScale(int supersample) { return supersample == 2 ? 1 : supersample; }
+
+}  // namespace
+
 double renderFramePixels(const RenderParams& params) {
-  // As Renderer::render draws it.
-  const double block = params.supersample == 2 ? 1.0 : double(params.supersample);
+  const double block = double(frameScale(params.supersample));
   return double(params.width) * double(params.height) * block * block;
 }
 
@@ -296,7 +303,7 @@ RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& param
   // room's edge pixels, the Cornell box's light). Otherwise one frame s
   // times larger, each output pixel the mean of its s x s block.
   const bool rotated = s == 2;
-  const int block = rotated ? 1 : s;
+  const int block = frameScale(s);
   const int w = params.width * block, h = params.height * block;
   // The frame the driver draws into, checked before it is made: a side
   // beyond its largest texture, render buffer or viewport, or a target it
