@@ -517,6 +517,7 @@ Scene loadScene(const std::string& path, const std::string& skyMesh) {
   }
   scene.sourcePath = path;
   scene_internal::validateScene(scene);
+  scene_internal::dropRepeatedTriangles(scene);
   return scene;
 }
 

@@ -100,4 +100,16 @@ void checkLightAndMaterialValues(Scene& scene);
 /// range; base colours clamped to [0, 1] (Scene::warnings says so).
 void validateScene(Scene& scene);
 
+/// Takes out every triangle that repeats an earlier one: the same three
+/// vertices (so the same positions, normals, UVs and colours) in the same
+/// winding (any starting corner) and the same material. Such copies (5,000
+/// primitives over one index accessor, whose vertices the loader shares)
+/// draw nothing a single one does not, yet every ray would test each of
+/// them. Copies through other vertices (another node instance in the same
+/// place, another colour) are kept. The first of each set is kept, the order of the rest
+/// unchanged; a triangle and its mirror image (the two faces of a sheet) are
+/// not copies. Scene::warnings says how many went. Returns that number.
+/// O(n log n) time, 16 bytes a triangle besides the scene.
+size_t dropRepeatedTriangles(Scene& scene);
+
 }  // namespace lo::scene_internal
