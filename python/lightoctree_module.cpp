@@ -528,6 +528,14 @@ py::array_t<float> lookup(Grid& g,
 /// The render settings the keywords select: the command line's flags by
 /// their Python names, defaults the library's (RenderSettings{}), so that
 /// `lightoctree.render` draws what `lightoctree render` draws.
+/// A keyword `progress`: a callable (task, done, total) or None.
+py::object progressArg(const py::handle& value, const std::string& name) {
+  if (!value.is_none() && !PyCallable_Check(value.ptr())) {
+    refuse(name, "a callable (task, done, total) or None", value);
+  }
+  return py::reinterpret_borrow<py::object>(value);
+}
+
 RenderSettings renderSettings(const Arg<int>& width, const Arg<int>& height,
                               const Arg<std::string>& mode, const py::kwargs& kw) {
   // The ranges and words of the command's flags (tools/render_options.cpp).
@@ -565,6 +573,8 @@ RenderSettings renderSettings(const Arg<int>& width, const Arg<int>& height,
       s.octree.volumeTolerance = float(numberArg(value, {0, 1}, name));
     } else if (name == "texels") {
       setTexels(s.octree, checkChoice(textArg(value, name), {"float", "half", "compact"}, name));
+    } else if (name == "progress") {
+      progressArg(value, name);  // the call's (renderImage), not the picture's
     } else {
       throw InputError("render: unknown setting '" + name + "'");
     }
@@ -586,16 +596,23 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Grid& g,
   Scene scene = loadScene(scenePath);
   warnIfStale(g.meta, scenePath, "grid");  // before the frame, as `render` warns
   RgbImage image;
-  withPythonNames([&] {  // the renderer's refusals name the flags ("--emitter-lights")
-    py::gil_scoped_release unlocked;
-    GlContextParams contextParams;
-    contextParams.backend = GlBackend::OSMesa;
-    std::unique_ptr<GlContext> context = createGlContext(contextParams);
-    RenderSession session(scene, g.grid, *context, settings);
-    // The scene's first camera, else one framing its bounds from the side its
-    // surfaces face (as `render`).
-    image = session.render(PinholeCamera::ofScene(scene), settings.frame.mode);
-    return 0;
+  // The renderer's refusals name the flags ("--emitter-lights"); Ctrl-C
+  // stops it between its set-up's stages and between frames.
+  withPythonNames([&] {
+    const py::object progress = kw.contains("progress") ? progressArg(kw["progress"], "progress")
+                                                        : py::object(py::none());
+    return withProgress(progress, "render", [&](ProgressSink* sink) {
+      GlContextParams contextParams;
+      contextParams.backend = GlBackend::OSMesa;
+      std::unique_ptr<GlContext> context = createGlContext(contextParams);
+      RenderSessionOptions options;
+      options.progress = sink;
+      RenderSession session(scene, g.grid, *context, settings, options);
+      // The scene's first camera, else one framing its bounds from the side
+      // its surfaces face (as `render`).
+      image = session.render(PinholeCamera::ofScene(scene), settings.frame.mode);
+      return 0;
+    });
   });
   py::array_t<float> out({size_t(settings.frame.height), size_t(settings.frame.width), size_t(3)});
   std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
@@ -905,10 +922,7 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
     const std::string name = py::str(key);
     // The ranges and words of the command's flags (tools/lightmap_command.cpp).
     if (name == "progress") {
-      if (!value.is_none() && !PyCallable_Check(value.ptr())) {
-        refuse(name, "a callable (task, done, total) or None", value);
-      }
-      progress = py::reinterpret_borrow<py::object>(value);
+      progress = progressArg(value, name);
     } else if (name == "texel_size") {
       p.lightmap.uv.texelSize = float(numberArg(value, kPositiveNumber, name));
     } else if (name == "atlas") {
@@ -1125,7 +1139,8 @@ PYBIND11_MODULE(lightoctree, m) {
         "linear RGB, shape (height, width, 3). Keywords as the command's flags, defaults the "
         "same: interpolation, specular, reflections, area_lights, cosine_correction (bool); "
         "lighting ('octree' | 'atlas'), texels ('compact' | 'half' | 'float'); supersample, vdls, "
-        "emitter_lights, shadow_map_size (int); tolerance, free_space_tolerance (0..1).");
+        "emitter_lights, shadow_map_size (int); tolerance, free_space_tolerance (0..1); "
+        "progress: a callable (task, done, total) told of the set-up and each frame.");
   m.def("reference", &referenceImage, py::arg("scene"), py::arg("width") = ReferenceOptions{}.width,
         py::arg("height") = ReferenceOptions{}.height, py::arg("spp") = ReferenceOptions{}.spp,
         py::arg("part") = ReferenceOptions{}.part, py::arg("seed") = ReferenceOptions{}.seed,

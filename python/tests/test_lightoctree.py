@@ -570,6 +570,41 @@ def test_ctrl_c_stops_the_work():
     assert time.monotonic() - start < 20
 
 
+def test_ctrl_c_stops_a_render_between_its_stages(grid):
+    """A render told of its set-up's stages and frames: SIGINT during the
+    set-up stops it at the next report, before any frame is drawn (a render
+    heard Ctrl-C only once it returned, P26 of the seventh hostile list); an
+    exception its callback raises stops it likewise."""
+    import signal
+    calls = []
+
+    def interrupt(task, done, total):
+        calls.append((task, done, total))
+        if task == "render: set-up" and done == 1:
+            os.kill(os.getpid(), signal.SIGINT)  # Python runs the handler at the next report
+
+    with pytest.raises(KeyboardInterrupt):
+        lightoctree.render(SCENE, grid, width=64, height=48, progress=interrupt)
+    assert ("render: set-up", 1, 4) in calls
+    assert not any(task == "render: frames" for task, _, _ in calls), calls
+    # Uninterrupted, the same call reports the four stages and the four frames
+    # of the rotated grid, and returns the picture.
+    calls.clear()
+    image = lightoctree.render(SCENE, grid, width=64, height=48,
+                               progress=lambda *report: calls.append(report))
+    assert image.shape == (48, 64, 3) and image.mean() > 0
+    assert ("render: set-up", 4, 4) in calls and ("render: frames", 4, 4) in calls
+
+    def stop(task, done, total):
+        if task == "render: frames" and done == 1:
+            raise Stop("after one frame")
+
+    with pytest.raises(Stop, match="after one frame"):
+        lightoctree.render(SCENE, grid, width=64, height=48, progress=stop)
+    with pytest.raises(lightoctree.InputError, match="progress: must be a callable"):
+        lightoctree.render(SCENE, grid, width=64, height=48, progress=3)
+
+
 def test_compare_measures_what_the_command_measures(tmp_path):
     image = lightoctree.reference(SCENE, width=16, height=12, spp=4)
     same = lightoctree.compare(image, image)

@@ -126,6 +126,7 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
                      "only); added objects are lit by the octree's free-space light");
   }
 
+  Progress setup(options.progress, "render: set-up", 4);
   StageTimer octreeTimer(s.stages, "octree");
   // The free-space light of the added objects is built now too, so that the
   // grid can go before the renderer's uploads.
@@ -137,6 +138,7 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
   s.octreeSummary = s.octree.ToString();
   s.octreeDepth = s.octree.depth;
   octreeTimer.finish("");
+  setup.advance();
 
   std::function<void(int)> textureUploaded;
   if (options.freeTexels) {
@@ -148,6 +150,7 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
   s.renderer = std::make_unique<Renderer>(scene, s.octree, settings.renderer, textureUploaded);
   s.stages.insert(s.stages.end(), s.renderer->startupStages().begin(),
                   s.renderer->startupStages().end());
+  setup.advance();
   if (options.freeTexels) {
     scene.releaseTexels();  // those no material draws with
     returnFreeMemory();
@@ -159,6 +162,7 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
     octrees.volume = GpuOctree();
     volumeTimer.finish(volume ? "for the added objects" : "none in the bake");
   }
+  setup.advance();
   StageTimer lightingTimer(s.stages, "prepare lighting");
   const std::optional<LightmapBake> atlas =
       prepareLighting(*s.renderer, scene, s.octree, settings.lightingParams());
@@ -166,6 +170,7 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
     s.atlasSummary = atlas->ToString() + "; " + formatBytes(s.renderer->atlasBytes()) + " on the GPU";
   }
   lightingTimer.finish(atlas ? "lightmap atlas" : "");
+  setup.advance();
   if (options.keepOctree) {
     s.atlas = atlas;
   } else {
@@ -193,7 +198,7 @@ RenderParams RenderSession::frame(RenderMode mode) const {
 }
 
 RgbImage RenderSession::render(const PinholeCamera& camera, RenderMode mode) {
-  return impl_->renderer->render(camera, frame(mode));
+  return impl_->renderer->render(camera, frame(mode), impl_->options.progress);
 }
 
 void RenderSession::setGrid(const VdlGrid& grid, const GpuOctreeParams& octree) {

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "core/resources.h"
 #include "image/image.h"
 #include "lightgrid/vdl_grid.h"
@@ -95,6 +96,11 @@ struct RenderSessionOptions {
   bool keepOctree = false;
   /// The grid's name in warnings (its file).
   std::string gridName = "the grid";
+  /// Told of the set-up's stages ("render: set-up": octree, renderer,
+  /// free-space light, lighting) and of each frame render() draws; a sink
+  /// that throws from a report stops the session there (the Python module's
+  /// Ctrl-C). Null: no reports. Must outlive the session.
+  ProgressSink* progress = nullptr;
 };
 
 /// @brief One render assembled: see the file's comment. The scene must

@@ -290,7 +290,8 @@ void checkRenderMemory(const RenderParams& params) {
   }
 }
 
-RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& params) {
+RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& params,
+                          ProgressSink* progress) {
   Impl& r = *impl_;
   const int s = params.supersample;
   if (s < 1 || s > 16) {
@@ -342,6 +343,7 @@ RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& param
   RgbImage image(params.width, params.height);
   std::vector<float> raw(size_t(w) * size_t(h) * 4);
   const float norm = 1.0f / float(s * s);
+  Progress frames(progress, "render: frames", size_t(passes));
   for (int pass = 0; pass < passes; ++pass) {
     r.pixelOffset = rotated ? glm::vec2(kRotated[pass][0], kRotated[pass][1]) : glm::vec2(0.0f);
     glBindFramebuffer(GL_FRAMEBUFFER, r.targetFbo.get());
@@ -364,6 +366,7 @@ RgbImage Renderer::render(const PinholeCamera& camera, const RenderParams& param
         }
       }
     }
+    frames.advance();
   }
   return image;
 }

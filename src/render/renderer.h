@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "core/progress.h"
 #include "core/resources.h"
 #include "image/image.h"
 #include "lightmap/lightmap_atlas.h"
@@ -166,7 +167,11 @@ class Renderer {
   const std::vector<StageReport>& startupStages() const;
 
   /// Renders into an offscreen RGBA32F target and reads its RGB back.
-  RgbImage render(const PinholeCamera& camera, const RenderParams& params);
+  /// `progress` hears of each frame drawn ("render: frames", the four of the
+  /// rotated grid or one); a sink that throws from its report stops the
+  /// render between frames (Python's Ctrl-C).
+  RgbImage render(const PinholeCamera& camera, const RenderParams& params,
+                  ProgressSink* progress = nullptr);
   /// Renders into the currently bound framebuffer (a window); `exposure` in EV
   /// scales the radiance, then a clamp and sRGB encoding are applied.
   void drawToScreen(const PinholeCamera& camera, const RenderParams& params, float exposure);
