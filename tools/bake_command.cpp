@@ -16,6 +16,7 @@
 #include "core/threads.h"
 #include "distributed/mpi_session.h"
 #include "distributed/distributed_stats.h"
+#include "distributed/rank_agreement.h"
 #include "distributed/tiled_bake.h"
 #include "report.h"
 #include "scene/scene.h"
@@ -52,7 +53,19 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   std::vector<StageReport> rows;
 
   StageTimer loadTimer(rows, "load scene");
-  Scene scene = loadSceneWith(opt.scene, opt.sceneOptions);
+  Scene scene;
+  if (comm) {
+    // Each rank reads its own copy: one that fails ends them all with its words.
+    std::string failure;
+    try {
+      scene = loadSceneWith(opt.scene, opt.sceneOptions);
+    } catch (const std::exception& e) {
+      failure = e.what();
+    }
+    checkRanksSucceeded(*comm, failure);
+  } else {
+    scene = loadSceneWith(opt.scene, opt.sceneOptions);
+  }
   printSceneWarnings(scene);
   if (opt.bounds.empty() && !scene.region.empty() && !opt.quiet) {
     Bounds3 world;  // the file's coordinates
@@ -163,6 +176,10 @@ int runBake(const BakeOptions& opt) {
   const int rank = session.world().rank();
   try {
     return runBakeOn(opt, &session.world());
+  } catch (const RanksRefuseError& e) {
+    // Every rank threw it at once: rank 0 says it, and each ends normally.
+    if (rank == 0) std::fprintf(stderr, "lightoctree: error: %s\n", e.what());
+    return 1;
   } catch (const std::exception& e) {
     // Rank 0 says what went wrong; the others add only what is their own.
     if (rank == 0 || !dynamic_cast<const InputError*>(&e)) {

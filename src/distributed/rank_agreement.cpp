@@ -170,6 +170,29 @@ uint64_t sceneFingerprint(const Scene& scene) {
   return f.value();
 }
 
+void checkRanksSucceeded(Communicator& comm, const std::string& failure) {
+  if (comm.size() < 2) {
+    if (!failure.empty()) throw InputError(failure);
+    return;
+  }
+  const std::vector<uint64_t> failed = comm.allgather(failure.empty() ? 0 : 1);
+  int first = -1;
+  for (size_t r = 0; r < failed.size() && first < 0; ++r) {
+    if (failed[r]) first = int(r);
+  }
+  if (first < 0) return;
+  // Rank 0 is the one that speaks: it needs the first failing rank's words.
+  const std::vector<std::vector<char>> messages =
+      comm.gatherBytes(std::vector<char>(failure.begin(), failure.end()), 0);
+  std::string message = "a rank failed";
+  if (comm.rank() == 0) {
+    const std::vector<char>& m = messages[size_t(first)];
+    message = (first == 0 ? "" : "rank " + std::to_string(first) + ": ") +
+              std::string(m.begin(), m.end());
+  }
+  throw RanksRefuseError(message);
+}
+
 void checkRanksAgree(const Scene& scene, const BakeParams& params, const TileParams& tiles,
                      Communicator& comm, const std::string& outputs) {
   if (comm.size() < 2) return;
@@ -195,7 +218,7 @@ void checkRanksAgree(const Scene& scene, const BakeParams& params, const TilePar
   }
   message += " every rank must run the same command on the same scene (one mpirun command line, "
              "the scene's files the same on every machine)";
-  throw InputError(message);
+  throw RanksRefuseError(message);
 }
 
 }  // namespace lo

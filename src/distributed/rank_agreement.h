@@ -11,6 +11,7 @@
 #include <string>
 
 #include "bake/bake.h"
+#include "core/error.h"
 #include "distributed/communicator.h"
 #include "distributed/tiled_bake.h"
 #include "scene/scene.h"
@@ -25,10 +26,25 @@ uint64_t bakeSettingsFingerprint(const BakeParams& params, const TileParams& til
 /// triangles, their materials, the lights and the sky.
 uint64_t sceneFingerprint(const Scene& scene);
 
+/// An error every rank of a bake throws at once, after they agreed on it:
+/// each may end normally (rank 0 saying it), where an error of one rank
+/// alone ends them all through MPI_Abort.
+struct RanksRefuseError : InputError {
+  using InputError::InputError;
+};
+
+/// Every rank calls it after a step each runs on its own (loading the
+/// scene), with what the step threw there ("" when it succeeded); returns
+/// when every rank succeeded. A rank whose copy of the scene was damaged
+/// aborted the job before it said why (rank 0's copy read well, and only
+/// rank 0 speaks): now every rank throws RanksRefuseError with the first
+/// failing rank's message, "rank N: ..." where rank 0 itself succeeded.
+void checkRanksSucceeded(Communicator& comm, const std::string& failure);
+
 /// Every rank calls it with its own settings, scene and `outputs` (the
 /// files rank 0 writes, as this rank was told: ranks given another -o saw
 /// rank 0's written without a word); returns when all agree.
-/// @throws InputError on every rank (the same message) when a rank's
+/// @throws RanksRefuseError on every rank (the same message) when a rank's
 /// settings, scene or outputs differ from rank 0's.
 void checkRanksAgree(const Scene& scene, const BakeParams& params, const TileParams& tiles,
                      Communicator& comm, const std::string& outputs = {});

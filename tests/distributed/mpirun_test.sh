@@ -3,7 +3,8 @@
 # bytes of `mpirun -np N lightoctree bake` equal those of the one-process
 # bake for N = 1, 2, 3, 4, on the Cornell box and the dragon; a rank killed
 # mid-bake makes mpirun exit non-zero and leaves no output file; ranks started
-# with different settings or output names refuse together.
+# with different settings or output names, or one whose scene is damaged,
+# refuse together.
 # Usage: mpirun_test.sh MPIEXEC LIGHTOCTREE SHARED_SCENES OUTPUT_DIR
 set -euo pipefail
 MPIEXEC=$1 CLI=$2 SCENES=$3 OUT=$4
@@ -79,6 +80,26 @@ if [ $rc -ne 0 ] && [ ! -e "$OUT/rank0.vdb" ] && [ ! -e "$OUT/rank1.vdb" ] &&
 else
   echo "FAIL: ranks given different -o: mpirun exited $rc"
   cat "$OUT/outputs.log"
+  failures=$((failures + 1))
+fi
+# A rank whose copy of the scene is damaged (a machine with another copy):
+# it aborted the job before it said why (rank 0's copy read well, and rank 0
+# alone speaks). Now every rank refuses together, rank 0 giving the failing
+# rank's words; nothing is written.
+printf '{"asset": {"version": "2.0"}, "meshes": [' >"$OUT/damaged.gltf"
+set +e
+"${MPI[@]}" -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" -o "$OUT/damaged.vdb" -q \
+  --depth 4 --photons 3000 : -np 1 "$CLI" bake "$OUT/damaged.gltf" \
+  -o "$OUT/damaged.vdb" -q --depth 4 --photons 3000 >"$OUT/damaged.log" 2>&1
+rc=$?
+set -e
+if [ $rc -ne 0 ] && [ ! -e "$OUT/damaged.vdb" ] &&
+   grep -q "lightoctree: error: rank 1: .*damaged.gltf: invalid glTF" "$OUT/damaged.log" &&
+   ! grep -q "MPI_ABORT" "$OUT/damaged.log"; then
+  echo "ok: a rank with a damaged scene: mpirun exits $rc, its message said, no output file"
+else
+  echo "FAIL: a rank with a damaged scene: mpirun exited $rc"
+  cat "$OUT/damaged.log"
   failures=$((failures + 1))
 fi
 exit $failures

@@ -436,6 +436,38 @@ TEST(ThreadRanks, CollectivesGiveWhatEachRankSent) {
   }
 }
 
+// A step each rank runs on its own (loading its copy of the scene): one
+// rank that fails makes every rank refuse at once, rank 0 with the failing
+// rank's words (under mpirun that rank aborted the job before it said why).
+TEST(RankAgreement, ARankWhoseOwnStepFailedMakesEveryRankRefuseWithItsWords) {
+  for (int failing : {1, 2, 0}) {
+    SCOPED_TRACE(failing);
+    std::vector<std::string> messages(3);
+    std::vector<int> refused(3, 0);
+    std::mutex mutex;
+    runThreadRanks(3, [&](Communicator& comm) {
+      const bool mine = comm.rank() == failing;
+      try {
+        checkRanksSucceeded(comm, mine ? "scene.gltf: invalid glTF" : "");
+      } catch (const RanksRefuseError& e) {
+        std::lock_guard<std::mutex> lock(mutex);
+        messages[size_t(comm.rank())] = e.what();
+        refused[size_t(comm.rank())] = 1;
+      }
+    });
+    EXPECT_EQ(refused, (std::vector<int>{1, 1, 1}));
+    EXPECT_EQ(messages[0], failing == 0 ? "scene.gltf: invalid glTF"
+                                        : "rank " + std::to_string(failing) + ": scene.gltf: invalid glTF");
+  }
+  // When every rank succeeded, none refuses.
+  std::atomic<int> passed{0};
+  runThreadRanks(3, [&](Communicator& comm) {
+    checkRanksSucceeded(comm, "");
+    ++passed;
+  });
+  EXPECT_EQ(passed.load(), 3);
+}
+
 TEST(ThreadRanks, ARankThatFailsEndsTheOthersWaits) {
   std::atomic<int> reached{0};
   try {
