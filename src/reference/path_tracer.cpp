@@ -75,7 +75,13 @@ struct Context {
   std::vector<const Light*> lights;  ///< punctual lights with positive intensity
   LightTree lightTree;               ///< the same, drawn by importance (many lights)
   SkySampler sky;                    ///< the sky's directions by radiance (empty: no sky)
-  float epsilon = 0;
+  /// Ray origins leave their surface by kRayEpsilonScale x (epsilonSize +
+  /// the larger of epsilonReach and the point's largest coordinate):
+  /// epsilonSize the baked part's diagonal, epsilonReach its largest
+  /// coordinate. An object added far away (--add at 1e5) made one offset of
+  /// the whole scene's size, 2 units in a 1-unit room, and the room's
+  /// picture 44% dark; now each point's offset follows its own precision.
+  float epsilonSize = 0, epsilonReach = 0;
   int maxBounces = 0;
   int rouletteStart = 0;
   bool unlit = false;  ///< the scene has unlit materials: camera rays look for them first
@@ -107,7 +113,10 @@ inline Vec3 emittedRadiance(const Context& ctx, uint32_t tri, float b1, float b2
 }
 
 inline Vec3 offsetOrigin(const Context& ctx, const Vec3& p, const Vec3& normal, const Vec3& dir) {
-  return p + (dot(dir, normal) > 0 ? normal : -normal) * ctx.epsilon;
+  const float reach =
+      std::max({ctx.epsilonReach, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+  const float epsilon = kRayEpsilonScale * std::max(ctx.epsilonSize + reach, 1e-6f);
+  return p + (dot(dir, normal) > 0 ? normal : -normal) * epsilon;
 }
 
 /// Light from punctual light `light` reflected at p towards wo, shadow ray
@@ -396,13 +405,22 @@ void buildContext(const Scene& scene, const ReferenceParams& params, Context& ct
   for (const Light& light : scene.lights)
     if (light.intensity > 0 && maxComponent(light.color) > 0) ctx.lights.push_back(&light);
   if (ctx.lights.size() > size_t(kPunctualDraws)) ctx.lightTree = LightTree(scene.lights);
-  Bounds3 bounds = scene.bounds();
+  // The baked part's size (objects added after the bake left out: one far
+  // away is no reason to offset every ray of the room by its distance).
+  Bounds3 bounds;
+  if (scene.hasAddedObjects()) {
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+      if (scene.isAdded(t)) continue;
+      for (int k = 0; k < 3; ++k) bounds.extend(scene.positions[scene.indices[3 * t + size_t(k)]]);
+    }
+  }
+  if (bounds.empty()) bounds = scene.bounds();
   if (!bounds.empty()) {
     Vec3 lo = bounds.lower, hi = bounds.upper;
     Vec3 a{std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z)};
     Vec3 c{std::fabs(hi.x), std::fabs(hi.y), std::fabs(hi.z)};
-    float scale = length(bounds.extent()) + maxComponent(max(a, c));
-    ctx.epsilon = kRayEpsilonScale * std::max(scale, 1e-6f);
+    ctx.epsilonSize = length(bounds.extent());
+    ctx.epsilonReach = maxComponent(max(a, c));
   }
 }
 

@@ -272,5 +272,26 @@ TEST(AddedObjects, ThePathTracerCanLetThemOnlyReceiveLight) {
   EXPECT_GT(sphere, 5);
 }
 
+// An object added far from the room, out of the camera's view, changes
+// nothing the path tracer draws of the room: its ray offsets followed the
+// whole scene's size, 2 units in this 1-unit room for a sphere 10^5 away,
+// and the picture went 44% dark. The offsets now follow the baked part's
+// size and each point's own precision: the same bytes as without it.
+TEST(AddedObjects, OneFarAwayChangesNothingThePathTracerDrawsOfTheRoom) {
+  const Scene room = test::pointLitRoom();
+  ReferenceParams params;
+  params.width = params.height = 16;
+  params.samplesPerPixel = 8;
+  const PinholeCamera camera = PinholeCamera::lookAt({0.1f, 0.5f, 0.15f}, {1, 0.35f, 0.5f}, 1.0f);
+  const ReferenceImage without = renderReference(room, camera, params);
+  ASSERT_GT(mean(without.image), 0.0);
+  for (float far : {1e3f, 1e5f, 1e9f}) {
+    SCOPED_TRACE(far);
+    const ReferenceImage with = renderReference(withSphere(room, {far, 0.5f, 0.5f}, 0.5f), camera, params);
+    EXPECT_EQ(with.image.rgb, without.image.rgb) << "mean " << mean(with.image) << " against "
+                                                 << mean(without.image);
+  }
+}
+
 }  // namespace
 }  // namespace lo
