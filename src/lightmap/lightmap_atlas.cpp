@@ -215,6 +215,9 @@ void texelSurface(const Scene& scene, const LightmapUvs& uvs, size_t t, size_t i
   if (!(lengthSquared(normal) > 0.5f)) normal = scene.faceNormal(t);
 }
 
+/// Rec. 709 luminance.
+float luminance(const Vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
 Vec3 unitOrZero(const Vec3& v) {
   const float l = length(v);
   return l > 0 && std::isfinite(l) ? v / l : Vec3{0, 0, 0};
@@ -474,6 +477,47 @@ std::string LightmapAtlas::ToString() const {
   return os.str();
 }
 
+std::vector<int8_t> atlasSurfaceSides(const Scene& scene, const GpuOctree& octree,
+                                      const OctreeShadeParams& shade) {
+  const size_t nt = scene.triangleCount();
+  std::vector<int8_t> sides(nt, 1);
+  if (octree.depth <= 0) return sides;
+  // Each point's own voxel alone: the trilinear lookup lends a side that no
+  // light reaches (the inside of a box) its neighbours' light.
+  OctreeShadeParams own = shade;
+  own.interpolation = false;
+  for (size_t t = 0; t < nt; ++t) {
+    {
+      const int32_t m = scene.triangleMaterial[t];
+      if (m < 0 || size_t(m) >= scene.materials.size()) continue;
+      const Material& material = scene.materials[size_t(m)];
+      if (material.backFaceCulling && !material.doubleSided) continue;  // one side drawn
+      const uint32_t* v = &scene.indices[3 * t];
+      const Vec3 a = scene.positions[v[0]], b = scene.positions[v[1]], c = scene.positions[v[2]];
+      Vec3 n{0, 0, 0};
+      if (!scene.normals.empty()) {
+        n = normalize(scene.normals[v[0]] + scene.normals[v[1]] + scene.normals[v[2]]);
+      }
+      if (!(lengthSquared(n) > 0.5f)) n = scene.faceNormal(t);  // as texelSurface
+      // Seven points spread over the triangle (its centroid, the midpoints of
+      // its edges, its corners a tenth of the way in): a large floor
+      // triangle's centroid may lie under a box, in the dark on both sides.
+      const Vec3 centroid = (a + b + c) * (1.0f / 3.0f);
+      const Vec3 points[7] = {centroid,           (a + b) * 0.5f,
+                              (b + c) * 0.5f,     (c + a) * 0.5f,
+                              a + (centroid - a) * 0.1f, b + (centroid - b) * 0.1f,
+                              c + (centroid - c) * 0.1f};
+      double front = 0, back = 0;
+      for (const Vec3& p : points) {
+        front += luminance(octreeIrradianceSample(octree, p, n, own).irradiance);
+        back += luminance(octreeIrradianceSample(octree, p, -n, own).irradiance);
+      }
+      if (back > front) sides[t] = -1;
+    }
+  }
+  return sides;
+}
+
 LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, const GpuOctree& octree,
                                 const AtlasBakeParams& params) {
   using namespace atlas_internal;
@@ -505,6 +549,8 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
   std::vector<RgbImage> albedo, emission;
   AtlasPageEvaluator* const evaluator = params.evaluator;
   if (evaluator) evaluator->begin(scene, uvs, octree, params.shade);
+  // The side each texel holds (the evaluator finds the same).
+  const std::vector<int8_t> sides = atlasSurfaceSides(scene, octree, params.shade);
   std::vector<int32_t> pageTriangles;
   for (int page = 0; page < uvs.pageCount; ++page) {
     auto start = Clock::now();
@@ -557,7 +603,10 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
       }
       Vec3 position{0, 0, 0}, normal{0, 0, 1};
       double b[3] = {1, 0, 0};
-      if (needSurface) texelSurface(scene, uvs, t, i, position, normal, b);
+      if (needSurface) {
+        texelSurface(scene, uvs, t, i, position, normal, b);
+        if (sides[t] < 0) normal = -normal;
+      }
       if (!evaluator) {
         const OctreeIrradianceSample s =
             octreeIrradianceSample(octree, position, normal, params.shade);

@@ -64,6 +64,19 @@ class AtlasPageEvaluator {
   virtual AtlasPageTexels evaluatePage(int page, const std::vector<int32_t>& triangles) = 0;
 };
 
+/// Which side of each triangle's surface its texels hold: +1 the side its
+/// shading normal faces, -1 the other. A texel holds one side's light; a
+/// surface drawn from both sides (glTF doubleSided, OBJ) whose normals face
+/// away from its light (a room modelled with outward normals) held the dark
+/// outside, and the room's lightmap was three quarters black where the
+/// renderer shows it lit. Such a triangle's texels take the side whose
+/// irradiance (the octree's, each point's own voxel alone, summed over seven
+/// points spread over the triangle) is larger; a one-sided one keeps its
+/// normal's. Both the CPU
+/// bake and GpuAtlasEvaluator follow it.
+std::vector<int8_t> atlasSurfaceSides(const Scene& scene, const GpuOctree& octree,
+                                      const OctreeShadeParams& shade);
+
 /// Peak memory per page texel of a lightmap bake and its export, measured
 /// (`lightmap` on the Cornell box, one 4096^2 page: 634 MB peak without the
 /// preview, 1.19 GB with it): the pages, coverage, the triangle and surface

@@ -33,6 +33,10 @@ struct GpuAtlasEvaluator::Impl {
   GlFramebuffer fbo;
   GlRenderbuffer depth;
   GlRenderbuffer colour[3];  ///< irradiance, direction (RGBA32F), triangle (R32I)
+  /// Per triangle, the side its texels hold (atlasSurfaceSides): a -1's
+  /// corners go in the other order and its normals turned, so the shader's
+  /// normal, the vertices' or the winding's, is the other side's.
+  std::vector<int8_t> sides;
   OctreeTextures octree;
   const Scene* scene = nullptr;
   const LightmapUvs* uvs = nullptr;
@@ -107,6 +111,7 @@ void GpuAtlasEvaluator::begin(const Scene& scene, const LightmapUvs& uvs, const 
   r.scene = &scene;
   r.uvs = &uvs;
   r.shade = shade;
+  r.sides = atlasSurfaceSides(scene, octree, shade);
   r.origin = octree.origin;
   if (r.width != uvs.width || r.height != uvs.height || !r.fbo) {
     r.width = uvs.width;
@@ -127,14 +132,16 @@ AtlasPageTexels GpuAtlasEvaluator::evaluatePage(int page, const std::vector<int3
   std::vector<AtlasVertex> vertices(3 * triangles.size());
   for (size_t k = 0; k < triangles.size(); ++k) {
     const size_t t = size_t(triangles[k]);
+    const bool back = t < r.sides.size() && r.sides[t] < 0;
     for (int c = 0; c < 3; ++c) {
-      AtlasVertex& v = vertices[3 * k + size_t(c)];
+      AtlasVertex& v = vertices[3 * k + size_t(back ? (3 - c) % 3 : c)];
       const uint32_t index = scene.indices[3 * t + size_t(c)];
       v.texel[0] = float(double(uvs.uv[6 * t + size_t(2 * c)]) * uvs.width);
       v.texel[1] = float(double(uvs.uv[6 * t + size_t(2 * c) + 1]) * uvs.height);
       const Vec3& p = scene.positions[index];
       for (int i = 0; i < 3; ++i) v.position[i] = float(double(p[i]) - double(r.origin[i]));
-      const Vec3 n = scene.normals.empty() ? Vec3{0, 0, 0} : scene.normals[index];
+      const Vec3 n = scene.normals.empty() ? Vec3{0, 0, 0}
+                                           : scene.normals[index] * (back ? -1.0f : 1.0f);
       for (int i = 0; i < 3; ++i) v.normal[i] = n[i];
       v.triangle = int32_t(t);
     }

@@ -363,6 +363,50 @@ TEST(LightmapAtlas, PlaneUnderAConstantVdlIsTheCosineLawAtEveryTexel) {
   }
 }
 
+// A surface drawn from both sides holds the side its light reaches, whatever
+// way its normals face: the tilted plane turned over (winding and normals
+// the other way) under the same VDL is the cosine law at every texel when
+// it is doubleSided (an OBJ's faces, drawn from both sides, alike), and dark
+// when it is one-sided glTF, whose back is not drawn. A room modelled with
+// outward normals had a lightmap three quarters black where the renderer
+// shows it lit.
+TEST(LightmapAtlas, ADoubleSidedSurfaceHoldsTheSideItsLightReaches) {
+  const PlaneCase plane = tiltedPlane();
+  const Vec3 c{2.0f, 1.0f, 0.5f};
+  const GpuOctree octree = denseOctree([&](const Coord&) {
+    return std::vector<Vdl>{vdl(c, {0.3f, -0.2f, 1.0f})};
+  });
+  const Vec3 d = decodedDirection(octree, 0);
+  const Vec3 analytic = c * std::max(0.0f, dot(plane.normal, d));
+  ASSERT_GT(analytic.x, 0.5f);
+  Scene turned = plane.scene;
+  for (size_t t = 0; t < turned.triangleCount(); ++t) std::swap(turned.indices[3 * t + 1], turned.indices[3 * t + 2]);
+  turned.normals.assign(turned.positions.size(), -plane.normal);
+  LightmapUvParams up;
+  up.atlasSize = 64;
+  const LightmapUvs uvs = buildLightmapUvs(turned, up);
+  struct Case {
+    const char* what;
+    bool doubleSided, backFaceCulling;
+    Vec3 expected;
+  };
+  for (const Case& k : {Case{"doubleSided", true, true, analytic}, Case{"OBJ", false, false, analytic},
+                        Case{"one-sided", false, true, Vec3{0, 0, 0}}}) {
+    SCOPED_TRACE(k.what);
+    turned.materials[0].doubleSided = k.doubleSided;
+    turned.materials[0].backFaceCulling = k.backFaceCulling;
+    const std::vector<int8_t> sides = atlasSurfaceSides(turned, octree, OctreeShadeParams{});
+    for (int8_t side : sides) ASSERT_EQ(side, k.expected.x > 0 ? -1 : 1);
+    const LightmapAtlas atlas = bakeLightmapAtlas(turned, uvs, octree);
+    ASSERT_GT(atlas.coveredTexels, 0u);
+    const std::vector<uint8_t>& cov = atlas.coverage[0];
+    for (size_t i = 0; i < cov.size(); ++i) {
+      if (cov[i] == kAtlasEmpty) continue;
+      ASSERT_NEAR(length(atlas.irradiance[0].at(i) - k.expected), 0.0f, 1e-5f) << i;
+    }
+  }
+}
+
 // --content full: the direct light function's value is added to every
 // covered texel's E, at the texel's own surface point and normal (here a
 // function of the position, so a mix-up of texels shows).

@@ -101,6 +101,40 @@ TEST(AtlasGpu, PlaneUnderAConstantVdlIsTheCosineLawAtEveryTexel) {
   }
 }
 
+// The plane turned over (winding and normals the other way), drawn from both
+// sides: the GPU holds the side its light reaches, as the CPU does
+// (atlasSurfaceSides), texel for texel; one-sided, the dark one.
+TEST(AtlasGpu, ADoubleSidedSurfaceHoldsTheSideItsLightReaches) {
+  if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
+  Scene scene = emptyScene();
+  addGrid(scene, 6, {0.35f, 0.3f, 0.55f}, {-0.2f, 0.9f, 0.35f}, {1.2f, 0.25f, 0.1f});  // turned
+  const Vec3 c{2.0f, 1.0f, 0.5f}, d = normalize(Vec3{0.3f, -0.2f, 1.0f});
+  const GpuOctree octree = denseOctree([&](const Coord&) { return std::vector<Vdl>{vdl(c, d)}; });
+  const Vec3 decoded = lookupOctree(octree, Vec3{1, 1, 1}).vdls[0].direction;
+  const Vec3 lit = c * std::max(0.0f, dot(-scene.faceNormal(0), decoded));
+  ASSERT_GT(lit.x, 0.5f);
+  LightmapUvParams up;
+  up.atlasSize = 64;
+  const LightmapUvs uvs = buildLightmapUvs(scene, up);
+  AtlasBakeParams params;
+  params.dilation = 0;
+  params.stitchSeams = false;
+  for (bool doubleSided : {true, false}) {
+    SCOPED_TRACE(doubleSided ? "doubleSided" : "one-sided");
+    scene.materials[0].doubleSided = doubleSided;
+    const LightmapAtlas gpu = gpuBake(scene, uvs, octree, params);
+    const LightmapAtlas cpu = bakeLightmapAtlas(scene, uvs, octree, params);
+    const AtlasDifference diff = difference(gpu, cpu);
+    EXPECT_EQ(diff.coverageDiffers, 0u);
+    EXPECT_LT(diff.irradiance, 1e-4f);
+    ASSERT_GT(gpu.coveredTexels, 0u);
+    for (size_t i = 0; i < gpu.coverage[0].size(); ++i) {
+      if (gpu.coverage[0][i] == kAtlasEmpty) continue;
+      ASSERT_NEAR(length(gpu.irradiance[0].at(i) - (doubleSided ? lit : Vec3{0, 0, 0})), 0.0f, 1e-5f) << i;
+    }
+  }
+}
+
 // A cube under light that varies across voxels, with and without
 // interpolation: texel for texel the CPU's values.
 TEST(AtlasGpu, CubeMatchesTheCpuPathTexelForTexel) {
