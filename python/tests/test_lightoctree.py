@@ -848,8 +848,12 @@ def test_ctrl_c_during_lightmap_leaves_no_file_of_it(grid_file, tmp_path):
 
     with pytest.raises(KeyboardInterrupt):
         lightoctree.lightmap(SCENE, grid_file, output, progress=interrupt)
-    assert [t for t, done, _ in tasks if done == 0] == ["lightmap: octree", "lightmap: atlas",
-                                                  "lightmap: encode", "lightmap: write"]
+    assert [t for t, done, _ in tasks if done == 0] == ["lightmap: octree", "lightmap: UVs",
+                                                  "lightmap: atlas", "lightmap: encode",
+                                                  "lightmap: write"]
+    # The atlas reports each row of texels: Ctrl-C within it is seen within a row.
+    atlas = [(done, total) for t, done, total in tasks if t == "lightmap: atlas"]
+    assert len(atlas) > 10 and atlas[-1][0] == atlas[-1][1] and atlas[-1][1] > 100
     assert os.listdir(out) == []  # not a file, not a temporary one
     # An earlier export (one page, no direction page) stays as it was, whole.
     lightoctree.lightmap(SCENE, grid_file, output, directions="off", image="png")
@@ -860,10 +864,11 @@ def test_ctrl_c_during_lightmap_leaves_no_file_of_it(grid_file, tmp_path):
     assert {name: (out / name).read_bytes() for name in os.listdir(out)} == before
 
     # A callback that raises stops it at any step, the same way.
-    for step in ("lightmap: octree", "lightmap: atlas", "lightmap: encode", "lightmap: write"):
+    for step in ("lightmap: octree", "lightmap: UVs", "lightmap: atlas", "lightmap: encode",
+                 "lightmap: write"):
         def stop(task, done, total, step=step):
-            if task == step:
-                raise Stop(step)
+            if task == step and (step != "lightmap: atlas" or 0 < done < total // 2):
+                raise Stop(step)  # the atlas in the middle of its rows
         with pytest.raises(Stop, match=step):
             lightoctree.lightmap(SCENE, grid_file, output, progress=stop)
         assert {name: (out / name).read_bytes() for name in os.listdir(out)} == before, step

@@ -147,7 +147,10 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
     gpu = std::make_unique<GpuAtlasEvaluator>();
     bake.atlas.evaluator = gpu.get();
   }
-  step.emplace(params.progress, "lightmap: atlas", 1);
+  // The UVs and the atlas report their own steps ("lightmap: UVs", "lightmap:
+  // atlas": each row of texels), where a sink may stop them.
+  step.reset();
+  bake.progress = params.progress;
   result.lightmap = bakeLightmap(scene, octree, bake);
   const LightmapUvs& uvs = result.lightmap.uvs;
   const LightmapAtlas& atlas = result.lightmap.atlas;

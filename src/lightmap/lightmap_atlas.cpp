@@ -551,6 +551,8 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
   if (evaluator) evaluator->begin(scene, uvs, octree, params.shade);
   // The side each texel holds (the evaluator finds the same).
   const std::vector<int8_t> sides = atlasSurfaceSides(scene, octree, params.shade);
+  Progress progress(params.progress, "lightmap: atlas",
+                    size_t(uvs.pageCount) * (size_t(uvs.height) + 1) + 1);
   std::vector<int32_t> pageTriangles;
   for (int page = 0; page < uvs.pageCount; ++page) {
     auto start = Clock::now();
@@ -569,6 +571,7 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
     RgbImage e(uvs.width, uvs.height), d(uvs.width, uvs.height);
     if (evaluator) {
       AtlasPageTexels done = evaluator->evaluatePage(page, pageTriangles);
+      progress.advance(size_t(uvs.height));  // the page's rows, at once
       if (done.triangle.size() != texels || done.irradiance.width != uvs.width ||
           done.irradiance.height != uvs.height || done.direction.width != uvs.width ||
           done.direction.height != uvs.height) {
@@ -596,6 +599,7 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
     // here, for the direct light and for the radiance.
     const bool needSurface = !evaluator || direct || params.radiance;
     for (size_t i = 0; i < texels; ++i) {
+      if (!evaluator && (i + 1) % size_t(uvs.width) == 0) progress.advance();  // a row
       if (raster.triangle[i] < 0) continue;
       const size_t t = size_t(raster.triangle[i]);
       if (t >= nt) {
@@ -641,6 +645,7 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
     if (params.radiance) extra = {&albedo.back(), &emission.back()};
     dilatePage(uvs.width, uvs.height, atlas.dilation, coverage, e, d, atlas.dilatedTexels, extra);
     atlas.dilateSeconds += secondsSince(start);
+    progress.advance();
     atlas.irradiance.push_back(std::move(e));
     atlas.direction.push_back(std::move(d));
     atlas.coverage.push_back(std::move(coverage));
@@ -659,6 +664,7 @@ LightmapAtlas bakeLightmapAtlas(const Scene& scene, const LightmapUvs& uvs, cons
     atlas.seamMismatchAfter = seamMismatch(system, atlas);
   }
   atlas.stitchSeconds = secondsSince(start);
+  progress.advance();
 
   if (params.radiance) {
     // L = albedo / pi * E + emission from the final E: a seam joined in E is

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "image/image.h"
 #include "lightmap/lightmap_uv.h"
 #include "octree/gpu_octree.h"
@@ -120,6 +121,10 @@ struct AtlasBakeParams {
   /// call), its time counted as LightmapAtlas::evaluateSeconds. Null: on
   /// the CPU, with octreeIrradianceSample.
   AtlasPageEvaluator* evaluator = nullptr;
+  /// Told of the work ("lightmap: atlas": each row of texels evaluated,
+  /// each page dilated, the seams stitched); a sink that throws from a
+  /// report stops the bake there (the Python module's Ctrl-C). Null: none.
+  ProgressSink* progress = nullptr;
 };
 
 /// The baked pages. Each vector holds pageCount entries, each page width x

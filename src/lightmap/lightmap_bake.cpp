@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <cmath>
 #include <sstream>
 
@@ -56,6 +57,7 @@ LightmapBake bakeLightmap(const Scene& scene, const GpuOctree& octree,
   using Clock = std::chrono::steady_clock;
   LightmapBake out;
   const auto start = Clock::now();
+  std::optional<Progress> uvStep(std::in_place, params.progress, "lightmap: UVs", 1);
   const bool hasTexcoord1 = scene.texcoords1.size() == 2 * scene.positions.size() &&
                             !scene.texcoords1.empty();
   const bool useTexcoord1 = params.uvSource == UvSource::Texcoord1 ||
@@ -95,8 +97,11 @@ LightmapBake bakeLightmap(const Scene& scene, const GpuOctree& octree,
     }
   }
   const auto uvDone = Clock::now();
+  uvStep.reset();
   checkAtlasMemory(out.uvs, params.atlas.radiance);
-  out.atlas = bakeLightmapAtlas(scene, out.uvs, octree, params.atlas);
+  AtlasBakeParams atlas = params.atlas;
+  if (!atlas.progress) atlas.progress = params.progress;
+  out.atlas = bakeLightmapAtlas(scene, out.uvs, octree, atlas);
   out.uvSeconds = std::chrono::duration<double>(uvDone - start).count();
   out.atlasSeconds = std::chrono::duration<double>(Clock::now() - uvDone).count();
   return out;

@@ -33,6 +33,10 @@ struct LightmapParams {
   /// chart, up to uv.atlasSize (then more pages).
   LightmapUvParams uv;
   AtlasBakeParams atlas;  ///< the octree lookup's settings, dilation, seams
+  /// Told of the UVs ("lightmap: UVs", one step) and, unless atlas.progress
+  /// is set, the atlas (AtlasBakeParams::progress); a sink that throws from
+  /// a report stops the bake there. Null: none.
+  ProgressSink* progress = nullptr;
 };
 
 struct LightmapBake {
