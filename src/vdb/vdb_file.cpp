@@ -28,6 +28,7 @@
 #include "core/file.h"
 #include "core/file_set.h"
 #include "core/isolate.h"
+#include "core/resources.h"
 #include "vdb/vdb_contract.h"
 #include "vdb/vdb_file.h"
 
@@ -226,8 +227,9 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
   m.insertMeta(kMetaDepth, openvdb::Int32Metadata(grid.frame.depth));
   m.insertMeta("photons", openvdb::Int64Metadata(meta.photons));
   m.insertMeta("emitted_paths", openvdb::Int64Metadata(meta.emittedPaths));
-  m.insertMeta("knn", openvdb::Int32Metadata(meta.knn));
-  m.insertMeta("radius", openvdb::FloatMetadata(meta.radius));
+  // 0: not recorded (a grid made in code); a reader refuses a recorded 0.
+  if (meta.knn != 0) m.insertMeta("knn", openvdb::Int32Metadata(meta.knn));
+  if (meta.radius != 0) m.insertMeta("radius", openvdb::FloatMetadata(meta.radius));
   m.insertMeta("vdls", openvdb::StringMetadata(meta.vdls));
   m.insertMeta("seed", openvdb::Int64Metadata(meta.seed));
   m.insertMeta("scene_bounds_min", openvdb::Vec3SMetadata(toVdb(meta.sceneBounds.lower)));
@@ -407,10 +409,15 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
       metaValue<openvdb::Vec3s>(path, m, "region_max", false, openvdb::Vec3s(-INFINITY)));
   // Values the commands rely on, refused when another tool left them out of
   // range: a NaN bound let a depth the voxels do not have through (convert
-  // then wrote a grid of the wrong size), a NaN radius was copied on.
-  if (!(meta.radius >= 0) || !std::isfinite(meta.radius)) {
-    throw InputError(path + ": file metadata 'radius' = " + std::to_string(meta.radius) +
-                     " is not a finite radius >= 0");
+  // then wrote a grid of the wrong size), a NaN radius was copied on, and
+  // a gather of k = 0 neighbours or of radius 0 passed inspect.
+  if (m["knn"] && meta.knn < 1) {
+    throw InputError(path + ": file metadata 'knn' = " + std::to_string(meta.knn) +
+                     " is not a number of neighbours >= 1");
+  }
+  if (m["radius"] && (!(meta.radius > 0) || !std::isfinite(meta.radius))) {
+    throw InputError(path + ": file metadata 'radius' = " + formatNumber(double(meta.radius)) +
+                     " is not a finite radius > 0");
   }
   if (meta.photons < 0 || meta.emittedPaths < 0) {
     throw InputError(path + ": file metadata 'photons' or 'emitted_paths' is negative");

@@ -35,6 +35,10 @@ struct Damage {
   /// String file metadata (key, value) written over what the writer wrote, as
   /// another tool may.
   std::vector<std::pair<std::string, std::string>> stringMetadata;
+  /// int32 and float file metadata (key, value) written over what the writer
+  /// wrote (or left out), as another tool may.
+  std::vector<std::pair<std::string, int32_t>> intMetadata;
+  std::vector<std::pair<std::string, float>> floatMetadata;
 };
 
 /// writeVdlGrid with damage applied (same metadata, same temp + rename).

@@ -315,6 +315,14 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
       fileMeta.removeMeta(key);
       fileMeta.insertMeta(key, openvdb::StringMetadata(value));
     }
+    for (const auto& [key, value] : damage->intMetadata) {
+      fileMeta.removeMeta(key);
+      fileMeta.insertMeta(key, openvdb::Int32Metadata(value));
+    }
+    for (const auto& [key, value] : damage->floatMetadata) {
+      fileMeta.removeMeta(key);
+      fileMeta.insertMeta(key, openvdb::FloatMetadata(value));
+    }
   }
   writeVdbFile(path, sources, fileMeta, into);
 }

@@ -670,6 +670,61 @@ TEST(Inspect, MetadataOutOfRangeAreRefusedNamingTheKey) {
   }
 }
 
+// A gather of no neighbours, or of a radius of 0, is not one a bake makes:
+// `knn` <= 0 and a `radius` of 0, negative or not finite passed inspect.
+// Refused by every reader and failed by inspect, naming the key; a file
+// without them (a grid made in code) is read.
+TEST(Inspect, ImpossibleKnnAndRadiusAreRefusedNamingTheKey) {
+  const std::string dir = test::outputDir("Inspect.KnnRadius");
+  struct Case {
+    const char* name;
+    const char* key;
+    vdb_internal::Damage damage;
+  };
+  auto knn = [](int32_t k) {
+    vdb_internal::Damage d;
+    d.intMetadata = {{"knn", k}};
+    return d;
+  };
+  auto radius = [](float r) {
+    vdb_internal::Damage d;
+    d.floatMetadata = {{"radius", r}};
+    return d;
+  };
+  const Case cases[] = {
+      {"knn-0", "'knn' = 0", knn(0)},
+      {"knn-negative", "'knn' = -7", knn(-7)},
+      {"radius-0", "'radius' = 0", radius(0.0f)},
+      {"radius-negative", "'radius' = -0.5", radius(-0.5f)},
+      {"radius-infinite", "'radius' = inf", radius(INFINITY)},
+      {"radius-nan", "'radius' = nan", radius(std::nanf(""))},
+  };
+  for (const Case& c : cases) {
+    const std::string path = dir + "/" + c.name + ".vdb";
+    vdb_internal::writeVdlGridDamaged(path, floorGrid(), metaWithBounds(), c.damage);
+    const std::string refused = readError(path);
+    EXPECT_NE(refused.find(c.key), std::string::npos) << c.name << ": " << refused;
+    const VdbReport report = inspectVdb(path);
+    EXPECT_FALSE(report.ok()) << c.name;
+    bool named = false;
+    for (const VdbCheck& check : report.checks) {
+      named = named || (!check.passed && check.detail.find(c.key) != std::string::npos);
+    }
+    EXPECT_TRUE(named) << c.name << ": inspect does not name " << c.key;
+  }
+  // Recorded and possible, or not recorded: read.
+  BakeMetadata recorded = metaWithBounds();
+  recorded.radius = 0.05f;
+  writeVdlGrid(dir + "/recorded.vdb", floorGrid(), recorded);
+  EXPECT_EQ(readVdlGrid(dir + "/recorded.vdb").meta.knn, 100);
+  EXPECT_TRUE(inspectVdb(dir + "/recorded.vdb").ok());
+  BakeMetadata none = metaWithBounds();
+  none.knn = 0;
+  writeVdlGrid(dir + "/none.vdb", floorGrid(), none);
+  EXPECT_EQ(readVdlGrid(dir + "/none.vdb").meta.knn, 0);
+  EXPECT_TRUE(inspectVdb(dir + "/none.vdb").ok());
+}
+
 // A photon map carries the hash of the scene it was traced in; a reader
 // given another scene is told (convert --photon-map --scene).
 TEST(PhotonPoints, CarryTheirScenesHash) {
