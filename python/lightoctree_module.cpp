@@ -763,7 +763,7 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
   if (!opt.camera.camera.empty() && !opt.camera.eye.empty()) {
     throw InputError("camera and eye: give one of them");
   }
-  if (!fov.value.is_none()) opt.camera.fovDegrees = float(numberArg(fov.value, {1, 179}, "fov"));
+  if (!fov.value.is_none()) opt.camera.fovDegrees = float(numberArg(fov.value, kFovDegreesRange, "fov"));
   opt.sceneOptions = sceneOptions(sky, skyImage, skyMesh, physicalSky);
   withPythonNames([&] {
     checkCameraOptions(opt.camera);

@@ -15,7 +15,7 @@ void addCameraOptions(CLI::App* cmd, CameraOptions& opt) {
   cmd->add_option("--target", opt.target, "Point the camera looks at, x,y,z (with --eye)");
   camera->excludes(eye);
   cmd->add_option("--fov", opt.fovDegrees, "Vertical field of view in degrees (default 45)")
-      ->check(numberIn({1, 179}));
+      ->check(numberIn(kFovDegreesRange));
 }
 
 Vec3d parseThreeNumbers(const std::string& text, const char* flag) {

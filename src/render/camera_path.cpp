@@ -12,11 +12,10 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "scene/scene.h"
 
 namespace lo {
 namespace {
-
-constexpr float kMinFov = 1.0f, kMaxFov = 179.0f;  // degrees, as `render --fov`
 
 std::string formatFloat(float v) {
   char buf[32];
@@ -120,9 +119,10 @@ CameraPath parseCameraPath(std::istream& in, const std::string& name) {
     }
     if (numbers.size() == 8) {
       key.fovDegrees = numbers[7];
-      if (!(key.fovDegrees >= kMinFov && key.fovDegrees <= kMaxFov)) {
-        throw InputError(where + "fov " + formatFloat(key.fovDegrees) +
-                         " degrees is outside 1..179");
+      if (!kFovDegreesRange.contains(key.fovDegrees)) {
+        throw InputError(where + "fov " + formatFloat(key.fovDegrees) + " degrees is outside " +
+                         formatFloat(float(kFovDegreesRange.min)) + ".." +
+                         formatFloat(float(kFovDegreesRange.max)));
       }
       if (firstFovKey < 0) firstFovKey = int(path.keys.size());
     } else if (!path.keys.empty()) {

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <string>
 
+#include "core/resources.h"
+
 namespace lo::scene_internal::gltf_internal {
 
 void SceneBuilder::addCamera(const tinygltf::Node& node, int nodeIndex, const Mat4& world) {
@@ -37,9 +39,16 @@ void SceneBuilder::addCamera(const tinygltf::Node& node, int nodeIndex, const Ma
                     std::to_string(c.znear) + " and zfar " + std::to_string(c.zfar) +
                     " (glTF: zfar > znear > 0, or no zfar)");
   }
-  if (!(c.yfov > 0 && c.yfov < kPi) || lengthSquared(c.forward) == 0) {
-    fail(path_,
-         "camera on node " + std::to_string(nodeIndex) + " has an invalid yfov or transform");
+  const double degrees = g.perspective.yfov * 180.0 / kPi;
+  if (!kFovDegreesRange.contains(degrees)) {
+    fail(path_, "camera '" + c.name + "' on node " + std::to_string(nodeIndex) + ": yfov " +
+                    formatNumber(g.perspective.yfov) + " radians (" + formatNumber(degrees) +
+                    " degrees): a field of view must be " + kFovDegreesRange.ToString() +
+                    " degrees, as --fov");
+  }
+  if (lengthSquared(c.forward) == 0) {
+    fail(path_, "camera '" + c.name + "' on node " + std::to_string(nodeIndex) +
+                    " has a degenerate transform");
   }
   scene_.cameras.push_back(c);
 }

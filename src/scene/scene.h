@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "core/number_range.h"
 
 namespace lo {
 
@@ -260,6 +261,13 @@ Vec3 skyPixelDirection(float x, float y, int w, int h);
 /// The solid angle of row y's texels of a w x h sky image, above the horizon
 /// only (0 for rows below it).
 float skyPixelSolidAngle(int y, int w, int h);
+
+/// The vertical fields of view a camera takes, degrees: a scene's camera
+/// (glTF `yfov`), `render --fov`, a camera path's keys and Python's `fov`
+/// alike. Narrower than a degree the image is a few texels of the scene
+/// (a yfov of 1e-30 made a projection of 1e30); 180 and wider is no
+/// perspective projection.
+constexpr NumberRange kFovDegreesRange{1, 179};
 
 /// A perspective camera in world space.
 struct Camera {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <string>
 
@@ -122,6 +123,34 @@ TEST_F(SceneGltf, CamerasThatCannotShowAnythingAreRefused) {
                    "zfar > znear");
   expectInputError(withCamera("away.gltf", R"({"camera": 0, "translation": [0, 0, 1e19]})", fine),
                    "beyond");
+}
+
+// A yfov of 1e-30 radians was taken (a projection of scale 1e30, an image of
+// one texel of the scene) and one of 0 or pi refused without a name: a
+// scene's camera takes the fields of view --fov takes (kFovDegreesRange),
+// and a refusal names the camera and its yfov.
+TEST_F(SceneGltf, ACameraFieldOfViewOutsideWhatFovTakesIsRefusedNamingTheCamera) {
+  auto withYfov = [&](const std::string& name, const std::string& yfov) {
+    MiniGltf g = oneTriangle();
+    g.nodes = R"([{"mesh": 0}, {"camera": 0, "name": "tele", "translation": [0, 0, 3]}])";
+    g.sceneNodes = "[0, 1]";
+    g.extraTop = R"("cameras": [{"type": "perspective", "perspective": {"yfov": )" + yfov +
+                 R"(, "znear": 0.1}}], )";
+    return write(name, g);
+  };
+  for (const char* yfov : {"1e-30", "0.0001", "0", "-0.5", "3.14159265358979", "3.2"}) {
+    const std::string path = withYfov(std::string("yfov-") + yfov + ".gltf", yfov);
+    expectInputError(path, "camera 'tele' on node 1: yfov");
+    expectInputError(path, "must be a finite number from 1 to 179 degrees");
+  }
+  // The edges of the range, as --fov takes them: 1 and 179 degrees.
+  for (double degrees : {1.0001, 30.0, 178.999}) {
+    char yfov[32];
+    std::snprintf(yfov, sizeof yfov, "%.17g", degrees * kPi / 180.0);
+    const Scene s = loadScene(withYfov("fine.gltf", yfov));
+    ASSERT_EQ(s.cameras.size(), 1u);
+    EXPECT_NEAR(double(s.cameras[0].yfov) * 180.0 / kPi, degrees, 1e-4);
+  }
 }
 
 // A scene without a camera is framed from the side its surfaces face: a room
