@@ -174,6 +174,13 @@ void checkPathText(const std::string& path, const std::string& name) {
                    "' holds a NUL byte, where the system would end it (and name another file)");
 }
 
+std::string notRegularFile(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) return "missing";
+  return fs::is_regular_file(status) ? "" : file_internal::describe(status);
+}
+
 void requireRegularFile(const std::string& path, const std::string& what) {
   checkPathText(path, what);
   std::error_code ec;

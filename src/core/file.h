@@ -20,6 +20,13 @@ namespace lo {
 /// pipe (only regular files are read)", or "... does not exist".
 void requireRegularFile(const std::string& path, const std::string& what);
 
+/// @brief What stands at `path` (links followed) when it is not a regular
+/// file, for the message of a loader that goes on without it: "missing"
+/// (nothing there, or it cannot be looked at), "a folder", "a pipe", "a
+/// device", "a socket"; "" for a regular file. A texture that names a folder
+/// was warned as missing.
+std::string notRegularFile(const std::string& path);
+
 /// @brief The rule for a path handed over as text (a flag, an argument of the
 /// Python module): it holds no NUL byte, where the system would end it and
 /// read or write another file ("out.vdb\0.png" is "out.vdb"). The readers

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "core/file.h"
+
 namespace lo::scene_internal::gltf_internal {
 
 namespace {
@@ -260,13 +262,15 @@ int SceneBuilder::textureFromImage(int source, int tex, bool srgb) {
   if (im.image.empty() && !im.uri.empty() && im.uri.rfind("data:", 0) != 0) {
     // A file the folder does not hold (an asset copied without all of its
     // textures): the materials show their factors; the user hears it once.
-    std::error_code ec;
+    // A folder (or a pipe) of that name is said to be one, not missing.
     const fs::path file = fs::path(path_).parent_path() / percentDecode(im.uri);
-    if (!fs::is_regular_file(file, ec)) {
+    const std::string problem = notRegularFile(file.string());
+    if (!problem.empty()) {
       if (missingImages_.insert(source).second) {
-        scene_.warnings.push_back(path_ + ": texture image '" + im.uri + "' " + what +
-                                  " is missing; the materials using it show their factors "
-                                  "alone");
+        scene_.warnings.push_back(
+            path_ + ": texture image " + what +
+            (problem == "missing" ? " is missing" : " is " + problem + ", not an image file") +
+            "; the materials using it show their factors alone");
       }
       return -1;
     }

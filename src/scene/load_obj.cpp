@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "core/file.h"
 #include "core/printable.h"
 #include "image/image.h"
 #include "scene/scene_internal.h"
@@ -45,9 +46,12 @@ class FolderMaterialReader : public tinyobj::MaterialReader {
     if (!error_.empty()) return false;
     try {
       std::string file = resolveInsideFolder(scenePath_, baseDir_, matId, "mtllib");
-      std::error_code ec;
-      if (!fs::is_regular_file(file, ec)) {
-        error_ = scenePath_ + ": missing material library file '" + matId + "' (not found)";
+      const std::string problem = notRegularFile(file);
+      if (!problem.empty()) {
+        error_ = scenePath_ + (problem == "missing"
+                                   ? ": missing material library file '" + matId + "' (not found)"
+                                   : ": material library '" + matId + "' is " + problem +
+                                         ", not a file");
         return false;
       }
       std::ifstream in(file);
@@ -213,11 +217,13 @@ Scene loadObj(const std::string& path) {
       } else {
         std::string what = "map_Kd '" + o.diffuse_texname + "'";
         std::string file = resolveInsideFolder(path, baseDir, o.diffuse_texname, what);
-        std::error_code ec;
-        if (!fs::is_regular_file(file, ec)) {
+        const std::string problem = notRegularFile(file);
+        if (!problem.empty()) {
           // Warned once; the materials that use it show their Kd alone.
-          scene.warnings.push_back(path + ": texture file " + what +
-                                   " is missing; the materials using it show their Kd alone");
+          scene.warnings.push_back(
+              path + ": texture file " + what +
+              (problem == "missing" ? " is missing" : " is " + problem + ", not an image file") +
+              "; the materials using it show their Kd alone");
           textureByFile[o.diffuse_texname] = -1;
           scene.materials.push_back(std::move(m));
           continue;

@@ -587,10 +587,9 @@ std::string resolveInsideFolder(const std::string& scenePath, const std::string&
 
 std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std::string& file,
                                          const std::string& what) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) {
-    fail(scenePath, "missing " + what + " '" + file + "' (not found)");
-  }
+  const std::string problem = notRegularFile(file);
+  if (problem == "missing") fail(scenePath, "missing " + what + " '" + file + "' (not found)");
+  if (!problem.empty()) fail(scenePath, what + " '" + file + "' is " + problem + ", not a file");
   std::ifstream in(file, std::ios::binary);
   if (!in) fail(scenePath, "cannot open " + what + " '" + file + "'");
   std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),

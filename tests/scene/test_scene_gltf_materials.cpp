@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -244,6 +245,27 @@ TEST_F(SceneGltf, MissingTextureFileIsWarnedOnceByName) {
   EXPECT_NE(s.warnings[0].find("missing"), std::string::npos) << s.warnings[0];
   EXPECT_EQ(s.materials[0].baseColorTexture, -1);
   EXPECT_EQ(s.materials[0].normalTexture, -1);
+  expectNear(s.materials[0].baseColor, {0.5f, 0.25f, 1.0f}, 1e-6f);
+}
+
+// A texture URI that names a folder was warned as missing, which sent the
+// user looking for a file that is there: the warning says it is a folder.
+// The scene loads, the materials keep their factors.
+TEST_F(SceneGltf, ATextureThatIsAFolderIsWarnedAsAFolder) {
+  std::filesystem::create_directories(dir + "/albedo.png");
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 1],
+                     "baseColorTexture": {"index": 0}}}])";
+  g.image = "albedo.png";
+  const Scene s = loadScene(write("folder.gltf", g));
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("texture image 'albedo.png' (texture 0, image 0) is a folder, "
+                               "not an image file"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_EQ(s.warnings[0].find("missing"), std::string::npos) << s.warnings[0];
+  EXPECT_EQ(s.materials[0].baseColorTexture, -1);
   expectNear(s.materials[0].baseColor, {0.5f, 0.25f, 1.0f}, 1e-6f);
 }
 

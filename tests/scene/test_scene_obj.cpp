@@ -136,6 +136,23 @@ TEST_F(SceneObj, VertexColoursMultiplyTheBaseColour) {
   expectNear(some.albedo(0, 0, 0), {0.5f, 0.5f, 0.5f}, 1e-6f, "no colours");
 }
 
+// A map_Kd or a material library that names a folder: said to be a folder,
+// not missing.
+TEST_F(SceneObj, ATextureOrLibraryThatIsAFolderIsNamedAsAFolder) {
+  fs::create_directories(dir + "/wood.png");
+  write("m.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd wood.png\n");
+  write("scene.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n");
+  const Scene s = loadScene(dir + "/scene.obj");
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("map_Kd 'wood.png' is a folder, not an image file"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_EQ(s.materials[0].baseColorTexture, -1);
+  fs::create_directories(dir + "/lib.mtl");
+  write("lib.obj", "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n");
+  expectInputError(dir + "/lib.obj", "material library 'lib.mtl' is a folder, not a file");
+}
+
 TEST_F(SceneObj, MissingTextureFileIsWarnedOnceByName) {
   write("m.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n"
                  "newmtl b\nKd 0.2 0.2 0.2\nmap_Kd gone.png\n");
