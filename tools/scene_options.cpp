@@ -161,16 +161,11 @@ void placeObjects(Scene& scene, const AddedObjects& opt) {
                      std::to_string(opt.placements.size()) +
                      " placements; give one --at per --add, in the same order");
   }
+  std::vector<AddedModel> models;
   for (size_t i = 0; i < opt.models.size(); ++i) {
-    const Placement placement = parsePlacement(opt.placements[i]);
-    Scene model;
-    try {
-      model = loadScene(opt.models[i]);
-    } catch (const InputError& e) {
-      throw InputError(std::string("--add: ") + e.what());
-    }
-    placeModel(scene, std::move(model), placement);
+    models.push_back({opt.models[i], parsePlacement(opt.placements[i])});
   }
+  placeModels(scene, models);
 }
 
 void addSceneFlags(CLI::App* cmd, SceneFlags& opt) {

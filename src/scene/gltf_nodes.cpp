@@ -67,17 +67,8 @@ void SceneBuilder::checkTriangleBudget() {
     if (node.mesh >= 0 && size_t(node.mesh) < perMesh.size()) triangles += perMesh[size_t(node.mesh)];
     for (int c : node.children) stack.push_back(c);
   }
-  // Per triangle, at most three vertices of their own (position, normal,
-  // two UV sets, tangent: 56 bytes; the double position kept for the
-  // rebase: 24), its indices and material (16).
-  const double bytes = double(triangles) * (3.0 * (56 + 24) + 16);
-  const size_t available = availableMemoryBytes();
-  if (triangles > (uint64_t(1) << 32) / 3 || (available > 0 && bytes > 0.5 * double(available))) {
-    fail(path_, "the node tree makes " + std::to_string(triangles) + " triangles (" +
-                    formatBytes(size_t(std::min(bytes, 1e18))) + " to hold), beyond " +
-                    (available > 0 ? "half the " + formatBytes(available) + " of memory available"
-                                   : std::string("32-bit indices")));
-  }
+  const std::string problem = triangleBudgetProblem(triangles);
+  if (!problem.empty()) fail(path_, "the node tree makes " + problem);
 }
 
 void SceneBuilder::traverse() {

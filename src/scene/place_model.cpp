@@ -3,6 +3,7 @@
 
 #include "scene/place_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -10,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/resources.h"
+#include "scene/scene_internal.h"
 
 namespace lo {
 
@@ -81,7 +83,12 @@ void appendOrFill(std::vector<T>& to, size_t toVertices, const std::vector<T>& f
 
 }  // namespace
 
-void placeModel(Scene& scene, Scene model, const Placement& placement) {
+namespace {
+
+/// placeModel; the model's materials take the scene's textures from
+/// `sharedTextures` on (those of an earlier copy of the same model) instead
+/// of appending its own when `sharedTextures` >= 0.
+void joinModel(Scene& scene, Scene model, const Placement& placement, int sharedTextures) {
   const float yaw = placement.yawDegrees * float(kPi / 180.0);
   const float c = std::cos(yaw), s = std::sin(yaw);
   auto turn = [c, s](const Vec3& v) { return Vec3{c * v.x + s * v.z, v.y, -s * v.x + c * v.z}; };
@@ -107,7 +114,7 @@ void placeModel(Scene& scene, Scene model, const Placement& placement) {
   const size_t baseVertices = scene.positions.size(), addVertices = model.positions.size();
   const uint32_t vertexOffset = uint32_t(baseVertices);
   const int32_t materialOffset = int32_t(scene.materials.size());
-  const int textureOffset = int(scene.textures.size());
+  const int textureOffset = sharedTextures >= 0 ? sharedTextures : int(scene.textures.size());
   // Normals: where one side has none, zero vectors, which every reader
   // takes for the face's own normal (Scene::normals): flat faces stay flat,
   // where normals averaged over shared corners would bend them.
@@ -127,7 +134,9 @@ void placeModel(Scene& scene, Scene model, const Placement& placement) {
     }
     scene.materials.push_back(std::move(m));
   }
-  for (Texture& t : model.textures) scene.textures.push_back(std::move(t));
+  if (sharedTextures < 0) {
+    for (Texture& t : model.textures) scene.textures.push_back(std::move(t));
+  }
   if (scene.movingMaterialsFrom > size_t(materialOffset)) {
     scene.movingMaterialsFrom = size_t(materialOffset);
   }
@@ -136,6 +145,60 @@ void placeModel(Scene& scene, Scene model, const Placement& placement) {
                              " lights are left out: an added object does not change the baked light");
   }
   for (std::string& w : model.warnings) scene.warnings.push_back(std::move(w));
+}
+
+}  // namespace
+
+void placeModel(Scene& scene, Scene model, const Placement& placement) {
+  joinModel(scene, std::move(model), placement, -1);
+}
+
+void placeModels(Scene& scene, const std::vector<AddedModel>& models) {
+  // Each file once, in the order first named; how many placements name it.
+  std::vector<std::string> files;
+  std::vector<Scene> loaded;
+  std::vector<size_t> uses;
+  std::vector<size_t> fileOf(models.size());
+  for (size_t i = 0; i < models.size(); ++i) {
+    const auto known = std::find(files.begin(), files.end(), models[i].path);
+    fileOf[i] = size_t(known - files.begin());
+    if (known != files.end()) {
+      ++uses[fileOf[i]];
+      continue;
+    }
+    files.push_back(models[i].path);
+    uses.push_back(1);
+    try {
+      loaded.push_back(loadScene(models[i].path));
+    } catch (const InputError& e) {
+      throw InputError(std::string("--add: ") + e.what());
+    }
+  }
+  // Every triangle the joined scene will hold, before any is joined.
+  uint64_t triangles = scene.triangleCount();
+  for (size_t f = 0; f < files.size(); ++f) triangles += uint64_t(loaded[f].triangleCount()) * uses[f];
+  const std::string problem = scene_internal::triangleBudgetProblem(triangles);
+  if (!problem.empty()) {
+    throw InputError("--add: the scene and its " + std::to_string(models.size()) +
+                     " added objects make " + problem + " (" +
+                     formatCount(scene.triangleCount()) + " in the scene; add fewer or smaller " +
+                     "models)");
+  }
+  // The first copy of a model brings its textures; the others share them.
+  std::vector<int> texturesOf(files.size(), -1);
+  for (size_t i = 0; i < models.size(); ++i) {
+    const size_t f = fileOf[i];
+    const int shared = texturesOf[f];
+    if (shared < 0) texturesOf[f] = int(scene.textures.size());
+    if (--uses[f] == 0) {
+      joinModel(scene, std::move(loaded[f]), models[i].placement, shared);
+    } else {
+      std::vector<Texture> textures = std::move(loaded[f].textures);
+      Scene copy = loaded[f];
+      if (shared < 0) copy.textures = std::move(textures);
+      joinModel(scene, std::move(copy), models[i].placement, shared);
+    }
+  }
 }
 
 }  // namespace lo

@@ -8,6 +8,7 @@
 /// alone).
 
 #include <string>
+#include <vector>
 
 #include "core/math.h"
 #include "scene/scene.h"
@@ -40,5 +41,23 @@ Placement parsePlacement(const std::string& text);
 /// change the baked light), and its cameras. @throws InputError when the
 /// placed vertices lie beyond kMaxCoordinate.
 void placeModel(Scene& scene, Scene model, const Placement& placement);
+
+/// One object to add: a model file (`--add`) and where it goes (`--at`).
+struct AddedModel {
+  std::string path;
+  Placement placement;
+};
+
+/// @brief The objects of `render`/`view`/`reference --add`: each model file
+/// loaded once (loadScene, whose own checks count its triangles and
+/// textures), then joined at every placement that names it (placeModel),
+/// its copies sharing its textures. The joined scene's triangles are counted
+/// against the memory before any is joined, by the rule of a glTF's node
+/// tree (256 bytes each within half the memory available, 32-bit indices):
+/// a model added many times grew until the system ended the process.
+/// @throws InputError "--add: ..." naming the file that cannot be loaded, or
+/// the triangles the scene and its added objects would make (`scene` is
+/// then left as it was), or placeModel's.
+void placeModels(Scene& scene, const std::vector<AddedModel>& models);
 
 }  // namespace lo

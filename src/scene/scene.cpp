@@ -585,6 +585,18 @@ std::string resolveInsideFolder(const std::string& scenePath, const std::string&
   return full.string();
 }
 
+std::string triangleBudgetProblem(uint64_t triangles) {
+  const double bytes = double(triangles) * kSceneBytesPerTriangle;
+  const size_t available = availableMemoryBytes();
+  if (triangles <= (uint64_t(1) << 32) / 3 && !(available > 0 && bytes > 0.5 * double(available))) {
+    return "";
+  }
+  return std::to_string(triangles) + " triangles (" +
+         formatBytes(size_t(std::min(bytes, 1e18))) + " to hold), beyond " +
+         (available > 0 ? "half the " + formatBytes(available) + " of memory available"
+                        : std::string("32-bit indices"));
+}
+
 std::vector<unsigned char> readFileBytes(const std::string& scenePath, const std::string& file,
                                          const std::string& what) {
   const std::string problem = notRegularFile(file);

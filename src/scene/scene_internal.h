@@ -83,6 +83,18 @@ struct RebaseBounds {
   static constexpr double kInfinity = std::numeric_limits<double>::infinity();
 };
 
+/// Bytes a scene holds per triangle, at most: three vertices of its own
+/// (position, normal, two UV sets, tangent: 56 bytes; the double position a
+/// loader keeps for the rebase: 24), its indices and material (16).
+constexpr double kSceneBytesPerTriangle = 3.0 * (56 + 24) + 16;
+
+/// "" when a scene of `triangles` fits: 32-bit indices, and
+/// kSceneBytesPerTriangle each within half the memory available; else "N
+/// triangles (X to hold), beyond half the Y of memory available" (or
+/// "beyond 32-bit indices"). Counted before the triangles are built: the
+/// glTF node tree's (instances included) and the objects `--add` joins.
+std::string triangleBudgetProblem(uint64_t triangles);
+
 /// `skyMesh`: loadScene's.
 Scene loadGltf(const std::string& path, const std::string& skyMesh);
 Scene loadObj(const std::string& path);

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "scene/place_model.h"
 #include "scene/scene.h"
 #include "scene/scene_fixture.h"
 #include "test_util.h"
@@ -96,6 +97,60 @@ TEST_F(SceneReject, TrianglesBeyondMemoryAreCountedBeforeBuilt) {
             "accessors": [{"componentType": 5126, "count": 300000000, "type": "VEC3",
             "min": [0, 0, 0], "max": [0, 0, 0]}]})");
   expectInputError(dir + "/many.gltf", "the node tree makes 2000000000 triangles");
+}
+
+// The objects of --add were loaded and joined one after the other, each
+// checked alone: a model added many times grew until the system ended the
+// process. Every copy's triangles are counted, with the scene's, before any
+// is joined (256 bytes each within half the memory available, as the node
+// tree's); each file is loaded once, and its copies share its textures.
+TEST_F(SceneReject, AddedObjectsTrianglesAreCountedBeforeAnyIsJoined) {
+  // A model of 1,000 triangles, textured.
+  write("tex.ppm", "P6\n2 2\n255\n" + std::string(12, '\x80'));
+  write("m.mtl", "newmtl a\nKd 1 1 1\nmap_Kd tex.ppm\n");
+  std::string obj = "mtllib m.mtl\nusemtl a\n";
+  for (int t = 0; t < 1000; ++t) {
+    const std::string x = std::to_string(t % 100), y = std::to_string(t / 100);
+    obj += "v " + x + " " + y + " 0\nv " + x + ".5 " + y + " 0\nv " + x + " " + y + ".5 0\n";
+    obj += "f " + std::to_string(3 * t + 1) + " " + std::to_string(3 * t + 2) + " " +
+           std::to_string(3 * t + 3) + "\n";
+  }
+  const std::string model = write("model.obj", obj);
+  const Scene base = loadScene(write("base.gltf", oneTriangle()));
+  auto copies = [&](int n) {
+    std::vector<AddedModel> added;
+    for (int i = 0; i < n; ++i) added.push_back({model, parsePlacement(std::to_string(i) + ",0,0")});
+    return added;
+  };
+  // 16 MiB: half of it holds 32,768 triangles of 256 bytes.
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "16M", 1);
+  Scene scene = base;
+  try {
+    placeModels(scene, copies(40));
+    ADD_FAILURE() << "40,001 triangles were joined";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--add: the scene and its 40 added objects make 40001 "
+                                         "triangles"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("half the 16.0 MiB of memory available"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(scene.triangleCount(), 1u);  // nothing joined
+  EXPECT_EQ(scene.materials.size(), base.materials.size());
+  // 30 copies fit, and share one texture.
+  EXPECT_NO_THROW(placeModels(scene, copies(30)));
+  unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+  EXPECT_EQ(scene.triangleCount(), 30001u);
+  ASSERT_EQ(scene.textures.size(), base.textures.size() + 1);
+  ASSERT_EQ(scene.materials.size(), base.materials.size() + 30);
+  for (size_t m = base.materials.size(); m < scene.materials.size(); ++m) {
+    EXPECT_EQ(scene.materials[m].baseColorTexture, int(base.textures.size())) << m;
+  }
+  EXPECT_EQ(scene.movingMaterialsFrom, base.materials.size());
+  // The 30th copy sits where its --at put it.
+  EXPECT_EQ(scene.positions.back().x, 29.0f + 99.0f);
 }
 
 TEST_F(SceneReject, BufferUriEscapingTheFolder) {
