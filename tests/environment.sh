@@ -90,4 +90,20 @@ if ls -a "$out" | grep -q "^\.keep\.vdb\..*\.tmp$"; then
   fail "ulimit -f: a temporary file was left: $(ls -a "$out")"
 fi
 
+# 5. A working folder deleted before the run, and a relative output: refused
+#    before the bake (it was found when the file was written, after the work),
+#    exit 1, nothing written; an absolute output is still written.
+mkdir -p "$out/gone"
+err=$(cd "$out/gone" && rmdir "$out/gone" &&
+      "$cli" bake "$scene" -o rel.vdb --depth 3 --photons 3000 --knn 20 2>&1)
+rc=$?
+if [ "$rc" -ne 1 ] || ! grep -q -- "--output: 'rel.vdb' is relative to the working folder, which was deleted" <<<"$err"; then
+  fail "deleted working folder: exit $rc: $err"
+fi
+mkdir -p "$out/gone"
+(cd "$out/gone" && rmdir "$out/gone" &&
+ "$cli" bake "$scene" -o "$out/abs.vdb" --depth 3 --photons 3000 --knn 20 --quiet) ||
+  fail "deleted working folder: an absolute output was refused"
+[ -f "$out/abs.vdb" ] || fail "deleted working folder: the absolute output was not written"
+
 [ "$failed" -eq 0 ] && echo "environment: every case refused or reported"

@@ -429,8 +429,49 @@ void writeOutputText(AtomicFileSet* set, const std::string& path, const std::str
   writeOutput(set, path, [&](const std::string& tmp) { file_internal::writeBytes(path, tmp, text); });
 }
 
+namespace {
+
+/// @throws InputError naming `flag` when `path` is relative and the working
+/// folder it is relative to was deleted (or cannot be named): its outputs
+/// would be refused only when written, after the work.
+void requireWorkingFolder(const std::string& path, const char* flag) {
+  if (!fs::path(path).is_relative()) return;
+  std::error_code ec;
+  const fs::path working = fs::current_path(ec);
+  if (!ec && !working.empty()) return;
+  throw InputError(std::string(flag) + ": '" + path + "' is relative to the working folder, " +
+                   (ec == std::errc::no_such_file_or_directory
+                        ? std::string("which was deleted")
+                        : "which cannot be named (" + ec.message() + ")") +
+                   ": run from a folder that exists, or give an absolute path");
+}
+
+/// @throws InputError naming `flag` unless a file can be created in `folder`
+/// now: /proc, /sys and read-only mounts refuse new files whatever their
+/// permission bits say (and root passes access()), which was found only when
+/// the output was written, after the work. A temporary file of `path` is
+/// created and removed at once.
+void requireNewFileIn(const fs::path& folder, const std::string& path, const char* flag) {
+  const std::string tmp = temporaryPathFor(path);
+  const int slot = file_internal::track(tmp);  // removed by a signal too
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  const int error = errno;
+  if (fd >= 0) {
+    ::close(fd);
+    ::unlink(tmp.c_str());
+  }
+  file_internal::untrack(slot);
+  if (fd < 0) {
+    throw InputError(std::string(flag) + ": folder '" + folder.string() +
+                     "' takes no new file: " + std::strerror(error));
+  }
+}
+
+}  // namespace
+
 void checkOutputFolder(const std::string& path, const char* flag) {
   checkOutputName(path, flag);
+  requireWorkingFolder(path, flag);
   const fs::path parent = fs::path(path).parent_path();
   const fs::path folder = parent.empty() ? fs::path(".") : parent;
   if (!fs::is_directory(folder)) {
@@ -440,6 +481,7 @@ void checkOutputFolder(const std::string& path, const char* flag) {
     throw InputError(std::string(flag) + ": folder '" + folder.string() +
                      "' is not writable: " + std::strerror(errno));
   }
+  requireNewFileIn(folder, path, flag);
   const std::string refused = file_internal::notReplaceable(path);
   if (!refused.empty()) {
     throw InputError(std::string(flag) + ": '" + path + "' is " + refused +
@@ -467,10 +509,14 @@ void checkResultsFolder(const std::string& path, const char* flag) {
   requireFolderIfPresent(path, flag);
   if (!fs::is_directory(path)) {
     checkOutputFolder(path, flag);  // a new folder: its parent exists and takes it
-  } else if (::access(path.c_str(), W_OK | X_OK) != 0) {
+    return;
+  }
+  requireWorkingFolder(path, flag);
+  if (::access(path.c_str(), W_OK | X_OK) != 0) {
     throw InputError(std::string(flag) + ": folder '" + path +
                      "' is not writable: " + std::strerror(errno));
   }
+  requireNewFileIn(path, (fs::path(path) / "results").string(), flag);
 }
 
 void makeOutputFolder(const std::string& path, const char* flag) {

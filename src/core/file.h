@@ -72,9 +72,12 @@ std::vector<std::string> leftoverTemporaries(const std::string& path);
 void checkOutputName(const std::string& path, const char* flag);
 
 /// @throws InputError naming `flag` when `path` cannot be written: its name is
-/// too long (checkOutputName), its folder
-/// does not exist or is not writable, or `path` names a folder, a link or
-/// anything but a regular file. Called by commands before any long work.
+/// too long (checkOutputName), its folder does not exist, is not writable or
+/// takes no new file (/proc, /sys, a read-only mount, whatever its permission
+/// bits say: a temporary file is created there and removed at once), a
+/// relative `path`'s working folder was deleted, or `path` names a folder, a
+/// link or anything but a regular file. Called by commands before any long
+/// work.
 void checkOutputFolder(const std::string& path, const char* flag);
 
 /// @brief checkOutputFolder, and that `path` ends in `extension` (".vdb",

@@ -101,6 +101,45 @@ TEST(OutputFiles, NeverWritesThroughALinkOrOverWhatIsNotARegularFile) {
   EXPECT_TRUE(leftoverTemporaries(link).empty());
 }
 
+// An output in /proc or /sys (which take no new file whatever their
+// permission bits say, and root passes access()), or relative to a working
+// folder deleted before the run, was found only when written, after the
+// work: checkOutputFolder finds both, naming the flag, and leaves nothing.
+TEST(OutputFiles, AFolderThatTakesNoFileOrADeletedWorkingFolderIsFoundFirst) {
+  const std::string dir = test::outputDir("OutputFiles.NoNewFile");
+  auto refusal = [](const std::string& path) -> std::string {
+    try {
+      checkOutputFolder(path, "--output");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "taken";
+  };
+  for (const char* folder : {"/proc", "/sys"}) {
+    if (!fs::is_directory(folder)) continue;
+    const std::string why = refusal(std::string(folder) + "/lightoctree-test.png");
+    EXPECT_EQ(why.rfind(std::string("--output: folder '") + folder + "' ", 0), 0u) << why;
+    EXPECT_TRUE(why.find("takes no new file") != std::string::npos ||
+                why.find("is not writable") != std::string::npos)
+        << why;
+  }
+  EXPECT_EQ(refusal(dir + "/fine.vdb"), "taken");
+  EXPECT_TRUE(leftoverTemporaries(dir + "/fine.vdb").empty());
+  // A working folder deleted under the process.
+  const fs::path before = fs::current_path();
+  const fs::path gone = fs::path(dir) / "gone";
+  fs::create_directories(gone);
+  fs::current_path(gone);
+  fs::remove(gone);
+  const std::string relative = refusal("out.vdb");
+  const std::string absolute = refusal(dir + "/fine.vdb");
+  fs::current_path(before);
+  EXPECT_EQ(relative,
+            "--output: 'out.vdb' is relative to the working folder, which was deleted: run from "
+            "a folder that exists, or give an absolute path");
+  EXPECT_EQ(absolute, "taken");
+}
+
 // A set of output files appears whole or not at all: a failure at its last
 // file (a link planted at its name) leaves an earlier run's files as they
 // were and no temporary; a committed set replaces them all.
