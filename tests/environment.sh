@@ -106,4 +106,29 @@ mkdir -p "$out/gone"
   fail "deleted working folder: an absolute output was refused"
 [ -f "$out/abs.vdb" ] || fail "deleted working folder: the absolute output was not written"
 
+# 6. Few file descriptors (ulimit -n): a read that cannot open its file says
+#    why, "Too many open files", where OpenVDB's "could not open file" hid it.
+#    Each limit from 4 up is read or refused so; at least one is refused, the
+#    largest read. Descriptors the test runner left open are closed first
+#    (with them the loader could not map the libraries).
+refused=0
+for n in 4 5 6 8 16; do
+  err=$(bash -c "for fd in \$(ls /proc/\$\$/fd); do [ \$fd -gt 2 ] && eval \"exec \$fd>&-\"; done
+                 ulimit -n $n; exec '$cli' inspect '$out/small.vdb'" 2>&1)
+  rc=$?
+  if grep -q "error while loading shared libraries" <<<"$err"; then
+    echo "ulimit -n $n: the libraries could not be loaded (not the reader's to report)"
+  elif [ "$rc" -ne 0 ]; then
+    refused=$((refused + 1))
+    if ! grep -q "cannot open '$out/small.vdb': Too many open files (this process may hold $n at once: ulimit -n)" <<<"$err" ||
+       grep -q "could not open file" <<<"$err"; then
+      fail "ulimit -n $n: exit $rc: $err"
+    fi
+  elif [ "$n" -eq 4 ]; then
+    echo "ulimit -n 4: read (no descriptor was short)"
+  fi
+done
+[ "$refused" -gt 0 ] || fail "ulimit -n: no limit from 4 up was short of descriptors"
+[ "$rc" -eq 0 ] || fail "ulimit -n 16: the read failed: $err"
+
 [ "$failed" -eq 0 ] && echo "environment: every case refused or reported"

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <climits>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include <array>
 #include <atomic>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -138,7 +140,7 @@ std::string createTemporary(const std::string& path) {
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd < 0) {
     throw IoError(path + ": cannot create the temporary file '" + tmp + "' (" +
-                  std::strerror(errno) + ")");
+                  openFailureText(errno) + ")");
   }
   ::close(fd);
   return tmp;
@@ -147,7 +149,7 @@ std::string createTemporary(const std::string& path) {
 /// Fills the temporary file `tmp` of `path` with `text`.
 void writeBytes(const std::string& path, const std::string& tmp, const std::string& text) {
   std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-  if (!f) throw IoError(path + ": cannot open '" + tmp + "' for writing");
+  if (!f) throw IoError(path + ": cannot open '" + tmp + "' for writing: " + openFailureText(errno));
   f.write(text.data(), std::streamsize(text.size()));
   if (!f.flush()) throw IoError(path + ": write failed");
 }
@@ -172,6 +174,23 @@ void checkPathText(const std::string& path, const std::string& name) {
   for (char c : path) shown += c == '\0' ? std::string("\\0") : std::string(1, c);
   throw InputError(name + ": the path '" + shown +
                    "' holds a NUL byte, where the system would end it (and name another file)");
+}
+
+std::string openFailureText(int error) {
+  std::string text = std::strerror(error);
+  rlimit files{};
+  if (error == EMFILE && getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur != RLIM_INFINITY) {
+    text += " (this process may hold " + std::to_string(files.rlim_cur) +
+            " at once: ulimit -n)";
+  }
+  return text;
+}
+
+void requireOpenable(const std::string& path) {
+  checkPathText(path, "cannot open");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError("cannot open '" + path + "': " + openFailureText(errno));
+  ::close(fd);
 }
 
 std::string notRegularFile(const std::string& path) {
@@ -200,7 +219,7 @@ std::string readFile(const std::string& path) {
   if (ec || !fs::exists(status)) throw IoError("cannot read '" + path + "': no such file");
   if (!fs::is_regular_file(status)) throw IoError("cannot read '" + path + "': not a regular file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot open '" + path + "': " + std::strerror(errno));
+  if (!in) throw IoError("cannot open '" + path + "': " + openFailureText(errno));
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw IoError("cannot read '" + path + "': " + std::strerror(errno));
   return bytes;

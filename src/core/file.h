@@ -35,6 +35,17 @@ std::string notRegularFile(const std::string& path);
 /// a NUL byte ...".
 void checkPathText(const std::string& path, const std::string& name);
 
+/// @brief Why an open failed, from its errno: strerror(error) and, when the
+/// process holds as many files as it may (EMFILE), that limit: "Too many
+/// open files (this process may hold 4 at once: ulimit -n)". Every open of
+/// these functions reports it; "could not open file" hid it.
+std::string openFailureText(int error);
+
+/// @brief That `path` can be opened for reading now: for a library that
+/// opens it itself and says only "could not open file" (OpenVDB), asked
+/// first. @throws IoError "cannot open '<path>': <openFailureText>".
+void requireOpenable(const std::string& path);
+
 /// @brief The whole content of the file at `path`, as bytes.
 /// @throws IoError naming `path` when it cannot be opened or read.
 std::string readFile(const std::string& path);

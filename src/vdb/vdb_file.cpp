@@ -81,7 +81,17 @@ OpenedFile openFile(const std::string& path) {
   const uintmax_t bytes = std::filesystem::file_size(path, ec);
   const IsolationLimits limits = readLimits(ec ? 0 : bytes);
   const MemoryFile handover;
+  // OpenVDB says only "could not open file" when the open fails (too many
+  // open files, a permission taken away): the open is tried first, and its
+  // failure reported with the system's reason (exit code 2 of the child).
+  constexpr int kCannotOpen = 2;
   auto trialRead = [&](std::string& message) {
+    try {
+      requireOpenable(path);
+    } catch (const IoError& e) {
+      message = e.what();
+      return kCannotOpen;
+    }
     openvdb::io::File file(path);
     file.open(false);
     openvdb::MetaMap::Ptr meta = file.getMetadata();
@@ -108,6 +118,9 @@ OpenedFile openFile(const std::string& path) {
       trial.outcome == IsolatedRun::Outcome::Crashed) {
     trial = runIsolated(trialRead, limits);
   }
+  if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode == kCannotOpen) {
+    throw IoError(trial.message);
+  }
   if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode != 0) {
     throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(trial.message));
   }
@@ -116,11 +129,19 @@ OpenedFile openFile(const std::string& path) {
     throw InputError(path + ": damaged or not an OpenVDB file: reading it " +
                      trial.ToString(limits));
   }
+  if (trial.outcome == IsolatedRun::Outcome::NotIsolated) requireOpenable(path);
+  std::ifstream is;
+  if (trial.outcome == IsolatedRun::Outcome::Finished) {
+    is.open(handover.name(), std::ios_base::in | std::ios_base::binary);
+    if (!is) {
+      throw IoError(path + ": cannot open the grids read from it (" + handover.name() +
+                    "): " + openFailureText(errno));
+    }
+  }
   OpenedFile f;
   try {
     if (trial.outcome == IsolatedRun::Outcome::Finished) {
       // The child's grids, as OpenVDB's writer wrote them.
-      std::ifstream is(handover.name(), std::ios_base::in | std::ios_base::binary);
       openvdb::io::Stream stream(is, /*delayLoad=*/false);
       f.meta = stream.getMetadata();
       f.grids = stream.getGrids();
@@ -196,7 +217,7 @@ void writeVdbFile(const std::string& path, const std::vector<GridSource>& source
   const auto write = [&](const std::string& tmp) {
     {
       std::ofstream file(tmp, std::ios_base::out | std::ios_base::binary);
-      if (!file) throw std::runtime_error("cannot open the file");
+      if (!file) throw std::runtime_error("cannot open the file: " + openFailureText(errno));
       GridByGridArchive().writeGrids(file, sources, meta);
       file.close();
       if (file.fail()) throw std::runtime_error(std::string("cannot write the file: ") + std::strerror(errno));

@@ -3,6 +3,10 @@
 // corrupted files, vdb_print on a converted file.
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -723,6 +727,53 @@ TEST(Inspect, ImpossibleKnnAndRadiusAreRefusedNamingTheKey) {
   writeVdlGrid(dir + "/none.vdb", floorGrid(), none);
   EXPECT_EQ(readVdlGrid(dir + "/none.vdb").meta.knn, 0);
   EXPECT_TRUE(inspectVdb(dir + "/none.vdb").ok());
+}
+
+// Under `ulimit -n` a reader that could open no more files said "cannot read
+// as an OpenVDB file: IoError: could not open file x.vdb" (OpenVDB's words),
+// hiding EMFILE: it says "Too many open files" and the limit. With no file
+// left (the handover file is not made, the read is in this process) and
+// with one (the handover takes it, the reading child has none).
+TEST(VdbIo, TooManyOpenFilesIsSaidNotHidden) {
+  const std::string dir = test::outputDir("VdbIo.TooManyOpenFiles");
+  const std::string path = dir + "/fine.vdb";
+  writeVdlGrid(path, floorGrid(), metaWithBounds());
+  for (int spare : {0, 1}) {
+    int channel[2];
+    ASSERT_EQ(pipe(channel), 0);
+    const pid_t pid = fork();  // the limit in a child, not in the tests' process
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      close(channel[0]);
+      const int lowest = ::open("/dev/null", O_RDONLY);  // the lowest free descriptor
+      if (lowest < 0) _exit(2);
+      ::close(lowest);
+      const rlimit files{rlim_t(lowest + spare), rlim_t(lowest + spare)};
+      if (setrlimit(RLIMIT_NOFILE, &files) != 0) _exit(2);
+      std::string text = "read";
+      try {
+        readVdlGrid(path);
+      } catch (const std::exception& e) {
+        text = e.what();
+      }
+      if (write(channel[1], text.data(), text.size()) < 0) _exit(3);
+      _exit(0);
+    }
+    close(channel[1]);
+    std::string text;
+    char buffer[256];
+    for (ssize_t r; (r = read(channel[0], buffer, sizeof buffer)) > 0;) text.append(buffer, size_t(r));
+    close(channel[0]);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+    EXPECT_EQ(text.rfind("cannot open '" + path + "': Too many open files (this process may hold ",
+                         0),
+              0u)
+        << "spare " << spare << ": " << text;
+    EXPECT_NE(text.find(" at once: ulimit -n)"), std::string::npos) << text;
+  }
+  EXPECT_EQ(readVdlGrid(path).grid.size(), floorGrid().size());
 }
 
 // A photon map carries the hash of the scene it was traced in; a reader
