@@ -131,4 +131,21 @@ done
 [ "$refused" -gt 0 ] || fail "ulimit -n: no limit from 4 up was short of descriptors"
 [ "$rc" -eq 0 ] || fail "ulimit -n 16: the read failed: $err"
 
+# 7. A valid .vdb read under an address-space limit too small for its reader
+#    (about 200 MB) is not called damaged: the read says it ran out of memory
+#    under the process's limit, naming ulimit -v. (Smaller limits end in a
+#    thread's start, E12 of docs/robustness.md.)
+if ! ldd "$cli" 2>/dev/null | grep -q libasan; then
+  for kib in 180000 200000 230000; do
+    err=$(bash -c "ulimit -v $kib; exec '$cli' inspect '$out/small.vdb'" 2>&1)
+    rc=$?
+    if grep -q "damaged" <<<"$err"; then
+      fail "ulimit -v $kib: a valid file called damaged: $err"
+    elif grep -q "not read: reading it ran out of memory" <<<"$err" &&
+         ! grep -q "(ulimit -v)" <<<"$err"; then
+      fail "ulimit -v $kib: the limit is not named: $err"
+    fi
+  done
+fi
+
 [ "$failed" -eq 0 ] && echo "environment: every case refused or reported"

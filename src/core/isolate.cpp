@@ -11,7 +11,9 @@
 #include <cstdio>
 #include <algorithm>
 #include <cstring>
+#include <exception>
 #include <new>
+#include <system_error>
 #include <thread>
 
 #include "core/resources.h"
@@ -33,6 +35,26 @@ void dieAsACrash() {
   signal(SIGABRT, SIG_DFL);
   raise(SIGABRT);
   _exit(134);
+}
+
+/// The child's std::terminate: an allocation that failed on a thread of the
+/// work (OpenVDB reads with TBB), where no catch takes it, or a thread that
+/// could not be started for want of address space, is out of memory (exit
+/// code 124), not a crash: a valid .vdb under ulimit -v was called damaged
+/// ("crashed the reader (signal 6)").
+[[noreturn]] void terminateOutOfMemory() {
+  if (const std::exception_ptr e = std::current_exception()) {
+    try {
+      std::rethrow_exception(e);
+    } catch (const std::bad_alloc&) {
+      _exit(124);
+    } catch (const std::system_error& error) {
+      if (error.code() == std::errc::resource_unavailable_try_again) _exit(124);
+    } catch (...) {
+    }
+  }
+  signal(SIGABRT, SIG_DFL);
+  abort();
 }
 
 /// Virtual memory of this process now (VmSize), bytes; 0 if unknown. Plain
@@ -60,6 +82,10 @@ std::string IsolatedRun::ToString(const IsolationLimits& limits) const {
     case Outcome::Finished:
       return "";
     case Outcome::OutOfMemory:
+      if (outOfTheProcessMemory(limits)) {
+        return "ran out of memory (it may take up to " + formatBytes(limits.memoryBytes) +
+               "): " + memoryShortfall();
+      }
       return "needed more than " + formatBytes(limits.memoryBytes) + " of memory";
     case Outcome::TimedOut:
       std::snprintf(text, sizeof text, "took longer than %.0f s", limits.seconds);
@@ -76,6 +102,16 @@ std::string IsolatedRun::ToString(const IsolationLimits& limits) const {
 IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
                         const IsolationLimits& limits) {
   IsolatedRun run;
+  // What the child may add: the limit, or what the process's hard limit on
+  // its address space leaves (the child cannot raise its limit past it).
+  run.memoryBytes = limits.memoryBytes;
+#if !defined(__SANITIZE_ADDRESS__)
+  rlimit inherited{};
+  if (getrlimit(RLIMIT_AS, &inherited) == 0 && inherited.rlim_max != RLIM_INFINITY) {
+    const size_t hard = size_t(inherited.rlim_max), used = virtualBytes();
+    run.memoryBytes = std::min(run.memoryBytes, hard > used ? hard - used : 0);
+  }
+#endif
   int channel[2];
   if (pipe(channel) != 0) return run;
   std::fflush(nullptr);  // no buffered output written twice
@@ -91,13 +127,21 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
     // (a sanitizer's or fuzzer's handler would turn them into exit codes).
     close(channel[0]);
     for (int fatal : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) signal(fatal, SIG_DFL);
+    std::set_terminate(terminateOutOfMemory);
     if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(dieAsACrash);
 #if !defined(__SANITIZE_ADDRESS__)
     const size_t base = virtualBytes();
     if (base > 0) {
       const rlim_t cap = rlim_t(base + limits.memoryBytes);
       const rlimit as{cap, cap};
-      setrlimit(RLIMIT_AS, &as);
+      if (setrlimit(RLIMIT_AS, &as) != 0) {
+        // Past the hard limit the process was given (ulimit -v): all of it.
+        rlimit held{};
+        if (getrlimit(RLIMIT_AS, &held) == 0) {
+          held.rlim_cur = held.rlim_max;
+          setrlimit(RLIMIT_AS, &held);
+        }
+      }
     }
 #endif
     const rlim_t cpu = rlim_t(std::ceil(limits.seconds));

@@ -35,8 +35,20 @@ struct IsolatedRun {
   /// What the work put in its message (at most kIsolatedMessageBytes), e.g.
   /// the text of the exception that ended it.
   std::string message;
+  /// The address space the work could add: the limit's memoryBytes, or less
+  /// where the process's own hard limit (ulimit -v) leaves less; the child
+  /// then has all that limit leaves.
+  size_t memoryBytes = 0;
+  /// Out of memory with less than the limit's memoryBytes: the process's
+  /// own address-space limit ended the work, not what it was given to read
+  /// (a valid .vdb under ulimit -v 200 MB was called damaged).
+  bool outOfTheProcessMemory(const IsolationLimits& limits) const {
+    return outcome == Outcome::OutOfMemory && memoryBytes < limits.memoryBytes;
+  }
   /// One sentence for an error message, e.g. "needed more than 1.00 GiB of
-  /// memory"; empty when Finished.
+  /// memory", or when outOfTheProcessMemory "ran out of memory: the
+  /// process's address space is limited to ... (ulimit -v) ..."
+  /// (memoryShortfall); empty when Finished.
   std::string ToString(const IsolationLimits& limits) const;
 };
 

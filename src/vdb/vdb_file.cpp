@@ -124,6 +124,11 @@ OpenedFile openFile(const std::string& path) {
   if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode != 0) {
     throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(trial.message));
   }
+  // Out of memory under the process's own limit (ulimit -v) says nothing
+  // about the file: a valid one was called damaged.
+  if (trial.outOfTheProcessMemory(limits)) {
+    throw InputError(path + ": not read: reading it " + trial.ToString(limits));
+  }
   if (trial.outcome != IsolatedRun::Outcome::Finished &&
       trial.outcome != IsolatedRun::Outcome::NotIsolated) {
     throw InputError(path + ": damaged or not an OpenVDB file: reading it " +

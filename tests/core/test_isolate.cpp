@@ -4,8 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <thread>
 #include <cstring>
 #include <new>
@@ -51,8 +55,84 @@ TEST(Isolate, MemoryBeyondTheLimitIsOutOfMemory) {
       },
       limits);
   EXPECT_EQ(run.outcome, IsolatedRun::Outcome::OutOfMemory);
+  EXPECT_FALSE(run.outOfTheProcessMemory(limits));
   EXPECT_NE(run.ToString(limits).find("more than 64.0 MiB"), std::string::npos)
       << run.ToString(limits);
+}
+
+// An allocation that fails on a thread of the work, where no catch takes it,
+// ends in std::terminate: out of memory, not a crash (OpenVDB reads with
+// threads; a valid .vdb under ulimit -v was "damaged: crashed the reader").
+TEST(Isolate, MemoryBeyondTheLimitOnAThreadIsOutOfMemory) {
+  IsolationLimits limits;
+  limits.memoryBytes = size_t(64) << 20;
+  const IsolatedRun run = runIsolated(
+      [](std::string&) {
+        int value = 0;
+        std::thread([&value] {
+          std::vector<char> big(size_t(1) << 30);  // 1 GiB against a 64 MiB limit
+          big[12345] = 1;
+          value = big[12345];
+        }).join();
+        return value;
+      },
+      limits);
+  EXPECT_EQ(run.outcome, IsolatedRun::Outcome::OutOfMemory) << run.ToString(limits);
+}
+
+// Under the process's own address-space limit (ulimit -v) the work has less
+// than its limit: running out of it says so, and names the process's limit
+// (a valid .vdb read under ulimit -v 200 MB was called damaged: "reading it
+// needed more than 551.5 MiB of memory").
+TEST(Isolate, OutOfMemoryUnderTheProcesssOwnLimitSaysSo) {
+  int channel[2];
+  ASSERT_EQ(pipe(channel), 0);
+  const pid_t pid = fork();  // the limit is set in a child, not in the tests' process
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    close(channel[0]);
+    const size_t vm = [] {
+      std::FILE* f = std::fopen("/proc/self/statm", "r");
+      unsigned long pages = 0;
+      if (f) {
+        if (std::fscanf(f, "%lu", &pages) != 1) pages = 0;
+        std::fclose(f);
+      }
+      return size_t(pages) * size_t(sysconf(_SC_PAGESIZE));
+    }();
+    const rlim_t cap = rlim_t(vm + (size_t(128) << 20));
+    const rlimit as{cap, cap};
+    if (vm == 0 || setrlimit(RLIMIT_AS, &as) != 0) _exit(2);
+    IsolationLimits limits;
+    limits.memoryBytes = size_t(1) << 30;
+    const IsolatedRun run = runIsolated(
+        [](std::string&) {
+          std::vector<char> big(size_t(512) << 20);  // within 1 GiB, beyond the 128 MiB left
+          big[12345] = 1;
+          return int(big[12345]);
+        },
+        limits);
+    const std::string text = std::to_string(int(run.outcome)) + " " +
+                             std::to_string(int(run.outOfTheProcessMemory(limits))) + " " +
+                             run.ToString(limits);
+    if (write(channel[1], text.data(), text.size()) < 0) _exit(3);
+    _exit(0);
+  }
+  close(channel[1]);
+  std::string text;
+  char buffer[256];
+  for (ssize_t r; (r = read(channel[0], buffer, sizeof buffer)) > 0;) text.append(buffer, size_t(r));
+  close(channel[0]);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status << " " << text;
+  EXPECT_EQ(text.rfind(std::to_string(int(IsolatedRun::Outcome::OutOfMemory)) + " 1 ran out of "
+                       "memory (it may take up to 1.00 GiB): the process's address space is "
+                       "limited to ",
+                       0),
+            0u)
+      << text;
+  EXPECT_NE(text.find("(ulimit -v)"), std::string::npos) << text;
 }
 #endif
 
