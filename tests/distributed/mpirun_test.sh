@@ -49,57 +49,44 @@ else
   cat "$OUT/killed.log"
   failures=$((failures + 1))
 fi
-# Ranks started with different settings (one mpirun, two command lines):
-# every rank refuses before any work, naming the rank; nothing is written
-# (they hung in a collective of unequal sizes, or failed in OpenMPI).
-set +e
-"${MPI[@]}" -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" -o "$OUT/disagree.vdb" -q \
-  --depth 4 --photons 3000 : -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" \
-  -o "$OUT/disagree.vdb" -q --depth 4 --photons 4000 >"$OUT/disagree.log" 2>&1
-rc=$?
-set -e
-if [ $rc -ne 0 ] && [ ! -e "$OUT/disagree.vdb" ] &&
-   grep -q "the settings of rank(s) 1 differ from rank 0's" "$OUT/disagree.log"; then
-  echo "ok: ranks with different settings: mpirun exits $rc, the rank named, no output file"
-else
-  echo "FAIL: ranks with different settings: mpirun exited $rc"
-  cat "$OUT/disagree.log"
-  failures=$((failures + 1))
-fi
-# Ranks given different output names: rank 0 alone writes, so the other's
-# name was dropped without a word; now every rank refuses, neither written.
-set +e
-"${MPI[@]}" -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" -o "$OUT/rank0.vdb" -q \
-  --depth 4 --photons 3000 : -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" \
-  -o "$OUT/rank1.vdb" -q --depth 4 --photons 3000 >"$OUT/outputs.log" 2>&1
-rc=$?
-set -e
-if [ $rc -ne 0 ] && [ ! -e "$OUT/rank0.vdb" ] && [ ! -e "$OUT/rank1.vdb" ] &&
-   grep -q "the output files (-o, --stats-json) given to rank(s) 1 differ" "$OUT/outputs.log"; then
-  echo "ok: ranks given different -o: mpirun exits $rc, the rank named, no output file"
-else
-  echo "FAIL: ranks given different -o: mpirun exited $rc"
-  cat "$OUT/outputs.log"
-  failures=$((failures + 1))
-fi
-# A rank whose copy of the scene is damaged (a machine with another copy):
-# it aborted the job before it said why (rank 0's copy read well, and rank 0
-# alone speaks). Now every rank refuses together, rank 0 giving the failing
-# rank's words; nothing is written.
+# Two ranks in one mpirun, each with its own `bake` arguments (paths without
+# spaces): every rank refuses before any work, together and ending normally
+# (no MPI_ABORT banner), the log matching PATTERN; none of FILES written.
+refuse_together() {  # name what pattern "rank 0's arguments" "rank 1's arguments" files...
+  local name=$1 what=$2 pattern=$3 first=$4 second=$5
+  shift 5
+  set +e
+  # shellcheck disable=SC2086  # each rank's arguments split into words
+  "${MPI[@]}" -np 1 "$CLI" bake $first -q : -np 1 "$CLI" bake $second -q >"$OUT/$name.log" 2>&1
+  local rc=$?
+  set -e
+  local written=""
+  for file in "$@"; do
+    if [ -e "$file" ]; then written="$written $file"; fi
+  done
+  if [ $rc -ne 0 ] && [ -z "$written" ] && grep -q "$pattern" "$OUT/$name.log" &&
+     ! grep -q "MPI_ABORT" "$OUT/$name.log"; then
+    echo "ok: $what: mpirun exits $rc, the rank named, no output file"
+  else
+    echo "FAIL: $what: mpirun exited $rc; written:${written:- nothing}"
+    cat "$OUT/$name.log"
+    failures=$((failures + 1))
+  fi
+}
+box="$SCENES/composed/cornell-box.glb"
+# Different settings: they hung in a collective of unequal sizes, or failed in OpenMPI.
+refuse_together disagree "ranks with different settings" "the settings of rank(s) 1 differ from rank 0's" \
+  "$box -o $OUT/disagree.vdb --depth 4 --photons 3000" \
+  "$box -o $OUT/disagree.vdb --depth 4 --photons 4000" "$OUT/disagree.vdb"
+# Different output names: rank 0 alone writes, so the other's name was dropped without a word.
+refuse_together outputs "ranks given different -o" "the output files (-o, --stats-json) given to rank(s) 1 differ" \
+  "$box -o $OUT/rank0.vdb --depth 4 --photons 3000" \
+  "$box -o $OUT/rank1.vdb --depth 4 --photons 3000" "$OUT/rank0.vdb" "$OUT/rank1.vdb"
+# A rank whose copy of the scene is damaged (a machine with another copy): it
+# aborted the job before it said why (rank 0's copy read well, and rank 0 alone
+# speaks); rank 0 now gives the failing rank's words.
 printf '{"asset": {"version": "2.0"}, "meshes": [' >"$OUT/damaged.gltf"
-set +e
-"${MPI[@]}" -np 1 "$CLI" bake "$SCENES/composed/cornell-box.glb" -o "$OUT/damaged.vdb" -q \
-  --depth 4 --photons 3000 : -np 1 "$CLI" bake "$OUT/damaged.gltf" \
-  -o "$OUT/damaged.vdb" -q --depth 4 --photons 3000 >"$OUT/damaged.log" 2>&1
-rc=$?
-set -e
-if [ $rc -ne 0 ] && [ ! -e "$OUT/damaged.vdb" ] &&
-   grep -q "lightoctree: error: rank 1: .*damaged.gltf: invalid glTF" "$OUT/damaged.log" &&
-   ! grep -q "MPI_ABORT" "$OUT/damaged.log"; then
-  echo "ok: a rank with a damaged scene: mpirun exits $rc, its message said, no output file"
-else
-  echo "FAIL: a rank with a damaged scene: mpirun exited $rc"
-  cat "$OUT/damaged.log"
-  failures=$((failures + 1))
-fi
+refuse_together damaged "a rank with a damaged scene" "lightoctree: error: rank 1: .*damaged.gltf: invalid glTF" \
+  "$box -o $OUT/damaged.vdb --depth 4 --photons 3000" \
+  "$OUT/damaged.gltf -o $OUT/damaged.vdb --depth 4 --photons 3000" "$OUT/damaged.vdb"
 exit $failures
