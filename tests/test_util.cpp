@@ -2,10 +2,13 @@
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -121,6 +124,30 @@ std::optional<std::string> messageUnderAddressSpaceLimit(size_t headroom,
   }
   setrlimit(RLIMIT_AS, &saved);
   return message;
+}
+
+std::string textFromChild(const std::function<std::string()>& child) {
+  int channel[2];
+  if (pipe(channel) != 0) return "child failed: no pipe";
+  const pid_t pid = fork();
+  if (pid < 0) return "child failed: no fork";
+  if (pid == 0) {
+    close(channel[0]);
+    const std::string text = child();
+    if (write(channel[1], text.data(), text.size()) < 0) std::_Exit(3);
+    std::_Exit(0);
+  }
+  close(channel[1]);
+  std::string text;
+  char buffer[256];
+  for (ssize_t r; (r = read(channel[0], buffer, sizeof buffer)) > 0;) text.append(buffer, size_t(r));
+  close(channel[0]);
+  int status = 0;
+  if (waitpid(pid, &status, 0) != pid) return "child failed: not waited for";
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    return "child failed: status " + std::to_string(status) + ", said '" + text + "'";
+  }
+  return text;
 }
 
 std::string runCommand(const std::string& command) {

@@ -81,6 +81,12 @@ std::string runCommand(const std::string& command);
 std::optional<std::string> messageUnderAddressSpaceLimit(size_t headroom,
                                                          const std::function<void()>& run);
 
+/// Runs `child` in a forked child process, so that limits it sets (ulimit -v,
+/// -n) stay there: the text it returns, read back through a pipe, or
+/// "child failed: ..." when it exits otherwise (a return code of its own:
+/// `std::_Exit(2)` for a set-up it could not make).
+std::string textFromChild(const std::function<std::string()>& child);
+
 /// The unit room (albedo 0.6) with a block on the floor, lit by a point light
 /// of intensity 1 at (0.5, 0.8, 0.5): a small scene for whole-bake tests.
 Scene pointLitRoom();

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/isolate.h"
+#include "test_util.h"
 
 namespace lo {
 namespace {
@@ -85,12 +86,8 @@ TEST(Isolate, MemoryBeyondTheLimitOnAThreadIsOutOfMemory) {
 // (a valid .vdb read under ulimit -v 200 MB was called damaged: "reading it
 // needed more than 551.5 MiB of memory").
 TEST(Isolate, OutOfMemoryUnderTheProcesssOwnLimitSaysSo) {
-  int channel[2];
-  ASSERT_EQ(pipe(channel), 0);
-  const pid_t pid = fork();  // the limit is set in a child, not in the tests' process
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    close(channel[0]);
+  // The limit is set in a child, not in the tests' process.
+  const std::string text = test::textFromChild([] {
     const size_t vm = [] {
       std::FILE* f = std::fopen("/proc/self/statm", "r");
       unsigned long pages = 0;
@@ -102,7 +99,7 @@ TEST(Isolate, OutOfMemoryUnderTheProcesssOwnLimitSaysSo) {
     }();
     const rlim_t cap = rlim_t(vm + (size_t(128) << 20));
     const rlimit as{cap, cap};
-    if (vm == 0 || setrlimit(RLIMIT_AS, &as) != 0) _exit(2);
+    if (vm == 0 || setrlimit(RLIMIT_AS, &as) != 0) std::_Exit(2);
     IsolationLimits limits;
     limits.memoryBytes = size_t(1) << 30;
     const IsolatedRun run = runIsolated(
@@ -112,20 +109,9 @@ TEST(Isolate, OutOfMemoryUnderTheProcesssOwnLimitSaysSo) {
           return int(big[12345]);
         },
         limits);
-    const std::string text = std::to_string(int(run.outcome)) + " " +
-                             std::to_string(int(run.outOfTheProcessMemory(limits))) + " " +
-                             run.ToString(limits);
-    if (write(channel[1], text.data(), text.size()) < 0) _exit(3);
-    _exit(0);
-  }
-  close(channel[1]);
-  std::string text;
-  char buffer[256];
-  for (ssize_t r; (r = read(channel[0], buffer, sizeof buffer)) > 0;) text.append(buffer, size_t(r));
-  close(channel[0]);
-  int status = 0;
-  ASSERT_EQ(waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status << " " << text;
+    return std::to_string(int(run.outcome)) + " " +
+           std::to_string(int(run.outOfTheProcessMemory(limits))) + " " + run.ToString(limits);
+  });
   EXPECT_EQ(text.rfind(std::to_string(int(IsolatedRun::Outcome::OutOfMemory)) + " 1 ran out of "
                        "memory (it may take up to 1.00 GiB): the process's address space is "
                        "limited to ",

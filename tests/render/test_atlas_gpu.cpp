@@ -70,23 +70,42 @@ LightmapAtlas gpuBake(const Scene& scene, const LightmapUvs& uvs, const GpuOctre
   return bakeLightmapAtlas(scene, uvs, octree, params);
 }
 
+/// A tilted plane (6 x 6 quads, facing its winding's way, or turned over)
+/// under one constant VDL, its UVs on a 64-texel page, and bake settings
+/// without dilation and stitching.
+struct PlaneUnderOneVdl {
+  Scene scene = emptyScene();
+  Vec3 c{2.0f, 1.0f, 0.5f};
+  GpuOctree octree;
+  Vec3 decoded;  ///< the VDL's direction as the lookup decodes it
+  LightmapUvs uvs;
+  AtlasBakeParams params;
+
+  explicit PlaneUnderOneVdl(bool turned) {
+    const Vec3 eu{1.2f, 0.25f, 0.1f}, ev{-0.2f, 0.9f, 0.35f};
+    addGrid(scene, 6, {0.35f, 0.3f, 0.55f}, turned ? ev : eu, turned ? eu : ev);
+    const Vec3 d = normalize(Vec3{0.3f, -0.2f, 1.0f});
+    octree = denseOctree([&](const Coord&) { return std::vector<Vdl>{vdl(c, d)}; });
+    decoded = lookupOctree(octree, Vec3{1, 1, 1}).vdls[0].direction;
+    LightmapUvParams up;
+    up.atlasSize = 64;
+    uvs = buildLightmapUvs(scene, up);
+    params.dilation = 0;
+    params.stitchSeams = false;
+  }
+};
+
 TEST(AtlasGpu, PlaneUnderAConstantVdlIsTheCosineLawAtEveryTexel) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
-  Scene scene = emptyScene();
-  addGrid(scene, 6, {0.35f, 0.3f, 0.55f}, {1.2f, 0.25f, 0.1f}, {-0.2f, 0.9f, 0.35f});
-  const Vec3 c{2.0f, 1.0f, 0.5f}, d = normalize(Vec3{0.3f, -0.2f, 1.0f});
-  const GpuOctree octree = denseOctree([&](const Coord&) { return std::vector<Vdl>{vdl(c, d)}; });
+  PlaneUnderOneVdl plane(false);
+  const Scene& scene = plane.scene;
+  const GpuOctree& octree = plane.octree;
+  const LightmapUvs& uvs = plane.uvs;
+  AtlasBakeParams& params = plane.params;
   // The lookup decodes the packed direction: the cosine law with that one.
-  const Vec3 decoded = lookupOctree(octree, Vec3{1, 1, 1}).vdls[0].direction;
-  const Vec3 n = scene.faceNormal(0);
-  const Vec3 analytic = c * std::max(0.0f, dot(n, decoded));
+  const Vec3 decoded = plane.decoded;
+  const Vec3 analytic = plane.c * std::max(0.0f, dot(scene.faceNormal(0), decoded));
   ASSERT_GT(analytic.x, 0.5f);
-  LightmapUvParams up;
-  up.atlasSize = 64;
-  const LightmapUvs uvs = buildLightmapUvs(scene, up);
-  AtlasBakeParams params;
-  params.dilation = 0;
-  params.stitchSeams = false;
   for (bool interpolation : {true, false}) {
     SCOPED_TRACE(interpolation ? "interpolated" : "nearest voxel");
     params.shade.interpolation = interpolation;
@@ -106,24 +125,14 @@ TEST(AtlasGpu, PlaneUnderAConstantVdlIsTheCosineLawAtEveryTexel) {
 // (atlasSurfaceSides), texel for texel; one-sided, the dark one.
 TEST(AtlasGpu, ADoubleSidedSurfaceHoldsTheSideItsLightReaches) {
   if (!test::osmesaContext()) GTEST_SKIP() << "no OSMesa context available";
-  Scene scene = emptyScene();
-  addGrid(scene, 6, {0.35f, 0.3f, 0.55f}, {-0.2f, 0.9f, 0.35f}, {1.2f, 0.25f, 0.1f});  // turned
-  const Vec3 c{2.0f, 1.0f, 0.5f}, d = normalize(Vec3{0.3f, -0.2f, 1.0f});
-  const GpuOctree octree = denseOctree([&](const Coord&) { return std::vector<Vdl>{vdl(c, d)}; });
-  const Vec3 decoded = lookupOctree(octree, Vec3{1, 1, 1}).vdls[0].direction;
-  const Vec3 lit = c * std::max(0.0f, dot(-scene.faceNormal(0), decoded));
+  PlaneUnderOneVdl plane(true);
+  const Vec3 lit = plane.c * std::max(0.0f, dot(-plane.scene.faceNormal(0), plane.decoded));
   ASSERT_GT(lit.x, 0.5f);
-  LightmapUvParams up;
-  up.atlasSize = 64;
-  const LightmapUvs uvs = buildLightmapUvs(scene, up);
-  AtlasBakeParams params;
-  params.dilation = 0;
-  params.stitchSeams = false;
   for (bool doubleSided : {true, false}) {
     SCOPED_TRACE(doubleSided ? "doubleSided" : "one-sided");
-    scene.materials[0].doubleSided = doubleSided;
-    const LightmapAtlas gpu = gpuBake(scene, uvs, octree, params);
-    const LightmapAtlas cpu = bakeLightmapAtlas(scene, uvs, octree, params);
+    plane.scene.materials[0].doubleSided = doubleSided;
+    const LightmapAtlas gpu = gpuBake(plane.scene, plane.uvs, plane.octree, plane.params);
+    const LightmapAtlas cpu = bakeLightmapAtlas(plane.scene, plane.uvs, plane.octree, plane.params);
     const AtlasDifference diff = difference(gpu, cpu);
     EXPECT_EQ(diff.coverageDiffers, 0u);
     EXPECT_LT(diff.irradiance, 1e-4f);

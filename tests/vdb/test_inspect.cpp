@@ -739,34 +739,21 @@ TEST(VdbIo, TooManyOpenFilesIsSaidNotHidden) {
   const std::string path = dir + "/fine.vdb";
   writeVdlGrid(path, floorGrid(), metaWithBounds());
   for (int spare : {0, 1}) {
-    int channel[2];
-    ASSERT_EQ(pipe(channel), 0);
-    const pid_t pid = fork();  // the limit in a child, not in the tests' process
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      close(channel[0]);
+    // The limit in a child, not in the tests' process.
+    const std::string text = test::textFromChild([&] {
       const int lowest = ::open("/dev/null", O_RDONLY);  // the lowest free descriptor
-      if (lowest < 0) _exit(2);
+      if (lowest < 0) std::_Exit(2);
       ::close(lowest);
       const rlimit files{rlim_t(lowest + spare), rlim_t(lowest + spare)};
-      if (setrlimit(RLIMIT_NOFILE, &files) != 0) _exit(2);
-      std::string text = "read";
+      if (setrlimit(RLIMIT_NOFILE, &files) != 0) std::_Exit(2);
+      std::string said = "read";
       try {
         readVdlGrid(path);
       } catch (const std::exception& e) {
-        text = e.what();
+        said = e.what();
       }
-      if (write(channel[1], text.data(), text.size()) < 0) _exit(3);
-      _exit(0);
-    }
-    close(channel[1]);
-    std::string text;
-    char buffer[256];
-    for (ssize_t r; (r = read(channel[0], buffer, sizeof buffer)) > 0;) text.append(buffer, size_t(r));
-    close(channel[0]);
-    int status = 0;
-    ASSERT_EQ(waitpid(pid, &status, 0), pid);
-    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+      return said;
+    });
     EXPECT_EQ(text.rfind("cannot open '" + path + "': Too many open files (this process may hold ",
                          0),
               0u)
