@@ -30,12 +30,14 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   BakeOptions opt = options;
   // Only rank 0 reports and writes; the others bake their tiles in silence.
   opt.quiet = opt.quiet || rank != 0;
-  checkOutputFile(opt.output, "--output", ".vdb");
-  if (!opt.photonMap.empty()) checkOutputFile(opt.photonMap, "--photon-map", ".vdb");
-  if (!opt.statsJson.empty()) checkOutputFile(opt.statsJson, "--stats-json", ".json");
-  checkDistinctFiles(
-      {{"--output", opt.output}, {"--photon-map", opt.photonMap}, {"--stats-json", opt.statsJson}},
-      sceneInputs(opt.scene, opt.sceneOptions));
+  if (rank == 0) {  // the one that writes: another machine may lack the folder
+    checkOutputFile(opt.output, "--output", ".vdb");
+    if (!opt.photonMap.empty()) checkOutputFile(opt.photonMap, "--photon-map", ".vdb");
+    if (!opt.statsJson.empty()) checkOutputFile(opt.statsJson, "--stats-json", ".json");
+    checkDistinctFiles(
+        {{"--output", opt.output}, {"--photon-map", opt.photonMap}, {"--stats-json", opt.statsJson}},
+        sceneInputs(opt.scene, opt.sceneOptions));
+  }
 
   ThreadLimit threadLimit(opt.threads);
   ConsoleProgress progress(opt.quiet);
@@ -166,9 +168,9 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   return 0;
 }
 
-/// Under mpirun (an MPI build), every rank bakes its tiles; a rank that
-/// fails ends the whole job (MpiSession::abort), so none waits forever and
-/// rank 0 writes nothing.
+/// Under mpirun (an MPI build), every rank bakes its tiles; a rank that fails
+/// ends the job (MpiSession::abort), saying why: none waits forever, rank 0
+/// writes nothing. What all refuse together (RanksRefuseError) rank 0 says.
 int runBake(const BakeOptions& opt) {
   const int launched = mpiLaunchSize();
   if (launched == 0 || (launched == 1 && !mpiAvailable())) return runBakeOn(opt, nullptr);
@@ -181,11 +183,9 @@ int runBake(const BakeOptions& opt) {
     if (rank == 0) std::fprintf(stderr, "lightoctree: error: %s\n", e.what());
     return 1;
   } catch (const std::exception& e) {
-    // Rank 0 says what went wrong; the others add only what is their own.
-    if (rank == 0 || !dynamic_cast<const InputError*>(&e)) {
-      std::fprintf(stderr, "lightoctree: error%s: %s\n",
-                   rank == 0 ? "" : (" on rank " + std::to_string(rank)).c_str(), e.what());
-    }
+    // An error of this rank alone (its memory, its machine), said by it.
+    std::fprintf(stderr, "lightoctree: error%s: %s\n",
+                 rank == 0 ? "" : (" on rank " + std::to_string(rank)).c_str(), e.what());
     std::fflush(stderr);
     session.abort(1);
   }

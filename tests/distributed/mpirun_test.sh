@@ -82,6 +82,12 @@ refuse_together disagree "ranks with different settings" "the settings of rank(s
 refuse_together outputs "ranks given different -o" "the output files (-o, --stats-json) given to rank(s) 1 differ" \
   "$box -o $OUT/rank0.vdb --depth 4 --photons 3000" \
   "$box -o $OUT/rank1.vdb --depth 4 --photons 3000" "$OUT/rank0.vdb" "$OUT/rank1.vdb"
+# Rank 1 given an output in a folder it lacks: only rank 0 checks the outputs
+# it writes (another machine may lack the folder), so rank 1 reaches the
+# agreement, where it was ended by its own check, unheard.
+refuse_together nofolder "rank 1 given -o in a missing folder" "the output files (-o, --stats-json) given to rank(s) 1 differ" \
+  "$box -o $OUT/nofolder0.vdb --depth 4 --photons 3000" \
+  "$box -o $OUT/missing/nofolder0.vdb --depth 4 --photons 3000" "$OUT/nofolder0.vdb"
 # A rank whose copy of the scene is damaged (a machine with another copy): it
 # aborted the job before it said why (rank 0's copy read well, and rank 0 alone
 # speaks); rank 0 now gives the failing rank's words.
