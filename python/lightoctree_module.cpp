@@ -683,6 +683,7 @@ GridPtr bakeScene(const Arg<std::string>& sceneArg, const Arg<int>& depthArg,
                   const py::object& skyImage, const py::object& skyMesh,
                   const py::object& physicalSky) {
   const std::string scenePath = pathArg(sceneArg.value, "scene");
+  progressArg(progress, "progress");
   const int depth = int(numberArg(depthArg.value, kDepthRange, "depth"));
   const auto photons =
       size_t(numberOrZeroArg(photonsArg.value, kPhotonsRange, "photons", "not given"));
@@ -743,6 +744,7 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
                           const py::object& physicalSky) {
   ReferenceOptions opt;  // the command's flags, as given
   opt.scene = pathArg(sceneArg.value, "scene");
+  progressArg(progress, "progress");
   const bool withStdError = boolArg(withStdErrorArg.value, "std_error");
   // The ranges of the command's flags (tools/reference_options.cpp,
   // command_options.cpp, camera_options.cpp); python/tests check that both

@@ -601,8 +601,15 @@ def test_ctrl_c_stops_a_render_between_its_stages(grid):
 
     with pytest.raises(Stop, match="after one frame"):
         lightoctree.render(SCENE, grid, width=64, height=48, progress=stop)
+    # Every call that takes a callback checks it first, by name (bake and
+    # reference started their work and failed at the first report with a
+    # bare "TypeError: 'int' object is not callable").
     with pytest.raises(lightoctree.InputError, match="progress: must be a callable"):
         lightoctree.render(SCENE, grid, width=64, height=48, progress=3)
+    with pytest.raises(lightoctree.InputError, match="progress: must be a callable"):
+        lightoctree.bake(SCENE, depth=4, photons=1000, progress=5)
+    with pytest.raises(lightoctree.InputError, match="progress: must be a callable"):
+        lightoctree.reference(SCENE, width=8, height=8, spp=1, progress=5)
 
 
 def test_compare_measures_what_the_command_measures(tmp_path):

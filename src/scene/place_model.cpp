@@ -23,8 +23,10 @@ Placement parsePlacement(const std::string& text) {
   while (std::getline(in, part, ',')) {
     char* end = nullptr;
     const double v = std::strtod(part.c_str(), &end);
-    if (part.empty() || end == part.c_str() || *end != '\0' || !std::isfinite(v)) {
-      throw InputError("--at '" + text + "': '" + part + "' is not a finite number");
+    // Decimal only, as every numeric flag: strtod reads "0x10" as 16.
+    const bool hex = part.find_first_of("xX") != std::string::npos;
+    if (part.empty() || hex || end == part.c_str() || *end != '\0' || !std::isfinite(v)) {
+      throw InputError("--at '" + text + "': '" + part + "' is not a finite decimal number");
     }
     values.push_back(v);
     parts.push_back(part);

@@ -102,6 +102,9 @@ TEST(AddedObjects, EachPartOfThePlacementIsCheckedByName) {
   EXPECT_EQ(refusal("0,0,0,1e300"),
             "--at '0,0,0,1e300': the yaw 1e300 must lie from -360 to 360 degrees");
   EXPECT_EQ(refusal("0,-2e12,0"), "--at '0,-2e12,0': y -2e12 lies beyond 1e+12 scene units");
+  // Decimal only, as every numeric flag (strtod read "0x10" as a scale of 16).
+  EXPECT_EQ(refusal("0,0.2,0,0,0x10"), "--at '0,0.2,0,0,0x10': '0x10' is not a finite decimal number");
+  EXPECT_EQ(refusal("0x1p3,0,0"), "--at '0x1p3,0,0': '0x1p3' is not a finite decimal number");
   EXPECT_EQ(refusal("1,2,3,-360,1e-30"), "taken");
   EXPECT_EQ(parsePlacement("1,2,3,-360,1e-30").scale, 1e-30f);
 }
