@@ -735,6 +735,11 @@ TEST(Inspect, ImpossibleKnnAndRadiusAreRefusedNamingTheKey) {
 // left (the handover file is not made, the read is in this process) and
 // with one (the handover takes it, the reading child has none).
 TEST(VdbIo, TooManyOpenFilesIsSaidNotHidden) {
+#if defined(__SANITIZE_ADDRESS__)
+  // The sanitizers' runtime needs descriptors of its own: without them
+  // UBSan reports every virtual call as an "invalid vptr".
+  GTEST_SKIP() << "a sanitizer build: its runtime needs descriptors of its own";
+#endif
   const std::string dir = test::outputDir("VdbIo.TooManyOpenFiles");
   const std::string path = dir + "/fine.vdb";
   writeVdlGrid(path, floorGrid(), metaWithBounds());
