@@ -28,6 +28,7 @@ uniform bool uHalfVdls;
 uniform bool uCompactVdls;
 uniform float uVdlScale;
 uniform int uShTerms;
+uniform bool uSurfaceTexels;
 uniform float uVoxelSize;
 uniform int uDepth;
 uniform float uNormalOffset;
@@ -45,6 +46,7 @@ layout(location = 2) out int oTriangle;
 #define LO_VDLS_COMPACT uCompactVdls
 #define LO_VDL_SCALE uVdlScale
 #define LO_SH_TERMS uShTerms
+#define LO_SURFACE_TEXELS uSurfaceTexels
 #include "octree_lookup.h"
 
 // Irradiance: the response to a VDL is its cosine (octree_irradiance.cpp).

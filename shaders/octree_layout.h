@@ -22,7 +22,18 @@
  *                  A = the number of layers
  *   per layer, in order: its header, RGB = a point of its surface in voxel
  *                  units relative to the voxel's lower corner, A = its unit
- *                  normal packed like a VDL direction; then its VDL texels.
+ *                  normal packed like a VDL direction; then its VDL texels
+ *                  (and its surface texel, below). The counts leave the
+ *                  surface texels out.
+ *
+ * Surface texel (octrees whose grid records the surfaces' reflectance,
+ * GpuOctree::surfaceTexels; LO_SURFACE_TEXELS in the lookup): right after
+ * the light of every leaf and of every layer, one texel read like a layer
+ * header: RGB = the reflectance (0..1) of the surface that light was
+ * gathered on, A = that surface's unit normal packed like a VDL direction
+ * (RGB zero where the voxel has no normal, and in merged leaves). The
+ * lookup lights a point from below that surface's plane with it
+ * (loSurfaceBelow in octree_lookup.h).
  *
  * VDL texture (paper §4.2.2, Fig. 8): a 2D texture, LO_VDL_TEXTURE_WIDTH
  * texels wide. One texel per VDL: RGB = irradiance (W/m^2), A = direction

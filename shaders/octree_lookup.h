@@ -15,7 +15,9 @@
  *   loNearestServingLeaf  the voxel in front of the point, else behind, that serves it
  *   loShadeVdlsFacing  sum_i response(d_i) c_i over those VDLs (paper §4.2.2),
  *                    or the SH irradiance as one light from its dominant
- *                    direction; their irradiance, and whether they face a surface
+ *                    direction, plus the light their surface reflects to a
+ *                    point below its horizon (loSurfaceBelow); their
+ *                    irradiance, and whether they face a surface
  *   loNearestLeaf    the voxel in front of a surface point, else the one behind it
  *   loOctreeIndirect the indirect light at a surface point: trilinear over the 8
  *                    voxels around it with empty ones left out and the weights
@@ -34,6 +36,7 @@
  *   LO_VDLS_COMPACT       true when those hold compact texels (RGB9E5)
  *   LO_VDL_SCALE          the compact texels' irradiance scale
  *   LO_SH_TERMS           0 when the leaves hold VDLs, else the SH terms per leaf
+ *   LO_SURFACE_TEXELS     true when each leaf's (layer's) light ends in a surface texel
  * and, anywhere in the same unit, the response of a surface to one VDL:
  *   vec3 loVdlResponse(LoSurface s, vec3 d)   (the BRDF times the cosine in the
  *   shader; the cosine alone, i.e. irradiance, in C++).
@@ -182,7 +185,7 @@ LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
     points[l] = vec3(c) + vec3(t);
     normals[l] = loVdlDirection(t.a);
     address[l] = a + 1u;
-    a += 1u + uint(counts[l]);
+    a += 1u + uint(counts[l]) + (LO_SURFACE_TEXELS ? 1u : 0u);
   }
   int best = -1;
   float bestCosine = LO_LAYER_MIN_COSINE;
@@ -262,6 +265,38 @@ LO_LOOKUP_FN bool loNearestLeaf(LO_TEX_PARAM vec3 q, vec3 n, int depth, float no
   return loLookupLeaf(LO_TEX voxel, depth, leaf);
 }
 
+/* The surface texel after the light of a leaf or layer (`count` VDLs at
+ * `first`, or LO_SH_TERMS terms; octree_layout.h): the normal m of the
+ * surface that light was gathered on and its reflectance. Returns the share
+ * of the cosine-weighted hemisphere of a point facing n that lies below
+ * that surface's plane, (1 - n . m) / 2, for n . m >= 0: what such a point
+ * (a step's riser, a rail, a door frame, thinner than a voxel and lit by
+ * the floor's or the wall's VDLs, which hold only light from above that
+ * surface) sees of the surface itself. For n . m < 0 it falls back to 0 at
+ * n = -m, as (1 - |n . m|) / 2: a face turned against the surface is as
+ * likely the far side of a thin wall, which sees another room, as a slab's
+ * underside. 0 without surface texels. */
+LO_LOOKUP_FN float loSurfaceBelow(LO_TEX_PARAM uint first, int count, vec3 n, LO_OUT(vec3) m,
+                                  LO_OUT(vec3) reflectance) {
+  m = vec3(0.0f);
+  reflectance = vec3(0.0f);
+  if (!LO_SURFACE_TEXELS) return 0.0f;
+  vec4 t = loFetchTexel(LO_TEX first + uint(LO_SH_TERMS > 0 ? LO_SH_TERMS : count));
+  m = loVdlDirection(t.a);
+  reflectance = vec3(t);
+  return max(0.0f, 0.5f * (1.0f - abs(dot(n, m))));
+}
+
+/* The light a surface point s reflects of irradiance e from below the plane
+ * of the surface whose normal is m: e from the mean direction of that part
+ * of its hemisphere (between s.ng and -m), through the surface's response. */
+LO_LOOKUP_FN vec3 loShadeBelow(LoSurface s, vec3 m, vec3 e) {
+  vec3 d = s.ng - m;
+  float len = length(d);
+  d = len > 1e-3f ? d / len : s.n;
+  return loVdlResponse(s, d) * e / max(dot(s.n, d), 0.05f);
+}
+
 /* Whether the light of a leaf's VDLs (the first maxVdls of `count` at
  * `first`) reaches a surface facing ng at all: some of it arrives from above
  * the surface's horizon, or the leaf holds none (a dark voxel is dark for
@@ -287,20 +322,39 @@ LO_LOOKUP_FN bool loLeafFaces(LO_TEX_PARAM uint first, int count, int maxVdls, v
  * at once (render_scene.frag). */
 LO_LOOKUP_FN vec3 loShadeVdlsFacing(LO_TEX_PARAM uint first, int count, int maxVdls, LoSurface s,
                                     LO_OUT(vec3) irradiance, LO_OUT(bool) faces) {
+  vec3 m;
+  vec3 reflectance;
+  /* The surface's own normal, not a normal map's: its bumps do not see
+   * below the surface they lie on. */
+  float below = loSurfaceBelow(LO_TEX first, count, s.ng, m, reflectance);
   if (LO_SH_TERMS > 0) {
     faces = true;
-    return loShadeShIrradiance(LO_TEX first, s, irradiance);
+    vec3 light = loShadeShIrradiance(LO_TEX first, s, irradiance);
+    if (below > 0.0f) {
+      vec3 d;
+      vec3 e = below * reflectance * loShIrradiance(LO_TEX first, m, d);
+      light += loShadeBelow(s, m, e);
+      irradiance += e;
+    }
+    return light;
   }
   faces = count <= 0;
   irradiance = vec3(0.0f);
   int n = min(count, maxVdls);
   vec3 sum = vec3(0.0f);
+  vec3 surface = vec3(0.0f); /* the VDLs' irradiance on their own surface */
   for (int i = 0; i < n; ++i) {
     vec4 t = loFetchVdl(LO_TEX first + uint(i));
     vec3 d = loVdlDirection(t.a);
     if (dot(s.ng, d) > 0.0f) faces = true;
     sum += loVdlResponse(s, d) * vec3(t);
     irradiance += vec3(max(dot(s.n, d), 0.0f)) * vec3(t);
+    surface += vec3(max(dot(m, d), 0.0f)) * vec3(t);
+  }
+  if (below > 0.0f) {
+    vec3 e = below * reflectance * surface;
+    sum += loShadeBelow(s, m, e);
+    irradiance += e;
   }
   return sum;
 }
@@ -409,14 +463,25 @@ LO_LOOKUP_FN vec3 loOctreeIndirect(LO_TEX_PARAM vec3 p, vec3 origin, float voxel
  * luminance, world space, towards the light). */
 LO_LOOKUP_FN vec3 loShadeVdlsIrradiance(LO_TEX_PARAM uint first, int count, int maxVdls, vec3 n,
                                         LO_OUT(vec3) direction) {
+  vec3 m;
+  vec3 reflectance;
+  float below = loSurfaceBelow(LO_TEX first, count, n, m, reflectance);
+  vec3 bd = n - m; /* where the light from below the surface comes from */
+  bd = length(bd) > 1e-3f ? normalize(bd) : n;
   if (LO_SH_TERMS > 0) {
     vec3 d;
     vec3 e = loShIrradiance(LO_TEX first, n, d);
     direction = dot(e, vec3(0.2126f, 0.7152f, 0.0722f)) * d;
+    if (below > 0.0f) {
+      vec3 eb = below * reflectance * loShIrradiance(LO_TEX first, m, d);
+      e += eb;
+      direction += dot(eb, vec3(0.2126f, 0.7152f, 0.0722f)) * bd;
+    }
     return e;
   }
   int used = min(count, maxVdls);
   vec3 irradiance = vec3(0.0f);
+  vec3 surface = vec3(0.0f);
   direction = vec3(0.0f);
   for (int i = 0; i < used; ++i) {
     vec4 t = loFetchVdl(LO_TEX first + uint(i));
@@ -424,6 +489,12 @@ LO_LOOKUP_FN vec3 loShadeVdlsIrradiance(LO_TEX_PARAM uint first, int count, int 
     float cosine = max(0.0f, dot(n, d));
     irradiance += vec3(cosine) * vec3(t);
     direction += (cosine * dot(vec3(t), vec3(0.2126f, 0.7152f, 0.0722f))) * d;
+    surface += vec3(max(dot(m, d), 0.0f)) * vec3(t);
+  }
+  if (below > 0.0f) {
+    vec3 eb = below * reflectance * surface;
+    irradiance += eb;
+    direction += dot(eb, vec3(0.2126f, 0.7152f, 0.0722f)) * bd;
   }
   return irradiance;
 }

@@ -19,6 +19,7 @@
 #define LO_VDLS_COMPACT uCompactVdls
 #define LO_VDL_SCALE uVdlScale
 #define LO_SH_TERMS uShTerms
+#define LO_SURFACE_TEXELS uSurfaceTexels
 #include "octree_lookup.h"
 
 // The VDLs light the diffuse lobe and the share of the specular one that the

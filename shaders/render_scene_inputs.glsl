@@ -23,6 +23,7 @@ uniform bool uHalfVdls;        // which of the two holds the VDLs
 uniform bool uCompactVdls;     // the 16-bit texels hold compact (RGB9E5) irradiance
 uniform float uVdlScale;       // ... times this scale
 uniform int uShTerms;          // 0: the leaves hold VDLs; else SH terms per leaf
+uniform bool uSurfaceTexels;   // each leaf's (layer's) light ends in a surface texel
 uniform sampler2DArrayShadow uShadowMaps;
 uniform sampler2DArray uShadowDepths;  // the same maps read as depths (PCSS blocker search)
 uniform vec3 uOctreeOrigin;  // world

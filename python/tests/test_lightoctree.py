@@ -92,7 +92,11 @@ def test_lookup_sees_the_light_from_the_front_and_none_from_behind(grid):
     # irradiance (interpolation mixes in the neighbours): brute-force mean.
     ratio = front.mean() / np.asarray(grid.irradiance)[lit].mean()
     assert 0.95 < ratio < 1.05, ratio  # 1.002 measured
-    assert back.mean() < 0.05 * front.mean()  # 0.018 measured
+    # Behind: what the neighbours' surfaces reflect from below their planes
+    # where their normals turn from the voxel's (edges and corners: the light
+    # from below a voxel's surface, docs/render.md) and no more; 0.018 before
+    # that light, 0.078 with it.
+    assert back.mean() < 0.1 * front.mean()
     far = lightoctree.lookup(grid, np.full((2, 3), 1e6), np.tile([0.0, 1.0, 0.0], (2, 1)))
     np.testing.assert_array_equal(far, 0.0)
     with pytest.raises(ValueError):

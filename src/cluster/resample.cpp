@@ -53,6 +53,7 @@ VdlGrid emptyLike(const GridFrame& frame, int maxVdls, size_t n) {
 struct Mixer {
   std::vector<DirectionSample> samples;
   double irr[3] = {0, 0, 0};
+  double reflected[3] = {0, 0, 0};  ///< sum of w E reflectance, per channel
   double photonCount = 0, radius = 0;
   // Variance of the weighted sum's luminance from the inputs' noise, taken
   // as independent (neighbouring gathers share some photons, so this
@@ -65,6 +66,7 @@ struct Mixer {
   void reset() {
     samples.clear();
     irr[0] = irr[1] = irr[2] = 0;
+    reflected[0] = reflected[1] = reflected[2] = 0;
     photonCount = radius = varianceSum = varianceWeight = noiseVariance = 0;
   }
 
@@ -73,6 +75,9 @@ struct Mixer {
     irr[0] += w * e.x;
     irr[1] += w * e.y;
     irr[2] += w * e.z;
+    if (!g.reflectance.empty()) {
+      for (int c = 0; c < 3; ++c) reflected[c] += w * double(e[c]) * double(g.reflectance[v][c]);
+    }
     photonCount += w * g.photonCount[v];
     radius += w * g.radius[v];
     if (!g.noise.empty()) {
@@ -92,6 +97,7 @@ struct Mixer {
   /// counts, radius, error); normal and area are the caller's.
   void finish(const ClusterParams& params, VdlGrid& out, size_t o) const {
     out.irradiance[o] = Vec3(float(irr[0]), float(irr[1]), float(irr[2]));
+    for (int c = 0; c < 3; ++c) out.reflectance[o][c] = irr[c] > 0 ? float(reflected[c] / irr[c]) : 0.0f;
     out.photonCount[o] = float(photonCount);
     out.radius[o] = float(radius);
     const double y = double(luminance(out.irradiance[o]));
@@ -227,6 +233,7 @@ struct ReclusterBody {
       // Keep the stored totals bit for bit: the mixer's double round trip is
       // exact for weight 1, but say so in code rather than rely on it.
       out.irradiance[v] = in.irradiance[v];
+      out.reflectance[v] = in.reflectance.empty() ? Vec3{} : in.reflectance[v];
       out.photonCount[v] = in.photonCount[v];
       out.noise[v] = in.noise.empty() ? 0.0f : in.noise[v];
       out.radius[v] = in.radius[v];

@@ -79,7 +79,7 @@ struct Worker {
   struct Layer {
     uint32_t voxel;
     int layer;
-    Vec3 normal, point, irradiance;
+    Vec3 normal, point, irradiance, reflectance;
     float photonCount, noise, radius;
     ClusterResult vdls;
     std::array<Vec3, layout::LO_SH_MAX_TERMS> sh;
@@ -148,14 +148,22 @@ struct BakeBody {
   }
 
   /// The smooth and the caustic estimates together: their sum, photons,
-  /// and noise (independent photons: the standard deviations add in squares).
+  /// noise (independent photons: the standard deviations add in squares)
+  /// and reflectance (weighted by each estimate's irradiance).
   struct Totals {
-    Vec3 irradiance;
+    Vec3 irradiance, reflectance;
     float photons, noise;
   };
   static Totals totals(const Worker& w) {
     const GatherResult &g = w.gathered, &c = w.caustic;
-    Totals t{g.irradiance + c.irradiance, float(g.photons.size() + c.photons.size()), g.noise};
+    Totals t{g.irradiance + c.irradiance, g.reflectance,
+             float(g.photons.size() + c.photons.size()), g.noise};
+    for (int k = 0; k < 3; ++k) {
+      const float e = t.irradiance[k];
+      if (e > 0) {
+        t.reflectance[k] = (g.reflectance[k] * g.irradiance[k] + c.reflectance[k] * c.irradiance[k]) / e;
+      }
+    }
     if (!c.photons.empty()) {
       const double sg = double(g.noise) * double(luminance(g.irradiance)),
                    sc = double(c.noise) * double(luminance(c.irradiance));
@@ -199,6 +207,7 @@ struct BakeBody {
       out.normals[v] = g.normal;
       out.points[v] = layered ? found[0].lit : grid.centroids[v];
       out.irradiance[v] = total.irradiance;
+      out.reflectance[v] = total.reflectance;
       out.photonCount[v] = total.photons;
       out.noise[v] = total.noise;
       out.radius[v] = g.radius;
@@ -214,7 +223,7 @@ struct BakeBody {
         const Totals layerTotal = totals(w);
         Clock::time_point t4 = Clock::now();
         Worker::Layer layer{uint32_t(v), l, w.gathered.normal, found[l].lit,
-                            layerTotal.irradiance, layerTotal.photons,
+                            layerTotal.irradiance, layerTotal.reflectance, layerTotal.photons,
                             layerTotal.noise, w.gathered.radius, ClusterResult{}, {}};
         layer.vdls = clusterGathered(w, stream + (uint64_t(l) << kCanonicalKeyBits), layer.sh.data());
         w.layers.push_back(layer);
@@ -250,6 +259,7 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
   out.areas = grid.areas;
   out.normals.assign(n, Vec3{});
   out.irradiance.assign(n, Vec3{});
+  out.reflectance.assign(n, Vec3{});
   out.photonCount.assign(n, 0.0f);
   out.noise.assign(n, 0.0f);
   out.radius.assign(n, 0.0f);
@@ -299,6 +309,7 @@ VdlGrid buildVdlGrid(const SurfaceGrid& grid, const std::vector<Photon>& photons
     L.normals.push_back(e.normal);
     L.points.push_back(e.point);
     L.irradiance.push_back(e.irradiance);
+    L.reflectance.push_back(e.reflectance);
     L.photonCount.push_back(e.photonCount);
     L.noise.push_back(e.noise);
     L.radius.push_back(e.radius);

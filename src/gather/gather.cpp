@@ -314,13 +314,15 @@ void gatherWith(const SurfaceGrid& grid, const std::vector<Photon>& photons,
   if (!(rk > 0)) rk = radius;
 
   out.photons.resize(keys.size());
-  double power[3] = {0, 0, 0}, y = 0, y2 = 0;
+  double power[3] = {0, 0, 0}, reflected[3] = {0, 0, 0}, y = 0, y2 = 0;
   for (size_t i = 0; i < keys.size(); ++i) {
     const uint32_t p = uint32_t(keys[i]);
     out.photons[i] = p;
-    power[0] += photons[p].power.x;
-    power[1] += photons[p].power.y;
-    power[2] += photons[p].power.z;
+    const Vec3 r = reflectanceOf(photons[p]);
+    for (int c = 0; c < 3; ++c) {
+      power[c] += photons[p].power[c];
+      reflected[c] += double(photons[p].power[c]) * double(r[c]);
+    }
     const double yp = double(luminance(photons[p].power));
     y += yp;
     y2 += yp * yp;
@@ -339,6 +341,9 @@ void gatherWith(const SurfaceGrid& grid, const std::vector<Photon>& photons,
   out.normal = n;
   out.irradiance = {float(power[0] * invArea), float(power[1] * invArea),
                     float(power[2] * invArea)};
+  for (int c = 0; c < 3; ++c) {
+    out.reflectance[c] = power[c] > 0 ? float(reflected[c] / power[c]) : 0.0f;
+  }
 }
 
 void checkParams(const GatherParams& params) {

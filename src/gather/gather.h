@@ -138,6 +138,10 @@ struct GatherResult {
       0.0f;  ///< r_k: distance (ellipsoid metric) of the k-th photon, or r if fewer found
   Vec3 normal{0, 0, 0};      ///< voxel normal oriented towards the side the light arrives from
   Vec3 irradiance{0, 0, 0};  ///< sum(power) / (pi r_k^2 coverage), W/m^2
+  /// The gathered photons' Photon::reflectance, weighted per channel by
+  /// their power: the share of `irradiance` the surface reflects (0 without
+  /// photons).
+  Vec3 reflectance{0, 0, 0};
   /// Share of the disc pi r_k^2 on the surface (GatherParams::edgeCorrection), else 1.
   float coverage = 1.0f;
   /// The estimate's relative standard error, sqrt(sum y_i^2) / sum y_i over

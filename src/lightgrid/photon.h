@@ -21,7 +21,27 @@ struct Photon {
   /// mirrors, glass or smooth metal alone (L S+ D): the gather reads it with
   /// its own, smaller reach (GatherParams::separateCaustics).
   uint16_t caustic = 0;
+  /// The hemispherical reflectance of the surface at the hit (RGB, 0..1 in
+  /// steps of 1/255; hemisphericalReflectance in material/bsdf.h): the share
+  /// of the photon's power that surface sends back into the room. The gather
+  /// averages it per voxel (VdlGrid::reflectance), so that the renderer can
+  /// light a surface that sees this one from below its horizon.
+  uint8_t reflectance[3] = {0, 0, 0};
 };
+
+/// Photon::reflectance as RGB in 0..1.
+inline Vec3 reflectanceOf(const Photon& p) {
+  return Vec3{float(p.reflectance[0]), float(p.reflectance[1]), float(p.reflectance[2])} *
+         (1.0f / 255.0f);
+}
+
+/// Stores RGB `r` (clamped to 0..1, rounded to the nearest 1/255) in p.reflectance.
+inline void setReflectance(Photon& p, const Vec3& r) {
+  for (int c = 0; c < 3; ++c) {
+    const float v = r[c] > 0 ? (r[c] < 1 ? r[c] : 1.0f) : 0.0f;
+    p.reflectance[c] = uint8_t(v * 255.0f + 0.5f);
+  }
+}
 
 /// One ray of a photon path whose light the octree holds: it starts where
 /// the light left its last surface (or, for the sky's and with

@@ -41,6 +41,13 @@ struct LightGridVoxels {
   std::vector<Vec3> normals;        ///< unit (oriented towards the light), or zero
   std::vector<float> areas;         ///< geometry area in the voxel, world units^2
   std::vector<Vec3> irradiance;     ///< total RGB irradiance, W/m^2
+  /// The share of `irradiance` the voxel's surface reflects, RGB 0..1: the
+  /// gathered photons' Photon::reflectance weighted by their power. A
+  /// surface that sees this one from below its horizon (a step's riser, a
+  /// rail, thinner than a voxel and lit by its floor's VDLs) receives its
+  /// light from there (shaders/octree_lookup.h, loReflectedIrradiance).
+  /// Zero where nothing was gathered or the file does not record it.
+  std::vector<Vec3> reflectance;
   std::vector<float> photonCount;   ///< photons gathered for the estimate
   /// The estimate's photon noise: its relative standard error (standard
   /// deviation / luminance of `irradiance`), from the gathered photons'
@@ -69,6 +76,7 @@ struct VdlLayers {
   std::vector<Vec3> normals;      ///< unit, facing the side the layer's light arrives from
   std::vector<Vec3> points;       ///< a point of the layer's surface, world space
   std::vector<Vec3> irradiance;   ///< W/m^2, the sum of the layer's VDLs
+  std::vector<Vec3> reflectance;  ///< as LightGridVoxels::reflectance
   std::vector<float> photonCount;
   std::vector<float> noise;
   std::vector<float> radius;

@@ -112,6 +112,17 @@ BsdfLobes bsdfLobes(const Material& m, float metallicIn, float roughnessIn) {
   return info;
 }
 
+Vec3 hemisphericalReflectance(const BsdfLobes& lobes, const Vec3& albedo) {
+  auto meanSchlick = [](float f0) { return f0 + (1.0f - f0) / 21.0f; };
+  const float layer = lobes.layerWeight * meanSchlick(lobes.dielectricF0);
+  const Vec3 dielectric = albedo * (1.0f - layer) + Vec3(layer);
+  const Vec3 metal{meanSchlick(albedo.x), meanSchlick(albedo.y), meanSchlick(albedo.z)};
+  const float f0 = (lobes.ior - 1.0f) / (lobes.ior + 1.0f);
+  const float glass = meanSchlick(f0 * f0);
+  return dielectric * lobes.diffuseWeight + metal * lobes.metalWeight +
+         Vec3(glass * lobes.transmissionWeight);
+}
+
 float fresnelDielectric(float cosI, float n1, float n2, float& cosT) {
   float eta = n1 / n2;
   float sin2T = eta * eta * std::max(0.0f, 1.0f - cosI * cosI);

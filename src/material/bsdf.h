@@ -108,6 +108,14 @@ Vec3 evalBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const 
 float pdfBsdf(const BsdfLobes& lobes, const Vec3& albedo, const Vec3& wo, const Vec3& wi,
               const Vec3& n);
 
+/// The share of light falling on the surface (over the hemisphere, cosine
+/// weighted) that it reflects back to the side it came from, RGB: the
+/// Lambert base weighted by 1 - F and the specular layer by F, F the
+/// Schlick Fresnel averaged over the hemisphere (F0 + (1 - F0) / 21), the
+/// metal's F0 = albedo, the glass's own Fresnel reflection. What a surface
+/// that sees this one from below its horizon receives of its light
+/// (Photon::reflectance); lobes' own energy loss (GGX) is left out.
+Vec3 hemisphericalReflectance(const BsdfLobes& lobes, const Vec3& albedo);
 /// Unpolarised Fresnel reflectance of a smooth dielectric interface, n1 -> n2.
 /// cosT receives the cosine of the refracted direction (0 at total reflection).
 float fresnelDielectric(float cosI, float n1, float n2, float& cosT);

@@ -31,12 +31,15 @@ namespace adaptive_internal {
 struct Node {
   std::vector<Vdl> vdls;  ///< intensities, as stored
   std::vector<Vec3> sh;
+  /// Its surface texel's (GpuOctree::surfaceTexels): the weighted mean
+  /// reflectance and the unit weighted mean normal of its voxels.
+  Vec3 reflectance{0, 0, 0}, normal{0, 0, 0};
   double weight = 0;
   std::vector<uint32_t> voxels;
 };
 
-/// Irradiance of a leaf's texels at normal n, as the shader computes it.
-Vec3 irradianceAt(const Node& node, const Vec3& n) {
+/// Irradiance of a leaf's light texels alone at normal n.
+Vec3 lightAt(const Node& node, const Vec3& n) {
   Vec3 e{0, 0, 0};
   if (!node.sh.empty()) {
     for (size_t i = 0; i < node.sh.size(); ++i) {
@@ -46,6 +49,14 @@ Vec3 irradianceAt(const Node& node, const Vec3& n) {
   }
   for (const Vdl& v : node.vdls) e += v.irradiance * std::max(0.0f, dot(n, v.direction));
   return e;
+}
+
+/// Irradiance of a leaf at normal n, as the shader computes it: its light,
+/// and what its surface reflects from below its plane (loSurfaceBelow).
+Vec3 irradianceAt(const Node& node, const Vec3& n) {
+  const float below = 0.5f * (1.0f - std::fabs(dot(n, node.normal)));
+  if (!(maxComponent(node.reflectance) > 0) || !(below > 0)) return lightAt(node, n);
+  return lightAt(node, n) + node.reflectance * lightAt(node, node.normal) * below;
 }
 
 float brightest(const Vec3& e) { return std::max({e.x, e.y, e.z}); }
@@ -132,6 +143,8 @@ AdaptiveLeaves collapseLeaves(const VdlGrid& grid, float tolerance, bool cosineC
       }
     }
     node.weight = grid.areas.size() == n && grid.areas[v] > 0 ? double(grid.areas[v]) : 1.0;
+    node.normal = unitNormal[v];
+    if (grid.reflectance.size() == n) node.reflectance = grid.reflectance[v];
     node.voxels.push_back(uint32_t(v));
     own[v] = irradianceAt(node, unitNormal[v]);
     meanBrightest += double(brightest(own[v]));
@@ -177,6 +190,12 @@ AdaptiveLeaves collapseLeaves(const VdlGrid& grid, float tolerance, bool cosineC
           merged.vdls = mergeVdls(std::move(pool), slots);
         }
         merged.weight = weight;
+        Vec3 normalSum{0, 0, 0};
+        for (const Node* c : children) {
+          merged.reflectance += c->reflectance * float(c->weight / weight);
+          normalSum += c->normal * float(c->weight);
+        }
+        merged.normal = lengthSquared(normalSum) > 0 ? normalize(normalSum) : Vec3{0, 0, 0};
         for (const Node* c : children) {
           merged.voxels.insert(merged.voxels.end(), c->voxels.begin(), c->voxels.end());
         }
@@ -205,6 +224,8 @@ AdaptiveLeaves collapseLeaves(const VdlGrid& grid, float tolerance, bool cosineC
           leaf.level = l + 1;
           leaf.vdls = c->vdls;
           leaf.sh = c->sh;
+          leaf.reflectance = c->reflectance;
+          leaf.normal = c->normal;
           for (uint32_t v : c->voxels) out.collapsed[v] = 1;
           out.voxelsCollapsed += c->voxels.size();
           out.leaves.push_back(std::move(leaf));
@@ -225,6 +246,8 @@ AdaptiveLeaves collapseLeaves(const VdlGrid& grid, float tolerance, bool cosineC
     leaf.level = 1;
     leaf.vdls = node.vdls;
     leaf.sh = node.sh;
+    leaf.reflectance = node.reflectance;
+    leaf.normal = node.normal;
     for (uint32_t v : node.voxels) out.collapsed[v] = 1;
     out.voxelsCollapsed += node.voxels.size();
     out.leaves.push_back(std::move(leaf));

@@ -25,6 +25,9 @@ struct CollapsedLeaf {
   /// terms (VdlGrid::shTerms of them).
   std::vector<Vdl> vdls;
   std::vector<Vec3> sh;
+  /// Its surface texel (GpuOctree::surfaceTexels): its voxels' reflectance
+  /// and unit normal, means weighted by their areas.
+  Vec3 reflectance{0, 0, 0}, normal{0, 0, 0};
   /// A free-space leaf (buildVolumeOctree): the box its voxels' light
   /// filled, in its own units (VolumeLight::litLower / litUpper).
   Vec3 litLower{0, 0, 0}, litUpper{1, 1, 1};

@@ -257,6 +257,7 @@ class OctreeBuilder {
         params_(params),
         depth_(grid.frame.depth),
         sh_(grid.shTerms > 0),
+        surfaces_(recordsReflectance(grid)),
         adaptive_(collapseLeaves(grid, params.tolerance, params.cosineCorrection)) {}
   /// A free-space octree: each leaf's light preceded by its header texel
   /// (octree_layout.h), headers[v] for voxel v; `adaptive` its merged leaves
@@ -267,6 +268,7 @@ class OctreeBuilder {
         params_(params),
         depth_(grid.frame.depth),
         sh_(grid.shTerms > 0),
+        surfaces_(false),
         adaptive_(std::move(adaptive)),
         headers_(std::move(headers)) {}
 
@@ -285,6 +287,7 @@ class OctreeBuilder {
     out_.collapsedVoxels = adaptive_.voxelsCollapsed;
     out_.nodeCount = tileCount_;
     out_.vdlCount = vdlTotal_;
+    out_.surfaceTexels = surfaces_;
     return std::move(out_);
   }
 
@@ -308,8 +311,36 @@ class OctreeBuilder {
     }
   }
 
-  /// Texels of one layer's light: its VDLs, or its SH terms.
-  size_t texelsOf(int vdlCount) const { return sh_ ? size_t(grid_.shTerms) : size_t(vdlCount); }
+  /// Whether any voxel or layer of `grid` reflects light: only then do the
+  /// leaves carry surface texels (octree_layout.h).
+  static bool recordsReflectance(const VdlGrid& grid) {
+    if (grid.reflectance.size() != grid.size() ||
+        grid.layers.reflectance.size() != grid.layers.size()) {
+      return false;
+    }
+    auto reflects = [](const Vec3& r) { return maxComponent(r) > 0; };
+    return std::any_of(grid.reflectance.begin(), grid.reflectance.end(), reflects) ||
+           std::any_of(grid.layers.reflectance.begin(), grid.layers.reflectance.end(), reflects);
+  }
+
+  /// Texels of one layer's light: its VDLs, or its SH terms, and its
+  /// surface texel when the octree has them.
+  size_t texelsOf(int vdlCount) const { return lightTexelsOf(vdlCount) + (surfaces_ ? 1 : 0); }
+  /// The light's texels alone: what a layer block's header counts.
+  size_t lightTexelsOf(int vdlCount) const {
+    return sh_ ? size_t(grid_.shTerms) : size_t(vdlCount);
+  }
+
+  /// A surface texel (octree_layout.h): the reflectance of the surface the
+  /// light before it was gathered on, and that surface's normal; zero
+  /// where the surface has no normal.
+  void writeSurface(const Vec3& reflectance, const Vec3& normal) {
+    if (!surfaces_) return;
+    const bool oriented = lengthSquared(normal) > 0.25f;
+    const Vec3 n = oriented ? normalize(normal) : Vec3{0, 0, 1};
+    writeTexel(nextVdl_++, oriented ? reflectance : Vec3{}, loPackDirection(n.x, n.y, n.z));
+  }
+  const Vec3& reflectanceOf(size_t v) const { return grid_.reflectance[v]; }
 
   /// Texels of a voxel's leaf: its light, or a layer block (octree_layout.h).
   size_t voxelTexels(size_t v) const {
@@ -326,7 +357,7 @@ class OctreeBuilder {
   size_t leafTexels(const Leaf& leaf) const {
     if (leaf.level == depth_) return voxelTexels(leaf.voxel);
     const CollapsedLeaf& c = adaptive_.leaves[leaf.voxel];
-    return (headers_.empty() ? 0 : 1) + (sh_ ? c.sh.size() : c.vdls.size());
+    return (headers_.empty() ? 0 : 1) + (sh_ ? c.sh.size() : c.vdls.size()) + (surfaces_ ? 1 : 0);
   }
 
   /// Lit voxels in Morton order. A voxel without VDLs is left out entirely:
@@ -611,6 +642,7 @@ class OctreeBuilder {
     } else {
       for (const Vdl& vdl : c.vdls) writeVdl(nextVdl_++, vdl, Vec3{0, 0, 0});
     }
+    writeSurface(c.reflectance, c.normal);
   }
 
   /// A voxel's leaf: its VDLs (or SH terms), or a layer block.
@@ -623,15 +655,17 @@ class OctreeBuilder {
       writeLayerBlock(v);
       return;
     }
+    const Vec3 surfaceNormal = grid_.normals.size() == grid_.size() ? grid_.normals[v] : Vec3{};
     if (sh_) {
       for (int i = 0; i < grid_.shTerms; ++i) writeSh(nextVdl_++, grid_.shOf(v)[i]);
-      return;
+    } else {
+      const Vdl* vdls = grid_.vdlsOf(v);
+      const Vec3 normal = params_.cosineCorrection && lengthSquared(surfaceNormal) > 0
+                              ? normalize(surfaceNormal)
+                              : Vec3{0, 0, 0};
+      for (int i = 0; i < count; ++i) writeVdl(nextVdl_++, vdls[i], normal);
     }
-    const Vdl* vdls = grid_.vdlsOf(v);
-    const Vec3 normal = params_.cosineCorrection && grid_.normals.size() == grid_.size()
-                            ? normalize(grid_.normals[v])
-                            : Vec3{0, 0, 0};
-    for (int i = 0; i < count; ++i) writeVdl(nextVdl_++, vdls[i], normal);
+    if (surfaces_) writeSurface(reflectanceOf(v), surfaceNormal);
   }
 
   /// A layer block (octree_layout.h): header, then per layer its header and VDLs.
@@ -639,9 +673,9 @@ class OctreeBuilder {
     const int count = grid_.vdlCount[v];
     const uint32_t e0 = extraFirst_[v];
     const int layers = 1 + extraCount_[v];
-    Vec3 counts{float(texelsOf(count)), 0, 0};
+    Vec3 counts{float(lightTexelsOf(count)), 0, 0};
     for (int l = 1; l < layers; ++l) {
-      counts[l] = float(texelsOf(grid_.layers.vdlCount[e0 + uint32_t(l) - 1]));
+      counts[l] = float(lightTexelsOf(grid_.layers.vdlCount[e0 + uint32_t(l) - 1]));
     }
     writeTexel(nextVdl_++, counts, float(layers));
     const Vec3 corner{float(grid_.coords[v].x), float(grid_.coords[v].y), float(grid_.coords[v].z)};
@@ -649,24 +683,27 @@ class OctreeBuilder {
       return (world - grid_.frame.origin) / grid_.frame.voxelSize - corner;
     };
     auto writeLayer = [&](const Vec3& layerNormal, const Vec3& point, const Vdl* layerVdls,
-                          int layerCount, const Vec3* layerSh) {
+                          int layerCount, const Vec3* layerSh, const Vec3& reflectance) {
       const Vec3 n = normalize(layerNormal);
       writeTexel(nextVdl_++, local(point), loPackDirection(n.x, n.y, n.z));
       if (sh_) {
         for (int i = 0; i < grid_.shTerms; ++i) writeSh(nextVdl_++, layerSh[i]);
-        return;
+      } else {
+        const Vec3 correction = params_.cosineCorrection ? n : Vec3{0, 0, 0};
+        for (int i = 0; i < layerCount; ++i) writeVdl(nextVdl_++, layerVdls[i], correction);
       }
-      const Vec3 correction = params_.cosineCorrection ? n : Vec3{0, 0, 0};
-      for (int i = 0; i < layerCount; ++i) writeVdl(nextVdl_++, layerVdls[i], correction);
+      writeSurface(reflectance, n);
     };
     const Vec3 point0 = grid_.points.empty()
                             ? grid_.frame.origin + (corner + Vec3(0.5f)) * grid_.frame.voxelSize
                             : grid_.points[v];
-    writeLayer(grid_.normals[v], point0, grid_.vdlsOf(v), count, sh_ ? grid_.shOf(v) : nullptr);
+    writeLayer(grid_.normals[v], point0, grid_.vdlsOf(v), count, sh_ ? grid_.shOf(v) : nullptr,
+               surfaces_ ? reflectanceOf(v) : Vec3{});
     for (int l = 1; l < layers; ++l) {
       const uint32_t e = e0 + uint32_t(l) - 1;
       writeLayer(grid_.layers.normals[e], grid_.layers.points[e], grid_.layerVdlsOf(e),
-                 grid_.layers.vdlCount[e], sh_ ? grid_.layerShOf(e) : nullptr);
+                 grid_.layers.vdlCount[e], sh_ ? grid_.layerShOf(e) : nullptr,
+                 surfaces_ ? grid_.layers.reflectance[e] : Vec3{});
     }
   }
 
@@ -674,6 +711,7 @@ class OctreeBuilder {
   const GpuOctreeParams& params_;
   const int depth_;
   const bool sh_;
+  const bool surfaces_;  ///< leaves and layers end in a surface texel
   const AdaptiveLeaves adaptive_;
   std::vector<Vec3> headers_;  ///< free-space octree: per voxel
   std::vector<uint32_t> extraFirst_;

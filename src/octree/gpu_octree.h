@@ -68,6 +68,11 @@ struct GpuOctree {
   /// 0: the leaves hold VDLs; 4 or 9: each leaf (and layer) holds that many
   /// SH terms (VdlGrid::shTerms), compact ones as halves times the scale.
   int shTerms = 0;
+  /// Each leaf's (and layer's) light is followed by one surface texel: the
+  /// reflectance of the surface it was gathered on and that surface's normal
+  /// (octree_layout.h; set when the grid records reflectance,
+  /// VdlGrid::reflectance).
+  bool surfaceTexels = false;
   std::vector<float> vdlTexels;
   std::vector<uint16_t> vdlTexelsHalf;
 

@@ -57,6 +57,7 @@ glm::uvec4 fetchVdlHalf(const GpuOctree& o, const glm::ivec2& p) {
 #define LO_VDLS_COMPACT tex.compact
 #define LO_VDL_SCALE tex.irradianceScale
 #define LO_SH_TERMS tex.shTerms
+#define LO_SURFACE_TEXELS tex.surfaceTexels
 #include <octree_lookup.h>
 
 namespace lo {

@@ -430,8 +430,10 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
                                p.z >= ctx.region.lower.z && p.x <= ctx.region.upper.x &&
                                p.y <= ctx.region.upper.y && p.z <= ctx.region.upper.z);
     const bool stored = bounce > 0 || ctx.includeDirect || start.storeFirstHit;
+    const Vec3 albedo = ctx.scene->albedo(hit.triangle, hit.b1, hit.b2);
     if (mat.storesPhotons && inRegion && (stored || ctx.countDirect)) {
       Photon ph;
+      setReflectance(ph, hemisphericalReflectance(mat, albedo));
       ph.position = p;
       ph.direction = wo;
       ph.power = power;
@@ -448,7 +450,6 @@ inline void tracePath(const Context& ctx, uint64_t pathIndex, std::vector<Photon
     }
     if (int(bounce) >= ctx.maxBounces || rayCount > kMaxPathRays) return;
 
-    Vec3 albedo = ctx.scene->albedo(hit.triangle, hit.b1, hit.b2);
     // Scattering about the shading normal (vertex normals, the normal map),
     // as the path tracer and the renderer shade; the stored photon keeps the
     // geometric one, which the gather compares with the voxel's.

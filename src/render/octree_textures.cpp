@@ -62,6 +62,7 @@ void OctreeTextures::upload(const GpuOctree& octree) {
   compact = half && octree.compact;
   scale = octree.irradianceScale;
   shTerms = octree.shTerms;
+  surfaceTexels = octree.surfaceTexels;
   const float zero[4] = {0, 0, 0, 0};
   const uint16_t zeroHalf[4] = {0, 0, 0, 0};
   makeTexture(vdl);
@@ -95,6 +96,7 @@ void OctreeTextures::bind(GLuint program, int poolUnit, int vdlUnit, int halfUni
   glUniform1i(glGetUniformLocation(program, "uCompactVdls"), compact ? 1 : 0);
   glUniform1f(glGetUniformLocation(program, "uVdlScale"), scale);
   glUniform1i(glGetUniformLocation(program, "uShTerms"), shTerms);
+  glUniform1i(glGetUniformLocation(program, "uSurfaceTexels"), surfaceTexels ? 1 : 0);
   glActiveTexture(GLenum(GL_TEXTURE0 + poolUnit));
   glBindTexture(GL_TEXTURE_3D, pool.get());
   glActiveTexture(GLenum(GL_TEXTURE0 + vdlUnit));

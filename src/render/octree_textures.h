@@ -30,8 +30,8 @@ class OctreeTextures {
   /// Binds the pool, the float VDLs and the half VDLs to texture units
   /// `poolUnit`, `vdlUnit` and `halfUnit`, and points `program`'s samplers
   /// uOctree, uVdls, uVdlsHalf at them, and uHalfVdls, uCompactVdls,
-  /// uVdlScale and uShTerms at `half`, `compact`, `scale` and `shTerms`; the
-  /// program must be in use.
+  /// uVdlScale, uShTerms and uSurfaceTexels at `half`, `compact`, `scale`,
+  /// `shTerms` and `surfaceTexels`; the program must be in use.
   void bind(GLuint program, int poolUnit, int vdlUnit, int halfUnit) const;
 
   GlTexture pool, vdl, vdlHalf;
@@ -39,6 +39,7 @@ class OctreeTextures {
   bool compact = false;    ///< ... holding compact (RGB9E5) irradiance
   float scale = 1;         ///< the compact texels' irradiance scale
   int shTerms = 0;         ///< GpuOctree::shTerms
+  bool surfaceTexels = false;  ///< GpuOctree::surfaceTexels
   int depth = 0;           ///< the octree's depth
   float voxelSize = 1;     ///< world units
   Vec3 origin{0, 0, 0};    ///< world position of the cube's corner

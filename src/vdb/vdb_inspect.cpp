@@ -197,20 +197,22 @@ class VdlChecker {
                   "file metadata representation is not " + representationChoices();
     }
     // The voxels' required grids of the field table.
+    // The optional ones, where present, with their types too.
+    std::string absent;
     forEachField([&](const auto& row) {
       using T = typename std::decay_t<decltype(row)>::Value;
-      if (row.optional || row.arity == FieldArity::OneOrNone) return;
+      if (row.arity == FieldArity::OneOrNone) return;
       const char* type = std::is_same_v<T, Vec3> || std::is_same_v<T, Vdl> ? "vec3s" : "float";
+      if (row.optional) {
+        need(row.gridName, type, false);
+        if (!find(row.gridName)) absent += (absent.empty() ? "" : ", ") + std::string(row.gridName);
+        return;
+      }
       for (const vdb_internal::FieldGrid& grid :
            vdb_internal::fieldGrids(row, 0, maxVdlsValid ? maxVdls : 0, std::max(shTerms, 0))) {
         need(grid.name, type, true);
       }
     });
-    std::string absent;
-    for (const std::string& name : optionalVdlGridNames()) {
-      need(name, "float", false);
-      if (!find(name)) absent += (absent.empty() ? "" : ", ") + name;
-    }
     add("contract", problems.empty(),
         problems.empty()
             ? "all required grids present with their types" +

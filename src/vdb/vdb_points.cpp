@@ -1,5 +1,5 @@
 // The photon map as an OpenVDB PointDataGrid ("photons": P, Cd, direction,
-// N, bounce). The only translation unit that includes OpenVDB's points
+// N, bounce, reflectance). The only translation unit that includes OpenVDB's points
 // headers, which compile slowly.
 
 #include <openvdb/openvdb.h>
@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,7 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   namespace pts = openvdb::points;
   const size_t n = photons.size();
   std::vector<openvdb::Vec3R> positions(n);
-  std::vector<openvdb::Vec3s> power(n), direction(n), normal(n);
+  std::vector<openvdb::Vec3s> power(n), direction(n), normal(n), reflectance(n);
   std::vector<int32_t> bounce(n);
   for (size_t i = 0; i < n; ++i) {
     const Photon& p = photons[i];
@@ -43,6 +44,7 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
     power[i] = toVdb(p.power);
     direction[i] = toVdb(p.direction);
     normal[i] = toVdb(p.normal);
+    reflectance[i] = toVdb(reflectanceOf(p));
     bounce[i] = int32_t(p.bounce);
   }
   // Points are world space; the grid only buckets them, from the scene's
@@ -66,12 +68,15 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   pts::appendAttribute<int32_t>(grid->tree(), "bounce");
   pts::PointAttributeVector<int32_t> bounceWrapper(bounce);
   pts::populateAttribute(grid->tree(), indexGrid->tree(), "bounce", bounceWrapper);
+  addVec3("reflectance", reflectance);
 
   grid->setName("photons");
   grid->insertMeta("units",
                    openvdb::StringMetadata("P: world units; Cd: photon power, W (RGB); "
                                            "direction: unit, towards where the photon came from; "
-                                           "N: unit surface normal"));
+                                           "N: unit surface normal; "
+                                           "reflectance: the surface's hemispherical "
+                                           "reflectance, RGB 0..1"));
   openvdb::MetaMap meta;
   meta.insertMeta("generator", openvdb::StringMetadata("lightoctree"));
   meta.insertMeta("version", openvdb::StringMetadata(LO_VERSION));
@@ -112,6 +117,9 @@ std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin,
   const size_t pIndex = attribute("P"), cdIndex = attribute("Cd");
   const size_t dIndex = attribute("direction"), nIndex = attribute("N");
   const size_t bIndex = attribute("bounce");
+  // Photon files written before the surfaces' reflectance was recorded lack
+  // it: their photons reflect nothing (VdlGrid::reflectance 0).
+  const size_t rIndex = descriptor.find("reflectance");
   const Transform& xform = grid->transform();
   try {
     for (; leaf; ++leaf) {
@@ -120,6 +128,11 @@ std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin,
       pts::AttributeHandle<openvdb::Vec3s> dHandle(leaf->constAttributeArray(dIndex));
       pts::AttributeHandle<openvdb::Vec3s> nHandle(leaf->constAttributeArray(nIndex));
       pts::AttributeHandle<int32_t> bHandle(leaf->constAttributeArray(bIndex));
+      std::unique_ptr<pts::AttributeHandle<openvdb::Vec3s>> rHandle;
+      if (rIndex != pts::AttributeSet::INVALID_POS) {
+        rHandle = std::make_unique<pts::AttributeHandle<openvdb::Vec3s>>(
+            leaf->constAttributeArray(rIndex));
+      }
       for (auto idx = leaf->beginIndexOn(); idx; ++idx) {
         const openvdb::Vec3d world =
             xform.indexToWorld(pHandle.get(*idx) + idx.getCoord().asVec3d());
@@ -130,6 +143,7 @@ std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin,
         p.direction = fromVdb(dHandle.get(*idx));
         p.normal = fromVdb(nHandle.get(*idx));
         p.bounce = uint16_t(std::clamp(bHandle.get(*idx), 0, 0xffff));
+        if (rHandle) setReflectance(p, fromVdb(rHandle->get(*idx)));
         out.push_back(p);
       }
     }

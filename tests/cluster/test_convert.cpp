@@ -185,6 +185,7 @@ TEST(Coarsen, ZeroAreaChildrenAverageEqually) {
   g.photonCount = {10, 20};
   g.radius = {0.1f, 0.3f};
   g.noise = {0.1f, 0.2f};
+  g.reflectance = {{0.5f, 0.25f, 0.125f}, {0.75f, 0.5f, 0.25f}};
   g.angularError = {0, 0};
   g.vdlCount = {1, 1};
   g.vdls = {Vdl{Vec3(1, 2, 3), Vec3(0, 1, 0)}, Vdl{}, Vdl{Vec3(3, 2, 1), Vec3(1, 0, 0)}, Vdl{}};

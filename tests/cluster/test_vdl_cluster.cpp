@@ -222,6 +222,7 @@ TEST(Smoothing, ShrinksNoiseKeepsStepsAndSurfaces) {
     g.layers.photonCount.push_back(150);
     g.layers.radius.push_back(0.05f);
     g.layers.noise.push_back(0.08f);
+    g.layers.reflectance.push_back({0.4f, 0.4f, 0.4f});
     g.layers.angularError.push_back(0);
     g.layers.vdlCount.push_back(0);
     g.layers.vdls.resize(g.layers.vdls.size() + 2);

@@ -265,7 +265,14 @@ TEST_F(Gather, UniformPlaneIrradiance) {
   scene = unitFloor();
   const size_t n = 100000;
   photons = uniformPhotons(scene, n, 21);
-  for (Photon& p : photons) p.power = Vec3(2e-5f, 1e-5f, 3e-5f);
+  // Every other photon on a surface of another reflectance: the gather's is
+  // their mean, weighted by power (equal here), within the draw of k photons.
+  const uint8_t even[3] = {51, 102, 153}, odd[3] = {153, 51, 255};
+  for (size_t i = 0; i < photons.size(); ++i) {
+    photons[i].power = Vec3(2e-5f, 1e-5f, 3e-5f);
+    for (int c = 0; c < 3; ++c) photons[i].reflectance[c] = (i % 2 ? odd : even)[c];
+  }
+  const Vec3 meanReflectance = (reflectanceOf(photons[0]) + reflectanceOf(photons[1])) * 0.5f;
   const Vec3 expected = Vec3(2e-5f, 1e-5f, 3e-5f) * float(n);  // A = 1 m^2
   grid = gridFor(scene, 5, photons);
   GatherParams params;
@@ -286,6 +293,8 @@ TEST_F(Gather, UniformPlaneIrradiance) {
     EXPECT_NEAR(res.noise, 1.0f / std::sqrt(float(params.k)), 1e-5f);
     for (int ch = 0; ch < 3; ++ch) {
       EXPECT_NEAR(res.irradiance[ch] / expected[ch], 1.0f, tol) << grid.coords[v].ToString();
+      // The share of odd photons among k: standard deviation 0.5 / sqrt(k).
+      EXPECT_NEAR(res.reflectance[ch], meanReflectance[ch], 0.4f * 2.0f / std::sqrt(float(params.k)));
     }
     sum += res.irradiance.x / expected.x;
     ++count;

@@ -165,7 +165,8 @@ TEST(LightgridSchema, TheTableIsConsistent) {
     }
   });
   EXPECT_EQ(optionalVdlGridNames(),
-            (std::vector<std::string>{"photon_count", "noise", "angular_error", "radius", "area"}));
+            (std::vector<std::string>{"reflectance", "photon_count", "noise", "angular_error", "radius",
+                                      "area"}));
 }
 
 TEST(LightgridSchema, ResizingSatisfiesTheArrayChecks) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -81,6 +82,32 @@ TEST(Bsdf, HandBuiltLobesAreLambertExactly) {
     const Vec3 wi = normalize(s.wi);
     EXPECT_NEAR(evalBsdf(lambert, albedo, viewAt(40), wi, Vec3(0, 0, 1)).x,
                 albedo.x * wi.z / kPi, 1e-6f);
+  }
+}
+
+// What a surface reflects of the light falling on it: a Lambert base alone
+// its albedo; with the specular layer, more towards white; a metal its
+// Schlick mean; no lobe more than all of the light.
+TEST(Bsdf, HemisphericalReflectanceOfEachLobe) {
+  const Vec3 albedo{0.7f, 0.3f, 0.05f};
+  BsdfLobes lambert;  // hand-built: a Lambert base without a specular layer
+  EXPECT_EQ(hemisphericalReflectance(lambert, albedo), albedo);
+  Material m;
+  m.baseColor = albedo;
+  m.roughness = 0.5f;
+  const Vec3 layered = hemisphericalReflectance(bsdfLobes(m), albedo);
+  const float f = 0.04f + 0.96f / 21.0f;  // the Schlick mean of F0 = 0.04
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(layered[c], albedo[c] * (1 - f) + f, 1e-5f);
+  m.metallic = 1;
+  const Vec3 metal = hemisphericalReflectance(bsdfLobes(m), albedo);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(metal[c], albedo[c] + (1 - albedo[c]) / 21.0f, 1e-5f);
+  m.baseColor = Vec3(1.0f);
+  m.metallic = 0;
+  for (float transmission : {0.0f, 0.5f, 1.0f}) {
+    m.transmission = transmission;
+    const Vec3 r = hemisphericalReflectance(bsdfLobes(m), m.baseColor);
+    EXPECT_LE(maxComponent(r), 1.0f + 1e-6f);
+    EXPECT_GT(std::min({r.x, r.y, r.z}), 0.0f);
   }
 }
 

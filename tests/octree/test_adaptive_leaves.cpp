@@ -40,6 +40,7 @@ VdlGrid floorGrid(int depth, const Vec3& direction, LightFn light) {
       g.photonCount.push_back(300);
       g.radius.push_back(kVoxel);
       g.noise.push_back(0.05f);
+      g.reflectance.push_back({0.5f, 0.5f, 0.5f});
       g.angularError.push_back(0);
       g.vdlCount.push_back(e.x > 0 ? 1 : 0);
       for (int i = 0; i < g.maxVdls; ++i) {
@@ -75,7 +76,7 @@ TEST(AdaptiveLeaves, ConstantLightCollapsesToTheCoarsestLeaves) {
   EXPECT_EQ(collapsed.leafCount, 4u);
   EXPECT_EQ(collapsed.collapsedLeaves, 4u);
   EXPECT_EQ(collapsed.collapsedVoxels, 256u);
-  EXPECT_EQ(collapsed.vdlCount, 4u);
+  EXPECT_EQ(collapsed.vdlCount, 4u * 2u);  // per leaf its VDL and its surface texel
   EXPECT_EQ(collapsed.nodeCount, 1u);  // the root tile alone
   expectSameIrradiance(collapsed, uniform, 16, 1e-5f);
   // Tolerance 0: the uniform tree, byte for byte.
@@ -149,6 +150,7 @@ TEST(AdaptiveLeaves, LayersAndDarkVoxelsAreNeverCovered) {
   L.photonCount.push_back(100);
   L.radius.push_back(kVoxel);
   L.noise.push_back(0.05f);
+  L.reflectance.push_back({0.5f, 0.5f, 0.5f});
   L.angularError.push_back(0);
   L.vdlCount.push_back(1);
   for (int i = 0; i < g.maxVdls; ++i) L.vdls.push_back(i == 0 ? Vdl{{1, 1, 1}, {0, 0, -1}} : Vdl{});
@@ -186,7 +188,9 @@ TEST(AdaptiveLeaves, ShTermsCollapseToo) {
   p.tolerance = 0.01f;
   const GpuOctree o = buildGpuOctree(g, p);
   EXPECT_EQ(o.leafCount, 4u);  // an 8 x 8 floor at depth 3: four level-1 nodes of 4 x 4
-  EXPECT_EQ(o.vdlCount, 16u);
+  // Each leaf's four terms and its surface texel (the floor reflects).
+  EXPECT_TRUE(o.surfaceTexels);
+  EXPECT_EQ(o.vdlCount, 4u * (4u + 1u));
   expectSameIrradiance(o, buildGpuOctree(g), 8, 1e-5f);
 }
 

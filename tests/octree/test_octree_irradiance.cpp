@@ -58,6 +58,13 @@ Vec3 decodedDirection(const GpuOctree& o, int k) {
   return s.vdls[k].direction;
 }
 
+/// Unit direction d as a texel's packed direction decodes it.
+Vec3 unpacked(const Vec3& d) {
+  const float code = layout::loPackDirection(d.x, d.y, d.z);
+  return {layout::loUnpackDirectionX(code), layout::loUnpackDirectionY(code),
+          layout::loUnpackDirectionZ(code)};
+}
+
 /// The x of the decoded direction of the first VDL of the voxel at p.
 Vec3 decodedDirectionAt(const GpuOctree& o, const Vec3& p) {
   OctreeSample s = lookupOctree(o, p);
@@ -94,6 +101,42 @@ TEST(OctreeIrradiance, ConstantVdlGivesTheCosineLawEverywhereOnTheSlab) {
     EXPECT_EQ(octreeIrradiance(o, Vec3{2, 2, 5} * kVoxel, {0, 0, 1}, p), Vec3(0, 0, 0));
     EXPECT_EQ(octreeIrradiance(o, Vec3{-3, 2, 1} * kVoxel, {0, 0, 1}, p), Vec3(0, 0, 0));
   }
+}
+
+// A surface facing across the voxels' own (a step's riser in the floor's
+// voxels) sees that surface below its own horizon over (1 - n.m) / 2 of its
+// cosine-weighted hemisphere: it receives the floor's irradiance E(m) times
+// the floor's reflectance from there, on top of the VDLs' cosine law; one
+// turned against it, (1 - |n.m|) / 2, nothing at n = -m (the far side of a
+// thin wall); without recorded reflectance, nothing more.
+TEST(OctreeIrradiance, ASurfaceFacingBelowTheVoxelsSurfaceGetsTheLightThatSurfaceReflects) {
+  const Vec3 c{2.0f, 1.0f, 0.5f};
+  const Vec3 rho{0.5f, 0.25f, 0.8f};
+  VdlGrid g = constantGrid(3, 0, 1, {vdl(c, {0, 0, 1})});
+  g.reflectance.assign(g.size(), rho);
+  for (int format = 0; format < 3; ++format) {
+    SCOPED_TRACE(format == 0 ? "float" : format == 1 ? "half" : "compact");
+    GpuOctreeParams params;
+    params.halfFloat = format > 0;
+    params.compact = format == 2;
+    const GpuOctree o = buildGpuOctree(g, params);
+    ASSERT_TRUE(o.surfaceTexels);
+    const float tol = format == 0 ? 1e-5f : 4e-3f;
+    for (bool interpolation : {true, false}) {
+      OctreeShadeParams p;
+      p.interpolation = interpolation;
+      for (const Vec3& n : {Vec3{0, 0, 1}, Vec3{1, 0, 0}, normalize(Vec3{0.3f, 1, -0.2f}),
+                            Vec3{0, 0, -1}, normalize(Vec3{1, 1, 1})}) {
+        const Vec3 expected = c * std::max(0.0f, n.z) + rho * c * (0.5f * (1.0f - std::fabs(n.z)));
+        const Vec3 e = octreeIrradiance(o, Vec3{4.3f, 2.6f, 1.0f} * kVoxel, n, p);
+        EXPECT_NEAR(length(e - expected), 0.0f, tol * length(expected)) << n.ToString();
+      }
+    }
+  }
+  g.reflectance.assign(g.size(), Vec3{});
+  const GpuOctree dark = buildGpuOctree(g);
+  EXPECT_FALSE(dark.surfaceTexels);
+  EXPECT_EQ(octreeIrradiance(dark, Vec3{4.3f, 2.6f, 1.0f} * kVoxel, {1, 0, 0}), Vec3(0.0f));
 }
 
 TEST(OctreeIrradiance, InterpolationBlendsNeighboursTrilinearly) {
@@ -400,6 +443,13 @@ TEST(OctreeLayers, EachSurfaceOfAVoxelGetsItsOwnLayer) {
   g.layers.angularError = {0};
   g.layers.vdlCount = {1};
   g.layers.vdls = {b, Vdl{}};
+  // Each layer's surface texel follows its VDLs: the lookup steps over it
+  // to the next layer and reads the one of the layer it chose.
+  const Vec3 floorRho{0.2f, 0.4f, 0.6f}, wallRho{0.7f, 0.5f, 0.3f};
+  for (bool reflects : {false, true}) {
+  SCOPED_TRACE(reflects ? "with reflectance" : "without");
+  g.reflectance = {reflects ? floorRho : Vec3{}};
+  g.layers.reflectance = {reflects ? wallRho : Vec3{}};
   for (int format = 0; format < 3; ++format) {
     const bool half = format > 0;
     SCOPED_TRACE(format == 0 ? "float" : format == 1 ? "half" : "compact");
@@ -409,7 +459,9 @@ TEST(OctreeLayers, EachSurfaceOfAVoxelGetsItsOwnLayer) {
     params.cosineCorrection = false;
     const GpuOctree o = buildGpuOctree(g, params);
     EXPECT_EQ(o.leafCount, 1u);
-    EXPECT_EQ(o.vdlCount, 1u + 2u * 2u) << "block header + per layer header and one VDL";
+    EXPECT_EQ(o.surfaceTexels, reflects);
+    EXPECT_EQ(o.vdlCount, 1u + 2u * (reflects ? 3u : 2u))
+        << "block header + per layer header, one VDL and the surface texel";
     const OctreeSample s = lookupOctree(o, corner + Vec3(0.6f) * kVoxel);
     EXPECT_EQ(s.layerCount, 2);
     EXPECT_EQ(s.vdlCount, 1);
@@ -428,7 +480,18 @@ TEST(OctreeLayers, EachSurfaceOfAVoxelGetsItsOwnLayer) {
       EXPECT_EQ(octreeIrradiance(o, behind, {0, 1, 0}, shade), Vec3(0.0f));
       // A surface facing neither layer's way.
       EXPECT_EQ(octreeIrradiance(o, floorPoint, {0, 0, -1}, shade), Vec3(0.0f));
+      // Tilted off the wall (the wall layer serves it): the wall's VDL, and
+      // what the wall reflects of it from below the wall's plane.
+      // The wall's normal and its VDL's direction as the texels pack them.
+      const Vec3 n = normalize(Vec3{1, 0, 0.6f});
+      const Vec3 m = unpacked(g.layers.normals[0]), d = unpacked(b.direction);
+      const Vec3 tilted = octreeIrradiance(o, wallPoint, n, shade);
+      const Vec3 expected =
+          b.irradiance * dot(n, d) +
+          (reflects ? wallRho * b.irradiance * (dot(m, d) * 0.5f * (1 - dot(n, m))) : Vec3{});
+      EXPECT_NEAR(length(tilted - expected), 0.0f, tol * length(expected));
     }
+  }
   }
 }
 

@@ -157,6 +157,7 @@ VdlGrid shSlab(int terms, float power) {
       g.photonCount.push_back(1);
       g.radius.push_back(0.3f);
       g.noise.push_back(0.05f);
+      g.reflectance.push_back({0, 0, 0});  // nothing reflected: the terms alone
       g.angularError.push_back(0);
       g.vdlCount.push_back(0);
       for (int i = 0; i < g.maxVdls; ++i) g.vdls.push_back(Vdl{});

@@ -51,6 +51,7 @@ VdlGrid floorGrid(int maxVdls = 3) {
       g.photonCount.push_back(float(100 + rng.uniformInt(200)));
       g.radius.push_back(0.2f);
       g.noise.push_back(0.04f);
+      g.reflectance.push_back({0.6f, 0.5f, 0.4f});
       g.angularError.push_back(0.2f * rng.uniform());
       const uint8_t count = uint8_t(1 + rng.uniformInt(uint32_t(maxVdls)));
       g.vdlCount.push_back(count);
@@ -191,7 +192,8 @@ TEST(OptionalGrids, DroppedGridsReadAsZero) {
   }
   VdbReport r = inspectVdb(dir + "/d.vdb");
   EXPECT_TRUE(r.ok());
-  EXPECT_EQ(r.grids.size(), 3u + 2u * 3u + 1u);  // + the display grid density
+  // irradiance, reflectance, normal, vdl_count; two grids per VDL slot; density.
+  EXPECT_EQ(r.grids.size(), 4u + 2u * 3u + 1u);
 
   for (const char* bad : {"irradiance", "vdl0_direction", "vdl_count", "bogus"}) {
     VdlWriteOptions o;
@@ -244,7 +246,7 @@ TEST(Inspect, GoodFileReportsGridsAndPasses) {
   VdbReport r = inspectVdb(dir + "/g.vdb");
   EXPECT_EQ(r.kind, "vdl");
   EXPECT_TRUE(r.ok());
-  ASSERT_EQ(r.grids.size(), 8u + 2u * 2u + 1u);  // + the display grid density
+  ASSERT_EQ(r.grids.size(), 9u + 2u * 2u + 1u);  // + the display grid density
   // VDL grids are active where the voxel has that VDL (sparse).
   size_t withTwo = 0;
   for (size_t v = 0; v < g.size(); ++v) withTwo += g.vdlCount[v] > 1;
@@ -357,6 +359,7 @@ TEST(PhotonPoints, ReadBackEqualsWritten) {
     p.normal = Vec3(0, 1, 0);
     p.power = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * 1e-4f;
     p.bounce = rng.uniformInt(4);
+    for (uint8_t& r : p.reflectance) r = uint8_t(rng.uniformInt(256));
   }
   writePhotonPoints(dir + "/p.vdb", photons, 0.05f);
   std::vector<Photon> back = readPhotonPoints(dir + "/p.vdb");
@@ -373,6 +376,7 @@ TEST(PhotonPoints, ReadBackEqualsWritten) {
     ASSERT_EQ(back[i].power, photons[i].power);
     ASSERT_EQ(back[i].direction, photons[i].direction);
     ASSERT_EQ(back[i].bounce, photons[i].bounce);
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(back[i].reflectance[c], photons[i].reflectance[c]);
   }
   EXPECT_LE(worstPos, 1e-6);
   EXPECT_THROW(readPhotonPoints(dir + "/missing.vdb"), InputError);

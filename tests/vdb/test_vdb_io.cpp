@@ -59,6 +59,7 @@ VdlGrid makeGrid(size_t voxels, int maxVdls, uint64_t seed) {
     g.photonCount.push_back(float(rng.uniformInt(301)));
     g.radius.push_back(rng.uniform() * 0.1f);
     g.noise.push_back(rng.uniform() * 0.2f);
+    g.reflectance.push_back(Vec3(rng.uniform(), rng.uniform(), rng.uniform()));
     g.angularError.push_back(rng.uniform() * 0.5f);
     uint8_t count = uint8_t(rng.uniformInt(uint32_t(maxVdls) + 1));
     g.vdlCount.push_back(count);
@@ -368,7 +369,7 @@ TEST(VdbIo, PhotonPointsReadBack) {
   vdb_internal::PointFileInfo info = vdb_internal::inspectPointFile(path);
   EXPECT_EQ(info.gridNames, std::vector<std::string>{"photons"});
   EXPECT_EQ(info.pointCount, photons.size());
-  EXPECT_EQ(info.attributes, (std::vector<std::string>{"P", "Cd", "direction", "N", "bounce"}));
+  EXPECT_EQ(info.attributes, (std::vector<std::string>{"P", "Cd", "direction", "N", "bounce", "reflectance"}));
   double cd[3] = {0, 0, 0};
   int64_t bounce = 0;
   Bounds3 bounds;
