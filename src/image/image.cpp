@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 
 #include "core/error.h"
@@ -337,10 +338,47 @@ size_t jpegBody(const unsigned char* bytes, size_t size) {
   return at >= 1 && at < size && bytes[at] == 0xd8 ? at + 1 : 0;
 }
 
+/// How many of the `height` rows of `width` pixels a Radiance HDR's bytes
+/// hold, walked as stb_image decodes them: after the header (lines up to an
+/// empty one) and the resolution line, flat RGBE below 8 or from 32768
+/// pixels wide, else run-length scanlines (2, 2, width; then each of the
+/// four streams as runs of one byte and dumps of literal bytes), which turn
+/// flat for the whole image where a scanline does not start so. stb reads
+/// on past the end, repeating the last pixel, so a cut file came back whole.
+int64_t radianceRowsHeld(const unsigned char* bytes, size_t size, int64_t width, int64_t height) {
+  size_t at = 0;
+  for (bool blank = false, resolution = false; !resolution;) {
+    const void* end = std::memchr(bytes + at, '\n', size - at);
+    if (!end) return 0;
+    const size_t next = size_t(static_cast<const unsigned char*>(end) - bytes) + 1;
+    resolution = blank;
+    blank = blank || next == at + 1;
+    at = next;
+  }
+  const size_t rowBytes = size_t(width) * 4;
+  auto flatRows = [&] { return std::min(height, int64_t((size - at) / rowBytes)); };
+  if (width < 8 || width >= 32768) return flatRows();
+  for (int64_t row = 0; row < height; ++row) {
+    if (size - at < 4) return row;
+    if (bytes[at] != 2 || bytes[at + 1] != 2 || (bytes[at + 2] & 0x80)) return flatRows();
+    at += 4;
+    for (int stream = 0; stream < 4; ++stream) {
+      for (int64_t x = 0; x < width;) {
+        if (at >= size) return row;
+        const unsigned count = bytes[at++];
+        x += count > 128 ? count - 128 : count;
+        at += count > 128 ? 1 : count;
+        if (at > size) return row;
+      }
+    }
+  }
+  return height;
+}
+
 /// Refuses an encoded image whose bytes cannot hold the pixels its header
 /// claims, before it is decoded: a PNG below its raw size / 1032 (deflate's
 /// largest ratio, at one bit per pixel), a JPEG below pixels / 4096 bytes, a
-/// Radiance HDR below pixels / 32. Other formats pass.
+/// Radiance HDR that ends before its last row. Other formats pass.
 void checkImageHoldsItsPixels(const unsigned char* bytes, size_t size, int64_t width,
                               int64_t height) {
   auto starts = [&](const char* magic, size_t n) {
@@ -360,9 +398,13 @@ void checkImageHoldsItsPixels(const unsigned char* bytes, size_t size, int64_t w
     least = pixels / 4096.0;
     why = "JPEG (at least a bit per 8 x 8 block)";
   } else if (starts("#?", 2)) {
-    // Radiance RLE: a run of up to 127 bytes in 2, four streams per pixel.
-    least = pixels * 4.0 * 2.0 / 127.0 / 2.0;
-    why = "Radiance HDR (runs of at most 127)";
+    const int64_t rows = radianceRowsHeld(bytes, size, width, height);
+    if (rows < height) {
+      throw InputError("a " + std::to_string(width) + " x " + std::to_string(height) +
+                       " Radiance HDR ends after " + std::to_string(rows) + " of the " +
+                       std::to_string(height) +
+                       " rows its header promises: truncated or damaged");
+    }
   }
   if (double(size) < least) {
     throw InputError("a " + std::to_string(width) + " x " + std::to_string(height) + " " + why +
@@ -429,17 +471,59 @@ void checkEncodedImage(const unsigned char* bytes, size_t size, double bytesPerP
   checkImageHoldsItsPixels(bytes, size, w, h);
 }
 
+/// The format an image file's first bytes name: "EXR", "Radiance HDR",
+/// "PNG", "JPEG", or "" for none of them.
+std::string imageFormatOf(const std::string& head) {
+  auto starts = [&](const char* magic) { return head.rfind(magic, 0) == 0; };
+  if (starts("\x76\x2f\x31\x01")) return "EXR";
+  if (starts("#?RADIANCE\n") || starts("#?RGBE\n")) return "Radiance HDR";
+  if (starts("\x89PNG\r\n\x1a\n")) return "PNG";
+  if (jpegBody(reinterpret_cast<const unsigned char*>(head.data()), head.size()) != 0) return "JPEG";
+  return "";
+}
+
+/// Refuses a file whose first bytes are not the format its extension names
+/// (an EXR or an HDR that is none; a PNG, JPEG, EXR or HDR under another's
+/// name): stb decodes any format it knows, so a PNG named .hdr was read as
+/// linear radiance.
+void checkFormatOfExtension(const std::string& path, const std::string& ext,
+                            const std::string& head) {
+  const std::string named = ext == ".exr"   ? "EXR"
+                            : ext == ".hdr" ? "Radiance HDR"
+                            : ext == ".png" ? "PNG"
+                                            : "JPEG";
+  const std::string found = imageFormatOf(head);
+  if (found == named || (found.empty() && ext != ".exr" && ext != ".hdr")) return;
+  throw InputError(path + ": named " + ext + " but " +
+                   (found.empty() ? "its first bytes are not those of " + named
+                                  : "it holds a " + found + " image, not " + named) +
+                   ": damaged, or renamed (give the file under its own format's extension)");
+}
+
+/// The first `n` bytes of the file at `path` (fewer when it is shorter).
+std::string fileHead(const std::string& path, size_t n) {
+  std::string head(n, '\0');
+  std::ifstream in(path, std::ios::binary);
+  in.read(head.data(), std::streamsize(n));
+  head.resize(size_t(std::max<std::streamsize>(in.gcount(), 0)));
+  return head;
+}
+
 }  // namespace
 
 RgbImage readImage(const std::string& path, bool linear8Bit) {
   requireRegularFile(path, "the image");
   const std::string ext = lowerExtension(path);
-  if (ext == ".exr") return readExr(path);
+  if (ext == ".exr") {
+    checkFormatOfExtension(path, ext, fileHead(path, 16));
+    return readExr(path);
+  }
   if (ext != ".hdr" && ext != ".png" && ext != ".jpg" && ext != ".jpeg") {
     throw InputError(path + ": unsupported image extension '" + ext +
                      "' (expected .exr, .hdr, .png or .jpg)");
   }
   const std::string file = readFile(path);
+  checkFormatOfExtension(path, ext, file);
   const auto* bytes = reinterpret_cast<const unsigned char*>(file.data());
   if (file.empty() || file.size() > size_t(std::numeric_limits<int>::max())) {
     throw InputError(path + ": cannot read image (empty or larger than 2 GiB)");

@@ -469,6 +469,73 @@ TEST(ReadImage, AnExrThatHoldsLessThanItsHeaderIsRefusedUnread) {
   EXPECT_EQ(readImage(dir + "/small.exr").rgb, ramp(16, 8000).rgb);
 }
 
+/// A Radiance HDR of `width` x `height` whose row r is (1, 0.5, 0.25) times
+/// 2^(r % 2): flat RGBE below 8 pixels wide, else one run per stream and
+/// row (12 bytes a row). Also the header's length.
+std::string radianceHdr(int width, int height, size_t* headerBytes) {
+  std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(height) +
+                    " +X " + std::to_string(width) + "\n";
+  *headerBytes = hdr.size();
+  for (int r = 0; r < height; ++r) {
+    const char rgbe[4] = {char(128), char(64), char(32), char(129 + r % 2)};
+    if (width < 8) {
+      for (int x = 0; x < width; ++x) hdr.append(rgbe, 4);
+      continue;
+    }
+    hdr += {2, 2, char(width >> 8), char(width & 0xff)};
+    for (char value : rgbe) hdr += {char(128 + width), value};
+  }
+  return hdr;
+}
+
+TEST(ReadImage, ARadianceHdrCutBeforeItsLastRowIsRefusedNotRepeatedToTheEnd) {
+  // stb_image reads on past the end of a Radiance file, repeating its last
+  // pixel: a sky cut after a fifth of its rows came back whole (eighth
+  // hostile list F7-43, F7-16, F7-48). Flat and run-length files alike.
+  const std::string dir = test::outputDir("ReadImage_CutHdr");
+  for (int width : {4, 16}) {
+    size_t header = 0;
+    const std::string whole = radianceHdr(width, 6, &header);
+    const size_t rowBytes = (whole.size() - header) / 6;
+    const std::string path = dir + "/sky" + std::to_string(width) + ".hdr";
+    std::ofstream(path, std::ios::binary) << whole;
+    const RgbImage image = readImage(path);
+    ASSERT_EQ(image.width, width);
+    ASSERT_EQ(image.height, 6);
+    for (int r = 0; r < 6; ++r) {
+      const float scale = r % 2 ? 2.0f : 1.0f;
+      EXPECT_EQ(image.rgb[3 * size_t(r * width)], scale) << "row " << r;
+      EXPECT_EQ(image.rgb[3 * size_t(r * width + width - 1) + 2], 0.25f * scale) << "row " << r;
+    }
+    // Cut inside row 3, and by its last byte alone.
+    for (const auto& [bytes, rows] : {std::pair{header + 3 * rowBytes + 5, 3},
+                                      std::pair{whole.size() - 1, 5}}) {
+      const std::string cut = dir + "/cut" + std::to_string(width) + ".hdr";
+      std::ofstream(cut, std::ios::binary) << whole.substr(0, bytes);
+      test::expectRefusal([&] { readImage(cut); },
+                          {cut, "ends after " + std::to_string(rows) + " of the 6 rows",
+                           "truncated or damaged"});
+    }
+  }
+}
+
+TEST(ReadImage, AFileWhoseBytesAreNotItsExtensionsFormatIsRefused) {
+  // stb decodes whatever it recognises: a PNG named .hdr was taken as a
+  // linear radiance sky (eighth hostile list F7-19).
+  const std::string dir = test::outputDir("ReadImage_Renamed");
+  const std::string png = seedImage("tiny.png");
+  std::ofstream(dir + "/p.png", std::ios::binary) << png;
+  EXPECT_EQ(readImage(dir + "/p.png").width, 16);
+  for (const char* name : {"/p.hdr", "/p.exr"}) {
+    std::ofstream(dir + name, std::ios::binary) << png;
+    test::expectRefusal([&] { readImage(dir + name); },
+                        {dir + name, "holds a PNG image, not", "renamed"});
+  }
+  std::ofstream(dir + "/text.hdr", std::ios::binary) << "not an image at all";
+  test::expectRefusal([&] { readImage(dir + "/text.hdr"); },
+                      {"its first bytes are not those of Radiance HDR"});
+}
+
 // A GIF whose header holds no frame (14 bytes, from a glTF's data URI): stb
 // refuses it with no reason, and the message was "unreadable image ...: "
 // and nothing; it now says which formats are read.
