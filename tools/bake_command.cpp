@@ -116,7 +116,7 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   if (!opt.photonMap.empty()) {
     StageTimer pointsTimer(rows, "write photon map");
     writePhotonPoints(opt.photonMap, baked.photons.photons, baked.grid.frame.voxelSize,
-                      scene.origin, &outputs, baked.metadata.sourceSceneHash);
+                      scene.origin, &outputs, photonMapInfo(baked.metadata));
     pointsTimer.finish(opt.photonMap);
   }
 

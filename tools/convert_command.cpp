@@ -139,12 +139,15 @@ int runConvert(const ConvertOptions& opt) {
   std::vector<Photon> photons;
   if (!opt.photonMap.empty()) {
     StageTimer readTimer(rows, "read photon map");
-    std::string photonHash;
-    photons = readPhotonPoints(opt.photonMap, in.grid.frame.offset, &photonHash);
+    PhotonMapInfo info;
+    photons = readPhotonPoints(opt.photonMap, in.grid.frame.offset, &info);
     params.photons = &photons;
+    params.photonRegion = info.region;
     readTimer.finish(formatCount(photons.size()) + " photons");
     const std::string what = "--photon-map '" + opt.photonMap + "'";
-    if (!opt.scene.empty()) warn(sceneMismatchWarning(what, photonHash, opt.scene, sceneHash));
+    if (!opt.scene.empty()) {
+      warn(sceneMismatchWarning(what, info.sourceSceneHash, opt.scene, sceneHash));
+    }
   }
   ConvertResult out = convertLightGrid(in.grid, in.meta, params, &progress);
   rows.insert(rows.end(), out.stages.begin(), out.stages.end());

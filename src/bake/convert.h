@@ -27,6 +27,10 @@ struct ConvertParams {
   /// Photons of the bake (`bake --photon-map`): re-gather at the new depth.
   /// Needs `scene`. May be null.
   const std::vector<Photon>* photons = nullptr;
+  /// The region the photons were stored in (their bake's --bounds,
+  /// PhotonMapInfo), in the scene's coordinates; empty = everywhere. A grid
+  /// reaching beyond it is refused (its voxels there would gather nothing).
+  Bounds3 photonRegion;
 };
 
 struct ConvertResult {
@@ -41,8 +45,9 @@ struct ConvertResult {
 /// @brief Converts `input` (with its file metadata `meta`) as `params` asks.
 /// `convertedFrom` is left to the caller, which knows the file name.
 /// @throws InputError naming the flag when the request needs what was not
-/// given (a finer depth without a scene, photons without a scene) or the
-/// scene does not match the grid's frame.
+/// given (a finer depth without a scene, photons without a scene), the
+/// scene does not match the grid's frame, or the photons' region does not
+/// hold the grid's.
 ConvertResult convertLightGrid(const VdlGrid& input, const BakeMetadata& meta,
                                const ConvertParams& params, ProgressSink* progress = nullptr);
 

@@ -103,26 +103,39 @@ std::vector<VdbCheck> checkLightGridValues(const VdlGrid& grid, bool halfFloat);
 LoadedVdl readVdlGrid(const std::string& path,
                       const std::optional<Vec3d>& origin = std::nullopt);
 
+/// What a photon file records besides its photons.
+struct PhotonMapInfo {
+  /// The content hash of the scene the photons were traced in
+  /// (BakeMetadata::sourceSceneHash), file metadata "source_scene_hash", so
+  /// that a reader can tell a photon map of another scene; "" = none.
+  std::string sourceSceneHash;
+  /// The bake's region (`bake --bounds`, BakeMetadata::region), outside
+  /// which no photon was stored; empty = the whole scene (or not recorded).
+  /// In the coordinates of the photons' positions: file metadata
+  /// "region_min" and "region_max" in world coordinates.
+  Bounds3 region;
+};
+
+/// What a photon file of the bake of `meta` records.
+inline PhotonMapInfo photonMapInfo(const BakeMetadata& meta) {
+  return {meta.sourceSceneHash, meta.region};
+}
+
 /// Writes photons as a PointDataGrid named "photons" with attributes P,
 /// Cd (RGB power, W), direction (wi), normal, bounce. Temp name + rename.
 /// `offset`: Scene::origin of the photons' scene; the file's positions are
-/// world positions (offset + position, in double).
-/// `sourceSceneHash`: the content hash of the scene the photons were traced
-/// in (BakeMetadata::sourceSceneHash), written as file metadata
-/// "source_scene_hash" so that a reader can tell a photon map of another
-/// scene; "" writes none.
+/// world positions (offset + position, in double), as the region of `info`.
 void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
                        const Vec3d& offset = Vec3d(), AtomicFileSet* into = nullptr,
-                       const std::string& sourceSceneHash = "");
+                       const PhotonMapInfo& info = {});
 
 /// Reads a photon file written by writePhotonPoints. Photons come back in the
 /// file's (leaf) order, which is deterministic but not the order written.
 /// @throws InputError naming the file when it cannot be read, holds no
 /// "photons" point grid or lacks one of the attributes.
-/// Positions come back relative to `origin` (computed in double).
-/// `sourceSceneHash`, when given, receives the file's "source_scene_hash"
-/// ("" when the file carries none).
+/// Positions come back relative to `origin` (computed in double), as the
+/// region `info` receives (with the scene hash: "" when the file has none).
 std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origin = Vec3d(),
-                                     std::string* sourceSceneHash = nullptr);
+                                     PhotonMapInfo* info = nullptr);
 
 }  // namespace lo

@@ -26,7 +26,7 @@ namespace {
 using openvdb::math::Transform;
 
 void writePoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
-                 const Vec3d& offset, AtomicFileSet* into, const std::string& sourceSceneHash) {
+                 const Vec3d& offset, AtomicFileSet* into, const PhotonMapInfo& info) {
   if (!(voxelSize > 0) || !std::isfinite(voxelSize)) {
     throw InputError(path + ": photon point voxel size must be positive, got " +
                      std::to_string(voxelSize));
@@ -83,19 +83,36 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   meta.insertMeta("photons", openvdb::Int64Metadata(int64_t(n)));
   // The scene the photons were traced in, as the .vdb records it: a reader
   // given another scene can say so (convert --photon-map --scene).
-  if (!sourceSceneHash.empty()) {
-    meta.insertMeta("source_scene_hash", openvdb::StringMetadata(sourceSceneHash));
+  if (!info.sourceSceneHash.empty()) {
+    meta.insertMeta("source_scene_hash", openvdb::StringMetadata(info.sourceSceneHash));
+  }
+  // The region the photons were stored in (bake --bounds), in world
+  // coordinates as the positions: a reader can tell a grid it does not cover.
+  if (!info.region.empty()) {
+    for (const auto& [key, corner] : {std::pair{"region_min", info.region.lower},
+                                      std::pair{"region_max", info.region.upper}}) {
+      const Vec3d w = offset + Vec3d(corner);
+      meta.insertMeta(key, openvdb::Vec3DMetadata(openvdb::Vec3d(w.x, w.y, w.z)));
+    }
   }
   writeVdbFile(path, {{"photons", [&grid] { return openvdb::GridBase::Ptr(grid); }}}, meta, into);
 }
 
 std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin,
-                               std::string* sourceSceneHash) {
+                               PhotonMapInfo* info) {
   namespace pts = openvdb::points;
   OpenedFile f = openFile(path);
-  if (sourceSceneHash) {
+  if (info) {
     auto hash = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f.meta)["source_scene_hash"]);
-    *sourceSceneHash = hash ? hash->value() : "";
+    info->sourceSceneHash = hash ? hash->value() : "";
+    auto lower = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>((*f.meta)["region_min"]);
+    auto upper = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>((*f.meta)["region_max"]);
+    info->region = Bounds3();
+    if (lower && upper && lower->value().isFinite() && upper->value().isFinite()) {
+      for (const openvdb::Vec3d& w : {lower->value(), upper->value()}) {
+        info->region.extend((Vec3d(w.x(), w.y(), w.z()) - origin).toVec3());
+      }
+    }
   }
   if (!findGrid(f, "photons") && findGrid(f, gridNameOf(&VdlGrid::irradiance))) {
     throw InputError(path + ": is a VDL file (written by `lightoctree bake -o`), not a photon "
@@ -190,13 +207,13 @@ PointFileInfo inspectPointFile(const std::string& path) {
 }  // namespace vdb_internal
 
 std::vector<Photon> readPhotonPoints(const std::string& path, const Vec3d& origin,
-                                     std::string* sourceSceneHash) {
-  return vdb_internal::readPoints(path, origin, sourceSceneHash);
+                                     PhotonMapInfo* info) {
+  return vdb_internal::readPoints(path, origin, info);
 }
 
 void writePhotonPoints(const std::string& path, const std::vector<Photon>& photons, float voxelSize,
-                       const Vec3d& offset, AtomicFileSet* into, const std::string& sourceSceneHash) {
-  vdb_internal::writePoints(path, photons, voxelSize, offset, into, sourceSceneHash);
+                       const Vec3d& offset, AtomicFileSet* into, const PhotonMapInfo& info) {
+  vdb_internal::writePoints(path, photons, voxelSize, offset, into, info);
 }
 
 }  // namespace lo

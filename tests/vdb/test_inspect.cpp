@@ -782,13 +782,14 @@ TEST(PhotonPoints, CarryTheirScenesHash) {
     photons[i].power = Vec3(1.0f);
     photons[i].direction = photons[i].normal = Vec3(0, 1, 0);
   }
-  writePhotonPoints(dir + "/hashed.vdb", photons, 0.05f, Vec3d(), nullptr, "0123456789abcdef");
+  writePhotonPoints(dir + "/hashed.vdb", photons, 0.05f, Vec3d(), nullptr,
+                    {"0123456789abcdef", Bounds3()});
   writePhotonPoints(dir + "/plain.vdb", photons, 0.05f);
-  std::string hash = "x";
-  EXPECT_EQ(readPhotonPoints(dir + "/hashed.vdb", Vec3d(), &hash).size(), 3u);
-  EXPECT_EQ(hash, "0123456789abcdef");
-  readPhotonPoints(dir + "/plain.vdb", Vec3d(), &hash);
-  EXPECT_EQ(hash, "");
+  PhotonMapInfo info{"x", Bounds3()};
+  EXPECT_EQ(readPhotonPoints(dir + "/hashed.vdb", Vec3d(), &info).size(), 3u);
+  EXPECT_EQ(info.sourceSceneHash, "0123456789abcdef");
+  readPhotonPoints(dir + "/plain.vdb", Vec3d(), &info);
+  EXPECT_EQ(info.sourceSceneHash, "");
   // The warning: none when the hashes agree or none was recorded.
   EXPECT_EQ(sceneMismatchWarning("--photon-map 'p.vdb'", "", "s.gltf", "1"), "");
   EXPECT_EQ(sceneMismatchWarning("--photon-map 'p.vdb'", "1", "s.gltf", "1"), "");
