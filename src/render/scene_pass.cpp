@@ -25,6 +25,9 @@ namespace {
 /// below another flickers through it): outside the scene's box, to 90% of
 /// the eye's distance from the box (nothing lies nearer); and at least
 /// 1e-4 of the far plane (depth steps under 1e-3 of the distance to its end).
+/// An authored near plane at or beyond the far one would clip the whole
+/// scene, which the tracers (that have none) draw: left out (the scene
+/// loader warns of it).
 float nearPlane(const PinholeCamera& camera, const RenderSpace& space, float zfar) {
   const Vec3 eye = space.toRender(camera.eye);
   const Bounds3& box = space.bounds;
@@ -33,7 +36,7 @@ float nearPlane(const PinholeCamera& camera, const RenderSpace& space, float zfa
     const float d = std::max({box.lower[a] - eye[a], eye[a] - box.upper[a], 0.0f});
     outside += d * d;
   }
-  const float authored = camera.znear > 0 ? camera.znear : 0.01f;
+  const float authored = camera.znear > 0 && camera.znear < zfar ? camera.znear : 0.01f;
   const float znear = std::max({authored, 0.9f * std::sqrt(outside), 1e-4f * zfar});
   return std::min(znear, 0.5f * zfar);
 }
@@ -444,9 +447,11 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
                        (rp.mode == RenderMode::Full || rp.mode == RenderMode::Indirect);
   if (reflect && !probe.valid) captureProbe(rp);
   const glm::vec3 eye = toGlm(space.toRender(camera.eye));
-  const float zfar =
-      camera.zfar > 0 ? camera.zfar
-                      : glm::length(eye - toGlm(space.bounds.center())) + space.sceneSize + 1e-3f;
+  // Nothing of the scene lies farther than its box: an authored far plane
+  // beyond it only spends the depth buffer's precision (a zfar of 1e30
+  // raised the near plane past the whole scene).
+  const float farthest = glm::length(eye - toGlm(space.bounds.center())) + space.sceneSize + 1e-3f;
+  const float zfar = camera.zfar > 0 ? std::min(camera.zfar, farthest) : farthest;
   const float znear = nearPlane(camera, space, zfar);
   const float aspect = float(width) / float(height);
   // The pixel's sample point moved by pixelOffset: the image shifted the

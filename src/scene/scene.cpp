@@ -751,8 +751,11 @@ Vec3d RebaseBounds::origin() const {
 }
 
 /// Cameras within the coordinates a scene may have (kMaxCoordinate), as
-/// lights are: a camera at 1e19 would abort the tracers.
-void checkCameras(const Scene& scene) {
+/// lights are: a camera at 1e19 would abort the tracers. A near plane
+/// beyond the whole scene would clip all of it: the renderer leaves it out,
+/// as the tracers (which have none), with a warning here.
+void checkCameras(Scene& scene) {
+  const Bounds3 box = scene.bounds();
   for (const Camera& c : scene.cameras) {
     const Vec3d w = scene.toWorld(c.position);
     const double reach = std::max({std::fabs(w.x), std::fabs(w.y), std::fabs(w.z)});
@@ -760,6 +763,21 @@ void checkCameras(const Scene& scene) {
       fail(scene.sourcePath, "camera '" + c.name + "' lies at " + w.toVec3().ToString() +
                                  ", beyond " + formatLimit(kMaxCoordinate) +
                                  " scene units from the origin");
+    }
+    double farthest = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double d = std::max(std::fabs(double(c.position[a]) - box.lower[a]),
+                                std::fabs(double(box.upper[a]) - c.position[a]));
+      farthest += d * d;
+    }
+    farthest = std::sqrt(farthest);
+    if (double(c.znear) >= farthest) {
+      scene.warnings.push_back(scene.sourcePath + ": camera '" + c.name + "' has znear " +
+                               formatLimit(c.znear) +
+                               ", beyond the whole scene (its farthest point is " +
+                               formatLimit(farthest) +
+                               " scene units away): left out, as a near plane that would clip "
+                               "everything");
     }
   }
 }

@@ -227,6 +227,27 @@ TEST_F(RenderImage, SupersamplingIsTheBoxFilterOfTheLargerImage) {
       InputError);
 }
 
+// A glTF camera's znear of 1e30 (beyond the whole scene), or a zfar of
+// 1e30, put the near plane past everything: a black image where the tracers
+// draw the scene (eighth hostile list F4-55, F4-56). The planes follow the
+// scene's box: the same image as the camera's usual planes.
+TEST_F(RenderImage, ACameraNearOrFarPlaneBeyondTheSceneDrawsItAsTheUsualPlanes) {
+  QuadSetup s;
+  const RenderParams p = QuadSetup::params(false);
+  const RgbImage usual = s.render(test::constantOctree(), p);
+  ASSERT_GT(usual.pixel(p.width / 2, p.height / 2)[0], 0.0f);
+  for (const auto& [znear, zfar] : {std::pair{1e30f, 0.0f}, std::pair{1e-30f, 1e30f}}) {
+    QuadSetup odd;
+    odd.camera.znear = znear;
+    odd.camera.zfar = zfar;
+    const RgbImage image = odd.render(test::constantOctree(), p);
+    ASSERT_EQ(image.rgb.size(), usual.rgb.size());
+    for (size_t i = 0; i < image.rgb.size(); ++i) {
+      ASSERT_NEAR(image.rgb[i], usual.rgb[i], 1e-5f) << "znear " << znear << ", zfar " << zfar;
+    }
+  }
+}
+
 // Two by two samples lie on a rotated grid (x offsets -3/8, -1/8, 1/8, 3/8
 // of a pixel, one per row as well): a vertical edge 0.247 px right of a
 // pixel's centre leaves 3 of its 4 samples on the quad, where an ordered

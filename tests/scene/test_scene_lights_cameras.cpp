@@ -123,6 +123,19 @@ TEST_F(SceneGltf, CamerasThatCannotShowAnythingAreRefused) {
                    "zfar > znear");
   expectInputError(withCamera("away.gltf", R"({"camera": 0, "translation": [0, 0, 1e19]})", fine),
                    "beyond");
+  // A near plane beyond the whole scene (eighth hostile list F4-55): the
+  // renderer leaves it out, as the tracers; the loader says so.
+  const Scene beyond = loadScene(withCamera("znear.gltf", R"({"camera": 0, "name": "far-near",
+                                              "translation": [0, 0, 3]})",
+                                            R"({"yfov": 0.8, "znear": 1e30})"));
+  std::string all;
+  for (const std::string& w : beyond.warnings) all += w + "\n";
+  EXPECT_NE(all.find("camera 'far-near' has znear 1e+30, beyond the whole scene"),
+            std::string::npos)
+      << all;
+  const Scene near = loadScene(withCamera("near.gltf", R"({"camera": 0, "translation": [0, 0, 3]})",
+                                          R"({"yfov": 0.8, "znear": 1e-30, "zfar": 1e30})"));
+  EXPECT_TRUE(near.warnings.empty()) << near.warnings.front();
 }
 
 // A yfov of 1e-30 radians was taken (a projection of scale 1e30, an image of
