@@ -734,6 +734,15 @@ void checkLightAndMaterialValues(Scene& scene) {
                                  ", outside [0, " + formatLimit(kMaxLightIntensity) +
                                  "] (cd or lx, as W/sr or W/m^2)");
     }
+    // glTF asks inner < outer; an inner cone beyond the outer one was drawn
+    // by the renderer and the tracers each their own way.
+    if (light.type == Light::Type::Spot && light.innerConeAngle > light.outerConeAngle) {
+      scene.warnings.push_back(scene.sourcePath + ": " + name + " has innerConeAngle " +
+                               formatLimit(light.innerConeAngle) + " beyond its outerConeAngle " +
+                               formatLimit(light.outerConeAngle) + " (radians): clamped to " +
+                               formatLimit(light.outerConeAngle));
+      light.innerConeAngle = light.outerConeAngle;
+    }
     const Vec3d world = scene.toWorld(light.position);
     const double reach = std::max({std::fabs(world.x), std::fabs(world.y), std::fabs(world.z)});
     if (!std::isfinite(reach) || reach > double(kMaxCoordinate)) {

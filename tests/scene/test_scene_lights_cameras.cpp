@@ -49,6 +49,23 @@ TEST_F(SceneGltf, LightAndMaterialValuesStayInTheirRanges) {
   EXPECT_NE(all.find("material 'odd' roughness is -3"), std::string::npos) << all;
   EXPECT_NE(all.find("material 'odd' has a negative emission"), std::string::npos) << all;
   EXPECT_NE(all.find("light 'L' colour channel 1 is -0.5"), std::string::npos) << all;
+  // A spot's inner cone beyond its outer one (glTF asks inner < outer): the
+  // renderer drew none of its direct light, the tracers the outer cone
+  // (eighth hostile list F4-35). Clamped to the outer cone, warned.
+  const Scene spot = loadScene(write(
+      "spot.gltf",
+      withLight(R"({"type": "spot", "intensity": 1,
+                    "spot": {"innerConeAngle": 1.0, "outerConeAngle": 0.2}})",
+                "[0, 1, 0]")));
+  ASSERT_EQ(spot.lights.size(), 1u);
+  EXPECT_FLOAT_EQ(spot.lights[0].outerConeAngle, 0.2f);
+  EXPECT_EQ(spot.lights[0].innerConeAngle, spot.lights[0].outerConeAngle);
+  all.clear();
+  for (const std::string& w : spot.warnings) all += w + "\n";
+  EXPECT_NE(all.find("light 'L' has innerConeAngle 1 beyond its outerConeAngle 0.2 (radians): "
+                     "clamped to 0.2"),
+            std::string::npos)
+      << all;
   expectInputError(
       write("bright.gltf",
                 withLight(R"({"type": "point", "intensity": 1e37})", "[0, 1, 0]")),
