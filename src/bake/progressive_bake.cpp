@@ -160,11 +160,22 @@ void checkDepths(const ProgressiveParams& params) {
   }
 }
 
+/// The photons to trace and the finest level's voxels against the memory,
+/// before any is traced, as bake checks them (checkBakeMemory): 2e8 photons
+/// traced for a minute, growing, until an allocation failed.
+void checkMemory(const Scene& scene, const ProgressiveParams& params) {
+  BakeParams bake;
+  bake.depth = params.targetDepth;
+  bake.photons = params.photons.storedPhotons;
+  checkBakeMemory(scene, bake);
+}
+
 }  // namespace
 
 ProgressiveBake::ProgressiveBake(const Scene& scene, const ProgressiveParams& params)
     : impl_(std::make_unique<Impl>(scene, params)) {
   checkDepths(params);
+  checkMemory(scene, params);
   impl_->thread = std::thread([this] { impl_->run(); });
 }
 

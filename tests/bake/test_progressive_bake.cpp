@@ -149,5 +149,19 @@ TEST(ProgressiveBake, RefusesBadDepths) {
   EXPECT_THROW(ProgressiveBake(scene, params), InputError);
 }
 
+// view --progressive traced 2e8 photons for a minute, growing, where bake
+// refuses them at once (eighth hostile list F4-74): the same check, before
+// any photon, under a limit the photons do not fit.
+TEST(ProgressiveBake, PhotonsBeyondTheMemoryAreRefusedBeforeTracing) {
+  Scene scene = test::pointLitRoom();
+  ProgressiveParams params = smallParams();
+  params.photons.storedPhotons = 20000000;  // 2.4 GB at kBakeBytesPerPhoton
+  const std::optional<std::string> message = test::messageUnderAddressSpaceLimit(
+      size_t(256) << 20, [&] { ProgressiveBake bake(scene, params); });
+  if (!message) GTEST_SKIP() << "a lower address-space limit is already in force";
+  EXPECT_NE(message->find("with the photons need about"), std::string::npos) << *message;
+  EXPECT_NE(message->find("of memory available"), std::string::npos) << *message;
+}
+
 }  // namespace
 }  // namespace lo
