@@ -157,4 +157,29 @@ if ! ldd "$cli" 2>/dev/null | grep -q libasan; then
   done
 fi
 
+# 8. The kill tests' hook, LIGHTOCTREE_PAUSE_SET, left in a user's
+#    environment without LIGHTOCTREE_TEST_HOOKS=1: no pause (it waited for a
+#    signal that never came; eighth hostile list F2-21).
+err=$(LIGHTOCTREE_PAUSE_SET=commit timeout 30 "$cli" bake "$scene" -o "$out/hook.vdb" --depth 3 \
+  --photons 3000 --knn 20 --quiet 2>&1)
+rc=$?
+if [ "$rc" -ne 0 ] || grep -q "paused at" <<<"$err"; then
+  fail "LIGHTOCTREE_PAUSE_SET alone: exit $rc: $err"
+fi
+
+# 9. Outputs take 0666 less the umask, as any new file (umask 002 gave 0644,
+#    not 0664: F2-29); a replaced file too.
+for mask in 002 022 077; do
+  for run in new replaced; do
+    (umask $mask && "$cli" bake "$scene" -o "$out/mode.vdb" --depth 3 --photons 3000 --knn 20 \
+      --quiet --stats-json "$out/mode.json") || fail "umask $mask: the bake failed"
+    want=$(printf '%o' $((0666 & ~0$mask)))
+    for f in "$out/mode.vdb" "$out/mode.json"; do
+      got=$(stat -c %a "$f")
+      [ "$got" = "$want" ] || fail "umask $mask ($run): $f has mode $got, not $want"
+    done
+  done
+  rm -f "$out/mode.vdb" "$out/mode.json"
+done
+
 [ "$failed" -eq 0 ] && echo "environment: every case refused or reported"

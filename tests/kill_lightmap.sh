@@ -3,8 +3,8 @@
 # (glTF, .bin, five pages, five chart images, preview: 13 files) replacing an
 # earlier one-page set is killed (SIGINT, SIGTERM, SIGKILL) at set moments:
 # while tracing, after the 1st, 7th and 13th file of the set is written (the
-# test hook LIGHTOCTREE_PAUSE_SET pauses there), and in the middle of the
-# renames. Afterwards the files are the old set or the new set, whole: never
+# test hook LIGHTOCTREE_PAUSE_SET, with LIGHTOCTREE_TEST_HOOKS=1, pauses
+# there), and in the middle of the renames. Afterwards the files are the old set or the new set, whole: never
 # a mix, never a page without its glTF; after SIGINT and SIGTERM no temporary
 # file. A signal that arrives during the renames waits for them (the new set).
 # Usage: kill_lightmap.sh LIGHTOCTREE SCENE WORKDIR
@@ -35,7 +35,7 @@ for sig in INT TERM KILL; do
     # read the file before the child has opened it, and must not find the
     # previous run's pause there.
     : > "$dir/stderr"
-    LIGHTOCTREE_PAUSE_SET=$pause "$cli" lightmap "$scene" "$dir/grid.vdb" -o "$out/lm.gltf" "${new[@]}" \
+    LIGHTOCTREE_TEST_HOOKS=1 LIGHTOCTREE_PAUSE_SET=$pause "$cli" lightmap "$scene" "$dir/grid.vdb" -o "$out/lm.gltf" "${new[@]}" \
       2> "$dir/stderr" &
     pid=$!
     if [ "$moment" = trace ]; then

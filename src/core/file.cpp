@@ -134,10 +134,11 @@ void requireReplaceable(const std::string& path) {
 
 /// A new temporary name of `path`, its file created exclusively and without
 /// following links: a name that exists (whoever put it there) is an error,
-/// never something to write through.
+/// never something to write through. Its mode is 0666 less the umask, as
+/// any new file's (0644 kept a group-writable folder's group out, umask 002).
 std::string createTemporary(const std::string& path) {
   const std::string tmp = temporaryPathFor(path);
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (fd < 0) {
     throw IoError(path + ": cannot create the temporary file '" + tmp + "' (" +
                   openFailureText(errno) + ")");
@@ -320,14 +321,17 @@ void writeAtomically(const std::string& path,
 
 namespace {
 
-/// The test hook of the kill tests (tests/kill_lightmap.sh):
-/// LIGHTOCTREE_PAUSE_SET=add:N pauses a set after writing its N-th file,
+/// The test hook of the kill tests (tests/kill_lightmap.sh), with
+/// LIGHTOCTREE_TEST_HOOKS=1: LIGHTOCTREE_PAUSE_SET=add:N pauses a set after writing its N-th file,
 /// =commit after its first rename, saying so on stderr, so that a signal
 /// lands at that moment every time.
 void pauseForTest(const char* moment, size_t n) {
   static const std::string wanted = [] {
+    // Only where LIGHTOCTREE_TEST_HOOKS=1 says a test runs: the variable
+    // alone, left in a user's environment, paused every run forever.
+    const char* hooks = std::getenv("LIGHTOCTREE_TEST_HOOKS");
     const char* v = std::getenv("LIGHTOCTREE_PAUSE_SET");
-    return std::string(v ? v : "");
+    return std::string(v && hooks && std::string(hooks) == "1" ? v : "");
   }();
   if (wanted.empty()) return;
   const std::string here = n ? std::string(moment) + ":" + std::to_string(n) : std::string(moment);
