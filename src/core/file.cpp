@@ -497,7 +497,16 @@ void checkOutputFolder(const std::string& path, const char* flag) {
   requireWorkingFolder(path, flag);
   const fs::path parent = fs::path(path).parent_path();
   const fs::path folder = parent.empty() ? fs::path(".") : parent;
-  if (!fs::is_directory(folder)) {
+  // A folder that cannot be looked up (a loop of links, one too long) is
+  // said so naming the flag: std::filesystem's own text named neither.
+  std::error_code ec;
+  const bool isFolder = fs::is_directory(folder, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory) {
+    throw InputError(std::string(flag) + ": folder '" + folder.string() +
+                     "' cannot be reached: " + ec.message() +
+                     (ec == std::errc::too_many_symbolic_link_levels ? " (a loop of links?)" : ""));
+  }
+  if (!isFolder) {
     throw InputError(std::string(flag) + ": folder '" + parent.string() + "' does not exist");
   }
   if (::access(folder.c_str(), W_OK | X_OK) != 0) {

@@ -16,6 +16,7 @@
 #define TINYGLTF_IMPLEMENTATION
 #include "scene/gltf_internal.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -174,8 +175,31 @@ Scene loadGltf(const std::string& path, const std::string& skyMesh) {
   // level: a document nested deeper than any glTF needs would overflow the
   // stack. Counted first, outside strings.
   checkJsonNesting(path, jsonText);
-  nlohmann::json j = nlohmann::json::parse(jsonText, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded()) fail(path, "invalid glTF: the JSON does not parse");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(jsonText);
+  } catch (const nlohmann::json::exception& e) {
+    // nlohmann's reason, without its tag ("[json.exception.parse_error.101]
+    // "): the line, the column and what it read there (a number beyond a
+    // double, 1e400, is as much an error as a missing comma).
+    std::string reason = e.what();
+    if (reason.rfind("[json.exception.", 0) == 0 && reason.find("] ") != std::string::npos) {
+      reason.erase(0, reason.find("] ") + 2);
+    }
+    // A number overflow names the number but not where: its first place.
+    const size_t quote = reason.find('\'');
+    if (quote != std::string::npos && reason.find("at line") == std::string::npos) {
+      const size_t at =
+          jsonText.find(reason.substr(quote + 1, reason.find('\'', quote + 1) - quote - 1));
+      if (at != std::string::npos) {
+        const auto line = std::count(jsonText.begin(), jsonText.begin() + ptrdiff_t(at), '\n');
+        const size_t lineStart = jsonText.rfind('\n', at) + 1;  // 0 on the first line
+        reason += " at line " + std::to_string(line + 1) + ", column " +
+                  std::to_string(at - lineStart + 1);
+      }
+    }
+    fail(path, "invalid glTF: the JSON does not parse: " + firstLine(reason));
+  }
   prevalidateJson(path, baseDir, j);
   j = nlohmann::json();
 

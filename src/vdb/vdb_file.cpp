@@ -65,6 +65,21 @@ struct MemoryFile {
   std::string name() const { return "/proc/self/fd/" + std::to_string(fd); }
 };
 
+/// The refusal of a file OpenVDB could not read. One that starts as a .vdb
+/// (OpenVDB's magic number) is damaged or truncated, whatever OpenVDB says
+/// of it ("Grid type  is not registered" for a cut grid file, a count of
+/// 2^64 - 1 bytes for a cut photon map); another is likely not a .vdb.
+InputError unreadable(const std::string& path, const std::string& what) {
+  const char kMagic[8] = {0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0};  // int64 0x56444220
+  char head[8] = {};
+  std::ifstream in(path, std::ios::binary);
+  const bool vdb = in.read(head, sizeof head) && std::memcmp(head, kMagic, sizeof head) == 0;
+  return InputError(path + ": cannot read as an OpenVDB file: " +
+                    (vdb ? "damaged or truncated (it starts as a .vdb, then OpenVDB fails: " +
+                               clipped(what) + ")"
+                         : clipped(what)));
+}
+
 }  // namespace
 
 OpenedFile openFile(const std::string& path) {
@@ -122,7 +137,7 @@ OpenedFile openFile(const std::string& path) {
     throw IoError(trial.message);
   }
   if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode != 0) {
-    throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(trial.message));
+    throw unreadable(path, trial.message);
   }
   // Out of memory under the process's own limit (ulimit -v) says nothing
   // about the file: a valid one was called damaged.
@@ -161,7 +176,7 @@ OpenedFile openFile(const std::string& path) {
       file.close();
     }
   } catch (const std::exception& e) {
-    throw InputError(path + ": cannot read as an OpenVDB file: " + clipped(e.what()));
+    throw unreadable(path, e.what());
   }
   if (!f.grids || !f.meta) throw InputError(path + ": cannot read as an OpenVDB file");
   return f;

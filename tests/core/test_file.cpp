@@ -99,6 +99,14 @@ TEST(OutputFiles, NeverWritesThroughALinkOrOverWhatIsNotARegularFile) {
   EXPECT_THROW(checkOutputFolder("/dev/null", "--output"), InputError);
   EXPECT_THROW(checkOutputFolder(dir + "/no-such-folder/x.vdb", "--output"), InputError);
   EXPECT_TRUE(leftoverTemporaries(link).empty());
+  // A folder that is a loop of links (a -> b -> a): refused naming the flag
+  // and the folder, not in std::filesystem's words (eighth hostile list F6-21).
+  fs::remove(dir + "/a");
+  fs::remove(dir + "/b");
+  fs::create_symlink("b", dir + "/a");
+  fs::create_symlink("a", dir + "/b");
+  test::expectRefusal([&] { checkOutputFolder(dir + "/a/o.vdb", "--output"); },
+                      {"--output: folder '" + dir + "/a' cannot be reached", "a loop of links"});
 }
 
 // An output in /proc or /sys (which take no new file whatever their

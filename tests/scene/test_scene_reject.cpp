@@ -250,6 +250,14 @@ TEST_F(SceneReject, NoTriangles) {
 TEST_F(SceneReject, InvalidJson) {
   expectInputError(write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": ["),
                    "invalid glTF");
+  // A number beyond a double (eighth hostile list F4-33) is refused with the
+  // reason and where, not "does not parse" alone.
+  MiniGltf g = oneTriangle();
+  g.extraTop = R"("extras": {"big": 1e400}, )";
+  const std::string path = write("overflow.gltf", g);
+  expectInputError(path, "the JSON does not parse: number overflow parsing '1e400' at line 1");
+  expectInputError(write("comma.gltf", "{\"asset\": {\"version\": \"2.0\"}\n \"nodes\": []}"),
+                   "parse error at line 2");
 }
 
 TEST_F(SceneReject, NodeCycle) {

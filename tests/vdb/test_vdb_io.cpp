@@ -659,5 +659,36 @@ TEST(VdbIo, APhotonMapIsRefusedForAGridBeyondItsRegion) {
   EXPECT_NO_THROW(convertLightGrid(whole.grid, whole.metadata, cp));
 }
 
+// A .vdb or a photon map cut short was refused in OpenVDB's words: "Grid
+// type  is not registered", "Expected to decompress 360000 bytes, got
+// 18446744073709551615 bytes" (eighth hostile list F7-37, F7-38). A file
+// that starts as a .vdb is said to be damaged or truncated.
+TEST(VdbIo, AFileCutShortIsCalledDamagedOrTruncated) {
+  BakeParams p = test::smallBake(3, 20000, 40);
+  p.keepPhotons = true;
+  const BakeResult baked = bake(test::pointLitRoom(), p);
+  const std::string dir = test::outputDir("VdbIo.Cut");
+  writeVdlGrid(dir + "/grid.vdb", baked.grid, baked.metadata);
+  writePhotonPoints(dir + "/photons.vdb", baked.photons.photons, baked.grid.frame.voxelSize);
+  for (const char* name : {"/grid.vdb", "/photons.vdb"}) {
+    const std::string whole = readFile(dir + name), cut = dir + "/cut" + (name + 1);
+    std::ofstream(cut, std::ios::binary) << whole.substr(0, whole.size() / 2);
+    test::expectRefusal(
+        [&] {
+          if (std::string(name) == "/grid.vdb") readVdlGrid(cut);
+          else readPhotonPoints(cut);
+        },
+        {cut + ": cannot read as an OpenVDB file: damaged or truncated"});
+  }
+  // Another format is not called damaged.
+  std::ofstream(dir + "/text.vdb") << "not a vdb at all, but long enough to be read";
+  try {
+    readVdlGrid(dir + "/text.vdb");
+    ADD_FAILURE() << "a text file was read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace lo
