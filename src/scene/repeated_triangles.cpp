@@ -1,6 +1,6 @@
 // Triangles that repeat an earlier one (scene_internal.h,
-// dropRepeatedTriangles): found by a hash of their vertices and material,
-// sorted, then compared exactly within each run of equal hashes.
+// dropRepeatedTriangles): found by a hash of their vertices, sorted, then
+// compared exactly within each run of equal hashes.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -23,8 +23,7 @@ std::array<uint32_t, 3> canonicalCorners(const Scene& scene, size_t t) {
 }
 
 bool sameTriangle(const Scene& scene, size_t a, size_t b) {
-  return scene.triangleMaterial[a] == scene.triangleMaterial[b] &&
-         canonicalCorners(scene, a) == canonicalCorners(scene, b);
+  return canonicalCorners(scene, a) == canonicalCorners(scene, b);
 }
 
 }  // namespace
@@ -42,7 +41,6 @@ size_t dropRepeatedTriangles(Scene& scene) {
     const std::array<uint32_t, 3> p = canonicalCorners(scene, t);
     Fnv1a64 h;
     h.bytes(p.data(), sizeof(p));
-    h.bytes(&scene.triangleMaterial[t], sizeof(int32_t));
     keys.push_back({h.value(), uint32_t(t)});
   }
   std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
@@ -51,7 +49,7 @@ size_t dropRepeatedTriangles(Scene& scene) {
   // Within a run of equal hashes each triangle is compared with the kept
   // ones before it (a run longer than one is a copy but for a collision).
   std::vector<uint8_t> repeated(n, 0);
-  size_t dropped = 0;
+  size_t dropped = 0, otherMaterial = 0;
   for (size_t i = 0; i < keys.size();) {
     size_t end = i + 1;
     while (end < keys.size() && keys[end].hash == keys[i].hash) ++end;
@@ -61,6 +59,8 @@ size_t dropRepeatedTriangles(Scene& scene) {
         if (sameTriangle(scene, keys[k].triangle, keys[j].triangle)) {
           repeated[keys[j].triangle] = 1;
           ++dropped;
+          otherMaterial += scene.triangleMaterial[keys[k].triangle] !=
+                           scene.triangleMaterial[keys[j].triangle];
           break;
         }
         // Distinct triangles of one hash are rare: the run is short then.
@@ -84,8 +84,13 @@ size_t dropRepeatedTriangles(Scene& scene) {
   scene.warnings.push_back(
       (scene.sourcePath.empty() ? std::string("scene") : scene.sourcePath) + ": " +
       std::to_string(dropped) + " of " + std::to_string(n) +
-      " triangles repeat an earlier one (the same vertices, winding and material) and were "
-      "left out: a copy draws nothing more, and every ray would test it");
+      " triangles repeat an earlier one (the same vertices and winding" +
+      (otherMaterial ? ", " + std::to_string(otherMaterial) +
+                           " of them in another material, where which face a rasteriser" +
+                           " shows is undefined"
+                     : std::string()) +
+      ") and were left out, the first kept: a copy draws nothing more, and every ray would "
+      "test it");
   return dropped;
 }
 

@@ -80,18 +80,21 @@ TEST_F(SceneObj, TrianglesThatRepeatAnEarlierOneAreLeftOut) {
         "f 3 1 2\n"   // the first again, from its third corner: out
         "f 3 1 2\n"   // and again: out
         "usemtl b\n"
-        "f 1 2 3\n");  // 6: the same vertices in another material: kept
+        "f 1 2 3\n");  // the same in another material: out (F5-18: 20,001 such copies
+                       // made every ray test each; which one GL draws is undefined)
   Scene s = loadScene(dir + "/scene.obj");
   SCOPED_TRACE(s.ToString());
-  ASSERT_EQ(s.triangleCount(), 4u);
+  ASSERT_EQ(s.triangleCount(), 3u);
   const Vec3 a{0, 0, 0}, b{1, 0, 0}, c{1, 1, 0};
-  const std::vector<std::vector<Vec3>> kept = {{a, b, c}, {a, c, b}, {a, b, c}, {a, b, c}};
+  const std::vector<std::vector<Vec3>> kept = {{a, b, c}, {a, c, b}, {a, b, c}};
   for (size_t t = 0; t < kept.size(); ++t)
     for (size_t k = 0; k < 3; ++k)
       expectNear(s.positions[s.indices[3 * t + k]], kept[t][k], 0, "corner");
   expectNear(s.albedo(2, 0, 0), {0.5f, 0, 0}, 1e-6f, "the red copy");
-  EXPECT_EQ(s.triangleMaterial, (std::vector<int32_t>{0, 0, 0, 1}));
-  EXPECT_TRUE(hasWarning(s, "3 of 7 triangles repeat an earlier one")) << s.warnings.size();
+  EXPECT_EQ(s.triangleMaterial, (std::vector<int32_t>{0, 0, 0}));
+  EXPECT_TRUE(hasWarning(s, "4 of 7 triangles repeat an earlier one (the same vertices and "
+                            "winding, 1 of them in another material"))
+      << s.warnings.size();
   // A scene without copies loads as it was, with no word.
   write("plain.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 3 2\n");
   Scene plain = loadScene(dir + "/plain.obj");
