@@ -31,7 +31,8 @@
  * the light of every leaf and of every layer, one texel read like a layer
  * header: RGB = the reflectance (0..1) of the surface that light was
  * gathered on, A = that surface's unit normal packed like a VDL direction
- * (RGB zero where the voxel has no normal, and in merged leaves). The
+ * (RGB zero where the voxel has no normal; a merged leaf's: its voxels'
+ * means weighted by their areas, octree/adaptive_leaves.h). The
  * lookup lights a point from below that surface's plane with it
  * (loSurfaceBelow in octree_lookup.h).
  *

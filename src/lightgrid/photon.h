@@ -27,7 +27,11 @@ struct Photon {
   /// averages it per voxel (VdlGrid::reflectance), so that the renderer can
   /// light a surface that sees this one from below its horizon.
   uint8_t reflectance[3] = {0, 0, 0};
+  /// Zero: the record has no byte left unset (photon maps are compared
+  /// and sent between ranks as bytes).
+  uint8_t spare = 0;
 };
+static_assert(sizeof(Photon) == 56, "Photon: 13 floats, 2 shorts and 4 bytes, no padding");
 
 /// Photon::reflectance as RGB in 0..1.
 inline Vec3 reflectanceOf(const Photon& p) {

@@ -45,7 +45,7 @@ struct LightGridVoxels {
   /// gathered photons' Photon::reflectance weighted by their power. A
   /// surface that sees this one from below its horizon (a step's riser, a
   /// rail, thinner than a voxel and lit by its floor's VDLs) receives its
-  /// light from there (shaders/octree_lookup.h, loReflectedIrradiance).
+  /// light from there (shaders/octree_lookup.h, loSurfaceBelow).
   /// Zero where nothing was gathered or the file does not record it.
   std::vector<Vec3> reflectance;
   std::vector<float> photonCount;   ///< photons gathered for the estimate
