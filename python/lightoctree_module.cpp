@@ -595,6 +595,8 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Grid& g,
       withPythonNames([&] { return renderSettings(width, height, mode, kw); });
   Scene scene = loadScene(scenePath);
   warnIfStale(g.meta, scenePath, "grid");  // before the frame, as `render` warns
+  const std::string skyWarning = skyMismatchWarning(g.meta, scene.sky);
+  if (!skyWarning.empty()) warn("grid: " + skyWarning);
   RgbImage image;
   // The renderer's refusals name the flags ("--emitter-lights"); Ctrl-C
   // stops it between its set-up's stages and between frames.

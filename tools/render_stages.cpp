@@ -29,6 +29,8 @@ LoadedVdl readLightsStage(const std::string& lights, const Scene& scene,
   LoadedVdl baked = readVdlGrid(lights, scene.origin);
   readTimer.finish(formatCount(baked.grid.size()) + " voxels");
   warnIfStale(baked.meta, scenePath, lights);
+  const std::string sky = skyMismatchWarning(baked.meta, scene.sky);
+  if (!sky.empty()) std::fprintf(stderr, "warning: %s: %s\n", lights.c_str(), sky.c_str());
   return baked;
 }
 

@@ -496,6 +496,7 @@ BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t 
   meta.representation = representationName(params.representation);
   meta.seed = int64_t(params.seed);
   meta.sceneBounds = scene.bounds();
+  meta.skyHash = scene.sky.fingerprint();
   meta.surfaceLayers = params.layers ? 1 : 0;
   meta.gatherOcclusion = params.occlusion ? 1 : 0;
   meta.edgeCorrection = params.edgeCorrection ? 1 : 0;
@@ -532,6 +533,15 @@ std::string staleBakeWarning(const BakeMetadata& meta, const std::string& sceneP
                    " (" + meta.sourceSceneHash + "); '" + scenePath +
                    "' and the files it reads differ (" + now +
                    "): bake again if the scene changed");
+}
+
+std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky) {
+  if (meta.skyHash.empty() || meta.skyHash == sky.fingerprint()) return "";
+  return "the light was baked under another sky than the one given (" +
+         (sky.present() ? std::string("a sky ") + sky.fingerprint() : std::string("no sky")) +
+         ", baked: " + printable(meta.skyHash) +
+         "): the surfaces keep the baked sky's light, only what is drawn of the sky itself "
+         "follows the one given; bake again with it to light them by it";
 }
 
 std::string sceneMismatchWarning(const std::string& what, const std::string& recordedHash,

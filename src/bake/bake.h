@@ -382,6 +382,12 @@ void recordSourceScene(BakeMetadata& meta, const std::string& scenePath);
 /// characters of the file's metadata escaped (core/printable.h).
 std::string staleBakeWarning(const BakeMetadata& meta, const std::string& scenePath);
 
+/// "" when `meta` records no sky (older files) or the sky it records is
+/// `sky` (Sky::fingerprint); else a sentence for a warning: the grid's light
+/// was baked under another sky, which the surfaces keep (render --sky, or the
+/// scene's sky changed, changes only the background and the reflections).
+std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky);
+
 /// The same rule for any input made from a scene (a photon map, a `.vdb`
 /// given to `convert --scene`): "" when `recordedHash` is empty (not
 /// recorded) or equals `sceneHash` (sceneContentHash of the scene given

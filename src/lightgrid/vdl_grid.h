@@ -235,6 +235,9 @@ struct BakeMetadata {
   int includeDirect = -1;
   /// The bake's region of interest (`bake --bounds`); empty = the whole scene.
   Bounds3 region;
+  /// Sky::fingerprint of the sky the bake lit the scene with ("sky_hash";
+  /// "none" without a sky); "" when not recorded (older files).
+  std::string skyHash;
 };
 
 }  // namespace lo

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/fnv.h"
 #include "core/resources.h"
 #include "image/image.h"
 #include "scene/scene_internal.h"
@@ -233,6 +234,23 @@ std::shared_ptr<const Texture> loadSkyImage(const std::string& path) {
   texture->format = TexelFormat::Float32;
   texture->floats = image.rgb;
   return texture;
+}
+
+std::string Sky::fingerprint() const {
+  if (!present()) return "none";
+  Fnv1a64 h;
+  h.bytes(&radiance, sizeof radiance);
+  if (image) {
+    const Texture& t = *image;
+    const int header[4] = {t.width, t.height, t.channels, int(t.format)};
+    h.bytes(header, sizeof header);
+    h.bytes(t.unorm8.data(), t.unorm8.size());
+    h.bytes(t.unorm16.data(), t.unorm16.size() * sizeof(uint16_t));
+    h.bytes(t.floats.data(), t.floats.size() * sizeof(float));
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h.value()));
+  return text;
 }
 
 Vec3 Sky::radianceFrom(const Vec3& towards) const {

@@ -239,6 +239,11 @@ struct Sky {
   /// integral, pi, over its half of the directions); for an image, the sum
   /// over its texels.
   Vec3 power(const Bounds3& box) const;
+  /// A hash of what this sky sends (its radiance and its image's texels),
+  /// as 16 hex digits; "none" for no sky. A bake records it
+  /// (BakeMetadata::skyHash) so that a renderer given another sky can say
+  /// that the surfaces keep the baked one's light.
+  std::string fingerprint() const;
 };
 
 /// A sky image (Sky::image) from an .exr or .hdr file of linear radiance.

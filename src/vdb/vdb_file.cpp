@@ -259,6 +259,7 @@ openvdb::MetaMap fileMetadata(const BakeMetadata& meta, const VdlGrid& grid) {
     m.insertMeta("source_scene_path", openvdb::StringMetadata(meta.sourceScenePath));
   if (!meta.sourceSceneHash.empty())
     m.insertMeta("source_scene_hash", openvdb::StringMetadata(meta.sourceSceneHash));
+  if (!meta.skyHash.empty()) m.insertMeta("sky_hash", openvdb::StringMetadata(meta.skyHash));
   // The frame the coordinates are in, for tools that would guess (Blender is
   // Z up): the scene file's, and a glTF's is Y up, right-handed, metres.
   m.insertMeta("up_axis", openvdb::StringMetadata("+Y"));
@@ -407,6 +408,7 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   meta.sourceScene = metaValue<std::string>(path, m, "source_scene", false, "");
   meta.sourceScenePath = metaValue<std::string>(path, m, "source_scene_path", false, "");
   meta.sourceSceneHash = metaValue<std::string>(path, m, "source_scene_hash", false, "");
+  meta.skyHash = metaValue<std::string>(path, m, "sky_hash", false, "");
   meta.depth = metaValue<int32_t>(path, m, kMetaDepth, true, 0);
   meta.photons = metaValue<int64_t>(path, m, "photons", false, 0);
   meta.emittedPaths = metaValue<int64_t>(path, m, "emitted_paths", false, 0);

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -798,6 +799,37 @@ TEST(PhotonPoints, CarryTheirScenesHash) {
             std::string::npos)
       << warning;
   EXPECT_NE(warning.find("'s.gltf' and the files it reads have 2"), std::string::npos) << warning;
+}
+
+// A grid records the sky it was baked under (eighth hostile list F7-42:
+// `render --sky 5,5,5` on a grid baked under the scene's own sky drew the
+// same surfaces as `--sky 0,0,0`, without a word). The same sky, read back
+// from the file, warns of nothing; another radiance, another image texel or
+// no sky does; a file that records none (older) warns of nothing.
+TEST(Inspect, AGridBakedUnderAnotherSkySaysSo) {
+  const std::string dir = test::outputDir("Inspect.SkyHash");
+  Sky baked;
+  baked.radiance = {1, 1, 1};
+  baked.image = std::make_shared<const Texture>(
+      Texture::fromLinear(2, 2, {{1, 2, 3}, {4, 5, 6}, {0, 0, 0}, {0, 0, 0}}));
+  BakeMetadata m = meta();
+  m.skyHash = baked.fingerprint();
+  writeVdlGrid(dir + "/sky.vdb", floorGrid(), m);
+  const LoadedVdl read = readVdlGrid(dir + "/sky.vdb");
+  EXPECT_EQ(read.meta.skyHash, baked.fingerprint());
+  EXPECT_EQ(skyMismatchWarning(read.meta, baked), "");
+  Sky brighter = baked;
+  brighter.radiance = {5, 5, 5};
+  Sky otherTexel = baked;
+  otherTexel.image = std::make_shared<const Texture>(
+      Texture::fromLinear(2, 2, {{1, 2, 3}, {4, 5, 7}, {0, 0, 0}, {0, 0, 0}}));
+  for (const Sky& given : {brighter, otherTexel, Sky{}}) {
+    const std::string warning = skyMismatchWarning(read.meta, given);
+    EXPECT_NE(warning.find("baked under another sky"), std::string::npos) << warning;
+    EXPECT_NE(given.fingerprint(), baked.fingerprint());
+  }
+  EXPECT_EQ(Sky{}.fingerprint(), "none");
+  EXPECT_EQ(skyMismatchWarning(meta(), brighter), "");  // not recorded
 }
 
 // A .vdb's string metadata is whatever wrote it: a source_scene_path with
