@@ -144,11 +144,7 @@ AdaptiveLeaves collapseLeaves(const VdlGrid& grid, float tolerance, bool cosineC
     }
     node.weight = grid.areas.size() == n && grid.areas[v] > 0 ? double(grid.areas[v]) : 1.0;
     node.normal = unitNormal[v];
-    if (grid.reflectance.size() == n) {
-      const Vec3& r = grid.reflectance[v];  // as the octree stores it
-      node.reflectance = Vec3{std::clamp(r.x, 0.0f, 1.0f), std::clamp(r.y, 0.0f, 1.0f),
-                              std::clamp(r.z, 0.0f, 1.0f)};
-    }
+    if (grid.reflectance.size() == n) node.reflectance = storedReflectance(grid.reflectance[v]);
     node.voxels.push_back(uint32_t(v));
     own[v] = irradianceAt(node, unitNormal[v]);
     meanBrightest += double(brightest(own[v]));

@@ -6,6 +6,7 @@
 /// The .vdb keeps every voxel; the adaptive tree is derived from it and the
 /// tolerance when the octree is built (GpuOctreeParams::tolerance).
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -58,6 +59,13 @@ AdaptiveLeaves collapseLeaves(const VdlGrid& grid, float tolerance, bool cosineC
 /// The floor under the tolerance's scale, as a share of the grid's mean
 /// brightest irradiance channel.
 constexpr float kAdaptiveFloorShare = 0.05f;
+
+/// A surface's reflectance as the octree stores it (its surface texel): each
+/// channel clamped to 0..1, since a file's values are only known finite and
+/// one beyond that range would add light, or take it.
+inline Vec3 storedReflectance(const Vec3& r) {
+  return {std::clamp(r.x, 0.0f, 1.0f), std::clamp(r.y, 0.0f, 1.0f), std::clamp(r.z, 0.0f, 1.0f)};
+}
 
 /// A VDL's intensity as the octree stores it: c / max(|n . d|,
 /// kMinCorrectionCosine) with the correction (and a unit normal n), else c.

@@ -338,11 +338,8 @@ class OctreeBuilder {
     if (!surfaces_) return;
     const bool oriented = lengthSquared(normal) > 0.25f;
     const Vec3 n = oriented ? normalize(normal) : Vec3{0, 0, 1};
-    // A file's values are only known finite: a reflectance beyond 0..1
-    // would add light, or take it.
-    const Vec3 r{std::clamp(reflectance.x, 0.0f, 1.0f), std::clamp(reflectance.y, 0.0f, 1.0f),
-                 std::clamp(reflectance.z, 0.0f, 1.0f)};
-    writeTexel(nextVdl_++, oriented ? r : Vec3{}, loPackDirection(n.x, n.y, n.z));
+    writeTexel(nextVdl_++, oriented ? storedReflectance(reflectance) : Vec3{},
+               loPackDirection(n.x, n.y, n.z));
   }
   const Vec3& reflectanceOf(size_t v) const { return grid_.reflectance[v]; }
 
