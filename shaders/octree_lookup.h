@@ -163,9 +163,14 @@ LO_LOOKUP_FN vec3 loVdlDirection(float code) {
  * other layer's plane (LO_LAYER_SIDE_TOLERANCE for a parallel plane,
  * LO_LAYER_JOINT_TOLERANCE for one across it): a floor layer lit from one
  * side of a thin wall does not light the floor on its other side, not even
- * at the wall's foot. False when
- * no layer serves the point: the voxel then lends it no light. */
-LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
+ * at the wall's foot. Relaxed, the layer closest in normal serves, wherever
+ * the other layers' planes lie: the lookup asks so only where no voxel of the
+ * cell around the point serves it strictly (loNearestServingLeaf), which
+ * would leave it black. A voxel across a grille holds faces of several bars
+ * in each layer, and the layers' points, means over those faces, separate
+ * nothing. False when no layer serves the point: the voxel then lends it no
+ * light. */
+LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng, bool relaxed,
                              LO_OUT(uint) first, LO_OUT(int) count) {
   first = loUnpackAddress(leaf.r, leaf.g, leaf.b);
   count = int(leaf.a);
@@ -200,7 +205,7 @@ LO_LOOKUP_FN bool loLeafVdls(LO_TEX_PARAM uvec4 leaf, ivec3 c, vec3 q, vec3 ng,
       float tolerance = abs(dot(normals[l], normals[m])) > LO_LAYER_MIN_COSINE
                             ? LO_LAYER_SIDE_TOLERANCE
                             : LO_LAYER_JOINT_TOLERANCE;
-      if ((sq > tolerance && sl < -tolerance) || (sq < -tolerance && sl > tolerance)) {
+      if (!relaxed && ((sq < -tolerance && sl > tolerance) || (sq > tolerance && sl < -tolerance))) {
         sameSide = false;
       }
     }
@@ -360,21 +365,13 @@ LO_LOOKUP_FN vec3 loShadeVdlsFacing(LO_TEX_PARAM uint first, int count, int maxV
 }
 
 /* The VDLs of voxel c that serve a surface point at q facing ng: its leaf
- * (loLookupLeaf), then the leaf's layer for the point (loLeafVdls). */
-LO_LOOKUP_FN bool loServingLeaf(LO_TEX_PARAM ivec3 c, vec3 q, vec3 ng, int depth,
+ * (loLookupLeaf), then the leaf's layer for the point (loLeafVdls, strictly
+ * or relaxed). */
+LO_LOOKUP_FN bool loServingLeaf(LO_TEX_PARAM ivec3 c, vec3 q, vec3 ng, int depth, bool relaxed,
                                 LO_OUT(uint) first, LO_OUT(int) count) {
   uvec4 leaf;
-  return loLookupLeaf(LO_TEX c, depth, leaf) && loLeafVdls(LO_TEX leaf, c, q, ng, first, count);
-}
-
-/* loNearestLeaf's choice, the voxel in front of the surface else the one
- * behind it, among the voxels that serve the point (loServingLeaf). */
-LO_LOOKUP_FN bool loNearestServingLeaf(LO_TEX_PARAM vec3 q, vec3 n, vec3 ng, int depth,
-                                       float normalOffset, LO_OUT(uint) first,
-                                       LO_OUT(int) count) {
-  if (loServingLeaf(LO_TEX ivec3(floor(q)), q, ng, depth, first, count)) return true;
-  return loServingLeaf(LO_TEX ivec3(floor(q - (normalOffset + normalOffset) * n)), q, ng, depth,
-                       first, count);
+  return loLookupLeaf(LO_TEX c, depth, leaf) &&
+         loLeafVdls(LO_TEX leaf, c, q, ng, relaxed, first, count);
 }
 
 /* Position in voxel units of the octree, moved normalOffset voxels along n. */
@@ -393,6 +390,38 @@ LO_LOOKUP_FN ivec3 loTrilinearCell(vec3 q, LO_OUT(vec3) f) {
 
 /* Corner k (0..7) of that cell: 0 or 1 per axis. */
 LO_LOOKUP_FN ivec3 loCellCorner(int k) { return ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1); }
+
+/* Whether a voxel of the cell of 8 around q serves the point strictly with
+ * light that faces it (loLeafFaces): what the interpolation takes. */
+LO_LOOKUP_FN bool loCellServes(LO_TEX_PARAM vec3 q, vec3 ng, int depth, int maxVdls) {
+  vec3 f;
+  ivec3 base = loTrilinearCell(q, f);
+  uint first;
+  int count;
+  for (int k = 0; k < 8; ++k) {
+    if (loServingLeaf(LO_TEX base + loCellCorner(k), q, ng, depth, false, first, count) &&
+        loLeafFaces(LO_TEX first, count, maxVdls, ng)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+/* loNearestLeaf's choice, the voxel in front of the surface else the one
+ * behind it, among the voxels that serve the point (loServingLeaf):
+ * strictly, or relaxed where no voxel of the cell around it serves it
+ * strictly (loCellServes), which would leave it black. */
+LO_LOOKUP_FN bool loNearestServingLeaf(LO_TEX_PARAM vec3 q, vec3 n, vec3 ng, int depth,
+                                       float normalOffset, int maxVdls, LO_OUT(uint) first,
+                                       LO_OUT(int) count) {
+  ivec3 front = ivec3(floor(q));
+  ivec3 back = ivec3(floor(q - (normalOffset + normalOffset) * n));
+  if (loServingLeaf(LO_TEX front, q, ng, depth, false, first, count)) return true;
+  if (loServingLeaf(LO_TEX back, q, ng, depth, false, first, count)) return true;
+  if (loCellServes(LO_TEX q, ng, depth, maxVdls)) return false;
+  if (loServingLeaf(LO_TEX front, q, ng, depth, true, first, count)) return true;
+  return loServingLeaf(LO_TEX back, q, ng, depth, true, first, count);
+}
 
 /* Weight of corner o (0 or 1 per axis) of the cell in a trilinear
  * interpolation at fraction f. */
@@ -429,7 +458,7 @@ LO_LOOKUP_FN vec3 loOctreeIndirectIrradiance(LO_TEX_PARAM vec3 p, vec3 origin, f
       ivec3 o = loCellCorner(k);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      if (!loServingLeaf(LO_TEX base + o, q, s.ng, depth, first, count)) continue;
+      if (!loServingLeaf(LO_TEX base + o, q, s.ng, depth, false, first, count)) continue;
       vec3 light = loShadeVdlsFacing(LO_TEX first, count, maxVdls, s, e, faces);
       if (!faces) continue;
       sum += w * light;
@@ -441,7 +470,7 @@ LO_LOOKUP_FN vec3 loOctreeIndirectIrradiance(LO_TEX_PARAM vec3 p, vec3 origin, f
       return sum / weightSum;
     }
   }
-  if (loNearestServingLeaf(LO_TEX q, s.n, s.ng, depth, normalOffset, first, count)) {
+  if (loNearestServingLeaf(LO_TEX q, s.n, s.ng, depth, normalOffset, maxVdls, first, count)) {
     return loShadeVdlsFacing(LO_TEX first, count, maxVdls, s, irradiance, faces);
   }
   return vec3(0.0f);
@@ -523,7 +552,7 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
       ivec3 o = loCellCorner(k);
       float w = loTrilinearWeight(f, o);
       if (w <= 0.0f) continue;
-      if (loServingLeaf(LO_TEX base + o, q, n, depth, first, count) &&
+      if (loServingLeaf(LO_TEX base + o, q, n, depth, false, first, count) &&
           loLeafFaces(LO_TEX first, count, maxVdls, n)) {
         e = loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, d);
         sum += w * e;
@@ -536,7 +565,7 @@ LO_LOOKUP_FN vec3 loOctreeIrradiance(LO_TEX_PARAM vec3 p, vec3 n, vec3 origin, f
       return sum / weightSum;
     }
   }
-  if (loNearestServingLeaf(LO_TEX q, n, n, depth, normalOffset, first, count)) {
+  if (loNearestServingLeaf(LO_TEX q, n, n, depth, normalOffset, maxVdls, first, count)) {
     return loShadeVdlsIrradiance(LO_TEX first, count, maxVdls, n, direction);
   }
   return vec3(0.0f);
