@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "core/printable.h"
 #include "bake/convert.h"
 #include "core/error.h"
 #include "core/file.h"
@@ -686,7 +687,18 @@ GridPtr bakeScene(const Arg<std::string>& sceneArg, const Arg<int>& depthArg,
                   const py::object& physicalSky) {
   const std::string scenePath = pathArg(sceneArg.value, "scene");
   progressArg(progress, "progress");
-  const int depth = int(numberArg(depthArg.value, kDepthRange, "depth"));
+  // "auto" (the default) or a whole number, as --depth; a number as text is
+  // refused, as for every argument.
+  int depth = kAutoDepth;
+  if (py::isinstance<py::str>(depthArg.value)) {
+    const std::string text = depthArg.value.cast<std::string>();
+    if (text != "auto") {
+      throw InputError("depth: must be 'auto' or " + kDepthRange.ToString() + ", got '" +
+                       printable(text) + "'");
+    }
+  } else {
+    depth = int(numberArg(depthArg.value, kDepthRange, "depth"));
+  }
   const auto photons =
       size_t(numberOrZeroArg(photonsArg.value, kPhotonsRange, "photons", "not given"));
   const double targetError =
@@ -1107,7 +1119,7 @@ PYBIND11_MODULE(lightoctree, m) {
                " VDL slots>";
       });
 
-  m.def("bake", &bakeScene, py::arg("scene"), py::arg("depth") = 6, py::arg("photons") = 0,
+  m.def("bake", &bakeScene, py::arg("scene"), py::arg("depth") = "auto", py::arg("photons") = 0,
         py::arg("target_error") = 0.0, py::arg("seed") = 1, py::arg("knn") = BakeParams{}.knn,
         py::arg("vdls") = "4", py::arg("include_direct") = false, py::arg("target_light") = "seen",
         py::arg("progress") = py::none(), py::arg("representation") = "vdl",

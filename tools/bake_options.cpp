@@ -15,7 +15,7 @@ namespace lo::tool {
 
 BakeParams BakeOptions::bakeParams(const Scene& scene) const {
   BakeParams params;
-  params.depth = depth;
+  params.depth = parseDepth(depth);
   setPhotonBudget(params, photons, targetError);
   if (params.targetError > 0) {
     params.maxPhotons = maxPhotons;
@@ -68,8 +68,10 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
   cmd->add_option("-o,--output", opt.output, "Output .vdb file (written atomically)")->required();
   addSceneOptions(cmd, opt.sceneOptions);
   cmd->add_option("--depth", opt.depth,
-                  "Octree depth: 2^depth voxels across the scene's bounding cube")
-      ->check(depthValidator())
+                  "Octree depth: 2^depth voxels across the scene's bounding cube, 1 to " +
+                      std::to_string(kMaxGridDepth) + "; auto: 6, or 7 where depth 6's voxels "
+                      "would be wider than 1 scene unit (glTF: a metre; a scene over 64 m)")
+      ->check(autoDepthValidator())
       ->capture_default_str();
   cmd->add_option("--photons", opt.photons,
                   "A fixed photon budget: store this many photons (the paper's 600000) instead "

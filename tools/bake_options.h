@@ -20,7 +20,7 @@ struct BakeOptions {
   std::string scene;
   SceneOptions sceneOptions;  // --sky
   std::string output;
-  int depth = 6;
+  std::string depth = "auto";
   size_t photons = 0;        // 0: not given (a target bake)
   double targetError = 0;    // 0: not given (kDefaultTargetError unless --photons)
   std::string targetLight = "seen";

@@ -17,6 +17,11 @@ CLI::Validator vdlCountValidator() {
 
 CLI::Validator depthValidator() { return numberIn(kDepthRange); }
 
+CLI::Validator autoDepthValidator() {
+  return CLI::Validator([](std::string& s) { return depthError(s); },
+                        "1.." + std::to_string(kMaxGridDepth) + "|auto", "Depth");
+}
+
 CLI::Validator numberIn(const NumberRange& range) {
   // The help's type after the option's own: "FLOAT:from 0.001 to 1", "INT:from 1 to 12".
   const std::string description = range.boundsText();

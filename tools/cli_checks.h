@@ -15,6 +15,8 @@ CLI::Validator vdlCountValidator();
 
 /// `--depth`: 1..kMaxGridDepth (kDepthRange, as the bake and the Python module).
 CLI::Validator depthValidator();
+/// --depth of bake: a depth or auto (bake.h, parseDepth).
+CLI::Validator autoDepthValidator();
 
 /// A number within `range` (core/number_range.h, the check the Python module
 /// applies to its arguments): finite first, so NaN and infinities are

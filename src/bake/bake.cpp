@@ -251,6 +251,30 @@ VdlGrid bakeLevel(const Scene& scene, const std::vector<Photon>& photons, const 
 
 void checkDepth(int depth, const std::string& what) { checkNumber(depth, kDepthRange, what); }
 
+int autoDepth(const Bounds3& region) {
+  for (int depth = kAutoDepthMin; depth < kAutoDepthMax; ++depth) {
+    if (makeGridFrame(region, depth).voxelSize <= kAutoVoxelSize) return depth;
+  }
+  return kAutoDepthMax;
+}
+
+std::string depthError(const std::string& text) {
+  if (text == "auto") return {};
+  try {
+    size_t used = 0;
+    const int v = std::stoi(text, &used);
+    if (used == text.size() && kDepthRange.contains(double(v))) return {};
+  } catch (const std::exception&) {
+  }
+  return "must be 'auto' or " + kDepthRange.ToString() + ", got '" + printable(text) + "'";
+}
+
+int parseDepth(const std::string& text, const char* flag) {
+  const std::string error = depthError(text);
+  if (!error.empty()) throw InputError(std::string(flag) + ": " + error);
+  return text == "auto" ? kAutoDepth : std::stoi(text);
+}
+
 namespace {
 
 void checkParams(const BakeParams& p, int processes) {
@@ -424,6 +448,18 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
   // The scene's own region of interest (a glTF marker node) when none is given.
   BakeParams params = requested;
   if (params.region.empty()) params.region = scene.region;
+  if (params.depth == kAutoDepth && scene.triangleCount() > 0) {
+    // The finer depth only where its memory is there; else the paper's.
+    params.depth = autoDepth(params.region.empty() ? scene.bounds() : params.region);
+    if (params.depth > kAutoDepthMin) {
+      try {
+        checkBakeMemory(scene, params, processes);
+      } catch (const InputError&) {
+        params.depth = kAutoDepthMin;
+      }
+    }
+  }
+  if (params.depth == kAutoDepth) params.depth = kAutoDepthMin;
   checkParams(params, processes);
   // A scene of unlit surfaces only (KHR_materials_unlit) holds no light to
   // bake: said at once, where the photons found nothing to store after the

@@ -43,6 +43,27 @@ std::string vdlCountError(const std::string& text);
 /// unless kDepthRange holds `depth`: the one depth check of the bake module.
 void checkDepth(int depth, const std::string& what = "--depth");
 
+/// BakeParams::depth "auto", the default: autoDepth picks it for the scene.
+constexpr int kAutoDepth = 0;
+/// The widest voxel an automatic depth leaves where it can, in scene units
+/// (glTF's metres): a room's light changes over a metre; a 78 m game level
+/// at depth 6 has 1.2 m voxels, and its picture is 11.7% off the path
+/// tracer's where depth 7's is 7.7% (docs/accuracy.md).
+constexpr double kAutoVoxelSize = 1.0;
+/// The depths an automatic depth takes: the paper's 6, and 7 at most (4x
+/// the voxels and about 3x the bake's time and memory of depth 6).
+constexpr int kAutoDepthMin = 6;
+constexpr int kAutoDepthMax = 7;
+/// The depth of `--depth auto` for a grid over `region`: the smallest of
+/// kAutoDepthMin..kAutoDepthMax whose voxels are at most kAutoVoxelSize
+/// wide, else kAutoDepthMax.
+int autoDepth(const Bounds3& region);
+/// "auto" (kAutoDepth) or a whole number in kDepthRange. @throws InputError
+/// naming `flag`.
+int parseDepth(const std::string& text, const char* flag = "--depth");
+/// The same check for a CLI validator: "" when valid, else the message.
+std::string depthError(const std::string& text);
+
 /// Memory a bake needs per stored photon (the map, its bins and the gather's
 /// copy), bytes: checked against the memory available before tracing.
 constexpr size_t kBakeBytesPerPhoton = 120;
@@ -106,7 +127,9 @@ constexpr float kMinRadiusVoxels = 0.1f;
 
 /// Every setting of a bake, with the defaults of `lightoctree bake`.
 struct BakeParams {
-  int depth = 6;            ///< 2^depth voxels across the padded bounding cube (paper's delta)
+  /// 2^depth voxels across the padded bounding cube (paper's delta);
+  /// kAutoDepth: autoDepth's for the scene (checkedBakeParams sets it).
+  int depth = kAutoDepth;
   /// Photons stored in the photon map (paper: 600k), when targetError is 0.
   size_t photons = 600000;
   /// > 0: trace photons in passes until the bake's noise figure

@@ -25,7 +25,7 @@ namespace lo {
 /// `lightoctree bake` does without flags.
 struct SweepPoint {
   std::string group = "paper";  ///< the parameter this point varies ("paper", "depth", ...)
-  int depth = BakeParams{}.depth;
+  int depth = kAutoDepthMin;  ///< the paper's 6 (a sweep names its depths)
   size_t photons = BakeParams{}.photons;
   int knn = BakeParams{}.knn;
   float radiusVoxels = kDefaultRadiusVoxels;  ///< gather radius in voxel sizes at this depth

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "bake/bake.h"
+#include "core/error.h"
 #include "test_util.h"
 
 namespace lo {
@@ -109,6 +110,63 @@ TEST(BakeMemory, TheVoxelEstimateIsAtMostTheGridsVoxels) {
   Scene one = test::oneMaterialScene();
   test::addQuad(one, Vec3(0.0f), Vec3(1, 0, 0), Vec3(0, 0, 1), Vec3(0, 1, 0), 0);
   EXPECT_NEAR(estimateActiveVoxels(one, frame, Bounds3()), 16.0, 2.0);
+}
+
+}  // namespace
+}  // namespace lo
+
+namespace lo {
+namespace {
+
+/// A square floor `size` scene units wide, its corner at the origin.
+Scene floorScene(float size) {
+  Scene scene = test::oneMaterialScene();
+  test::addQuad(scene, Vec3(0.0f), Vec3(size, 0, 0), Vec3(0, 0, size), Vec3(0, 1, 0), 0);
+  return scene;
+}
+
+// --depth auto: the paper's 6 where its voxels are at most a scene unit (a
+// metre) wide, else 7; 7 at most, and 6 where 7's memory is not there.
+TEST(BakeDepth, AutoIsSixUnlessItsVoxelsAreWiderThanAMetre) {
+  Bounds3 box;
+  box.extend(Vec3(0.0f));
+  for (float size : {0.01f, 2.0f, 60.0f, 70.0f, 100.0f, 1e4f}) {
+    SCOPED_TRACE(size);
+    Bounds3 b = box;
+    b.extend(Vec3(size));
+    // 2^6 voxels across the padded cube: 64 m of scene hold 1 m voxels.
+    const int expected = size <= 60.0f ? 6 : 7;
+    EXPECT_EQ(autoDepth(b), expected);
+  }
+  EXPECT_EQ(BakeParams{}.depth, kAutoDepth);
+  BakeParams params;
+  params.photons = 1000;
+  EXPECT_EQ(checkedBakeParams(floorScene(2.0f), params).depth, 6);
+  EXPECT_EQ(checkedBakeParams(floorScene(100.0f), params).depth, 7);
+  // A depth given is the depth taken.
+  params.depth = 5;
+  EXPECT_EQ(checkedBakeParams(floorScene(100.0f), params).depth, 5);
+  // Where depth 7's voxels do not fit in memory and depth 6's do, auto is 6.
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "12M", 1);
+  params.depth = 7;
+  EXPECT_THROW(checkedBakeParams(floorScene(100.0f), params), InputError);
+  params.depth = 6;
+  EXPECT_EQ(checkedBakeParams(floorScene(100.0f), params).depth, 6);
+  params.depth = kAutoDepth;
+  EXPECT_EQ(checkedBakeParams(floorScene(100.0f), params).depth, 6);
+  unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+}
+
+TEST(BakeDepth, ParsedAsAutoOrAWholeNumberFrom1To12) {
+  EXPECT_EQ(parseDepth("auto"), kAutoDepth);
+  EXPECT_EQ(parseDepth("1"), 1);
+  EXPECT_EQ(parseDepth("12"), 12);
+  for (const char* bad : {"0", "13", "-1", "6.5", "6x", "", "AUTO", "nan"}) {
+    SCOPED_TRACE(bad);
+    EXPECT_THROW(parseDepth(bad), InputError);
+    EXPECT_FALSE(depthError(bad).empty());
+  }
+  EXPECT_TRUE(depthError("auto").empty());
 }
 
 }  // namespace
