@@ -163,7 +163,8 @@ SurfaceGrid voxelize(const Scene& scene, const GridParams& params, ProgressSink*
   s.activeVoxels = grid.size();
   const size_t dense = size_t(1) << (3 * params.depth);
   s.voxelizeSeconds =
-      voxelize.finish(formatCount(grid.size()) + " of " + formatCount(dense) + " voxels active");
+      voxelize.finish(formatCount(grid.size()) + " of " + formatCount(dense) + " voxels active at depth " +
+                      std::to_string(params.depth));
   return grid;
 }
 
