@@ -45,18 +45,36 @@ GridFrame readFrame(const std::string& path, const Transform& xform, int depth,
     throw InputError(path + ": transform is " + xform.mapType() +
                      ", expected a uniform scale and translation");
   }
-  // The size a voxel has, from the map itself (one index step along x), not
-  // the voxel size a file states beside it: a negative scale (a mirror), a
-  // NaN or a size the map does not have would place every voxel wrongly.
-  const openvdb::Vec3d centre0 = xform.indexToWorld(openvdb::Vec3d(0.0));
-  const double h = (xform.indexToWorld(openvdb::Vec3d(1, 0, 0)) - centre0).x();
+  // The size a voxel has, from the map's own scale, not the voxel size a file
+  // states beside it: a negative scale (a mirror), a NaN or a size the map
+  // does not have would place every voxel wrongly. Read from the map, not as
+  // the difference of two mapped points: far from the origin (9.9e11, within
+  // kMaxCoordinate) that difference keeps only the translation's last bits
+  // (0.0356445 for 0.035649) and a grid the bake wrote was refused.
+  openvdb::Vec3d scale, centre0;
+  if (const auto st = xform.constMap<openvdb::math::UniformScaleTranslateMap>()) {
+    scale = st->getScale();
+    centre0 = st->getTranslation();
+  } else {
+    scale = xform.constMap<openvdb::math::UniformScaleMap>()->getScale();
+    centre0 = openvdb::Vec3d(0.0);
+  }
+  const double h = scale.x();
   const openvdb::Vec3d stated = xform.voxelSize();
-  if (!(h > 0) || !std::isfinite(h) || !(float(h) >= std::numeric_limits<float>::min()) ||
-      !(std::fabs(stated[0] - h) <= 1e-6 * h)) {
-    char text[96];
-    std::snprintf(text, sizeof text, "%.6g (the file states %.6g)", h, stated[0]);
+  if (!(h > 0) || !std::isfinite(h) || !(float(h) >= std::numeric_limits<float>::min())) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.6g", h);
     throw InputError(path + ": transform has voxel size " + text +
                      ", expected a finite size > 0 (a uniform scale and translation)");
+  }
+  if (!(std::fabs(stated[0] - h) <= 1e-6 * h) || !std::isfinite(centre0.x()) ||
+      !std::isfinite(centre0.y()) || !std::isfinite(centre0.z())) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "transform's scale %.9g differs from the voxel size %.9g the file states, or its "
+                  "translation (%.6g, %.6g, %.6g) is not finite",
+                  h, stated[0], centre0.x(), centre0.y(), centre0.z());
+    throw InputError(path + ": " + text + ": the file is inconsistent");
   }
   GridFrame frame;
   frame.voxelSize = float(h);
