@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -187,6 +188,81 @@ openvdb::GridBase::Ptr findGrid(const OpenedFile& f, const std::string& name) {
     if (g && g->getName() == name) return g;
   }
   return nullptr;
+}
+
+bool isFreeSpaceGrid(const std::string& name) { return name.rfind("volume_", 0) == 0; }
+
+GridsCheck sameTransform(const OpenedFile& f) {
+  const openvdb::GridBase* ref[2] = {nullptr, nullptr};
+  for (const auto& g : *f.grids) {
+    if (!g) continue;
+    const openvdb::GridBase*& r = ref[isFreeSpaceGrid(g->getName()) ? 1 : 0];
+    if (!r) {
+      r = g.get();
+    } else if (!(g->transform() == r->transform())) {
+      return {false, "grid '" + g->getName() + "' differs from '" + r->getName() + "'"};
+    }
+  }
+  return {true, ref[1] ? "every grid on one transform, the free-space grids on theirs"
+                       : "every grid on one transform"};
+}
+
+namespace {
+
+/// Which active set a grid shares: the voxels' (0), or surface layer l's
+/// (layer 0's points go with layer 1: the voxels that have layers).
+int layerGroup(const std::string& name) {
+  if (name == gridNameOf(&VdlGrid::points)) return 1;
+  if (name.rfind("layer", 0) == 0 && name.size() > 6 && name[6] == '_' && name[5] >= '1' &&
+      name[5] <= '9') {
+    return name[5] - '0';
+  }
+  return 0;
+}
+
+/// The VDL grids of one slot ("vdl2", "layer1_vdl0"): active where the
+/// voxel (or layer) has that VDL (sparse since format version 2).
+std::string vdlSlot(const std::string& name) {
+  const size_t at = name.find("vdl");
+  if (at == std::string::npos || (at != 0 && at != 7)) return "";
+  const size_t under = name.find('_', at);
+  if (under == std::string::npos || under == at + 3) return "";
+  const std::string tail = name.substr(under);
+  if (tail != "_irradiance" && tail != "_direction") return "";
+  return name.substr(0, under);
+}
+
+}  // namespace
+
+GridsCheck sameActiveVoxels(const OpenedFile& f) {
+  std::map<std::string, const openvdb::GridBase*> ref;
+  std::string counts;
+  for (const auto& g : *f.grids) {
+    if (!g) continue;
+    const std::string slot = vdlSlot(g->getName());
+    const int group = layerGroup(g->getName());
+    const bool volume = isFreeSpaceGrid(g->getName());
+    const std::string key =
+        volume ? "volume" : !slot.empty() ? slot : "layer" + std::to_string(group);
+    const openvdb::GridBase*& r = ref[key];
+    if (!r) {
+      r = g.get();
+      if (volume) {
+        counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
+                  " in every free-space grid";
+      } else if (slot.empty()) {
+        counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
+                  (group == 0 ? " in every voxel grid"
+                              : " in every layer" + std::to_string(group) + " grid");
+      }
+    } else if (g->activeVoxelCount() != r->activeVoxelCount() ||
+               g->evalActiveVoxelBoundingBox() != r->evalActiveVoxelBoundingBox()) {
+      return {false, "grid '" + g->getName() + "' has " + std::to_string(g->activeVoxelCount()) +
+                         " active voxels, '" + r->getName() + "' " +
+                         std::to_string(r->activeVoxelCount())};
+    }
+  }
+  return {true, counts.empty() ? "no grids" : counts};
 }
 
 namespace {

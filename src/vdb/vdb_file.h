@@ -87,6 +87,26 @@ inline openvdb::Coord toVdb(const Coord& c) { return {c.x, c.y, c.z}; }
 inline Vec3 fromVdb(const openvdb::Vec3s& v) { return {v.x(), v.y(), v.z()}; }
 inline Coord fromVdb(const openvdb::Coord& c) { return {c.x(), c.y(), c.z()}; }
 
+/// One check of the file's grids among themselves, as `inspect` reports it.
+struct GridsCheck {
+  bool passed = true;
+  std::string detail;  ///< what holds, or the first grid that breaks it (without the path)
+};
+
+/// Grids whose names start "volume_": the free-space light, on a coarser
+/// transform and voxels of their own.
+bool isFreeSpaceGrid(const std::string& name);
+
+/// The one rule `inspect` ("same_transform", "same_active_voxels") and every
+/// reader (readVdlStructure) apply to a file's grids, so that a file passes
+/// inspect exactly when the readers take it: every grid on one transform
+/// (the free-space grids on theirs); the grids of one set of voxels (the
+/// voxels', surface layer l's, one VDL slot's, the free-space voxels') with
+/// the same number of active voxels over the same bounding box. A file with
+/// a surface layer's grid zeroed was read as a layer of zeros.
+GridsCheck sameTransform(const OpenedFile& f);
+GridsCheck sameActiveVoxels(const OpenedFile& f);
+
 /// The grid of the file named `name`, or null.
 openvdb::GridBase::Ptr findGrid(const OpenedFile& f, const std::string& name);
 

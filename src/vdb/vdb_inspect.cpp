@@ -247,37 +247,11 @@ class VdlChecker {
                  : std::to_string(bad) + " active values with NaN/Inf (first in '" + first + "')");
   }
 
-  /// The free-space light's grids (volume_*): on a coarser transform and
-  /// voxels of their own, checked among themselves.
-  static bool isVolumeGrid(const std::string& name) { return name.rfind("volume_", 0) == 0; }
+  static bool isVolumeGrid(const std::string& name) { return vdb_internal::isFreeSpaceGrid(name); }
 
   void checkSameTransform() {
-    const openvdb::GridBase* ref[2] = {nullptr, nullptr};
-    for (const auto& g : *f_.grids) {
-      if (!g) continue;
-      const openvdb::GridBase*& r = ref[isVolumeGrid(g->getName()) ? 1 : 0];
-      if (!r) {
-        r = g.get();
-      } else if (!(g->transform() == r->transform())) {
-        add("same_transform", false,
-            "grid '" + g->getName() + "' differs from '" + r->getName() + "'");
-        return;
-      }
-    }
-    add("same_transform", true,
-        ref[1] ? "every grid on one transform, the free-space grids on theirs"
-               : "every grid on one transform");
-  }
-
-  /// Which active set a grid shares: the voxels' (0), or surface layer l's
-  /// (layer_point goes with layer 1: the voxels that have layers).
-  static int layerGroup(const std::string& name) {
-    if (name == vdb_internal::gridNameOf(&VdlGrid::points)) return 1;
-    if (name.rfind("layer", 0) == 0 && name.size() > 6 && name[6] == '_' && name[5] >= '1' &&
-        name[5] <= '9') {
-      return name[5] - '0';
-    }
-    return 0;
+    const vdb_internal::GridsCheck c = vdb_internal::sameTransform(f_);
+    add("same_transform", c.passed, c.detail);
   }
 
   /// What the reader (readVdlGrid) and the GPU octree refuse, checked the
@@ -340,48 +314,9 @@ class VdlChecker {
                    : std::to_string(count) + " grid(s) beyond it; first " + outside);
   }
 
-  /// The VDL grids of one slot ("vdl2", "layer1_vdl0"): active where the
-  /// voxel (or layer) has that VDL (sparse since format version 2).
-  static std::string vdlSlot(const std::string& name) {
-    const size_t at = name.find("vdl");
-    if (at == std::string::npos || (at != 0 && at != 7)) return "";
-    const size_t under = name.find('_', at);
-    if (under == std::string::npos || under == at + 3) return "";
-    const std::string tail = name.substr(under);
-    if (tail != "_irradiance" && tail != "_direction") return "";
-    return name.substr(0, under);
-  }
-
   void checkSameActive() {
-    std::map<std::string, const openvdb::GridBase*> ref;
-    std::string counts;
-    for (const auto& g : *f_.grids) {
-      if (!g) continue;
-      const std::string slot = vdlSlot(g->getName());
-      const int group = layerGroup(g->getName());
-      const bool volume = isVolumeGrid(g->getName());
-      const std::string key =
-          volume ? "volume" : !slot.empty() ? slot : "layer" + std::to_string(group);
-      const openvdb::GridBase*& r = ref[key];
-      if (!r) {
-        r = g.get();
-        if (volume) {
-          counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
-                    " in every free-space grid";
-        } else if (slot.empty()) {
-          counts += (counts.empty() ? "" : ", ") + std::to_string(g->activeVoxelCount()) +
-                    (group == 0 ? " in every voxel grid"
-                                : " in every layer" + std::to_string(group) + " grid");
-        }
-      } else if (g->activeVoxelCount() != r->activeVoxelCount() ||
-                 g->evalActiveVoxelBoundingBox() != r->evalActiveVoxelBoundingBox()) {
-        add("same_active_voxels", false,
-            "grid '" + g->getName() + "' has " + std::to_string(g->activeVoxelCount()) +
-                " active voxels, '" + r->getName() + "' " + std::to_string(r->activeVoxelCount()));
-        return;
-      }
-    }
-    add("same_active_voxels", true, counts.empty() ? "no grids" : counts);
+    const vdb_internal::GridsCheck c = vdb_internal::sameActiveVoxels(f_);
+    add("same_active_voxels", c.passed, c.detail);
   }
 
   /// The values' meaning: the one validation every reader runs

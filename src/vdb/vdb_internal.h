@@ -17,6 +17,7 @@ namespace lo::vdb_internal {
 struct Damage {
   std::string omitGrid;          ///< leave this grid out of the file ("" = none)
   std::string shiftGrid;         ///< give this grid a transform shifted by one voxel ("" = none)
+  std::string emptyGrid;         ///< write this grid with no active voxel ("" = none)
   bool rotateTransform = false;  ///< every grid gets the same transform with a rotation
   VdlWriteOptions options;       ///< half floats / dropped grids, as writeVdlGrid
   /// Write this int32 as the file's format_version instead of kVdlFormatVersion

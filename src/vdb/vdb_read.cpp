@@ -391,6 +391,15 @@ LoadedVdl readVdlStructure(const std::string& path, const std::optional<Vec3d>& 
   });
   out.halfFloat = findGrid(f, gridNameOf(&VdlGrid::irradiance))->saveFloatAsHalf();
   auto key = requireGrid<FloatGrid>(path, f, keyGridName());
+  // inspect's same_transform and same_active_voxels, by the same functions:
+  // a layer grid zeroed by damage was read as a layer of zeros.
+  if (const GridsCheck c = sameTransform(f); !c.passed) {
+    throw InputError(path + ": mismatched transforms: " + c.detail);
+  }
+  if (const GridsCheck c = sameActiveVoxels(f); !c.passed) {
+    throw InputError(path + ": " + c.detail + ": grids of one set of voxels differ; the file is "
+                     "damaged (`lightoctree inspect` lists every check)");
+  }
 
   const Transform& xform = key->transform();
   const openvdb::Index64 active = key->activeVoxelCount();

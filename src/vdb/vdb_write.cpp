@@ -277,6 +277,16 @@ void writeVdl(const std::string& path, const VdlGrid& grid, const BakeMetadata& 
                        }});
   }
   addVolumeSources(sources, grid.volume, options.halfFloat);
+  if (damage && !damage->emptyGrid.empty()) {
+    for (GridSource& source : sources) {
+      if (source.name != damage->emptyGrid) continue;
+      source.make = [make = std::move(source.make)] {
+        openvdb::GridBase::Ptr g = make();
+        g->clear();
+        return g;
+      };
+    }
+  }
   openvdb::MetaMap fileMeta = fileMetadata(meta, grid);
   if (!grid.volume.empty()) {
     fileMeta.insertMeta(kMetaFreeSpaceDepth, openvdb::Int32Metadata(grid.volume.frame.depth));

@@ -18,6 +18,7 @@
 #include "bake/convert.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "vdb/vdb_contract.h"
 #include "vdb/vdb_internal.h"
 #include "vdb/vdb_inspect.h"
 #include "vdb/vdb_io.h"
@@ -537,6 +538,43 @@ TEST(VdbLayers, RoundTrip) {
   EXPECT_EQ(coarse.grid.layers.size(), 0u);
   EXPECT_NE(coarse.method.find("surface layers are not carried"), std::string::npos)
       << coarse.method;
+}
+
+// A grid of a file with no active voxel where the others of its set have
+// some (4 KB of a bake's file zeroed emptied 'layer1_normal'): inspect failed
+// "same_active_voxels" while render, convert and Python read the layer as
+// zeros. Every reader refuses it now, by the very check inspect runs.
+TEST(VdbLayers, AGridWithoutTheVoxelsOfItsSetIsRefusedByTheReadersAsByInspect) {
+  const BakeResult baked = smallRoomBake();
+  ASSERT_GT(baked.grid.layers.size(), 0u);
+  const std::string dir = test::outputDir("VdbLayers.EmptyGrid");
+  for (const std::string& name :
+       {std::string("layer1_normal"), std::string("layer1_angular_error"),
+        std::string(vdb_internal::gridNameOf(&VdlGrid::points)), std::string("density")}) {
+    vdb_internal::Damage d;
+    d.emptyGrid = name;
+    const std::string path = dir + "/" + name + ".vdb";
+    vdb_internal::writeVdlGridDamaged(path, baked.grid, baked.metadata, d);
+    const VdbReport report = inspectVdb(path);
+    bool failed = false;
+    for (const VdbCheck& c : report.checks) {
+      if (c.name == "same_active_voxels") failed = !c.passed;
+    }
+    EXPECT_TRUE(failed) << name;
+    try {
+      readVdlGrid(path);
+      ADD_FAILURE() << name << ": read, where inspect fails it";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      // The emptied grid is named, against another of its set or as the set's first.
+      EXPECT_NE(msg.find("'" + name + "'"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("grids of one set of voxels differ"), std::string::npos) << msg;
+    }
+  }
+  // Undamaged, both take it.
+  vdb_internal::writeVdlGridDamaged(dir + "/good.vdb", baked.grid, baked.metadata, {});
+  EXPECT_TRUE(inspectVdb(dir + "/good.vdb").ok());
+  EXPECT_NO_THROW(readVdlGrid(dir + "/good.vdb"));
 }
 
 }  // namespace
