@@ -143,11 +143,13 @@ int runConvert(const ConvertOptions& opt) {
     photons = readPhotonPoints(opt.photonMap, in.grid.frame.offset, &info);
     params.photons = &photons;
     params.photonRegion = info.region;
+    params.photonSkyHash = info.skyHash;
     readTimer.finish(formatCount(photons.size()) + " photons");
     const std::string what = "--photon-map '" + opt.photonMap + "'";
     if (!opt.scene.empty()) {
       warn(sceneMismatchWarning(what, info.sourceSceneHash, opt.scene, sceneHash));
     }
+    warn(photonSkyMismatchWarning(what, info.skyHash, "IN '" + opt.input + "'", in.meta.skyHash));
   }
   ConvertResult out = convertLightGrid(in.grid, in.meta, params, &progress);
   rows.insert(rows.end(), out.stages.begin(), out.stages.end());

@@ -581,6 +581,18 @@ std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky) {
          "follows the one given; bake again with it to light them by it";
 }
 
+std::string photonSkyMismatchWarning(const std::string& what, const std::string& photonSkyHash,
+                                     const std::string& gridWhat, const std::string& gridSkyHash) {
+  if (photonSkyHash.empty() || gridSkyHash.empty() || photonSkyHash == gridSkyHash) return "";
+  auto sky = [](const std::string& hash) {
+    return hash == "none" ? std::string("no sky") : "the sky " + hash;
+  };
+  return printable(what + " was traced under another sky (" + sky(photonSkyHash) + ") than " +
+                   gridWhat + " was baked under (" + sky(gridSkyHash) +
+                   "): the output holds the photons' light and records their sky; render it "
+                   "under that sky, or bake the photon map again under this one");
+}
+
 std::string sceneMismatchWarning(const std::string& what, const std::string& recordedHash,
                                  const std::string& scenePath, const std::string& sceneHash) {
   if (recordedHash.empty() || recordedHash == sceneHash) return "";

@@ -411,6 +411,13 @@ std::string staleBakeWarning(const BakeMetadata& meta, const std::string& sceneP
 /// scene's sky changed, changes only the background and the reflections).
 std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky);
 
+/// "" when either hash is not recorded or they agree; else a sentence for a
+/// warning: the photon map `what` was traced under another sky than the grid
+/// `gridWhat` was baked under (recorded as `gridSkyHash`), so the grid
+/// re-gathered from it holds the photons' sky's light and records that sky.
+std::string photonSkyMismatchWarning(const std::string& what, const std::string& photonSkyHash,
+                                     const std::string& gridWhat, const std::string& gridSkyHash);
+
 /// The same rule for any input made from a scene (a photon map, a `.vdb`
 /// given to `convert --scene`): "" when `recordedHash` is empty (not
 /// recorded) or equals `sceneHash` (sceneContentHash of the scene given

@@ -115,6 +115,7 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
       r.metadata.knn = gather.k;
       r.metadata.radius = resolveRadius(gather, grid.frame);
       r.metadata.photons = int64_t(photons.size());
+      r.metadata.skyHash = params.photonSkyHash;
       r.method = "re-gathered " + formatCount(photons.size()) + " photons";
       gatherTimer.finish(r.method);
     } else if (depth > inDepth) {

@@ -31,6 +31,10 @@ struct ConvertParams {
   /// PhotonMapInfo), in the scene's coordinates; empty = everywhere. A grid
   /// reaching beyond it is refused (its voxels there would gather nothing).
   Bounds3 photonRegion;
+  /// The sky the photons were traced under (PhotonMapInfo::skyHash; "" = not
+  /// recorded). A grid re-gathered from them holds their sky's light, so its
+  /// metadata records this sky, not the input's (whose light it replaces).
+  std::string photonSkyHash;
 };
 
 struct ConvertResult {

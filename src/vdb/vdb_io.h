@@ -114,11 +114,15 @@ struct PhotonMapInfo {
   /// In the coordinates of the photons' positions: file metadata
   /// "region_min" and "region_max" in world coordinates.
   Bounds3 region;
+  /// Sky::fingerprint of the sky the photons were traced under
+  /// (BakeMetadata::skyHash), file metadata "sky_hash", so that a grid
+  /// re-gathered from them records the sky its light is of; "" = not recorded.
+  std::string skyHash;
 };
 
 /// What a photon file of the bake of `meta` records.
 inline PhotonMapInfo photonMapInfo(const BakeMetadata& meta) {
-  return {meta.sourceSceneHash, meta.region};
+  return {meta.sourceSceneHash, meta.region, meta.skyHash};
 }
 
 /// Writes photons as a PointDataGrid named "photons" with attributes P,

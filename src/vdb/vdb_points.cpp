@@ -86,6 +86,8 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   if (!info.sourceSceneHash.empty()) {
     meta.insertMeta("source_scene_hash", openvdb::StringMetadata(info.sourceSceneHash));
   }
+  // The sky they were traced under: a grid re-gathered from them holds its light.
+  if (!info.skyHash.empty()) meta.insertMeta("sky_hash", openvdb::StringMetadata(info.skyHash));
   // The region the photons were stored in (bake --bounds), in world
   // coordinates as the positions: a reader can tell a grid it does not cover.
   if (!info.region.empty()) {
@@ -105,6 +107,8 @@ std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin,
   if (info) {
     auto hash = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f.meta)["source_scene_hash"]);
     info->sourceSceneHash = hash ? hash->value() : "";
+    auto sky = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f.meta)["sky_hash"]);
+    info->skyHash = sky ? sky->value() : "";
     auto lower = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>((*f.meta)["region_min"]);
     auto upper = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>((*f.meta)["region_max"]);
     info->region = Bounds3();

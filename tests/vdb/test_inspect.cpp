@@ -784,9 +784,9 @@ TEST(PhotonPoints, CarryTheirScenesHash) {
     photons[i].direction = photons[i].normal = Vec3(0, 1, 0);
   }
   writePhotonPoints(dir + "/hashed.vdb", photons, 0.05f, Vec3d(), nullptr,
-                    {"0123456789abcdef", Bounds3()});
+                    {"0123456789abcdef", Bounds3(), ""});
   writePhotonPoints(dir + "/plain.vdb", photons, 0.05f);
-  PhotonMapInfo info{"x", Bounds3()};
+  PhotonMapInfo info{"x", Bounds3(), ""};
   EXPECT_EQ(readPhotonPoints(dir + "/hashed.vdb", Vec3d(), &info).size(), 3u);
   EXPECT_EQ(info.sourceSceneHash, "0123456789abcdef");
   readPhotonPoints(dir + "/plain.vdb", Vec3d(), &info);
@@ -799,6 +799,41 @@ TEST(PhotonPoints, CarryTheirScenesHash) {
             std::string::npos)
       << warning;
   EXPECT_NE(warning.find("'s.gltf' and the files it reads have 2"), std::string::npos) << warning;
+}
+
+// A photon map records the sky it was traced under, as the grid does
+// (ninth hostile list H9-7-38: photons of `--sky 3,3,3` re-gathered into a
+// grid baked without a sky gave no warning, and the 24 times brighter output
+// still recorded sky_hash "none", misleading render's sky check).
+TEST(PhotonPoints, CarryTheSkyTheyWereTracedUnder) {
+  const std::string dir = test::outputDir("PhotonPoints.SkyHash");
+  std::vector<Photon> photons(3);
+  for (size_t i = 0; i < photons.size(); ++i) {
+    photons[i].position = Vec3(float(i), 0, 0);
+    photons[i].power = Vec3(1.0f);
+    photons[i].direction = photons[i].normal = Vec3(0, 1, 0);
+  }
+  Sky sky;
+  sky.radiance = {3, 3, 3};
+  BakeMetadata m = meta();
+  m.skyHash = sky.fingerprint();
+  writePhotonPoints(dir + "/sky.vdb", photons, 0.05f, Vec3d(), nullptr, photonMapInfo(m));
+  writePhotonPoints(dir + "/plain.vdb", photons, 0.05f);
+  PhotonMapInfo info;
+  readPhotonPoints(dir + "/sky.vdb", Vec3d(), &info);
+  EXPECT_EQ(info.skyHash, sky.fingerprint());
+  readPhotonPoints(dir + "/plain.vdb", Vec3d(), &info);
+  EXPECT_EQ(info.skyHash, "");
+  // The warning: only when both are recorded and differ.
+  EXPECT_EQ(photonSkyMismatchWarning("p", "", "g", "none"), "");
+  EXPECT_EQ(photonSkyMismatchWarning("p", "none", "g", ""), "");
+  EXPECT_EQ(photonSkyMismatchWarning("p", sky.fingerprint(), "g", sky.fingerprint()), "");
+  const std::string warning =
+      photonSkyMismatchWarning("--photon-map 'p.vdb'", sky.fingerprint(), "IN 'g.vdb'", "none");
+  EXPECT_NE(warning.find("--photon-map 'p.vdb' was traced under another sky (the sky " +
+                         sky.fingerprint() + ") than IN 'g.vdb' was baked under (no sky)"),
+            std::string::npos)
+      << warning;
 }
 
 // A grid records the sky it was baked under (eighth hostile list F7-42:

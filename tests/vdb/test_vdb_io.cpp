@@ -720,9 +720,13 @@ TEST(VdbIo, APhotonMapIsRefusedForAGridBeyondItsRegion) {
   test::expectRefusal([&] { convertLightGrid(whole.grid, whole.metadata, cp); },
                       {"--photon-map: its photons were stored inside", "(the whole scene)",
                        "would gather no light"});
-  // The region's own grid is re-gathered from them, with light.
+  // The region's own grid is re-gathered from them, with light; it records
+  // the photons' sky (here another than the input's), whose light it holds.
+  cp.photonSkyHash = "0123456789abcdef";
   const ConvertResult regathered = convertLightGrid(part.grid, part.metadata, cp);
   EXPECT_GT(lightGridEnergy(regathered.grid), 0.5 * lightGridEnergy(part.grid));
+  EXPECT_EQ(regathered.metadata.skyHash, "0123456789abcdef");
+  EXPECT_EQ(part.metadata.skyHash, "none");
   // A photon map that records no region (before this check) is taken.
   cp.photonRegion = Bounds3();
   EXPECT_NO_THROW(convertLightGrid(whole.grid, whole.metadata, cp));
