@@ -149,6 +149,8 @@ class SceneBuilder {
   void traverse();
 
   /// A region-of-interest marker: `"extras": {"lightoctree_region": true}`.
+  /// Refuses a node matrix whose bottom row is not (0, 0, 0, 1), naming the node.
+  void checkAffine(const tinygltf::Node& node, int nodeIndex) const;
   bool isRegionMarker(const tinygltf::Node& node, int nodeIndex) const;
 
   /// The marker's mesh, loaded like any other for its world-space bounds, then

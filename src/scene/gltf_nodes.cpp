@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/printable.h"
 #include "core/resources.h"
 
 namespace lo::scene_internal::gltf_internal {
@@ -95,6 +96,7 @@ void SceneBuilder::traverse() {
                       std::to_string(item.node) + ")");
     }
     const tinygltf::Node& node = model_.nodes[size_t(item.node)];
+    checkAffine(node, item.node);
     Mat4 world = item.parent * nodeLocalTransform(node);
     for (double v : world.m)
       if (!std::isfinite(v))
@@ -115,6 +117,25 @@ void SceneBuilder::traverse() {
     for (auto c = node.children.rbegin(); c != node.children.rend(); ++c)
       stack.push_back({*c, world, item.depth + 1});
   }
+}
+
+void SceneBuilder::checkAffine(const tinygltf::Node& node, int nodeIndex) const {
+  // Column-major: the bottom row is elements 3, 7, 11 and 15. glTF asks a
+  // matrix decomposable to translation, rotation and scale; a projective one
+  // (bottom row not 0, 0, 0, 1) had its bottom row dropped without a word.
+  const std::vector<double>& m = node.matrix;
+  if (m.size() != 16) return;
+  const double tolerance = 1e-6;
+  if (std::fabs(m[3]) <= tolerance && std::fabs(m[7]) <= tolerance &&
+      std::fabs(m[11]) <= tolerance && std::fabs(m[15] - 1.0) <= tolerance) {
+    return;
+  }
+  fail(path_, "node " + std::to_string(nodeIndex) +
+                  (node.name.empty() ? std::string() : " '" + printable(node.name) + "'") +
+                  ": matrix has the bottom row (" + formatNumber(m[3]) + ", " + formatNumber(m[7]) +
+                  ", " + formatNumber(m[11]) + ", " + formatNumber(m[15]) +
+                  "), expected (0, 0, 0, 1): a projective matrix, which glTF forbids (a node's "
+                  "matrix is translation, rotation and scale)");
 }
 
 bool SceneBuilder::isRegionMarker(const tinygltf::Node& node, int nodeIndex) const {

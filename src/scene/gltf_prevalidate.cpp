@@ -12,7 +12,9 @@
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <vector>
 
+#include "core/printable.h"
 #include "scene/scene_internal.h"
 
 namespace lo::scene_internal {
@@ -91,6 +93,132 @@ static void checkIntegerRanges(const std::string& path, const nlohmann::json& j,
   }
 }
 
+namespace {
+
+/// What a field the loader reads must hold: tinygltf takes a field of
+/// another type (an intensity "5", an emissiveFactor "bright") for absent
+/// and gives its default without a word.
+struct FieldRule {
+  const char* pointer;  ///< JSON pointer; "*" stands for every element of an array
+  enum Kind { kNumber, kNumbers, kString, kBool, kObject } kind;
+  size_t count = 0;  ///< kNumbers: how many
+};
+
+const FieldRule kFieldRules[] = {
+    {"/materials/*/name", FieldRule::kString},
+    {"/materials/*/emissiveFactor", FieldRule::kNumbers, 3},
+    {"/materials/*/alphaMode", FieldRule::kString},
+    {"/materials/*/alphaCutoff", FieldRule::kNumber},
+    {"/materials/*/doubleSided", FieldRule::kBool},
+    {"/materials/*/pbrMetallicRoughness", FieldRule::kObject},
+    {"/materials/*/pbrMetallicRoughness/baseColorFactor", FieldRule::kNumbers, 4},
+    {"/materials/*/pbrMetallicRoughness/metallicFactor", FieldRule::kNumber},
+    {"/materials/*/pbrMetallicRoughness/roughnessFactor", FieldRule::kNumber},
+    {"/materials/*/normalTexture/scale", FieldRule::kNumber},
+    {"/materials/*/occlusionTexture/strength", FieldRule::kNumber},
+    {"/materials/*/extensions/KHR_materials_emissive_strength/emissiveStrength",
+     FieldRule::kNumber},
+    {"/materials/*/extensions/KHR_materials_ior/ior", FieldRule::kNumber},
+    {"/materials/*/extensions/KHR_materials_transmission/transmissionFactor", FieldRule::kNumber},
+    {"/materials/*/extensions/KHR_materials_specular/specularFactor", FieldRule::kNumber},
+    {"/materials/*/extensions/KHR_materials_volume/thicknessFactor", FieldRule::kNumber},
+    {"/extensions/KHR_lights_punctual/lights/*/name", FieldRule::kString},
+    {"/extensions/KHR_lights_punctual/lights/*/type", FieldRule::kString},
+    {"/extensions/KHR_lights_punctual/lights/*/color", FieldRule::kNumbers, 3},
+    {"/extensions/KHR_lights_punctual/lights/*/intensity", FieldRule::kNumber},
+    {"/extensions/KHR_lights_punctual/lights/*/range", FieldRule::kNumber},
+    {"/extensions/KHR_lights_punctual/lights/*/spot", FieldRule::kObject},
+    {"/extensions/KHR_lights_punctual/lights/*/spot/innerConeAngle", FieldRule::kNumber},
+    {"/extensions/KHR_lights_punctual/lights/*/spot/outerConeAngle", FieldRule::kNumber},
+    {"/nodes/*/name", FieldRule::kString},
+    {"/nodes/*/matrix", FieldRule::kNumbers, 16},
+    {"/nodes/*/translation", FieldRule::kNumbers, 3},
+    {"/nodes/*/rotation", FieldRule::kNumbers, 4},
+    {"/nodes/*/scale", FieldRule::kNumbers, 3},
+    {"/cameras/*/type", FieldRule::kString},
+    {"/cameras/*/perspective/yfov", FieldRule::kNumber},
+    {"/cameras/*/perspective/aspectRatio", FieldRule::kNumber},
+    {"/cameras/*/perspective/znear", FieldRule::kNumber},
+    {"/cameras/*/perspective/zfar", FieldRule::kNumber},
+};
+
+bool holds(const nlohmann::json& v, const FieldRule& rule) {
+  switch (rule.kind) {
+    case FieldRule::kNumber: return v.is_number();
+    case FieldRule::kString: return v.is_string();
+    case FieldRule::kBool: return v.is_boolean();
+    case FieldRule::kObject: return v.is_object();
+    case FieldRule::kNumbers:
+      if (!v.is_array() || v.size() != rule.count) return false;
+      for (const nlohmann::json& x : v) {
+        if (!x.is_number()) return false;
+      }
+      return true;
+  }
+  return false;
+}
+
+std::string expected(const FieldRule& rule) {
+  switch (rule.kind) {
+    case FieldRule::kNumber: return "a number";
+    case FieldRule::kString: return "a string";
+    case FieldRule::kBool: return "true or false";
+    case FieldRule::kObject: return "an object";
+    case FieldRule::kNumbers: return "an array of " + std::to_string(rule.count) + " numbers";
+  }
+  return "";
+}
+
+/// Checks `rule` from `at` (the pointer's parts from `part` on) in `j`, whose
+/// own pointer is `where`.
+void checkField(const std::string& path, const nlohmann::json& j, const FieldRule& rule,
+                const std::vector<std::string>& parts, size_t part, const std::string& where) {
+  if (part == parts.size()) {
+    if (holds(j, rule)) return;
+    std::string shown = j.dump();
+    if (shown.size() > 60) shown = shown.substr(0, 60) + "...";
+    fail(path, "invalid glTF: " + where + " is " + printable(shown) + ", expected " +
+                   expected(rule));
+  }
+  const std::string& key = parts[part];
+  if (key == "*") {
+    if (!j.is_array()) return;
+    for (size_t i = 0; i < j.size(); ++i) {
+      checkField(path, j[i], rule, parts, part + 1, where + "/" + std::to_string(i));
+    }
+    return;
+  }
+  if (!j.is_object()) return;
+  auto it = j.find(key);
+  if (it != j.end()) checkField(path, *it, rule, parts, part + 1, where + "/" + key);
+}
+
+}  // namespace
+
+void checkFieldTypes(const std::string& path, const nlohmann::json& j) {
+  for (const FieldRule& rule : kFieldRules) {
+    std::vector<std::string> parts;
+    std::string pointer = rule.pointer;
+    for (size_t at = 1, next; at <= pointer.size(); at = next + 1) {
+      next = pointer.find('/', at);
+      if (next == std::string::npos) next = pointer.size();
+      parts.push_back(pointer.substr(at, next - at));
+    }
+    checkField(path, j, rule, parts, 0, "");
+  }
+  // The project's keys are read from the scene's extras (docs/scene.md): in
+  // the file's own extras they were ignored without a word.
+  auto extras = j.find("extras");
+  if (extras != j.end() && extras->is_object()) {
+    for (auto it = extras->begin(); it != extras->end(); ++it) {
+      if (it.key().rfind("lightoctree_", 0) != 0) continue;
+      fail(path, "invalid glTF: /extras/" + printable(it.key()) +
+                     " is read from the scene's extras (/scenes/N/extras/" +
+                     printable(it.key()) + "), not the file's: move it there");
+    }
+  }
+}
+
 bool readsGltfExtension(const std::string& name) {
   static const char* const kRead[] = {
       "KHR_lights_punctual",          "KHR_materials_emissive_strength", "KHR_materials_ior",
@@ -133,6 +261,7 @@ void prevalidateJson(const std::string& path, const std::string& baseDir, const 
     }
   }
   checkIntegerRanges(path, j, "", 0);
+  checkFieldTypes(path, j);
   std::vector<uint64_t> bufferLengths;
   auto buffers = j.find("buffers");
   if (buffers != j.end() && buffers->is_array()) {

@@ -20,6 +20,15 @@ void checkJsonNesting(const std::string& path, const std::string& text);
 /// and present.
 void prevalidateJson(const std::string& path, const std::string& baseDir, const nlohmann::json& j);
 
+/// The fields the loader reads (a material's factors, a light's colour,
+/// intensity and cone, a node's transform, a camera's projection) of the JSON
+/// type glTF gives them, and the project's extras keys (lightoctree_*) where
+/// they are read: refused naming the JSON pointer and the value
+/// ("/extensions/KHR_lights_punctual/lights/0/intensity is \"5\", expected a
+/// number"), where tinygltf would take the field as absent. Part of
+/// prevalidateJson.
+void checkFieldTypes(const std::string& path, const nlohmann::json& j);
+
 /// Whether the loader reads the glTF extension `name` (KHR_lights_punctual,
 /// the KHR_materials_* it maps to Material, KHR_texture_transform,
 /// KHR_mesh_quantization's integer attributes; the archived

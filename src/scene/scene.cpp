@@ -752,6 +752,27 @@ void checkLightAndMaterialValues(Scene& scene) {
                                  ", outside [0, " + formatLimit(kMaxLightIntensity) +
                                  "] (cd or lx, as W/sr or W/m^2)");
     }
+    // glTF asks 0 < outer <= pi/2 and 0 <= inner < outer. A spot of no cone
+    // sends nothing (it was taken without a word, and dark); negative angles
+    // lit the whole room (cos of a negative angle is that of a positive one).
+    if (light.type == Light::Type::Spot &&
+        !(light.outerConeAngle > 0 && std::isfinite(light.outerConeAngle))) {
+      fail(scene.sourcePath, name + " has outerConeAngle " + formatLimit(light.outerConeAngle) +
+                                 " (radians): a spot's cone must be wider than 0 and at most "
+                                 "pi/2 (glTF: 0 < outerConeAngle <= pi/2)");
+    }
+    if (light.type == Light::Type::Spot && light.outerConeAngle > kPi / 2) {
+      scene.warnings.push_back(scene.sourcePath + ": " + name + " has outerConeAngle " +
+                               formatLimit(light.outerConeAngle) +
+                               " (radians), beyond pi/2: clamped to pi/2");
+      light.outerConeAngle = kPi / 2;
+    }
+    if (light.type == Light::Type::Spot && !(light.innerConeAngle >= 0)) {
+      scene.warnings.push_back(scene.sourcePath + ": " + name + " has innerConeAngle " +
+                               formatLimit(light.innerConeAngle) +
+                               " (radians), below 0: clamped to 0");
+      light.innerConeAngle = 0;
+    }
     // glTF asks inner < outer; an inner cone beyond the outer one was drawn
     // by the renderer and the tracers each their own way.
     if (light.type == Light::Type::Spot && light.innerConeAngle > light.outerConeAngle) {

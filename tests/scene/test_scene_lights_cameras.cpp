@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -73,6 +74,106 @@ TEST_F(SceneGltf, LightAndMaterialValuesStayInTheirRanges) {
   expectInputError(
       write("far.gltf", withLight(R"({"type": "point", "intensity": 1})", "[1e19, 0, 0]")),
       "light 'L' lies at");
+}
+
+// A field of another JSON type than glTF gives it was taken by tinygltf as
+// absent, its default without a word (ninth hostile list H9-4-103: a point
+// light's "intensity": "5" lit as 1; H9-4-111: "emissiveFactor": "bright"
+// on the only emitter, then "scene has no light"; H9-4-120..122: the sky key
+// in the file's own extras, ignored). Refused, naming the JSON pointer.
+TEST_F(SceneGltf, FieldsOfAnotherTypeAreRefusedNamingTheirPointer) {
+  auto withLight = [](const std::string& light) {
+    MiniGltf g = oneTriangle();
+    g.nodes = R"([{"mesh": 0}, {"name": "L", "translation": [0, 1, 0],
+                  "extensions": {"KHR_lights_punctual": {"light": 0}}}])";
+    g.sceneNodes = "[0, 1]";
+    g.extraTop = R"("extensionsUsed": ["KHR_lights_punctual"], "extensions": {"KHR_lights_punctual":
+                    {"lights": [)" + light + R"(]}}, )";
+    return g;
+  };
+  // The same light with a number is read as it says.
+  const Scene five = loadScene(write("five.gltf", withLight(R"({"type": "point", "intensity": 5})")));
+  ASSERT_EQ(five.lights.size(), 1u);
+  EXPECT_EQ(five.lights[0].intensity, 5.0f);
+  expectInputError(write("text.gltf", withLight(R"({"type": "point", "intensity": "5"})")),
+                   "/extensions/KHR_lights_punctual/lights/0/intensity is \"5\", expected a number");
+  expectInputError(write("colour.gltf", withLight(R"({"type": "point", "color": [1, 1]})")),
+                   "/extensions/KHR_lights_punctual/lights/0/color is [1,1], expected an array of 3 numbers");
+  MiniGltf material = oneTriangle();
+  material.material = 0;
+  material.materials = R"([{"name": "lamp", "emissiveFactor": "bright"}])";
+  expectInputError(write("emissive.gltf", material),
+                   "/materials/0/emissiveFactor is \"bright\", expected an array of 3 numbers");
+  material.materials = R"([{"pbrMetallicRoughness": {"roughnessFactor": null}}])";
+  expectInputError(write("rough.gltf", material),
+                   "/materials/0/pbrMetallicRoughness/roughnessFactor is null, expected a number");
+  MiniGltf node = oneTriangle();
+  node.nodes = R"([{"mesh": 0, "translation": [0, "1", 0]}])";
+  expectInputError(write("node.gltf", node), "/nodes/0/translation is [0,\"1\",0]");
+  for (const char* sky : {"[-1, -1, -1]", "[1, 1]", "\"blue\"", "[1, 1, 1]"}) {
+    MiniGltf top = oneTriangle();
+    top.extraTop = std::string(R"("extras": {"lightoctree_sky": )") + sky + "}, ";
+    expectInputError(write("top-sky.gltf", top),
+                     "/extras/lightoctree_sky is read from the scene's extras "
+                     "(/scenes/N/extras/lightoctree_sky), not the file's");
+  }
+}
+
+// A node matrix whose bottom row is not (0, 0, 0, 1) is projective, which
+// glTF forbids; its bottom row was dropped without a word (H9-4-94).
+TEST_F(SceneGltf, AProjectiveNodeMatrixIsRefusedNamingTheNode) {
+  MiniGltf g = oneTriangle();
+  g.nodes = R"([{"name": "floor", "mesh": 0,
+                 "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0]}])";
+  expectInputError(write("projective.gltf", g),
+                   "node 0 'floor': matrix has the bottom row (0, 0, 1, 0), expected (0, 0, 0, 1)");
+  g.nodes = R"([{"name": "floor", "mesh": 0,
+                 "matrix": [2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 1, 2, 3, 1]}])";
+  const Scene s = loadScene(write("affine.gltf", g));
+  ASSERT_FALSE(s.positions.empty());
+  double lowX = 1e30, highX = -1e30;  // the triangle spans x 0..1, scaled by 2 and moved by 1
+  for (const Vec3& p : s.positions) {
+    lowX = std::min(lowX, s.toWorld(p).x);
+    highX = std::max(highX, s.toWorld(p).x);
+    EXPECT_NEAR(s.toWorld(p).z, 3.0, 1e-5);
+  }
+  EXPECT_NEAR(lowX, 1.0, 1e-5);
+  EXPECT_NEAR(highX, 3.0, 1e-5);
+}
+
+// A spot's cone out of glTF's range (0 < outer <= pi/2, 0 <= inner < outer):
+// negative angles lit the room as a wide cone, an outer cone of 0 sent nothing,
+// both without a word (H9-4-101). An outer cone of no width is refused, the
+// other angles clamped with a warning naming the light.
+TEST_F(SceneGltf, SpotConesOutsideGltfsRangeAreRefusedOrClampedNamingTheLight) {
+  auto spot = [&](const std::string& name, const std::string& cone) {
+    MiniGltf g = oneTriangle();
+    g.nodes = R"([{"mesh": 0}, {"name": "S", "translation": [0, 1, 0],
+                  "extensions": {"KHR_lights_punctual": {"light": 0}}}])";
+    g.sceneNodes = "[0, 1]";
+    g.extraTop = R"("extensionsUsed": ["KHR_lights_punctual"], "extensions": {"KHR_lights_punctual":
+                    {"lights": [{"type": "spot", "intensity": 10, "spot": )" + cone + "}]}}, ";
+    return write(name, g);
+  };
+  expectInputError(spot("neg.gltf", R"({"innerConeAngle": -1, "outerConeAngle": -0.5})"),
+                   "light 'S' has outerConeAngle -0.5 (radians)");
+  expectInputError(spot("zero.gltf", R"({"innerConeAngle": 0, "outerConeAngle": 0})"),
+                   "light 'S' has outerConeAngle 0 (radians)");
+  const Scene inner = loadScene(spot("inner.gltf", R"({"innerConeAngle": -1, "outerConeAngle": 0.5})"));
+  ASSERT_EQ(inner.lights.size(), 1u);
+  EXPECT_EQ(inner.lights[0].innerConeAngle, 0.0f);
+  EXPECT_FLOAT_EQ(inner.lights[0].outerConeAngle, 0.5f);
+  const Scene wide = loadScene(spot("wide.gltf", R"({"outerConeAngle": 3})"));
+  EXPECT_FLOAT_EQ(wide.lights[0].outerConeAngle, kPi / 2);
+  std::string all;
+  for (const std::string& w : inner.warnings) all += w + "\n";
+  for (const std::string& w : wide.warnings) all += w + "\n";
+  EXPECT_NE(all.find("light 'S' has innerConeAngle -1 (radians), below 0: clamped to 0"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("light 'S' has outerConeAngle 3 (radians), beyond pi/2: clamped to pi/2"),
+            std::string::npos)
+      << all;
 }
 
 TEST_F(SceneGltf, PunctualLights) {
