@@ -266,6 +266,10 @@ class SceneBuilder {
   std::set<int> missingImages_;  ///< images whose file is missing, warned once
   /// Each image's file bytes, kept by the textures that decode it (Texture::encoded).
   std::map<int, std::shared_ptr<const std::vector<uint8_t>>> imageBytes_;
+  /// The first image of each source (its file, its data URI, its
+  /// bufferView): images that name one source are one image, decoded once.
+  std::map<std::string, int> imageBySource_;
+  int sharedImage(int image);
   std::vector<PendingTexture> pendingTextures_;  ///< textureFromImage's, for decodeTextures
   int defaultMaterial_ = -1;
   bool hasNormals_ = false, hasUv0_ = false, hasUv1_ = false, hasTangents_ = false,

@@ -275,7 +275,11 @@ TEST_F(SceneGltf, ATextureThatIsAFolderIsWarnedAsAFolder) {
 TEST_F(SceneGltf, TexturesAreCheckedAgainstTheMemoryAsATotal) {
   // 256 x 256 RGB: 192 KiB kept per texture (1 MiB by the check of one image,
   // which counts the decoder's working copies).
-  writeFile(dir + "/big.ppm", "P6\n256 256\n255\n" + std::string(256 * 256 * 3, '\x80'));
+  // Each its own file: images of one file are one texture (below).
+  for (int i = 0; i < 16; ++i) {
+    writeFile(dir + "/big" + std::to_string(i) + ".ppm",
+              "P6\n256 256\n255\n" + std::string(256 * 256 * 3, '\x80'));
+  }
   auto scene = [&](int n) {
     MiniGltf g = oneTriangle();
     g.material = 0;
@@ -283,7 +287,7 @@ TEST_F(SceneGltf, TexturesAreCheckedAgainstTheMemoryAsATotal) {
     for (int i = 0; i < n; ++i) {
       const std::string comma = i ? ", " : "", index = std::to_string(i);
       textures += comma + R"({"source": )" + index + "}";
-      images += comma + R"({"uri": "big.ppm"})";
+      images += comma + R"({"uri": "big)" + index + R"(.ppm"})";
       materials += comma + R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": )" +
                    index + "}}}";
     }
@@ -300,8 +304,48 @@ TEST_F(SceneGltf, TexturesAreCheckedAgainstTheMemoryAsATotal) {
   const Scene s = loadScene(scene(16));
   ASSERT_EQ(s.textures.size(), 16u);
   EXPECT_EQ(s.textures[15].width, 256);
-  EXPECT_EQ(s.textures[15].name, "big.ppm");
+  EXPECT_EQ(s.textures[15].name, "big15.ppm");
   expectNear(s.textures[15].texelAt(0), Vec3{srgbToLinear(128.0f / 255.0f)}, 1e-6f);
+}
+
+// Images that name one file are one image: 300 images of one 1024^2 PNG
+// were decoded 300 times (1.85 GB for a 4.5 KB file, ninth hostile list
+// H9-5-10, H9-5-11) and the total-texture check let them through. One
+// texture per file, decoding (colour or data) and sampler; "./one.ppm" is
+// "one.ppm".
+TEST_F(SceneGltf, ImagesOfOneFileAreDecodedOnce) {
+  writeFile(dir + "/one.ppm", "P6\n256 256\n255\n" + std::string(256 * 256 * 3, '\x80'));
+  writeFile(dir + "/two.ppm", "P6\n2 2\n255\n" + std::string(2 * 2 * 3, '\x40'));
+  MiniGltf g = oneTriangle();
+  g.material = 0;
+  std::string textures, images, materials;
+  const int n = 40;
+  for (int i = 0; i < n; ++i) {
+    const std::string comma = i ? ", " : "", index = std::to_string(i);
+    textures += comma + R"({"source": )" + index + "}";
+    images += comma + (i == n - 1 ? std::string(R"({"uri": "two.ppm"})")
+                       : i % 2  ? std::string(R"({"uri": "./one.ppm"})")
+                                : std::string(R"({"uri": "one.ppm"})"));
+    materials += comma + R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": )" + index +
+                 "}}}";
+  }
+  // Material 0 also takes texture 1 as data (its normal map): another decoding.
+  materials = R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+                 "normalTexture": {"index": 1}})" + materials.substr(materials.find("}}}") + 3);
+  g.extraTop = R"("textures": [)" + textures + R"(], "images": [)" + images + "], ";
+  g.materials = "[" + materials + "]";
+  // Under a limit that holds the two decodings of one.ppm (192 KiB each),
+  // not its 39 images decoded each (7.3 MiB).
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "4M", 1);
+  const Scene s = loadScene(write("shared.gltf", g));
+  unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+  ASSERT_EQ(s.textures.size(), 3u);  // one.ppm as colour and as data, two.ppm
+  EXPECT_EQ(s.textures[0].width, 256);
+  ASSERT_EQ(s.materials.size(), size_t(n));
+  for (int i = 0; i < n - 1; ++i) EXPECT_EQ(s.materials[size_t(i)].baseColorTexture, 0) << i;
+  EXPECT_EQ(s.materials[0].normalTexture, 1);
+  EXPECT_EQ(s.textures[2].width, 2);
+  EXPECT_EQ(s.materials[size_t(n - 1)].baseColorTexture, 2);
 }
 
 /// A 2 x 2 texture of texel values 0, 1 (top row), 2, 3 (bottom row).
