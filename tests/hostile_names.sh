@@ -51,4 +51,16 @@ rc=$?
 [ -e pm.vdb ] || [ -e s.json ] && fail "a side file of the failed set appeared"
 ls -A | grep -q '\.tmp$' && fail "temporary files left: $(ls -A | grep '\.tmp$')"
 
+# 4. A file name with a newline and a terminal escape that does not exist:
+#    the parser's own "File does not exist" quotes it escaped, as every other
+#    error (it turned the terminal red).
+odd=$(printf 'a\nb\033[31m.gltf')
+msg=$("$cli" bake "$odd" -o x.vdb --quiet 2>&1)
+rc=$?
+[ "$rc" -eq 2 ] || fail "a missing scene with control characters: exit $rc"
+printf '%s' "$msg" | grep -qF 'File does not exist: a\x0ab\x1b[31m.gltf' ||
+  fail "the parser's message does not escape the name: '$(printf '%s' "$msg" | od -c | head -3)'"
+printf '%s' "$msg" | grep -q "$(printf '\033')" && fail "a raw escape reached the terminal"
+[ "$(printf '%s\n' "$msg" | wc -l)" -eq 2 ] || fail "the name's newline reached the terminal: '$msg'"
+
 [ "$failures" -eq 0 ] && echo "hostile names: all checks passed" || exit 1

@@ -133,6 +133,16 @@ int run(int argc, char** argv) {
   commands.push_back(lo::tool::addSweepCommand(app));
   commands.push_back(lo::tool::addViewCommand(app));
   lo::tool::requireNumberRules(app);  // every numeric flag, those with a range or not
+  // The parser's own messages ("scene: File does not exist: NAME") quote what
+  // was typed: escaped as every other error, where a name's newline and
+  // terminal escapes reached the terminal raw.
+  app.failure_message([](const CLI::App* from, const CLI::Error& e) {
+    std::string text = lo::printable(e.what()) + "\n";
+    if (from->get_help_ptr() != nullptr) {
+      text += "Run with " + from->get_help_ptr()->get_name() + " for more information.\n";
+    }
+    return text;
+  });
   try {
     app.parse(argc, argv);
   } catch (const CLI::ConversionError& e) {
