@@ -30,6 +30,7 @@
 #include "core/error.h"
 #include "core/file.h"
 #include "core/number_range.h"
+#include "core/printable.h"
 #include "core/progress.h"
 #include "core/resources.h"
 #include "export/lightmap_export.h"
@@ -393,7 +394,7 @@ std::string vdlsArg(const py::handle& value, const std::string& name, const char
 /// os.fsdecode with its bytes as surrogate escapes; pybind11's str to UTF-8
 /// raised UnicodeEncodeError on those, bytes were refused, and a PathLike of
 /// bytes was taken as the text "b'...'"). Checked as checkPathText.
-std::string pathArg(const py::handle& value, const std::string& name) {
+std::string pathArg(const py::handle& value, const std::string& name, bool mayBeEmpty = false) {
   if (!py::isinstance<py::str>(value) && !py::isinstance<py::bytes>(value) &&
       !py::hasattr(value, "__fspath__")) {
     refuse(name, "a path (str, bytes or os.PathLike)", value);
@@ -408,8 +409,39 @@ std::string pathArg(const py::handle& value, const std::string& name) {
                      " is not a file name the system can take (" + e.what() + ")");
   }
   const std::string path = encoded.cast<std::string>();
+  // '' named no file: "InputError: : file does not exist".
+  if (path.empty() && !mayBeEmpty) throw InputError(name + ": the path is empty: name a file");
   checkPathText(path, name);
   return path;
+}
+
+/// A grid argument: a lightoctree.Grid (from bake, read or convert); pybind11's
+/// own conversion answered None with "incompatible function arguments",
+/// naming no argument.
+Grid& gridArg(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<Grid>(value)) {
+    refuse(name, "a lightoctree.Grid (from bake, read or convert)", value);
+  }
+  return value.cast<Grid&>();
+}
+
+/// An (N, 3) array of numbers as doubles (NumPy converts lists, tuples and
+/// other numeric arrays), refused by its name when it holds anything else.
+py::array_t<double, py::array::c_style | py::array::forcecast> pointsArg(const py::handle& value,
+                                                                           const std::string& name) {
+  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  Array a;
+  if (!value.is_none() && !py::isinstance<py::str>(value) && !py::isinstance<py::bytes>(value)) {
+    try {
+      a = Array::ensure(value);
+    } catch (const py::error_already_set&) {
+      a = Array();
+    }
+  }
+  if (!a || a.ndim() != 2 || a.shape(1) != 3) {
+    refuse(name, "an array of numbers of shape (N, 3)", value);
+  }
+  return a;
 }
 
 /// A path for Python, as os.fsdecode gives it: a str whatever the bytes, which
@@ -451,11 +483,12 @@ py::dict inspectFile(const Arg<std::string>& pathArgument) {
   return d;
 }
 
-GridPtr convertGrid(const Grid& in, const Arg<int>& depthArg, const Arg<std::string>& vdlsValue,
-                    const Arg<std::string>& sceneArg) {
+GridPtr convertGrid(const Arg<Grid>& gridValue, const Arg<int>& depthArg,
+                    const Arg<std::string>& vdlsValue, const Arg<std::string>& sceneArg) {
+  const Grid& in = gridArg(gridValue.value, "grid");
   const int depth = int(numberOrZeroArg(depthArg.value, kDepthRange, "depth", "the grid's own"));
   const std::string vdls = vdlsArg(vdlsValue.value, "vdls", "the grid's own");
-  const std::string scenePath = pathArg(sceneArg.value, "scene");
+  const std::string scenePath = pathArg(sceneArg.value, "scene", true);  // '': none
   ConvertParams params;
   params.depth = depth;
   params.vdls = vdls;
@@ -486,12 +519,14 @@ std::string rowText(const double* v, size_t i) {
 /// other argument of the module is by its name: the lookup has no answer
 /// there (it gave 0, a value a caller cannot tell from darkness), and NaN in
 /// the result would spread silently through the caller's sums.
-py::array_t<float> lookup(Grid& g,
-                          py::array_t<double, py::array::c_style | py::array::forcecast> points,
-                          py::array_t<double, py::array::c_style | py::array::forcecast> normals) {
-  if (points.ndim() != 2 || points.shape(1) != 3 || normals.ndim() != 2 || normals.shape(1) != 3 ||
-      normals.shape(0) != points.shape(0)) {
-    throw InputError("lookup: points and normals must both be arrays of shape (N, 3)");
+py::array_t<float> lookup(const Arg<Grid>& gridValue, const Arg<py::array_t<double>>& pointsValue,
+                          const Arg<py::array_t<double>>& normalsValue) {
+  Grid& g = gridArg(gridValue.value, "grid");
+  const auto points = pointsArg(pointsValue.value, "points");
+  const auto normals = pointsArg(normalsValue.value, "normals");
+  if (normals.shape(0) != points.shape(0)) {
+    throw InputError("normals: " + std::to_string(normals.shape(0)) + " rows, where points has " +
+                     std::to_string(points.shape(0)) + ": one normal per point");
   }
   const size_t n = size_t(points.shape(0));
   const double* p = points.data();
@@ -587,10 +622,11 @@ RenderSettings renderSettings(const Arg<int>& width, const Arg<int>& height,
 /// The scene lit by the grid, drawn by the GL renderer (OSMesa, headless)
 /// from the scene's camera through the library's render session: linear
 /// RGB, shape (height, width, 3).
-py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Grid& g,
+py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Arg<Grid>& gridValue,
                                const Arg<int>& width, const Arg<int>& height,
                                const Arg<std::string>& mode, const py::kwargs& kw) {
   const std::string scenePath = pathArg(sceneArg.value, "scene");
+  const Grid& g = gridArg(gridValue.value, "grid");
   // Its checks (the frame's memory among them) name the flags.
   const RenderSettings settings =
       withPythonNames([&] { return renderSettings(width, height, mode, kw); });
@@ -765,13 +801,18 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
   // refuse the same values.
   opt.width = wholeArg(width.value, 1, kMaxImageSide, "width");
   opt.height = wholeArg(height.value, 1, kMaxImageSide, "height");
-  opt.spp = wholeArg(spp.value, 1, 1000000, "spp");
+  if (!spp.value.is_none()) opt.spp = wholeArg(spp.value, 1, 1000000, "spp");
   opt.maxBounces = wholeArg(maxBounces.value, 0, 100000, "max_bounces");
   opt.part = checkChoice(textArg(part.value, "part"), {"full", "direct", "indirect", "irradiance"},
                          "part");
   if (!seed.value.is_none()) opt.seed = seedArg(seed.value, "seed");
   if (!timeBudget.value.is_none()) {
     opt.timeBudget = numberArg(timeBudget.value, {1e-3, 1e7}, "time_budget");
+    // As the command: "--spp excludes --time-budget" (spp was taken and ignored).
+    if (!spp.value.is_none()) {
+      throw InputError("spp and time_budget: give one of them (time_budget renders passes of 1 "
+                       "sample per pixel until it runs out)");
+    }
   }
   if (!camera.is_none()) opt.camera.camera = textArg(camera, "camera");
   if (!eye.is_none()) opt.camera.eye = vec3Text(eye, "eye");
@@ -873,6 +914,8 @@ py::dict compareImagesArg(const py::object& testArg, const py::object& reference
   if (!maskArg.is_none()) mask = imageArg(maskArg, "mask", true, &maskPath);
   if (!referenceErrorArg.is_none()) {
     stdError = imageArg(referenceErrorArg, "reference_error", false, &errorPath);
+    checkStdError(*stdError, errorPath.empty() ? "reference_error"
+                                               : "reference_error: " + printable(errorPath));
   }
   if (mask && (mask->width != reference.width || mask->height != reference.height)) {
     throw InputError("mask: " + sizeText("the mask", maskPath, *mask) + ", the images are " +
@@ -889,7 +932,7 @@ py::dict compareImagesArg(const py::object& testArg, const py::object& reference
     r = compareReport(test, reference, settings, mask ? &*mask : nullptr,
                       stdError ? &*stdError : nullptr);
   }
-  warn(r.nonFiniteWarning());  // as the command's "warning: ..." on stderr
+  for (const std::string& w : r.warnings()) warn(w);  // as the command's "warning: ..." on stderr
   const CompareResult& m = r.result;
   py::dict d;  // the keys and values of `compare --json`
   d["test"] = testPath.empty() ? py::object(py::none()) : pathValue(testPath);
@@ -1033,6 +1076,8 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
 
 }  // namespace
 
+const std::string kDefaultSppText = std::to_string(ReferenceOptions{}.spp);
+
 PYBIND11_MODULE(lightoctree, m) {
   m.doc() =
       "Light Octree: photon-mapped global illumination baked into sparse OpenVDB grids of "
@@ -1134,8 +1179,9 @@ PYBIND11_MODULE(lightoctree, m) {
   m.def("read", &readGrid, py::arg("path"), "Reads a .vdb written by bake or convert.");
   m.def(
       "write",
-      [](const Arg<std::string>& path, const Grid& g) {
+      [](const Arg<std::string>& path, const Arg<Grid>& grid) {
         const std::string file = pathArg(path.value, "path");
+        const Grid& g = gridArg(grid.value, "grid");
         checkOutputFile(file, "path", ".vdb");
         writeVdlGrid(file, g.grid, g.meta);
       },
@@ -1158,7 +1204,9 @@ PYBIND11_MODULE(lightoctree, m) {
         "emitter_lights, shadow_map_size (int); tolerance, free_space_tolerance (0..1); "
         "progress: a callable (task, done, total) told of the set-up and each frame.");
   m.def("reference", &referenceImage, py::arg("scene"), py::arg("width") = ReferenceOptions{}.width,
-        py::arg("height") = ReferenceOptions{}.height, py::arg("spp") = ReferenceOptions{}.spp,
+        py::arg("height") = ReferenceOptions{}.height,
+        // None: not given (it excludes time_budget); shown as the command's default.
+        py::arg_v("spp", py::none(), kDefaultSppText.c_str()),
         py::arg("part") = ReferenceOptions{}.part, py::arg("seed") = ReferenceOptions{}.seed,
         py::arg("max_bounces") = ReferenceOptions{}.maxBounces, py::arg("camera") = py::none(),
         py::arg("eye") = py::none(), py::arg("target") = py::none(), py::arg("fov") = py::none(),
@@ -1170,8 +1218,8 @@ PYBIND11_MODULE(lightoctree, m) {
         "defaults and camera: the scene's first camera or `camera` by name, else the scene "
         "framed; eye and target as x, y, z; fov in degrees): linear RGB, shape (height, width, "
         "3); with std_error=True (image, per-pixel standard error). part 'full' | 'direct' | "
-        "'indirect' | 'irradiance'; time_budget (seconds) renders passes of 1 spp instead of "
-        "spp. progress(task, done, total) is called as it goes; an exception it raises, or "
+        "'indirect' | 'irradiance'; spp (default 64), or time_budget (seconds): passes of 1 spp "
+        "until it runs out, not both. progress(task, done, total) is called as it goes; an exception it raises, or "
         "Ctrl-C, stops the work and is raised.");
   m.def("compare", &compareImagesArg, py::arg("test"), py::arg("reference"),
         py::arg("bin") = CompareSettings{}.bin,

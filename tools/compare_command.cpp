@@ -70,6 +70,7 @@ int runCompare(const CompareOptions& opt) {
                        ", the images are " + std::to_string(reference.width) + " x " +
                        std::to_string(reference.height));
     }
+    checkStdError(stdError, "--reference-error: " + opt.referenceError);
   }
   CompareSettings settings;
   settings.bin = opt.bin;
@@ -107,9 +108,9 @@ int runCompare(const CompareOptions& opt) {
                  "render it with more samples or compare over larger --bin blocks\n",
                  noise, result.luminance.relRmse);
   }
-  // Pixels left out for NaN or inf, which the figures alone hide (--quiet too).
-  if (const std::string w = report.nonFiniteWarning(); !w.empty())
-    std::fprintf(stderr, "warning: %s\n", w.c_str());
+  // What the figures alone hide (pixels left out for NaN or inf, relative
+  // errors against black), --quiet too.
+  for (const std::string& w : report.warnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (!opt.diff.empty()) {
     // Linear float values in an EXR; PNG keeps the false colour as it is.
     writeImage(opt.diff, differenceImage(report.test, report.reference, report.params(), opt.diffScale));

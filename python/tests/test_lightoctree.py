@@ -925,3 +925,59 @@ print("after:", lightoctree.bake(sys.argv[1], depth=3, photons=5000).size > 0)
                      r"LIGHTOCTREE_MEMORY_LIMIT=[0-9]+ \([0-9.]+ [KMG]iB\); stopped, nothing returned "
                      r"or written$", run.stdout, re.M), run.stdout
     assert "after: True" in run.stdout, run.stdout
+
+
+def test_grids_and_arrays_of_another_type_are_refused_by_name(grid, tmp_path):
+    """A grid argument that is not a Grid, or points that are not numbers, got
+    pybind11's "incompatible function arguments ... Invoked with: None, ...",
+    naming no argument (ninth hostile list H9-1-3)."""
+    points, normals = np.zeros((1, 3)), np.array([[0, 1.0, 0]])
+    for call, message in [
+        (lambda: lightoctree.lookup(None, points, normals), "grid: must be a lightoctree.Grid"),
+        (lambda: lightoctree.write(str(tmp_path / "x.vdb"), None), "grid: must be a lightoctree.Grid"),
+        (lambda: lightoctree.convert(None, 3), "grid: must be a lightoctree.Grid"),
+        (lambda: lightoctree.render(SCENE, "grid.vdb", width=8, height=8), "grid: must be a lightoctree.Grid"),
+        (lambda: lightoctree.lookup(grid, np.array([[0, "a", 0]], dtype=object), normals),
+         "points: must be an array of numbers of shape (N, 3)"),
+        (lambda: lightoctree.lookup(grid, points, None), "normals: must be an array of numbers"),
+        (lambda: lightoctree.lookup(grid, np.zeros((2, 2)), normals), "points: must be an array"),
+        (lambda: lightoctree.lookup(grid, np.zeros((2, 3)), normals), "normals: 1 rows, where points has 2"),
+    ]:
+        with pytest.raises(lightoctree.InputError) as refusal:
+            call()
+        assert str(refusal.value).startswith(message), str(refusal.value)
+    assert list(tmp_path.iterdir()) == []
+    # Lists and integer arrays are numbers, as before.
+    by_list = lightoctree.lookup(grid, [[0, 0.5, 0]], [[0, 1, 0]])
+    assert by_list.shape == (1, 3)
+    assert np.array_equal(by_list, lightoctree.lookup(grid, np.array([[0, 0.5, 0]]), np.array([[0, 1, 0]])))
+
+
+def test_an_empty_path_is_named_as_empty():
+    """read('') said "InputError: : file does not exist" (H9-1-4)."""
+    for call, name in [(lightoctree.read, "path"), (lightoctree.inspect, "path"),
+                       (lightoctree.read_image, "path"), (lightoctree.bake, "scene")]:
+        with pytest.raises(lightoctree.InputError, match="^" + name + r": the path is empty: name a file$"):
+            call("")
+
+
+def test_reference_refuses_spp_with_a_time_budget_as_the_command_does():
+    """spp=4 with time_budget=1.0 ran for the budget and ignored spp, where the
+    command refuses "--spp excludes --time-budget" (H9-1-7)."""
+    with pytest.raises(lightoctree.InputError, match="^spp and time_budget: give one of them"):
+        lightoctree.reference(SCENE, width=8, height=8, spp=4, time_budget=1.0)
+    assert lightoctree.reference(SCENE, width=8, height=8, spp=2).shape == (8, 8, 3)
+
+
+def test_compare_refuses_a_negative_standard_error_and_warns_of_a_black_reference():
+    """A negative reference_error was taken (reference_noise 0.909); against
+    a black reference rel_rmse was inf without a word (H9-1-8)."""
+    a = np.ones((8, 8, 3), np.float32)
+    with pytest.raises(lightoctree.InputError,
+                       match=r"^reference_error: pixel \(0, 0\) holds a standard error of -1 in channel R"):
+        lightoctree.compare(a, a * 1.1, reference_error=-a)
+    assert lightoctree.compare(a, a * 1.1, reference_error=0.01 * a)["reference_noise"] > 0
+    with pytest.warns(UserWarning, match=r"the reference is black \(0\) in R, G, B, Y, RGB"):
+        result = lightoctree.compare(a, np.zeros_like(a))
+    assert math.isinf(result["channels"]["Y"]["rel_rmse"])
+    assert result["channels"]["Y"]["max_abs"] > 0

@@ -313,6 +313,46 @@ std::string CompareReport::nonFiniteWarning() const {
          " that hold them are left out, the figures are of the " + compared + " bins compared";
 }
 
+std::string CompareReport::blackReferenceWarning() const {
+  const char* names[5] = {"R", "G", "B", "Y", "RGB"};
+  const ChannelError* channels[5] = {&result.channel[0], &result.channel[1], &result.channel[2],
+                                     &result.luminance, &result.rgb};
+  std::string black;
+  for (int c = 0; c < 5; ++c) {
+    if (std::isinf(channels[c]->relRmse) || std::isinf(channels[c]->relMae)) {
+      black += (black.empty() ? "" : ", ") + std::string(names[c]);
+    }
+  }
+  if (black.empty()) return "";
+  return "the reference is black (0) in " + black +
+         " over the pixels compared, where the test image is not: relative errors (rel_rmse, "
+         "rel_mae) are undefined there and reported as inf; max_abs measures the difference";
+}
+
+std::vector<std::string> CompareReport::warnings() const {
+  std::vector<std::string> out;
+  for (const std::string& w : {nonFiniteWarning(), blackReferenceWarning()}) {
+    if (!w.empty()) out.push_back(w);
+  }
+  return out;
+}
+
+void checkStdError(const RgbImage& stdError, const std::string& what) {
+  for (size_t i = 0; i < stdError.pixelCount(); ++i) {
+    const Vec3 e = stdError.at(i);
+    for (int c = 0; c < 3; ++c) {
+      if (!(e[c] < 0)) continue;
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "pixel (%d, %d) holds a standard error of %g in channel %c: a standard error "
+                    "is 0 or more",
+                    int(i % size_t(stdError.width)), int(i / size_t(stdError.width)), double(e[c]),
+                    "RGB"[c]);
+      throw InputError(what + ": " + text);
+    }
+  }
+}
+
 CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSettings& settings,
                             const RgbImage* mask, const RgbImage* stdError) {
   CompareReport r;
@@ -324,6 +364,7 @@ CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSett
       throw InputError("compare: standard error is " + std::to_string(stdError->width) + " x " +
                        std::to_string(stdError->height) + ", images are " +
                        std::to_string(reference.width) + " x " + std::to_string(reference.height));
+    checkStdError(*stdError, "compare: the reference's standard error");
     error = *stdError;
   }
   // Black holes are judged per pixel against the reference as it is.

@@ -158,7 +158,20 @@ struct CompareReport {
   /// for a warning saying how many were, and what the figures are of: a
   /// test image half NaN scored its other half without a word.
   std::string nonFiniteWarning() const;
+  /// "" unless a channel's relative errors are infinite: the reference is
+  /// black (0) there over the pixels compared and the test image is not, so
+  /// rel_rmse and rel_mae are undefined (inf in the figures and the JSON).
+  std::string blackReferenceWarning() const;
+  /// Every warning of the comparison (nonFiniteWarning, blackReferenceWarning), in order.
+  std::vector<std::string> warnings() const;
 };
+
+/// A standard error image (`reference --std-error`, `compare
+/// --reference-error`): every value is 0 or more, or NaN where the reference
+/// had no sample. A negative value was taken and made the reference's noise
+/// figure a meaningless number. @throws InputError starting with `what`,
+/// naming the pixel and channel.
+void checkStdError(const RgbImage& stdError, const std::string& what);
 
 /// @brief `compare`'s measurement in its order: black holes judged per pixel
 /// against the reference as it is; then both images clipped at the

@@ -196,6 +196,33 @@ TEST(Compare, NothingComparedIsRefusedNotAPerfectScore) {
   test::expectRefusal([&] { compareReport(nan, ref, binned); }, {"4 not finite", "2 x 2 bins"});
 }
 
+// A negative standard error was taken and gave a reference noise figure of
+// nothing measured (ninth hostile list H9-1-8); against a black reference the
+// relative errors were inf without a word. Refused naming the pixel; warned.
+TEST(Compare, ANegativeStandardErrorIsRefusedAndABlackReferenceWarned) {
+  RgbImage ref(4, 4), test(4, 4), error(4, 4);
+  std::fill(ref.rgb.begin(), ref.rgb.end(), 1.0f);
+  std::fill(test.rgb.begin(), test.rgb.end(), 1.1f);
+  std::fill(error.rgb.begin(), error.rgb.end(), 0.01f);
+  EXPECT_GT(compareReport(test, ref, CompareSettings{}, nullptr, &error).referenceNoise, 0.0);
+  error.rgb[3 * (4 * 2 + 1) + 1] = -0.5f;  // pixel (1, 2), channel G
+  test::expectRefusal([&] { compareReport(test, ref, CompareSettings{}, nullptr, &error); },
+                      {"standard error", "pixel (1, 2) holds a standard error of -0.5 in channel G",
+                       "0 or more"});
+  test::expectRefusal([&] { checkStdError(error, "--reference-error: e.exr"); },
+                      {"--reference-error: e.exr: pixel (1, 2)"});
+  EXPECT_EQ(compareReport(test, ref, CompareSettings{}).blackReferenceWarning(), "");
+  const RgbImage black(4, 4);
+  const CompareReport dark = compareReport(test, black, CompareSettings{});
+  EXPECT_TRUE(std::isinf(dark.result.luminance.relRmse));
+  EXPECT_NE(dark.blackReferenceWarning().find("the reference is black (0) in R, G, B, Y, RGB"),
+            std::string::npos)
+      << dark.blackReferenceWarning();
+  ASSERT_EQ(dark.warnings().size(), 1u);
+  // Black against black is no difference: nothing undefined to warn of.
+  EXPECT_EQ(compareReport(black, black, CompareSettings{}).warnings().size(), 0u);
+}
+
 // A test image half NaN was scored over its other half without a word:
 // the report counts the pixels left out, per pixel before binning, and says
 // so in a warning the command and the Python module give.
