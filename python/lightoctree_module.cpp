@@ -12,6 +12,8 @@
 #include <pybind11/stl.h>
 
 #include <cctype>
+#include <clocale>
+#include <locale.h>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
@@ -232,6 +234,36 @@ std::string pythonNames(const std::string& message) {
     }
   }
   return out;
+}
+
+/// Numbers in the library's text (the flags' "x,y,z", messages, metadata)
+/// are written and read in the C locale, whatever locale the program that
+/// imports the module set: after Python's locale.setlocale(LC_ALL,
+/// "de_DE.UTF-8"), printf writes 0.5 as "0,5" and strtod stops at ".". Each
+/// call of the module runs with the C locale on its thread (uselocale) and
+/// gives the thread its own back after.
+class CLocale {
+ public:
+  CLocale() : previous_(uselocale(c())) {}
+  ~CLocale() { uselocale(previous_); }
+  CLocale(const CLocale&) = delete;
+  CLocale& operator=(const CLocale&) = delete;
+
+ private:
+  static locale_t c() {
+    static const locale_t locale = newlocale(LC_ALL_MASK, "C", locale_t(0));
+    return locale;
+  }
+  locale_t previous_;
+};
+
+/// A function of the module run under CLocale.
+template <typename R, typename... A>
+auto inCLocale(R (*f)(A...)) {
+  return [f](A... a) -> R {
+    CLocale numbers;
+    return f(std::forward<A>(a)...);
+  };
 }
 
 /// `work()` with an InputError of the options code reworded by pythonNames.
@@ -1164,7 +1196,7 @@ PYBIND11_MODULE(lightoctree, m) {
                " VDL slots>";
       });
 
-  m.def("bake", &bakeScene, py::arg("scene"), py::arg("depth") = "auto", py::arg("photons") = 0,
+  m.def("bake", inCLocale(&bakeScene), py::arg("scene"), py::arg("depth") = "auto", py::arg("photons") = 0,
         py::arg("target_error") = 0.0, py::arg("seed") = 1, py::arg("knn") = BakeParams{}.knn,
         py::arg("vdls") = "4", py::arg("include_direct") = false, py::arg("target_light") = "seen",
         py::arg("progress") = py::none(), py::arg("representation") = "vdl",
@@ -1176,10 +1208,11 @@ PYBIND11_MODULE(lightoctree, m) {
         "representation 'vdl', 'sh1' or 'sh2'; sky, sky_image, sky_mesh, physical_sky as the "
         "--sky flags (give lightmap the same). progress(task, done, total) is called as the "
         "bake goes; an exception it raises, or Ctrl-C, stops the bake and is raised.");
-  m.def("read", &readGrid, py::arg("path"), "Reads a .vdb written by bake or convert.");
+  m.def("read", inCLocale(&readGrid), py::arg("path"), "Reads a .vdb written by bake or convert.");
   m.def(
       "write",
       [](const Arg<std::string>& path, const Arg<Grid>& grid) {
+        CLocale numbers;
         const std::string file = pathArg(path.value, "path");
         const Grid& g = gridArg(grid.value, "grid");
         checkOutputFile(file, "path", ".vdb");
@@ -1187,15 +1220,15 @@ PYBIND11_MODULE(lightoctree, m) {
       },
       py::arg("path"), py::arg("grid"),
       "Writes the grid as a .vdb (atomically; a grid the readers would refuse is not written).");
-  m.def("inspect", &inspectFile, py::arg("path"),
+  m.def("inspect", inCLocale(&inspectFile), py::arg("path"),
         "The checks `lightoctree inspect` runs: {'ok', 'checks': [{'name', 'passed', 'detail'}], ...}.");
-  m.def("convert", &convertGrid, py::arg("grid"), py::arg("depth") = 0, py::arg("vdls") = "",
+  m.def("convert", inCLocale(&convertGrid), py::arg("grid"), py::arg("depth") = 0, py::arg("vdls") = "",
         py::arg("scene") = "",
         "Another depth (a finer one needs the scene) or VDL count, as `lightoctree convert`.");
-  m.def("lookup", &lookup, py::arg("grid"), py::arg("points"), py::arg("normals"),
+  m.def("lookup", inCLocale(&lookup), py::arg("grid"), py::arg("points"), py::arg("normals"),
         "Irradiance E(p, n) at world points with unit normals, (N, 3) each: the renderer's "
         "octree lookup on the CPU.");
-  m.def("render", &renderImage, py::arg("scene"), py::arg("grid"), py::arg("width") = 400,
+  m.def("render", inCLocale(&renderImage), py::arg("scene"), py::arg("grid"), py::arg("width") = 400,
         py::arg("height") = 300, py::arg("mode") = "full",
         "The scene lit by the grid from its camera, as `lightoctree render` draws it (OSMesa): "
         "linear RGB, shape (height, width, 3). Keywords as the command's flags, defaults the "
@@ -1203,7 +1236,7 @@ PYBIND11_MODULE(lightoctree, m) {
         "lighting ('octree' | 'atlas'), texels ('compact' | 'half' | 'float'); supersample, vdls, "
         "emitter_lights, shadow_map_size (int); tolerance, free_space_tolerance (0..1); "
         "progress: a callable (task, done, total) told of the set-up and each frame.");
-  m.def("reference", &referenceImage, py::arg("scene"), py::arg("width") = ReferenceOptions{}.width,
+  m.def("reference", inCLocale(&referenceImage), py::arg("scene"), py::arg("width") = ReferenceOptions{}.width,
         py::arg("height") = ReferenceOptions{}.height,
         // None: not given (it excludes time_budget); shown as the command's default.
         py::arg_v("spp", py::none(), kDefaultSppText.c_str()),
@@ -1221,7 +1254,7 @@ PYBIND11_MODULE(lightoctree, m) {
         "'indirect' | 'irradiance'; spp (default 64), or time_budget (seconds): passes of 1 spp "
         "until it runs out, not both. progress(task, done, total) is called as it goes; an exception it raises, or "
         "Ctrl-C, stops the work and is raised.");
-  m.def("compare", &compareImagesArg, py::arg("test"), py::arg("reference"),
+  m.def("compare", inCLocale(&compareImagesArg), py::arg("test"), py::arg("reference"),
         py::arg("bin") = CompareSettings{}.bin,
         py::arg("clip_percentile") = double(CompareSettings{}.clipPercentile),
         py::arg("mask") = py::none(), py::arg("ignore_background") = CompareSettings{}.ignoreBackground,
@@ -1231,7 +1264,7 @@ PYBIND11_MODULE(lightoctree, m) {
         "standard error) as paths or arrays of shape (height, width, 3). Black holes are "
         "judged first, then both images clipped at the reference's clip_percentile, then "
         "binned (mask and standard error alike) over bin x bin blocks.");
-  m.def("lightmap", &lightmapExport, py::arg("scene"), py::arg("lights"), py::arg("output"),
+  m.def("lightmap", inCLocale(&lightmapExport), py::arg("scene"), py::arg("lights"), py::arg("output"),
         "Lightmaps from a baked grid file, as `lightoctree lightmap SCENE LIGHTS -o OUTPUT` "
         "writes them (the same files; an output that would replace an input is refused): "
         "OUTPUT .glb or .gltf, the pages beside it. Keywords as the command's flags, defaults "
@@ -1244,7 +1277,7 @@ PYBIND11_MODULE(lightoctree, m) {
         "of it is left (an earlier export's files stay as they were). Returns what it wrote: "
         "the figures of `lightmap --json` (page_files, gltf, pages, texel_size, ...) and the "
         "files' bytes.");
-  m.def("read_image", &readImageFile, py::arg("path"),
+  m.def("read_image", inCLocale(&readImageFile), py::arg("path"),
         "An image file: EXR as linear floats, PNG decoded from sRGB; shape (height, width, 3).");
 }
 

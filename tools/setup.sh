@@ -32,6 +32,8 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest
   # `pip install .` of the module into a virtual environment (test python.pip_install)
   python3-pip python3-venv python3-setuptools python3-wheel
+  # a decimal-comma locale that the Python module's test sets (localedef)
+  locales
   # Node.js runs the Khronos glTF validator on the `lightoctree lightmap`
   # exports (tests gltf.validate_*); npm, which installs the validator, is
   # handled below

@@ -981,3 +981,32 @@ def test_compare_refuses_a_negative_standard_error_and_warns_of_a_black_referenc
         result = lightoctree.compare(a, np.zeros_like(a))
     assert math.isinf(result["channels"]["Y"]["rel_rmse"])
     assert result["channels"]["Y"]["max_abs"] > 0
+
+
+def test_numbers_are_read_in_the_c_locale_whatever_the_program_set(tmp_path):
+    """A program that sets a decimal-comma locale (Python's locale.setlocale,
+    which sets the C library's) bakes with sky=(0.5, 0.5, 0.5) as the C locale
+    does: the module's numbers are read and written in the C locale."""
+    import shutil
+    import subprocess
+    import sys
+    localedef = shutil.which("localedef")
+    if localedef is None:
+        pytest.skip("localedef (Debian's locales, which tools/setup.sh installs) is missing")
+    subprocess.run([localedef, "-i", "de_DE", "-f", "UTF-8", str(tmp_path / "de_DE.UTF-8")],
+                   check=True, capture_output=True)
+    code = (
+        "import locale, sys, numpy as np, lightoctree\n"
+        "locale.setlocale(locale.LC_ALL, 'de_DE.UTF-8')\n"
+        "assert locale.localeconv()['decimal_point'] == ','\n"
+        "g = lightoctree.bake(sys.argv[1], depth=3, photons=3000, knn=20, sky=(0.5, 0.5, 0.5))\n"
+        "print(repr(float(np.asarray(g.irradiance, dtype=np.float64).sum())))\n"
+        "print(locale.localeconv()['decimal_point'])\n")
+    env = dict(os.environ, LOCPATH=str(tmp_path))
+    run = subprocess.run([sys.executable, "-c", code, SCENE], env=env, capture_output=True,
+                         text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    lit, point = run.stdout.split()
+    assert point == ",", "the program's own locale is given back after each call"
+    g = lightoctree.bake(SCENE, depth=3, photons=3000, knn=20, sky=(0.5, 0.5, 0.5))
+    assert float(lit) == float(np.asarray(g.irradiance, dtype=np.float64).sum())

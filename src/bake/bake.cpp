@@ -450,8 +450,14 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
   BakeParams params = requested;
   if (params.region.empty()) params.region = scene.region;
   if (params.depth == kAutoDepth && scene.triangleCount() > 0) {
-    // The finer depth only where its memory is there; else the paper's.
-    params.depth = autoDepth(params.region.empty() ? scene.bounds() : params.region);
+    // The finer depth only where its memory is there; else the paper's; and
+    // no finer than a .vdb stores (a scene of a millimetre: depth 5).
+    const Bounds3 region = params.region.empty() ? scene.bounds() : params.region;
+    params.depth = autoDepth(region);
+    while (params.depth > 1 &&
+           !(double(makeGridFrame(region, params.depth).voxelSize) >= kMinStorableVoxel)) {
+      --params.depth;
+    }
     if (params.depth > kAutoDepthMin) {
       try {
         checkBakeMemory(scene, params, processes);

@@ -56,7 +56,9 @@ constexpr int kAutoDepthMin = 6;
 constexpr int kAutoDepthMax = 7;
 /// The depth of `--depth auto` for a grid over `region`: the smallest of
 /// kAutoDepthMin..kAutoDepthMax whose voxels are at most kAutoVoxelSize
-/// wide, else kAutoDepthMax.
+/// wide, else kAutoDepthMax. (checkedBakeParams then takes a coarser one
+/// where the voxels would be finer than a .vdb stores, or 6 where 7's
+/// memory is not there.)
 int autoDepth(const Bounds3& region);
 /// "auto" (kAutoDepth) or a whole number in kDepthRange. @throws InputError
 /// naming `flag`.

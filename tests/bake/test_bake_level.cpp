@@ -9,6 +9,7 @@
 
 #include "bake/bake.h"
 #include "core/error.h"
+#include "bake/bake_fixture.h"
 #include "test_util.h"
 
 namespace lo {
@@ -155,6 +156,13 @@ TEST(BakeDepth, AutoIsSixUnlessItsVoxelsAreWiderThanAMetre) {
   params.depth = kAutoDepth;
   EXPECT_EQ(checkedBakeParams(floorScene(100.0f), params).depth, 6);
   unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
+  // A scene of half a millimetre: depth 6's voxels (7.9e-6) are finer than
+  // a .vdb stores (kMinStorableVoxel): auto takes the finest that it does.
+  const Scene tiny = floorScene(5e-4f);
+  EXPECT_THROW(checkedBakeParams(tiny, test::smallBake(6, 1000)), InputError);
+  const int depth = checkedBakeParams(tiny, params).depth;
+  EXPECT_EQ(depth, 5);
+  EXPECT_GE(makeGridFrame(tiny.bounds(), depth).voxelSize, kMinStorableVoxel);
 }
 
 TEST(BakeDepth, ParsedAsAutoOrAWholeNumberFrom1To12) {
