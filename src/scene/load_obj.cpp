@@ -148,6 +148,19 @@ Scene loadObj(const std::string& path) {
     fail(path, "invalid OBJ: " + (err.empty() ? std::string("parse failed") : err));
   }
 
+  // The reader keeps a face's vertex count in 8 bits: a face of 256 or more
+  // vertices would shift every later face and material. Its counts then do
+  // not sum to its indices.
+  for (const tinyobj::shape_t& shape : shapes) {
+    size_t sum = 0;
+    for (unsigned char n : shape.mesh.num_face_vertices) sum += n;
+    if (sum != shape.mesh.indices.size()) {
+      fail(path, "object '" + printable(shape.name) +
+                     "' has a face of more than 255 vertices, which the OBJ reader cannot "
+                     "hold: triangulate it (Blender: Triangulate Faces) or save it as glTF");
+    }
+  }
+
   Scene scene;
   // usemtl with a name no .mtl defines: tinyobjloader gives those faces no
   // material (they get the default, grey); the user hears it once per name.

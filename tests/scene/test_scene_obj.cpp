@@ -208,6 +208,41 @@ TEST_F(SceneObj, AVertexThatIsNotThreeFiniteNumbersIsRefusedNamingItsLine) {
             1u);
 }
 
+// A polygon of n vertices on a circle, then a triangle of another material:
+// the OBJ reader keeps a face's vertex count in 8 bits, so a face of 256
+// vertices would read as one of 0 and shift the triangle's indices and
+// material. Up to 255 vertices load (fan-triangulated), 256 are refused.
+TEST_F(SceneObj, AFaceOfMoreThan255VerticesIsRefusedNotShifted) {
+  write("two.mtl", "newmtl grey\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 1 1 1\n");
+  for (int n : {255, 256, 300}) {
+    SCOPED_TRACE(n);
+    std::string obj = "mtllib two.mtl\n";
+    for (int i = 0; i < n; ++i) {
+      const double a = 6.283185307179586 * i / n;
+      obj += "v " + std::to_string(std::cos(a)) + " 0 " + std::to_string(std::sin(a)) + "\n";
+    }
+    obj += "v 0 1 0\nv 1 1 0\nv 0 1 1\no disc\nusemtl grey\nf";
+    for (int i = 1; i <= n; ++i) obj += " " + std::to_string(i);
+    obj += "\no lamp\nusemtl lamp\nf " + std::to_string(n + 1) + " " + std::to_string(n + 2) +
+           " " + std::to_string(n + 3) + "\n";
+    const std::string path = write("disc" + std::to_string(n) + ".obj", obj);
+    if (n <= 255) {
+      const Scene s = loadScene(path);
+      ASSERT_EQ(s.triangleCount(), size_t(n - 2 + 1));
+      int lamp = 0;
+      for (size_t t = 0; t < s.triangleCount(); ++t) {
+        if (s.materials[size_t(s.triangleMaterial[t])].name == "lamp") {
+          ++lamp;
+          EXPECT_NEAR(s.positions[s.indices[3 * t]].y, 1.0f, 1e-6f);
+        }
+      }
+      EXPECT_EQ(lamp, 1);
+    } else {
+      expectInputError(path, "object 'disc' has a face of more than 255 vertices");
+    }
+  }
+}
+
 TEST_F(SceneObj, ASceneFarFromTheOriginKeepsItsPrecision) {
   // The OBJ's own numbers, read again in double (its parser reads float).
   write("far.obj",
