@@ -99,8 +99,8 @@ namespace {
 /// another type (an intensity "5", an emissiveFactor "bright") for absent
 /// and gives its default without a word.
 struct FieldRule {
-  const char* pointer;  ///< JSON pointer; "*" stands for every element of an array
-  enum Kind { kNumber, kNumbers, kString, kBool, kObject } kind;
+  const char* pointer;  ///< JSON pointer; "*" stands for every element of an array or member of an object
+  enum Kind { kNumber, kNumbers, kString, kBool, kObject, kArray, kIndex, kIndices } kind;
   size_t count = 0;  ///< kNumbers: how many
 };
 
@@ -140,7 +140,34 @@ const FieldRule kFieldRules[] = {
     {"/cameras/*/perspective/aspectRatio", FieldRule::kNumber},
     {"/cameras/*/perspective/znear", FieldRule::kNumber},
     {"/cameras/*/perspective/zfar", FieldRule::kNumber},
+    // What ties the file together: an index of another type, or -1, made
+    // tinygltf drop the node's mesh, a subtree or an accessor's offset.
+    {"/scenes/*/nodes", FieldRule::kIndices},
+    {"/nodes/*/children", FieldRule::kIndices},
+    {"/nodes/*/mesh", FieldRule::kIndex},
+    {"/nodes/*/camera", FieldRule::kIndex},
+    {"/meshes/*/primitives", FieldRule::kArray},
+    {"/meshes/*/primitives/*/attributes", FieldRule::kObject},
+    {"/meshes/*/primitives/*/attributes/*", FieldRule::kIndex},
+    {"/meshes/*/primitives/*/indices", FieldRule::kIndex},
+    {"/meshes/*/primitives/*/material", FieldRule::kIndex},
+    {"/meshes/*/primitives/*/mode", FieldRule::kIndex},
+    {"/accessors/*/bufferView", FieldRule::kIndex},
+    {"/accessors/*/byteOffset", FieldRule::kIndex},
+    {"/accessors/*/count", FieldRule::kIndex},
+    {"/accessors/*/componentType", FieldRule::kIndex},
+    {"/accessors/*/type", FieldRule::kString},
+    {"/bufferViews/*/buffer", FieldRule::kIndex},
+    {"/bufferViews/*/byteOffset", FieldRule::kIndex},
+    {"/bufferViews/*/byteLength", FieldRule::kIndex},
+    {"/bufferViews/*/byteStride", FieldRule::kIndex},
 };
+
+/// A whole number from 0 written as an integer (tinygltf drops 5.0 too).
+bool isIndex(const nlohmann::json& v) {
+  if (v.is_number_unsigned()) return true;
+  return v.is_number_integer() && v.get<int64_t>() >= 0;
+}
 
 bool holds(const nlohmann::json& v, const FieldRule& rule) {
   switch (rule.kind) {
@@ -148,6 +175,14 @@ bool holds(const nlohmann::json& v, const FieldRule& rule) {
     case FieldRule::kString: return v.is_string();
     case FieldRule::kBool: return v.is_boolean();
     case FieldRule::kObject: return v.is_object();
+    case FieldRule::kArray: return v.is_array();
+    case FieldRule::kIndex: return isIndex(v);
+    case FieldRule::kIndices:
+      if (!v.is_array()) return false;
+      for (const nlohmann::json& x : v) {
+        if (!isIndex(x)) return false;
+      }
+      return true;
     case FieldRule::kNumbers:
       if (!v.is_array() || v.size() != rule.count) return false;
       for (const nlohmann::json& x : v) {
@@ -164,6 +199,9 @@ std::string expected(const FieldRule& rule) {
     case FieldRule::kString: return "a string";
     case FieldRule::kBool: return "true or false";
     case FieldRule::kObject: return "an object";
+    case FieldRule::kArray: return "an array";
+    case FieldRule::kIndex: return "a whole number from 0 (an integer)";
+    case FieldRule::kIndices: return "an array of whole numbers from 0 (integers)";
     case FieldRule::kNumbers: return "an array of " + std::to_string(rule.count) + " numbers";
   }
   return "";
@@ -182,6 +220,12 @@ void checkField(const std::string& path, const nlohmann::json& j, const FieldRul
   }
   const std::string& key = parts[part];
   if (key == "*") {
+    if (j.is_object()) {  // every member of an object (a primitive's attributes)
+      for (auto it = j.begin(); it != j.end(); ++it) {
+        checkField(path, it.value(), rule, parts, part + 1, where + "/" + it.key());
+      }
+      return;
+    }
     if (!j.is_array()) return;
     for (size_t i = 0; i < j.size(); ++i) {
       checkField(path, j[i], rule, parts, part + 1, where + "/" + std::to_string(i));

@@ -110,6 +110,15 @@ TEST_F(SceneGltf, FieldsOfAnotherTypeAreRefusedNamingTheirPointer) {
   MiniGltf node = oneTriangle();
   node.nodes = R"([{"mesh": 0, "translation": [0, "1", 0]}])";
   expectInputError(write("node.gltf", node), "/nodes/0/translation is [0,\"1\",0]");
+  // What ties the file together (tenth list H10-4-197..244): a node's mesh of
+  // -1 dropped the node's object, children "7" its subtree; now refused.
+  node.nodes = R"([{"mesh": -1}])";
+  expectInputError(write("mesh.gltf", node), "/nodes/0/mesh is -1, expected a whole number from 0");
+  node.nodes = R"([{"mesh": 0, "children": "7"}])";
+  expectInputError(write("children.gltf", node),
+                   "/nodes/0/children is \"7\", expected an array of whole numbers from 0");
+  node.nodes = R"([{"mesh": 0.0}])";  // tinygltf drops an index written as 0.0 too
+  expectInputError(write("whole.gltf", node), "/nodes/0/mesh is 0.0, expected a whole number");
   for (const char* sky : {"[-1, -1, -1]", "[1, 1]", "\"blue\"", "[1, 1, 1]"}) {
     MiniGltf top = oneTriangle();
     top.extraTop = std::string(R"("extras": {"lightoctree_sky": )") + sky + "}, ";
