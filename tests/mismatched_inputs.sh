@@ -63,4 +63,20 @@ if ! grep -q "baked under another sky" <<<"$err"; then
   fail "render without the photons' sky said nothing: $err"
 fi
 
+# A photon map traced with --include-direct, re-gathered into a grid baked
+# without it: named, and the output records include_direct 1, so that render
+# does not add the direct light a second time (it recorded the input's 0).
+"$cli" bake "$scene" -o "$out/d.vdb" --photon-map "$out/d-photons.vdb" --depth 3 --photons 3000 \
+  --knn 20 --include-direct --quiet || fail "the bake with --include-direct failed"
+err=$("$cli" convert "$out/a.vdb" -o "$out/direct.vdb" --scene "$scene" \
+  --photon-map "$out/d-photons.vdb" --quiet 2>&1)
+rc=$?
+if [ "$rc" -ne 0 ] || ! grep -q -- "was traced with --include-direct" <<<"$err"; then
+  fail "a photon map with the direct light was taken without a word (exit $rc): $err"
+fi
+directOf() { "$cli" inspect "$1" | awk '$1 == "include_direct" {print $2}'; }
+if [ "$(directOf "$out/direct.vdb")" != 1 ] || [ "$(directOf "$out/a.vdb")" != 0 ]; then
+  fail "the re-gathered grid records include_direct '$(directOf "$out/direct.vdb")', its photons hold the direct light"
+fi
+
 [ "$failed" -eq 0 ] && echo "mismatched inputs: every one named"

@@ -144,12 +144,15 @@ int runConvert(const ConvertOptions& opt) {
     params.photons = &photons;
     params.photonRegion = info.region;
     params.photonSkyHash = info.skyHash;
+    params.photonIncludeDirect = info.includeDirect;
     readTimer.finish(formatCount(photons.size()) + " photons");
     const std::string what = "--photon-map '" + opt.photonMap + "'";
     if (!opt.scene.empty()) {
       warn(sceneMismatchWarning(what, info.sourceSceneHash, opt.scene, sceneHash));
     }
     warn(photonSkyMismatchWarning(what, info.skyHash, "IN '" + opt.input + "'", in.meta.skyHash));
+    warn(photonDirectMismatchWarning(what, info.includeDirect, "IN '" + opt.input + "'",
+                                     in.meta.includeDirect));
   }
   ConvertResult out = convertLightGrid(in.grid, in.meta, params, &progress);
   rows.insert(rows.end(), out.stages.begin(), out.stages.end());

@@ -587,6 +587,22 @@ std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky) {
          "follows the one given; bake again with it to light them by it";
 }
 
+std::string photonDirectMismatchWarning(const std::string& what, int photonIncludeDirect,
+                                        const std::string& gridWhat, int gridIncludeDirect) {
+  if (photonIncludeDirect < 0 || gridIncludeDirect < 0 || photonIncludeDirect == gridIncludeDirect) {
+    return "";
+  }
+  auto holds = [](int direct) {
+    return direct ? std::string("with --include-direct (the direct light in it)")
+                  : std::string("without --include-direct (the indirect light alone)");
+  };
+  return printable(what + " was traced " + holds(photonIncludeDirect) + ", " + gridWhat +
+                   " was baked " + holds(gridIncludeDirect) +
+                   ": the output holds the photons' light and records it, so that render "
+                   "adds the direct light " +
+                   (photonIncludeDirect ? "no more" : "itself"));
+}
+
 std::string photonSkyMismatchWarning(const std::string& what, const std::string& photonSkyHash,
                                      const std::string& gridWhat, const std::string& gridSkyHash) {
   if (photonSkyHash.empty() || gridSkyHash.empty() || photonSkyHash == gridSkyHash) return "";

@@ -417,6 +417,11 @@ std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky);
 /// warning: the photon map `what` was traced under another sky than the grid
 /// `gridWhat` was baked under (recorded as `gridSkyHash`), so the grid
 /// re-gathered from it holds the photons' sky's light and records that sky.
+/// "" unless a photon map's include_direct (`photonIncludeDirect`, -1 = not
+/// recorded) differs from the grid's it is re-gathered into: the output holds
+/// the photons' light, with or without the direct light, and records it.
+std::string photonDirectMismatchWarning(const std::string& what, int photonIncludeDirect,
+                                        const std::string& gridWhat, int gridIncludeDirect);
 std::string photonSkyMismatchWarning(const std::string& what, const std::string& photonSkyHash,
                                      const std::string& gridWhat, const std::string& gridSkyHash);
 

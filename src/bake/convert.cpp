@@ -116,6 +116,7 @@ ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
       r.metadata.radius = resolveRadius(gather, grid.frame);
       r.metadata.photons = int64_t(photons.size());
       r.metadata.skyHash = params.photonSkyHash;
+      if (params.photonIncludeDirect >= 0) r.metadata.includeDirect = params.photonIncludeDirect;
       r.method = "re-gathered " + formatCount(photons.size()) + " photons";
       gatherTimer.finish(r.method);
     } else if (depth > inDepth) {

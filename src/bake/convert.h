@@ -35,6 +35,10 @@ struct ConvertParams {
   /// recorded). A grid re-gathered from them holds their sky's light, so its
   /// metadata records this sky, not the input's (whose light it replaces).
   std::string photonSkyHash;
+  /// Whether the photons hold the direct light (PhotonMapInfo::includeDirect;
+  /// -1 = not recorded): a grid re-gathered from them records it, so that a
+  /// renderer neither adds the direct light again nor leaves it out.
+  int photonIncludeDirect = -1;
 };
 
 struct ConvertResult {

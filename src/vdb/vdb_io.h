@@ -118,11 +118,15 @@ struct PhotonMapInfo {
   /// (BakeMetadata::skyHash), file metadata "sky_hash", so that a grid
   /// re-gathered from them records the sky its light is of; "" = not recorded.
   std::string skyHash;
+  /// 1: the photons hold the light's first hits too (bake --include-direct,
+  /// BakeMetadata::includeDirect), file metadata "include_direct"; 0: only
+  /// what bounced; -1: not recorded.
+  int includeDirect = -1;
 };
 
 /// What a photon file of the bake of `meta` records.
 inline PhotonMapInfo photonMapInfo(const BakeMetadata& meta) {
-  return {meta.sourceSceneHash, meta.region, meta.skyHash};
+  return {meta.sourceSceneHash, meta.region, meta.skyHash, meta.includeDirect};
 }
 
 /// Writes photons as a PointDataGrid named "photons" with attributes P,

@@ -88,6 +88,10 @@ void writePoints(const std::string& path, const std::vector<Photon>& photons, fl
   }
   // The sky they were traced under: a grid re-gathered from them holds its light.
   if (!info.skyHash.empty()) meta.insertMeta("sky_hash", openvdb::StringMetadata(info.skyHash));
+  // Whether they hold the direct light: a grid re-gathered from them does.
+  if (info.includeDirect >= 0) {
+    meta.insertMeta("include_direct", openvdb::Int32Metadata(info.includeDirect));
+  }
   // The region the photons were stored in (bake --bounds), in world
   // coordinates as the positions: a reader can tell a grid it does not cover.
   if (!info.region.empty()) {
@@ -109,6 +113,14 @@ std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin,
     info->sourceSceneHash = hash ? hash->value() : "";
     auto sky = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f.meta)["sky_hash"]);
     info->skyHash = sky ? sky->value() : "";
+    // Either integer width (a file written back by pyopenvdb holds int64).
+    info->includeDirect = -1;
+    const openvdb::Metadata::ConstPtr direct = (*f.meta)["include_direct"];
+    if (auto i32 = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(direct)) {
+      info->includeDirect = i32->value() != 0 ? 1 : 0;
+    } else if (auto i64 = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(direct)) {
+      info->includeDirect = i64->value() != 0 ? 1 : 0;
+    }
     auto lower = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>((*f.meta)["region_min"]);
     auto upper = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>((*f.meta)["region_max"]);
     info->region = Bounds3();

@@ -836,6 +836,39 @@ TEST(PhotonPoints, CarryTheSkyTheyWereTracedUnder) {
       << warning;
 }
 
+// A photon map records whether it holds the direct light (tenth hostile list
+// H10-7-81: photons of `--include-direct` re-gathered into a grid baked
+// without it doubled the direct light, and the output recorded
+// include_direct 0, so render added it once more without a word).
+TEST(PhotonPoints, RecordWhetherTheyHoldTheDirectLight) {
+  const std::string dir = test::outputDir("PhotonPoints.IncludeDirect");
+  std::vector<Photon> photons(2);
+  for (size_t i = 0; i < photons.size(); ++i) {
+    photons[i].position = Vec3(float(i), 0, 0);
+    photons[i].power = Vec3(1.0f);
+    photons[i].direction = photons[i].normal = Vec3(0, 1, 0);
+  }
+  PhotonMapInfo info;
+  for (int direct : {1, 0}) {
+    BakeMetadata m = meta();
+    m.includeDirect = direct;
+    writePhotonPoints(dir + "/p.vdb", photons, 0.05f, Vec3d(), nullptr, photonMapInfo(m));
+    readPhotonPoints(dir + "/p.vdb", Vec3d(), &info);
+    EXPECT_EQ(info.includeDirect, direct);
+  }
+  writePhotonPoints(dir + "/plain.vdb", photons, 0.05f);
+  readPhotonPoints(dir + "/plain.vdb", Vec3d(), &info);
+  EXPECT_EQ(info.includeDirect, -1);
+  EXPECT_EQ(photonDirectMismatchWarning("p", -1, "g", 0), "");
+  EXPECT_EQ(photonDirectMismatchWarning("p", 1, "g", -1), "");
+  EXPECT_EQ(photonDirectMismatchWarning("p", 1, "g", 1), "");
+  const std::string warning = photonDirectMismatchWarning("--photon-map 'p.vdb'", 1, "IN 'g.vdb'", 0);
+  EXPECT_NE(warning.find("--photon-map 'p.vdb' was traced with --include-direct (the direct "
+                         "light in it), IN 'g.vdb' was baked without --include-direct"),
+            std::string::npos)
+      << warning;
+}
+
 // A grid records the sky it was baked under (eighth hostile list F7-42:
 // `render --sky 5,5,5` on a grid baked under the scene's own sky drew the
 // same surfaces as `--sky 0,0,0`, without a word). The same sky, read back
