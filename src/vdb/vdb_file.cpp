@@ -454,6 +454,17 @@ int32_t metaInt(const std::string& path, const openvdb::MetaMap& m, const std::s
   return metaValue<int32_t>(path, m, key, required, fallback);
 }
 
+int32_t metaOnOff(const std::string& path, const openvdb::MetaMap& m, const std::string& key) {
+  // Any other integer was read as off (include_direct = 7 hid render's
+  // warning that the direct light is counted twice).
+  const int32_t v = metaValue<int32_t>(path, m, key, false, -1);
+  if (m[key] && v != 0 && v != 1) {
+    throw InputError(path + ": file metadata '" + key + "' = " + std::to_string(v) +
+                     " is neither 0 (off) nor 1 (on)");
+  }
+  return v;
+}
+
 FormatVersion formatVersionOf(const openvdb::MetaMap& m) {
   FormatVersion out;
   if (!m[kMetaFormatVersion]) {
@@ -507,21 +518,11 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m) {
   if (!version.problem.empty()) throw InputError(path + ": " + version.problem);
   meta.formatVersion = version.version;
   meta.convertedFrom = metaValue<std::string>(path, m, "converted_from", false, "");
-  // The bake's switches: 0 or 1, -1 when not recorded. Any other integer was
-  // read as off (include_direct = 7 hid render's warning that the direct
-  // light is counted twice).
-  auto onOff = [&](const char* key) {
-    const int32_t v = metaValue<int32_t>(path, m, key, false, -1);
-    if (m[key] && v != 0 && v != 1) {
-      throw InputError(path + ": file metadata '" + key + "' = " + std::to_string(v) +
-                       " is neither 0 (off) nor 1 (on)");
-    }
-    return v;
-  };
-  meta.surfaceLayers = onOff("surface_layers");
-  meta.gatherOcclusion = onOff("gather_occlusion");
-  meta.edgeCorrection = onOff("edge_correction");
-  meta.includeDirect = onOff("include_direct");
+  // The bake's switches: 0 or 1, -1 when not recorded.
+  meta.surfaceLayers = metaOnOff(path, m, "surface_layers");
+  meta.gatherOcclusion = metaOnOff(path, m, "gather_occlusion");
+  meta.edgeCorrection = metaOnOff(path, m, "edge_correction");
+  meta.includeDirect = metaOnOff(path, m, "include_direct");
   meta.region.lower = fromVdb(
       metaValue<openvdb::Vec3s>(path, m, "region_min", false, openvdb::Vec3s(INFINITY)));
   meta.region.upper = fromVdb(

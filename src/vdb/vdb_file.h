@@ -70,6 +70,9 @@ BakeMetadata readMetadata(const std::string& path, const openvdb::MetaMap& m);
 /// @throws InputError as readMetadata.
 int32_t metaInt(const std::string& path, const openvdb::MetaMap& m, const std::string& key,
                 bool required, int32_t fallback);
+/// A switch of the bake in the file metadata (include_direct, ...): 0 or 1,
+/// -1 when absent. @throws InputError for any other integer or another type.
+int32_t metaOnOff(const std::string& path, const openvdb::MetaMap& m, const std::string& key);
 
 /// The file's format_version by the one rule the reader and `inspect` share
 /// (they disagreed: the reader took a stored 0 for a missing key, inspect

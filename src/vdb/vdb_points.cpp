@@ -113,14 +113,8 @@ std::vector<Photon> readPoints(const std::string& path, const Vec3d& origin,
     info->sourceSceneHash = hash ? hash->value() : "";
     auto sky = openvdb::DynamicPtrCast<const openvdb::StringMetadata>((*f.meta)["sky_hash"]);
     info->skyHash = sky ? sky->value() : "";
-    // Either integer width (a file written back by pyopenvdb holds int64).
-    info->includeDirect = -1;
-    const openvdb::Metadata::ConstPtr direct = (*f.meta)["include_direct"];
-    if (auto i32 = openvdb::DynamicPtrCast<const openvdb::Int32Metadata>(direct)) {
-      info->includeDirect = i32->value() != 0 ? 1 : 0;
-    } else if (auto i64 = openvdb::DynamicPtrCast<const openvdb::Int64Metadata>(direct)) {
-      info->includeDirect = i64->value() != 0 ? 1 : 0;
-    }
+    // As the grid's (either integer width; 0 or 1).
+    info->includeDirect = metaOnOff(path, *f.meta, "include_direct");
     auto lower = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>((*f.meta)["region_min"]);
     auto upper = openvdb::DynamicPtrCast<const openvdb::Vec3DMetadata>((*f.meta)["region_max"]);
     info->region = Bounds3();
