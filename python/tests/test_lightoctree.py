@@ -572,6 +572,19 @@ def test_ctrl_c_stops_the_work():
     finally:
         timer.cancel()
     assert time.monotonic() - start < 20
+    # A few pixels of many samples: a percent of the work takes half a
+    # minute, and reports come a quarter second apart as well (H10-1-118).
+    reports = []
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            lightoctree.reference(SCENE, width=16, height=12, spp=1_000_000,
+                                  progress=lambda task, done, total: reports.append((done, total)))
+    finally:
+        timer.cancel()
+    done, total = reports[-1]
+    assert 0 < done < total // 100, reports
 
 
 def test_ctrl_c_stops_a_render_between_its_stages(grid):

@@ -7,6 +7,7 @@
 /// when a new percent is reached, under a mutex, so TBB bodies may call it.
 
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <mutex>
 #include <string>
@@ -37,6 +38,8 @@ class Progress {
   size_t total_;
   std::atomic<size_t> done_{0};
   std::atomic<size_t> nextReport_{0};
+  /// When the next report is due whatever the percent (steady clock ticks).
+  std::atomic<std::chrono::steady_clock::rep> nextReportTime_{0};
   std::mutex mutex_;
   size_t reported_ = 0;
 };

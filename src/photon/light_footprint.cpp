@@ -10,6 +10,9 @@
 
 namespace lo {
 
+static_assert(LightFootprint::kResolution * LightFootprint::kResolution % 64 == 0,
+              "the cells fill whole words of bits");
+
 namespace {
 
 /// Whether 2D box b overlaps 2D box a (lower u, lower v, upper u, upper v).
@@ -86,7 +89,7 @@ LightFootprint::LightFootprint(const Scene& scene, const Vec3& direction, const 
   minV_ = lowV;
   const int cellsU = std::clamp(int(std::ceil((highU - lowU) / cellSize_)), 1, n);
   const int cellsV = std::clamp(int(std::ceil((highV - lowV) / cellSize_)), 1, n);
-  std::vector<uint8_t> covered(size_t(n) * size_t(n), 0);
+  bits_.assign(size_t(n) * size_t(n) / 64, 0);
   for (const std::array<float, 6>& p : projected) {
     // Counter-clockwise in (u, v); a triangle seen edge-on lets no light through.
     float area2 = (p[2] - p[0]) * (p[5] - p[1]) - (p[4] - p[0]) * (p[3] - p[1]);
@@ -111,18 +114,37 @@ LightFootprint::LightFootprint(const Scene& scene, const Vec3& direction, const 
           const float qv = s * eu > 0 ? cv0 + cellSize_ : cv0;
           inside = s * (eu * (qv - av) - ev * (qu - au)) >= 0;
         }
-        if (inside) covered[size_t(v) * size_t(n) + size_t(u)] = 1;
+        if (inside) {
+          const size_t i = size_t(v) * size_t(n) + size_t(u);
+          bits_[i / 64] |= uint64_t(1) << (i % 64);
+        }
       }
     }
   }
-  for (size_t i = 0; i < covered.size(); ++i) {
-    if (covered[i]) cells_.push_back(uint32_t(i));
+  coveredBefore_.resize(bits_.size());
+  for (size_t w = 0; w < bits_.size(); ++w) {
+    coveredBefore_[w] = uint32_t(covered_);
+    covered_ += size_t(__builtin_popcountll(bits_[w]));
+  }
+  if (covered_ == 0) {
+    bits_.clear();
+    coveredBefore_.clear();
   }
 }
 
+size_t LightFootprint::bytes() const {
+  return sizeof(*this) + bits_.capacity() * sizeof(uint64_t) +
+         coveredBefore_.capacity() * sizeof(uint32_t);
+}
+
 Vec3 LightFootprint::sample(float u0, float u1, float u2) const {
-  const size_t k = std::min(cells_.size() - 1, size_t(double(u0) * double(cells_.size())));
-  const uint32_t cell = cells_[k];
+  // The k-th covered cell in index order: its word, then its bit there.
+  const size_t k = std::min(covered_ - 1, size_t(double(u0) * double(covered_)));
+  const size_t w = size_t(std::upper_bound(coveredBefore_.begin(), coveredBefore_.end(),
+                                           uint32_t(k)) - coveredBefore_.begin()) - 1;
+  uint64_t word = bits_[w];
+  for (size_t skip = k - coveredBefore_[w]; skip > 0; --skip) word &= word - 1;
+  const uint32_t cell = uint32_t(w * 64 + size_t(__builtin_ctzll(word)));
   const float u = minU_ + (float(cell % uint32_t(kResolution)) + u1) * cellSize_;
   const float v = minV_ + (float(cell / uint32_t(kResolution)) + u2) * cellSize_;
   return planeOrigin_ + tangent_ * u + bitangent_ * v;

@@ -15,8 +15,10 @@
 #include <tbb/partitioner.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "core/discrete_distribution.h"
@@ -513,6 +515,33 @@ void pickEmitters(Context& ctx, const std::vector<bool>& leftOut);
 /// Fills the emitter table; throws if the scene emits nothing.
 inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
   totalPower = Vec3{0, 0, 0};
+  // Directional lights of one direction share its footprint (a footprint
+  // is a pass over every triangle; 10,000 suns made 10,000 of them), and
+  // the footprints of different directions are made at once, in the order
+  // of their first light: index -1 for one that covers nothing.
+  std::map<std::array<float, 3>, int> footprintOf;
+  {
+    std::vector<Vec3> directions;
+    std::vector<std::array<float, 3>> keys;
+    for (const Light& light : scene.lights) {
+      if (light.type != Light::Type::Directional) continue;
+      const std::array<float, 3> key{light.direction.x, light.direction.y, light.direction.z};
+      if (footprintOf.emplace(key, -1).second) {
+        directions.push_back(light.direction);
+        keys.push_back(key);
+      }
+    }
+    std::vector<LightFootprint> made(directions.size());
+    const float margin = 1e-3f * length(ctx.emitBounds.extent());
+    tbb::parallel_for(size_t(0), directions.size(), [&](size_t d) {
+      made[d] = LightFootprint(scene, directions[d], ctx.emitBounds, margin);
+    });
+    for (size_t d = 0; d < made.size(); ++d) {
+      if (made[d].empty() || !std::isfinite(made[d].area())) continue;
+      footprintOf[keys[d]] = int(ctx.footprints.size());
+      ctx.footprints.push_back(std::move(made[d]));
+    }
+  }
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& light = scene.lights[i];
     Emitter e;
@@ -530,12 +559,12 @@ inline void buildEmitters(const Scene& scene, Context& ctx, Vec3& totalPower) {
       case Light::Type::Directional: {
         e.kind = Emitter::Kind::Directional;
         e.power = light.power(ctx.emitBounds);
-        LightFootprint footprint(scene, light.direction, ctx.emitBounds,
-                                 1e-3f * length(ctx.emitBounds.extent()));
-        if (!footprint.empty() && std::isfinite(footprint.area())) {
-          e.power = light.color * float(double(light.intensity) * footprint.area());
-          e.footprint = int(ctx.footprints.size());
-          ctx.footprints.push_back(std::move(footprint));
+        const int footprint =
+            footprintOf.at({light.direction.x, light.direction.y, light.direction.z});
+        if (footprint >= 0) {
+          const double area = ctx.footprints[size_t(footprint)].area();
+          e.power = light.color * float(double(light.intensity) * area);
+          e.footprint = footprint;
         }
         break;
       }

@@ -121,6 +121,20 @@ TEST(Progress, ReportsMonotonicallyAndFinishesAtTotal) {
   EXPECT_LE(sink.updates, 102);
 }
 
+TEST(Progress, AStageOfLongStepsReportsAQuarterSecondAfterItsLastReport) {
+  // A stage whose percent takes long (a path-traced image of few pixels and
+  // many samples: 1% took 38 s) still reports, so that a front end hears
+  // Ctrl-C (Python checks for signals at a report; H10-1-118).
+  RecordingSink sink;
+  Progress p(&sink, "task", 1000000);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  p.advance();
+  EXPECT_EQ(sink.updates, 1);
+  EXPECT_EQ(sink.last, 1u);
+  p.advance();  // neither a new percent nor a quarter second later: no report
+  EXPECT_EQ(sink.updates, 1);
+}
+
 
 TEST(Resources, MemoryLimitTakesUnitsAndRefusesWhatItCannotRead) {
   // LIGHTOCTREE_MEMORY_LIMIT=2G used to be ignored without a word.

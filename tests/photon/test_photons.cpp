@@ -16,6 +16,7 @@
 
 #include "test_util.h"
 #include "core/error.h"
+#include "photon/light_footprint.h"
 #include "photon/photon_map.h"
 
 namespace lo {
@@ -477,6 +478,43 @@ TEST(Photons, DirectionalLightFluxThroughFloor) {
   double hit = 4.0 / (M_PI * radius * radius);
   double stdErr = full * std::sqrt(hit * (1.0 - hit) / double(map.emittedPaths));
   EXPECT_NEAR(sum, sun.intensity * 4.0, 4.0 * stdErr + full / double(map.emittedPaths));
+}
+
+TEST(Photons, ManySunsOfOneDirectionLightTheFloorAsTheirSum) {
+  // 2,000 suns of one direction (H10-5-5: 10,000 baked at 2.6 GB, a
+  // footprint each) share one footprint: the flux is their summed
+  // irradiance over the floor, as for one sun.
+  Scene scene = blackFloor();
+  for (int i = 0; i < 2000; ++i) scene.lights.push_back(test::sun({0, -1, 0}, 2.5f / 2000.0f));
+  PhotonParams params = withDirect(40000);
+  PhotonMap map = tracePhotons(scene, params);
+  ASSERT_EQ(map.photons.size(), params.storedPhotons);
+  double sum = 0;
+  for (const Photon& p : map.photons) sum += p.power.x;
+  EXPECT_NEAR(sum, 2.5 * 4.0, 0.01 * 2.5 * 4.0);
+}
+
+TEST(LightFootprint, ASquareSeenAlongItsNormalIsSampledUniformlyOverItsCells) {
+  // A 2 x 2 floor seen from above: the covered cells are the square (the
+  // grid spans it), its area 4, and a bit per cell with a count per 64:
+  // at most 12 KiB and change, where a list of cells took 256 KiB.
+  Scene scene = blackFloor();
+  const LightFootprint footprint(scene, {0, -1, 0}, Bounds3{}, 0.01f);
+  ASSERT_FALSE(footprint.empty());
+  EXPECT_NEAR(footprint.area(), 4.0, 0.04);
+  EXPECT_LT(footprint.bytes(), size_t(13 * 1024));
+  // Starts above the floor, inside it, a quarter in each quadrant (the
+  // k-th covered cell for u0 = k / covered, walked in index order).
+  int quadrant[4] = {0, 0, 0, 0};
+  const int n = 4096;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 p = footprint.sample((float(i) + 0.5f) / float(n), 0.5f, 0.5f);
+    ASSERT_GT(p.y, 0.0f);
+    ASSERT_LE(std::fabs(p.x), 1.0f);
+    ASSERT_LE(std::fabs(p.z), 1.0f);
+    ++quadrant[(p.x > 0 ? 1 : 0) + (p.z > 0 ? 2 : 0)];
+  }
+  for (int q = 0; q < 4; ++q) EXPECT_EQ(quadrant[q], n / 4) << "quadrant " << q;
 }
 
 TEST(Photons, SkyImageLightsAnOpenFloorWithItsCosineIntegral) {
