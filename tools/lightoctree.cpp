@@ -20,6 +20,8 @@
 #include "core/file.h"
 #include "core/printable.h"
 #include "core/resources.h"
+#include "distributed/mpi_session.h"
+#include "distributed/rank_agreement.h"
 
 namespace {
 
@@ -114,6 +116,21 @@ std::string conversionMessage(const CLI::App& app, const std::string& parserText
   return flag + ": '" + value + "' is not " + kind + ": see `" + command + " --help`";
 }
 
+/// Under mpirun beside other ranks (an MPI build), a rank that bakes nothing
+/// (--version, --help, inspect) ends the job with the bake ranks, which
+/// would wait for it in MPI_Init forever: every rank refuses, rank 0 says
+/// why. Else `rc`.
+int leaveBakeRanks(int argc, char** argv, int rc) {
+  if (lo::mpiLaunchSize() < 2 || !lo::mpiAvailable()) return rc;
+  std::string given;
+  for (int i = 1; i < argc && i < 4; ++i) given += (i > 1 ? " " : "") + std::string(argv[i]);
+  const std::string message = lo::refuseBakeRanks(given);
+  if (!message.empty()) {
+    std::fprintf(stderr, "lightoctree: error: %s\n", lo::printable(message).c_str());
+  }
+  return 1;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{
       "Light Octree " LO_VERSION
@@ -153,9 +170,13 @@ int run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; a usage error exits 2, as command-line
     // tools do (the parser's own codes, 105-109, say nothing to a script).
-    return app.exit(e) == 0 ? 0 : kUsageError;
+    return app.exit(e) == 0 ? leaveBakeRanks(argc, argv, 0) : kUsageError;
   }
   for (const CLI::App* sub : app.get_subcommands()) commandName = sub->get_name();
+  if (commandName != "bake") {
+    const int rc = leaveBakeRanks(argc, argv, -1);
+    if (rc >= 0) return rc;
+  }
   const size_t limit = lo::memoryLimitSetting();
   const lo::MemoryWatch watch(limit, [limit](size_t rss) { onMemoryLimit(rss, limit); });
   for (auto& command : commands) {

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/fnv.h"
+#include "distributed/mpi_session.h"
 
 namespace lo {
 namespace {
@@ -191,6 +192,21 @@ void checkRanksSucceeded(Communicator& comm, const std::string& failure) {
               std::string(m.begin(), m.end());
   }
   throw RanksRefuseError(message);
+}
+
+std::string refuseBakeRanks(const std::string& given) {
+  MpiSession session;
+  const int rank = session.world().rank();
+  std::string message;
+  try {
+    checkRanksSucceeded(session.world(),
+                        "`lightoctree " + given +
+                            "` given, not `bake`: under mpirun every rank runs the same "
+                            "`lightoctree bake`, the one command that runs on several ranks");
+  } catch (const InputError& e) {  // always: the step above failed here
+    message = e.what();
+  }
+  return rank == 0 ? message : std::string();
 }
 
 void checkRanksAgree(const Scene& scene, const BakeParams& params, const TileParams& tiles,

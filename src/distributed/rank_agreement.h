@@ -41,6 +41,13 @@ struct RanksRefuseError : InputError {
 /// failing rank's message, "rank N: ..." where rank 0 itself succeeded.
 void checkRanksSucceeded(Communicator& comm, const std::string& failure);
 
+/// Under mpirun, what a rank that runs anything but `bake` (`given`:
+/// "--version", "inspect") does: it starts MPI and joins the bake ranks'
+/// first step (checkRanksSucceeded) as a rank that failed, so that every
+/// rank refuses at once. A bake rank waited for it in MPI_Init forever
+/// (H10-3-23). Returns the message rank 0 says ("" on other ranks).
+std::string refuseBakeRanks(const std::string& given);
+
 /// Every rank calls it with its own settings, scene and `outputs` (the
 /// files rank 0 writes, as this rank was told: ranks given another -o saw
 /// rank 0's written without a word); returns when all agree.

@@ -95,4 +95,22 @@ printf '{"asset": {"version": "2.0"}, "meshes": [' >"$OUT/damaged.gltf"
 refuse_together damaged "a rank with a damaged scene" "lightoctree: error: rank 1: .*damaged.gltf: invalid glTF" \
   "$box -o $OUT/damaged.vdb --depth 4 --photons 3000" \
   "$OUT/damaged.gltf -o $OUT/damaged.vdb --depth 4 --photons 3000" "$OUT/damaged.vdb"
+# A rank that runs no bake (--version, bake --help) beside one that bakes: the
+# baking rank waited for it in MPI_Init until killed (H10-3-23). Every rank
+# now refuses at once, rank 0 naming what rank 1 was given.
+for given in --version "bake --help"; do
+  set +e
+  timeout -s KILL 120 "${MPI[@]}" -np 1 "$CLI" bake "$box" -o "$OUT/alone.vdb" --depth 4 \
+    --photons 3000 -q : -np 1 "$CLI" $given >"$OUT/alone.log" 2>&1
+  rc=$?
+  set -e
+  if [ $rc -ne 0 ] && [ $rc -ne 137 ] && [ ! -e "$OUT/alone.vdb" ] &&
+     grep -q "rank 1: \`lightoctree $given\` given, not \`bake\`" "$OUT/alone.log"; then
+    echo "ok: rank 1 given $given beside a bake: mpirun exits $rc, the rank named"
+  else
+    echo "FAIL: rank 1 given $given beside a bake: mpirun exited $rc (137: killed, hung)"
+    cat "$OUT/alone.log"
+    failures=$((failures + 1))
+  fi
+done
 exit $failures
