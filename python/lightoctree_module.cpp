@@ -124,6 +124,18 @@ py::array vec3s(const py::object& owner, const std::vector<Vec3>& v) {
   return view<float>(owner, &v.data()->x, {v.size(), 3}, {sizeof(Vec3), sizeof(float)});
 }
 
+/// The program's own locale on this thread while it lives: a progress
+/// callback runs in it, as the program set it, not in the C locale of the
+/// module's calls (CLocale, below; H11-1-4: a callback on the calling
+/// thread saw C, one on a worker thread the program's).
+struct ProgramLocale {
+  ProgramLocale() : previous(uselocale(LC_GLOBAL_LOCALE)) {}
+  ~ProgramLocale() { uselocale(previous); }
+  ProgramLocale(const ProgramLocale&) = delete;
+  ProgramLocale& operator=(const ProgramLocale&) = delete;
+  locale_t previous;
+};
+
 /// Thrown through the library's loops by CallbackProgress to stop the work.
 struct Stopped {};
 
@@ -175,7 +187,10 @@ class CallbackProgress : public ProgressSink {
       if (task) task_ = *task;  // read by other threads' reports, under the same lock
       try {
         if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-        if (!callback_.is_none()) callback_(task_, done, total);
+        if (!callback_.is_none()) {
+          const ProgramLocale programs;
+          callback_(task_, done, total);
+        }
       } catch (py::error_already_set&) {
         if (!stopped_.exchange(true)) error_ = std::current_exception();
       }
@@ -457,19 +472,32 @@ Grid& gridArg(const py::handle& value, const std::string& name) {
   return value.cast<Grid&>();
 }
 
-/// An (N, 3) array of numbers as doubles (NumPy converts lists, tuples and
-/// other numeric arrays), refused by its name when it holds anything else.
+/// `value` as an array of T (NumPy converts lists, tuples and other numeric
+/// arrays), or null where it holds no real numbers: bools (taken as 1 and
+/// 0), complex numbers (their imaginary part dropped with only a NumPy
+/// warning), text, or objects NumPy cannot convert (its bare ValueError
+/// named no argument; H11-1-28/29, H10-1-73).
+template <typename T>
+py::array_t<T, py::array::c_style | py::array::forcecast> realArray(const py::handle& value) {
+  using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
+  if (value.is_none() || py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value)) {
+    return Array();
+  }
+  try {
+    const py::object seen = py::module_::import("numpy").attr("asarray")(value);
+    const char kind = seen.attr("dtype").attr("kind").cast<std::string>().at(0);
+    if (kind != 'i' && kind != 'u' && kind != 'f' && kind != 'O') return Array();
+    return Array::ensure(seen);
+  } catch (const py::error_already_set&) {
+    return Array();
+  }
+}
+
+/// An (N, 3) array of numbers as doubles, refused by its name when it holds
+/// anything else.
 py::array_t<double, py::array::c_style | py::array::forcecast> pointsArg(const py::handle& value,
                                                                            const std::string& name) {
-  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-  Array a;
-  if (!value.is_none() && !py::isinstance<py::str>(value) && !py::isinstance<py::bytes>(value)) {
-    try {
-      a = Array::ensure(value);
-    } catch (const py::error_already_set&) {
-      a = Array();
-    }
-  }
+  const auto a = realArray<double>(value);
   if (!a || a.ndim() != 2 || a.shape(1) != 3) {
     refuse(name, "an array of numbers of shape (N, 3)", value);
   }
@@ -886,12 +914,7 @@ RgbImage imageArg(const py::object& value, const std::string& name, bool isMask,
     *path = pathArg(value, name);
     return readImage(*path, isMask);
   }
-  using Floats = py::array_t<float, py::array::c_style | py::array::forcecast>;
-  Floats a;
-  try {
-    a = value.cast<Floats>();
-  } catch (const py::cast_error&) {
-  }
+  const auto a = realArray<float>(value);
   const bool plane = isMask && a && a.ndim() == 2;
   if (!a || !((a.ndim() == 3 && a.shape(2) == 3) || plane) || a.shape(0) < 1 || a.shape(1) < 1 ||
       a.shape(0) > kMaxImageSide || a.shape(1) > kMaxImageSide) {

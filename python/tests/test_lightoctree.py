@@ -129,6 +129,17 @@ def test_lookup_refuses_points_and_normals_it_has_no_answer_for(grid, argument, 
         lightoctree.lookup(grid, points, normals)
 
 
+def test_lookup_refuses_points_that_are_not_real_numbers(grid):
+    """Bool points were taken as 1 and 0, complex ones lost their imaginary
+    part with only NumPy's warning (H11-1-28/29): refused by name."""
+    normals = np.tile([0.0, 1.0, 0.0], (2, 1))
+    for bad in (np.ones((2, 3), bool), np.ones((2, 3), complex), np.full((2, 3), "1")):
+        with pytest.raises(lightoctree.InputError, match=r"points: must be an array of numbers of shape \(N, 3\)"):
+            lightoctree.lookup(grid, bad, normals)
+    with pytest.raises(lightoctree.InputError, match=r"normals: must be an array of numbers"):
+        lightoctree.lookup(grid, np.ones((2, 3)), normals.astype(bool))
+
+
 def test_render_draws_the_scene_lit_by_the_grid(grid):
     image = lightoctree.render(SCENE, grid, width=64, height=48, mode="indirect")
     assert image.shape == (48, 64, 3) and image.dtype == np.float32
@@ -757,6 +768,14 @@ def test_compare_refuses_bad_arguments_by_name():
         lightoctree.compare(image, image, mask=image[:, :8])
     with pytest.raises(ValueError, match="reference_error: "):
         lightoctree.compare(image, image, reference_error=image[:4])
+    # Text, bools and complex numbers are no image: refused by name, not
+    # NumPy's bare "could not convert string to float" (H10-1-73).
+    for bad in (np.full((12, 16, 3), "a", dtype=object), np.full((12, 16, 3), "a"),
+                image.astype(bool), image.astype(complex)):
+        with pytest.raises(lightoctree.InputError, match=r"test: must be a path or an array"):
+            lightoctree.compare(bad, image)
+    # An array of number objects is numbers.
+    assert lightoctree.compare(image.astype(object), image)["channels"]["RGB"]["rel_rmse"] == 0
 
 
 @pytest.fixture(scope="module")
@@ -1012,14 +1031,20 @@ def test_numbers_are_read_in_the_c_locale_whatever_the_program_set(tmp_path):
         "import locale, sys, numpy as np, lightoctree\n"
         "locale.setlocale(locale.LC_ALL, 'de_DE.UTF-8')\n"
         "assert locale.localeconv()['decimal_point'] == ','\n"
-        "g = lightoctree.bake(sys.argv[1], depth=3, photons=3000, knn=20, sky=(0.5, 0.5, 0.5))\n"
+        "seen = set()\n"
+        "report = lambda task, done, total: seen.add(locale.localeconv()['decimal_point'])\n"
+        "g = lightoctree.bake(sys.argv[1], depth=3, photons=3000, knn=20, sky=(0.5, 0.5, 0.5),\n"
+        "                     progress=report)\n"
         "print(repr(float(np.asarray(g.irradiance, dtype=np.float64).sum())))\n"
-        "print(locale.localeconv()['decimal_point'])\n")
+        "print(locale.localeconv()['decimal_point'])\n"
+        "print(''.join(sorted(seen)))\n")
     env = dict(os.environ, LOCPATH=str(tmp_path))
     run = subprocess.run([sys.executable, "-c", code, SCENE], env=env, capture_output=True,
                          text=True, timeout=120)
     assert run.returncode == 0, run.stderr
-    lit, point = run.stdout.split()
+    lit, point, in_callback = run.stdout.split()
     assert point == ",", "the program's own locale is given back after each call"
+    # A progress callback runs in the program's locale, on every thread (H11-1-4).
+    assert in_callback == ",", in_callback
     g = lightoctree.bake(SCENE, depth=3, photons=3000, knn=20, sky=(0.5, 0.5, 0.5))
     assert float(lit) == float(np.asarray(g.irradiance, dtype=np.float64).sum())

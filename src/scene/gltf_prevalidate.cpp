@@ -100,11 +100,30 @@ namespace {
 /// and gives its default without a word.
 struct FieldRule {
   const char* pointer;  ///< JSON pointer; "*" stands for every element of an array or member of an object
-  enum Kind { kNumber, kNumbers, kString, kBool, kObject, kArray, kIndex, kIndices } kind;
-  size_t count = 0;  ///< kNumbers: how many
+  enum Kind { kNumber, kNumbers, kString, kStrings, kBool, kObject, kArray, kIndex, kIndices } kind;
+  size_t count = 0;  ///< kNumbers: how many; kArray: at least how many elements
 };
 
 const FieldRule kFieldRules[] = {
+    {"/asset", FieldRule::kObject},
+    {"/asset/version", FieldRule::kString},
+    {"/asset/minVersion", FieldRule::kString},
+    {"/scene", FieldRule::kIndex},
+    {"/extensionsUsed", FieldRule::kStrings},
+    {"/extensionsRequired", FieldRule::kStrings},
+    // Every element of the file's arrays is an object (a null primitive or
+    // node was dropped without a word).
+    {"/scenes/*", FieldRule::kObject},
+    {"/nodes/*", FieldRule::kObject},
+    {"/meshes/*", FieldRule::kObject},
+    {"/materials/*", FieldRule::kObject},
+    {"/textures/*", FieldRule::kObject},
+    {"/images/*", FieldRule::kObject},
+    {"/samplers/*", FieldRule::kObject},
+    {"/accessors/*", FieldRule::kObject},
+    {"/bufferViews/*", FieldRule::kObject},
+    {"/buffers/*", FieldRule::kObject},
+    {"/cameras/*", FieldRule::kObject},
     {"/materials/*/name", FieldRule::kString},
     {"/materials/*/emissiveFactor", FieldRule::kNumbers, 3},
     {"/materials/*/alphaMode", FieldRule::kString},
@@ -114,6 +133,7 @@ const FieldRule kFieldRules[] = {
     {"/materials/*/pbrMetallicRoughness/baseColorFactor", FieldRule::kNumbers, 4},
     {"/materials/*/pbrMetallicRoughness/metallicFactor", FieldRule::kNumber},
     {"/materials/*/pbrMetallicRoughness/roughnessFactor", FieldRule::kNumber},
+    {"/materials/*/extensions/KHR_materials_unlit", FieldRule::kObject},
     {"/materials/*/normalTexture/scale", FieldRule::kNumber},
     {"/materials/*/occlusionTexture/strength", FieldRule::kNumber},
     {"/materials/*/extensions/KHR_materials_emissive_strength/emissiveStrength",
@@ -140,13 +160,18 @@ const FieldRule kFieldRules[] = {
     {"/cameras/*/perspective/aspectRatio", FieldRule::kNumber},
     {"/cameras/*/perspective/znear", FieldRule::kNumber},
     {"/cameras/*/perspective/zfar", FieldRule::kNumber},
+    {"/cameras/*/orthographic/xmag", FieldRule::kNumber},
+    {"/cameras/*/orthographic/ymag", FieldRule::kNumber},
+    {"/cameras/*/orthographic/znear", FieldRule::kNumber},
+    {"/cameras/*/orthographic/zfar", FieldRule::kNumber},
     // What ties the file together: an index of another type, or -1, made
     // tinygltf drop the node's mesh, a subtree or an accessor's offset.
     {"/scenes/*/nodes", FieldRule::kIndices},
     {"/nodes/*/children", FieldRule::kIndices},
     {"/nodes/*/mesh", FieldRule::kIndex},
     {"/nodes/*/camera", FieldRule::kIndex},
-    {"/meshes/*/primitives", FieldRule::kArray},
+    {"/meshes/*/primitives", FieldRule::kArray, 1},
+    {"/meshes/*/primitives/*", FieldRule::kObject},
     {"/meshes/*/primitives/*/attributes", FieldRule::kObject},
     {"/meshes/*/primitives/*/attributes/*", FieldRule::kIndex},
     {"/meshes/*/primitives/*/indices", FieldRule::kIndex},
@@ -161,6 +186,39 @@ const FieldRule kFieldRules[] = {
     {"/bufferViews/*/byteOffset", FieldRule::kIndex},
     {"/bufferViews/*/byteLength", FieldRule::kIndex},
     {"/bufferViews/*/byteStride", FieldRule::kIndex},
+    {"/buffers/*/byteLength", FieldRule::kIndex},
+    {"/buffers/*/uri", FieldRule::kString},
+    {"/images/*/uri", FieldRule::kString},
+    {"/images/*/mimeType", FieldRule::kString},
+    {"/images/*/bufferView", FieldRule::kIndex},
+    {"/textures/*/source", FieldRule::kIndex},
+    {"/textures/*/sampler", FieldRule::kIndex},
+    {"/samplers/*/magFilter", FieldRule::kIndex},
+    {"/samplers/*/minFilter", FieldRule::kIndex},
+    {"/samplers/*/wrapS", FieldRule::kIndex},
+    {"/samplers/*/wrapT", FieldRule::kIndex},
+    // A material's textures: an index "0" dropped the texture.
+    {"/materials/*/pbrMetallicRoughness/baseColorTexture", FieldRule::kObject},
+    {"/materials/*/pbrMetallicRoughness/baseColorTexture/index", FieldRule::kIndex},
+    {"/materials/*/pbrMetallicRoughness/baseColorTexture/texCoord", FieldRule::kIndex},
+    {"/materials/*/pbrMetallicRoughness/metallicRoughnessTexture", FieldRule::kObject},
+    {"/materials/*/pbrMetallicRoughness/metallicRoughnessTexture/index", FieldRule::kIndex},
+    {"/materials/*/pbrMetallicRoughness/metallicRoughnessTexture/texCoord", FieldRule::kIndex},
+    {"/materials/*/normalTexture", FieldRule::kObject},
+    {"/materials/*/normalTexture/index", FieldRule::kIndex},
+    {"/materials/*/normalTexture/texCoord", FieldRule::kIndex},
+    {"/materials/*/occlusionTexture", FieldRule::kObject},
+    {"/materials/*/occlusionTexture/index", FieldRule::kIndex},
+    {"/materials/*/occlusionTexture/texCoord", FieldRule::kIndex},
+    {"/materials/*/emissiveTexture", FieldRule::kObject},
+    {"/materials/*/emissiveTexture/index", FieldRule::kIndex},
+    {"/materials/*/emissiveTexture/texCoord", FieldRule::kIndex},
+    {"/materials/*/extensions/KHR_materials_transmission/transmissionTexture/index",
+     FieldRule::kIndex},
+    {"/materials/*/extensions/KHR_materials_volume/thicknessTexture/index", FieldRule::kIndex},
+    {"/materials/*/extensions/KHR_materials_specular/specularTexture/index", FieldRule::kIndex},
+    {"/materials/*/extensions/KHR_materials_specular/specularColorTexture/index",
+     FieldRule::kIndex},
 };
 
 /// A whole number from 0 written as an integer (tinygltf drops 5.0 too).
@@ -175,7 +233,13 @@ bool holds(const nlohmann::json& v, const FieldRule& rule) {
     case FieldRule::kString: return v.is_string();
     case FieldRule::kBool: return v.is_boolean();
     case FieldRule::kObject: return v.is_object();
-    case FieldRule::kArray: return v.is_array();
+    case FieldRule::kArray: return v.is_array() && v.size() >= rule.count;
+    case FieldRule::kStrings:
+      if (!v.is_array()) return false;
+      for (const nlohmann::json& x : v) {
+        if (!x.is_string()) return false;
+      }
+      return true;
     case FieldRule::kIndex: return isIndex(v);
     case FieldRule::kIndices:
       if (!v.is_array()) return false;
@@ -199,7 +263,11 @@ std::string expected(const FieldRule& rule) {
     case FieldRule::kString: return "a string";
     case FieldRule::kBool: return "true or false";
     case FieldRule::kObject: return "an object";
-    case FieldRule::kArray: return "an array";
+    case FieldRule::kArray:
+      return rule.count > 0 ? "an array of at least " + std::to_string(rule.count) + " element" +
+                                  (rule.count > 1 ? "s" : "")
+                            : "an array";
+    case FieldRule::kStrings: return "an array of strings";
     case FieldRule::kIndex: return "a whole number from 0 (an integer)";
     case FieldRule::kIndices: return "an array of whole numbers from 0 (integers)";
     case FieldRule::kNumbers: return "an array of " + std::to_string(rule.count) + " numbers";
@@ -263,6 +331,40 @@ void checkFieldTypes(const std::string& path, const nlohmann::json& j) {
   }
 }
 
+/// glTF 2.0 alone: a file of another major version, or one whose
+/// minVersion asks for a newer 2.x, is not read as its author meant (a
+/// version "3.0" or minVersion "9.0" loaded without a word).
+static void checkAssetVersion(const std::string& path, const nlohmann::json& j) {
+  const auto asset = j.find("asset");
+  if (asset == j.end() || !asset->is_object()) return;
+  auto majorMinor = [&](const char* key, int& major, int& minor) {
+    const auto field = asset->find(key);
+    if (field == asset->end()) return false;
+    const std::string text = field->get<std::string>();
+    const size_t dot = text.find('.');
+    auto digits = [](const std::string& part) {
+      return !part.empty() && part.size() < 6 &&
+             part.find_first_not_of("0123456789") == std::string::npos;
+    };
+    if (dot == std::string::npos || !digits(text.substr(0, dot)) || !digits(text.substr(dot + 1))) {
+      fail(path, std::string("invalid glTF: /asset/") + key + " is \"" + printable(text) +
+                     "\", expected MAJOR.MINOR (\"2.0\")");
+    }
+    major = std::stoi(text.substr(0, dot));
+    minor = std::stoi(text.substr(dot + 1));
+    return true;
+  };
+  int major = 0, minor = 0;
+  if (majorMinor("version", major, minor) && major != 2) {
+    fail(path, "glTF " + std::to_string(major) + "." + std::to_string(minor) +
+                   " (/asset/version): lightoctree reads glTF 2.0");
+  }
+  if (majorMinor("minVersion", major, minor) && (major != 2 || minor > 0)) {
+    fail(path, "needs glTF " + std::to_string(major) + "." + std::to_string(minor) +
+                   " (/asset/minVersion): lightoctree reads glTF 2.0");
+  }
+}
+
 bool readsGltfExtension(const std::string& name) {
   static const char* const kRead[] = {
       "KHR_lights_punctual",          "KHR_materials_emissive_strength", "KHR_materials_ior",
@@ -306,6 +408,7 @@ void prevalidateJson(const std::string& path, const std::string& baseDir, const 
   }
   checkIntegerRanges(path, j, "", 0);
   checkFieldTypes(path, j);
+  checkAssetVersion(path, j);
   std::vector<uint64_t> bufferLengths;
   auto buffers = j.find("buffers");
   if (buffers != j.end() && buffers->is_array()) {

@@ -174,6 +174,14 @@ Scene loadGltf(const std::string& path, const std::string& skyMesh) {
   // Both JSON parsers (nlohmann here, tinygltf's copy below) recurse once per
   // level: a document nested deeper than any glTF needs would overflow the
   // stack. Counted first, outside strings.
+  // UTF-16 or UTF-32 (a byte-order mark, or a zero byte in the first
+  // character): the parser's error quoted the raw bytes.
+  if (jsonText.size() >= 2 &&
+      ((jsonText[0] == '\xff' && jsonText[1] == '\xfe') ||
+       (jsonText[0] == '\xfe' && jsonText[1] == '\xff') || jsonText[0] == 0 || jsonText[1] == 0)) {
+    fail(path, "invalid glTF: the JSON is UTF-16 or UTF-32 (its first bytes are a byte-order "
+               "mark or hold a zero byte); glTF's JSON is UTF-8: save it as UTF-8");
+  }
   checkJsonNesting(path, jsonText);
   nlohmann::json j;
   try {

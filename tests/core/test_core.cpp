@@ -251,7 +251,13 @@ TEST(Resources, MemoryWatchCallsBackWhenTheProcessGrowsPastItsLimit) {
 
 // Control characters of a file's strings, escaped before a terminal sees them.
 TEST(Printable, EscapesControlCharactersAndKeepsTheRest) {
-  EXPECT_EQ(printable("plain \xc3\xa9t\xc3\xa9 \xff"), "plain \xc3\xa9t\xc3\xa9 \xff");
+  // Well-formed UTF-8 kept; a byte of no UTF-8 character (a Latin-1 é, a
+  // UTF-16 file's byte-order mark, a cut or overlong sequence) escaped.
+  EXPECT_EQ(printable("plain \xc3\xa9t\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80"),
+            "plain \xc3\xa9t\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80");
+  EXPECT_EQ(printable("caf\xe9 \xff\xfe{"), "caf\\xe9 \\xff\\xfe{");
+  EXPECT_EQ(printable("\xe2\x82 \xc0\xaf \xed\xa0\x80"),
+            "\\xe2\\x82 \\xc0\\xaf \\xed\\xa0\\x80");
   EXPECT_EQ(printable(std::string("a\0b\tc\x7f", 6)), "a\\x00b\\x09c\\x7f");
   EXPECT_EQ(printable("one\ntwo"), "one\\x0atwo");
   EXPECT_EQ(printable("one\ntwo", true), "one\ntwo");

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 #include <string>
 
@@ -126,6 +127,52 @@ TEST_F(SceneGltf, FieldsOfAnotherTypeAreRefusedNamingTheirPointer) {
                      "/extras/lightoctree_sky is read from the scene's extras "
                      "(/scenes/N/extras/lightoctree_sky), not the file's");
   }
+}
+
+// More fields tinygltf dropped without a word, from the eleventh hostile
+// list (H11-4-222/223, -205, -158, -153/155, -258/266): a mesh's primitives
+// empty or null, a texture index "0", a buffer's byteLength "2496", a file of
+// another glTF version, and JSON in UTF-16.
+TEST_F(SceneGltf, EmptyPrimitivesTextIndicesAndOtherVersionsAreRefused) {
+  const MiniGltf g = oneTriangle();
+  auto edited = [&](const char* name, const std::string& from, const std::string& to) {
+    std::string text = g.json();
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    const std::string path = dir + "/" + name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  };
+  const std::string meshes = R"("meshes": [{"primitives": [)";
+  expectInputError(edited("none.gltf", meshes, R"("meshes": [{"primitives": []}, {"primitives": [)"),
+                   "/meshes/0/primitives is [], expected an array of at least 1 element");
+  expectInputError(edited("null.gltf", meshes, R"("meshes": [{"primitives": [null]}, {"primitives": [)"),
+                   "/meshes/0/primitives/0 is null, expected an object");
+  const std::string version = R"({"version": "2.0"})";
+  expectInputError(edited("v3.gltf", version, R"({"version": "3.0"})"),
+                   "glTF 3.0 (/asset/version): lightoctree reads glTF 2.0");
+  expectInputError(edited("min9.gltf", version, R"({"version": "2.0", "minVersion": "9.0"})"),
+                   "needs glTF 9.0 (/asset/minVersion)");
+  expectInputError(edited("vtext.gltf", version, R"({"version": "two"})"),
+                   "/asset/version is \"two\", expected MAJOR.MINOR");
+  EXPECT_NO_THROW(loadScene(edited("v21.gltf", version, R"({"version": "2.1", "minVersion": "2.0"})")));
+  const std::string length = "\"byteLength\": " + std::to_string(g.blob().size()) + ", \"uri\"";
+  expectInputError(edited("length.gltf", length,
+                          "\"byteLength\": \"" + std::to_string(g.blob().size()) + "\", \"uri\""),
+                   "/buffers/0/byteLength is \"" + std::to_string(g.blob().size()) +
+                       "\", expected a whole number from 0");
+  MiniGltf textured = oneTriangle();
+  textured.material = 0;
+  textured.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": "0"}}}])";
+  expectInputError(write("index.gltf", textured),
+                   "/materials/0/pbrMetallicRoughness/baseColorTexture/index is \"0\", expected a "
+                   "whole number from 0");
+  // UTF-16 (little-endian, with its byte-order mark): named as such.
+  std::string utf16 = "\xff\xfe";
+  for (char c : g.json()) utf16 += std::string{c, '\0'};
+  std::ofstream(dir + "/utf16.gltf", std::ios::binary) << utf16;
+  expectInputError(dir + "/utf16.gltf", "the JSON is UTF-16 or UTF-32");
 }
 
 // A node matrix whose bottom row is not (0, 0, 0, 1) is projective, which
