@@ -90,6 +90,21 @@ if ls -a "$out" | grep -q "^\.keep\.vdb\..*\.tmp$"; then
   fail "ulimit -f: a temporary file was left: $(ls -a "$out")"
 fi
 
+# 4b. Reading under a file-size limit smaller than the grid: the grids cross
+#    from the reading process in a file in memory, which the limit counts (a
+#    healthy grid was called damaged, H11-2-32). A soft limit is lifted there;
+#    a hard one is named, with exit 1.
+size_kb=$(( $(stat -c %s "$out/keep.vdb") / 1024 ))
+[ "$size_kb" -gt 8 ] || fail "ulimit -f reads: the grid is too small to test ($size_kb KiB)"
+bash -c "ulimit -S -f 8; exec '$cli' inspect '$out/keep.vdb'" >/dev/null 2>&1 ||
+  fail "ulimit -S -f 8: inspect of a healthy grid failed"
+err=$(bash -c "ulimit -f 8; exec '$cli' inspect '$out/keep.vdb'" 2>&1)
+rc=$?
+if [ "$rc" -ne 1 ] || ! grep -q "which the file-size limit (ulimit -f: 8.0 KiB) does not hold" <<<"$err" ||
+   grep -q "damaged" <<<"$err"; then
+  fail "ulimit -f 8, inspect: exit $rc: $err"
+fi
+
 # 5. A working folder deleted before the run, and a relative output: refused
 #    before the bake (it was found when the file was written, after the work),
 #    exit 1, nothing written; an absolute output is still written.

@@ -8,6 +8,7 @@
 #include <openvdb/openvdb.h>
 
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -101,7 +102,17 @@ OpenedFile openFile(const std::string& path) {
   // open files, a permission taken away): the open is tried first, and its
   // failure reported with the system's reason (exit code 2 of the child).
   constexpr int kCannotOpen = 2;
+  // The grids cross in a file in memory, which a file-size limit (ulimit -f)
+  // counts: the child lifts its own soft limit to the hard one (it writes
+  // nothing else), and past the hard one says so (exit code 3): a healthy
+  // grid was called damaged.
+  constexpr int kBeyondFileSizeLimit = 3;
   auto trialRead = [&](std::string& message) {
+    struct rlimit fileSize {};
+    if (::getrlimit(RLIMIT_FSIZE, &fileSize) == 0 && fileSize.rlim_cur != fileSize.rlim_max) {
+      fileSize.rlim_cur = fileSize.rlim_max;
+      ::setrlimit(RLIMIT_FSIZE, &fileSize);
+    }
     try {
       requireOpenable(path);
     } catch (const IoError& e) {
@@ -119,7 +130,15 @@ OpenedFile openFile(const std::string& path) {
     out.write(*grids, *meta);
     os.close();
     if (os.fail()) {
-      message = std::string("cannot hand the grids back: ") + std::strerror(errno);
+      const int error = errno;
+      if (error == EFBIG && ::getrlimit(RLIMIT_FSIZE, &fileSize) == 0 &&
+          fileSize.rlim_max != RLIM_INFINITY) {
+        message = path + ": not read: its grids cross from the reading process in a file in " +
+                  "memory, which the file-size limit (ulimit -f: " +
+                  formatBytes(size_t(fileSize.rlim_max)) + ") does not hold: raise it";
+        return kBeyondFileSizeLimit;
+      }
+      message = std::string("cannot hand the grids back: ") + std::strerror(error);
       return 1;
     }
     return 0;
@@ -136,6 +155,9 @@ OpenedFile openFile(const std::string& path) {
   }
   if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode == kCannotOpen) {
     throw IoError(trial.message);
+  }
+  if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode == kBeyondFileSizeLimit) {
+    throw InputError(trial.message);
   }
   if (trial.outcome == IsolatedRun::Outcome::Finished && trial.exitCode != 0) {
     throw unreadable(path, trial.message);
