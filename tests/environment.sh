@@ -197,4 +197,16 @@ for mask in 002 022 077; do
   rm -f "$out/mode.vdb" "$out/mode.json"
 done
 
+# 10. GALLIUM_DRIVER naming no software rasterizer: OSMesa crashed in its
+#     context creation (H11-2-38); refused by name, exit 1, nothing written.
+err=$(GALLIUM_DRIVER=nonsense "$cli" render "$scene" "$out/small.vdb" -o "$out/gallium.png" \
+      --width 8 --height 8 --quiet 2>&1)
+rc=$?
+if [ "$rc" -ne 1 ] || [ -e "$out/gallium.png" ] ||
+   ! grep -q "GALLIUM_DRIVER='nonsense' names no software rasterizer OSMesa has" <<<"$err"; then
+  fail "GALLIUM_DRIVER=nonsense: exit $rc: $err"
+fi
+GALLIUM_DRIVER=llvmpipe "$cli" render "$scene" "$out/small.vdb" -o "$out/gallium.png" \
+  --width 8 --height 8 --quiet || fail "GALLIUM_DRIVER=llvmpipe: the render failed"
+
 [ "$failed" -eq 0 ] && echo "environment: every case refused or reported"

@@ -10,10 +10,13 @@
 // glad's header defines __gl_h_, so osmesa.h takes glad's GL types.
 #include <GL/osmesa.h>
 
+#include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include "core/printable.h"
 #include "core/resources.h"
 #include "render/context_internal.h"
 
@@ -71,9 +74,24 @@ const OsMesaApi& osMesa() {
   return api;
 }
 
+/// Mesa's OSMesa picks its rasterizer by GALLIUM_DRIVER: a name it lacks
+/// made OSMesaCreateContextAttribs crash (H11-2-38). The software ones it
+/// has are taken; another is refused, named, before Mesa sees it.
+void checkGalliumDriver() {
+  const char* driver = std::getenv("GALLIUM_DRIVER");
+  if (!driver || !*driver) return;
+  for (const char* known : {"llvmpipe", "softpipe", "swr", "zink"}) {
+    if (std::strcmp(driver, known) == 0) return;
+  }
+  throw GlError("osmesa: GALLIUM_DRIVER='" + printable(driver) +
+                "' names no software rasterizer OSMesa has (llvmpipe, softpipe): unset it "
+                "or set it to llvmpipe");
+}
+
 class OsMesaContext final : public GlContext {
  public:
   explicit OsMesaContext(const GlContextParams& params) : GlContext(GlBackend::OSMesa) {
+    checkGalliumDriver();
     // Core profile 4.5 (llvmpipe in Mesa 22), else 3.3.
     for (int minorMajor : {45, 33}) {
       const int attribs[] = {OSMESA_FORMAT,
