@@ -830,6 +830,53 @@ void checkCameras(Scene& scene) {
   }
 }
 
+/// Triangle sizes single precision can hold, and rays that leave small
+/// parts where they are. A triangle wider than kMaxTriangleSpan has an area
+/// that overflows a float (the Cornell box scaled by 1e11 was refused as
+/// "emits non-finite power"). The tracers offset a ray from its surface by
+/// 1e-5 of the scene's size (kRayEpsilonScale x its diagonal and reach):
+/// beside a ground far larger than the rest, that offset reaches past half
+/// the triangles' size and their light is lost (the Cornell box on a floor
+/// stretched 3e4 times lost its indirect light without a word): warned.
+void checkTriangleSizes(Scene& scene) {
+  constexpr double kMaxTriangleSpan = 1e9;
+  std::vector<float> longest(scene.triangleCount());
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const Vec3& a = scene.positions[scene.indices[3 * t]];
+    const Vec3& b = scene.positions[scene.indices[3 * t + 1]];
+    const Vec3& c = scene.positions[scene.indices[3 * t + 2]];
+    auto span = [](const Vec3& p, const Vec3& q) {
+      const double x = double(p.x) - q.x, y = double(p.y) - q.y, z = double(p.z) - q.z;
+      return std::sqrt(x * x + y * y + z * z);
+    };
+    const double edge = std::max({span(a, b), span(b, c), span(c, a)});
+    if (edge > kMaxTriangleSpan) {
+      fail(scene.sourcePath, "triangle " + std::to_string(t) + " spans " + formatLimit(edge) +
+                                 " scene units, beyond " + formatLimit(kMaxTriangleSpan) +
+                                 ": its area overflows single precision; give the scene in "
+                                 "larger units (a node scale)");
+    }
+    longest[t] = float(edge);
+  }
+  const Bounds3 box = scene.bounds();
+  if (longest.empty() || box.empty()) return;
+  auto middle = longest.begin() + ptrdiff_t(longest.size() / 2);
+  std::nth_element(longest.begin(), middle, longest.end());
+  // The offset in the tracers' frame (centred on the scene: its reach is
+  // half its size), as photon_map.cpp and path_tracer.cpp take it.
+  const double diagonal = double(length(box.extent()));
+  const double offset = 1e-5 * 1.5 * diagonal;
+  if (offset > 0.1 * double(*middle)) {
+    scene.warnings.push_back(
+        scene.sourcePath + ": the scene spans " + formatLimit(diagonal) +
+        " scene units (its box's diagonal) while half its triangles are under " +
+        formatLimit(*middle) + " across: rays leave a surface about " + formatLimit(offset) +
+        " units off it (1e-5 of the scene's size, for single precision), beyond a tenth of "
+        "those triangles, and light between small parts is lost. Leave out or cut the large "
+        "parts (a ground far wider than the rest)");
+  }
+}
+
 void validateScene(Scene& scene) {
   if (scene.triangleCount() == 0) fail(scene.sourcePath, "no triangles in the scene");
   checkSkyRadiance(scene.sky, scene.sourcePath);
@@ -863,6 +910,7 @@ void validateScene(Scene& scene) {
       m.baseColor = clamped;
     }
   }
+  checkTriangleSizes(scene);
   checkLightAndMaterialValues(scene);
   checkCameras(scene);
   LO_CHECK(scene.normals.empty() || scene.normals.size() == scene.positions.size());

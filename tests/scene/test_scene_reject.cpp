@@ -301,6 +301,41 @@ TEST_F(SceneLimits, CoordinatesBeyondTheTracersRangeAreRefused) {
   EXPECT_EQ(loadScene(write("farish.gltf", g)).triangleCount(), 1u);
 }
 
+// A triangle whose area overflows single precision (the Cornell box scaled
+// by 1e11 was refused as "emits non-finite power", H10-4-232), and a ground
+// so much wider than the rest that the tracers' ray offset, 1e-5 of the
+// scene's size, passes small parts by (H11-5-36: a room's indirect light lost
+// without a word): refused, and warned.
+TEST_F(SceneLimits, TrianglesBeyondSinglePrecisionAreRefusedAndAHugeGroundWarned) {
+  MiniGltf g = oneTriangle();
+  g.nodes = R"([{"mesh": 0, "scale": [2e9, 2e9, 2e9]}])";
+  expectInputError(write("wide.gltf", g), "triangle 0 spans 2.82843e+09 scene units, beyond 1e+09");
+  // Twenty small triangles on a 1 x 1 patch, and one ground of side S: the
+  // offset is 1.5e-5 of the diagonal, warned past a tenth of the median
+  // triangle (0.1 of 1.41 here: S about 6,700).
+  auto withGround = [&](float side) {
+    MiniGltf m;
+    for (int i = 0; i < 20; ++i) {
+      const float x = 0.05f * float(i);
+      m.positions.insert(m.positions.end(), {x, 0, 0, x + 1, 0, 0, x, 1, 0});
+    }
+    m.positions.insert(m.positions.end(), {-side, -1, -side, side, -1, -side, 0, -1, side});
+    for (uint32_t i = 0; i < 63; ++i) m.indices.push_back(i);
+    return loadScene(write("ground.gltf", m)).warnings;
+  };
+  auto warned = [](const std::vector<std::string>& warnings) {
+    for (const std::string& w : warnings) {
+      if (w.find("rays leave a surface about") != std::string::npos) return true;
+    }
+    return false;
+  };
+  EXPECT_FALSE(warned(withGround(1000)));
+  const std::vector<std::string> far = withGround(1e5f);
+  EXPECT_TRUE(warned(far));
+  EXPECT_NE(far.front().find("while half its triangles are under 1.41421 across"), std::string::npos)
+      << far.front();
+}
+
 TEST_F(SceneLimits, BaseColourAboveOneIsClampedWithAWarning) {
   MiniGltf g = oneTriangle();
   g.material = 0;
