@@ -495,10 +495,14 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
         makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth);
     const double h = frame.voxelSize;
     if (!(h * h * h >= kMinStorableVoxel * kMinStorableVoxel * kMinStorableVoxel)) {
+      // At depth 1 no smaller depth helps (H10-4-241): the scene's units do.
       throw InputError("--depth " + std::to_string(params.depth) + ": voxels of " +
                        formatNumber(float(h)) + " scene units are smaller than a .vdb stores (" +
-                       formatNumber(float(kMinStorableVoxel)) +
-                       "): bake at a smaller --depth, or the scene in larger units");
+                       formatNumber(float(kMinStorableVoxel)) + "): " +
+                       (params.depth > 1 ? "bake at a smaller --depth, or the scene in smaller "
+                                           "units (a node scale)"
+                                         : "the scene is too small for a .vdb at any depth: "
+                                           "give it in smaller units (a node scale)"));
     }
     // A radius far below the photons' spacing gathers none: every voxel
     // dark, and a noise figure of 0 (no photon, no variance) that would call

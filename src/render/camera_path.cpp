@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/file.h"
+#include "core/printable.h"
 #include "scene/scene.h"
 
 namespace lo {
@@ -83,6 +84,12 @@ CameraPath parseCameraPath(std::istream& in, const std::string& name) {
   while (std::getline(in, line)) {
     ++lineNumber;
     std::string where = name + ":" + std::to_string(lineNumber) + ": ";
+    // A NUL byte (a binary file given as the path) cut the message short at
+    // it, and "1\0x" read as 1 (H10-7-85).
+    if (line.find('\0') != std::string::npos) {
+      throw InputError(where + "holds a NUL byte: not a text file of keyframes "
+                               "('t ex ey ez tx ty tz [fov]' a line)");
+    }
     size_t hash = line.find('#');
     if (hash != std::string::npos) line.resize(hash);
     std::istringstream words(line);
@@ -93,10 +100,10 @@ CameraPath parseCameraPath(std::istream& in, const std::string& name) {
       char* end = nullptr;
       double v = std::strtod(word.c_str(), &end);
       if (end == word.c_str() || *end != '\0') {
-        throw InputError(where + "'" + word + "' is not a number");
+        throw InputError(where + "'" + printable(word) + "' is not a number");
       }
       if (errno == ERANGE || !std::isfinite(v) || std::fabs(v) > 3.0e38) {
-        throw InputError(where + "'" + word + "' is not a finite float");
+        throw InputError(where + "'" + printable(word) + "' is not a finite float");
       }
       numbers.push_back(float(v));
     }

@@ -16,10 +16,26 @@ void SceneBuilder::addCamera(const tinygltf::Node& node, int nodeIndex, const Ma
     fail(path_, "node " + std::to_string(nodeIndex) + ": camera index out of range");
   }
   const tinygltf::Camera& g = model_.cameras[size_t(node.camera)];
-  if (g.type != "perspective") return;  // orthographic cameras are skipped (docs/scene.md)
+  const std::string name =
+      !node.name.empty() ? node.name
+                         : (!g.name.empty() ? g.name : "camera" + std::to_string(nodeIndex));
+  if (g.type != "perspective") {
+    // Orthographic cameras are left out (docs/scene.md), said so; one glTF
+    // forbids (a magnification of 0) is refused, as a perspective one is
+    // (H10-4-166: taken without a word).
+    const double xmag = g.orthographic.xmag, ymag = g.orthographic.ymag;
+    if (!(std::isfinite(xmag) && std::isfinite(ymag) && xmag != 0 && ymag != 0)) {
+      fail(path_, "camera '" + name + "' on node " + std::to_string(nodeIndex) +
+                      ": orthographic xmag " + formatNumber(xmag) + " and ymag " +
+                      formatNumber(ymag) + " (glTF: finite and not zero)");
+    }
+    scene_.warnings.push_back(path_ + ": camera '" + name + "' on node " +
+                              std::to_string(nodeIndex) +
+                              " is orthographic, which lightoctree does not draw: left out");
+    return;
+  }
   Camera c;
-  c.name = !node.name.empty() ? node.name
-                              : (!g.name.empty() ? g.name : "camera" + std::to_string(nodeIndex));
+  c.name = name;
   c.position = world.point({0, 0, 0});
   world_.cameras.push_back(world.pointInDouble({0, 0, 0}));
   c.forward = normalize(world.vector({0, 0, -1}));

@@ -279,7 +279,15 @@ TEST(BakeLimits, VoxelsTooSmallForAVdbAreRefusedFirst) {
   for (Light& l : scene.lights) l.position = l.position * 1e-3f;
   BakeParams p;
   p.depth = 8;
-  test::expectRefusal([&] { bake(scene, p); }, {"--depth 8", "smaller than a .vdb stores"});
+  test::expectRefusal([&] { bake(scene, p); },
+                      {"--depth 8", "smaller than a .vdb stores", "bake at a smaller --depth"});
+  // At depth 1 no smaller depth helps (H10-4-241): only the scene's units.
+  Scene tiny = scene;
+  for (Vec3& q : tiny.positions) q = q * 1e-4f;
+  for (Light& l : tiny.lights) l.position = l.position * 1e-4f;
+  p.depth = 1;
+  test::expectRefusal([&] { bake(tiny, p); },
+                      {"--depth 1", "the scene is too small for a .vdb at any depth"});
   p.depth = 4;  // 16 voxels across a millimetre: storable
   p.photons = 2000;
   EXPECT_NO_THROW(bake(scene, p));

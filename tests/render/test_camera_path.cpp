@@ -106,6 +106,13 @@ TEST(CameraPath, ErrorsNameTheFileAndLine) {
   EXPECT_EQ(parseError("# only a comment\n\n"),
             "path.txt: no keyframes (expected lines 't ex ey ez tx ty tz [fov]')");
   EXPECT_EQ(parseError(""), "path.txt: no keyframes (expected lines 't ex ey ez tx ty tz [fov]')");
+  // A NUL byte cut the message at it, and "1\0x" read as 1; bytes of a
+  // binary file (a JPEG given as the path) were quoted raw (H10-7-85).
+  EXPECT_EQ(parseError(std::string("0 0 0 1 0 0 1\0x\n", 16)),
+            "path.txt:1: holds a NUL byte: not a text file of keyframes ('t ex ey ez tx ty tz "
+            "[fov]' a line)");
+  EXPECT_EQ(parseError("\xff\xd8\xff\xe0 0 0 1 0 0 0\n"), "path.txt:1: '\\xff\\xd8\\xff\\xe0' is not a number");
+  EXPECT_EQ(parseError("0 0 0 1 0 0 \x1b[31m\n"), "path.txt:1: '\\x1b[31m' is not a number");
 }
 
 TEST(CameraPath, MissingFileIsNamed) {

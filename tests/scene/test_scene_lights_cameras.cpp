@@ -310,6 +310,25 @@ TEST_F(SceneGltf, CamerasThatCannotShowAnythingAreRefused) {
   const Scene near = loadScene(withCamera("near.gltf", R"({"camera": 0, "translation": [0, 0, 3]})",
                                           R"({"yfov": 0.8, "znear": 1e-30, "zfar": 1e30})"));
   EXPECT_TRUE(near.warnings.empty()) << near.warnings.front();
+  // An orthographic camera is left out, said so; one of magnification 0
+  // (glTF forbids it) is refused (H10-4-166: both taken without a word).
+  auto ortho = [&](const std::string& name, const std::string& mags) {
+    MiniGltf g = oneTriangle();
+    g.nodes = R"([{"mesh": 0}, {"camera": 0, "name": "top", "translation": [0, 0, 3]}])";
+    g.sceneNodes = "[0, 1]";
+    g.extraTop = R"("cameras": [{"type": "orthographic", "orthographic": {)" + mags +
+                 R"(, "znear": 0.1, "zfar": 10}}], )";
+    return write(name, g);
+  };
+  const Scene top = loadScene(ortho("ortho.gltf", R"("xmag": 1, "ymag": 1)"));
+  EXPECT_TRUE(top.cameras.empty());
+  ASSERT_EQ(top.warnings.size(), 1u);
+  EXPECT_NE(top.warnings[0].find("camera 'top' on node 1 is orthographic, which lightoctree does "
+                                 "not draw: left out"),
+            std::string::npos)
+      << top.warnings[0];
+  expectInputError(ortho("ortho0.gltf", R"("xmag": 0, "ymag": 0)"),
+                   "camera 'top' on node 1: orthographic xmag 0 and ymag 0 (glTF: finite and not zero)");
 }
 
 // A yfov of 1e-30 radians was taken (a projection of scale 1e30, an image of
