@@ -21,6 +21,7 @@
 #include <cstdint>
 
 #include "core/error.h"
+#include "core/printable.h"
 
 namespace lo {
 
@@ -123,8 +124,11 @@ size_t memoryLimitSetting() {
     }
   }
   const double bytes = number * scale;
-  if (end == limit || !(bytes >= 1) || !std::isfinite(bytes) || bytes > 1e18) {
-    throw InputError(std::string("LIGHTOCTREE_MEMORY_LIMIT='") + limit +
+  // Decimal only, as every flag (strtod read "0x100000000" as hexadecimal).
+  const bool decimal = std::string(limit, end ? size_t(end - limit) : 0)
+                           .find_first_not_of("0123456789.eE+-") == std::string::npos;
+  if (end == limit || !decimal || !(bytes >= 1) || !std::isfinite(bytes) || bytes > 1e18) {
+    throw InputError(std::string("LIGHTOCTREE_MEMORY_LIMIT='") + printable(limit) +
                      "': expected a size in bytes, or a number with K, M, G or T (2G: 2 GiB)");
   }
   return size_t(bytes);

@@ -149,7 +149,7 @@ TEST(Resources, MemoryLimitTakesUnitsAndRefusesWhatItCannotRead) {
   EXPECT_EQ(limited("3M"), size_t(3) << 20);
   EXPECT_EQ(limited("1.5MiB"), size_t(3) << 19);
   EXPECT_EQ(limited("2k"), size_t(2048));
-  for (const char* bad : {"2X", "lots", "-5", "0", "2GB and more"}) {
+  for (const char* bad : {"2X", "lots", "-5", "0", "2GB and more", "0x100000000", "0x1p32", "inf"}) {
     setenv("LIGHTOCTREE_MEMORY_LIMIT", bad, 1);
     EXPECT_THROW(availableMemoryBytes(), InputError) << bad;
     unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
