@@ -312,6 +312,12 @@ void warn(const std::string& text) {
   }
 }
 
+/// Each of `warnings` (a loaded scene's, a render session's) through warn(),
+/// as the commands print them.
+void warnEach(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) warn(w);
+}
+
 /// The commands' warning of a grid baked from another version of the scene
 /// (tools/render_stages.h warnIfStale), "`what`: the light was baked from
 /// ...", through warn().
@@ -555,6 +561,7 @@ GridPtr convertGrid(const Arg<Grid>& gridValue, const Arg<int>& depthArg,
   Scene scene;
   if (!scenePath.empty()) {
     scene = loadScene(scenePath);
+    warnEach(scene.warnings);
     params.scene = &scene;
   }
   // No callback (convert takes none), but Ctrl-C and the memory watch stop it.
@@ -691,10 +698,12 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Arg<Grid>
   const RenderSettings settings =
       withPythonNames([&] { return renderSettings(width, height, mode, kw); });
   Scene scene = loadScene(scenePath);
+  warnEach(scene.warnings);
   warnIfStale(g.meta, scenePath, "grid");  // before the frame, as `render` warns
   const std::string skyWarning = skyMismatchWarning(g.meta, scene.sky);
   if (!skyWarning.empty()) warn("grid: " + skyWarning);
   RgbImage image;
+  std::vector<std::string> sessionWarnings;  // said once the work is done (the lock held)
   // The renderer's refusals name the flags ("--emitter-lights"); Ctrl-C
   // stops it between its set-up's stages and between frames.
   withPythonNames([&] {
@@ -707,12 +716,14 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Arg<Grid>
       RenderSessionOptions options;
       options.progress = sink;
       RenderSession session(scene, g.grid, *context, settings, options);
+      sessionWarnings = session.warnings();
       // The scene's first camera, else one framing its bounds from the side
       // its surfaces face (as `render`).
       image = session.render(PinholeCamera::ofScene(scene), settings.frame.mode);
       return 0;
     });
   });
+  warnEach(sessionWarnings);
   py::array_t<float> out({size_t(settings.frame.height), size_t(settings.frame.width), size_t(3)});
   std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
   return out;
@@ -813,6 +824,7 @@ GridPtr bakeScene(const Arg<std::string>& sceneArg, const Arg<int>& depthArg,
   }
   const SceneOptions lighting = sceneOptions(sky, skyImage, skyMesh, physicalSky);
   Scene scene = withPythonNames([&] { return loadSceneWith(scenePath, lighting); });
+  warnEach(scene.warnings);
   params.depth = depth;
   setPhotonBudget(params, photons, targetError);
   params.seed = seed;
@@ -888,13 +900,16 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
     return 0;
   });
   const ReferenceParams params = referenceParams(opt);
+  std::vector<std::string> sceneWarnings;  // said once the work is done (the lock held)
   const ReferenceImage r = withPythonNames([&] {
     return withProgress(progress, "reference", [&](ProgressSink* sink) {
       const Scene scene = loadSceneWith(opt);
+      sceneWarnings = scene.warnings;
       const PinholeCamera view = chooseCamera(opt.camera, scene, opt.scene);
       return renderReference(scene, view, params, sink);
     });
   });
+  warnEach(sceneWarnings);
   withPythonNames([&] {
     checkStdErrorSamples(opt, withStdError, r.samplesPerPixel);
     return 0;
@@ -1087,12 +1102,16 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
   });
   // Its steps to `progress`, and Ctrl-C at each: a stop before the commit
   // leaves no file of this export (an earlier export's set as it was).
+  std::vector<std::string> sceneWarnings;  // said once the work is done (the lock held)
   const LightmapExportResult r = withPythonNames([&] {
     return withProgress(progress, "lightmap", [&](ProgressSink* sink) {
       p.progress = sink;
-      return exportLightmap(loadSceneWith(scenePath, scene), lightsPath, p);
+      const Scene loaded = loadSceneWith(scenePath, scene);
+      sceneWarnings = loaded.warnings;
+      return exportLightmap(loaded, lightsPath, p);
     });
   });
+  warnEach(sceneWarnings);
   warnIfStale(r.gridMetadata, scenePath, lightsPath);
   const LightmapUvs& uvs = r.lightmap.uvs;
   const LightmapAtlas& atlas = r.lightmap.atlas;

@@ -872,6 +872,31 @@ def test_render_and_lightmap_warn_of_a_grid_baked_from_another_scene(grid, grid_
     assert os.path.exists(out / "lit.glb")
 
 
+def test_the_scene_warnings_of_the_commands_are_python_warnings(grid, tmp_path):
+    """What the loader warns of (an orthographic camera left out, a base
+    colour above 1 clamped) the commands print as "warning: ..."; the
+    module's calls said nothing. Each call that loads the scene warns."""
+    import json
+    with open(SCENE) as f:
+        doc = json.load(f)
+    doc["cameras"].append({"type": "orthographic",
+                           "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}})
+    doc["nodes"].append({"name": "plan", "camera": len(doc["cameras"]) - 1})
+    doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
+    path = str(tmp_path / "plan.gltf")
+    with open(path, "w") as f:
+        json.dump(doc, f)
+    said = "camera 'plan' on node .* is orthographic, which lightoctree does not draw: left out"
+    with pytest.warns(UserWarning, match=said):
+        lightoctree.bake(path, depth=3, photons=2000, knn=20)
+    with pytest.warns(UserWarning, match=said):
+        lightoctree.reference(path, width=8, height=6, spp=1)
+    with pytest.warns(UserWarning, match=said):
+        lightoctree.render(path, grid, width=8, height=6)
+    with pytest.warns(UserWarning, match=said):
+        lightoctree.convert(grid, 3, scene=path)
+
+
 def test_ctrl_c_during_lightmap_leaves_no_file_of_it(grid_file, tmp_path):
     """Ctrl-C during the export was raised only when it ended, its files
     written. Now each step reports (to `progress`, and to the interpreter's

@@ -11,6 +11,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/error.h"
+#include "core/resources.h"
 #include "render/context.h"
 #include "render/gl_util.h"
 
@@ -26,6 +27,18 @@ constexpr int kMaxShadowLayers = shader::LO_MAX_SHADOW_LAYERS;
 /// size up to 16384.
 constexpr double kShadowMapBudget = 48.0 * 1024 * 1024;
 constexpr int kCascades = shader::LO_SUN_CASCADES;
+/// The most texels one drawing of every shadow map may cover, counted as the
+/// scene's triangles projected into each layer: a scene of 5,000 copies of
+/// a floor stacked under a lamp covered its maps 1,400 times over, 17.6 G
+/// texels, and the software rasteriser took 85 s (H10-5-19). The scenes of
+/// docs/results/public-scenes.md cover theirs 0.5 to 5.4 times over, at most
+/// 91 M texels (the game level's 17 layers), a tenth of it. Beyond it the
+/// maps are halved, down to kMinFillSize, and the report says why.
+constexpr double kShadowFillBudget = 1024.0 * 1024 * 1024;
+constexpr int kMinFillSize = 128;
+/// At most this many triangle-layer pairs are projected to count the fill;
+/// beyond, an even sample of the triangles, scaled up.
+constexpr size_t kFillSamplePairs = size_t(1) << 22;
 
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
 glm::vec4 toVec4(const Vec3& v, float w) { return {v.x, v.y, v.z, w}; }
@@ -39,6 +52,60 @@ glm::vec3 perpendicular(const glm::vec3& d) {
 /// A spot's shadow map: its outer cone and a little more, at most 172 degrees.
 float spotShadowFov(const GpuLight& l) {
   return std::min(2.0f * std::acos(std::clamp(l.params[0], -1.0f, 1.0f)) + 0.05f, 3.0f);
+}
+
+/// The share of a layer that the triangle of clip-space corners `c` covers:
+/// its part in front of the near plane (z >= -w), its area there, at most
+/// the part of the layer its bounds span.
+double coveredShare(const glm::vec4 (&c)[3]) {
+  glm::vec4 kept[4];
+  int n = 0;
+  for (int i = 0; i < 3; ++i) {
+    const glm::vec4& a = c[i];
+    const glm::vec4& b = c[(i + 1) % 3];
+    const float da = a.z + a.w, db = b.z + b.w;
+    if (da >= 0) kept[n++] = a;
+    if ((da >= 0) != (db >= 0) && n < 4) kept[n++] = a + (b - a) * (da / (da - db));
+  }
+  if (n < 3) return 0;
+  double area2 = 0, lowX = 1, lowY = 1, highX = -1, highY = -1;
+  for (int i = 0; i < n; ++i) {
+    const glm::vec4& a = kept[i];
+    const glm::vec4& b = kept[(i + 1) % n];
+    if (!(a.w > 0) || !(b.w > 0)) return 0;
+    const double ax = a.x / a.w, ay = a.y / a.w, bx = b.x / b.w, by = b.y / b.w;
+    area2 += ax * by - bx * ay;
+    lowX = std::min(lowX, ax);
+    lowY = std::min(lowY, ay);
+    highX = std::max(highX, ax);
+    highY = std::max(highY, ay);
+  }
+  const double spanned = std::max(0.0, std::min(highX, 1.0) - std::max(lowX, -1.0)) *
+                         std::max(0.0, std::min(highY, 1.0) - std::max(lowY, -1.0));
+  return std::min(0.5 * std::fabs(area2), spanned) / 4.0;
+}
+
+/// How many times over the scene's triangles cover the shadow maps' first
+/// `layers` layers, on average (the texels drawn per texel held).
+double coveredTimesOver(const Scene& scene, const RenderSpace& space, const glm::mat4* matrices,
+                     int layers) {
+  const size_t triangles = scene.triangleCount();
+  if (layers <= 0 || triangles == 0) return 0;
+  const size_t pairs = triangles * size_t(layers);
+  const size_t stride = (pairs + kFillSamplePairs - 1) / kFillSamplePairs;
+  double covered = 0;
+  for (size_t t = 0; t < triangles; t += stride) {
+    glm::vec4 corner[3];
+    for (int k = 0; k < 3; ++k) {
+      corner[k] = toVec4(space.toRender(scene.positions[scene.indices[3 * t + size_t(k)]]), 1);
+    }
+    for (int layer = 0; layer < layers; ++layer) {
+      const glm::vec4 clip[3] = {matrices[layer] * corner[0], matrices[layer] * corner[1],
+                                 matrices[layer] * corner[2]};
+      covered += coveredShare(clip);
+    }
+  }
+  return covered * double(stride) / double(layers);
 }
 
 GpuLight punctualLight(const Light& light, const RenderSpace& space) {
@@ -164,6 +231,23 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
   while (shadowMapSize > 256 &&
          double(shadowMapSize) * double(shadowMapSize) * 2.0 * double(layers) > kShadowMapBudget) {
     shadowMapSize = std::max(256, shadowMapSize / 2);
+  }
+  // And within the fill budget (kShadowFillBudget).
+  const double overlap = coveredTimesOver(scene, space, block.uShadowMatrices, layers);
+  shadowOverlap = overlap;
+  auto fill = [&](int size) { return overlap * double(size) * double(size) * double(layers); };
+  const int asked = shadowMapSize;
+  while (shadowMapSize > kMinFillSize && fill(shadowMapSize) > kShadowFillBudget) {
+    shadowMapSize = std::max(kMinFillSize, shadowMapSize / 2);
+  }
+  if (shadowMapSize < asked) {
+    shadowMapNote = "shadow maps of " + std::to_string(shadowMapSize) + "^2, not " +
+                    std::to_string(asked) + "^2: the scene covers them " +
+                    formatNumber(std::round(overlap)) +
+                    " times over (surfaces stacked before its lights), and a drawing of them at " +
+                    std::to_string(asked) + "^2 would cover " + formatCount(size_t(fill(asked))) +
+                    " texels, more than " + formatCount(size_t(kShadowFillBudget)) +
+                    "; --shadow-map-size sets a smaller size";
   }
   // Each shadowed light's tangent per texel (the shader's normal offset and
   // depth bias are texels at the receiver's distance, never scene units): a

@@ -5,6 +5,7 @@
 #include <render_constants.h>
 
 #include <array>
+#include <string>
 #include <glm/glm.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <vector>
@@ -24,6 +25,10 @@ struct SceneLights {
   GlSampler depthSampler;  ///< reads the shadow maps' depths (no comparison): PCSS blocker search
   GlProgram shadowProgram;
   int shadowMapSize = 1;
+  /// Why the maps are smaller than asked beyond the memory budget (the fill
+  /// budget, lights.cpp), or "".
+  std::string shadowMapNote;
+  double shadowOverlap = 0;  ///< how many times over the scene covers the maps (lights.cpp)
   int emitterLights = 0;   ///< VPLs in the block
   int areaLightCount = 0;  ///< area lights in the block (the last ones): groups of triangles
   int areaTriangleCount = 0;  ///< their triangles (uAreaTriangles)

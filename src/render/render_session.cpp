@@ -150,6 +150,7 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
   s.renderer = std::make_unique<Renderer>(scene, s.octree, settings.renderer, textureUploaded);
   s.stages.insert(s.stages.end(), s.renderer->startupStages().begin(),
                   s.renderer->startupStages().end());
+  if (!s.renderer->shadowMapNote().empty()) s.warnings.push_back(s.renderer->shadowMapNote());
   setup.advance();
   if (options.freeTexels) {
     scene.releaseTexels();  // those no material draws with

@@ -139,7 +139,9 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
     r.geometry.drawDepthOnly(program, shadows);
   });
   shadowTimer.finish(std::to_string(r.lights.layerCount()) + " layers of " +
-                     std::to_string(r.lights.shadowMapSize) + "^2");
+                     std::to_string(r.lights.shadowMapSize) + "^2, covered " +
+                     formatNumber(std::round(10.0 * r.lights.shadowOverlap) / 10.0) +
+                     " times over" + (r.lights.shadowMapNote.empty() ? "" : " (fill budget)"));
   for (const Material& m : scene.materials) {
     r.probe.wanted =
         r.probe.wanted || m.roughness < shader::LO_PROBE_NONE || m.metallicRoughnessTexture >= 0;
@@ -147,6 +149,8 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
 }
 
 bool Renderer::hasReflectionProbe() const { return impl_->probe.wanted; }
+
+const std::string& Renderer::shadowMapNote() const { return impl_->lights.shadowMapNote; }
 
 const std::vector<StageReport>& Renderer::startupStages() const { return impl_->startup; }
 

@@ -183,6 +183,10 @@ class Renderer {
   /// Whether the scene has a surface the reflection probe serves (roughness,
   /// by factor or map, below the probe's cut-off, shaders/render_constants.h).
   bool hasReflectionProbe() const;
+  /// Why the shadow maps are smaller than RendererParams::shadowMapSize
+  /// beyond the memory budget (the scene covers them many times over:
+  /// a budget of texels drawn), or "".
+  const std::string& shadowMapNote() const;
   int emitterLightCount() const;  ///< virtual point lights on emissive triangles
   int areaLightCount() const;     ///< emissive triangles drawn as area lights (one-sided)
   int areaLightGroups() const;    ///< their groups, each shadowed from one cube map
