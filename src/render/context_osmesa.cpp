@@ -6,16 +6,16 @@
 // distributed bake) should not carry it.
 
 #include <dlfcn.h>
+#include <unistd.h>
 #include <glad/gl.h>
 // glad's header defines __gl_h_, so osmesa.h takes glad's GL types.
 #include <GL/osmesa.h>
 
-#include <cstdlib>
-#include <cstring>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include "core/isolate.h"
 #include "core/printable.h"
 #include "core/resources.h"
 #include "render/context_internal.h"
@@ -74,38 +74,68 @@ const OsMesaApi& osMesa() {
   return api;
 }
 
-/// Mesa's OSMesa picks its rasterizer by GALLIUM_DRIVER: a name it lacks
-/// made OSMesaCreateContextAttribs crash (H11-2-38). The software ones it
-/// has are taken; another is refused, named, before Mesa sees it.
-void checkGalliumDriver() {
-  const char* driver = std::getenv("GALLIUM_DRIVER");
-  if (!driver || !*driver) return;
-  for (const char* known : {"llvmpipe", "softpipe", "swr", "zink"}) {
-    if (std::strcmp(driver, known) == 0) return;
+/// OSMesa's attributes for a core profile of version major.minor (45: 4.5).
+std::vector<int> contextAttributes(int majorMinor) {
+  return {OSMESA_FORMAT,  OSMESA_RGBA,         OSMESA_DEPTH_BITS,           24,
+          OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, majorMinor / 10,
+          OSMESA_CONTEXT_MINOR_VERSION, majorMinor % 10, 0};
+}
+
+/// The variables of the environment by which Mesa changes what it does
+/// (GALLIUM_DRIVER other than llvmpipe or softpipe, MESA_*, GALLIUM_*,
+/// LP_*, GALLIVM_*), as NAME=value.
+std::vector<std::string> mesaSettings() {
+  std::vector<std::string> found;
+  for (char** entry = environ; entry && *entry; ++entry) {
+    const std::string text = *entry;
+    if (text == "GALLIUM_DRIVER=llvmpipe" || text == "GALLIUM_DRIVER=softpipe") continue;
+    for (const char* prefix : {"MESA_", "GALLIUM_", "LP_", "GALLIVM_"}) {
+      if (text.rfind(prefix, 0) == 0) found.push_back(text);
+    }
   }
-  throw GlError("osmesa: GALLIUM_DRIVER='" + printable(driver) +
-                "' names no software rasterizer OSMesa has (llvmpipe, softpipe): unset it "
-                "or set it to llvmpipe");
+  return found;
+}
+
+/// Mesa's OSMesa crashed in OSMesaCreateContextAttribs under some of its
+/// own settings (GALLIUM_DRIVER=swr or zink, which this Mesa lacks,
+/// MESA_GLSL_VERSION_OVERRIDE=100, MESA_EXTENSION_OVERRIDE=...; H11-2-38,
+/// H12-2-1..19), ending the process, a Python interpreter with it. Where
+/// the environment holds such settings, a child process makes a context
+/// first; a crash there is refused, naming them.
+void probeMesaSettings() {
+  const std::vector<std::string> settings = mesaSettings();
+  if (settings.empty()) return;
+  osMesa();  // the library opened here, where its failure is said
+  const IsolatedRun run = runIsolated(
+      [](std::string&) {
+        for (int version : {45, 33}) {
+          const OSMesaContext context = osMesa().createContextAttribs(contextAttributes(version).data(), nullptr);
+          if (context) {
+            osMesa().destroyContext(context);
+            return 0;
+          }
+        }
+        return 1;
+      },
+      IsolationLimits{size_t(4) << 30, 60});
+  if (run.outcome != IsolatedRun::Outcome::Crashed && run.outcome != IsolatedRun::Outcome::TimedOut) {
+    return;
+  }
+  std::string named;
+  for (const std::string& s : settings) named += (named.empty() ? "" : ", ") + printable(s);
+  throw GlError("osmesa: Mesa " +
+                std::string(run.outcome == IsolatedRun::Outcome::Crashed ? "crashed" : "hung") +
+                " making its OpenGL context under the environment's settings of Mesa (" + named +
+                "): unset them (GALLIUM_DRIVER may be llvmpipe or softpipe)");
 }
 
 class OsMesaContext final : public GlContext {
  public:
   explicit OsMesaContext(const GlContextParams& params) : GlContext(GlBackend::OSMesa) {
-    checkGalliumDriver();
+    probeMesaSettings();
     // Core profile 4.5 (llvmpipe in Mesa 22), else 3.3.
-    for (int minorMajor : {45, 33}) {
-      const int attribs[] = {OSMESA_FORMAT,
-                             OSMESA_RGBA,
-                             OSMESA_DEPTH_BITS,
-                             24,
-                             OSMESA_PROFILE,
-                             OSMESA_CORE_PROFILE,
-                             OSMESA_CONTEXT_MAJOR_VERSION,
-                             minorMajor / 10,
-                             OSMESA_CONTEXT_MINOR_VERSION,
-                             minorMajor % 10,
-                             0};
-      context_ = osMesa().createContextAttribs(attribs, nullptr);
+    for (int version : {45, 33}) {
+      context_ = osMesa().createContextAttribs(contextAttributes(version).data(), nullptr);
       if (context_) break;
     }
     if (!context_) {
