@@ -119,12 +119,14 @@ std::string conversionMessage(const CLI::App& app, const std::string& parserText
 /// Under mpirun beside other ranks (an MPI build), a rank that bakes nothing
 /// (--version, --help, inspect) ends the job with the bake ranks, which
 /// would wait for it in MPI_Init forever: every rank refuses, rank 0 says
-/// why. Else `rc`.
+/// why. Else `rc` (also where MPI finds the process alone: a size variable
+/// left in a job script's environment).
 int leaveBakeRanks(int argc, char** argv, int rc) {
   if (lo::mpiLaunchSize() < 2 || !lo::mpiAvailable()) return rc;
   std::string given;
   for (int i = 1; i < argc && i < 4; ++i) given += (i > 1 ? " " : "") + std::string(argv[i]);
-  const std::string message = lo::refuseBakeRanks(given);
+  std::string message;
+  if (!lo::refuseBakeRanks(given, message)) return rc;
   if (!message.empty()) {
     std::fprintf(stderr, "lightoctree: error: %s\n", lo::printable(message).c_str());
   }

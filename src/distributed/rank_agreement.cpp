@@ -194,19 +194,19 @@ void checkRanksSucceeded(Communicator& comm, const std::string& failure) {
   throw RanksRefuseError(message);
 }
 
-std::string refuseBakeRanks(const std::string& given) {
+bool refuseBakeRanks(const std::string& given, std::string& message) {
   MpiSession session;
+  if (session.world().size() < 2) return false;
   const int rank = session.world().rank();
-  std::string message;
   try {
     checkRanksSucceeded(session.world(),
                         "`lightoctree " + given +
                             "` given, not `bake`: under mpirun every rank runs the same "
                             "`lightoctree bake`, the one command that runs on several ranks");
   } catch (const InputError& e) {  // always: the step above failed here
-    message = e.what();
+    message = rank == 0 ? e.what() : "";
   }
-  return rank == 0 ? message : std::string();
+  return true;
 }
 
 void checkRanksAgree(const Scene& scene, const BakeParams& params, const TileParams& tiles,

@@ -45,8 +45,10 @@ void checkRanksSucceeded(Communicator& comm, const std::string& failure);
 /// "--version", "inspect") does: it starts MPI and joins the bake ranks'
 /// first step (checkRanksSucceeded) as a rank that failed, so that every
 /// rank refuses at once. A bake rank waited for it in MPI_Init forever
-/// (H10-3-23). Returns the message rank 0 says ("" on other ranks).
-std::string refuseBakeRanks(const std::string& given);
+/// (H10-3-23). Returns false where MPI finds this process alone (a size
+/// variable left in the environment of a job script: nothing to refuse),
+/// else true with `message` what rank 0 says ("" on other ranks).
+bool refuseBakeRanks(const std::string& given, std::string& message);
 
 /// Every rank calls it with its own settings, scene and `outputs` (the
 /// files rank 0 writes, as this rank was told: ranks given another -o saw

@@ -113,4 +113,14 @@ for given in --version "bake --help"; do
     failures=$((failures + 1))
   fi
 done
+# Outside mpirun, a size variable left in a job script's environment: MPI
+# finds the process alone, and the command runs (H12-2-36..38: it refused).
+for variable in OMPI_COMM_WORLD_SIZE PMI_SIZE PMIX_SIZE; do
+  if out=$(env "$variable=2" timeout 120 "$CLI" --version 2>&1) && [ -n "$out" ]; then
+    echo "ok: $variable=2 outside mpirun: --version runs"
+  else
+    echo "FAIL: $variable=2 outside mpirun: --version: $out"
+    failures=$((failures + 1))
+  fi
+done
 exit $failures
