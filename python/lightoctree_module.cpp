@@ -355,7 +355,13 @@ bool isBool(const py::handle& value) {
 /// The number `value` holds (int, float, a NumPy number; not a bool, not a
 /// string), else nullopt.
 std::optional<double> numberOf(const py::handle& value) {
-  if (isBool(value) || !PyNumber_Check(value.ptr())) return std::nullopt;
+  // A real number: not a complex one (NumPy's gave its real part with only a
+  // warning, H12-1-59), nor an object that merely converts to float.
+  static const py::object real = py::module_::import("numbers").attr("Real");
+  if (isBool(value) || !(PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()) ||
+                         py::isinstance(value, real))) {
+    return std::nullopt;
+  }
   const double v = PyFloat_AsDouble(value.ptr());  // int beyond a double: OverflowError
   if (v == -1.0 && PyErr_Occurred()) {
     PyErr_Clear();
@@ -418,7 +424,10 @@ bool boolArg(const py::handle& value, const std::string& name) {
 
 std::string textArg(const py::handle& value, const std::string& name) {
   if (!py::isinstance<py::str>(value)) refuse(name, "a string", value);
-  return value.cast<std::string>();
+  const std::string text = value.cast<std::string>();
+  // A NUL cut the messages that quote it (H12-1-66).
+  if (text.find('\0') != std::string::npos) refuse(name, "a string without NUL bytes", value);
+  return text;
 }
 
 /// A number of VDLs as --vdls takes it: 1 to kMaxVdls or "auto", as a
@@ -483,19 +492,32 @@ Grid& gridArg(const py::handle& value, const std::string& name) {
 /// 0), complex numbers (their imaginary part dropped with only a NumPy
 /// warning), text, or objects NumPy cannot convert (its bare ValueError
 /// named no argument; H11-1-28/29, H10-1-73).
+/// With `bools`, bools are taken as 1 and 0 (a mask). An array of objects is
+/// taken when each is a real number (strings of digits were read as numbers,
+/// H12-1-34). `dtype` gets what NumPy saw, for the refusal.
 template <typename T>
-py::array_t<T, py::array::c_style | py::array::forcecast> realArray(const py::handle& value) {
+std::optional<py::array_t<T, py::array::c_style | py::array::forcecast>> realArray(
+    const py::handle& value, std::string& dtype, bool bools = false) {
   using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
   if (value.is_none() || py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value)) {
-    return Array();
+    return std::nullopt;
   }
   try {
     const py::object seen = py::module_::import("numpy").attr("asarray")(value);
-    const char kind = seen.attr("dtype").attr("kind").cast<std::string>().at(0);
-    if (kind != 'i' && kind != 'u' && kind != 'f' && kind != 'O') return Array();
-    return Array::ensure(seen);
+    dtype = py::str(seen.attr("dtype"));
+    const char kind = py::str(seen.attr("dtype").attr("kind")).cast<std::string>().at(0);
+    if (kind == 'O') {
+      for (const py::handle item : seen.attr("flat")) {
+        if (!numberOf(item)) return std::nullopt;
+      }
+    } else if (kind != 'i' && kind != 'u' && kind != 'f' && !(bools && kind == 'b')) {
+      return std::nullopt;
+    }
+    Array a = Array::ensure(seen);
+    if (!a) return std::nullopt;
+    return a;
   } catch (const py::error_already_set&) {
-    return Array();
+    return std::nullopt;
   }
 }
 
@@ -503,11 +525,12 @@ py::array_t<T, py::array::c_style | py::array::forcecast> realArray(const py::ha
 /// anything else.
 py::array_t<double, py::array::c_style | py::array::forcecast> pointsArg(const py::handle& value,
                                                                            const std::string& name) {
-  const auto a = realArray<double>(value);
-  if (!a || a.ndim() != 2 || a.shape(1) != 3) {
+  std::string dtype;
+  const auto a = realArray<double>(value, dtype);
+  if (!a || a->ndim() != 2 || a->shape(1) != 3) {
     refuse(name, "an array of numbers of shape (N, 3)", value);
   }
-  return a;
+  return *a;
 }
 
 /// A path for Python, as os.fsdecode gives it: a str whatever the bytes, which
@@ -743,14 +766,19 @@ py::array_t<float> readImageFile(const Arg<std::string>& pathArgument) {
 /// Three numbers, or their text "x,y,z", as the flags' text "x,y,z" that
 /// parseVec3d reads (%.17g gives every double back exactly).
 std::string vec3Text(const py::handle& value, const std::string& name) {
-  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  if (py::isinstance<py::str>(value)) return textArg(value, name);
+  // Three real numbers each (True or a complex number was read as 1 or its
+  // real part, H12-1-35).
   std::vector<double> v;
-  try {
-    v = value.cast<std::vector<double>>();
-  } catch (const py::cast_error&) {
+  if (py::isinstance<py::sequence>(value) && py::len(value) == 3) {
+    for (const py::handle item : value) {
+      const std::optional<double> x = numberOf(item);
+      if (!x) break;
+      v.push_back(*x);
+    }
   }
   if (v.size() != 3) {
-    throw InputError(name + ": expected three numbers x, y, z, got " + std::string(py::repr(value)));
+    throw InputError(name + ": expected three numbers x, y, z, got " + shortRepr(value));
   }
   char text[96];
   std::snprintf(text, sizeof text, "%.17g,%.17g,%.17g", v[0], v[1], v[2]);
@@ -929,17 +957,26 @@ RgbImage imageArg(const py::object& value, const std::string& name, bool isMask,
     *path = pathArg(value, name);
     return readImage(*path, isMask);
   }
-  const auto a = realArray<float>(value);
-  const bool plane = isMask && a && a.ndim() == 2;
-  if (!a || !((a.ndim() == 3 && a.shape(2) == 3) || plane) || a.shape(0) < 1 || a.shape(1) < 1 ||
-      a.shape(0) > kMaxImageSide || a.shape(1) > kMaxImageSide) {
-    throw InputError(name + ": must be a path or an array of shape (height, width, 3)" +
+  std::string dtype;
+  const auto array = realArray<float>(value, dtype, isMask);  // a mask may be bools
+  const bool plane = isMask && array && array->ndim() == 2;
+  if (!array || !((array->ndim() == 3 && array->shape(2) == 3) || plane) ||
+      array->shape(0) < 1 || array->shape(1) < 1 || array->shape(0) > kMaxImageSide ||
+      array->shape(1) > kMaxImageSide) {
+    // What was given: the array's shape, else the dtype NumPy saw (an array
+    // of text or complex numbers), else its type.
+    const std::string given =
+        array ? "shape " + std::string(py::str(py::tuple(py::cast(std::vector<py::ssize_t>(
+                                array->shape(), array->shape() + array->ndim())))))
+        : !dtype.empty() ? "an array of dtype " + dtype
+                         : std::string(py::repr(py::type::of(value)));
+    throw InputError(name + ": must be a path or an array of " +
+                     std::string(isMask ? "numbers or bools" : "numbers") +
+                     " of shape (height, width, 3)" +
                      std::string(isMask ? " or (height, width)" : "") + " of 1 to " +
-                     std::to_string(kMaxImageSide) + " pixels a side, got " +
-                     (a ? "shape " + std::string(py::str(py::tuple(py::cast(std::vector<py::ssize_t>(
-                                                     a.shape(), a.shape() + a.ndim())))))
-                        : std::string(py::repr(py::type::of(value)))));
+                     std::to_string(kMaxImageSide) + " pixels a side, got " + given);
   }
+  const auto& a = *array;
   RgbImage image(int(a.shape(1)), int(a.shape(0)));
   const float* data = a.data();
   if (plane) {

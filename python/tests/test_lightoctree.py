@@ -138,6 +138,21 @@ def test_lookup_refuses_points_that_are_not_real_numbers(grid):
             lightoctree.lookup(grid, bad, normals)
     with pytest.raises(lightoctree.InputError, match=r"normals: must be an array of numbers"):
         lightoctree.lookup(grid, np.ones((2, 3)), normals.astype(bool))
+    # Objects that are text or bools are no numbers either (H12-1-34, -35).
+    for bad in (np.array([["0", "0.27", "-0.28"]] * 2, object), np.ones((2, 3), bool).astype(object)):
+        with pytest.raises(lightoctree.InputError, match=r"points: must be an array of numbers"):
+            lightoctree.lookup(grid, bad, normals)
+
+
+def test_three_numbers_are_three_real_numbers_and_text_has_no_nul(tmp_path):
+    """sky=(True, True, True) lit as (1, 1, 1), and a complex array as its
+    real part with only NumPy's warning (H12-1-35, -60); camera='a\\x00b' was
+    named cut at the NUL (H12-1-66)."""
+    for bad in ((True, True, True), np.ones(3, complex), (1, 2), "1,2"):
+        with pytest.raises(lightoctree.InputError, match="sky: expected three numbers"):
+            lightoctree.bake(SCENE, depth=3, photons=1000, sky=bad)
+    with pytest.raises(lightoctree.InputError, match="camera: must be a string without NUL bytes"):
+        lightoctree.reference(SCENE, width=4, height=3, spp=1, camera="a\x00b")
 
 
 def test_render_draws_the_scene_lit_by_the_grid(grid):
@@ -762,7 +777,7 @@ def test_compare_refuses_bad_arguments_by_name():
         lightoctree.compare(image, image, clip_percentile=0)
     with pytest.raises(ValueError, match="test is 16 x 8 but reference is 16 x 12"):
         lightoctree.compare(image[:8], image)
-    with pytest.raises(ValueError, match=r"reference: must be a path or an array of shape \(height, width, 3\)"):
+    with pytest.raises(ValueError, match=r"reference: must be a path or an array of numbers of shape \(height, width, 3\)"):
         lightoctree.compare(image, image[..., 0])
     with pytest.raises(ValueError, match="mask: the mask is 8 x 12, the images are 16 x 12"):
         lightoctree.compare(image, image, mask=image[:, :8])
@@ -774,8 +789,17 @@ def test_compare_refuses_bad_arguments_by_name():
                 image.astype(bool), image.astype(complex)):
         with pytest.raises(lightoctree.InputError, match=r"test: must be a path or an array"):
             lightoctree.compare(bad, image)
-    # An array of number objects is numbers.
+    # An array of number objects is numbers; the refusal names the dtype
+    # NumPy saw (it said "got shape (0,)", H12-1-52).
     assert lightoctree.compare(image.astype(object), image)["channels"]["RGB"]["rel_rmse"] == 0
+    with pytest.raises(lightoctree.InputError, match="got an array of dtype complex128"):
+        lightoctree.compare(image.astype(complex), image)
+    # A mask may be bools, as it may be 0 and 1.
+    half = np.zeros((12, 16), bool)
+    half[:, :8] = True
+    by_bools = lightoctree.compare(image, image * 1.1, mask=half)
+    by_numbers = lightoctree.compare(image, image * 1.1, mask=half.astype(np.float32))
+    assert by_bools["compared_pixels"] == by_numbers["compared_pixels"] == 12 * 8
 
 
 @pytest.fixture(scope="module")

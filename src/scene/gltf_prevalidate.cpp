@@ -102,6 +102,7 @@ struct FieldRule {
   const char* pointer;  ///< JSON pointer; "*" stands for every element of an array or member of an object
   enum Kind { kNumber, kNumbers, kString, kStrings, kBool, kObject, kArray, kIndex, kIndices } kind;
   size_t count = 0;  ///< kNumbers: how many; kArray: at least how many elements
+  bool required = false;  ///< glTF requires it where its parent is (a primitive's attributes)
 };
 
 const FieldRule kFieldRules[] = {
@@ -142,6 +143,9 @@ const FieldRule kFieldRules[] = {
     {"/materials/*/extensions/KHR_materials_transmission/transmissionFactor", FieldRule::kNumber},
     {"/materials/*/extensions/KHR_materials_specular/specularFactor", FieldRule::kNumber},
     {"/materials/*/extensions/KHR_materials_volume/thicknessFactor", FieldRule::kNumber},
+    {"/extensions/KHR_lights_punctual/lights", FieldRule::kArray},
+    {"/extensions/KHR_lights_punctual/lights/*", FieldRule::kObject},
+    {"/nodes/*/extensions/KHR_lights_punctual/light", FieldRule::kIndex, 0, true},
     {"/extensions/KHR_lights_punctual/lights/*/name", FieldRule::kString},
     {"/extensions/KHR_lights_punctual/lights/*/type", FieldRule::kString},
     {"/extensions/KHR_lights_punctual/lights/*/color", FieldRule::kNumbers, 3},
@@ -172,21 +176,21 @@ const FieldRule kFieldRules[] = {
     {"/nodes/*/camera", FieldRule::kIndex},
     {"/meshes/*/primitives", FieldRule::kArray, 1},
     {"/meshes/*/primitives/*", FieldRule::kObject},
-    {"/meshes/*/primitives/*/attributes", FieldRule::kObject},
+    {"/meshes/*/primitives/*/attributes", FieldRule::kObject, 0, true},
     {"/meshes/*/primitives/*/attributes/*", FieldRule::kIndex},
     {"/meshes/*/primitives/*/indices", FieldRule::kIndex},
     {"/meshes/*/primitives/*/material", FieldRule::kIndex},
     {"/meshes/*/primitives/*/mode", FieldRule::kIndex},
     {"/accessors/*/bufferView", FieldRule::kIndex},
     {"/accessors/*/byteOffset", FieldRule::kIndex},
-    {"/accessors/*/count", FieldRule::kIndex},
-    {"/accessors/*/componentType", FieldRule::kIndex},
-    {"/accessors/*/type", FieldRule::kString},
-    {"/bufferViews/*/buffer", FieldRule::kIndex},
+    {"/accessors/*/count", FieldRule::kIndex, 0, true},
+    {"/accessors/*/componentType", FieldRule::kIndex, 0, true},
+    {"/accessors/*/type", FieldRule::kString, 0, true},
+    {"/bufferViews/*/buffer", FieldRule::kIndex, 0, true},
     {"/bufferViews/*/byteOffset", FieldRule::kIndex},
-    {"/bufferViews/*/byteLength", FieldRule::kIndex},
+    {"/bufferViews/*/byteLength", FieldRule::kIndex, 0, true},
     {"/bufferViews/*/byteStride", FieldRule::kIndex},
-    {"/buffers/*/byteLength", FieldRule::kIndex},
+    {"/buffers/*/byteLength", FieldRule::kIndex, 0, true},
     {"/buffers/*/uri", FieldRule::kString},
     {"/images/*/uri", FieldRule::kString},
     {"/images/*/mimeType", FieldRule::kString},
@@ -199,19 +203,19 @@ const FieldRule kFieldRules[] = {
     {"/samplers/*/wrapT", FieldRule::kIndex},
     // A material's textures: an index "0" dropped the texture.
     {"/materials/*/pbrMetallicRoughness/baseColorTexture", FieldRule::kObject},
-    {"/materials/*/pbrMetallicRoughness/baseColorTexture/index", FieldRule::kIndex},
+    {"/materials/*/pbrMetallicRoughness/baseColorTexture/index", FieldRule::kIndex, 0, true},
     {"/materials/*/pbrMetallicRoughness/baseColorTexture/texCoord", FieldRule::kIndex},
     {"/materials/*/pbrMetallicRoughness/metallicRoughnessTexture", FieldRule::kObject},
-    {"/materials/*/pbrMetallicRoughness/metallicRoughnessTexture/index", FieldRule::kIndex},
+    {"/materials/*/pbrMetallicRoughness/metallicRoughnessTexture/index", FieldRule::kIndex, 0, true},
     {"/materials/*/pbrMetallicRoughness/metallicRoughnessTexture/texCoord", FieldRule::kIndex},
     {"/materials/*/normalTexture", FieldRule::kObject},
-    {"/materials/*/normalTexture/index", FieldRule::kIndex},
+    {"/materials/*/normalTexture/index", FieldRule::kIndex, 0, true},
     {"/materials/*/normalTexture/texCoord", FieldRule::kIndex},
     {"/materials/*/occlusionTexture", FieldRule::kObject},
-    {"/materials/*/occlusionTexture/index", FieldRule::kIndex},
+    {"/materials/*/occlusionTexture/index", FieldRule::kIndex, 0, true},
     {"/materials/*/occlusionTexture/texCoord", FieldRule::kIndex},
     {"/materials/*/emissiveTexture", FieldRule::kObject},
-    {"/materials/*/emissiveTexture/index", FieldRule::kIndex},
+    {"/materials/*/emissiveTexture/index", FieldRule::kIndex, 0, true},
     {"/materials/*/emissiveTexture/texCoord", FieldRule::kIndex},
     {"/materials/*/extensions/KHR_materials_transmission/transmissionTexture/index",
      FieldRule::kIndex},
@@ -302,7 +306,13 @@ void checkField(const std::string& path, const nlohmann::json& j, const FieldRul
   }
   if (!j.is_object()) return;
   auto it = j.find(key);
-  if (it != j.end()) checkField(path, *it, rule, parts, part + 1, where + "/" + key);
+  if (it != j.end()) {
+    checkField(path, *it, rule, parts, part + 1, where + "/" + key);
+  } else if (rule.required && part + 1 == parts.size()) {
+    // A primitive without attributes was dropped, a texture without an index
+    // read as none, without a word (H12-4-23, -167).
+    fail(path, "invalid glTF: " + where + "/" + key + " is missing, expected " + expected(rule));
+  }
 }
 
 }  // namespace
@@ -347,7 +357,9 @@ static void checkAssetVersion(const std::string& path, const nlohmann::json& j) 
              part.find_first_not_of("0123456789") == std::string::npos;
     };
     if (dot == std::string::npos || !digits(text.substr(0, dot)) || !digits(text.substr(dot + 1))) {
-      fail(path, std::string("invalid glTF: /asset/") + key + " is \"" + printable(text) +
+      // Cut as the field checks cut a value (a 10 MB version was quoted whole).
+      const std::string shown = text.size() > 60 ? text.substr(0, 60) + "..." : text;
+      fail(path, std::string("invalid glTF: /asset/") + key + " is \"" + printable(shown) +
                      "\", expected MAJOR.MINOR (\"2.0\")");
     }
     major = std::stoi(text.substr(0, dot));

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "core/error.h"
 #include "scene/pinhole_camera.h"
 #include "scene/scene.h"
 #include "scene/scene_fixture.h"
@@ -149,6 +150,13 @@ TEST_F(SceneGltf, EmptyPrimitivesTextIndicesAndOtherVersionsAreRefused) {
                    "/meshes/0/primitives is [], expected an array of at least 1 element");
   expectInputError(edited("null.gltf", meshes, R"("meshes": [{"primitives": [null]}, {"primitives": [)"),
                    "/meshes/0/primitives/0 is null, expected an object");
+  // Members glTF requires (twelfth list H12-4-23, -36, -167): a primitive
+  // without attributes, lights given as an object, a texture without index.
+  expectInputError(edited("bare.gltf", meshes, R"("meshes": [{"primitives": [{}]}, {"primitives": [)"),
+                   "/meshes/0/primitives/0/attributes is missing, expected an object");
+  expectInputError(edited("lights.gltf", "\"scene\": 0",
+                          R"("extensions": {"KHR_lights_punctual": {"lights": {"type": "point"}}}, "scene": 0)"),
+                   "/extensions/KHR_lights_punctual/lights is {\"type\":\"point\"}, expected an array");
   const std::string version = R"({"version": "2.0"})";
   expectInputError(edited("v3.gltf", version, R"({"version": "3.0"})"),
                    "glTF 3.0 (/asset/version): lightoctree reads glTF 2.0");
@@ -156,6 +164,13 @@ TEST_F(SceneGltf, EmptyPrimitivesTextIndicesAndOtherVersionsAreRefused) {
                    "needs glTF 9.0 (/asset/minVersion)");
   expectInputError(edited("vtext.gltf", version, R"({"version": "two"})"),
                    "/asset/version is \"two\", expected MAJOR.MINOR");
+  // A long one is quoted cut, as other values (H12-5-23: 10 MB quoted whole).
+  try {
+    loadScene(edited("vlong.gltf", version, "{\"version\": \"" + std::string(100000, '7') + "\"}"));
+    ADD_FAILURE() << "a version of 100,000 digits was taken";
+  } catch (const InputError& e) {
+    EXPECT_LT(std::string(e.what()).size(), 400u) << std::string(e.what()).substr(0, 400);
+  }
   EXPECT_NO_THROW(loadScene(edited("v21.gltf", version, R"({"version": "2.1", "minVersion": "2.0"})")));
   const std::string length = "\"byteLength\": " + std::to_string(g.blob().size()) + ", \"uri\"";
   expectInputError(edited("length.gltf", length,
@@ -168,6 +183,9 @@ TEST_F(SceneGltf, EmptyPrimitivesTextIndicesAndOtherVersionsAreRefused) {
   expectInputError(write("index.gltf", textured),
                    "/materials/0/pbrMetallicRoughness/baseColorTexture/index is \"0\", expected a "
                    "whole number from 0");
+  textured.materials = R"([{"emissiveTexture": {"texCoord": 0}}])";
+  expectInputError(write("noindex.gltf", textured),
+                   "/materials/0/emissiveTexture/index is missing, expected a whole number from 0");
   // UTF-16 (little-endian, with its byte-order mark): named as such.
   std::string utf16 = "\xff\xfe";
   for (char c : g.json()) utf16 += std::string{c, '\0'};
