@@ -64,4 +64,15 @@ void Progress::advance(size_t n) {
   sink_->update(reported_, total_);
 }
 
+void Progress::heartbeat() {
+  if (!sink_ || std::chrono::steady_clock::now().time_since_epoch().count() <
+                    nextReportTime_.load(std::memory_order_relaxed)) {
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (reported_ >= total_) return;
+  nextReportTime_.store(reportDue(), std::memory_order_relaxed);
+  sink_->update(reported_, total_);
+}
+
 }  // namespace lo

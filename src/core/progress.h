@@ -32,6 +32,11 @@ class Progress {
   Progress& operator=(const Progress&) = delete;
 
   void advance(size_t n = 1);
+  /// Reports again what is done so far when a quarter of a second passed
+  /// since the last report, for work that cannot say how far it got (a pass
+  /// of a path tracer under a time budget, the direct light of a lightmap
+  /// page): a front end still hears Ctrl-C there. Never the last report.
+  void heartbeat();
 
  private:
   ProgressSink* sink_;

@@ -127,12 +127,13 @@ LightmapExportResult exportWith(const Scene& scene, const std::function<GpuOctre
   if (params.content == AtlasContent::Full) {
     direct = std::make_unique<DirectIrradiance>(scene);
     bake.atlas.directLight = [&direct, samples = params.directSamples](
-                                 const std::vector<AtlasSurfacePoint>& texels, int page) {
+                                 const std::vector<AtlasSurfacePoint>& texels, int page,
+                                 const std::function<void()>& alive) {
       std::vector<DirectIrradiance::Point> points(texels.size());
       for (size_t i = 0; i < texels.size(); ++i) {
         points[i] = {texels[i].position, texels[i].triangle, texels[i].normal};
       }
-      return direct->atMany(points, samples, /*seed=*/1, uint64_t(page) << 32);
+      return direct->atMany(points, samples, /*seed=*/1, uint64_t(page) << 32, alive);
     };
   }
   // The octree rendered into the atlas by GL (render/atlas_gpu.h) in a

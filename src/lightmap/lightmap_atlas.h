@@ -115,8 +115,12 @@ struct AtlasBakeParams {
   /// function's value at the covered texels' surface points (the lightmap
   /// command passes the path tracer's DirectIrradiance::atMany: ray-traced
   /// soft shadows; this stage itself links no ray tracer). The direction
-  /// keeps the indirect light's. Called once per page, points in texel order.
-  std::function<std::vector<Vec3>(const std::vector<AtlasSurfacePoint>&, int page)> directLight;
+  /// keeps the indirect light's. Called once per page, points in texel order;
+  /// it calls `alive` (on any thread) as it goes, so that the bake's progress
+  /// reports stay a quarter second apart (Progress::heartbeat).
+  std::function<std::vector<Vec3>(const std::vector<AtlasSurfacePoint>&, int page,
+                                  const std::function<void()>& alive)>
+      directLight;
   /// Set: steps 1 and 2 are done by it (not owned; it must outlive the
   /// call), its time counted as LightmapAtlas::evaluateSeconds. Null: on
   /// the CPU, with octreeIrradianceSample.

@@ -8,6 +8,7 @@
 /// (scene/scene.h), or, for Part::Irradiance, irradiance W/m^2.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -138,8 +139,11 @@ class DirectIrradiance {
   };
   /// `at` for many points in parallel (TBB); point i uses index
   /// firstIndex + i: the result does not depend on the thread count.
+  /// `chunkDone` (if set) is called, on any thread, after each chunk of
+  /// points: a caller's Progress::heartbeat.
   std::vector<Vec3> atMany(const std::vector<Point>& points, int samples, uint64_t seed,
-                           uint64_t firstIndex = 0) const;
+                           uint64_t firstIndex = 0,
+                           const std::function<void()>& chunkDone = {}) const;
 
  private:
   struct Impl;

@@ -133,6 +133,14 @@ TEST(Progress, AStageOfLongStepsReportsAQuarterSecondAfterItsLastReport) {
   EXPECT_EQ(sink.last, 1u);
   p.advance();  // neither a new percent nor a quarter second later: no report
   EXPECT_EQ(sink.updates, 1);
+  // Work that cannot say how far it got keeps the reports coming: a
+  // heartbeat a quarter second on repeats what is done (H12-1-2, H12-5-31).
+  p.heartbeat();
+  EXPECT_EQ(sink.updates, 1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  p.heartbeat();
+  EXPECT_EQ(sink.updates, 2);
+  EXPECT_EQ(sink.last, 1u);  // the report, not the two advances it has not told yet
 }
 
 
