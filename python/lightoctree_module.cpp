@@ -424,7 +424,15 @@ bool boolArg(const py::handle& value, const std::string& name) {
 
 std::string textArg(const py::handle& value, const std::string& name) {
   if (!py::isinstance<py::str>(value)) refuse(name, "a string", value);
-  const std::string text = value.cast<std::string>();
+  // Text UTF-8 can hold: a lone surrogate ('\udcff') failed pybind11's cast
+  // with its bare "Unable to cast" (H13-1-63).
+  py::ssize_t size = 0;
+  const char* utf8 = PyUnicode_AsUTF8AndSize(value.ptr(), &size);
+  if (!utf8) {
+    PyErr_Clear();
+    refuse(name, "a string of text (this one holds a lone surrogate)", value);
+  }
+  const std::string text(utf8, size_t(size));
   // A NUL cut the messages that quote it (H12-1-66).
   if (text.find('\0') != std::string::npos) refuse(name, "a string without NUL bytes", value);
   return text;
@@ -437,7 +445,7 @@ std::string vdlsArg(const py::handle& value, const std::string& name, const char
   if (py::isinstance<py::int_>(value) && !isBool(value)) {
     text = py::str(value);
   } else if (py::isinstance<py::str>(value)) {
-    text = value.cast<std::string>();
+    text = textArg(value, name);
   } else {
     text = "?";  // refused below
   }
@@ -702,7 +710,7 @@ RenderSettings renderSettings(const Arg<int>& width, const Arg<int>& height,
     } else if (name == "progress") {
       progressArg(value, name);  // the call's (renderImage), not the picture's
     } else {
-      throw InputError("render: unknown setting '" + name + "'");
+      throw InputError("render: unknown setting '" + printable(name) + "'");
     }
   }
   s.check();
@@ -770,7 +778,9 @@ std::string vec3Text(const py::handle& value, const std::string& name) {
   // Three real numbers each (True or a complex number was read as 1 or its
   // real part, H12-1-35).
   std::vector<double> v;
-  if (py::isinstance<py::sequence>(value) && py::len(value) == 3) {
+  // bytes are a sequence of small numbers: b'abc' was taken as (97, 98, 99).
+  const bool bytes = py::isinstance<py::bytes>(value) || py::isinstance<py::bytearray>(value);
+  if (!bytes && py::isinstance<py::sequence>(value) && py::len(value) == 3) {
     for (const py::handle item : value) {
       const std::optional<double> x = numberOf(item);
       if (!x) break;
@@ -826,7 +836,7 @@ GridPtr bakeScene(const Arg<std::string>& sceneArg, const Arg<int>& depthArg,
   // refused, as for every argument.
   int depth = kAutoDepth;
   if (py::isinstance<py::str>(depthArg.value)) {
-    const std::string text = depthArg.value.cast<std::string>();
+    const std::string text = textArg(depthArg.value, "depth");
     if (text != "auto") {
       throw InputError("depth: must be 'auto' or " + kDepthRange.ToString() + ", got '" +
                        printable(text) + "'");
@@ -1122,7 +1132,7 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
     } else if (name == "physical_sky") {
       physicalSky = py::reinterpret_borrow<py::object>(value);
     } else {
-      throw InputError("lightmap: unknown setting '" + name + "'");
+      throw InputError("lightmap: unknown setting '" + printable(name) + "'");
     }
   }
   const SceneOptions scene = sceneOptions(sky, skyImage, skyMesh, physicalSky);

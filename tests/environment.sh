@@ -197,18 +197,23 @@ for mask in 002 022 077; do
   rm -f "$out/mode.vdb" "$out/mode.json"
 done
 
-# 10. Mesa's own settings under which OSMesa crashed making its context
-#     (H11-2-38, H12-2-1..19): a child makes one first; refused naming them,
-#     exit 1, nothing written.
-for setting in GALLIUM_DRIVER=nonsense GALLIUM_DRIVER=swr MESA_GLSL_VERSION_OVERRIDE=100; do
+# 10. Mesa's own settings under which OSMesa crashed (making its context:
+#     H11-2-38, H12-2-1..19; drawing: H13-2-22) or drew garbage (GALLIUM_NOOP,
+#     H13-2-5): refused naming them, exit 1, nothing written.
+for setting in GALLIUM_DRIVER=nonsense GALLIUM_DRIVER=swr MESA_GLSL_VERSION_OVERRIDE=100 \
+               LP_NATIVE_VECTOR_WIDTH=7 GALLIUM_NOOP=1; do
   err=$(env "$setting" "$cli" render "$scene" "$out/small.vdb" -o "$out/gallium.png" \
         --width 8 --height 8 --quiet 2>&1)
   rc=$?
   if [ "$rc" -ne 1 ] || [ -e "$out/gallium.png" ] ||
-     ! grep -q "Mesa crashed making its OpenGL context under the environment's settings of Mesa ($setting)" <<<"$err"; then
+     ! grep -q "osmesa: the environment changes how Mesa draws ($setting): unset it" <<<"$err"; then
     fail "$setting: exit $rc: $err"
   fi
 done
+# Mesa's cache and log settings are no such change.
+MESA_SHADER_CACHE_DISABLE=true "$cli" render "$scene" "$out/small.vdb" -o "$out/gallium.png" \
+  --width 8 --height 8 --quiet || fail "MESA_SHADER_CACHE_DISABLE=true: the render failed"
+rm -f "$out/gallium.png"
 GALLIUM_DRIVER=llvmpipe "$cli" render "$scene" "$out/small.vdb" -o "$out/gallium.png" \
   --width 8 --height 8 --quiet || fail "GALLIUM_DRIVER=llvmpipe: the render failed"
 

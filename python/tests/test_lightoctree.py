@@ -153,6 +153,12 @@ def test_three_numbers_are_three_real_numbers_and_text_has_no_nul(tmp_path):
             lightoctree.bake(SCENE, depth=3, photons=1000, sky=bad)
     with pytest.raises(lightoctree.InputError, match="camera: must be a string without NUL bytes"):
         lightoctree.reference(SCENE, width=4, height=3, spp=1, camera="a\x00b")
+    # bytes are no triple (b'abc' was taken as 97, 98, 99), a lone surrogate
+    # no text (pybind11's bare "Unable to cast", H13-1-5, -63).
+    with pytest.raises(lightoctree.InputError, match="eye: expected three numbers"):
+        lightoctree.reference(SCENE, width=4, height=3, spp=1, eye=b"abc", target=(0, 0.3, 0))
+    with pytest.raises(lightoctree.InputError, match="camera: must be a string of text"):
+        lightoctree.reference(SCENE, width=4, height=3, spp=1, camera="\udcff")
 
 
 def test_render_draws_the_scene_lit_by_the_grid(grid):

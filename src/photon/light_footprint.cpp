@@ -101,8 +101,27 @@ LightFootprint::LightFootprint(const Scene& scene, const Vec3& direction, const 
     const int u1 = std::min(cellsU - 1, int(std::floor((triHighU - minU_) / cellSize_)));
     const int v0 = std::max(0, int(std::floor((triLowV - minV_) / cellSize_)));
     const int v1 = std::min(cellsV - 1, int(std::floor((triHighV - minV_) / cellSize_)));
+    // Cells covered already need no test, and a triangle over covered cells
+    // none at all: 2,000 floors stacked under 24 suns tested every cell of
+    // every floor (23.6 s; H13-5-26).
+    auto spanCovered = [&](size_t first, size_t last) {  // cells [first, last]
+      for (size_t w = first / 64; w <= last / 64; ++w) {
+        const size_t lo = w == first / 64 ? first % 64 : 0, hi = w == last / 64 ? last % 64 : 63;
+        const uint64_t mask = (hi == 63 ? ~uint64_t(0) : (uint64_t(1) << (hi + 1)) - 1) &
+                              ~((uint64_t(1) << lo) - 1);
+        if ((bits_[w] & mask) != mask) return false;
+      }
+      return true;
+    };
+    bool allCovered = u0 <= u1;
+    for (int v = v0; v <= v1 && allCovered; ++v) {
+      allCovered = spanCovered(size_t(v) * size_t(n) + size_t(u0), size_t(v) * size_t(n) + size_t(u1));
+    }
+    if (allCovered) continue;
     for (int v = v0; v <= v1; ++v) {
       for (int u = u0; u <= u1; ++u) {
+        const size_t cell = size_t(v) * size_t(n) + size_t(u);
+        if ((bits_[cell / 64] >> (cell % 64)) & 1) continue;
         const float cu0 = minU_ + float(u) * cellSize_, cv0 = minV_ + float(v) * cellSize_;
         bool inside = true;
         for (int e = 0; e < 3 && inside; ++e) {

@@ -691,8 +691,9 @@ std::vector<Vec3> DirectIrradiance::atMany(const std::vector<Point>& points, int
                       for (size_t i = r.begin(); i != r.end(); ++i) {
                         const Point& q = points[i];
                         out[i] = at(q.position, q.triangle, q.normal, samples, seed, firstIndex + i);
+                        // After each point: a chunk at 256 samples took 1.5 s (H13-2-59).
+                        if (chunkDone) chunkDone();
                       }
-                      if (chunkDone) chunkDone();
                     });
   return out;
 }

@@ -139,8 +139,8 @@ class DirectIrradiance {
   };
   /// `at` for many points in parallel (TBB); point i uses index
   /// firstIndex + i: the result does not depend on the thread count.
-  /// `chunkDone` (if set) is called, on any thread, after each chunk of
-  /// points: a caller's Progress::heartbeat.
+  /// `chunkDone` (if set) is called, on any thread, after each point: a
+  /// caller's Progress::heartbeat.
   std::vector<Vec3> atMany(const std::vector<Point>& points, int samples, uint64_t seed,
                            uint64_t firstIndex = 0,
                            const std::function<void()>& chunkDone = {}) const;
