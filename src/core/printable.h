@@ -7,18 +7,6 @@
 
 namespace lo {
 
-/// @brief `text` with every control character escaped: the C0 controls and
-/// DEL as `\xNN`, the C1 controls (U+0080..U+009F, as UTF-8) as `\uNNNN`,
-/// every byte that is not part of a well-formed UTF-8 character (a Latin-1
-/// file's 0xE9, a UTF-16 file's 0xFF) as `\xNN`, the rest as it is.
-///
-/// Strings a file supplies (a .vdb's `source_scene_path`, a grid's name, a
-/// library's error text quoting either) reach a terminal through messages and
-/// reports: printed raw, an ESC or CSI in them recolours, moves the cursor,
-/// retitles the window or hides the text after it. Printable input is
-/// returned unchanged, so the escapes (themselves printable) survive a second
-/// pass. With `keepLineBreaks`, '\n' stays: for a whole message of several
-/// lines, whose parts were not escaped one by one.
 /// How many bytes the well-formed UTF-8 character at `text[i]` (a byte from
 /// 0x80) takes, or 0 (RFC 3629: no overlong form, surrogate or code beyond
 /// U+10FFFF).
@@ -45,6 +33,18 @@ inline size_t utf8Length(const std::string& text, size_t i) {
   return n;
 }
 
+/// @brief `text` with every control character escaped: the C0 controls and
+/// DEL as `\xNN`, the C1 controls (U+0080..U+009F, as UTF-8) as `\uNNNN`,
+/// every byte that is not part of a well-formed UTF-8 character (a Latin-1
+/// file's 0xE9, a UTF-16 file's 0xFF) as `\xNN`, the rest as it is.
+///
+/// Strings a file supplies (a .vdb's `source_scene_path`, a grid's name, a
+/// library's error text quoting either) reach a terminal through messages and
+/// reports: printed raw, an ESC or CSI in them recolours, moves the cursor,
+/// retitles the window or hides the text after it. Printable input is
+/// returned unchanged, so the escapes (themselves printable) survive a second
+/// pass. With `keepLineBreaks`, '\n' stays: for a whole message of several
+/// lines, whose parts were not escaped one by one.
 inline std::string printable(const std::string& text, bool keepLineBreaks = false) {
   std::string out;
   out.reserve(text.size());

@@ -4,7 +4,9 @@
 ///
 /// A stage receives a ProgressSink* (may be null) and wraps its work in a
 /// Progress. Progress::advance is thread-safe and cheap: it only calls the sink
-/// when a new percent is reached, under a mutex, so TBB bodies may call it.
+/// when a new percent is reached or a quarter of a second passed since the
+/// last report (a front end hears Ctrl-C at a report), under a mutex, so TBB
+/// bodies may call it.
 
 #include <atomic>
 #include <chrono>

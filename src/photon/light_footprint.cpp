@@ -133,10 +133,7 @@ LightFootprint::LightFootprint(const Scene& scene, const Vec3& direction, const 
           const float qv = s * eu > 0 ? cv0 + cellSize_ : cv0;
           inside = s * (eu * (qv - av) - ev * (qu - au)) >= 0;
         }
-        if (inside) {
-          const size_t i = size_t(v) * size_t(n) + size_t(u);
-          bits_[i / 64] |= uint64_t(1) << (i % 64);
-        }
+        if (inside) bits_[cell / 64] |= uint64_t(1) << (cell % 64);
       }
     }
   }

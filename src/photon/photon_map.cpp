@@ -36,10 +36,6 @@ namespace lo {
 
 namespace photon_internal {
 
-/// Ray origins move off the surface by this fraction of the scene's size
-/// (diagonal plus largest absolute coordinate, so far-from-origin scenes keep
-/// enough float precision).
-constexpr float kRayEpsilonScale = 1e-5f;
 /// Paths per work item: the unit TBB schedules and the unit whose photons stay
 /// in path order inside one buffer.
 constexpr size_t kChunkPaths = 256;

@@ -53,9 +53,6 @@ std::string toString(ReferencePart part) {
 
 namespace reference_internal {
 
-/// Ray origins move off the surface by this fraction of the scene's size, as
-/// in the photon tracer (photon_map.cpp kRayEpsilonScale).
-constexpr float kRayEpsilonScale = 1e-5f;
 constexpr int kTileSize = 16;
 /// Shadow rays to punctual lights per shading point, at most: a scene with
 /// this many lights or fewer has each of them traced (exact, no noise), a

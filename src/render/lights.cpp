@@ -88,7 +88,7 @@ double coveredShare(const glm::vec4 (&c)[3]) {
 /// How many times over the scene's triangles cover the shadow maps' first
 /// `layers` layers, on average (the texels drawn per texel held).
 double coveredTimesOver(const Scene& scene, const RenderSpace& space, const glm::mat4* matrices,
-                     int layers) {
+                        int layers) {
   const size_t triangles = scene.triangleCount();
   if (layers <= 0 || triangles == 0) return 0;
   const size_t pairs = triangles * size_t(layers);
@@ -99,8 +99,8 @@ double coveredTimesOver(const Scene& scene, const RenderSpace& space, const glm:
   constexpr uint64_t kStep = 2654435761u;
   const size_t sampled = (triangles + stride - 1) / stride;
   double covered = 0;
-  for (size_t k = 0; k < sampled; ++k) {
-    const size_t t = stride == 1 ? k : size_t((uint64_t(k) * kStep) % uint64_t(triangles));
+  for (size_t s = 0; s < sampled; ++s) {
+    const size_t t = stride == 1 ? s : size_t((uint64_t(s) * kStep) % uint64_t(triangles));
     glm::vec4 corner[3];
     for (int k = 0; k < 3; ++k) {
       corner[k] = toVec4(space.toRender(scene.positions[scene.indices[3 * t + size_t(k)]]), 1);

@@ -834,10 +834,10 @@ void checkCameras(Scene& scene) {
 /// parts where they are. A triangle wider than kMaxTriangleSpan has an area
 /// that overflows a float (the Cornell box scaled by 1e11 was refused as
 /// "emits non-finite power"). The tracers offset a ray from its surface by
-/// 1e-5 of the scene's size (kRayEpsilonScale x its diagonal and reach):
-/// beside a ground far larger than the rest, that offset reaches past a
-/// tenth of the size of a quarter of the triangles and their light is lost (the Cornell box on a floor
-/// stretched 3e4 times lost its indirect light without a word): warned.
+/// kRayEpsilonScale of the scene's size (its diagonal and reach): beside a
+/// ground far larger than the rest, that offset passes small parts by and
+/// their light is lost (the Cornell box on a floor stretched 3e4 times lost
+/// its indirect light without a word): warned.
 void checkTriangleSizes(Scene& scene) {
   constexpr double kMaxTriangleSpan = 1e9;
   std::vector<float> longest;
@@ -868,7 +868,7 @@ void checkTriangleSizes(Scene& scene) {
   // The offset in the tracers' frame (centred on the scene: its reach is
   // half its size), as photon_map.cpp and path_tracer.cpp take it.
   const double diagonal = double(length(box.extent()));
-  const double offset = 1e-5 * 1.5 * diagonal;
+  const double offset = double(kRayEpsilonScale) * 1.5 * diagonal;
   // Or a small part among many large triangles: 2% of them narrower than
   // the offset itself (the living room of ../shared has 1.25%, slivers).
   const size_t narrower = size_t(
@@ -877,10 +877,12 @@ void checkTriangleSizes(Scene& scene) {
     scene.warnings.push_back(
         scene.sourcePath + ": the scene spans " + formatLimit(diagonal) +
         " scene units (its box's diagonal) while a quarter of its triangles are under " +
-        formatLimit(*quarter) + " across: rays leave a surface about " + formatLimit(offset) +
-        " units off it (1e-5 of the scene's size, for single precision), beyond a tenth of "
-        "those triangles, and light between small parts is lost. Leave out or cut the large "
-        "parts (a ground far wider than the rest)");
+        formatLimit(*quarter) + " across and " + std::to_string(narrower) + " of " +
+        std::to_string(longest.size()) + " under " + formatLimit(offset) +
+        ": rays leave a surface about " + formatLimit(offset) +
+        " units off it (1e-5 of the scene's size, for single precision), and light between "
+        "small parts is lost. Leave out or cut the large parts (a ground far wider than the "
+        "rest)");
   }
 }
 

@@ -447,6 +447,11 @@ double directSunIlluminance(double sunZenith, double turbidity);
 /// (a million km). The tracers work in single precision in a frame centred
 /// on the scene; loadScene refuses vertices beyond this, naming the vertex.
 constexpr float kMaxCoordinate = 1e12f;
+/// Ray origins move off their surface by this fraction of the scene's size
+/// (its diagonal plus its largest absolute coordinate in the tracers' frame),
+/// in the photon tracer and the path tracer alike; the loader warns where
+/// that offset passes small parts by (scene.cpp, checkTriangleSizes).
+constexpr float kRayEpsilonScale = 1e-5f;
 
 /// Largest emitted radiance a material may have, W/(m^2 sr) (emissive
 /// factor x KHR_materials_emissive_strength, OBJ Ke): 1e9, fifty times the
