@@ -78,8 +78,8 @@ int runView(const ViewOptions& opt) {
   std::optional<CameraPath> path;
   if (!opt.cameraPath.empty()) path = readCameraPath(opt.cameraPath);
   if (!opt.view.saveFrames.empty()) makeOutputFolder(opt.view.saveFrames, "--save-frames");
-  const RenderSettings settings =
-      opt.shading.settings(parseRenderMode(opt.mode), opt.width, opt.height);
+  RenderSettings settings = opt.shading.settings(parseRenderMode(opt.mode), opt.width, opt.height);
+  settings.renderer.interactive = true;
 
   Scene scene = loadSceneStage(opt, rows);
   std::optional<LoadedVdl> baked;

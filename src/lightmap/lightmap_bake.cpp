@@ -48,6 +48,32 @@ void checkAtlasMemory(const LightmapUvs& uvs, bool radiance) {
   throw InputError(os.str());
 }
 
+namespace {
+
+/// The charts of `uvs` repacked at coarser texels, each step by the root of
+/// the pages over `maxPages` and a tenth more, until they fit (at most eight
+/// steps: a chart takes a few texels and its gutter at any texel size, so a
+/// scene of very many charts may never fit). Returns the note.
+std::string capPages(LightmapCharts& charts, LightmapUvParams uv, int maxPages, LightmapUvs& uvs) {
+  const float first = uv.texelSize;
+  const int pages = uvs.pageCount;
+  for (int step = 0; step < 8 && uvs.pageCount > maxPages; ++step) {
+    uv.texelSize *= 1.1f * std::sqrt(float(uvs.pageCount) / float(maxPages));
+    uvs = charts.pack(uv);
+  }
+  std::ostringstream os;
+  os << "lightmap atlas: texel " << uvs.texelSize << ", not the default " << first
+     << " (a quarter voxel), which would take " << pages << " pages of " << uv.atlasSize << " x "
+     << uv.atlasSize << "; at most " << maxPages << " are drawn"
+     << (uvs.pageCount > maxPages ? " (" + std::to_string(uvs.pageCount) +
+                                        " still: the scene has too many charts)"
+                                  : std::string())
+     << ". `lightmap --texel-size` bakes finer pages";
+  return os.str();
+}
+
+}  // namespace
+
 float defaultLightmapTexel(const GpuOctree& octree) {
   return 0.25f * octree.cubeSize / float(1 << std::max(octree.depth, 0));
 }
@@ -94,6 +120,9 @@ LightmapBake bakeLightmap(const Scene& scene, const GpuOctree& octree,
       if (uv.atlasSize < params.uv.atlasSize && charts.exceedsOnePage(uv)) continue;
       out.uvs = charts.pack(uv);
       if (out.uvs.pageCount <= 1 || uv.atlasSize >= params.uv.atlasSize) break;
+    }
+    if (params.maxPages > 0 && out.uvs.pageCount > params.maxPages) {
+      out.note = capPages(charts, uv, params.maxPages, out.uvs);
     }
   }
   const auto uvDone = Clock::now();

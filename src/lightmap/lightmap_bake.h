@@ -33,6 +33,12 @@ struct LightmapParams {
   /// chart, up to uv.atlasSize (then more pages).
   LightmapUvParams uv;
   AtlasBakeParams atlas;  ///< the octree lookup's settings, dilation, seams
+  /// With the default texel size (uv.texelSize 0, automatic charts): the
+  /// most pages of uv.atlasSize^2 the atlas may take; beyond, the texel is
+  /// made coarser until it fits (LightmapBake::note says so). 0: no cap.
+  /// `render --lighting atlas` caps (kRenderAtlasPages); `lightmap`, whose
+  /// pages are its output, does not.
+  int maxPages = 0;
   /// Told of the UVs ("lightmap: UVs", one step) and, unless atlas.progress
   /// is set, the atlas (AtlasBakeParams::progress); a sink that throws from
   /// a report stops the bake there. Null: none.
@@ -44,6 +50,9 @@ struct LightmapBake {
   LightmapAtlas atlas;
   bool fromTexcoord1 = false;  ///< the UVs are the scene's TEXCOORD_1
   double uvSeconds = 0, atlasSeconds = 0;
+  /// Why the texel is coarser than the default (LightmapParams::maxPages),
+  /// for a warning; empty when it is not.
+  std::string note;
   std::string ToString() const;  ///< one line: UV source, charts, pages, texels, seconds
 };
 

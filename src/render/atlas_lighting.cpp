@@ -22,6 +22,8 @@ std::optional<LightmapBake> prepareLighting(Renderer& renderer, const Scene& sce
   lightmap.uvSource = params.uvSource;
   lightmap.atlas.shade = params.shade;
   lightmap.atlas.stitchSeams = params.stitchSeams;
+  lightmap.maxPages = params.maxPages;
+  lightmap.progress = params.progress;
   std::unique_ptr<GpuAtlasEvaluator> gpu;
   if (params.atlasOnGpu) {
     gpu = std::make_unique<GpuAtlasEvaluator>();

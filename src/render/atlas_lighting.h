@@ -17,6 +17,13 @@
 
 namespace lo {
 
+/// The most pages (of 1024^2 texels) the atlas of `render --lighting atlas`
+/// and `view` takes at the default texel size: the public scenes of
+/// docs/results take at most 3 (the game level); 200 stacked floors took 13
+/// pages and 35 s, 5,000 grew without bound (H13-5-20). Beyond, a coarser
+/// texel, with a warning (LightmapParams::maxPages).
+constexpr int kRenderAtlasPages = 4;
+
 struct LightingParams {
   /// Octree: the fragment shader walks the octree, nothing to prepare.
   /// Atlas: the atlas is baked and set on the renderer.
@@ -29,6 +36,8 @@ struct LightingParams {
   /// Evaluate the octree per texel in the GL context current on this thread
   /// (GpuAtlasEvaluator: the scene shader's lookup); false: on the CPU.
   bool atlasOnGpu = false;
+  int maxPages = kRenderAtlasPages;  ///< LightmapParams::maxPages
+  ProgressSink* progress = nullptr;  ///< told of the UVs and the atlas; null: none
 };
 
 /// The octree lookup settings of frames drawn with `frame`: interpolation,

@@ -39,6 +39,17 @@ constexpr int kMinFillSize = 128;
 /// At most this many triangle-layer pairs are projected to count the fill;
 /// beyond, an even sample of the triangles, scaled up.
 constexpr size_t kFillSamplePairs = size_t(1) << 22;
+/// The sample of triangles the cascades' fill is counted on at each fit.
+constexpr size_t kCascadeSampleTriangles = size_t(1) << 14;
+/// The sample's triangles spread over the index range by a step coprime
+/// with the count (a prime beyond any count): every second triangle, the
+/// floors' halves all at odd indices, saw none of them (H13-5-3).
+constexpr uint64_t kSampleStep = 2654435761u;
+
+/// Index of the s-th of `sampled` triangles of `triangles` in an even sample.
+size_t sampledTriangle(size_t s, size_t sampled, size_t triangles) {
+  return sampled == triangles ? s : size_t((uint64_t(s) * kSampleStep) % uint64_t(triangles));
+}
 
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
 glm::vec4 toVec4(const Vec3& v, float w) { return {v.x, v.y, v.z, w}; }
@@ -93,14 +104,10 @@ double coveredTimesOver(const Scene& scene, const RenderSpace& space, const glm:
   if (layers <= 0 || triangles == 0) return 0;
   const size_t pairs = triangles * size_t(layers);
   const size_t stride = (pairs + kFillSamplePairs - 1) / kFillSamplePairs;
-  // The sample's triangles spread over the index range by a step coprime
-  // with the count (a prime beyond any count): every second triangle, the
-  // floors' halves all at odd indices, saw none of them (H13-5-3).
-  constexpr uint64_t kStep = 2654435761u;
   const size_t sampled = (triangles + stride - 1) / stride;
   double covered = 0;
   for (size_t s = 0; s < sampled; ++s) {
-    const size_t t = stride == 1 ? s : size_t((uint64_t(s) * kStep) % uint64_t(triangles));
+    const size_t t = sampledTriangle(s, sampled, triangles);
     glm::vec4 corner[3];
     for (int k = 0; k < 3; ++k) {
       corner[k] = toVec4(space.toRender(scene.positions[scene.indices[3 * t + size_t(k)]]), 1);
@@ -238,6 +245,20 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
          double(shadowMapSize) * double(shadowMapSize) * 2.0 * double(layers) > kShadowMapBudget) {
     shadowMapSize = std::max(256, shadowMapSize / 2);
   }
+  // The triangles the fitted cascades' fill is counted on.
+  cascadeFillBudget = params.interactive ? kShadowFillBudget / 16 : kShadowFillBudget;
+  if (!sunLights.empty()) {
+    const size_t triangles = scene.triangleCount();
+    const size_t sampled = std::min(triangles, kCascadeSampleTriangles);
+    for (size_t s = 0; s < sampled; ++s) {
+      const size_t t = sampledTriangle(s, sampled, triangles);
+      for (int k = 0; k < 3; ++k) {
+        cascadeSample.push_back(
+            toVec4(space.toRender(scene.positions[scene.indices[3 * t + size_t(k)]]), 1));
+      }
+    }
+    cascadeSampleScale = sampled > 0 ? double(triangles) / double(sampled) : 0;
+  }
   // And within the fill budget (kShadowFillBudget).
   const double overlap = coveredTimesOver(scene, space, block.uShadowMatrices, layers);
   shadowOverlap = overlap;
@@ -346,9 +367,55 @@ void SceneLights::beginLayer(int layer, bool checkComplete) {
 /// texel size does not change as the camera turns), its centre snapped to
 /// whole texels (no shimmer as the camera moves), its depth range the
 /// whole scene's along the light (casters outside the slice still cast).
-void SceneLights::fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye,
+bool SceneLights::fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye,
                                      const glm::vec3& forward, float yfov, float aspect,
-                                     float znear, float zfar) {
+                                     float znear, float zfar, int fits) {
+  std::vector<glm::mat4> before;
+  for (int light : sunLights) {
+    const int first = int(block.uLights[light].params[2]);
+    before.insert(before.end(), block.uShadowMatrices + first,
+                  block.uShadowMatrices + first + kCascades);
+  }
+  fitCascadeSlices(space, eye, forward, yfov, aspect, znear, zfar, false);
+  cascadesWhole = cascadeFill() * double(fits) > cascadeFillBudget;
+  if (cascadesWhole) fitCascadeSlices(space, eye, forward, yfov, aspect, znear, zfar, true);
+  bool changed = false;
+  glBindBuffer(GL_UNIFORM_BUFFER, ubo.get());
+  for (size_t i = 0; i < sunLights.size(); ++i) {
+    const int first = int(block.uLights[sunLights[i]].params[2]);
+    for (int c = 0; c < kCascades; ++c) {
+      const glm::mat4& m = block.uShadowMatrices[first + c];
+      if (m == before[i * kCascades + size_t(c)]) continue;
+      changed = true;
+      glBufferSubData(
+          GL_UNIFORM_BUFFER,
+          GLintptr(offsetof(LightBlock, uShadowMatrices) + sizeof(glm::mat4) * size_t(first + c)),
+          sizeof(glm::mat4), glm::value_ptr(m));
+    }
+  }
+  glBindBuffer(GL_UNIFORM_BUFFER, 0);
+  return changed;
+}
+
+double SceneLights::cascadeFill() const {
+  double covered = 0;
+  for (size_t t = 0; t + 2 < cascadeSample.size(); t += 3) {
+    for (int light : sunLights) {
+      const int first = int(block.uLights[light].params[2]);
+      for (int c = 0; c < kCascades; ++c) {
+        const glm::mat4& m = block.uShadowMatrices[first + c];
+        const glm::vec4 clip[3] = {m * cascadeSample[t], m * cascadeSample[t + 1],
+                                   m * cascadeSample[t + 2]};
+        covered += coveredShare(clip);
+      }
+    }
+  }
+  return covered * cascadeSampleScale * double(shadowMapSize) * double(shadowMapSize);
+}
+
+void SceneLights::fitCascadeSlices(const RenderSpace& space, const glm::vec3& eye,
+                                   const glm::vec3& forward, float yfov, float aspect, float znear,
+                                   float zfar, bool whole) {
   const Bounds3& bounds = space.bounds;
   const float sceneSize = space.sceneSize;
   const glm::vec3 center = toGlm(bounds.center());
@@ -370,7 +437,6 @@ void SceneLights::fitCascadeMatrices(const RenderSpace& space, const glm::vec3& 
     splits[i] = 0.5f * n * std::pow(f / n, t) + 0.5f * (n + (f - n) * t);
   }
   const float th = std::tan(0.5f * yfov), tw = th * aspect;
-  glBindBuffer(GL_UNIFORM_BUFFER, ubo.get());
   for (int c = 0; c < kCascades; ++c) {
     // The slice's bounding sphere: centred on the view axis where it is
     // equidistant from the near and far corners.
@@ -382,7 +448,7 @@ void SceneLights::fitCascadeMatrices(const RenderSpace& space, const glm::vec3& 
     const float r1 = std::sqrt((d1 - z) * (d1 - z) + d1 * d1 * k2);
     float radius = std::max(r0, r1);
     glm::vec3 sphere = eye + forward * z;
-    if (radius >= sceneRadius) {
+    if (whole || radius >= sceneRadius) {
       radius = sceneRadius;
       sphere = center;
     }
@@ -414,13 +480,8 @@ void SceneLights::fitCascadeMatrices(const RenderSpace& space, const glm::vec3& 
       block.uShadowMatrices[layer] =
           glm::ortho(-radius, radius, -radius, radius, 0.0f, cascadeDepth[c]) *
           glm::lookAt(lightEye, snapped, perpendicular(dir));
-      glBufferSubData(
-          GL_UNIFORM_BUFFER,
-          GLintptr(offsetof(LightBlock, uShadowMatrices) + sizeof(glm::mat4) * size_t(layer)),
-          sizeof(glm::mat4), glm::value_ptr(block.uShadowMatrices[layer]));
     }
   }
-  glBindBuffer(GL_UNIFORM_BUFFER, 0);
 }
 
 }  // namespace lo::render_internal

@@ -39,6 +39,18 @@ struct SceneLights {
   float cascadeTexel[4] = {0, 0, 0, 0};  ///< world size of one texel of each cascade
   float cascadeDepth[4] = {1, 1, 1, 1};  ///< world depth range of each cascade's map
   std::array<float, 12> fittedCamera{};  ///< the camera the cascades were fitted to
+  /// Corners (render space, w = 1) of an even sample of the scene's
+  /// triangles, 3 each, and the triangles each stands for: the fitted
+  /// cascades' fill is counted on them (fitCascadeMatrices). Empty without
+  /// suns.
+  std::vector<glm::vec4> cascadeSample;
+  double cascadeSampleScale = 1;
+  /// The last fit's cascades would have covered more than the fill budget,
+  /// so each cascade covers the whole scene, as before the first frame.
+  bool cascadesWhole = false;
+  /// The fill one fit's drawing may cover: the budget, a sixteenth of it
+  /// for interactive frames (RendererParams::interactive).
+  double cascadeFillBudget = 0;
 
   /// Shadow map layers of the lights in the block (6 per point light or VPL).
   int layerCount() const;
@@ -57,18 +69,22 @@ struct SceneLights {
   }
 
   /// Refits the directional lights' cascades to a camera (render space) and
-  /// re-renders those layers, unless the camera is the last one fitted.
+  /// re-renders those layers, unless the camera is the last one fitted or
+  /// the matrices are unchanged. `fits`: how many cameras the frame fits
+  /// them to (the probe's six faces), whose fill together keeps to the
+  /// budget.
   template <class DrawDepthOnly>
   void fitCascades(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
                    const glm::vec3& up, float yfov, float aspect, float znear, float zfar,
-                   GLuint vao, const DrawDepthOnly& draw) {
+                   int fits, GLuint vao, const DrawDepthOnly& draw) {
     if (sunLights.empty()) return;
     const std::array<float, 12> key = {eye.x, eye.y, eye.z, forward.x, forward.y, forward.z,
                                        up.x,  up.y,  up.z,  yfov,      aspect,    znear};
     if (key == fittedCamera) return;
     fittedCamera = key;
-    fitCascadeMatrices(space, eye, forward, yfov, aspect, znear, zfar);
-    renderCascades(vao, draw);
+    if (fitCascadeMatrices(space, eye, forward, yfov, aspect, znear, zfar, fits)) {
+      renderCascades(vao, draw);
+    }
   }
 
   /// Draws every shadow map again (a caster moved): the lights' now, the
@@ -96,8 +112,20 @@ struct SceneLights {
     glUniform3fv(glGetUniformLocation(shadowProgram.get(), "uIgnoreUpper"), 1,
                  glm::value_ptr(upper));
   }
-  void fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
-                          float yfov, float aspect, float znear, float zfar);
+  /// Fits the cascades to the camera and uploads their matrices; returns
+  /// whether any changed. Cascades whose fitted maps the scene would cover,
+  /// times `fits`, past the fill budget cover the whole scene instead, whose
+  /// fill build() budgeted and which no camera changes (stacked floors under
+  /// a sun: seven drawings for a frame and its probe, 13 s, H13-5-22).
+  bool fitCascadeMatrices(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
+                          float yfov, float aspect, float znear, float zfar, int fits);
+  /// The slices and their matrices in the block (not uploaded); `whole`:
+  /// every slice covers the whole scene.
+  void fitCascadeSlices(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
+                        float yfov, float aspect, float znear, float zfar, bool whole);
+  /// Texels one drawing of the cascades at their matrices covers, counted on
+  /// cascadeSample.
+  double cascadeFill() const;
 
   template <class DrawDepthOnly>
   void renderShadowMaps(GLuint vao, const DrawDepthOnly& draw) {

@@ -87,13 +87,13 @@ void Renderer::Impl::captureProbe(const RenderParams& rp) {
   glBindFramebuffer(GL_FRAMEBUFFER, probe.fbo.get());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
                             probe.depth.get());
-  const Vec3 forward[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  const Vec3 up[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+  const Vec3 forward[kProbeFaces] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const Vec3 up[kProbeFaces] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
   RenderParams face = rp;
   face.mode = RenderMode::Full;
   face.reflections = false;
   probe.capturing = true;
-  for (int f = 0; f < 6; ++f) {
+  for (int f = 0; f < kProbeFaces; ++f) {
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
                            GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f), probe.spare.get(), 0);
     GLenum drawBuffer = GL_COLOR_ATTACHMENT0;

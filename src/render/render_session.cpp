@@ -165,10 +165,12 @@ RenderSession::RenderSession(Scene& scene, VdlGrid grid, const GlContext& contex
   }
   setup.advance();
   StageTimer lightingTimer(s.stages, "prepare lighting");
-  const std::optional<LightmapBake> atlas =
-      prepareLighting(*s.renderer, scene, s.octree, settings.lightingParams());
+  LightingParams lighting = settings.lightingParams();
+  lighting.progress = options.progress;
+  const std::optional<LightmapBake> atlas = prepareLighting(*s.renderer, scene, s.octree, lighting);
   if (atlas) {
     s.atlasSummary = atlas->ToString() + "; " + formatBytes(s.renderer->atlasBytes()) + " on the GPU";
+    if (!atlas->note.empty()) s.warnings.push_back(atlas->note);
   }
   lightingTimer.finish(atlas ? "lightmap atlas" : "");
   setup.advance();

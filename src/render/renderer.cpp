@@ -151,6 +151,7 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
 bool Renderer::hasReflectionProbe() const { return impl_->probe.wanted; }
 
 const std::string& Renderer::shadowMapNote() const { return impl_->lights.shadowMapNote; }
+bool Renderer::cascadesCoverWholeScene() const { return impl_->lights.cascadesWhole; }
 
 const std::vector<StageReport>& Renderer::startupStages() const { return impl_->startup; }
 

@@ -106,6 +106,12 @@ struct RendererParams {
   /// Texels per side of each face of the reflection probe's cube map
   /// (RenderParams::reflections); captured on the first frame that needs it.
   int probeSize = 128;
+  /// Frames follow a moving camera (`view`): the sun's cascades, drawn again
+  /// whenever they are refitted to it, are fitted only while one drawing of
+  /// them covers at most a sixteenth of the shadow maps' fill budget (2^26
+  /// texels, lights.cpp); beyond, they cover the whole scene, which no
+  /// camera move redraws. Off: the whole budget.
+  bool interactive = false;
 };
 
 
@@ -187,6 +193,10 @@ class Renderer {
   /// beyond the memory budget (the scene covers them many times over:
   /// a budget of texels drawn), or "".
   const std::string& shadowMapNote() const;
+  /// The last frame's sun cascades each cover the whole scene: fitted to its
+  /// camera they would have covered more than the fill budget allows
+  /// (RendererParams::interactive).
+  bool cascadesCoverWholeScene() const;
   int emitterLightCount() const;  ///< virtual point lights on emissive triangles
   int areaLightCount() const;     ///< emissive triangles drawn as area lights (one-sided)
   int areaLightGroups() const;    ///< their groups, each shadowed from one cube map

@@ -151,6 +151,8 @@ struct SceneGeometry {
 /// from the scene's centre (render space origin), parallax-corrected to the
 /// scene's bounds in the shader. Captured on the first frame that wants it,
 /// again after setOctree (reflection_probe.cpp).
+constexpr int kProbeFaces = 6;  ///< the cube map's faces, one frame drawn each
+
 struct ReflectionProbe {
   bool wanted = false;
   bool valid = false;

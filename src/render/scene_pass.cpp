@@ -465,7 +465,7 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
   if (withDirect) {
     lights.fitCascades(
         space, eye, glm::normalize(toGlm(camera.forward)), toGlm(camera.up), camera.yfov, aspect,
-        znear, zfar, geometry.vao.get(),
+        znear, zfar, probe.capturing ? kProbeFaces : 1, geometry.vao.get(),
         [this](GLuint program, bool shadows) { geometry.drawDepthOnly(program, shadows); });
   }
 

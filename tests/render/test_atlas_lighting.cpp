@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 #include "lightmap/lightmap_bake.h"
 #include "octree/gpu_octree.h"
 #include "render/atlas_lighting.h"
@@ -57,6 +60,36 @@ TEST(AtlasLighting, AtlasIsBakedWithTheGivenSettingsAndSet) {
   for (int i = 0; i < expected.atlas.pageCount; ++i) {
     EXPECT_EQ(atlas->atlas.irradiance[size_t(i)].rgb, expected.atlas.irradiance[size_t(i)].rgb);
   }
+}
+
+TEST(AtlasLighting, PagesBeyondTheCapTakeACoarserTexelAndSaySo) {
+  // The Cornell box on pages of 128^2 at the default quarter-voxel texel
+  // takes several; capped at 2 pages, the texel grows to fit and no further
+  // than the area ratio calls for (H13-5-20: stacked floors grew without
+  // bound in `render --lighting atlas`).
+  const Scene scene = loadScene(test::dataDir() + "/cornell-box.gltf");
+  const GpuOctree octree = test::goldenCornellOctree();
+  LightmapParams lp;
+  lp.uv.atlasSize = 128;
+  const LightmapBake free = bakeLightmap(scene, octree, lp);
+  ASSERT_GT(free.uvs.pageCount, 3);
+  EXPECT_TRUE(free.note.empty());
+  EXPECT_FLOAT_EQ(free.uvs.texelSize, defaultLightmapTexel(octree));
+  lp.maxPages = 2;
+  const LightmapBake capped = bakeLightmap(scene, octree, lp);
+  EXPECT_LE(capped.uvs.pageCount, 2);
+  EXPECT_EQ(capped.atlas.pageCount, capped.uvs.pageCount);
+  EXPECT_GT(capped.uvs.texelSize, free.uvs.texelSize);
+  const float areaRatio = std::sqrt(float(free.uvs.pageCount) / 2.0f);
+  EXPECT_LT(capped.uvs.texelSize, 1.5f * areaRatio * free.uvs.texelSize)
+      << "no coarser than the pages' area calls for";
+  EXPECT_NE(capped.note.find(std::to_string(free.uvs.pageCount) + " pages"), std::string::npos)
+      << capped.note;
+  // A cap the default already meets changes nothing.
+  lp.maxPages = free.uvs.pageCount;
+  const LightmapBake met = bakeLightmap(scene, octree, lp);
+  EXPECT_TRUE(met.note.empty());
+  EXPECT_EQ(met.uvs.texelSize, free.uvs.texelSize);
 }
 
 }  // namespace

@@ -168,5 +168,53 @@ TEST_F(RenderImage, ShadowMapsOfFloorsStackedManyTimesOverKeepToTheFillBudget) {
   EXPECT_NEAR(centre.y, fullCentre.y, 0.03f * fullCentre.y);
 }
 
+// Floors stacked under a sun: every refit of its cascades draws them again,
+// each floor over the whole of a cascade fitted to a camera that looks at
+// the stack (H13-5-22: 9 s a frame in `view`). Interactive frames fit them
+// only within a sixteenth of the fill budget; beyond, each cascade covers the
+// whole scene, which a moving camera does not redraw. The top floor is lit
+// as with fitted cascades.
+TEST_F(RenderImage, SunCascadesOverStackedFloorsCoverTheWholeSceneInInteractiveFrames) {
+  auto stacked = [](int floors) {
+    Scene scene;
+    Material m;
+    m.baseColor = {0.8f, 0.8f, 0.8f};
+    scene.materials.push_back(m);
+    for (int i = 0; i < floors; ++i) {
+      test::addQuad(scene, {-1, -1e-4f * float(i), -1}, {0, 0, 2}, {2, 0, 0}, {0, 1, 0}, 0);
+    }
+    scene.lights.push_back(test::sun({0.2f, -1, 0.1f}, 3.0f));
+    return scene;
+  };
+  RenderParams p;
+  p.width = p.height = 32;
+  p.mode = RenderMode::Direct;
+  p.specular = false;
+  p.supersample = 1;
+  const PinholeCamera view = PinholeCamera::lookAt({0, 0.6f, 0.6f}, {0, 0, 0}, 0.8f);
+  const PinholeCamera moved = PinholeCamera::lookAt({0.1f, 0.6f, 0.6f}, {0, 0, 0}, 0.8f);
+  // Maps of 512^2: 300 floors cover a fitted cascade about 300 times over,
+  // 315 M texels a drawing of four, within the budget but not its sixteenth.
+  RendererParams offlineParams;
+  offlineParams.shadowMapSize = 512;
+  RendererParams interactive = offlineParams;
+  interactive.interactive = true;
+  const Scene few = stacked(4);
+  Renderer light(few, test::constantOctree(), interactive);
+  light.render(view, p);
+  EXPECT_FALSE(light.cascadesCoverWholeScene()) << "four floors: fitted";
+  const Scene many = stacked(300);
+  Renderer offline(many, test::constantOctree(), offlineParams);
+  const Vec3 fitted = offline.render(view, p).at(16 * 32 + 16);
+  EXPECT_FALSE(offline.cascadesCoverWholeScene()) << "one drawing within the whole budget";
+  Renderer live(many, test::constantOctree(), interactive);
+  const Vec3 whole = live.render(view, p).at(16 * 32 + 16);
+  EXPECT_TRUE(live.cascadesCoverWholeScene());
+  live.render(moved, p);
+  EXPECT_TRUE(live.cascadesCoverWholeScene());
+  ASSERT_GT(fitted.y, 0.0f);
+  EXPECT_NEAR(whole.y, fitted.y, 0.03f * fitted.y);
+}
+
 }  // namespace
 }  // namespace lo
