@@ -217,4 +217,41 @@ rm -f "$out/gallium.png"
 GALLIUM_DRIVER=llvmpipe "$cli" render "$scene" "$out/small.vdb" -o "$out/gallium.png" \
   --width 8 --height 8 --quiet || fail "GALLIUM_DRIVER=llvmpipe: the render failed"
 
+# 10. Reading a grid under address-space limits from where the program
+#     just starts to where the read fits: each one reads it (exit 0), or says
+#     it ran out of memory (exit 1, or 3 for inspect's failed check), and
+#     `convert` writes nothing. OpenVDB freeing a tree while a failed read
+#     unwound ended the process ("terminate called", 134, H12-2-68), and a
+#     healthy grid was called damaged. Not under the sanitizers (see 2).
+if ldd "$cli" 2>/dev/null | grep -q libasan; then
+  echo "ulimit -v reads: skipped (AddressSanitizer build)"
+else
+  "$cli" bake "$scene" -o "$out/d6.vdb" --depth 6 --photons 20000 --quiet ||
+    fail "ulimit -v reads: the depth-6 bake failed"
+  start=100000
+  while [ "$start" -lt 1000000 ] &&
+        ! (bash -c "ulimit -S -v $start; exec '$cli' --version" >/dev/null 2>&1) 2>/dev/null; do
+    start=$((start + 10000))
+  done
+  read_ok=0
+  for kb in $(seq "$start" 20000 $((start + 240000))); do
+    for cmd in inspect convert; do
+      rm -f "$out/d6-half.vdb"
+      args=("$out/d6.vdb")
+      [ "$cmd" = convert ] && args+=(-o "$out/d6-half.vdb" --half --quiet)
+      err=$(bash -c "ulimit -S -v $kb; exec \"\$@\"" - "$cli" "$cmd" "${args[@]}" 2>&1)
+      rc=$?
+      if [ "$rc" -eq 0 ]; then
+        read_ok=1
+      elif [ "$rc" -ge 128 ] || { [ "$rc" -ne 1 ] && [ "$rc" -ne 3 ]; } ||
+           ! grep -q "out of memory\|ran out of memory" <<<"$err" || grep -q "damaged" <<<"$err"; then
+        fail "ulimit -v $kb, $cmd: exit $rc: $(tail -c 400 <<<"$err")"
+      elif [ "$cmd" = convert ] && [ -e "$out/d6-half.vdb" ]; then
+        fail "ulimit -v $kb, convert: exit $rc, but the output was written"
+      fi
+    done
+  done
+  [ "$read_ok" -eq 1 ] || fail "ulimit -v reads: no limit up to $((start + 240000)) KiB read the grid"
+fi
+
 [ "$failed" -eq 0 ] && echo "environment: every case refused or reported"

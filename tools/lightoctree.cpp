@@ -14,6 +14,7 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <system_error>
 
 #include "cli_checks.h"
 #include "commands.h"
@@ -46,6 +47,61 @@ std::string memoryAdvice() {
   }
   if (commandName == "sweep") return "sweep smaller depths and photon counts";
   return "give the process more memory";
+}
+
+/// The allocation failure main's catch and terminateSaysMemory report.
+void sayOutOfMemory() {
+  std::string advice;
+  try {
+    advice = memoryAdvice();
+  } catch (...) {
+    advice = "give the process more memory";
+  }
+  std::fprintf(stderr,
+               "%s: error: out of memory (an allocation failed): the machine or the "
+               "process's limits (ulimit -v, the container's, LIGHTOCTREE_MEMORY_LIMIT) "
+               "hold less than this run needs: %s\n",
+               program().c_str(), advice.c_str());
+}
+
+/// A thread that could not start, for want of address space: TBB says
+/// "pthread_create has failed" in a std::runtime_error.
+bool isThreadStartFailure(const std::exception& e) {
+  if (const auto* error = dynamic_cast<const std::system_error*>(&e)) {
+    return error->code() == std::errc::resource_unavailable_try_again;
+  }
+  return std::strstr(e.what(), "pthread_create") != nullptr;
+}
+
+std::terminate_handler defaultTerminate = nullptr;
+
+/// The last resort past main's catch: an allocation or a thread start that
+/// failed where no catch can take it ends here, not in "terminate called
+/// after throwing": OpenVDB frees a tree with TBB (allocating, starting
+/// threads) while a read that ran out of memory unwinds, and a throw from
+/// that destructor ends the process (H12-2-68, `ulimit -v`). Temporary files
+/// are removed, the shortage said, exit status 1. Anything else goes to the
+/// runtime's own handler.
+[[noreturn]] void terminateSaysMemory() {
+  bool memory = false;
+  if (const std::exception_ptr e = std::current_exception()) {
+    try {
+      std::rethrow_exception(e);
+    } catch (const std::bad_alloc&) {
+      memory = true;
+    } catch (const std::exception& error) {
+      memory = isThreadStartFailure(error);
+    } catch (...) {
+    }
+  }
+  if (memory) {
+    lo::removeLiveTemporaries();
+    sayOutOfMemory();
+    std::fflush(stderr);
+    ::_exit(1);
+  }
+  if (defaultTerminate) defaultTerminate();
+  std::abort();
 }
 
 /// A closed standard stream (a script's `>&-`) would be taken by the next file
@@ -192,6 +248,7 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   holdClosedStandardStreams();
+  defaultTerminate = std::set_terminate(terminateSaysMemory);
   // Past the file-size limit (ulimit -f) a write fails with EFBIG, reported
   // as any failed write with its temporary file removed, instead of the
   // signal ending the process and leaving the temporary behind.
@@ -202,14 +259,15 @@ int main(int argc, char** argv) {
     // The checks before the work compare estimates with the memory available
     // (the machine's, the cgroup's, ulimit -v, LIGHTOCTREE_MEMORY_LIMIT);
     // what they missed ends here, said plainly.
-    std::fprintf(stderr,
-                 "%s: error: out of memory (an allocation failed): the machine or the "
-                 "process's limits (ulimit -v, the container's, LIGHTOCTREE_MEMORY_LIMIT) "
-                 "hold less than this run needs: %s\n",
-                 program().c_str(), memoryAdvice().c_str());
+    sayOutOfMemory();
     finishOutput(1);
     return 1;
   } catch (const std::exception& e) {
+    if (isThreadStartFailure(e)) {
+      sayOutOfMemory();
+      finishOutput(1);
+      return 1;
+    }
     // A message may quote what a file holds (a grid's name in OpenVDB's
     // error, a scene's name): its control characters escaped, its lines kept.
     std::fprintf(stderr, "lightoctree: error: %s\n", lo::printable(e.what(), true).c_str());

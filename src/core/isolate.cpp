@@ -156,7 +156,9 @@ IsolatedRun runIsolated(const std::function<int(std::string& message)>& work,
     } catch (const std::bad_alloc&) {
       code = 124;
     } catch (const std::exception& e) {
-      code = 125;
+      // OpenVDB's reader wraps what it caught in its own IoError, naming
+      // it: "std::bad_alloc" is an allocation that failed all the same.
+      code = std::strstr(e.what(), "bad_alloc") != nullptr ? 124 : 125;
       try {
         message = e.what();
       } catch (...) {

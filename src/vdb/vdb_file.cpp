@@ -199,6 +199,13 @@ OpenedFile openFile(const std::string& path) {
       file.close();
     }
   } catch (const std::exception& e) {
+    // The child's grids are whole (OpenVDB's writer made them): failing to
+    // take them is this process's want of memory (ulimit -v), not damage.
+    if (trial.outcome == IsolatedRun::Outcome::Finished &&
+        std::strstr(e.what(), "bad_alloc") != nullptr) {
+      throw InputError(path + ": not read: this process ran out of memory taking its grids: " +
+                       memoryShortfall());
+    }
     throw unreadable(path, e.what());
   }
   if (!f.grids || !f.meta) throw InputError(path + ": cannot read as an OpenVDB file");
