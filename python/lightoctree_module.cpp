@@ -12,6 +12,8 @@
 #include <pybind11/stl.h>
 
 #include <cctype>
+#include <cxxabi.h>
+#include <unistd.h>
 #include <clocale>
 #include <locale.h>
 #include <cstdio>
@@ -150,6 +152,43 @@ struct Stopped {};
 /// exception the callback raises, stops the work at that report, and the
 /// call raises it. Never thrown from end() or update(total, total), which
 /// Progress's destructor sends, also while the stack unwinds.
+/// The interpreter is ending (Py_Finalize has begun): a thread that takes
+/// its lock now is ended there by a forced unwind (pthread_exit), which the
+/// work's frames that catch everything (TBB hands exceptions between its
+/// threads) swallowed: "FATAL: exception not rethrown", an abort, a crash
+/// or a hang at exit when a daemon thread was inside a call (H12-1-71).
+/// Set by the module's atexit hook (stopCallsAtExit): the main thread has
+/// ended and the interpreter is about to.
+std::atomic<bool> interpreterExiting{false};
+
+bool interpreterEnding() {
+#if PY_VERSION_HEX >= 0x030D0000
+  return interpreterExiting.load() || Py_IsFinalizing() != 0;
+#else
+  return interpreterExiting.load() || _Py_IsFinalizing() != 0;
+#endif
+}
+
+/// Calls whose work runs now without the interpreter's lock (withProgress).
+std::atomic<int> callsAtWork{0};
+
+/// The atexit hook: calls still at work (a daemon thread's) stop at their
+/// next report, and the interpreter waits for them (a few seconds at most)
+/// before it ends: work that ran on while the process's static objects were
+/// destroyed ended it ("pure virtual method called", H12-1-71).
+void stopCallsAtExit() {
+  interpreterExiting = true;
+  py::gil_scoped_release unlocked;  // a report waiting for the lock gets it, and stops
+  for (int i = 0; i < 1000 && callsAtWork.load() > 0; ++i) ::usleep(10000);
+}
+
+/// Where a call's thread goes when the interpreter ends under it: it waits
+/// for the process to end, as Python 3.14 makes such threads wait, never
+/// taking the lock (nor unwinding through frames that would need it).
+[[noreturn]] void waitForTheEnd() {
+  for (;;) ::pause();
+}
+
 class CallbackProgress : public ProgressSink {
  public:
   explicit CallbackProgress(py::object callback) : callback_(std::move(callback)) {}
@@ -182,6 +221,8 @@ class CallbackProgress : public ProgressSink {
 
  private:
   void report(size_t done, size_t total, bool mayStop, const std::string* task = nullptr) {
+    // The interpreter is ending: the work stops without its lock.
+    if (!stopped_ && interpreterEnding()) stopped_ = true;
     if (!stopped_) {
       py::gil_scoped_acquire lock;
       if (task) task_ = *task;  // read by other threads' reports, under the same lock
@@ -216,13 +257,26 @@ auto withProgress(const py::object& progress, const char* call, Work work) {
   const size_t limit = memoryLimitSetting();
   CallbackProgress sink(progress);
   std::optional<decltype(work(&sink))> result;
-  try {
+  std::exception_ptr failure;
+  {
     // Declared after `sink`, so its thread ends before the sink goes.
     const MemoryWatch watch(limit, [&sink](size_t rss) { sink.stopForMemory(rss); });
     py::gil_scoped_release unlocked;
-    result.emplace(work(&sink));
-  } catch (const Stopped&) {
+    ++callsAtWork;
+    try {
+      result.emplace(work(&sink));
+    } catch (const Stopped&) {
+    } catch (abi::__forced_unwind&) {
+      --callsAtWork;
+      throw;  // a thread ended by the system unwinds on
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    --callsAtWork;
+    // Taking the lock back now would end this thread by a forced unwind.
+    if (interpreterEnding()) waitForTheEnd();
   }
+  if (failure) std::rethrow_exception(failure);
   sink.raiseIfStopped(call, limit, result.has_value());
   if (!result) throw InputError("stopped");  // not reached: a stop has its error
   return std::move(*result);
@@ -352,14 +406,20 @@ bool isBool(const py::handle& value) {
   throw InputError(name + ": must be " + what + ", got " + shortRepr(value));
 }
 
+/// numbers.Real, looked up when the module is imported. Not a function's
+/// static: its first use, an import, may let another thread take the lock,
+/// which then waited on the static's guard holding the lock: two threads'
+/// first calls hung for ever (H12-1-71's runs). A handle, never released:
+/// nothing to free while the interpreter ends.
+py::handle realNumberType;
+
 /// The number `value` holds (int, float, a NumPy number; not a bool, not a
 /// string), else nullopt.
 std::optional<double> numberOf(const py::handle& value) {
   // A real number: not a complex one (NumPy's gave its real part with only a
   // warning, H12-1-59), nor an object that merely converts to float.
-  static const py::object real = py::module_::import("numbers").attr("Real");
   if (isBool(value) || !(PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()) ||
-                         py::isinstance(value, real))) {
+                         py::isinstance(value, realNumberType))) {
     return std::nullopt;
   }
   const double v = PyFloat_AsDouble(value.ptr());  // int beyond a double: OverflowError
@@ -1204,6 +1264,12 @@ PYBIND11_MODULE(lightoctree, m) {
       "Light Octree: photon-mapped global illumination baked into sparse OpenVDB grids of "
       "virtual directional lights (docs/python.md).";
   m.attr("__version__") = LO_VERSION;
+  // What the calls look up once, now, while one thread imports the module
+  // (see realNumberType): numbers.Real, and NumPy's C API, which pybind11
+  // imports on its first use, under a static's guard.
+  realNumberType = py::object(py::module_::import("numbers").attr("Real")).release();
+  py::detail::npy_api::get();
+  py::module_::import("atexit").attr("register")(py::cpp_function(stopCallsAtExit));
   static py::handle inputError =
       py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
   static py::handle ioError = py::register_exception<IoError>(m, "IoError", PyExc_OSError);

@@ -1014,6 +1014,38 @@ print("after:", lightoctree.bake(sys.argv[1], depth=3, photons=5000).size > 0)
     assert "after: True" in run.stdout, run.stdout
 
 
+def test_the_interpreter_ends_cleanly_with_daemon_threads_inside_calls():
+    """Daemon threads inside long calls when the main thread ends: a thread
+    that took the interpreter's lock during its shutdown was ended by a forced
+    unwind, which the work's frames swallowed; the process aborted ("FATAL:
+    exception not rethrown"), crashed or hung at exit in 6 of 8 runs
+    (H12-1-71). The calls now stop and their threads wait for the end: every
+    run exits 0, at once."""
+    import subprocess
+    import sys
+    code = r"""
+import sys, threading, time, lightoctree
+def work(i):
+    try:
+        if i % 2:
+            lightoctree.bake(sys.argv[1], depth=6, photons=2000000)
+        else:
+            lightoctree.reference(sys.argv[1], width=64, height=48, spp=100000)
+    except BaseException:
+        pass
+threads = [threading.Thread(target=work, args=(i,), daemon=True) for i in range(3)]
+for t in threads:
+    t.start()
+time.sleep(float(sys.argv[2]))
+print("main ends")
+"""
+    for pause in ("0.05", "0.4", "1.0", "0.7"):
+        run = subprocess.run([sys.executable, "-c", code, SCENE, pause], capture_output=True,
+                             text=True, timeout=120)
+        assert run.returncode == 0, (pause, run.returncode, run.stderr[-2000:])
+        assert run.stdout == "main ends\n", run.stdout
+
+
 def test_grids_and_arrays_of_another_type_are_refused_by_name(grid, tmp_path):
     """A grid argument that is not a Grid, or points that are not numbers, got
     pybind11's "incompatible function arguments ... Invoked with: None, ...",
