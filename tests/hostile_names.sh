@@ -63,4 +63,24 @@ printf '%s' "$msg" | grep -qF 'File does not exist: a\x0ab\x1b[31m.gltf' ||
 printf '%s' "$msg" | grep -q "$(printf '\033')" && fail "a raw escape reached the terminal"
 [ "$(printf '%s\n' "$msg" | wc -l)" -eq 2 ] || fail "the name's newline reached the terminal: '$msg'"
 
+# 9. Inputs and output folders that are not what they are named as: each
+#    refused with its own reason (CLI11 said "File does not exist" of a loop
+#    of links, and an output folder that is a file "does not exist", H14-2-1).
+echo x > afile
+ln -s loop loop
+ln -s /nonexistent/target dangling
+mkdir -p afolder
+for probe in "render loop|'loop' is a loop of symbolic links" \
+             "render dangling|'dangling' is a symbolic link to nothing" \
+             "render afolder|'afolder' is a folder, not a file"; do
+  input=${probe%%|*} expected=${probe#*|}
+  msg=$("$cli" ${input% *} "${input#* }" -o out.exr 2>&1)
+  rc=$?
+  [ "$rc" -eq 2 ] && grep -qF "$expected" <<<"$msg" || fail "${input}: exit $rc: $msg"
+done
+msg=$("$cli" reference "$scene" -o afile/o.exr --width 8 --height 8 --spp 1 2>&1)
+rc=$?
+[ "$rc" -eq 1 ] && grep -qF "folder 'afile' is a file, not a folder" <<<"$msg" ||
+  fail "an output folder that is a file: exit $rc: $msg"
+
 [ "$failures" -eq 0 ] && echo "hostile names: all checks passed" || exit 1

@@ -64,7 +64,7 @@ void addBakeOptions(CLI::App* cmd, BakeOptions& opt) {
       "(VDLs), written as a .vdb file.");
   cmd->add_option("scene", opt.scene, "Scene to bake: .gltf, .glb or .obj")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("-o,--output", opt.output, "Output .vdb file (written atomically)")->required();
   addSceneOptions(cmd, opt.sceneOptions);
   cmd->add_option("--depth", opt.depth,

@@ -1,5 +1,10 @@
 #include "cli_checks.h"
 
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -9,6 +14,25 @@
 #include "distributed/tiled_bake.h"
 
 namespace lo::tool {
+
+CLI::Validator existingFile() {
+  return CLI::Validator(
+      [](std::string& path) -> std::string {
+        struct stat link {}, target {};
+        if (::lstat(path.c_str(), &link) != 0) {
+          return errno == ENOENT ? "File does not exist: " + path
+                                 : "'" + path + "' cannot be reached: " + std::strerror(errno);
+        }
+        if (::stat(path.c_str(), &target) != 0) {
+          if (errno == ELOOP) return "'" + path + "' is a loop of symbolic links";
+          if (errno == ENOENT) return "'" + path + "' is a symbolic link to nothing";
+          return "'" + path + "' cannot be reached: " + std::strerror(errno);
+        }
+        if (S_ISDIR(target.st_mode)) return "'" + path + "' is a folder, not a file";
+        return "";
+      },
+      "FILE");
+}
 
 CLI::Validator vdlCountValidator() {
   return CLI::Validator([](std::string& s) { return vdlCountError(s); },

@@ -10,6 +10,11 @@
 
 namespace lo::tool {
 
+/// An input file that exists and is a file, or why not: CLI::ExistingFile
+/// said "File does not exist" of a loop of symbolic links, one to nothing
+/// and one that cannot be reached (H14-2-1).
+CLI::Validator existingFile();
+
 /// `--vdls`: 1..kMaxVdls or "auto" (lo::vdlCountError).
 CLI::Validator vdlCountValidator();
 

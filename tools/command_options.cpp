@@ -9,7 +9,7 @@ namespace lo::tool {
 
 CLI::Option* addLightsArgument(CLI::App* cmd, std::string& lights, const std::string& note) {
   return cmd->add_option("lights", lights, "Baked VDL grid (.vdb from `lightoctree bake`)" + note)
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
 }
 
 void addSizeOptions(CLI::App* cmd, int& width, int& height, const std::string& noun,

@@ -152,18 +152,18 @@ void addCompareOptions(CLI::App* cmd, CompareOptions& opt) {
       "a reference (per channel and luminance), a false-colour difference image, JSON.");
   cmd->add_option("test", opt.test, "Test image (.exr, or .png decoded to linear)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("reference", opt.reference, "Reference image, e.g. from `lightoctree reference`")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("--mask", opt.mask,
                   "Image of the same size; pixels that are 0 in every channel are left out")
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("--reference-error", opt.referenceError,
                   "The reference's per-pixel standard error (`reference --std-error`): prints "
                   "its noise over the compared pixels (binned with --bin), the floor under the "
                   "error, and warns when the error measured is not above it")
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_flag("--ignore-background", opt.ignoreBackground,
                 "Leave out pixels where the reference is exactly black (by value: `reference "
                 "--geometry-mask` with --mask leaves out the background by what it shows)");

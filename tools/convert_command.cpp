@@ -49,7 +49,7 @@ void addConvertOptions(CLI::App* cmd, ConvertOptions& opt) {
       "from a photon map), VDL count or storage.");
   cmd->add_option("input", opt.input, "Baked VDL file (.vdb)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("-o,--output", opt.output, "Output .vdb file (written atomically)")->required();
   cmd->add_option("--depth", opt.depth, "Output depth (default: the input's)")
       ->check(depthValidator());
@@ -65,10 +65,10 @@ void addConvertOptions(CLI::App* cmd, ConvertOptions& opt) {
       ->delimiter(',');
   cmd->add_option("--scene", opt.scene,
                   "The baked scene: needed for a finer --depth and for --photon-map")
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("--photon-map", opt.photonMap,
                   "Photon file written by 'bake --photon-map': re-gather at the new depth")
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("--seed", opt.seed, "K-means seed")
       ->check(seedValidator())
       ->capture_default_str();

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cli_checks.h"
 #include "bake/stats_json.h"
 #include "core/printable.h"
 #include "commands.h"
@@ -126,7 +127,7 @@ void addInspectOptions(CLI::App* cmd, InspectOptions& opt) {
   cmd->description(
       "List a .vdb file's grids, metadata, value ranges and memory, and check the VDL contract "
       "(exit 0: checks pass, 3: a check failed, 1: unreadable file, 2: bad command line).");
-  cmd->add_option("input", opt.input, ".vdb file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("input", opt.input, ".vdb file")->required()->check(existingFile());
   cmd->add_flag("--json", opt.json, "Print the report as JSON");
 }
 

@@ -97,13 +97,13 @@ void addReferenceOptions(CLI::App* cmd, ReferenceOptions& opt) {
                   "Also write a mask for `compare --mask` (.png or .exr): white where the "
                   "pixel's centre sees no emissive surface, black on the light fixtures, whose "
                   "own pixels the octree and the path tracer define differently")
-      ->check(CLI::NonexistentPath | CLI::ExistingFile);
+      ->check(CLI::NonexistentPath | existingFile());
   cmd->add_option("--geometry-mask", opt.geometryMaskOutput,
                   "Also write a mask for `compare --mask` (.png or .exr): white where the "
                   "pixel's centre sees a surface that does not emit, black on the background "
                   "and on the light fixtures: the pixels left out by what they show, never by "
                   "their value (unlike `compare --ignore-background`)")
-      ->check(CLI::NonexistentPath | CLI::ExistingFile);
+      ->check(CLI::NonexistentPath | existingFile());
   cmd->add_option("--json", opt.json,
                   "Also write a JSON report: the files read and written, samples, rays and time "
                   "(README.md, \"Scripting\")");

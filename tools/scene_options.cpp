@@ -16,7 +16,7 @@ namespace lo::tool {
 void addSceneArgument(CLI::App* cmd, std::string& scene) {
   cmd->add_option("scene", scene, "Scene: .gltf, .glb or .obj")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
 }
 
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
@@ -27,7 +27,7 @@ void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
   cmd->add_option("--sky-image", opt.skyImage,
                   "Light the scene with an equirectangular radiance map (.exr or .hdr, linear; "
                   "its upper half, row 0 at the zenith), scaled by --sky (default 1,1,1)")
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("--sky-mesh", opt.skyMesh,
                   "Take the triangles of this material (a sky box or dome around the scene) out "
                   "of the geometry and light the scene with them as its sky: their emission, or "
@@ -149,7 +149,7 @@ void addObjectOptions(CLI::App* cmd, AddedObjects& opt) {
   cmd->add_option("--add", opt.models,
                   "A model (.gltf, .glb or .obj) added to the baked scene, not in the bake: lit "
                   "by the bake's free-space light, casting shadows (repeatable; each needs an --at)")
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("--at", opt.placements,
                   "Where the --add of the same rank goes: x,y,z[,yaw[,scale]] (its origin to "
                   "x,y,z in scene units, turned yaw degrees about +Y, scaled)");

@@ -65,7 +65,7 @@ void addViewOptions(CLI::App* cmd, ViewOptions& opt) {
       ->check(numberIn(kPositiveNumber));
   cmd->add_option("--camera-path", opt.cameraPath,
                   "Play this camera path (format below) and exit at its end")
-      ->check(CLI::ExistingFile);
+      ->check(existingFile());
   cmd->add_option("--save-frames", opt.view.saveFrames,
                   "Write every frame drawn as DIR/frame_00000.png, ... (created if missing)");
   cmd->add_option("--frames", opt.view.frames,

@@ -619,6 +619,99 @@ def test_ctrl_c_stops_the_work():
     assert 0 < done < total // 100, reports
 
 
+def test_ctrl_c_stops_a_long_lookup_and_is_never_a_bad_argument(grid):
+    """lookup of 4 M points heard Ctrl-C only when it ended (10^7 points:
+    14 s, H14-1-2): its points go in chunks, Ctrl-C heard between them.
+    And Ctrl-C while compare's arrays were converted was taken for a bad
+    argument ("reference: must be ... got numpy.ndarray", H14-1-1)."""
+    import signal
+    import threading
+    import time
+    n = 4_000_000
+    points = np.tile(np.array([[0.0, 0.27, -0.28]]), (n, 1))
+    normals = np.tile(np.array([[0.0, 1.0, 0.0]]), (n, 1))
+    start = time.monotonic()
+    lightoctree.lookup(grid, points[:200_000], normals[:200_000])
+    per_point = (time.monotonic() - start) / 200_000
+    timer = threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            lightoctree.lookup(grid, points, normals)
+    finally:
+        timer.cancel()
+    took = time.monotonic() - start
+    assert took < 0.2 + 0.25 * n * per_point, (took, n * per_point)
+    # Ctrl-C (or a want of memory) while NumPy converts an argument.
+    image = np.ones((64, 64, 3), np.float64)
+    for raised in (KeyboardInterrupt, MemoryError):
+        class Interrupted:
+            def __array__(self, *args, **kwargs):
+                raise raised()
+        with pytest.raises(raised):
+            lightoctree.compare(Interrupted(), image)
+        with pytest.raises(raised):
+            lightoctree.lookup(grid, Interrupted(), normals[:1])
+
+
+def test_an_unknown_camera_names_the_first_ten_of_many(tmp_path):
+    """An unknown camera listed every camera of the scene: 20,000 made one
+    line of 249 KB (H14-5-2). The first ten, and how many more."""
+    import json
+    import shutil
+    scene = json.load(open(SCENE))
+    folder = os.path.dirname(SCENE)
+    for buffer in scene.get("buffers", []):
+        if "uri" in buffer and not buffer["uri"].startswith("data:"):
+            shutil.copy(os.path.join(folder, buffer["uri"]), tmp_path)
+    for i in range(30):
+        scene.setdefault("cameras", []).append(
+            {"name": f"cam{i}", "type": "perspective",
+             "perspective": {"yfov": 0.7, "znear": 0.01, "aspectRatio": 1.0}})
+        scene["nodes"].append({"camera": len(scene["cameras"]) - 1, "translation": [0, 0.3, 1]})
+        scene["scenes"][0]["nodes"].append(len(scene["nodes"]) - 1)
+    path = tmp_path / "cameras.gltf"
+    path.write_text(json.dumps(scene))
+    with pytest.raises(lightoctree.InputError) as refused:
+        lightoctree.reference(str(path), width=8, height=8, spp=1, camera="nosuch")
+    message = str(refused.value)
+    assert re.search(r"no camera named 'nosuch' in .* \(it has '[^']*', .* and \d+ more\)$",
+                     message), message
+    assert len(message) < 600, message
+    assert message.count("'cam") <= 10, message
+
+
+def test_a_render_from_a_renders_own_callback_is_refused_by_name(grid):
+    """A render called from the progress callback of a render on the same
+    thread took its GL context: the outer render then failed naming a
+    texture limit of 0 and advising a rebake (H14-1-3). Refused by name;
+    from another thread, and after, a render works."""
+    import threading
+    inner = []
+
+    def again(task, done, total):
+        if not inner:
+            inner.append(lightoctree.render(SCENE, grid, width=8, height=8))
+
+    with pytest.raises(lightoctree.InputError, match=r"^render: called from the progress "
+                       r"callback of a call that draws with OpenGL on this thread"):
+        lightoctree.render(SCENE, grid, width=8, height=8, progress=again)
+    assert not inner
+    elsewhere = []
+
+    def on_another_thread(task, done, total):
+        if not elsewhere:
+            worker = threading.Thread(target=lambda: elsewhere.append(
+                lightoctree.render(SCENE, grid, width=8, height=8)))
+            worker.start()
+            worker.join()
+
+    image = lightoctree.render(SCENE, grid, width=8, height=8, progress=on_another_thread)
+    assert elsewhere and np.array_equal(elsewhere[0], image)
+    assert np.array_equal(lightoctree.render(SCENE, grid, width=8, height=8), image)
+
+
 def test_ctrl_c_stops_a_render_between_its_stages(grid):
     """A render told of its set-up's stages and frames: SIGINT during the
     set-up stops it at the next report, before any frame is drawn (a render

@@ -507,7 +507,10 @@ void checkOutputFolder(const std::string& path, const char* flag) {
                      (ec == std::errc::too_many_symbolic_link_levels ? " (a loop of links?)" : ""));
   }
   if (!isFolder) {
-    throw InputError(std::string(flag) + ": folder '" + parent.string() + "' does not exist");
+    std::error_code ignored;
+    const bool other = fs::exists(folder, ignored);
+    throw InputError(std::string(flag) + ": folder '" + parent.string() +
+                     (other ? "' is a file, not a folder" : "' does not exist"));
   }
   if (::access(folder.c_str(), W_OK | X_OK) != 0) {
     throw InputError(std::string(flag) + ": folder '" + folder.string() +
