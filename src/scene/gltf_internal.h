@@ -27,6 +27,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -165,7 +166,18 @@ class SceneBuilder {
 
   // Meshes and vertex attributes (gltf_meshes.cpp).
 
-  void addMesh(int meshIndex, const Mat4& world);
+  /// `nodeWeights`: the node's morph target weights (glTF: they override
+  /// the mesh's), null or empty for the mesh's own.
+  void addMesh(int meshIndex, const Mat4& world, const std::vector<double>* nodeWeights = nullptr);
+  /// Adds the morph targets of `prim` at `weights` to its positions and
+  /// normals (those it has). @throws InputError for a target of another count.
+  void morph(const tinygltf::Primitive& prim, const std::vector<double>& weights,
+             const std::string& what, size_t nverts, std::vector<double>& pos,
+             std::vector<double>& nrm);
+  /// Warns once per material and set of a texture on a UV set that the
+  /// primitive `what` lacks (`has(set)`).
+  void warnMissingUvSets(int material, const std::function<bool(int)>& has,
+                         const std::string& what);
 
   /// Triangle list from TRIANGLES / TRIANGLE_STRIP / TRIANGLE_FAN (glTF 2.0
   /// spec 3.7.2.1); triangles with a repeated index (strip restarts) dropped.
@@ -264,6 +276,9 @@ class SceneBuilder {
   bool skyScale_ = false;  ///< extras.lightoctree_sky was given
   float turbidity_ = 0;    ///< extras.lightoctree_physical_sky; 0 = none
   std::set<int> missingImages_;  ///< images whose file is missing, warned once
+  /// (material, UV set) pairs whose texture a primitive without that set
+  /// uses, warned once.
+  std::set<std::pair<int, int>> missingUvSets_;
   /// Each image's file bytes, kept by the textures that decode it (Texture::encoded).
   std::map<int, std::shared_ptr<const std::vector<uint8_t>>> imageBytes_;
   /// The first image of each source (its file, its data URI, its

@@ -184,6 +184,10 @@ void SceneBuilder::textureReference(size_t i, const std::string& what, int index
   if (texCoord == 0 || texCoord == 1) {
     texture = textureFromImage(model_.textures[size_t(index)].source, index, srgb);
     texCoordOut = texCoord;
+  } else {
+    scene_.warnings.push_back(path_ + ": material " + std::to_string(i) + ": " + what +
+                              " uses TEXCOORD_" + std::to_string(texCoord) +
+                              ", and only TEXCOORD_0 and TEXCOORD_1 are read: left out");
   }
 }
 

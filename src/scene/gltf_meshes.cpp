@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -19,11 +20,59 @@
 
 namespace lo::scene_internal::gltf_internal {
 
-void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
+void SceneBuilder::morph(const tinygltf::Primitive& prim, const std::vector<double>& weights,
+                         const std::string& what, size_t nverts, std::vector<double>& pos,
+                         std::vector<double>& nrm) {
+  for (size_t t = 0; t < prim.targets.size() && t < weights.size(); ++t) {
+    if (weights[t] == 0) continue;
+    for (const auto& [name, accessor] : prim.targets[t]) {
+      std::vector<double>* into = name == "POSITION" ? &pos : name == "NORMAL" ? &nrm : nullptr;
+      if (!into || into->empty()) continue;  // TANGENT, or a normal the primitive lacks
+      const std::string label = what + " morph target " + std::to_string(t) + " " + name;
+      const std::vector<double> delta = reader_.read(accessor, TINYGLTF_TYPE_VEC3, label);
+      if (reader_.count(accessor) != nverts) {
+        fail(path_, label + " has " + std::to_string(reader_.count(accessor)) +
+                        " elements, POSITION has " + std::to_string(nverts));
+      }
+      for (size_t k = 0; k < into->size(); ++k) (*into)[k] += weights[t] * delta[k];
+    }
+  }
+}
+
+void SceneBuilder::warnMissingUvSets(int material, const std::function<bool(int)>& has,
+                                     const std::string& what) {
+  const Material& m = scene_.materials[size_t(material)];
+  const std::pair<int, int> uses[] = {{m.baseColorTexture, m.baseColorTexCoord},
+                                      {m.normalTexture, m.normalTexCoord},
+                                      {m.metallicRoughnessTexture, m.metallicRoughnessTexCoord},
+                                      {m.occlusionTexture, m.occlusionTexCoord},
+                                      {m.emissiveTexture, m.emissiveTexCoord}};
+  for (const auto& [texture, set] : uses) {
+    if (texture < 0 || has(set) || !missingUvSets_.insert({material, set}).second) continue;
+    scene_.warnings.push_back(path_ + ": " + what + ": material " + std::to_string(material) +
+                              " has a texture on TEXCOORD_" + std::to_string(set) +
+                              ", which the primitive lacks: its texels are read at (0, 0)");
+  }
+}
+
+void SceneBuilder::addMesh(int meshIndex, const Mat4& world,
+                           const std::vector<double>* nodeWeights) {
   if (size_t(meshIndex) >= model_.meshes.size()) {
     fail(path_, "mesh index " + std::to_string(meshIndex) + " out of range");
   }
   const tinygltf::Mesh& mesh = model_.meshes[size_t(meshIndex)];
+  // Morph targets at their default weights, the node's over the mesh's
+  // (glTF 2.0, morph targets): they were left out, and a lifted part drawn
+  // where its base shape lies (H14-4-1).
+  const std::vector<double>& weights =
+      nodeWeights && !nodeWeights->empty() ? *nodeWeights : mesh.weights;
+  for (size_t i = 0; i < weights.size(); ++i) {
+    if (!std::isfinite(weights[i])) {
+      fail(path_, "mesh " + std::to_string(meshIndex) + ": morph target weight " +
+                      std::to_string(i) + " is not finite");
+    }
+  }
+  const bool morphed = std::any_of(weights.begin(), weights.end(), [](double w) { return w != 0; });
   Mat4 normalMatrix = world.normalMatrix();
   bool flip = world.det3() < 0;
   for (size_t p = 0; p < mesh.primitives.size(); ++p) {
@@ -48,7 +97,9 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
                              {sameValues(posAcc), sameValues(attr("NORMAL")),
                               sameValues(attr("TANGENT")), sameValues(attr("TEXCOORD_0")),
                               sameValues(attr("TEXCOORD_1")), sameValues(attr("COLOR_0"))}};
-    const auto converted = vertexBlocks_.find(key);
+    // Morphed vertices are this node's own.
+    const bool morphs = morphed && !prim.targets.empty();
+    const auto converted = morphs ? vertexBlocks_.end() : vertexBlocks_.find(key);
     const bool shared = converted != vertexBlocks_.end();
     std::vector<double> pos, nrm, uv0, uv1, tan, color;
     size_t nverts = reader_.count(posAcc);
@@ -84,6 +135,7 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
                 : TINYGLTF_TYPE_VEC4;
         color = readSameCount(attr("COLOR_0"), type, "COLOR_0");
       }
+      if (morphs) morph(prim, weights, what, nverts, pos, nrm);
     }
 
     std::vector<uint32_t> idx;
@@ -114,6 +166,8 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
     else if (size_t(material) >= model_.materials.size())
       fail(path_, what + ": material index " + std::to_string(material) + " out of range");
 
+    warnMissingUvSets(material, [&](int set) { return attr(set == 0 ? "TEXCOORD_0" : "TEXCOORD_1") >= 0; },
+                      what);
     uint32_t base = shared ? converted->second : uint32_t(scene_.positions.size());
     if (!shared) {
       if (uint64_t(base) + nverts > std::numeric_limits<uint32_t>::max()) {
@@ -136,7 +190,7 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world) {
       appendUv(scene_.texcoords1, hasUv1_, uv1, nverts, base);
       appendTangents(tan, world, nverts, base, flip);
       appendColors(color, nverts, base, what);
-      vertexBlocks_.emplace(key, base);
+      if (!morphs) vertexBlocks_.emplace(key, base);
     }
 
     for (auto& t : tris) {

@@ -104,7 +104,7 @@ void SceneBuilder::traverse() {
     if (isRegionMarker(node, item.node)) {
       addRegion(node, item.node, world);
     } else if (node.mesh >= 0) {
-      addMesh(node.mesh, world);
+      addMesh(node.mesh, world, &node.weights);
     }
     if (node.camera >= 0) addCamera(node, item.node, world);
     auto ext = node.extensions.find("KHR_lights_punctual");

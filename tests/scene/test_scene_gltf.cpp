@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "scene/scene.h"
 #include "scene/scene_fixture.h"
 #include "test_util.h"
@@ -132,6 +133,55 @@ TEST_F(SceneGltf, SparseAccessor) {
   Scene s = loadScene(write("sparse.gltf", j));
   expectNear(s.positions[0], {0, 0, 1}, 1e-6f, "substituted");
   expectNear(s.positions[1], {1, 0, 0}, 1e-6f, "kept");
+}
+
+// Morph targets at their default weights, the node's over the mesh's: they
+// were left out, a lifted part drawn in its base shape (H14-4-1). The
+// target here is the normals' accessor, (0, 0, 1) at each vertex.
+TEST_F(SceneGltf, MorphTargetsAreAppliedAtTheirDefaultWeights) {
+  MiniGltf g = oneTriangle();
+  auto morphed = [&](const std::string& meshWeights, const std::string& nodes) {
+    g.nodes = nodes;
+    std::string j = g.json();
+    const std::string mode = ", \"mode\": 4}]";
+    j.replace(j.find(mode), mode.size(),
+              ", \"mode\": 4, \"targets\": [{\"POSITION\": 1}]}]" + meshWeights);
+    return loadScene(write("morph.gltf", j));
+  };
+  const Scene base = morphed("", R"([{"mesh": 0}])");
+  expectNear(base.positions[0], {0, 0, 0}, 1e-6f, "no weights: the base shape");
+  const Scene lifted = morphed(", \"weights\": [0.5]", R"([{"mesh": 0}])");
+  for (size_t v = 0; v < 3; ++v) {
+    expectNear(lifted.positions[v], base.positions[v] + Vec3{0, 0, 0.5f}, 1e-6f, "mesh weight");
+  }
+  const Scene byNode = morphed(", \"weights\": [0.5]", R"([{"mesh": 0, "weights": [2]}])");
+  expectNear(byNode.positions[1], base.positions[1] + Vec3{0, 0, 2}, 1e-6f, "the node's weight");
+  EXPECT_THROW(morphed(", \"weights\": [1e300]", R"([{"mesh": 0}])"), InputError);
+}
+
+// A texture on a UV set the primitive lacks, or on a set the loader does
+// not read, is said (it was drawn at one texel, or left out, silently).
+TEST_F(SceneGltf, TexturesOnMissingUvSetsAreWarned) {
+  MiniGltf g = oneTriangle();
+  g.image =  // one white texel
+      "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg==";
+  g.material = 0;
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])";
+  const Scene s = loadScene(write("no-uv.gltf", g));
+  bool said = false;
+  for (const std::string& w : s.warnings) {
+    said |= w.find("material 0 has a texture on TEXCOORD_0, which the primitive lacks") !=
+            std::string::npos;
+  }
+  EXPECT_TRUE(said) << ::testing::PrintToString(s.warnings);
+  g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 9}}}])";
+  const Scene nine = loadScene(write("uv9.gltf", g));
+  said = false;
+  for (const std::string& w : nine.warnings) {
+    said |= w.find("texture uses TEXCOORD_9, and only TEXCOORD_0 and TEXCOORD_1 are read") !=
+            std::string::npos;
+  }
+  EXPECT_TRUE(said) << ::testing::PrintToString(nine.warnings);
 }
 
 // A sparse accessor without a bufferView stands for zeros: 2^28 of them in
