@@ -977,6 +977,8 @@ GridPtr bakeScene(const Arg<std::string>& sceneArg, const Arg<int>& depthArg,
   params.vdls = parseVdlCount(vdls, "vdls");
   params.includeDirect = includeDirect;
   params.targetSeenLight = targetLight == "seen";
+  const std::string sparse = sparsePhotonsWarning(scene, params);
+  if (!sparse.empty()) warn(pythonNames(sparse));
   auto out = std::make_shared<Grid>();
   BakeResult r = withProgress(progress, "bake", [&](ProgressSink* sink) {
     BakeResult result = bake(scene, params, sink);

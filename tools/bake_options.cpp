@@ -54,6 +54,8 @@ BakeParams BakeOptions::bakeParams(const Scene& scene) const {
     params.region.extend(scene.toLocal(Vec3d{bounds[0], bounds[1], bounds[2]}));
     params.region.extend(scene.toLocal(Vec3d{bounds[3], bounds[4], bounds[5]}));
   }
+  const std::string sparse = sparsePhotonsWarning(scene, params);
+  if (!sparse.empty()) std::fprintf(stderr, "warning: %s\n", sparse.c_str());
   params.keepPhotons = !photonMap.empty();
   return params;
 }

@@ -179,3 +179,33 @@ TEST(BakeDepth, ParsedAsAutoOrAWholeNumberFrom1To12) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// A fixed budget spread thinner than a photon per ten voxels over a million
+// of them is warned before the work (H14-5-3: --depth 10, 100,000 photons,
+// 78 s and 6.2 GB). A floor of one unit at depth 10 crosses 1024^2 voxels.
+TEST(BakeDepth, PhotonsSpreadThinOverAMillionVoxelsAreWarned) {
+  Scene scene = test::oneMaterialScene();
+  test::addQuad(scene, Vec3(0.0f), Vec3(1, 0, 0), Vec3(0, 0, 1), Vec3(0, 1, 0), 0);
+  BakeParams p;
+  p.depth = 10;
+  setPhotonBudget(p, 50000, 0);
+  const std::string warning = sparsePhotonsWarning(scene, p);
+  EXPECT_NE(warning.find("--depth 10: the surfaces cross about 1,0"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("--photons 50,000 are 0.05 a voxel"), std::string::npos) << warning;
+  setPhotonBudget(p, 200000, 0);  // 0.19 a voxel
+  EXPECT_EQ(sparsePhotonsWarning(scene, p), "");
+  p.depth = 9;  // 262,144 voxels
+  setPhotonBudget(p, 1000, 0);
+  EXPECT_EQ(sparsePhotonsWarning(scene, p), "");
+  p.depth = kAutoDepth;
+  EXPECT_EQ(sparsePhotonsWarning(scene, p), "");
+  p.depth = 10;
+  setPhotonBudget(p, 0, 0.05);  // a target fits the photons to the voxels
+  EXPECT_EQ(sparsePhotonsWarning(scene, p), "");
+}
+
+}  // namespace
+}  // namespace lo
