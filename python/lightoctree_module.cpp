@@ -6,30 +6,29 @@
 // memory (no copy; each keeps the Grid alive), read-only so that the VDL
 // sums the file contract demands cannot be broken behind its back.
 
+#include <cxxabi.h>
+#include <locale.h>
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-
-#include <cctype>
-#include <cxxabi.h>
 #include <unistd.h>
+
+#include <atomic>
+#include <cctype>
 #include <clocale>
-#include <locale.h>
 #include <cstdio>
 #include <cstdlib>
-#include <limits>
 #include <exception>
 #include <initializer_list>
+#include <limits>
 #include <memory>
 #include <optional>
-#include <atomic>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bake/bake.h"
-#include "core/printable.h"
 #include "bake/convert.h"
 #include "core/error.h"
 #include "core/file.h"
@@ -42,8 +41,8 @@
 #include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "octree/octree_irradiance.h"
-#include "render/context.h"
 #include "reference/path_tracer.h"
+#include "render/context.h"
 #include "render/render_session.h"
 #include "scene/pinhole_camera.h"
 #include "scene/scene.h"
@@ -1152,12 +1151,11 @@ py::dict compareImagesArg(const py::object& testArg, const py::object& reference
                      ", the images are " + std::to_string(reference.width) + " x " +
                      std::to_string(reference.height));
   }
-  CompareReport r;
-  {
-    py::gil_scoped_release unlocked;
-    r = compareReport(test, reference, settings, mask ? &*mask : nullptr,
-                      stdError ? &*stdError : nullptr);
-  }
+  // Ctrl-C heard between its steps (withProgress).
+  const CompareReport r = withProgress(py::none(), "compare", [&](ProgressSink* sink) {
+    return compareReport(test, reference, settings, mask ? &*mask : nullptr,
+                         stdError ? &*stdError : nullptr, sink);
+  });
   for (const std::string& w : r.warnings()) warn(w);  // as the command's "warning: ..." on stderr
   const CompareResult& m = r.result;
   py::dict d;  // the keys and values of `compare --json`

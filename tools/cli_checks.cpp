@@ -2,12 +2,11 @@
 
 #include <sys/stat.h>
 
-#include <cerrno>
-#include <cstring>
-
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 
 #include "bake/bake.h"
@@ -18,7 +17,8 @@ namespace lo::tool {
 CLI::Validator existingFile() {
   return CLI::Validator(
       [](std::string& path) -> std::string {
-        struct stat link {}, target {};
+        struct stat link = {};
+        struct stat target = {};
         if (::lstat(path.c_str(), &link) != 0) {
           return errno == ENOENT ? "File does not exist: " + path
                                  : "'" + path + "' cannot be reached: " + std::strerror(errno);

@@ -47,9 +47,7 @@ void addConvertOptions(CLI::App* cmd, ConvertOptions& opt) {
   cmd->description(
       "Convert a baked .vdb to another depth (merge children / interpolate parents, or re-gather "
       "from a photon map), VDL count or storage.");
-  cmd->add_option("input", opt.input, "Baked VDL file (.vdb)")
-      ->required()
-      ->check(existingFile());
+  cmd->add_option("input", opt.input, "Baked VDL file (.vdb)")->required()->check(existingFile());
   cmd->add_option("-o,--output", opt.output, "Output .vdb file (written atomically)")->required();
   cmd->add_option("--depth", opt.depth, "Output depth (default: the input's)")
       ->check(depthValidator());

@@ -7,10 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "cli_checks.h"
 #include "bake/stats_json.h"
-#include "core/printable.h"
+#include "cli_checks.h"
 #include "commands.h"
+#include "core/printable.h"
 #include "report.h"
 #include "vdb/vdb_inspect.h"
 

@@ -1,11 +1,11 @@
 // lightoctree: the command-line front end. Parses, calls the stages, reports.
 
-#include <csignal>
 #include <fcntl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>

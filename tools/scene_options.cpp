@@ -14,9 +14,7 @@
 namespace lo::tool {
 
 void addSceneArgument(CLI::App* cmd, std::string& scene) {
-  cmd->add_option("scene", scene, "Scene: .gltf, .glb or .obj")
-      ->required()
-      ->check(existingFile());
+  cmd->add_option("scene", scene, "Scene: .gltf, .glb or .obj")->required()->check(existingFile());
 }
 
 void addSceneOptions(CLI::App* cmd, SceneOptions& opt) {
@@ -146,9 +144,10 @@ Scene loadSceneWith(const std::string& path, const SceneOptions& opt) {
 }
 
 void addObjectOptions(CLI::App* cmd, AddedObjects& opt) {
-  cmd->add_option("--add", opt.models,
-                  "A model (.gltf, .glb or .obj) added to the baked scene, not in the bake: lit "
-                  "by the bake's free-space light, casting shadows (repeatable; each needs an --at)")
+  cmd->add_option(
+         "--add", opt.models,
+         "A model (.gltf, .glb or .obj) added to the baked scene, not in the bake: lit "
+         "by the bake's free-space light, casting shadows (repeatable; each needs an --at)")
       ->check(existingFile());
   cmd->add_option("--at", opt.placements,
                   "Where the --add of the same rank goes: x,y,z[,yaw[,scale]] (its origin to "

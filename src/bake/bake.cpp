@@ -393,7 +393,8 @@ std::string sparsePhotonsWarning(const Scene& scene, const BakeParams& params) {
   std::snprintf(share, sizeof share, "%.2g", perVoxel);
   return "--depth " + std::to_string(params.depth) + ": the surfaces cross about " +
          formatCount(size_t(voxels)) + " voxels, and --photons " + formatCount(params.photons) +
-         " are " + share + " a voxel: each voxel's light is gathered from photons far beyond "
+         " are " + share +
+         " a voxel: each voxel's light is gathered from photons far beyond "
          "it, and the bake spends the time and memory of every voxel (about " +
          formatBytes(size_t(voxels * double(kBakeBytesPerVoxel))) +
          "): --depth auto picks the depth the photons resolve, or give more --photons";

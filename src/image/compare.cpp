@@ -354,7 +354,9 @@ void checkStdError(const RgbImage& stdError, const std::string& what) {
 }
 
 CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSettings& settings,
-                            const RgbImage* mask, const RgbImage* stdError) {
+                            const RgbImage* mask, const RgbImage* stdError,
+                            ProgressSink* progress) {
+  Progress steps(progress, "compare", 7);
   CompareReport r;
   r.ignoreBackground = settings.ignoreBackground;
   if (mask) r.mask = *mask;
@@ -367,17 +369,21 @@ CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSett
     checkStdError(*stdError, "compare: the reference's standard error");
     error = *stdError;
   }
+  steps.advance();
   // Black holes are judged per pixel against the reference as it is.
   r.holes = darkHoles(test, reference, r.params());
+  steps.advance();
   if (settings.clipPercentile < 100) {
     r.clip = channelPercentiles(reference, settings.clipPercentile, r.params());
     clipChannels(test, r.clip);
     clipChannels(reference, r.clip);
   }
+  steps.advance();
   // Per pixel, as clipped and before binning, over the mask as given.
   for (size_t i = 0; i < reference.pixelCount(); ++i) {
     if (pixelUse(test, reference, r.params(), i) == PixelUse::NonFinite) ++r.nonFiniteImagePixels;
   }
+  steps.advance();
   r.bin = settings.bin;
   if (settings.bin > 1) {
     test = binImage(test, settings.bin);
@@ -385,7 +391,9 @@ CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSett
     if (mask) r.mask = binMask(r.mask, settings.bin);
     if (stdError) error = binStdError(error, settings.bin);
   }
+  steps.advance();
   r.result = compareImages(test, reference, r.params());
+  steps.advance();
   // Nothing compared is no score (its figures would read 0: a perfect one).
   if (r.result.comparedPixels == 0) {
     throw InputError("compare: no pixel to compare: " + std::to_string(r.result.ignoredPixels) +
@@ -397,6 +405,7 @@ CompareReport compareReport(RgbImage test, RgbImage reference, const CompareSett
                                        : std::string()));
   }
   if (stdError) r.referenceNoise = referenceNoise(reference, error, r.params());
+  steps.advance();
   r.test = std::move(test);
   r.reference = std::move(reference);
   return r;

@@ -65,9 +65,9 @@ std::string capPages(LightmapCharts& charts, LightmapUvParams uv, int maxPages, 
   os << "lightmap atlas: texel " << uvs.texelSize << ", not the default " << first
      << " (a quarter voxel), which would take " << pages << " pages of " << uv.atlasSize << " x "
      << uv.atlasSize << "; at most " << maxPages << " are drawn"
-     << (uvs.pageCount > maxPages ? " (" + std::to_string(uvs.pageCount) +
-                                        " still: the scene has too many charts)"
-                                  : std::string())
+     << (uvs.pageCount > maxPages
+             ? " (" + std::to_string(uvs.pageCount) + " still: the scene has too many charts)"
+             : std::string())
      << ". `lightmap --texel-size` bakes finer pages";
   return os.str();
 }

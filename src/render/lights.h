@@ -75,8 +75,8 @@ struct SceneLights {
   /// budget.
   template <class DrawDepthOnly>
   void fitCascades(const RenderSpace& space, const glm::vec3& eye, const glm::vec3& forward,
-                   const glm::vec3& up, float yfov, float aspect, float znear, float zfar,
-                   int fits, GLuint vao, const DrawDepthOnly& draw) {
+                   const glm::vec3& up, float yfov, float aspect, float znear, float zfar, int fits,
+                   GLuint vao, const DrawDepthOnly& draw) {
     if (sunLights.empty()) return;
     const std::array<float, 12> key = {eye.x, eye.y, eye.z, forward.x, forward.y, forward.z,
                                        up.x,  up.y,  up.z,  yfov,      aspect,    znear};

@@ -87,8 +87,10 @@ void Renderer::Impl::captureProbe(const RenderParams& rp) {
   glBindFramebuffer(GL_FRAMEBUFFER, probe.fbo.get());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
                             probe.depth.get());
-  const Vec3 forward[kProbeFaces] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  const Vec3 up[kProbeFaces] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+  const Vec3 forward[kProbeFaces] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  const Vec3 up[kProbeFaces] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1},
+                                {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
   RenderParams face = rp;
   face.mode = RenderMode::Full;
   face.reflections = false;

@@ -279,6 +279,7 @@ class SceneBuilder {
   /// (material, UV set) pairs whose texture a primitive without that set
   /// uses, warned once.
   std::set<std::pair<int, int>> missingUvSets_;
+  std::set<int> morphCountsWarned_;  ///< meshes whose weights and targets differ in count, warned once
   /// Each image's file bytes, kept by the textures that decode it (Texture::encoded).
   std::map<int, std::shared_ptr<const std::vector<uint8_t>>> imageBytes_;
   /// The first image of each source (its file, its data URI, its

@@ -4,19 +4,18 @@
 /// the vertex attributes (normals, two UV sets, tangents, colours) that
 /// only some primitives carry filled in for the others.
 
-#include "scene/gltf_internal.h"
-
 #include <algorithm>
 #include <array>
-#include <functional>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/resources.h"
+#include "scene/gltf_internal.h"
 
 namespace lo::scene_internal::gltf_internal {
 
@@ -73,6 +72,17 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world,
     }
   }
   const bool morphed = std::any_of(weights.begin(), weights.end(), [](double w) { return w != 0; });
+  // glTF asks one weight a target; other counts are read as far as both go.
+  for (size_t p = 0; p < mesh.primitives.size() && morphed; ++p) {
+    const size_t targets = mesh.primitives[p].targets.size();
+    if (targets == weights.size() || !morphCountsWarned_.insert(meshIndex).second) continue;
+    scene_.warnings.push_back(path_ + ": mesh " + std::to_string(meshIndex) + " primitive " +
+                              std::to_string(p) + " has " + std::to_string(targets) +
+                              " morph targets and " + std::to_string(weights.size()) +
+                              " weights (glTF asks one a target): " +
+                              (targets < weights.size() ? "the extra weights are left out"
+                                                        : "the targets without one weigh 0"));
+  }
   Mat4 normalMatrix = world.normalMatrix();
   bool flip = world.det3() < 0;
   for (size_t p = 0; p < mesh.primitives.size(); ++p) {
@@ -166,8 +176,8 @@ void SceneBuilder::addMesh(int meshIndex, const Mat4& world,
     else if (size_t(material) >= model_.materials.size())
       fail(path_, what + ": material index " + std::to_string(material) + " out of range");
 
-    warnMissingUvSets(material, [&](int set) { return attr(set == 0 ? "TEXCOORD_0" : "TEXCOORD_1") >= 0; },
-                      what);
+    warnMissingUvSets(
+        material, [&](int set) { return attr(set == 0 ? "TEXCOORD_0" : "TEXCOORD_1") >= 0; }, what);
     uint32_t base = shared ? converted->second : uint32_t(scene_.positions.size());
     if (!shared) {
       if (uint64_t(base) + nverts > std::numeric_limits<uint32_t>::max()) {

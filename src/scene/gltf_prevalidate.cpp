@@ -101,7 +101,7 @@ namespace {
 struct FieldRule {
   const char* pointer;  ///< JSON pointer; "*" stands for every element of an array or member of an object
   enum Kind { kNumber, kNumbers, kString, kStrings, kBool, kObject, kArray, kIndex, kIndices } kind;
-  size_t count = 0;  ///< kNumbers: how many; kArray: at least how many elements
+  size_t count = 0;  ///< kNumbers: how many (0: any); kArray: at least how many elements
   bool required = false;  ///< glTF requires it where its parent is (a primitive's attributes)
 };
 
@@ -181,6 +181,13 @@ const FieldRule kFieldRules[] = {
     {"/meshes/*/primitives/*/indices", FieldRule::kIndex},
     {"/meshes/*/primitives/*/material", FieldRule::kIndex},
     {"/meshes/*/primitives/*/mode", FieldRule::kIndex},
+    // Morph targets and their weights (strings or an object of weights were
+    // taken as none, H15-4-1).
+    {"/meshes/*/primitives/*/targets", FieldRule::kArray},
+    {"/meshes/*/primitives/*/targets/*", FieldRule::kObject},
+    {"/meshes/*/primitives/*/targets/*/*", FieldRule::kIndex},
+    {"/meshes/*/weights", FieldRule::kNumbers},
+    {"/nodes/*/weights", FieldRule::kNumbers},
     {"/accessors/*/bufferView", FieldRule::kIndex},
     {"/accessors/*/byteOffset", FieldRule::kIndex},
     {"/accessors/*/count", FieldRule::kIndex, 0, true},
@@ -252,7 +259,7 @@ bool holds(const nlohmann::json& v, const FieldRule& rule) {
       }
       return true;
     case FieldRule::kNumbers:
-      if (!v.is_array() || v.size() != rule.count) return false;
+      if (!v.is_array() || (rule.count > 0 && v.size() != rule.count)) return false;
       for (const nlohmann::json& x : v) {
         if (!x.is_number()) return false;
       }
@@ -274,7 +281,9 @@ std::string expected(const FieldRule& rule) {
     case FieldRule::kStrings: return "an array of strings";
     case FieldRule::kIndex: return "a whole number from 0 (an integer)";
     case FieldRule::kIndices: return "an array of whole numbers from 0 (integers)";
-    case FieldRule::kNumbers: return "an array of " + std::to_string(rule.count) + " numbers";
+    case FieldRule::kNumbers:
+      return rule.count > 0 ? "an array of " + std::to_string(rule.count) + " numbers"
+                            : "an array of numbers";
   }
   return "";
 }

@@ -131,23 +131,28 @@ TEST_F(RenderImage, AWallBesideALampKeepsItsShadow) {
   EXPECT_LT(behind, 0.01 * front) << "the lamp's light passes through the wall (" << dir << ")";
 }
 
+/// `floors` grey 2 x 2 floors stacked 1e-4 apart below y = 0 (the top), lit
+/// by `light`.
+Scene stackedFloors(int floors, const Light& light) {
+  Scene scene;
+  Material m;
+  m.baseColor = {0.8f, 0.8f, 0.8f};
+  scene.materials.push_back(m);
+  for (int i = 0; i < floors; ++i) {
+    test::addQuad(scene, {-1, -1e-4f * float(i), -1}, {0, 0, 2}, {2, 0, 0}, {0, 1, 0}, 0);
+  }
+  scene.lights.push_back(light);
+  return scene;
+}
+
 // Floors stacked under a lamp: each cube face of its shadow map is drawn
 // once per floor, and 5,000 of them took the software rasteriser 85 s
 // (H10-5-19). The maps are halved until one drawing covers at most
 // kShadowFillBudget texels (lights.cpp), and the renderer says why; the top
 // floor is lit as with full maps.
 TEST_F(RenderImage, ShadowMapsOfFloorsStackedManyTimesOverKeepToTheFillBudget) {
-  auto stacked = [](int floors) {
-    Scene scene;
-    Material m;
-    m.baseColor = {0.8f, 0.8f, 0.8f};
-    scene.materials.push_back(m);
-    for (int i = 0; i < floors; ++i) {
-      test::addQuad(scene, {-1, -1e-4f * float(i), -1}, {0, 0, 2}, {2, 0, 0}, {0, 1, 0}, 0);  // the top at y = 0
-    }
-    scene.lights.push_back(test::pointLight({0, 1, 0}, 1.0f));
-    return scene;
-  };
+  const Light lamp = test::pointLight({0, 1, 0}, 1.0f);
+  auto stacked = [&lamp](int floors) { return stackedFloors(floors, lamp); };
   RenderParams p;
   p.width = p.height = 32;
   p.mode = RenderMode::Direct;
@@ -175,17 +180,8 @@ TEST_F(RenderImage, ShadowMapsOfFloorsStackedManyTimesOverKeepToTheFillBudget) {
 // whole scene, which a moving camera does not redraw. The top floor is lit
 // as with fitted cascades.
 TEST_F(RenderImage, SunCascadesOverStackedFloorsCoverTheWholeSceneInInteractiveFrames) {
-  auto stacked = [](int floors) {
-    Scene scene;
-    Material m;
-    m.baseColor = {0.8f, 0.8f, 0.8f};
-    scene.materials.push_back(m);
-    for (int i = 0; i < floors; ++i) {
-      test::addQuad(scene, {-1, -1e-4f * float(i), -1}, {0, 0, 2}, {2, 0, 0}, {0, 1, 0}, 0);
-    }
-    scene.lights.push_back(test::sun({0.2f, -1, 0.1f}, 3.0f));
-    return scene;
-  };
+  const Light sun = test::sun({0.2f, -1, 0.1f}, 3.0f);
+  auto stacked = [&sun](int floors) { return stackedFloors(floors, sun); };
   RenderParams p;
   p.width = p.height = 32;
   p.mode = RenderMode::Direct;

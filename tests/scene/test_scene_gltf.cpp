@@ -157,6 +157,21 @@ TEST_F(SceneGltf, MorphTargetsAreAppliedAtTheirDefaultWeights) {
   const Scene byNode = morphed(", \"weights\": [0.5]", R"([{"mesh": 0, "weights": [2]}])");
   expectNear(byNode.positions[1], base.positions[1] + Vec3{0, 0, 2}, 1e-6f, "the node's weight");
   EXPECT_THROW(morphed(", \"weights\": [1e300]", R"([{"mesh": 0}])"), InputError);
+  // Weights of another type are refused by their pointer; another count is
+  // read as far as both go, and warned (H15-4-1: taken as none, silently).
+  for (const char* weights : {", \"weights\": [\"1\"]", ", \"weights\": {\"a\": 1}"}) {
+    try {
+      morphed(weights, R"([{"mesh": 0}])");
+      ADD_FAILURE() << weights << " was taken";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("/meshes/0/weights"), std::string::npos) << e.what();
+    }
+  }
+  const Scene extra = morphed(", \"weights\": [0.5, 1, 1]", R"([{"mesh": 0}])");
+  expectNear(extra.positions[0], base.positions[0] + Vec3{0, 0, 0.5f}, 1e-6f, "first weight");
+  ASSERT_FALSE(extra.warnings.empty());
+  EXPECT_NE(extra.warnings.back().find("has 1 morph targets and 3 weights"), std::string::npos)
+      << extra.warnings.back();
 }
 
 // A texture on a UV set the primitive lacks, or on a set the loader does
@@ -164,7 +179,10 @@ TEST_F(SceneGltf, MorphTargetsAreAppliedAtTheirDefaultWeights) {
 TEST_F(SceneGltf, TexturesOnMissingUvSetsAreWarned) {
   MiniGltf g = oneTriangle();
   g.image =  // one white texel
-      "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg==";
+      "data:image/"
+      "png;base64,"
+      "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJg"
+      "gg==";
   g.material = 0;
   g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])";
   const Scene s = loadScene(write("no-uv.gltf", g));
