@@ -341,11 +341,13 @@ void checkStdError(const RgbImage& stdError, const std::string& what) {
   for (size_t i = 0; i < stdError.pixelCount(); ++i) {
     const Vec3 e = stdError.at(i);
     for (int c = 0; c < 3; ++c) {
-      if (!(e[c] < 0)) continue;
+      // NaN and infinities too: they read as a reference without noise
+      // ("reference noise: 0", H15-4-2).
+      if (e[c] >= 0 && std::isfinite(e[c])) continue;
       char text[160];
       std::snprintf(text, sizeof text,
                     "pixel (%d, %d) holds a standard error of %g in channel %c: a standard error "
-                    "is 0 or more",
+                    "is a finite number, 0 or more",
                     int(i % size_t(stdError.width)), int(i / size_t(stdError.width)), double(e[c]),
                     "RGB"[c]);
       throw InputError(what + ": " + text);

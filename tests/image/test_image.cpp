@@ -211,6 +211,13 @@ TEST(Compare, ANegativeStandardErrorIsRefusedAndABlackReferenceWarned) {
                        "0 or more"});
   test::expectRefusal([&] { checkStdError(error, "--reference-error: e.exr"); },
                       {"--reference-error: e.exr: pixel (1, 2)"});
+  // NaN and infinities read as a reference without noise (H15-4-2).
+  for (const float odd : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
+    error.rgb[3 * (4 * 2 + 1) + 1] = odd;
+    test::expectRefusal([&] { checkStdError(error, "e.exr"); },
+                        {"pixel (1, 2) holds a standard error of", "a finite number, 0 or more"});
+  }
+  error.rgb[3 * (4 * 2 + 1) + 1] = 0.01f;
   EXPECT_EQ(compareReport(test, ref, CompareSettings{}).blackReferenceWarning(), "");
   const RgbImage black(4, 4);
   const CompareReport dark = compareReport(test, black, CompareSettings{});
