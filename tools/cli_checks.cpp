@@ -1,37 +1,18 @@
 #include "cli_checks.h"
 
-#include <sys/stat.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <limits>
 
 #include "bake/bake.h"
+#include "core/file.h"
 #include "distributed/tiled_bake.h"
 
 namespace lo::tool {
 
 CLI::Validator existingFile() {
-  return CLI::Validator(
-      [](std::string& path) -> std::string {
-        struct stat link = {};
-        struct stat target = {};
-        if (::lstat(path.c_str(), &link) != 0) {
-          return errno == ENOENT ? "File does not exist: " + path
-                                 : "'" + path + "' cannot be reached: " + std::strerror(errno);
-        }
-        if (::stat(path.c_str(), &target) != 0) {
-          if (errno == ELOOP) return "'" + path + "' is a loop of symbolic links";
-          if (errno == ENOENT) return "'" + path + "' is a symbolic link to nothing";
-          return "'" + path + "' cannot be reached: " + std::strerror(errno);
-        }
-        if (S_ISDIR(target.st_mode)) return "'" + path + "' is a folder, not a file";
-        return "";
-      },
-      "FILE");
+  return CLI::Validator([](std::string& path) { return inputFileProblem(path); }, "FILE");
 }
 
 CLI::Validator vdlCountValidator() {

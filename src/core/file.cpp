@@ -212,6 +212,22 @@ void requireRegularFile(const std::string& path, const std::string& what) {
   }
 }
 
+std::string inputFileProblem(const std::string& path) {
+  struct stat link = {};
+  struct stat target = {};
+  if (::lstat(path.c_str(), &link) != 0) {
+    return errno == ENOENT ? "File does not exist: " + path
+                           : "'" + path + "' cannot be reached: " + std::strerror(errno);
+  }
+  if (::stat(path.c_str(), &target) != 0) {
+    if (errno == ELOOP) return "'" + path + "' is a loop of symbolic links";
+    if (errno == ENOENT) return "'" + path + "' is a symbolic link to nothing";
+    return "'" + path + "' cannot be reached: " + std::strerror(errno);
+  }
+  if (S_ISDIR(target.st_mode)) return "'" + path + "' is a folder, not a file";
+  return "";
+}
+
 std::string readFile(const std::string& path) {
   checkPathText(path, "cannot read");
   // A FIFO or a device would block or never end: only regular files are read.

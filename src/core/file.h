@@ -20,6 +20,12 @@ namespace lo {
 /// pipe (only regular files are read)", or "... does not exist".
 void requireRegularFile(const std::string& path, const std::string& what);
 
+/// Why `path` cannot be read as an input file, or "" when it can: "File does
+/// not exist: PATH" (the command line parser's words), or that it is a loop
+/// of symbolic links, a link to nothing, a folder, or cannot be reached (the
+/// parser said "File does not exist" of each, H14-2-1).
+std::string inputFileProblem(const std::string& path);
+
 /// @brief What stands at `path` (links followed) when it is not a regular
 /// file, for the message of a loader that goes on without it: "missing"
 /// (nothing there, or it cannot be looked at), "a folder", "a pipe", "a
