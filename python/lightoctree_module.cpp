@@ -14,6 +14,7 @@
 #include <pybind11/stl.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <clocale>
@@ -869,10 +870,15 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Arg<Grid>
 /// An EXR (linear) or PNG (sRGB decoded) image as (height, width, 3) floats.
 py::array_t<float> readImageFile(const Arg<std::string>& pathArgument) {
   const std::string path = pathArg(pathArgument.value, "path");
-  const RgbImage image = readImage(path);
-  py::array_t<float> out({size_t(image.height), size_t(image.width), size_t(3)});
-  std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
-  return out;
+  // Without the lock (a large PNG decodes for seconds), and the array holds
+  // the image's floats rather than a copy of them.
+  auto image = std::make_unique<RgbImage>(withProgress(
+      py::none(), "read_image", [&](ProgressSink*) { return readImage(path); }));
+  const std::array<size_t, 3> shape = {size_t(image->height), size_t(image->width), 3};
+  float* data = image->rgb.data();
+  py::capsule owner(image.get(), [](void* held) { delete static_cast<RgbImage*>(held); });
+  image.release();
+  return py::array_t<float>(shape, data, owner);
 }
 
 // ---- reference, compare, lightmap: the commands' settings and defaults ----

@@ -151,6 +151,7 @@ int runConvert(const ConvertOptions& opt) {
     warn(photonSkyMismatchWarning(what, info.skyHash, "IN '" + opt.input + "'", in.meta.skyHash));
     warn(photonDirectMismatchWarning(what, info.includeDirect, "IN '" + opt.input + "'",
                                      in.meta.includeDirect));
+    warn(sparseRegatherWarning(in.grid, in.meta, params));
   }
   ConvertResult out = convertLightGrid(in.grid, in.meta, params, &progress);
   rows.insert(rows.end(), out.stages.begin(), out.stages.end());

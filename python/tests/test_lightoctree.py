@@ -1228,3 +1228,34 @@ def test_numbers_are_read_in_the_c_locale_whatever_the_program_set(tmp_path):
     assert in_callback == ",", in_callback
     g = lightoctree.bake(SCENE, depth=3, photons=3000, knn=20, sky=(0.5, 0.5, 0.5))
     assert float(lit) == float(np.asarray(g.irradiance, dtype=np.float64).sum())
+
+
+def _png_gray_to_rgb(path, values):
+    """A one-row 8-bit RGB PNG whose pixels are the grey levels `values`."""
+    import struct
+    import zlib
+    row = b"\0" + bytes(v for v in values for _ in range(3))
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff))
+    header = struct.pack(">IIBBBBB", len(values), 1, 8, 2, 0, 0, 0)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) +
+                chunk(b"IDAT", zlib.compress(row)) + chunk(b"IEND", b""))
+
+
+def test_read_image_decodes_every_8_bit_value_by_the_srgb_curve(tmp_path):
+    # The decode's table (one sRGB-to-linear value per 8-bit level) against
+    # IEC 61966-2-1 in double precision; the array owns its floats and stays
+    # valid after the call.
+    path = str(tmp_path / "levels.png")
+    _png_gray_to_rgb(path, range(256))
+    image = lightoctree.read_image(path)
+    assert image.shape == (1, 256, 3) and image.dtype == np.float32
+    s = np.arange(256) / 255.0
+    expected = np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4)
+    for channel in range(3):
+        assert np.allclose(image[0, :, channel], expected, rtol=1e-6, atol=1e-7)
+    image[0, 0, 0] = 7.0  # writable, its own memory
+    assert lightoctree.read_image(path)[0, 0, 0] == 0.0

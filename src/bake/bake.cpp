@@ -379,25 +379,30 @@ void checkVoxelMemory(const Scene& scene, const GridFrame& frame, const Bounds3&
 }
 
 std::string sparsePhotonsWarning(const Scene& scene, const BakeParams& params) {
-  constexpr double kManyVoxels = 1e6, kPhotonsPerVoxel = 0.1;
-  if (params.photons == 0 || params.targetError > 0 || params.depth == kAutoDepth ||
-      scene.triangleCount() == 0) {
-    return "";
-  }
+  if (params.photons == 0 || params.targetError > 0 || params.depth == kAutoDepth) return "";
   const GridFrame frame =
       makeGridFrame(params.region.empty() ? scene.bounds() : params.region, params.depth);
-  const double voxels = estimateActiveVoxels(scene, frame, params.region);
-  const double perVoxel = double(params.photons) / std::max(voxels, 1.0);
+  return sparsePhotonsWarning(scene, frame, params.region, params.photons,
+                              "--photons " + formatCount(params.photons),
+                              "--depth auto picks the depth the photons resolve, or give more "
+                              "--photons");
+}
+
+std::string sparsePhotonsWarning(const Scene& scene, const GridFrame& frame,
+                                 const Bounds3& region, size_t photons, const std::string& what,
+                                 const std::string& advice) {
+  constexpr double kManyVoxels = 1e6, kPhotonsPerVoxel = 0.1;
+  if (scene.triangleCount() == 0) return "";
+  const double voxels = estimateActiveVoxels(scene, frame, region);
+  const double perVoxel = double(photons) / std::max(voxels, 1.0);
   if (voxels < kManyVoxels || perVoxel >= kPhotonsPerVoxel) return "";
   char share[32];
   std::snprintf(share, sizeof share, "%.2g", perVoxel);
-  return "--depth " + std::to_string(params.depth) + ": the surfaces cross about " +
-         formatCount(size_t(voxels)) + " voxels, and --photons " + formatCount(params.photons) +
-         " are " + share +
+  return "--depth " + std::to_string(frame.depth) + ": the surfaces cross about " +
+         formatCount(size_t(voxels)) + " voxels, and " + what + " are " + share +
          " a voxel: each voxel's light is gathered from photons far beyond "
-         "it, and the bake spends the time and memory of every voxel (about " +
-         formatBytes(size_t(voxels * double(kBakeBytesPerVoxel))) +
-         "): --depth auto picks the depth the photons resolve, or give more --photons";
+         "it, and the work takes the time and memory of every voxel (about " +
+         formatBytes(size_t(voxels * double(kBakeBytesPerVoxel))) + "): " + advice;
 }
 
 void checkBakeMemory(const Scene& scene, const BakeParams& params, int processes) {

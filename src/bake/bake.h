@@ -384,6 +384,12 @@ void checkVoxelMemory(const Scene& scene, const GridFrame& frame, const Bounds3&
 /// beyond each voxel, H14-5-3); empty otherwise, and for --depth auto or a
 /// target error, which fit the depth or the photons to each other.
 std::string sparsePhotonsWarning(const Scene& scene, const BakeParams& params);
+/// The same for `photons` photons gathered over `frame` (a bake's, or
+/// `convert --photon-map` to a finer depth), `what` naming them and `advice`
+/// ending the message.
+std::string sparsePhotonsWarning(const Scene& scene, const GridFrame& frame,
+                                 const Bounds3& region, size_t photons, const std::string& what,
+                                 const std::string& advice);
 
 /// Refuses, before any work, a bake whose voxels (estimateActiveVoxels x
 /// kBakeBytesPerVoxel) and photons (kBakeBytesPerPhoton) need more memory

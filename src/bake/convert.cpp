@@ -3,6 +3,8 @@
 
 #include "bake/convert.h"
 
+#include <cmath>
+
 #include "cluster/resample.h"
 #include "core/error.h"
 
@@ -38,6 +40,19 @@ void checkPhotonRegion(const Bounds3& photons, const BakeMetadata& inMeta, const
 }
 
 }  // namespace
+
+std::string sparseRegatherWarning(const VdlGrid& input, const BakeMetadata& meta,
+                                  const ConvertParams& params) {
+  if (!params.photons || !params.scene) return "";
+  const int depth = params.depth != 0 ? params.depth : input.frame.depth;
+  if (depth < 1 || depth > kMaxGridDepth) return "";  // refused by the conversion
+  GridFrame frame = input.frame;
+  frame.depth = depth;
+  frame.voxelSize = float(std::ldexp(double(input.frame.voxelSize), input.frame.depth - depth));
+  return sparsePhotonsWarning(*params.scene, frame, meta.region, params.photons->size(),
+                              "the " + formatCount(params.photons->size()) + " photons of --photon-map",
+                              "a coarser --depth, or bake again with more --photons");
+}
 
 ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,
                                const ConvertParams& params, ProgressSink* progress) {

@@ -50,6 +50,12 @@ struct ConvertResult {
   std::vector<StageReport> stages;
 };
 
+/// The warning of a fixed photon budget spread thin (sparsePhotonsWarning)
+/// for re-gathering `params.photons` at `params.depth` over `input`'s
+/// voxels; empty without photons or a scene, or where they suffice.
+std::string sparseRegatherWarning(const VdlGrid& input, const BakeMetadata& meta,
+                                  const ConvertParams& params);
+
 /// @brief Converts `input` (with its file metadata `meta`) as `params` asks.
 /// `convertedFrom` is left to the caller, which knows the file name.
 /// @throws InputError naming the flag when the request needs what was not

@@ -7,6 +7,7 @@
 /// neither links the other's libraries (the reference renderer and `compare`
 /// run where no OpenGL exists).
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,8 @@ void checkImageSize(int64_t width, int64_t height, double bytesPerPixel);
 
 /// sRGB transfer function (IEC 61966-2-1) to linear, for one channel in [0, 1].
 float srgbToLinear(float s);
+/// srgbToLinear of the 256 values of an 8-bit channel (v / 255), computed once.
+const std::array<float, 256>& srgb8ToLinear();
 /// Its inverse: linear (clamped to [0, 1]; not finite: 0) to sRGB, in [0, 1].
 float linearToSrgb(float linear);
 

@@ -84,15 +84,6 @@ Texture Texture::fromLinear(int width, int height, const std::vector<Vec3>& rgb,
 
 namespace {
 
-/// 8-bit sRGB to linear, every value once.
-const std::array<float, 256>& srgb8ToLinear() {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) t[size_t(i)] = srgbToLinear(float(i) / 255.0f);
-    return t;
-  }();
-  return table;
-}
 
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "bake/bake.h"
+#include "bake/convert.h"
 #include "core/error.h"
 #include "bake/bake_fixture.h"
 #include "test_util.h"
@@ -205,6 +206,32 @@ TEST(BakeDepth, PhotonsSpreadThinOverAMillionVoxelsAreWarned) {
   p.depth = 10;
   setPhotonBudget(p, 0, 0.05);  // a target fits the photons to the voxels
   EXPECT_EQ(sparsePhotonsWarning(scene, p), "");
+}
+
+// The same warning before `convert --photon-map` re-gathers a small photon
+// map at a fine depth (list 14: --depth 10 from a small map, no word).
+TEST(BakeDepth, ARegatherOfFewPhotonsOverAMillionVoxelsIsWarned) {
+  Scene scene = test::oneMaterialScene();
+  test::addQuad(scene, Vec3(0.0f), Vec3(1, 0, 0), Vec3(0, 0, 1), Vec3(0, 1, 0), 0);
+  VdlGrid grid;
+  grid.frame = makeGridFrame(scene.bounds(), 4);
+  const std::vector<Photon> photons(50000);
+  ConvertParams params;
+  params.scene = &scene;
+  params.photons = &photons;
+  params.depth = 10;
+  const std::string warning = sparseRegatherWarning(grid, BakeMetadata{}, params);
+  EXPECT_NE(warning.find("--depth 10: the surfaces cross about 1,0"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("the 50,000 photons of --photon-map are 0.05 a voxel"), std::string::npos)
+      << warning;
+  EXPECT_NE(warning.find("a coarser --depth"), std::string::npos) << warning;
+  params.depth = 9;  // 262,144 voxels
+  EXPECT_EQ(sparseRegatherWarning(grid, BakeMetadata{}, params), "");
+  params.depth = 0;  // the input's depth, 4
+  EXPECT_EQ(sparseRegatherWarning(grid, BakeMetadata{}, params), "");
+  params.depth = 10;
+  params.photons = nullptr;  // merged or interpolated, not gathered
+  EXPECT_EQ(sparseRegatherWarning(grid, BakeMetadata{}, params), "");
 }
 
 }  // namespace
