@@ -872,8 +872,8 @@ py::array_t<float> readImageFile(const Arg<std::string>& pathArgument) {
   const std::string path = pathArg(pathArgument.value, "path");
   // Without the lock (a large PNG decodes for seconds), and the array holds
   // the image's floats rather than a copy of them.
-  auto image = std::make_unique<RgbImage>(withProgress(
-      py::none(), "read_image", [&](ProgressSink*) { return readImage(path); }));
+  auto image = std::make_unique<RgbImage>(
+      withProgress(py::none(), "read_image", [&](ProgressSink*) { return readImage(path); }));
   const std::array<size_t, 3> shape = {size_t(image->height), size_t(image->width), 3};
   float* data = image->rgb.data();
   py::capsule owner(image.get(), [](void* held) { delete static_cast<RgbImage*>(held); });

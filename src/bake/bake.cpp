@@ -388,8 +388,8 @@ std::string sparsePhotonsWarning(const Scene& scene, const BakeParams& params) {
                               "--photons");
 }
 
-std::string sparsePhotonsWarning(const Scene& scene, const GridFrame& frame,
-                                 const Bounds3& region, size_t photons, const std::string& what,
+std::string sparsePhotonsWarning(const Scene& scene, const GridFrame& frame, const Bounds3& region,
+                                 size_t photons, const std::string& what,
                                  const std::string& advice) {
   constexpr double kManyVoxels = 1e6, kPhotonsPerVoxel = 0.1;
   if (scene.triangleCount() == 0) return "";

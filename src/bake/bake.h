@@ -387,8 +387,8 @@ std::string sparsePhotonsWarning(const Scene& scene, const BakeParams& params);
 /// The same for `photons` photons gathered over `frame` (a bake's, or
 /// `convert --photon-map` to a finer depth), `what` naming them and `advice`
 /// ending the message.
-std::string sparsePhotonsWarning(const Scene& scene, const GridFrame& frame,
-                                 const Bounds3& region, size_t photons, const std::string& what,
+std::string sparsePhotonsWarning(const Scene& scene, const GridFrame& frame, const Bounds3& region,
+                                 size_t photons, const std::string& what,
                                  const std::string& advice);
 
 /// Refuses, before any work, a bake whose voxels (estimateActiveVoxels x

@@ -49,9 +49,10 @@ std::string sparseRegatherWarning(const VdlGrid& input, const BakeMetadata& meta
   GridFrame frame = input.frame;
   frame.depth = depth;
   frame.voxelSize = float(std::ldexp(double(input.frame.voxelSize), input.frame.depth - depth));
-  return sparsePhotonsWarning(*params.scene, frame, meta.region, params.photons->size(),
-                              "the " + formatCount(params.photons->size()) + " photons of --photon-map",
-                              "a coarser --depth, or bake again with more --photons");
+  return sparsePhotonsWarning(
+      *params.scene, frame, meta.region, params.photons->size(),
+      "the " + formatCount(params.photons->size()) + " photons of --photon-map",
+      "a coarser --depth, or bake again with more --photons");
 }
 
 ConvertResult convertLightGrid(const VdlGrid& in, const BakeMetadata& inMeta,

@@ -8,9 +8,9 @@
 #include <cstring>
 
 #include "bake/bake.h"
+#include "bake/bake_fixture.h"
 #include "bake/convert.h"
 #include "core/error.h"
-#include "bake/bake_fixture.h"
 #include "test_util.h"
 
 namespace lo {
