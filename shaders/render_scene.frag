@@ -412,7 +412,12 @@ void main() {
     }
   }
   if (uTransmission > 0.0) radiance += transmittedLight(n, v, baseColor);
+#ifdef LO_ALPHA_CUT
+  // Built without it for the other materials: a shader that may discard is
+  // shaded before the depth and stencil tests on the software rasteriser
+  // (Renderer::Impl::uncutTwins).
   if (cutOut) discard;
+#endif
   radiance *= uExposureScale;
   fragColor = vec4(uEncodeSrgb ? srgbEncode(radiance) : radiance, coverage);
 }

@@ -79,13 +79,13 @@ void Renderer::Impl::captureProbe(const RenderParams& rp) {
     probe.fbo = GlFramebuffer::create();
     probe.depth = GlRenderbuffer::create();
     glBindRenderbuffer(GL_RENDERBUFFER, probe.depth.get());
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, size, size);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, size, size);
     checkGl("allocating the reflection probe");
   }
   GLint previous = 0;
   glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous);
   glBindFramebuffer(GL_FRAMEBUFFER, probe.fbo.get());
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER,
                             probe.depth.get());
   const Vec3 forward[kProbeFaces] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
                                      {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};

@@ -82,8 +82,6 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.sky = scene.sky.radiance;
   for (const Material& m : scene.materials) r.volumes |= m.transmission > 0 && m.thickness > 0;
   r.sceneProgram = GlProgram(r.buildSceneProgram({"LO_DIRECT_LIGHT"}));
-  glUniformBlockBinding(r.sceneProgram.get(),
-                        glGetUniformBlockIndex(r.sceneProgram.get(), "LightBlock"), 0);
   r.sceneIndirectProgram = GlProgram(r.buildSceneProgram({}));
   r.depthProgram = GlProgram(buildProgram({"render_depth.vert", "render_depth.frag"}));
   if (maxComponent(r.sky) > 0) {
@@ -241,8 +239,6 @@ void Renderer::setFreeSpaceLight(const GpuOctree& volume) {
   OctreeTextures::checkLimits(volume, r.params.max3DTextureSize, r.params.max2DTextureSize);
   if (!r.sceneMovingProgram) {
     r.sceneMovingProgram = GlProgram(r.buildSceneProgram({"LO_DIRECT_LIGHT", "LO_FREE_SPACE"}));
-    glUniformBlockBinding(r.sceneMovingProgram.get(),
-                          glGetUniformBlockIndex(r.sceneMovingProgram.get(), "LightBlock"), 0);
     r.sceneIndirectMovingProgram =
         GlProgram(r.buildSceneProgram({"LO_FREE_SPACE"}));
   }
@@ -410,7 +406,11 @@ void compileAllShaders() {
            {"LO_FREE_SPACE"},
            {"LO_DIRECT_LIGHT", "LO_VOLUMES"},
            {"LO_VOLUMES"}}) {
+    // Each with and without the alpha cut (Renderer::Impl::uncutTwins).
+    std::vector<std::string> cut = defines;
+    cut.push_back("LO_ALPHA_CUT");
     const GlProgram program(buildProgram({"render_scene.vert", "render_scene.frag"}, defines));
+    const GlProgram cutProgram(buildProgram({"render_scene.vert", "render_scene.frag"}, cut));
   }
 }
 

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <glm/glm.hpp>
+#include <map>
 #include <vector>
 
 #include "core/math.h"
@@ -189,8 +190,18 @@ struct Renderer::Impl {
   /// rasteriser's compile time follows the shader's size).
   bool volumes = false;
   /// The scene program's files built with `defines`, plus LO_VOLUMES where
-  /// the scene has a volume.
-  GLuint buildSceneProgram(std::vector<std::string> defines) const;
+  /// the scene has a volume, and LO_ALPHA_CUT (the masked materials' cut);
+  /// its twin without the cut goes to uncutTwins. Both have their LightBlock,
+  /// where they use one, at binding 0.
+  GLuint buildSceneProgram(std::vector<std::string> defines);
+  /// Each scene program's twin built without the alpha cut's `discard`,
+  /// which draws every material but the masked ones: the software
+  /// rasteriser depth- and stencil-tests the fragments of a shader without
+  /// one before shading them, so that surfaces at one depth shade a pixel
+  /// once (drawRanges); with one, it shades first and tests after.
+  std::map<GLuint, render_internal::GlProgram> uncutTwins;
+  /// `program`'s twin in uncutTwins (0 for 0).
+  GLuint uncut(GLuint program) const;
   /// The scene pass in two variants: with the direct light compiled in (full,
   /// direct) and without it (indirect, voxels), so the octree-only modes do
   /// not pay for the lights' code on a software rasterizer.
@@ -267,8 +278,11 @@ struct Renderer::Impl {
                         bool encodeSrgb);
   /// `movingProgram` (0: none) draws the ranges of added objects, with the
   /// free-space light's textures bound in place of the octree's.
+  /// `oncePerPixel` (after the depth pre-pass): the opaque ranges shade a
+  /// pixel once, the first fragment at the pre-pass's depth (the stencil).
   void drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye,
-                  const glm::mat4& viewProj, GLuint program, GLuint movingProgram);
+                  const glm::mat4& viewProj, GLuint program, GLuint movingProgram,
+                  bool oncePerPixel);
 
   // reflection_probe.cpp
   /// Renders the probe's six faces with the full scene program, reflections

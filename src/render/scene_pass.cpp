@@ -76,10 +76,11 @@ void Renderer::Impl::ensureTarget(int width, int height) {
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   glBindRenderbuffer(GL_RENDERBUFFER, targetDepth.get());
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+  // With a stencil: the scene pass shades each pixel once (drawRanges).
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, width, height);
   glBindFramebuffer(GL_FRAMEBUFFER, targetFbo.get());
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, targetColor.get(), 0);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER,
                             targetDepth.get());
   GLenum drawBuffer = GL_COLOR_ATTACHMENT0;
   glDrawBuffers(1, &drawBuffer);
@@ -207,9 +208,23 @@ void Renderer::Impl::copyBehind(int width, int height, bool floatTarget) {
   checkGl("copying the opaque image for transmissive surfaces");
 }
 
-GLuint Renderer::Impl::buildSceneProgram(std::vector<std::string> defines) const {
+GLuint Renderer::Impl::buildSceneProgram(std::vector<std::string> defines) {
   if (volumes) defines.push_back("LO_VOLUMES");
-  return buildProgram({"render_scene.vert", "render_scene.frag"}, defines);
+  auto withLightBlock = [](GLuint program) {
+    const GLuint block = glGetUniformBlockIndex(program, "LightBlock");
+    if (block != GL_INVALID_INDEX) glUniformBlockBinding(program, block, 0);
+    return program;
+  };
+  GlProgram twin(withLightBlock(buildProgram({"render_scene.vert", "render_scene.frag"}, defines)));
+  defines.push_back("LO_ALPHA_CUT");
+  const GLuint program =
+      withLightBlock(buildProgram({"render_scene.vert", "render_scene.frag"}, defines));
+  uncutTwins[program] = std::move(twin);
+  return program;
+}
+
+GLuint Renderer::Impl::uncut(GLuint program) const {
+  return program ? uncutTwins.at(program).get() : 0;
 }
 
 /// The scene program for a frame: with or without the direct light, with
@@ -219,8 +234,6 @@ GLuint Renderer::Impl::sceneProgramFor(const RenderParams& rp, bool withDirect) 
                             rp.mode != RenderMode::Voxels && atlasVbo;
   if (atlasProgram && !sceneAtlasProgram) {
     sceneAtlasProgram = GlProgram(buildSceneProgram({"LO_DIRECT_LIGHT", "LO_ATLAS_LIGHTING"}));
-    glUniformBlockBinding(sceneAtlasProgram.get(),
-                          glGetUniformBlockIndex(sceneAtlasProgram.get(), "LightBlock"), 0);
     sceneIndirectAtlasProgram =
         GlProgram(buildSceneProgram({"LO_ATLAS_LIGHTING"}));
   }
@@ -311,7 +324,7 @@ void Renderer::Impl::setFrameUniforms(GLuint p, const PinholeCamera& camera, con
 /// was drawn before them.
 void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const glm::vec3& eye,
                                 const glm::mat4& viewProj, GLuint staticProgram,
-                                GLuint movingProgram) {
+                                GLuint movingProgram, bool oncePerPixel) {
   glBindVertexArray(geometry.vao.get());
   GLuint p = 0;
   GLint hasTexture = -1, hasNormal = -1, normalScale = -1, hasMr = -1, hasOcclusion = -1,
@@ -319,11 +332,11 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
         alphaCutoff = -1, thickness = -1, ior = -1, dielectric = -1, unlit = -1,
         emitsBothSides = -1;
   // The program of a range, in use with its octree's textures bound.
-  auto use = [&](GLuint program) {
+  auto use = [&](GLuint program, bool movingLight) {
     if (program == p) return;
     p = program;
     glUseProgram(p);
-    if (p == movingProgram) {
+    if (movingLight) {
       volumeTextures.bind(p, 0, 1, 3);
     } else {
       octreeTextures.bind(p, 0, 1, 3);
@@ -352,8 +365,23 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
   bool copied = false, blending = false;
   for (size_t i = 0; i < geometry.ranges.size(); ++i) {
     const DrawRange& range = geometry.ranges[i];
-    use(range.moving && movingProgram ? movingProgram : staticProgram);
+    // Masked materials with their cut, the others without (uncutTwins).
+    const bool movingLight = range.moving && movingProgram;
+    const GLuint program = movingLight ? movingProgram : staticProgram;
+    use(range.alphaMode == shader::LO_ALPHA_MASK ? program : uncut(program), movingLight);
     const bool blended = geometry.rangeCategory[i] == kBlended;
+    // Surfaces at one depth (coplanar copies) shaded every fragment: 3,000
+    // coplanar quads took 140 s for a 128 x 96 frame. The first opaque
+    // fragment at the pre-pass's depth marks its pixel and the others are
+    // not shaded. Masked surfaces (decals on a wall's plane), blended and
+    // transmissive ones draw over what is drawn, unmarked, as before.
+    if (oncePerPixel) {
+      if (geometry.rangeCategory[i] == kSolid) {
+        glEnable(GL_STENCIL_TEST);
+      } else {
+        glDisable(GL_STENCIL_TEST);
+      }
+    }
     if (blended && !blending) {
       // Over the opaque scene, back to front, without depth writes.
       geometry.sortBlended(eye);
@@ -373,7 +401,8 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
       // the refracted rays leave them (render_scene.frag).
       if (volumes) {
         drawVolumeBacks(width, height, viewProj, eye);
-        for (GLuint program : {staticProgram, movingProgram}) {
+        for (GLuint program :
+             {staticProgram, uncut(staticProgram), movingProgram, uncut(movingProgram)}) {
           if (!program) continue;
           glUseProgram(program);
           glUniform1i(glGetUniformLocation(program, "uHasVolumeBacks"), 1);
@@ -427,6 +456,7 @@ void Renderer::Impl::drawRanges(int width, int height, bool encodeSrgb, const gl
     }
   }
   if (blending) glDisable(GL_BLEND);
+  glDisable(GL_STENCIL_TEST);
 }
 
 void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, int width,
@@ -471,7 +501,8 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
 
   glViewport(0, 0, width, height);
   glClearColor(0, 0, 0, 1);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glClearStencil(0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
   if (skyProgram) {
     // The background: the sky above the horizon, black below.
     const float tanHalf = std::tan(0.5f * camera.yfov);
@@ -520,30 +551,41 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);
   }
+  // Each program with its twin without the alpha cut (uncutTwins), the
+  // program last in use.
   const GLuint p = sceneProgramFor(rp, withDirect);
-  glUseProgram(p);
-  setFrameUniforms(p, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
+  for (const GLuint variant : {uncut(p), p}) {
+    glUseProgram(variant);
+    setFrameUniforms(variant, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
+  }
   // The opaque image's copy for transmissive surfaces: bound from the first
   // draw, its share that this frame fills.
   ensureBehind(width, height, !encodeSrgb);
   const glm::vec2 behindScale(float(width) / float(behindWidth),
                               float(height) / float(behindHeight));
-  glUniform2fv(glGetUniformLocation(p, "uBehindScale"), 1, glm::value_ptr(behindScale));
+  for (const GLuint variant : {uncut(p), p}) {
+    glUseProgram(variant);
+    glUniform2fv(glGetUniformLocation(variant, "uBehindScale"), 1, glm::value_ptr(behindScale));
+  }
   // Added objects: the free-space light's program, its frame uniforms, and
   // the free-space octree's frame in place of the surfaces'.
   GLuint moving = 0;
   if (hasVolume && hasMovingRanges && rp.mode != RenderMode::Voxels &&
       rp.lighting == Lighting::Octree) {
     moving = withDirect ? sceneMovingProgram.get() : sceneIndirectMovingProgram.get();
-    glUseProgram(moving);
-    setFrameUniforms(moving, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
-    glUniform2fv(glGetUniformLocation(moving, "uBehindScale"), 1, glm::value_ptr(behindScale));
-    glUniform3f(glGetUniformLocation(moving, "uOctreeOrigin"), volumeOrigin.x, volumeOrigin.y,
-                volumeOrigin.z);
-    glUniform1f(glGetUniformLocation(moving, "uVoxelSize"), volumeTextures.voxelSize);
-    glUniform1i(glGetUniformLocation(moving, "uDepth"), volumeTextures.depth);
+    for (const GLuint variant : {uncut(moving), moving}) {
+      glUseProgram(variant);
+      setFrameUniforms(variant, camera, rp, viewProj, reflect, exposureScale, encodeSrgb);
+      glUniform2fv(glGetUniformLocation(variant, "uBehindScale"), 1, glm::value_ptr(behindScale));
+      glUniform3f(glGetUniformLocation(variant, "uOctreeOrigin"), volumeOrigin.x, volumeOrigin.y,
+                  volumeOrigin.z);
+      glUniform1f(glGetUniformLocation(variant, "uVoxelSize"), volumeTextures.voxelSize);
+      glUniform1i(glGetUniformLocation(variant, "uDepth"), volumeTextures.depth);
+    }
   }
-  drawRanges(width, height, encodeSrgb, eye, viewProj, p, moving);
+  glStencilFunc(GL_EQUAL, 0, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+  drawRanges(width, height, encodeSrgb, eye, viewProj, p, moving, prePass);
   glDisable(GL_CULL_FACE);
   glBindVertexArray(0);
   glBindSampler(5, 0);
