@@ -182,6 +182,21 @@ void stopCallsAtExit() {
   for (int i = 0; i < 1000 && callsAtWork.load() > 0; ++i) ::usleep(10000);
 }
 
+/// The process that imported the module. A child forked from it hung at
+/// its exit (H16-1-2): log4cplus, OpenVDB's logger, waits at exit for its
+/// thread pool's threads, which the fork did not copy. Registered at import,
+/// after log4cplus's own exit-time handler (the last registered runs first),
+/// endForkedChild ends such a child's exit as os._exit would: after the
+/// interpreter has finalised and stdio is flushed, without the libraries'
+/// exit-time handlers.
+pid_t importingProcess = 0;
+
+void endForkedChild(int status, void*) {
+  if (::getpid() == importingProcess) return;
+  std::fflush(nullptr);
+  ::_exit(status);
+}
+
 /// Where a call's thread goes when the interpreter ends under it: it waits
 /// for the process to end, as Python 3.14 makes such threads wait, never
 /// taking the lock (nor unwinding through frames that would need it).
@@ -1325,6 +1340,8 @@ PYBIND11_MODULE(lightoctree, m) {
   realNumberType = py::object(py::module_::import("numbers").attr("Real")).release();
   py::detail::npy_api::get();
   py::module_::import("atexit").attr("register")(py::cpp_function(stopCallsAtExit));
+  importingProcess = ::getpid();
+  ::on_exit(endForkedChild, nullptr);
   static py::handle inputError =
       py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
   static py::handle ioError = py::register_exception<IoError>(m, "IoError", PyExc_OSError);

@@ -1259,3 +1259,33 @@ def test_read_image_decodes_every_8_bit_value_by_the_srgb_curve(tmp_path):
         assert np.allclose(image[0, :, channel], expected, rtol=1e-6, atol=1e-7)
     image[0, 0, 0] = 7.0  # writable, its own memory
     assert lightoctree.read_image(path)[0, 0, 0] == 0.0
+
+
+def test_a_child_forked_after_the_import_ends_with_its_exit_status():
+    """A child forked from a process that had imported the module hung at its
+    exit, in OpenVDB's logger, whose threads the fork did not copy (H16-1-2).
+    It ends, with its own status and its output flushed, whether it calls
+    sys.exit or runs off the end of the script."""
+    import subprocess
+    import sys
+    script = (
+        "import os, sys, time\n"
+        "import lightoctree\n"
+        "pid = os.fork()\n"
+        "if pid == 0:\n"
+        "    print('child', flush=False)\n"
+        "    sys.exit(int(sys.argv[1]))\n"
+        "deadline = time.monotonic() + 30\n"
+        "while time.monotonic() < deadline:\n"
+        "    done, status = os.waitpid(pid, os.WNOHANG)\n"
+        "    if done:\n"
+        "        print('exit', os.waitstatus_to_exitcode(status))\n"
+        "        sys.exit(0)\n"
+        "    time.sleep(0.05)\n"
+        "os.kill(pid, 9)\n"
+        "print('hung')\n")
+    for code in (0, 3):
+        run = subprocess.run([sys.executable, "-c", script, str(code)], capture_output=True,
+                             text=True, timeout=120)
+        assert run.returncode == 0, run.stderr
+        assert run.stdout.split() == ["child", "exit", str(code)], run.stdout
