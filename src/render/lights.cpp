@@ -46,11 +46,6 @@ constexpr size_t kCascadeSampleTriangles = size_t(1) << 14;
 /// floors' halves all at odd indices, saw none of them (H13-5-3).
 constexpr uint64_t kSampleStep = 2654435761u;
 
-/// Index of the s-th of `sampled` triangles of `triangles` in an even sample.
-size_t sampledTriangle(size_t s, size_t sampled, size_t triangles) {
-  return sampled == triangles ? s : size_t((uint64_t(s) * kSampleStep) % uint64_t(triangles));
-}
-
 glm::vec3 toGlm(const Vec3& v) { return {v.x, v.y, v.z}; }
 glm::vec4 toVec4(const Vec3& v, float w) { return {v.x, v.y, v.z, w}; }
 
@@ -482,6 +477,10 @@ void SceneLights::fitCascadeSlices(const RenderSpace& space, const glm::vec3& ey
           glm::lookAt(lightEye, snapped, perpendicular(dir));
     }
   }
+}
+
+size_t sampledTriangle(size_t s, size_t sampled, size_t triangles) {
+  return sampled == triangles ? s : size_t((uint64_t(s) * kSampleStep) % uint64_t(triangles));
 }
 
 }  // namespace lo::render_internal

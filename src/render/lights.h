@@ -16,6 +16,10 @@
 
 namespace lo::render_internal {
 
+/// Index of the s-th of `sampled` triangles of `triangles` in an even sample
+/// (a step coprime with the count spreads it over the index range).
+size_t sampledTriangle(size_t s, size_t sampled, size_t triangles);
+
 /// The light block and the shadow maps of a scene (lights.cpp).
 struct SceneLights {
   LightBlock block{};

@@ -176,6 +176,10 @@ struct Renderer::Impl {
   RendererParams params;
   std::vector<StageReport> startup;  ///< Renderer::startupStages
   render_internal::RenderSpace space;
+  /// The corners of an even sample of the scene's triangles (2^14 at most,
+  /// render space): the camera's near plane stays nearer than the nearest
+  /// of them (nearPlane).
+  std::vector<glm::vec3> nearSample;
   int depth = 0;
   Vec3 octreeOrigin;
   float voxelSize = 1;

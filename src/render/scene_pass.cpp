@@ -8,6 +8,7 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <limits>
 
 #include "core/error.h"
 #include "render/context.h"
@@ -20,15 +21,46 @@ using namespace render_internal;
 
 namespace {
 
+/// Distance from p to the triangle abc: its closest point by the regions of
+/// the triangle's corners and edges (Ericson, Real-Time Collision Detection,
+/// 5.1.5).
+float distanceToTriangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
+                         const glm::vec3& c) {
+  const glm::vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return glm::length(ap);
+  const glm::vec3 bp = p - b;
+  const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return glm::length(bp);
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
+  const glm::vec3 cp = p - c;
+  const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return glm::length(cp);
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+  }
+  const float denom = va + vb + vc;
+  if (!(std::fabs(denom) > 0)) return glm::length(ap);  // degenerate: a corner's distance
+  return glm::length(p - (a + ab * (vb / denom) + ac * (vc / denom)));
+}
+
 /// The camera's near plane, raised where the 24-bit depth buffer needs it
 /// (a 1 km scene seen with a glTF's znear of 1 cm z-fights: a surface 1 m
 /// below another flickers through it): outside the scene's box, to 90% of
 /// the eye's distance from the box (nothing lies nearer); and at least
 /// 1e-4 of the far plane (depth steps under 1e-3 of the distance to its end).
-/// An authored near plane at or beyond the far one would clip the whole
-/// scene, which the tracers (that have none) draw: left out (the scene
-/// loader warns of it).
-float nearPlane(const PinholeCamera& camera, const RenderSpace& space, float zfar) {
+/// But never past 90% of the distance to the nearest triangle of `sample`
+/// (nor below 1e-6 of the far plane): a room on a ground 10^4 units wide
+/// lay nearer than 1e-4 of the far plane, and every pixel was black
+/// (H16-4-1). An authored near plane at or beyond the far one would clip
+/// the whole scene, which the tracers (that have none) draw: left out (the
+/// scene loader warns of it).
+float nearPlane(const PinholeCamera& camera, const RenderSpace& space, float zfar,
+                const std::vector<glm::vec3>& sample) {
   const Vec3 eye = space.toRender(camera.eye);
   const Bounds3& box = space.bounds;
   float outside = 0;
@@ -37,7 +69,15 @@ float nearPlane(const PinholeCamera& camera, const RenderSpace& space, float zfa
     outside += d * d;
   }
   const float authored = camera.znear > 0 && camera.znear < zfar ? camera.znear : 0.01f;
-  const float znear = std::max({authored, 0.9f * std::sqrt(outside), 1e-4f * zfar});
+  float znear = std::max({authored, 0.9f * std::sqrt(outside), 1e-4f * zfar});
+  const glm::vec3 p(eye.x, eye.y, eye.z);
+  float nearest = std::numeric_limits<float>::infinity();
+  for (size_t i = 0; i + 2 < sample.size(); i += 3) {
+    nearest = std::min(nearest, distanceToTriangle(p, sample[i], sample[i + 1], sample[i + 2]));
+  }
+  if (nearest < std::numeric_limits<float>::infinity()) {
+    znear = std::min(znear, std::max(0.9f * nearest, 1e-6f * zfar));
+  }
   return std::min(znear, 0.5f * zfar);
 }
 
@@ -482,7 +522,7 @@ void Renderer::Impl::draw(const PinholeCamera& camera, const RenderParams& rp, i
   // raised the near plane past the whole scene).
   const float farthest = glm::length(eye - toGlm(space.bounds.center())) + space.sceneSize + 1e-3f;
   const float zfar = camera.zfar > 0 ? std::min(camera.zfar, farthest) : farthest;
-  const float znear = nearPlane(camera, space, zfar);
+  const float znear = nearPlane(camera, space, zfar, nearSample);
   const float aspect = float(width) / float(height);
   // The pixel's sample point moved by pixelOffset: the image shifted the
   // other way, by a translation after the projection.

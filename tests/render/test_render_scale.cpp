@@ -168,3 +168,33 @@ TEST_F(RenderScale, ASmallObjectInALargeSceneShadowsTheSameAtEveryScale) {
 
 }  // namespace
 }  // namespace lo
+
+namespace lo {
+namespace {
+
+// A lit quad with a second one 10^4 and 10^5 units away (a room on a large
+// ground): the camera's near plane followed the far plane (1e-4 of it), lay
+// beyond the quad, and every pixel was black (H16-4-1). It stays nearer
+// than the nearest triangle: the picture is the one without the far quad.
+TEST_F(RenderScale, AQuadIsDrawnWithAnotherFarAway) {
+  using test::QuadSetup;
+  const RenderParams p = QuadSetup::directParams();
+  const GpuOctree octree = test::emptyOctree();
+  QuadSetup alone;
+  alone.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
+  const RgbImage near = alone.render(octree, p);
+  const float* centre = near.pixel(p.width / 2, p.height / 2);
+  ASSERT_GT(centre[0], 0.01f);
+  for (float away : {1e4f, 1e5f}) {
+    QuadSetup s = alone;
+    test::addQuad(s.scene, {away, -1, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 1}, 0);
+    const RgbImage both = s.render(octree, p);
+    const float* c = both.pixel(p.width / 2, p.height / 2);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(c[k], centre[k], 0.02f * centre[k]) << "quad " << away << " away, channel " << k;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lo
