@@ -854,6 +854,12 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Arg<Grid>
   warnIfStale(g.meta, scenePath, "grid");  // before the frame, as `render` warns
   const std::string skyWarning = skyMismatchWarning(g.meta, scene.sky);
   if (!skyWarning.empty()) warn("grid: " + skyWarning);
+  const RenderMode drawn = settings.frame.mode;
+  if (drawn == RenderMode::Full || drawn == RenderMode::Direct) {
+    const std::string twice =
+        directTwiceWarning(g.meta, "mode '" + toString(drawn) + "'", "use mode='indirect'");
+    if (!twice.empty()) warn("grid: " + pythonNames(twice));
+  }
   RgbImage image;
   std::vector<std::string> sessionWarnings;  // said once the work is done (the lock held)
   // The renderer's refusals name the flags ("--emitter-lights"); Ctrl-C
@@ -1280,6 +1286,14 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
   std::vector<std::string> sceneWarnings;  // said once the work is done (the lock held)
   std::optional<GlCall> drawing;
   if (p.atlasGl) drawing.emplace("lightmap");
+  // The grid's warnings before the work (a warning turned into an error
+  // stops it, nothing written), with the lock taken for them.
+  p.scenePath = scenePath;
+  p.warn = [](const std::string& w) {
+    if (interpreterEnding()) return;
+    py::gil_scoped_acquire locked;
+    warn(pythonNames(w));
+  };
   const LightmapExportResult r = withPythonNames([&] {
     return withProgress(progress, "lightmap", [&](ProgressSink* sink) {
       p.progress = sink;
@@ -1289,7 +1303,6 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
     });
   });
   warnEach(sceneWarnings);
-  warnIfStale(r.gridMetadata, scenePath, lightsPath);
   const LightmapUvs& uvs = r.lightmap.uvs;
   const LightmapAtlas& atlas = r.lightmap.atlas;
   py::dict d;  // the figures of `lightmap --json`, and the files' sizes

@@ -11,7 +11,6 @@
 #include "core/file.h"
 #include "export/lightmap_export.h"
 #include "json_report.h"
-#include "render_stages.h"
 #include "report.h"
 #include "scene/scene.h"
 #include "scene_options.h"
@@ -109,8 +108,9 @@ int runLightmap(const LightmapOptions& opt) {
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.materials.size()) + " materials");
 
+  params.scenePath = opt.scene;
+  params.warn = printWarning;
   const LightmapExportResult r = exportLightmap(scene, opt.lights, params);
-  warnIfStale(r.gridMetadata, opt.scene, opt.lights);
   if (opt.quiet) return 0;
   if (params.atlasGl) std::printf("%s: %s\n", opt.atlasOn.c_str(), r.glInfo.c_str());
   rows.insert(rows.end(), r.stages.begin(), r.stages.end());

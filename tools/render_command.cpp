@@ -116,12 +116,11 @@ int runRender(const RenderOptions& opt) {
       opt.shading.settings(parseRenderMode(opt.mode), opt.width, opt.height);
   const RenderParams& params = settings.frame;
   PinholeCamera camera = chooseCamera(opt.camera, scene, opt.scene);
-  if (baked.meta.includeDirect == 1 &&
-      (params.mode == RenderMode::Full || params.mode == RenderMode::Direct)) {
-    std::fprintf(stderr,
-                 "warning: %s was baked with --include-direct: its VDLs hold the direct light, "
-                 "which mode %s draws again (counted twice); use --mode indirect\n",
-                 opt.lights.c_str(), opt.mode.c_str());
+  if (params.mode == RenderMode::Full || params.mode == RenderMode::Direct) {
+    const std::string twice =
+        directTwiceWarning(baked.meta, "mode " + opt.mode, "use --mode indirect");
+    if (!twice.empty())
+      std::fprintf(stderr, "warning: %s: %s\n", opt.lights.c_str(), twice.c_str());
   }
 
   GlContextParams contextParams;

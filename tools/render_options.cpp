@@ -1,12 +1,12 @@
 #include "render_options.h"
 
 #include <CLI/CLI.hpp>
-
 #include <cstdio>
 
 #include "cli_checks.h"
 #include "core/error.h"
 #include "lightmap/lightmap_bake.h"
+#include "report.h"
 
 namespace lo::tool {
 
@@ -35,7 +35,7 @@ RenderSettings ShadingOptions::settings(RenderMode mode, int width, int height) 
 }
 
 void printWarnings(const std::vector<std::string>& warnings) {
-  for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const std::string& w : warnings) printWarning(w);
 }
 
 CLI::Validator onOff() { return CLI::IsMember({"on", "off"}); }

@@ -17,10 +17,15 @@ Scene loadSceneStage(const SceneFlags& opt, std::vector<StageReport>& rows) {
   return scene;
 }
 
-void warnIfStale(const BakeMetadata& meta, const std::string& scenePath,
-                 const std::string& lights) {
-  const std::string stale = staleBakeWarning(meta, scenePath);
-  if (!stale.empty()) std::fprintf(stderr, "warning: %s: %s\n", lights.c_str(), stale.c_str());
+void warnOfGrid(const BakeMetadata& meta, const Scene& scene, const std::string& scenePath,
+                const std::string& lights, const std::string& drawnAgain,
+                const std::string& advice) {
+  for (const std::string& warning :
+       {staleBakeWarning(meta, scenePath), skyMismatchWarning(meta, scene.sky),
+        drawnAgain.empty() ? std::string() : directTwiceWarning(meta, drawnAgain, advice)}) {
+    if (!warning.empty())
+      std::fprintf(stderr, "warning: %s: %s\n", lights.c_str(), warning.c_str());
+  }
 }
 
 LoadedVdl readLightsStage(const std::string& lights, const Scene& scene,
@@ -28,9 +33,7 @@ LoadedVdl readLightsStage(const std::string& lights, const Scene& scene,
   StageTimer readTimer(rows, "read grid");
   LoadedVdl baked = readVdlGrid(lights, scene.origin);
   readTimer.finish(formatCount(baked.grid.size()) + " voxels");
-  warnIfStale(baked.meta, scenePath, lights);
-  const std::string sky = skyMismatchWarning(baked.meta, scene.sky);
-  if (!sky.empty()) std::fprintf(stderr, "warning: %s: %s\n", lights.c_str(), sky.c_str());
+  warnOfGrid(baked.meta, scene, scenePath, lights);
   return baked;
 }
 

@@ -4,7 +4,6 @@
 /// (the scene, the baked grid, the GL context, the render session), each
 /// timed as a row of the stage table and reported the same way: on stdout
 /// unless quiet, warnings on stderr, the figures in the --json report.
-/// `lightmap` warns of a stale bake with warnIfStale too.
 
 #include <memory>
 #include <string>
@@ -26,12 +25,17 @@ struct JsonReport;
 /// objects placed, its warnings printed. @throws as loadSceneWith.
 Scene loadSceneStage(const SceneFlags& opt, std::vector<StageReport>& rows);
 
-/// "warning: LIGHTS: ..." on stderr when `meta` says the grid was baked from
-/// another version of `scenePath` (staleBakeWarning).
-void warnIfStale(const BakeMetadata& meta, const std::string& scenePath, const std::string& lights);
+/// "warning: LIGHTS: ..." on stderr for each thing `meta` says of the grid
+/// drawn with `scene` (from `scenePath`): baked from another version of it
+/// (staleBakeWarning), under another sky (skyMismatchWarning), with the
+/// direct light that `drawnAgain` draws again (directTwiceWarning; "" when
+/// nothing draws it again).
+void warnOfGrid(const BakeMetadata& meta, const Scene& scene, const std::string& scenePath,
+                const std::string& lights, const std::string& drawnAgain = "",
+                const std::string& advice = "");
 
 /// The "read grid" row: the baked grid `lights` in the scene's coordinates,
-/// with warnIfStale. @throws as readVdlGrid.
+/// with warnOfGrid (but the direct light's). @throws as readVdlGrid.
 LoadedVdl readLightsStage(const std::string& lights, const Scene& scene,
                           const std::string& scenePath, std::vector<StageReport>& rows);
 

@@ -63,8 +63,12 @@ void printSummary(std::FILE* out, const std::vector<StageReport>& rows) {
   std::fprintf(out, "%-18s %9.3fs\n", "total", total);
 }
 
+void printWarning(const std::string& warning) {
+  std::fprintf(stderr, "warning: %s\n", warning.c_str());
+}
+
 void printSceneWarnings(const Scene& scene) {
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const std::string& w : scene.warnings) printWarning(w);
   if (scene.rebased()) {
     std::fprintf(stderr,
                  "note: %s lies far from the origin; it is kept relative to its centre "

@@ -32,6 +32,9 @@ class ConsoleProgress : public ProgressSink {
 
 void printSummary(std::FILE* out, const std::vector<StageReport>& rows);
 
+/// "warning: WARNING" on stderr.
+void printWarning(const std::string& warning);
+
 /// The scene's Scene::warnings on stderr, one "warning: ..." line each.
 void printSceneWarnings(const Scene& scene);
 

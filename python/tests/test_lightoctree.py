@@ -995,6 +995,32 @@ def test_render_and_lightmap_warn_of_a_grid_baked_from_another_scene(grid, grid_
     assert os.path.exists(out / "lit.glb")
 
 
+def test_a_grid_with_the_direct_light_is_warned_before_the_work(tmp_path):
+    """A grid baked with include_direct holds the direct light, which render's
+    mode 'full' and lightmap's content 'full' add again: both warn, as the
+    commands do (H16-7-1, H16-7-2), and lightmap before any file is written,
+    so that warnings turned into errors stop it with nothing written
+    (H16-1-3)."""
+    import warnings
+    path = str(tmp_path / "direct.vdb")
+    lightoctree.write(path, lightoctree.bake(SCENE, depth=3, photons=3000, knn=20,
+                                             include_direct=True))
+    twice = "baked with include_direct: its VDLs hold the direct light, which "
+    with pytest.warns(UserWarning, match="^grid: " + twice + "mode 'full' adds again"):
+        lightoctree.render(SCENE, lightoctree.read(path), width=16, height=12)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lightoctree.render(SCENE, lightoctree.read(path), width=16, height=12, mode="indirect")
+    out = tmp_path / "out"
+    out.mkdir()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match=re.escape(path) + ": " + twice + ".*counted twice"):
+            lightoctree.lightmap(SCENE, path, str(out / "lit.glb"), content="full",
+                                 texel_size=0.05)
+    assert os.listdir(out) == []
+
+
 def test_the_scene_warnings_of_the_commands_are_python_warnings(grid, tmp_path):
     """What the loader warns of (an orthographic camera left out, a base
     colour above 1 clamped) the commands print as "warning: ..."; the

@@ -609,6 +609,13 @@ std::string staleBakeWarning(const BakeMetadata& meta, const std::string& sceneP
                    "): bake again if the scene changed");
 }
 
+std::string directTwiceWarning(const BakeMetadata& meta, const std::string& drawnAgain,
+                               const std::string& advice) {
+  if (meta.includeDirect != 1) return "";
+  return "baked with --include-direct: its VDLs hold the direct light, which " + drawnAgain +
+         " adds again (counted twice); " + advice;
+}
+
 std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky) {
   if (meta.skyHash.empty() || meta.skyHash == sky.fingerprint()) return "";
   return "the light was baked under another sky than the one given (" +

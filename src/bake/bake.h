@@ -426,6 +426,12 @@ std::string staleBakeWarning(const BakeMetadata& meta, const std::string& sceneP
 /// scene's sky changed, changes only the background and the reflections).
 std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky);
 
+/// "" unless `meta` records a bake with --include-direct; else a sentence for
+/// a warning: the VDLs hold the direct light, which `drawnAgain` ("mode
+/// full", "--content full") adds again, counted twice; `advice` ends it.
+std::string directTwiceWarning(const BakeMetadata& meta, const std::string& drawnAgain,
+                               const std::string& advice);
+
 /// "" when either hash is not recorded or they agree; else a sentence for a
 /// warning: the photon map `what` was traced under another sky than the grid
 /// `gridWhat` was baked under (recorded as `gridSkyHash`), so the grid

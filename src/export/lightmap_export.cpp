@@ -9,9 +9,10 @@
 #include <memory>
 #include <optional>
 
+#include "bake/bake.h"
 #include "core/error.h"
-#include "core/file_set.h"
 #include "core/file.h"
+#include "core/file_set.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "reference/path_tracer.h"
@@ -353,9 +354,18 @@ LightmapExportResult exportLightmap(const Scene& scene, const std::string& light
   BakeMetadata meta;
   LightmapExportResult result = lightmap_export_internal::exportWith(
       scene,
-      [&lightsPath, &scene, &meta] {
+      [&lightsPath, &scene, &meta, &params] {
         LoadedVdl loaded = readVdlGrid(lightsPath, scene.origin);
         meta = std::move(loaded.meta);
+        if (params.warn) {
+          const bool full = params.content == AtlasContent::Full;
+          for (const std::string& w :
+               {params.scenePath.empty() ? "" : staleBakeWarning(meta, params.scenePath),
+                skyMismatchWarning(meta, scene.sky),
+                full ? directTwiceWarning(meta, "--content full", "use --content indirect") : ""}) {
+            if (!w.empty()) params.warn(lightsPath + ": " + w);
+          }
+        }
         return buildGpuOctree(loaded.grid, GpuOctreeParams{});
       },
       params);
