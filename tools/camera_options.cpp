@@ -63,11 +63,11 @@ const Camera* findSceneCamera(const CameraOptions& opt, const Scene& scene,
     std::string names;
     const size_t count = scene.cameras.size();
     for (size_t i = 0; i < std::min(count, kNamesShown); ++i) {
-      names += (names.empty() ? "'" : ", '") + printable(scene.cameras[i].name) + "'";
+      names += (names.empty() ? "'" : ", '") + printableShort(scene.cameras[i].name) + "'";
     }
     if (count > kNamesShown) names += " and " + std::to_string(count - kNamesShown) + " more";
-    throw InputError("--camera: no camera named '" + opt.camera + "' in " + scenePath +
-                     (names.empty() ? " (it has none)" : " (it has " + names + ")"));
+    throw InputError("--camera: no camera named '" + printableShort(opt.camera) + "' in " +
+                     scenePath + (names.empty() ? " (it has none)" : " (it has " + names + ")"));
   }
   return nullptr;
 }

@@ -1,8 +1,6 @@
 #include "core/file.h"
-#include "core/file_set.h"
 
 #include <fcntl.h>
-#include <climits>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -14,6 +12,7 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -25,7 +24,9 @@
 #include <thread>
 
 #include "core/error.h"
+#include "core/file_set.h"
 #include "core/fnv.h"
+#include "core/resources.h"
 
 namespace lo {
 
@@ -342,13 +343,7 @@ namespace {
 /// =commit after its first rename, saying so on stderr, so that a signal
 /// lands at that moment every time.
 void pauseForTest(const char* moment, size_t n) {
-  static const std::string wanted = [] {
-    // Only where LIGHTOCTREE_TEST_HOOKS=1 says a test runs: the variable
-    // alone, left in a user's environment, paused every run forever.
-    const char* hooks = std::getenv("LIGHTOCTREE_TEST_HOOKS");
-    const char* v = std::getenv("LIGHTOCTREE_PAUSE_SET");
-    return std::string(v && hooks && std::string(hooks) == "1" ? v : "");
-  }();
+  static const std::string wanted = testHook("LIGHTOCTREE_PAUSE_SET");
   if (wanted.empty()) return;
   const std::string here = n ? std::string(moment) + ":" + std::to_string(n) : std::string(moment);
   if (wanted != here) return;

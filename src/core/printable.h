@@ -75,4 +75,18 @@ inline std::string printable(const std::string& text, bool keepLineBreaks = fals
   return out;
 }
 
+/// printable(text), cut to at most `most` bytes with "..." where it was
+/// longer (never inside a UTF-8 character or an escape): a name quoted in a
+/// message, which a file may make 100,000 characters long (H16-4-4).
+inline std::string printableShort(const std::string& text, size_t most = 60) {
+  const std::string whole = printable(text);
+  if (whole.size() <= most) return whole;
+  size_t end = most - 3;
+  while (end > 0 && (static_cast<unsigned char>(whole[end]) & 0xc0) == 0x80) --end;
+  // An escape (\xNN, \uNNNN) is not split: cut before its backslash.
+  const size_t slash = whole.rfind('\\', end);
+  if (slash != std::string::npos && end - slash < 6) end = slash;
+  return whole.substr(0, end) + "...";
+}
+
 }  // namespace lo

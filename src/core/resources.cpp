@@ -78,6 +78,12 @@ void returnFreeMemory() {
 #endif
 }
 
+std::string testHook(const char* name) {
+  const char* hooks = std::getenv("LIGHTOCTREE_TEST_HOOKS");
+  const char* value = std::getenv(name);
+  return value && hooks && std::string(hooks) == "1" ? std::string(value) : std::string();
+}
+
 std::string formatBytes(size_t bytes) {
   char buf[32];
   double b = double(bytes);

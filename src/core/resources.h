@@ -51,6 +51,13 @@ size_t availableMemoryBytes();
 /// variable is not set. @throws InputError when it is not a size.
 size_t memoryLimitSetting();
 
+/// The test hook `name`'s value (an environment variable the tests set:
+/// LIGHTOCTREE_PAUSE_SET, LIGHTOCTREE_KILL_RANK), only where
+/// LIGHTOCTREE_TEST_HOOKS=1 says a test runs: the variable alone, left in a
+/// user's environment, paused every run forever or killed a rank of every
+/// job (H16-3-1). "" otherwise.
+std::string testHook(const char* name);
+
 /// What the process's address-space limit (setrlimit RLIMIT_AS, `ulimit -v`)
 /// leaves: its soft limit less the address space in use now (VmSize), bytes;
 /// SIZE_MAX when there is no limit. Every allocation counts against it,

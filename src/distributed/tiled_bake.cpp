@@ -435,9 +435,7 @@ class RankBake {
     if (!planned) makePlan({}, 0);
     // The tests' stand-in for a machine lost mid-bake (docs/scale.md): this
     // rank dies as a killed process does, between the exchange and the gather.
-    if (const char* kill = std::getenv("LIGHTOCTREE_KILL_RANK")) {
-      if (std::string(kill) == std::to_string(me_)) std::raise(SIGKILL);
-    }
+    if (testHook("LIGHTOCTREE_KILL_RANK") == std::to_string(me_)) std::raise(SIGKILL);
     scalePhotonPower(held_, size_t(emitted_));
     st_.storedPhotons = size_t(stored_);
     st_.emittedPaths = size_t(emitted_);

@@ -258,6 +258,21 @@ TEST(Resources, MemoryWatchCallsBackWhenTheProcessGrowsPastItsLimit) {
 }
 
 // Control characters of a file's strings, escaped before a terminal sees them.
+// A quoted name cut to 60 bytes, never inside a UTF-8 character or an
+// escape (H16-4-4: a camera named with 100,000 characters made a 100 KB line).
+TEST(Printable, AShortFormIsCutWholeCharactersAndEscapes) {
+  EXPECT_EQ(printableShort("hall"), "hall");
+  EXPECT_EQ(printableShort(std::string(60, 'a')), std::string(60, 'a'));
+  EXPECT_EQ(printableShort(std::string(100000, 'a')), std::string(57, 'a') + "...");
+  // 56 bytes, then a 2-byte character across the cut at 57.
+  const std::string accented = printableShort(std::string(56, 'a') + "\xc3\xa9\xc3\xa9tage");
+  EXPECT_EQ(accented, std::string(56, 'a') + "...");
+  // An escape across the cut goes whole.
+  const std::string escaped = printableShort(std::string(55, 'a') + "\x1b" + std::string(10, 'b'));
+  EXPECT_EQ(escaped, std::string(55, 'a') + "...");
+  EXPECT_LE(printableShort(std::string(1000, '\x01')).size(), 60u);
+}
+
 TEST(Printable, EscapesControlCharactersAndKeepsTheRest) {
   // Well-formed UTF-8 kept; a byte of no UTF-8 character (a Latin-1 é, a
   // UTF-16 file's byte-order mark, a cut or overlong sequence) escaped.

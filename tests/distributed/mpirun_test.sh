@@ -36,7 +36,8 @@ same_bytes dragon "$SCENES/composed/cornell-dragon.glb" --depth 5 --photons 6000
 
 # A rank killed between the photon exchange and the gather (a lost machine).
 set +e
-LIGHTOCTREE_KILL_RANK=1 "${MPI[@]}" -x LIGHTOCTREE_KILL_RANK -np 2 "$CLI" bake \
+LIGHTOCTREE_TEST_HOOKS=1 LIGHTOCTREE_KILL_RANK=1 "${MPI[@]}" -x LIGHTOCTREE_TEST_HOOKS \
+  -x LIGHTOCTREE_KILL_RANK -np 2 "$CLI" bake \
   "$SCENES/composed/cornell-box.glb" -o "$OUT/killed.vdb" -q --depth 6 --photons 150000 \
   >"$OUT/killed.log" 2>&1
 rc=$?
@@ -47,6 +48,20 @@ if [ $rc -ne 0 ] && [ ! -e "$OUT/killed.vdb" ] && [ "$leftovers" -eq 0 ]; then
 else
   echo "FAIL: a killed rank: mpirun exited $rc; output file present: $([ -e "$OUT/killed.vdb" ] && echo yes || echo no), temporary files: $leftovers"
   cat "$OUT/killed.log"
+  failures=$((failures + 1))
+fi
+# The hook alone, left in a job script's environment, kills no rank (H16-3-1).
+set +e
+LIGHTOCTREE_KILL_RANK=1 "${MPI[@]}" -x LIGHTOCTREE_KILL_RANK -np 2 "$CLI" bake \
+  "$SCENES/composed/cornell-box.glb" -o "$OUT/unkilled.vdb" -q --depth 4 --photons 20000 \
+  >"$OUT/unkilled.log" 2>&1
+rc=$?
+set -e
+if [ $rc -eq 0 ] && [ -e "$OUT/unkilled.vdb" ]; then
+  echo "ok: LIGHTOCTREE_KILL_RANK without LIGHTOCTREE_TEST_HOOKS=1 kills no rank"
+else
+  echo "FAIL: LIGHTOCTREE_KILL_RANK alone: mpirun exited $rc"
+  cat "$OUT/unkilled.log"
   failures=$((failures + 1))
 fi
 # Two ranks in one mpirun, each with its own `bake` arguments (paths without
