@@ -299,6 +299,16 @@ auto withProgress(const py::object& progress, const char* call, Work work) {
     } catch (const InputError& e) {
       // The library's advice names the command's flags ("needs --scene").
       throw InputError(pythonNames(e.what()));
+    } catch (const std::bad_alloc&) {
+      // Named, as the command names it: a bare MemoryError('std::bad_alloc')
+      // said neither the call nor the limits (H16-1-5).
+      const std::string text =
+          std::string(call) +
+          ": out of memory (an allocation failed): the machine or the process's limits "
+          "(ulimit -v, the container's, LIGHTOCTREE_MEMORY_LIMIT) hold less than this call "
+          "needs; nothing returned or written";
+      PyErr_SetString(PyExc_MemoryError, text.c_str());
+      throw py::error_already_set();
     }
   }
   sink.raiseIfStopped(call, limit, result.has_value());
@@ -663,7 +673,10 @@ py::object pathValue(const std::string& path) {
 
 GridPtr readGrid(const Arg<std::string>& pathArgument) {
   const std::string path = pathArg(pathArgument.value, "path");
-  LoadedVdl loaded = readVdlGrid(path);
+  // Without the interpreter's lock, as the other long calls (a depth-8 grid
+  // reads for seconds; other threads stood still, H16-1-4).
+  LoadedVdl loaded =
+      withProgress(py::none(), "read", [&](ProgressSink*) { return readVdlGrid(path); });
   auto out = std::make_shared<Grid>();
   out->grid = std::move(loaded.grid);
   out->meta = std::move(loaded.meta);
@@ -672,7 +685,8 @@ GridPtr readGrid(const Arg<std::string>& pathArgument) {
 
 py::dict inspectFile(const Arg<std::string>& pathArgument) {
   const std::string path = pathArg(pathArgument.value, "path");
-  const VdbReport r = inspectVdb(path);
+  const VdbReport r =
+      withProgress(py::none(), "inspect", [&](ProgressSink*) { return inspectVdb(path); });
   py::dict d;
   d["path"] = pathValue(r.path);
   d["kind"] = r.kind;
@@ -1456,7 +1470,10 @@ PYBIND11_MODULE(lightoctree, m) {
         const std::string file = pathArg(path.value, "path");
         const Grid& g = gridArg(grid.value, "grid");
         checkOutputFile(file, "path", ".vdb");
-        writeVdlGrid(file, g.grid, g.meta);
+        withProgress(py::none(), "write", [&](ProgressSink*) {
+          writeVdlGrid(file, g.grid, g.meta);
+          return 0;
+        });
       },
       py::arg("path"), py::arg("grid"),
       "Writes the grid as a .vdb (atomically; a grid the readers would refuse is not written).");

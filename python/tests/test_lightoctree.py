@@ -1315,3 +1315,30 @@ def test_a_child_forked_after_the_import_ends_with_its_exit_status():
                              text=True, timeout=120)
         assert run.returncode == 0, run.stderr
         assert run.stdout.split() == ["child", "exit", str(code)], run.stdout
+
+
+def test_out_of_memory_is_a_memory_error_naming_the_call():
+    """Under an address-space limit, compare's allocation failure was a bare
+    MemoryError('std::bad_alloc') (H16-1-5): it names the call and the
+    limits, as the command does. In a fresh interpreter, whose limit this
+    test's process does not share."""
+    import subprocess
+    import sys
+    script = (
+        "import resource, numpy as np, lightoctree\n"
+        "a = np.random.default_rng(1).random((3000, 3000, 3), dtype=np.float32)\n"
+        "soft, hard = resource.getrlimit(resource.RLIMIT_AS)\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (800 << 20, hard))\n"
+        "try:\n"
+        "    lightoctree.compare(a, a * 1.1)\n"
+        "    print('returned')\n"
+        "except MemoryError as e:\n"
+        "    print('MemoryError:', e)\n")
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         timeout=300)
+    said = run.stdout.strip()
+    if said == "returned":
+        pytest.skip("compare fitted in 800 MiB of address space here")
+    assert said.startswith("MemoryError: compare: out of memory (an allocation failed)"), \
+        said + run.stderr
+    assert "ulimit -v" in said and "LIGHTOCTREE_MEMORY_LIMIT" in said, said
