@@ -14,6 +14,7 @@
 #include <pybind11/stl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cctype>
@@ -1101,6 +1102,11 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
     checkStdErrorSamples(opt, withStdError, r.samplesPerPixel);
     return 0;
   });
+  if (std::all_of(r.image.rgb.begin(), r.image.rgb.end(), [](float v) { return v == 0; })) {
+    warn(
+        "every pixel is black: no light reaches what the camera sees (a scene without a light "
+        "of positive power, an emissive surface or a sky?)");
+  }
   py::array_t<float> image = imageArray(r.image);
   if (!withStdError) return std::move(image);
   return py::make_tuple(image, imageArray(r.stdError));

@@ -1,6 +1,7 @@
 // `lightoctree reference`: scene -> unbiased path-traced image (the ground truth).
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 
 #include "camera_options.h"
@@ -104,6 +105,12 @@ int runReference(const ReferenceOptions& opt) {
   StageTimer traceTimer(rows, "path trace");
   ReferenceImage result = renderReference(scene, camera, params, &progress);
   traceTimer.finish(std::to_string(result.samplesPerPixel) + " spp");
+  // A scene with no light drew black, exit 0, without a word (H16-4-2).
+  const std::vector<float>& rgb = result.image.rgb;
+  if (std::all_of(rgb.begin(), rgb.end(), [](float v) { return v == 0; })) {
+    printWarning(opt.output + ": every pixel is black: no light reaches what the camera sees (a " +
+                 "scene without a light of positive power, an emissive surface or a sky?)");
+  }
   checkStdErrorSamples(opt, !opt.stdErrorOutput.empty(), result.samplesPerPixel);
   // The image and its side images (and the report) appear together.
   AtomicFileSet outputs;

@@ -1342,3 +1342,12 @@ def test_out_of_memory_is_a_memory_error_naming_the_call():
     assert said.startswith("MemoryError: compare: out of memory (an allocation failed)"), \
         said + run.stderr
     assert "ulimit -v" in said and "LIGHTOCTREE_MEMORY_LIMIT" in said, said
+
+
+def test_a_black_reference_is_warned():
+    """A scene without light drew black with no word (H16-4-2)."""
+    scene = os.path.join(os.path.dirname(__file__), "..", "..", "tests", "fuzz", "seeds", "gltf",
+                         "no-light.gltf")
+    with pytest.warns(UserWarning, match="every pixel is black: no light reaches"):
+        image = lightoctree.reference(scene, width=8, height=8, spp=1)
+    assert image.max() == 0
