@@ -310,12 +310,25 @@ void SceneBuilder::appendColors(const std::vector<double>& color, size_t nverts,
     return;
   }
   const size_t channels = color.size() / nverts;  // 3 or 4
+  size_t outside = 0;
+  double lowest = 0, highest = 1;
   for (size_t v = 0; v < nverts; ++v) {
     for (size_t a = 0; a < 4; ++a) {
       const double c = a < channels ? color[channels * v + a] : 1.0;
       if (!std::isfinite(c)) fail(path_, what + ": non-finite vertex colour (COLOR_0)");
+      if (c < 0 || c > 1) ++outside;
+      lowest = std::min(lowest, c);
+      highest = std::max(highest, c);
       scene_.colors.push_back(float(std::clamp(c, 0.0, 1.0)));
     }
+  }
+  // Clamped as a base colour factor out of range is, and said as it is
+  // (H16-4-3: a COLOR_0 of 100 drew as 1 without a word).
+  if (outside > 0) {
+    scene_.warnings.push_back(path_ + ": " + what + ": " + std::to_string(outside) +
+                              " vertex colour channel(s) (COLOR_0) outside [0, 1], from " +
+                              formatNumber(lowest) + " to " + formatNumber(highest) +
+                              ": clamped to [0, 1]");
   }
 }
 

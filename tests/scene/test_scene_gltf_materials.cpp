@@ -214,6 +214,7 @@ TEST_F(SceneGltf, VertexColoursMultiplyTheBaseColour) {
      << blob.size() << R"(, "uri": "data:application/octet-stream;base64,)" << base64(blob)
      << R"("}]})";
   const Scene s = loadScene(write("colors.gltf", os.str()));
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
   ASSERT_EQ(s.triangleCount(), 3u);
   ASSERT_EQ(s.colors.size(), 4 * s.positions.size());
   // Triangle 0 at its corner 0 (red), at corner 1 (green, alpha 128/255).
@@ -228,6 +229,38 @@ TEST_F(SceneGltf, VertexColoursMultiplyTheBaseColour) {
   // Triangle 2: no COLOR_0, white.
   expectNear(s.albedo(2, 0.2f, 0.3f), {0.5f, 1, 1}, 1e-6f, "no colour");
   EXPECT_NEAR(s.coverage(2, 0.2f, 0.3f), 0.8f, 1e-6f);
+}
+
+// Float vertex colours beyond [0, 1] are clamped, as a base colour factor
+// beyond it is, and said (H16-4-3: a COLOR_0 of 100 drew as 1 without a word).
+TEST_F(SceneGltf, VertexColoursOutsideTheUnitRangeAreClampedAndWarned) {
+  std::string blob;
+  append(blob, std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0});
+  append(blob, std::vector<float>{100, 0.5f, 0.5f, -5, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f});
+  std::ostringstream os;
+  os << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}}]}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                  {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                    {"buffer": 0, "byteOffset": 36, "byteLength": 36}],
+    "buffers": [{"byteLength": )"
+     << blob.size() << R"(, "uri": "data:application/octet-stream;base64,)" << base64(blob)
+     << R"("}]})";
+  const Scene s = loadScene(write("colors-out.gltf", os.str()));
+  ASSERT_EQ(s.colors.size(), 12u);
+  EXPECT_EQ(s.colors[0], 1.0f);
+  EXPECT_EQ(s.colors[4], 0.0f);
+  EXPECT_EQ(s.colors[8], 0.5f);
+  size_t said = 0;
+  for (const std::string& w : s.warnings) {
+    if (w.find("2 vertex colour channel(s) (COLOR_0) outside [0, 1], from -5 to 100: clamped") !=
+        std::string::npos) {
+      ++said;
+    }
+  }
+  EXPECT_EQ(said, 1u) << ::testing::PrintToString(s.warnings);
 }
 
 TEST_F(SceneGltf, MissingTextureFileIsWarnedOnceByName) {
