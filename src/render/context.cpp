@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/resources.h"
 #include "render/context_internal.h"
 
 namespace lo {
@@ -114,8 +115,32 @@ void GlContext::initialize(bool debugOutput) {
   }
 }
 
+namespace {
+
+/// The address space llvmpipe maps beyond what the process maps when its
+/// context is made, as it compiles and draws (its threads, the JIT's code,
+/// the render targets): a 64 x 64 Cornell box rose from 241 MiB to 858 MiB
+/// (VmPeak), 1024 x 768 to 906 MiB (the frame's own memory is checkRenderMemory's).
+/// Under `ulimit -v` limits that leave less, Mesa failed at random: a
+/// segmentation fault inside it, GL errors, a false refusal of the frame's
+/// size (450 to 850 MB, H15-2-1). Refused before the context, naming the
+/// limit: for every back end, `view`'s GLFW and EGL too (a GPU's driver maps
+/// more; H16-2-1: `view` crashed at 630 to 700 MiB).
+constexpr size_t kGlAddressSpaceBytes = size_t(640) << 20;
+
+void requireAddressSpaceForGl(const std::string& backend) {
+  const size_t room = addressSpaceRoomBytes();
+  if (room >= kGlAddressSpaceBytes) return;
+  throw GlError(backend + ": out of memory: the GL driver (llvmpipe, in software) maps about " +
+                formatBytes(kGlAddressSpaceBytes) + " of address space as it draws, and " +
+                memoryShortfall());
+}
+
+}  // namespace
+
 std::unique_ptr<GlContext> createGlContext(const GlContextParams& params) {
   checkGlProcess();
+  requireAddressSpaceForGl(toString(params.backend));
   switch (params.backend) {
     case GlBackend::OSMesa:
       return render_internal::createOsMesaContext(params);

@@ -107,23 +107,6 @@ std::vector<std::string> mesaSettings() {
 /// (LP_NATIVE_VECTOR_WIDTH=7, H13-2-22), ending the process, a Python
 /// interpreter with it; GALLIUM_NOOP=1 drew an image of garbage (H13-2-5).
 /// None of them is one a picture can be trusted under: refused, named.
-/// The address space llvmpipe maps beyond what the process maps when its
-/// context is made, as it compiles and draws (its threads, the JIT's code,
-/// the render targets): a 64 x 64 Cornell box rose from 241 MiB to 858 MiB
-/// (VmPeak), 1024 x 768 to 906 MiB (the frame's own memory is checkRenderMemory's).
-/// Under `ulimit -v` limits that leave less, Mesa failed at random: a
-/// segmentation fault inside it, GL errors, a false refusal of the frame's
-/// size (450 to 850 MB, H15-2-1). Refused before the context, naming the limit.
-constexpr size_t kMesaAddressSpaceBytes = size_t(640) << 20;
-
-void requireAddressSpaceForMesa() {
-  const size_t room = addressSpaceRoomBytes();
-  if (room >= kMesaAddressSpaceBytes) return;
-  throw GlError("osmesa: out of memory: the software GL driver (llvmpipe) maps about " +
-                formatBytes(kMesaAddressSpaceBytes) + " of address space as it draws, and " +
-                memoryShortfall());
-}
-
 void refuseMesaSettings() {
   const std::vector<std::string> settings = mesaSettings();
   if (settings.empty()) return;
@@ -138,7 +121,6 @@ class OsMesaContext final : public GlContext {
  public:
   explicit OsMesaContext(const GlContextParams& params) : GlContext(GlBackend::OSMesa) {
     refuseMesaSettings();
-    requireAddressSpaceForMesa();
     // Core profile 4.5 (llvmpipe in Mesa 22), else 3.3.
     for (int version : {45, 33}) {
       context_ = osMesa().createContextAttribs(contextAttributes(version).data(), nullptr);

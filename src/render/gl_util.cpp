@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "core/resources.h"
 #include "render/context.h"
 #include "render/gl_resources.h"
 
@@ -130,6 +131,12 @@ std::vector<std::vector<std::string>> allPrograms() {
 
 void checkGl(const char* what) {
   GLenum e = glGetError();
+  if (e == GL_OUT_OF_MEMORY) {
+    // The driver's memory, not a defect: said as memory (H16-2-1: `view`
+    // under `ulimit -v` 900 MiB said "GL error 0x0505").
+    throw GlError(std::string(what) +
+                  ": out of memory in the GL driver (GL_OUT_OF_MEMORY): " + memoryShortfall());
+  }
   if (e != GL_NO_ERROR) {
     char buf[16];
     std::snprintf(buf, sizeof buf, "0x%04x", e);
