@@ -73,6 +73,16 @@ bool isThreadStartFailure(const std::exception& e) {
   return std::strstr(e.what(), "pthread_create") != nullptr;
 }
 
+/// A thread that could not start: said as the limits it meets (H16-2-2:
+/// under `ulimit -u` it was called out of memory, or "terminate called").
+void sayThreadsShort() {
+  std::fprintf(stderr,
+               "lightoctree: error: cannot start a thread: out of memory for its stack "
+               "(ulimit -v, the container's memory) or at the limit on this user's processes "
+               "and threads (ulimit -u, a container's pids limit): raise the limit reached, or "
+               "run fewer processes beside this one\n");
+}
+
 std::terminate_handler defaultTerminate = nullptr;
 
 /// The last resort past main's catch: an allocation or a thread start that
@@ -83,20 +93,24 @@ std::terminate_handler defaultTerminate = nullptr;
 /// are removed, the shortage said, exit status 1. Anything else goes to the
 /// runtime's own handler.
 [[noreturn]] void terminateSaysMemory() {
-  bool memory = false;
+  bool memory = false, thread = false;
   if (const std::exception_ptr e = std::current_exception()) {
     try {
       std::rethrow_exception(e);
     } catch (const std::bad_alloc&) {
       memory = true;
     } catch (const std::exception& error) {
-      memory = isThreadStartFailure(error);
+      thread = isThreadStartFailure(error);
     } catch (...) {
     }
   }
-  if (memory) {
+  if (memory || thread) {
     lo::removeLiveTemporaries();
-    sayOutOfMemory();
+    if (memory) {
+      sayOutOfMemory();
+    } else {
+      sayThreadsShort();
+    }
     std::fflush(stderr);
     ::_exit(1);
   }
@@ -244,11 +258,19 @@ int run(int argc, char** argv) {
   return 1;
 }
 
+/// The handler set before the shared libraries' own initialisers run:
+/// log4cplus (OpenVDB's logger) starts its thread pool there, and under a
+/// tight `ulimit -u` that start failed before main set anything (H16-2-2).
+void setTerminateHandler(int, char**, char**) {
+  defaultTerminate = std::set_terminate(terminateSaysMemory);
+}
+__attribute__((section(".preinit_array"),
+               used)) void (*const setTerminateFirst)(int, char**, char**) = setTerminateHandler;
+
 }  // namespace
 
 int main(int argc, char** argv) {
   holdClosedStandardStreams();
-  defaultTerminate = std::set_terminate(terminateSaysMemory);
   // Past the file-size limit (ulimit -f) a write fails with EFBIG, reported
   // as any failed write with its temporary file removed, instead of the
   // signal ending the process and leaving the temporary behind.
@@ -264,7 +286,7 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const std::exception& e) {
     if (isThreadStartFailure(e)) {
-      sayOutOfMemory();
+      sayThreadsShort();
       finishOutput(1);
       return 1;
     }
