@@ -481,6 +481,12 @@ std::optional<double> numberOf(const py::handle& value) {
   }
   const double v = PyFloat_AsDouble(value.ptr());  // int beyond a double: OverflowError
   if (v == -1.0 && PyErr_Occurred()) {
+    // Not a number: refused by name. Ctrl-C, MemoryError or another error
+    // raised by the object's own __float__ goes on as itself (H16-1-1).
+    if (!PyErr_ExceptionMatches(PyExc_TypeError) && !PyErr_ExceptionMatches(PyExc_ValueError) &&
+        !PyErr_ExceptionMatches(PyExc_OverflowError)) {
+      throw py::error_already_set();
+    }
     PyErr_Clear();
     return std::nullopt;
   }

@@ -1351,3 +1351,23 @@ def test_a_black_reference_is_warned():
     with pytest.warns(UserWarning, match="every pixel is black: no light reaches"):
         image = lightoctree.reference(scene, width=8, height=8, spp=1)
     assert image.max() == 0
+
+
+def test_an_error_raised_while_a_number_is_read_goes_on_as_itself(grid):
+    """A real number whose __float__ raises KeyboardInterrupt, MemoryError or
+    another error: the error went, and the argument was refused as not a
+    number (H16-1-1). A TypeError or ValueError still means 'not a number'."""
+    import numbers
+
+    class Raising:
+        def __init__(self, error):
+            self.error = error
+
+        def __float__(self):
+            raise self.error("from __float__")
+    numbers.Real.register(Raising)
+    for error in (KeyboardInterrupt, MemoryError, RuntimeError):
+        with pytest.raises(error, match="from __float__"):
+            lightoctree.render(SCENE, grid, width=8, height=8, tolerance=Raising(error))
+    with pytest.raises(lightoctree.InputError, match="tolerance: must be"):
+        lightoctree.render(SCENE, grid, width=8, height=8, tolerance=Raising(ValueError))
