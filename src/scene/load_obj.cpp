@@ -33,6 +33,35 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// The numbers of an .mtl's colour and scalar statements that are not finite
+/// numbers (`Ke inf`, `Kd seven`, `Ns nan`): tinyobjloader reads them as 0
+/// without a word (H16-4-5: `Ke inf` drew black). One warning per statement,
+/// for the first ten.
+std::vector<std::string> mtlNumberWarnings(const std::string& text, const std::string& name) {
+  static const std::set<std::string> numeric = {"Ka", "Kd", "Ks",  "Ke",    "Kt",    "Tf",
+                                                "Ns", "Ni", "d",   "Tr",    "Pr",    "Pm",
+                                                "Ps", "Pc", "Pcr", "aniso", "anisor"};
+  std::vector<std::string> warnings;
+  std::istringstream lines(text);
+  std::string line;
+  for (size_t number = 1; std::getline(lines, line) && warnings.size() < 10; ++number) {
+    std::istringstream words(line);
+    std::string key, word;
+    if (!(words >> key) || numeric.count(key) == 0) continue;
+    while (words >> word) {
+      char* end = nullptr;
+      const double v = std::strtod(word.c_str(), &end);
+      if (word == "spectral" || word == "xyz") break;  // other forms of Ka/Kd/Ks/Tf
+      if (end != word.c_str() + word.size() || !std::isfinite(v)) {
+        warnings.push_back(name + " line " + std::to_string(number) + ": " + key + " '" +
+                           printableShort(word) + "' is not a finite number: read as 0");
+        break;
+      }
+    }
+  }
+  return warnings;
+}
+
 /// Opens .mtl files only inside the scene folder; remembers the first refusal
 /// so that the loader can raise it (tinyobj treats a missing .mtl as a warning).
 class FolderMaterialReader : public tinyobj::MaterialReader {
@@ -59,7 +88,13 @@ class FolderMaterialReader : public tinyobj::MaterialReader {
         error_ = scenePath_ + ": cannot open material library '" + matId + "'";
         return false;
       }
-      tinyobj::LoadMtl(matMap, materials, &in, warn, err);
+      std::ostringstream text;
+      text << in.rdbuf();
+      for (std::string& w : mtlNumberWarnings(text.str(), scenePath_ + ": " + printable(matId))) {
+        warnings_.push_back(std::move(w));
+      }
+      std::istringstream mtl(text.str());
+      tinyobj::LoadMtl(matMap, materials, &mtl, warn, err);
       return true;
     } catch (const InputError& e) {
       error_ = e.what();
@@ -68,9 +103,11 @@ class FolderMaterialReader : public tinyobj::MaterialReader {
   }
 
   const std::string& error() const { return error_; }
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
   std::string scenePath_, baseDir_, error_;
+  std::vector<std::string> warnings_;
 };
 
 struct VertexKey {
@@ -162,6 +199,7 @@ Scene loadObj(const std::string& path) {
   }
 
   Scene scene;
+  scene.warnings = reader.warnings();
   // usemtl with a name no .mtl defines: tinyobjloader gives those faces no
   // material (they get the default, grey); the user hears it once per name.
   {

@@ -119,6 +119,21 @@ TEST_F(SceneObj, UndefinedMaterialIsWarnedOnceByName) {
   EXPECT_EQ(defaults, 2);
 }
 
+// MTL numbers that are not finite numbers were read as 0 without a word
+// (H16-4-5: `Ke inf` drew black): each statement is warned, by line.
+TEST_F(SceneObj, MtlValuesThatAreNotNumbersAreWarned) {
+  write("m.mtl", "newmtl lamp\nKd 0.5 0.5 0.5\nKe inf 1 1\nKs seven\nNs 10\nKa spectral f.spd\n");
+  write("scene.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl lamp\nf 1 2 3\n");
+  Scene s = loadScene(dir + "/scene.obj");
+  ASSERT_EQ(s.warnings.size(), 2u) << ::testing::PrintToString(s.warnings);
+  EXPECT_NE(s.warnings[0].find("m.mtl line 3: Ke 'inf' is not a finite number: read as 0"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_NE(s.warnings[1].find("m.mtl line 4: Ks 'seven' is not a finite number"),
+            std::string::npos)
+      << s.warnings[1];
+}
+
 // OBJ vertex colours (`v x y z r g b`) multiply the base colour like glTF's
 // COLOR_0, when every vertex has one, read as the display (sRGB) values the
 // tools that write them mean; a file where only some have one keeps none
