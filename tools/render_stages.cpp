@@ -17,23 +17,15 @@ Scene loadSceneStage(const SceneFlags& opt, std::vector<StageReport>& rows) {
   return scene;
 }
 
-void warnOfGrid(const BakeMetadata& meta, const Scene& scene, const std::string& scenePath,
-                const std::string& lights, const std::string& drawnAgain,
-                const std::string& advice) {
-  for (const std::string& warning :
-       {staleBakeWarning(meta, scenePath), skyMismatchWarning(meta, scene.sky),
-        drawnAgain.empty() ? std::string() : directTwiceWarning(meta, drawnAgain, advice)}) {
-    if (!warning.empty())
-      std::fprintf(stderr, "warning: %s: %s\n", lights.c_str(), warning.c_str());
-  }
-}
-
 LoadedVdl readLightsStage(const std::string& lights, const Scene& scene,
                           const std::string& scenePath, std::vector<StageReport>& rows) {
   StageTimer readTimer(rows, "read grid");
   LoadedVdl baked = readVdlGrid(lights, scene.origin);
   readTimer.finish(formatCount(baked.grid.size()) + " voxels");
-  warnOfGrid(baked.meta, scene, scenePath, lights);
+  for (const std::string& warning :
+       {staleBakeWarning(baked.meta, scenePath), skyMismatchWarning(baked.meta, scene.sky)}) {
+    if (!warning.empty()) printWarning(lights + ": " + warning);
+  }
   return baked;
 }
 

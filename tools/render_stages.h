@@ -25,17 +25,10 @@ struct JsonReport;
 /// objects placed, its warnings printed. @throws as loadSceneWith.
 Scene loadSceneStage(const SceneFlags& opt, std::vector<StageReport>& rows);
 
-/// "warning: LIGHTS: ..." on stderr for each thing `meta` says of the grid
-/// drawn with `scene` (from `scenePath`): baked from another version of it
-/// (staleBakeWarning), under another sky (skyMismatchWarning), with the
-/// direct light that `drawnAgain` draws again (directTwiceWarning; "" when
-/// nothing draws it again).
-void warnOfGrid(const BakeMetadata& meta, const Scene& scene, const std::string& scenePath,
-                const std::string& lights, const std::string& drawnAgain = "",
-                const std::string& advice = "");
-
 /// The "read grid" row: the baked grid `lights` in the scene's coordinates,
-/// with warnOfGrid (but the direct light's). @throws as readVdlGrid.
+/// with a "warning: LIGHTS: ..." for a bake of another version of the scene
+/// at `scenePath` (staleBakeWarning) or under another sky
+/// (skyMismatchWarning). @throws as readVdlGrid.
 LoadedVdl readLightsStage(const std::string& lights, const Scene& scene,
                           const std::string& scenePath, std::vector<StageReport>& rows);
 

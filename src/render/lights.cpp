@@ -243,16 +243,11 @@ void SceneLights::build(const Scene& scene, const RenderSpace& space,
   // The triangles the fitted cascades' fill is counted on.
   cascadeFillBudget = params.interactive ? kShadowFillBudget / 16 : kShadowFillBudget;
   if (!sunLights.empty()) {
-    const size_t triangles = scene.triangleCount();
-    const size_t sampled = std::min(triangles, kCascadeSampleTriangles);
-    for (size_t s = 0; s < sampled; ++s) {
-      const size_t t = sampledTriangle(s, sampled, triangles);
-      for (int k = 0; k < 3; ++k) {
-        cascadeSample.push_back(
-            toVec4(space.toRender(scene.positions[scene.indices[3 * t + size_t(k)]]), 1));
-      }
+    for (const glm::vec3& corner : sampledCorners(scene, space, kCascadeSampleTriangles)) {
+      cascadeSample.emplace_back(corner, 1.0f);
     }
-    cascadeSampleScale = sampled > 0 ? double(triangles) / double(sampled) : 0;
+    const size_t sampled = cascadeSample.size() / 3;
+    cascadeSampleScale = sampled > 0 ? double(scene.triangleCount()) / double(sampled) : 0;
   }
   // And within the fill budget (kShadowFillBudget).
   const double overlap = coveredTimesOver(scene, space, block.uShadowMatrices, layers);
@@ -481,6 +476,20 @@ void SceneLights::fitCascadeSlices(const RenderSpace& space, const glm::vec3& ey
 
 size_t sampledTriangle(size_t s, size_t sampled, size_t triangles) {
   return sampled == triangles ? s : size_t((uint64_t(s) * kSampleStep) % uint64_t(triangles));
+}
+
+std::vector<glm::vec3> sampledCorners(const Scene& scene, const RenderSpace& space, size_t most) {
+  const size_t triangles = scene.triangleCount();
+  const size_t sampled = std::min(triangles, most);
+  std::vector<glm::vec3> corners;
+  corners.reserve(3 * sampled);
+  for (size_t s = 0; s < sampled; ++s) {
+    const size_t t = sampledTriangle(s, sampled, triangles);
+    for (int k = 0; k < 3; ++k) {
+      corners.push_back(toGlm(space.toRender(scene.positions[scene.indices[3 * t + size_t(k)]])));
+    }
+  }
+  return corners;
 }
 
 }  // namespace lo::render_internal

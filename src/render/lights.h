@@ -20,6 +20,11 @@ namespace lo::render_internal {
 /// (a step coprime with the count spreads it over the index range).
 size_t sampledTriangle(size_t s, size_t sampled, size_t triangles);
 
+/// The three corners (render space) of each of an even sample of at most
+/// `most` of the scene's triangles: the cascades' fill is counted on them,
+/// the camera's near plane kept nearer than them.
+std::vector<glm::vec3> sampledCorners(const Scene& scene, const RenderSpace& space, size_t most);
+
 /// The light block and the shadow maps of a scene (lights.cpp).
 struct SceneLights {
   LightBlock block{};

@@ -79,19 +79,7 @@ Renderer::Renderer(const Scene& scene, const GpuOctree& octree, const RendererPa
   r.space.bounds.extend(r.space.toRender(world.lower));
   r.space.bounds.extend(r.space.toRender(world.upper));
   r.space.sceneSize = std::max(length(r.space.bounds.extent()), 1e-3f);
-  {
-    constexpr size_t kNearSampleTriangles = size_t(1) << 14;
-    const size_t triangles = scene.triangleCount();
-    const size_t sampled = std::min(triangles, kNearSampleTriangles);
-    r.nearSample.reserve(3 * sampled);
-    for (size_t s = 0; s < sampled; ++s) {
-      const size_t t = sampledTriangle(s, sampled, triangles);
-      for (int k = 0; k < 3; ++k) {
-        const Vec3 v = r.space.toRender(scene.positions[scene.indices[3 * t + size_t(k)]]);
-        r.nearSample.emplace_back(v.x, v.y, v.z);
-      }
-    }
-  }
+  r.nearSample = sampledCorners(scene, r.space, size_t(1) << 14);
   r.sky = scene.sky.radiance;
   for (const Material& m : scene.materials) r.volumes |= m.transmission > 0 && m.thickness > 0;
   r.sceneProgram = GlProgram(r.buildSceneProgram({"LO_DIRECT_LIGHT"}));
