@@ -429,14 +429,6 @@ void warnEach(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) warn(w);
 }
 
-/// The commands' warning of a grid baked from another version of the scene
-/// (tools/render_stages.h warnIfStale), "`what`: the light was baked from
-/// ...", through warn().
-void warnIfStale(const BakeMetadata& meta, const std::string& scenePath, const std::string& what) {
-  const std::string stale = staleBakeWarning(meta, scenePath);
-  if (!stale.empty()) warn(what + ": " + stale);
-}
-
 // ---- arguments: each checked by its name, as the commands check their flags ----
 
 /// repr(value), cut to 60 characters (a refused argument may be large).
@@ -872,9 +864,8 @@ py::array_t<float> renderImage(const Arg<std::string>& sceneArg, const Arg<Grid>
       withPythonNames([&] { return renderSettings(width, height, mode, kw); });
   Scene scene = loadScene(scenePath);
   warnEach(scene.warnings);
-  warnIfStale(g.meta, scenePath, "grid");  // before the frame, as `render` warns
-  const std::string skyWarning = skyMismatchWarning(g.meta, scene.sky);
-  if (!skyWarning.empty()) warn("grid: " + skyWarning);
+  // Before the frame, as `render` warns.
+  for (const std::string& w : gridWarnings(g.meta, scene)) warn("grid: " + w);
   const RenderMode drawn = settings.frame.mode;
   if (drawn == RenderMode::Full || drawn == RenderMode::Direct) {
     const std::string twice =
@@ -1029,7 +1020,7 @@ GridPtr bakeScene(const Arg<std::string>& sceneArg, const Arg<int>& depthArg,
   auto out = std::make_shared<Grid>();
   BakeResult r = withProgress(progress, "bake", [&](ProgressSink* sink) {
     BakeResult result = bake(scene, params, sink);
-    recordSourceScene(result.metadata, scenePath);
+    recordSourceScene(result.metadata, scene);
     return result;
   });
   out->grid = std::move(r.grid);
@@ -1297,7 +1288,9 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
   }
   const SceneOptions scene = sceneOptions(sky, skyImage, skyMesh, physicalSky);
   // What the command checks before any work: the folder, the name, and that
-  // no file written (or removed as an earlier export's) replaces an input.
+  // no file written (or removed as an earlier export's) replaces an input,
+  // the inputs watched until this call ends.
+  const InputsWatch watch;
   checkOutputFolder(output, "output");
   checkLightmapExportPath(output, "output");
   NamedPaths inputs = sceneInputs(scenePath, "scene");
@@ -1314,7 +1307,6 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
   if (p.atlasGl) drawing.emplace("lightmap");
   // The grid's warnings before the work (a warning turned into an error
   // stops it, nothing written), with the lock taken for them.
-  p.scenePath = scenePath;
   p.warn = [](const std::string& w) {
     if (interpreterEnding()) return;
     py::gil_scoped_acquire locked;

@@ -254,4 +254,36 @@ else
   [ "$read_ok" -eq 1 ] || fail "ulimit -v reads: no limit up to $((start + 240000)) KiB read the grid"
 fi
 
+# 11. A small stack limit (ulimit -s 128, hard and soft): `lightmap` crashed
+#     (H16-2-3). The command runs on a thread of its own 8 MiB stack; every
+#     command here ends with exit 0.
+for cmd in "lightmap $scene $out/small.vdb -o $out/stack.glb --content full --quiet" \
+           "render $scene $out/small.vdb -o $out/stack.png --width 16 --height 16 --quiet" \
+           "bake $scene -o $out/stack.vdb --depth 3 --photons 3000 --knn 20 --quiet"; do
+  err=$(bash -c "ulimit -s 128; exec $cli $cmd" 2>&1)
+  rc=$?
+  [ "$rc" -eq 0 ] || fail "ulimit -s 128, ${cmd%% *}: exit $rc: $(tail -c 300 <<<"$err")"
+done
+
+# 12. A limit on the user's threads (ulimit -u, which holds users other than
+#     root): llvmpipe waited for ever for render threads it could not start
+#     (H16-2-2). As user nobody, where this machine lets the test run so: the
+#     render ends within a minute, drawn or refused naming the limit.
+if [ "$(id -u)" -eq 0 ] && command -v setpriv >/dev/null &&
+   setpriv --reuid=nobody --regid=nogroup --clear-groups test -x "$cli"; then
+  mkdir -p "$out/nobody" && chmod 777 "$out/nobody" && cp "$out/small.vdb" "$out/nobody/"
+  for u in 7 8 10; do
+    err=$(timeout -k 5 60 setpriv --reuid=nobody --regid=nogroup --clear-groups bash -c \
+      "ulimit -u $u; exec '$cli' render '$scene' '$out/nobody/small.vdb' -o '$out/nobody/u.png' --width 16 --height 16 --quiet" 2>&1)
+    rc=$?
+    if [ "$rc" -eq 124 ] || [ "$rc" -eq 137 ]; then
+      fail "ulimit -u $u: the render hung"
+    elif [ "$rc" -ne 0 ] && ! grep -q "cannot start a thread" <<<"$err"; then
+      fail "ulimit -u $u: exit $rc: $(tail -c 300 <<<"$err")"
+    fi
+  done
+else
+  echo "ulimit -u: skipped (needs root, setpriv, and a build user nobody can run)"
+fi
+
 [ "$failed" -eq 0 ] && echo "environment: every case refused or reported"

@@ -103,7 +103,7 @@ int runBakeOn(const BakeOptions& options, Communicator* comm) {
   rows.insert(rows.end(), baked.stats.stages.begin(), baked.stats.stages.end());
   const std::string missed = photonBudgetWarning(params, baked.stats);
   if (!missed.empty()) std::fprintf(stderr, "warning: %s\n", missed.c_str());
-  recordSourceScene(baked.metadata, opt.scene);
+  recordSourceScene(baked.metadata, scene);
 
   // The .vdb, the photon map and the stats appear together or not at all: a
   // side file that fails (a full disk, a name refused) leaves the old .vdb.

@@ -108,7 +108,6 @@ int runLightmap(const LightmapOptions& opt) {
   loadTimer.finish(formatCount(scene.triangleCount()) + " triangles, " +
                    std::to_string(scene.materials.size()) + " materials");
 
-  params.scenePath = opt.scene;
   params.warn = printWarning;
   const LightmapExportResult r = exportLightmap(scene, opt.lights, params);
   if (opt.quiet) return 0;

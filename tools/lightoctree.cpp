@@ -1,6 +1,8 @@
 // lightoctree: the command-line front end. Parses, calls the stages, reports.
 
 #include <fcntl.h>
+#include <pthread.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -267,14 +269,33 @@ void setTerminateHandler(int, char**, char**) {
 __attribute__((section(".preinit_array"),
                used)) void (*const setTerminateFirst)(int, char**, char**) = setTerminateHandler;
 
-}  // namespace
+/// The stack a command needs: the software GL driver's shader compiler
+/// (LLVM) and the libraries' recursions were written for the usual 8 MiB.
+constexpr size_t kStackBytes = size_t(8) << 20;
 
-int main(int argc, char** argv) {
-  holdClosedStandardStreams();
-  // Past the file-size limit (ulimit -f) a write fails with EFBIG, reported
-  // as any failed write with its temporary file removed, instead of the
-  // signal ending the process and leaving the temporary behind.
-  std::signal(SIGXFSZ, SIG_IGN);
+/// Whether the main thread's stack may grow to kStackBytes, its soft limit
+/// raised that far if the hard one allows. Else (`ulimit -s 128` sets both;
+/// `lightmap` crashed, H16-2-3) the command runs on a thread of that stack,
+/// which the limit does not hold; and every thread the process starts gets
+/// that stack, not the limit's (glibc's default follows `ulimit -s`).
+bool mainStackHolds() {
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_STACK, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY ||
+      limit.rlim_cur >= kStackBytes) {
+    return true;
+  }
+  pthread_attr_t attributes;
+  if (::pthread_attr_init(&attributes) == 0) {
+    ::pthread_attr_setstacksize(&attributes, kStackBytes);
+    ::pthread_setattr_default_np(&attributes);
+    ::pthread_attr_destroy(&attributes);
+  }
+  if (limit.rlim_max != RLIM_INFINITY && limit.rlim_max < kStackBytes) return false;
+  limit.rlim_cur = kStackBytes;
+  return ::setrlimit(RLIMIT_STACK, &limit) == 0;
+}
+
+int runAndReport(int argc, char** argv) {
   try {
     return finishOutput(run(argc, argv));
   } catch (const std::bad_alloc&) {
@@ -296,4 +317,34 @@ int main(int argc, char** argv) {
     finishOutput(1);
     return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  holdClosedStandardStreams();
+  // Past the file-size limit (ulimit -f) a write fails with EFBIG, reported
+  // as any failed write with its temporary file removed, instead of the
+  // signal ending the process and leaving the temporary behind.
+  std::signal(SIGXFSZ, SIG_IGN);
+  if (mainStackHolds()) return runAndReport(argc, argv);
+  struct Call {
+    int argc;
+    char** argv;
+    int rc;
+  } call{argc, argv, 1};
+  pthread_t thread;  // with the default stack mainStackHolds set
+  if (::pthread_create(
+          &thread, nullptr,
+          [](void* p) -> void* {
+            auto* c = static_cast<Call*>(p);
+            c->rc = runAndReport(c->argc, c->argv);
+            return nullptr;
+          },
+          &call) != 0) {
+    sayThreadsShort();
+    return 1;
+  }
+  ::pthread_join(thread, nullptr);
+  return call.rc;
 }

@@ -110,7 +110,7 @@ int runRender(const RenderOptions& opt) {
   checkCameraOptions(opt.camera);
   (void)opt.picture.toneParams();  // a bad --exposure is refused before the work
   Scene scene = loadSceneStage(opt, rows);
-  LoadedVdl baked = readLightsStage(opt.lights, scene, opt.scene, rows);
+  LoadedVdl baked = readLightsStage(opt.lights, scene, rows);
   if (opt.mode == "irradiance") return renderIrradiance(opt, scene, baked, report, rows);
   const RenderSettings settings =
       opt.shading.settings(parseRenderMode(opt.mode), opt.width, opt.height);

@@ -18,13 +18,12 @@ Scene loadSceneStage(const SceneFlags& opt, std::vector<StageReport>& rows) {
 }
 
 LoadedVdl readLightsStage(const std::string& lights, const Scene& scene,
-                          const std::string& scenePath, std::vector<StageReport>& rows) {
+                          std::vector<StageReport>& rows) {
   StageTimer readTimer(rows, "read grid");
   LoadedVdl baked = readVdlGrid(lights, scene.origin);
   readTimer.finish(formatCount(baked.grid.size()) + " voxels");
-  for (const std::string& warning :
-       {staleBakeWarning(baked.meta, scenePath), skyMismatchWarning(baked.meta, scene.sky)}) {
-    if (!warning.empty()) printWarning(lights + ": " + warning);
+  for (const std::string& warning : gridWarnings(baked.meta, scene)) {
+    printWarning(lights + ": " + warning);
   }
   return baked;
 }

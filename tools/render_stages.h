@@ -27,10 +27,9 @@ Scene loadSceneStage(const SceneFlags& opt, std::vector<StageReport>& rows);
 
 /// The "read grid" row: the baked grid `lights` in the scene's coordinates,
 /// with a "warning: LIGHTS: ..." for a bake of another version of the scene
-/// at `scenePath` (staleBakeWarning) or under another sky
-/// (skyMismatchWarning). @throws as readVdlGrid.
+/// or under another sky (gridWarnings). @throws as readVdlGrid.
 LoadedVdl readLightsStage(const std::string& lights, const Scene& scene,
-                          const std::string& scenePath, std::vector<StageReport>& rows);
+                          std::vector<StageReport>& rows);
 
 /// The "GL context" row (its result `name`): the context, "name: GL info" on
 /// stdout unless `quiet`, the info as the report's figure "gl".

@@ -83,7 +83,7 @@ int runView(const ViewOptions& opt) {
 
   Scene scene = loadSceneStage(opt, rows);
   std::optional<LoadedVdl> baked;
-  if (!opt.progressive) baked = readLightsStage(opt.lights, scene, opt.scene, rows);
+  if (!opt.progressive) baked = readLightsStage(opt.lights, scene, rows);
   ViewerParams view = opt.viewerParams(scene, settings, std::move(path));
 
   GlContextParams contextParams;

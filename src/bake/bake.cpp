@@ -579,12 +579,15 @@ BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t 
   return meta;
 }
 
-void recordSourceScene(BakeMetadata& meta, const std::string& scenePath) {
+void recordSourceScene(BakeMetadata& meta, const Scene& scene) {
+  const std::string& scenePath = scene.sourcePath;
+  if (scenePath.empty()) return;
   std::error_code ec;
   const std::filesystem::path absolute = std::filesystem::absolute(scenePath, ec);
   meta.sourceScene = std::filesystem::path(scenePath).filename().string();
   meta.sourceScenePath = ec ? scenePath : absolute.lexically_normal().string();
-  meta.sourceSceneHash = sceneContentHash(scenePath);
+  meta.sourceSceneHash =
+      scene.contentHash.empty() ? sceneContentHash(scenePath) : scene.contentHash;
 }
 
 VolumeLight bakeFreeSpaceLight(const std::vector<PhotonSegment>& segments, const GridFrame& frame,
@@ -597,16 +600,37 @@ VolumeLight bakeFreeSpaceLight(const std::vector<PhotonSegment>& segments, const
   return volume;
 }
 
-std::string staleBakeWarning(const BakeMetadata& meta, const std::string& scenePath) {
-  if (meta.sourceSceneHash.empty()) return "";
-  const std::string now = sceneContentHash(scenePath);
-  if (now == meta.sourceSceneHash) return "";
+namespace {
+
+/// staleBakeWarning of the scene at `scenePath` whose files hash to `now`.
+std::string staleWarning(const BakeMetadata& meta, const std::string& scenePath,
+                         const std::string& now) {
+  if (meta.sourceSceneHash.empty() || now == meta.sourceSceneHash) return "";
   // The path and hash are the file's metadata, whatever another tool wrote.
   return printable("the light was baked from " +
                    (meta.sourceScenePath.empty() ? meta.sourceScene : meta.sourceScenePath) +
                    " (" + meta.sourceSceneHash + "); '" + scenePath +
                    "' and the files it reads differ (" + now +
                    "): bake again if the scene changed");
+}
+
+}  // namespace
+
+std::string staleBakeWarning(const BakeMetadata& meta, const std::string& scenePath) {
+  if (meta.sourceSceneHash.empty()) return "";
+  return staleWarning(meta, scenePath, sceneContentHash(scenePath));
+}
+
+std::vector<std::string> gridWarnings(const BakeMetadata& meta, const Scene& scene) {
+  std::vector<std::string> warnings;
+  const std::string& path = scene.sourcePath;
+  const std::string stale = !scene.contentHash.empty() ? staleWarning(meta, path, scene.contentHash)
+                            : !path.empty()            ? staleBakeWarning(meta, path)
+                                                       : std::string();
+  for (const std::string& w : {stale, skyMismatchWarning(meta, scene.sky)}) {
+    if (!w.empty()) warnings.push_back(w);
+  }
+  return warnings;
 }
 
 std::string directTwiceWarning(const BakeMetadata& meta, const std::string& drawnAgain,

@@ -410,9 +410,11 @@ BakeParams checkedBakeParams(const Scene& scene, const BakeParams& requested, in
 BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t photons,
                           int64_t emittedPaths, float radius);
 
-/// Records the scene file a bake read, `scenePath`, in `meta`: its name, its
-/// absolute path and its content hash (scene/scene_files.h sceneContentHash).
-void recordSourceScene(BakeMetadata& meta, const std::string& scenePath);
+/// Records the scene file a bake read, `scene.sourcePath`, in `meta`: its
+/// name, its absolute path and the content hash of its files as they were
+/// read (Scene::contentHash; for a scene made in code with a sourcePath, the
+/// files' hash now).
+void recordSourceScene(BakeMetadata& meta, const Scene& scene);
 
 /// "" when `meta` records no content hash or `scenePath`'s files still have
 /// it; else a sentence for a warning: the grid was baked from a scene whose
@@ -425,6 +427,13 @@ std::string staleBakeWarning(const BakeMetadata& meta, const std::string& sceneP
 /// was baked under another sky, which the surfaces keep (render --sky, or the
 /// scene's sky changed, changes only the background and the reflections).
 std::string skyMismatchWarning(const BakeMetadata& meta, const Sky& sky);
+
+/// The warnings of a grid drawn with `scene`, each a sentence, for every
+/// reader alike (render, lightmap, the Python module): staleBakeWarning
+/// against the scene's files as it read them (Scene::contentHash; its
+/// sourcePath's files now for a scene made in code; none without either)
+/// and skyMismatchWarning.
+std::vector<std::string> gridWarnings(const BakeMetadata& meta, const Scene& scene);
 
 /// "" unless `meta` records a bake with --include-direct; else a sentence for
 /// a warning: the VDLs hold the direct light, which `drawnAgain` ("mode

@@ -156,6 +156,53 @@ void writeBytes(const std::string& path, const std::string& tmp, const std::stri
   if (!f.flush()) throw IoError(path + ": write failed");
 }
 
+/// The inputs checkDistinctFiles and checkFolderOutputs were given, by
+/// identity (device, inode) and with the thread that named them: what no
+/// output may be renamed over, whatever name reaches it by then (H16-6-1).
+struct WatchedInput {
+  dev_t device;
+  ino_t inode;
+  std::string role, path;
+  std::string absolute;  // path from the working folder of the check
+  std::thread::id owner;
+  uint64_t serial;  // in the order named (InputsWatch forgets from one on)
+};
+std::mutex watchedMutex;
+std::vector<WatchedInput> watched;
+uint64_t watchedSerial = 0;
+
+void watchInputs(const NamedPaths& inputs) {
+  const std::lock_guard<std::mutex> lock(watchedMutex);
+  for (const auto& [role, path] : inputs) {
+    struct stat st {};
+    if (path.empty() || ::stat(path.c_str(), &st) != 0) continue;  // nothing there to replace
+    std::error_code ec;
+    const fs::path absolute = fs::absolute(path, ec);
+    watched.push_back({st.st_dev, st.st_ino, role, path, ec ? path : absolute.string(),
+                       std::this_thread::get_id(), watchedSerial++});
+  }
+}
+
+/// @throws IoError when `path` (links on its way followed) is now one of the
+/// watched inputs: a folder of it was replaced during the work.
+void requireNotAnInput(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return;
+  const std::lock_guard<std::mutex> lock(watchedMutex);
+  for (const WatchedInput& in : watched) {
+    if (in.device != st.st_dev || in.inode != st.st_ino) continue;
+    // Still that input under its own name: an input removed since (its
+    // inode given to a new file) is no longer one.
+    struct stat now {};
+    if (::stat(in.absolute.c_str(), &now) == 0 && now.st_dev == in.device &&
+        now.st_ino == in.inode) {
+      throw IoError(path + ": will not write: it is now the input " + in.role + " ('" + in.path +
+                    "'): a folder on its way was replaced during the work (a link to the "
+                    "inputs' folder?); nothing written");
+    }
+  }
+}
+
 }  // namespace file_internal
 
 void removeLiveTemporaries() {
@@ -369,6 +416,7 @@ void AtomicFileSet::add(const std::string& path,
   using namespace file_internal;
   checkPathText(path, "cannot write");
   requireReplaceable(path);
+  requireNotAnInput(path);
   for (const Entry& e : entries_) {
     if (e.path == path) throw IoError(path + ": named twice in one set of output files");
   }
@@ -397,7 +445,9 @@ void AtomicFileSet::addText(const std::string& path, const std::string& text) {
 void AtomicFileSet::commit() {
   using namespace file_internal;
   for (const Entry& e : entries_) {
-    if (!e.committed) requireReplaceable(e.path);
+    if (e.committed) continue;
+    requireReplaceable(e.path);
+    requireNotAnInput(e.path);
   }
   // The renames are a few system calls; a signal waits for them to end.
   struct Deferral {
@@ -438,6 +488,23 @@ uint64_t AtomicFileSet::bytesOf(const std::string& path) const {
     if (e.path == path) return e.bytes;
   }
   return 0;
+}
+
+InputsWatch::~InputsWatch() {
+  using namespace file_internal;
+  const std::lock_guard<std::mutex> lock(watchedMutex);
+  const std::thread::id self = std::this_thread::get_id();
+  watched.erase(std::remove_if(watched.begin(), watched.end(),
+                               [&](const WatchedInput& in) {
+                                 return in.owner == self && in.serial >= first_;
+                               }),
+                watched.end());
+}
+
+InputsWatch::InputsWatch() {
+  using namespace file_internal;
+  const std::lock_guard<std::mutex> lock(watchedMutex);
+  first_ = watchedSerial;
 }
 
 std::vector<std::string> AtomicFileSet::paths() const {
@@ -590,6 +657,7 @@ fs::path resolvedPath(const std::string& path) {
 }  // namespace
 
 void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs) {
+  file_internal::watchInputs(inputs);
   auto same = [](const std::string& a, const std::string& b) {
     std::error_code ec1, ec2;
     if (fs::exists(a, ec1) && fs::exists(b, ec2)) {
@@ -620,6 +688,7 @@ void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs) {
 void checkFolderOutputs(const std::string& folder,
                         const std::function<std::string(const std::string& name)>& kindOf,
                         const std::string& flag, const NamedPaths& inputs) {
+  file_internal::watchInputs(inputs);
   const fs::path where = resolvedPath(folder);
   for (const auto& [role, path] : inputs) {
     if (path.empty()) continue;

@@ -6,6 +6,7 @@
 /// regular file, and a bad output path is reported before any long work.
 /// See docs/architecture.md, "Outputs".
 
+#include <cstdint>
 #include <functional>
 #include <initializer_list>
 #include <string>
@@ -131,8 +132,26 @@ using NamedPaths = std::vector<std::pair<std::string, std::string>>;  // (flag, 
 
 /// @throws InputError naming both flags when an output is one of the inputs
 /// (the same file, by any name) or two outputs are the same file. Empty paths
-/// are skipped. Called by commands before any work.
+/// are skipped. Called by commands before any work. The inputs are then
+/// watched: no output of the process (writeAtomically, AtomicFileSet) is
+/// written over one of them, by whatever name reaches it when it is written
+/// (a folder replaced meanwhile by a link to the inputs' folder, H16-6-1), until
+/// the process ends or an InputsWatch of this thread ends.
 void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs);
+
+/// @brief The inputs the checks of this thread name while one lives are
+/// forgotten when it ends: the scope of one call in a process that makes many
+/// (the Python module). A command's process keeps them to its end.
+class InputsWatch {
+ public:
+  InputsWatch();
+  ~InputsWatch();
+  InputsWatch(const InputsWatch&) = delete;
+  InputsWatch& operator=(const InputsWatch&) = delete;
+
+ private:
+  uint64_t first_;
+};
 
 /// @brief checkDistinctFiles for outputs named by a rule rather than listed
 /// (numbered pages, saved frames, a results folder): `kindOf(name)` says what
@@ -142,7 +161,8 @@ void checkDistinctFiles(const NamedPaths& outputs, const NamedPaths& inputs);
 /// scene's folder) is caught as surely as a full one.
 /// @throws InputError "<flag>: the <kind> would replace the input <role>
 /// ('<path>'); write to another name" when an input lies in `folder` under
-/// such a name. Called by commands before any work.
+/// such a name. Called by commands before any work; the inputs are then
+/// watched as checkDistinctFiles watches them.
 void checkFolderOutputs(const std::string& folder,
                         const std::function<std::string(const std::string& name)>& kindOf,
                         const std::string& flag, const NamedPaths& inputs);

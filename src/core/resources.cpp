@@ -1,5 +1,6 @@
 #include "core/resources.h"
 
+#include <dirent.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #ifdef __GLIBC__
@@ -148,6 +149,58 @@ size_t mappedBytes() {
     std::fclose(f);
   }
   return used;
+}
+
+namespace {
+
+/// The threads of every process whose real user is `uid` (/proc/PID/status).
+long threadsOfUser(uid_t uid) {
+  long total = 0;
+  DIR* proc = ::opendir("/proc");
+  if (!proc) return 0;
+  while (const dirent* entry = ::readdir(proc)) {
+    if (!std::isdigit(static_cast<unsigned char>(entry->d_name[0]))) continue;
+    const std::string status = std::string("/proc/") + entry->d_name + "/status";
+    std::FILE* f = std::fopen(status.c_str(), "r");
+    if (!f) continue;  // ended meanwhile, or not ours to read
+    char line[256];
+    long real = -1, threads = 0;
+    while (std::fgets(line, sizeof line, f)) {
+      std::sscanf(line, "Uid: %ld", &real);
+      std::sscanf(line, "Threads: %ld", &threads);
+    }
+    std::fclose(f);
+    if (real == long(uid)) total += threads;
+  }
+  ::closedir(proc);
+  return total;
+}
+
+/// A number read from a cgroup file ("max" and anything else: -1).
+long cgroupNumber(const char* path) {
+  long value = -1;
+  if (std::FILE* f = std::fopen(path, "r")) {
+    if (std::fscanf(f, "%ld", &value) != 1) value = -1;
+    std::fclose(f);
+  }
+  return value;
+}
+
+}  // namespace
+
+long threadRoom() {
+  long room = -1;
+  rlimit limit{};
+  if (::geteuid() != 0 && getrlimit(RLIMIT_NPROC, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    room = std::max(0L, long(limit.rlim_cur) - threadsOfUser(::getuid()));
+  }
+  const long most = cgroupNumber("/sys/fs/cgroup/pids.max");
+  const long now = cgroupNumber("/sys/fs/cgroup/pids.current");
+  if (most >= 0 && now >= 0) {
+    const long left = std::max(0L, most - now);
+    room = room < 0 ? left : std::min(room, left);
+  }
+  return room;
 }
 
 size_t addressSpaceRoomBytes() {

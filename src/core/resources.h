@@ -64,6 +64,13 @@ std::string testHook(const char* name);
 /// resident or not, so availableMemoryBytes takes it as a cap too.
 size_t addressSpaceRoomBytes();
 
+/// How many more threads the process may start now: what `ulimit -u`
+/// (RLIMIT_NPROC, counted over every thread of the process's real user)
+/// and a container's pids limit (cgroup pids.max less pids.current) leave,
+/// the smaller; -1 when neither holds (no limit, or a root process, which
+/// RLIMIT_NPROC does not hold).
+long threadRoom();
+
 /// @brief For the message of an allocation that failed inside a library (a
 /// shared library that could not be mapped, a device that could not be
 /// made): under an address-space limit, "the process's address space is

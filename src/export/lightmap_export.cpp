@@ -358,11 +358,12 @@ LightmapExportResult exportLightmap(const Scene& scene, const std::string& light
         LoadedVdl loaded = readVdlGrid(lightsPath, scene.origin);
         meta = std::move(loaded.meta);
         if (params.warn) {
-          const bool full = params.content == AtlasContent::Full;
-          for (const std::string& w :
-               {params.scenePath.empty() ? "" : staleBakeWarning(meta, params.scenePath),
-                skyMismatchWarning(meta, scene.sky),
-                full ? directTwiceWarning(meta, "--content full", "use --content indirect") : ""}) {
+          std::vector<std::string> warnings = gridWarnings(meta, scene);
+          if (params.content == AtlasContent::Full) {
+            warnings.push_back(
+                directTwiceWarning(meta, "--content full", "use --content indirect"));
+          }
+          for (const std::string& w : warnings) {
             if (!w.empty()) params.warn(lightsPath + ": " + w);
           }
         }

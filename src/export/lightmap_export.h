@@ -96,12 +96,11 @@ struct LightmapExportParams {
   ProgressSink* progress = nullptr;
   /// Told, by exportLightmap(scene, path), once it has read the grid and
   /// before the work, of what its metadata says against this export: baked
-  /// from another version of the scene at `scenePath` ("" = not checked),
-  /// under another sky, or with the direct light in it that --content full
-  /// traces again. A `warn` that throws (Python's warnings as errors) stops
-  /// the export before any file is written. Null: nothing told.
+  /// from another version of the scene, under another sky (gridWarnings),
+  /// or with the direct light in it that --content full traces again. A
+  /// `warn` that throws (Python's warnings as errors) stops the export
+  /// before any file is written. Null: nothing told.
   std::function<void(const std::string&)> warn;
-  std::string scenePath;
 };
 
 struct LightmapExportResult {

@@ -5,10 +5,13 @@
 #include <glad/gl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "core/error.h"
 #include "core/resources.h"
@@ -136,11 +139,28 @@ void requireAddressSpaceForGl(const std::string& backend) {
                 memoryShortfall());
 }
 
+/// llvmpipe starts a thread per core to rasterise and waits for ever for one
+/// it could not start: under `ulimit -u` 8 or 10 every render hung (H16-2-2).
+/// Where a limit on threads holds, it is told to start no more than leave
+/// room for the rest of the process (LP_NUM_THREADS, unless the user set
+/// it; 0 rasterises on the drawing thread). Software GL only: a GPU's driver
+/// reads no such variable.
+void fitRasterThreadsToLimit() {
+  if (std::getenv("LP_NUM_THREADS")) return;
+  const long room = threadRoom();
+  if (room < 0) return;
+  constexpr long kKeep = 8;  // the process's own workers yet to start, and Mesa's queues
+  const long cores = std::max(1L, long(std::thread::hardware_concurrency()));
+  const long threads = std::clamp(room - kKeep, 0L, cores);
+  ::setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 0);
+}
+
 }  // namespace
 
 std::unique_ptr<GlContext> createGlContext(const GlContextParams& params) {
   checkGlProcess();
   requireAddressSpaceForGl(toString(params.backend));
+  fitRasterThreadsToLimit();
   switch (params.backend) {
     case GlBackend::OSMesa:
       return render_internal::createOsMesaContext(params);

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -33,33 +34,93 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The numbers of an .mtl's colour and scalar statements that are not finite
-/// numbers (`Ke inf`, `Kd seven`, `Ns nan`): tinyobjloader reads them as 0
-/// without a word (H16-4-5: `Ke inf` drew black). One warning per statement,
-/// for the first ten.
-std::vector<std::string> mtlNumberWarnings(const std::string& text, const std::string& name) {
-  static const std::set<std::string> numeric = {"Ka", "Kd", "Ks",  "Ke",    "Kt",    "Tf",
-                                                "Ns", "Ni", "d",   "Tr",    "Pr",    "Pm",
-                                                "Ps", "Pc", "Pcr", "aniso", "anisor"};
+/// What an .mtl says that tinyobjloader reads otherwise than it means.
+struct MtlScan {
+  /// The numbers of colour and scalar statements that are not finite
+  /// numbers (`Ke inf`, `Kd seven`, `Ns nan`): tinyobjloader reads them as 0
+  /// without a word (H16-4-5: `Ke inf` drew black); and colours of two
+  /// numbers (`Ke 1 1`), whose third it reads as 0. One warning per
+  /// statement, for the first ten.
   std::vector<std::string> warnings;
+  /// Colours of one number (`Kd 0.5`): grey in the MTL format, red to
+  /// tinyobjloader (g and b read as 0). Each as (material, statement, value),
+  /// set right after the parse.
+  struct Grey {
+    std::string material, key;
+    double value;
+  };
+  std::vector<Grey> greys;
+};
+
+MtlScan scanMtl(const std::string& text, const std::string& name) {
+  static const std::set<std::string> colours = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf"};
+  static const std::set<std::string> scalars = {"Ns", "Ni", "d",   "Tr",    "Pr",    "Pm",
+                                                "Ps", "Pc", "Pcr", "aniso", "anisor"};
+  MtlScan scan;
   std::istringstream lines(text);
-  std::string line;
-  for (size_t number = 1; std::getline(lines, line) && warnings.size() < 10; ++number) {
+  std::string line, material;
+  for (size_t number = 1; std::getline(lines, line); ++number) {
     std::istringstream words(line);
     std::string key, word;
-    if (!(words >> key) || numeric.count(key) == 0) continue;
+    if (!(words >> key)) continue;
+    if (key == "newmtl") {
+      std::getline(words >> std::ws, material);
+      // tinyobjloader's name: the rest of the line, without trailing space.
+      while (!material.empty() && std::isspace(static_cast<unsigned char>(material.back()))) {
+        material.pop_back();
+      }
+      continue;
+    }
+    const bool colour = colours.count(key) != 0;
+    if (!colour && scalars.count(key) == 0) continue;
+    const std::string where = name + " line " + std::to_string(number) + ": " + key;
+    std::vector<double> values;
+    bool other = false;  // spectral or xyz: another form of Ka/Kd/Ks/Tf
     while (words >> word) {
-      char* end = nullptr;
-      const double v = std::strtod(word.c_str(), &end);
-      if (word == "spectral" || word == "xyz") break;  // other forms of Ka/Kd/Ks/Tf
-      if (end != word.c_str() + word.size() || !std::isfinite(v)) {
-        warnings.push_back(name + " line " + std::to_string(number) + ": " + key + " '" +
-                           printableShort(word) + "' is not a finite number: read as 0");
+      if (word == "spectral" || word == "xyz") {
+        other = true;
         break;
       }
+      char* end = nullptr;
+      const double v = std::strtod(word.c_str(), &end);
+      if (end != word.c_str() + word.size() || !std::isfinite(v)) {
+        if (scan.warnings.size() < 10) {
+          scan.warnings.push_back(where + " '" + printableShort(word) +
+                                  "' is not a finite number: read as 0");
+        }
+        other = true;
+        break;
+      }
+      values.push_back(v);
+    }
+    if (!colour || other) continue;
+    if (values.size() == 1) {
+      scan.greys.push_back({material, key, values[0]});
+    } else if (values.size() == 2 && scan.warnings.size() < 10) {
+      scan.warnings.push_back(where +
+                              " has two numbers: its blue is read as 0; write three (r g b) or "
+                              "one (grey)");
     }
   }
-  return warnings;
+  return scan;
+}
+
+/// Sets each one-number colour of `scan` grey in the parsed `materials`.
+void applyGreys(const MtlScan& scan, const std::map<std::string, int>& byName,
+                std::vector<tinyobj::material_t>& materials) {
+  for (const MtlScan::Grey& g : scan.greys) {
+    const auto found = byName.find(g.material);
+    if (found == byName.end() || found->second < 0 || size_t(found->second) >= materials.size()) {
+      continue;
+    }
+    tinyobj::material_t& m = materials[size_t(found->second)];
+    tinyobj::real_t* c = g.key == "Ka"   ? m.ambient
+                         : g.key == "Kd" ? m.diffuse
+                         : g.key == "Ks" ? m.specular
+                         : g.key == "Ke" ? m.emission
+                                         : m.transmittance;  // Kt, Tf
+    c[0] = c[1] = c[2] = tinyobj::real_t(g.value);
+  }
 }
 
 /// Opens .mtl files only inside the scene folder; remembers the first refusal
@@ -90,11 +151,11 @@ class FolderMaterialReader : public tinyobj::MaterialReader {
       }
       std::ostringstream text;
       text << in.rdbuf();
-      for (std::string& w : mtlNumberWarnings(text.str(), scenePath_ + ": " + printable(matId))) {
-        warnings_.push_back(std::move(w));
-      }
+      MtlScan scan = scanMtl(text.str(), scenePath_ + ": " + printable(matId));
+      for (std::string& w : scan.warnings) warnings_.push_back(std::move(w));
       std::istringstream mtl(text.str());
       tinyobj::LoadMtl(matMap, materials, &mtl, warn, err);
+      applyGreys(scan, *matMap, *materials);
       return true;
     } catch (const InputError& e) {
       error_ = e.what();

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -15,6 +15,7 @@
 #include "core/fnv.h"
 #include "core/resources.h"
 #include "image/image.h"
+#include "scene/scene_files.h"
 #include "scene/scene_internal.h"
 
 namespace lo {
@@ -512,6 +513,11 @@ Scene loadScene(const std::string& path, const std::string& skyMesh) {
   std::error_code ec;
   if (!fs::exists(path, ec)) scene_internal::fail(path, "missing file (not found)");
   requireRegularFile(path, "the scene");
+  // The files as the file system has them before the read and after the
+  // hash: a file written meanwhile would make a scene of both versions, and
+  // a hash of neither (H16-7-4).
+  const std::vector<std::string> files = sceneFiles(path);
+  const std::string before = sceneFilesStamp(files);
   Scene scene;
   try {
     if (gltf) {
@@ -525,6 +531,12 @@ Scene loadScene(const std::string& path, const std::string& skyMesh) {
     scene_internal::fail(path, "out of memory while loading (corrupt sizes?)");
   }
   scene.sourcePath = path;
+  scene.contentHash = sceneContentHash(path, files);
+  if (sceneFilesStamp(files) != before) {
+    scene_internal::fail(path,
+                         "a file of the scene was written while it was read: read it again "
+                         "once the writer is done");
+  }
   scene_internal::validateScene(scene);
   scene_internal::dropRepeatedTriangles(scene);
   return scene;

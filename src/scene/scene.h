@@ -292,6 +292,9 @@ struct Camera {
 /// the world's origin.
 struct Scene {
   std::string sourcePath;
+  /// sceneContentHash of the files as loadScene read them ("" for a scene
+  /// made in code): what a bake records, whatever the files hold later.
+  std::string contentHash;
   /// Where the stored positions are measured from, in the file's world
   /// coordinates (world = stored + origin). loadScene keeps (0, 0, 0) unless
   /// the scene's centre lies farther from the world origin than 128x its size

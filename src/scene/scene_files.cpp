@@ -1,6 +1,6 @@
 #include "scene/scene_files.h"
 
-#include <nlohmann/json.hpp>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/error.h"
@@ -146,13 +147,36 @@ std::vector<std::string> sceneFiles(const std::string& path) {
   return unique;
 }
 
+std::string sceneFilesStamp(const std::vector<std::string>& files) {
+  std::string stamp;
+  for (const std::string& file : files) {
+    struct stat st {};
+    char text[160];
+    if (::stat(file.c_str(), &st) != 0) {
+      std::snprintf(text, sizeof text, "missing\n");
+    } else {
+      std::snprintf(text, sizeof text, "%llu %llu %lld %lld.%09ld %lld.%09ld\n",
+                    static_cast<unsigned long long>(st.st_dev),
+                    static_cast<unsigned long long>(st.st_ino), static_cast<long long>(st.st_size),
+                    static_cast<long long>(st.st_mtim.tv_sec), st.st_mtim.tv_nsec,
+                    static_cast<long long>(st.st_ctim.tv_sec), st.st_ctim.tv_nsec);
+    }
+    stamp += text;
+  }
+  return stamp;
+}
+
 std::string sceneContentHash(const std::string& path) {
+  return sceneContentHash(path, sceneFiles(path));
+}
+
+std::string sceneContentHash(const std::string& path, const std::vector<std::string>& files) {
   Fnv1a64 hash;
   auto add = [&hash](const void* data, size_t size) { hash.bytes(data, size); };
   const fs::path folder = fs::path(path).parent_path();
   std::vector<char> buffer(1 << 16);
   bool first = true;
-  for (const std::string& file : sceneFiles(path)) {
+  for (const std::string& file : files) {
     // The files it reads by name, but not the scene's own name: a renamed
     // copy is the same scene.
     std::error_code ec;

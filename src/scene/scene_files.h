@@ -24,5 +24,12 @@ std::vector<std::string> sceneFiles(const std::string& path);
 /// written "fnv1a64:" and 16 hex digits. The same files give the same hash
 /// wherever they lie; a change to any byte the load reads changes it.
 std::string sceneContentHash(const std::string& path);
+/// sceneContentHash over `files` (sceneFiles(path), listed once by the caller).
+std::string sceneContentHash(const std::string& path, const std::vector<std::string>& files);
+
+/// What the file system says of each of `files` now (device, inode, size and
+/// time of the last change, or that it is missing): unchanged while no
+/// file of them is written. The load compares it before and after reading.
+std::string sceneFilesStamp(const std::vector<std::string>& files);
 
 }  // namespace lo

@@ -113,13 +113,12 @@ BakeParams bakeParamsOf(const SweepPoint& point, const Scene& scene, uint64_t se
 
 /// Bakes in this process and writes the .vdb; memory is the peak resident
 /// set during the bake above the resident set before it.
-BakeFigures bakeAndWrite(const Scene& scene, const std::string& scenePath, const BakeParams& b,
-                         const std::string& vdb) {
+BakeFigures bakeAndWrite(const Scene& scene, const BakeParams& b, const std::string& vdb) {
   const size_t before = currentRssBytes();
   const bool reset = resetPeakRss();
   Stopwatch clock;
   BakeResult baked = bake(scene, b);
-  recordSourceScene(baked.metadata, scenePath);
+  recordSourceScene(baked.metadata, scene);
   writeVdlGrid(vdb, baked.grid, baked.metadata);
   BakeFigures f;
   f.bakeSeconds = clock.seconds();
@@ -234,7 +233,7 @@ std::vector<SweepResult> runSweep(const SweepParams& params, std::FILE* log) {
     const std::string vdb = cache.vdbPath(point);
     BakeFigures figures;
     if (!cache.loadBake(point, figures)) {
-      figures = bakeAndWrite(scene, params.scene, bakeParamsOf(point, scene, params.seed), vdb);
+      figures = bakeAndWrite(scene, bakeParamsOf(point, scene, params.seed), vdb);
       cache.storeBake(point, figures);
     }
     SweepResult r;

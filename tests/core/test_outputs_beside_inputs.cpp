@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <string>
 
 #include "core/error.h"
@@ -84,6 +85,53 @@ TEST(OutputsBesideInputs, ALinkLeadsToTheFolderItNames) {
   EXPECT_THROW(checkFolderOutputs(dir + "/alias", pageKind, "--output",
                                   {{"SCENE's file", dir + "/real/out-9.png"}}),
                InputError);
+}
+
+// The check before the work compares names; an output folder replaced
+// during the work by a link to the inputs' folder (H16-6-1) is caught at the
+// write, for a file alone and for a set at its commit, the input untouched.
+// Once the call's InputsWatch ends, its inputs are files like any other.
+TEST(OutputsBesideInputs, AnOutputFolderSwappedForTheInputsFolderIsNotWrittenThrough) {
+  const std::string dir = test::outputDir("OutputsBesideInputs.Swapped");
+  fs::create_directories(dir + "/in");
+  fs::create_directories(dir + "/out");
+  const std::string input = dir + "/in/scene.gltf";
+  std::ofstream(input) << "the scene";
+  auto content = [&] {
+    std::ifstream in(input);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  auto swap = [&] {
+    fs::remove_all(dir + "/out");
+    fs::create_directory_symlink("in", dir + "/out");
+  };
+  {
+    const InputsWatch call;
+    checkDistinctFiles({{"--output", dir + "/out/scene.gltf"}}, {{"SCENE", input}});
+    swap();
+    try {
+      writeTextAtomically(dir + "/out/scene.gltf", "output");
+      ADD_FAILURE() << "written through the swapped folder";
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find("will not write: it is now the input SCENE"),
+                std::string::npos)
+          << e.what();
+    }
+    EXPECT_EQ(content(), "the scene");
+
+    // A set whose file was written before the swap: its commit refuses.
+    fs::remove(dir + "/out");
+    fs::create_directories(dir + "/out");
+    AtomicFileSet set;
+    set.addText(dir + "/out/scene.gltf", "output");
+    swap();
+    EXPECT_THROW(set.commit(), IoError);
+    EXPECT_EQ(content(), "the scene");
+    EXPECT_TRUE(leftoverTemporaries(input).empty());
+  }
+  // The watch ended: the same write is the user's to make.
+  writeTextAtomically(dir + "/out/scene.gltf", "output");
+  EXPECT_EQ(content(), "output");
 }
 
 TEST(OutputsBesideInputs, APathWithANulByteIsNeitherReadNorWritten) {

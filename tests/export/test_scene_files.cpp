@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 
@@ -111,6 +112,23 @@ TEST(SceneFiles, TheContentHashFollowsTheBytesNotTheNames) {
   EXPECT_NE(a, sceneContentHash(dir + "/b/renamed.gltf"));
   fs::remove(dir + "/b/t.png");  // a missing image counts too
   EXPECT_NE(a, sceneContentHash(dir + "/b/renamed.gltf"));
+}
+
+// The stamp the load compares before and after reading changes when a file
+// of the scene is written, and only then.
+TEST(SceneFiles, TheStampChangesWhenAFileIsWritten) {
+  const std::string dir = test::outputDir("SceneFiles.Stamp");
+  std::ofstream(dir + "/scene.gltf") << R"({"asset":{"version":"2.0"},"images":[{"uri":"t.png"}]})";
+  std::ofstream(dir + "/t.png") << "texture";
+  // Times in the past, so that the write below is seen on any clock.
+  const auto past = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  fs::last_write_time(dir + "/t.png", past);
+  const std::vector<std::string> files = sceneFiles(dir + "/scene.gltf");
+  ASSERT_EQ(files.size(), 2u);
+  const std::string stamp = sceneFilesStamp(files);
+  EXPECT_EQ(stamp, sceneFilesStamp(files));
+  std::ofstream(dir + "/t.png") << "texturE";  // the same size
+  EXPECT_NE(stamp, sceneFilesStamp(files));
 }
 
 }  // namespace

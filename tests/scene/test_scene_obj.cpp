@@ -134,6 +134,23 @@ TEST_F(SceneObj, MtlValuesThatAreNotNumbersAreWarned) {
       << s.warnings[1];
 }
 
+// An MTL colour of one number is grey, as the format says (tinyobjloader
+// read `Kd 0.5` as red: green and blue 0); one of two numbers is warned
+// (its blue is read as 0).
+TEST_F(SceneObj, MtlColourOfOneNumberIsGreyAndOfTwoIsWarned) {
+  write("m.mtl", "newmtl grey\nKd 0.5\nnewmtl two\nKd 0.25 0.5 0.75\nKe 1 1\n");
+  write("scene.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl grey\nf 1 2 3\n"
+        "usemtl two\nf 1 3 4\n");
+  const Scene s = loadScene(dir + "/scene.obj");
+  expectNear(s.albedo(0, 0, 0), {0.5f, 0.5f, 0.5f}, 1e-6f, "Kd 0.5");
+  expectNear(s.albedo(1, 0, 0), {0.25f, 0.5f, 0.75f}, 1e-6f, "Kd of three");
+  ASSERT_EQ(s.warnings.size(), 1u) << ::testing::PrintToString(s.warnings);
+  EXPECT_NE(s.warnings[0].find("m.mtl line 5: Ke has two numbers: its blue is read as 0"),
+            std::string::npos)
+      << s.warnings[0];
+}
+
 // OBJ vertex colours (`v x y z r g b`) multiply the base colour like glTF's
 // COLOR_0, when every vertex has one, read as the display (sRGB) values the
 // tools that write them mean; a file where only some have one keeps none

@@ -2,8 +2,8 @@
 // half-float storage, photon read-back, `inspect` on good, damaged and
 // corrupted files, vdb_print on a converted file.
 
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -21,11 +21,12 @@
 #include "bake/bake.h"
 #include "cluster/resample.h"
 #include "core/error.h"
-#include "core/rng.h"
 #include "core/file.h"
 #include "core/printable.h"
-#include "test_util.h"
+#include "core/rng.h"
 #include "octree/gpu_octree.h"
+#include "scene/scene_files.h"
+#include "test_util.h"
 #include "vdb/vdb_inspect.h"
 #include "vdb/vdb_internal.h"
 #include "vdb/vdb_io.h"
@@ -932,6 +933,24 @@ TEST(Inspect, ControlCharactersOfTheMetadataArePrintedEscaped) {
   const std::string refused = readError(dir + "/representation.vdb");
   EXPECT_EQ(refused.find('\x1b'), std::string::npos) << refused;
   EXPECT_NE(refused.find("'sh9\\x1b[8m'"), std::string::npos) << refused;
+}
+
+// A bake records the scene as it was read, not as it is when the bake ends:
+// a scene edited during its bake (H16-7-4) is then called stale, not
+// recorded with the edited file's hash.
+TEST(Inspect, TheBakeRecordsTheSceneAsItWasRead) {
+  const std::string dir = test::outputDir("Inspect.RecordedAsRead");
+  const std::string path = dir + "/room.gltf";
+  fs::copy_file(test::dataDir() + "/cornell-box.gltf", path, fs::copy_options::overwrite_existing);
+  const Scene scene = loadScene(path);
+  const std::string asRead = sceneContentHash(path);
+  EXPECT_EQ(scene.contentHash, asRead);
+  std::ofstream(path, std::ios::app) << "\n";  // edited while the bake runs
+  BakeMetadata m = meta();
+  recordSourceScene(m, scene);
+  EXPECT_EQ(m.sourceSceneHash, asRead);
+  EXPECT_NE(sceneContentHash(path), asRead);
+  EXPECT_FALSE(staleBakeWarning(m, path).empty());
 }
 
 }  // namespace
