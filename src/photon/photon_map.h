@@ -152,15 +152,19 @@ class PhotonTracer {
 /// are still needed, with a margin, within [4096, 2^19] (the first batch:
 /// min(target, 65536)), and never beyond `maxEmitted`. 0: stop, also once
 /// kReachProbePaths paths say that `maxEmitted` would store under 1% of the
-/// target. Only the work wasted past the target and that early stop depend
-/// on it, never the photons.
+/// target, or sooner (from 16,384 paths) once even the Poisson bound of the
+/// rate so far says it would store under 0.25% (by the last path, or by
+/// kPathsPerPhoton paths per photon of the target if that comes first). Only the work wasted past
+/// the target and that early stop depend on it, never the photons.
 size_t photonBatchPaths(size_t target, size_t stored, size_t emitted, size_t maxEmitted);
 /// Paths traced before photonBatchPaths judges whether the lights reach the
 /// scene at all: from then on, a map that would hold under 1% of its
 /// photons at maxEmitted paths stops (a light under the floor, seen in a
 /// second rather than after a billion paths).
 constexpr size_t kReachProbePaths = size_t(1) << 20;
-/// PhotonParams::maxEmitted, or its default 64 * storedPhotons.
+/// The paths a map may trace per photon it is to store, by default.
+constexpr size_t kPathsPerPhoton = 64;
+/// PhotonParams::maxEmitted, or its default kPathsPerPhoton * storedPhotons.
 size_t maxEmittedPaths(const PhotonParams& params);
 /// Divides every photon's power by the paths emitted to obtain them (the
 /// Monte Carlo estimator of the emitted flux): the last step of a map.

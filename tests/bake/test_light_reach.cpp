@@ -46,8 +46,19 @@ TEST(PhotonBatchPaths, StopsWhenTheLightsReachAlmostNothing) {
   // target by the last path stops; 1% or more goes on.
   EXPECT_EQ(photonBatchPaths(target, 100, kReachProbePaths, maxEmitted), 0u);
   EXPECT_GT(photonBatchPaths(target, 200, kReachProbePaths, maxEmitted), 0u);
-  // Before the probe's paths, no judgement.
-  EXPECT_GT(photonBatchPaths(target, 0, kReachProbePaths / 2, maxEmitted), 0u);
+  // Before the probe's paths, only a judgement beyond doubt: nothing from
+  // 2^19 paths, where even 3 photons (the bound of none) would store 0.04%
+  // by the last path, stops; 300 photons (4% at the bound) go on,
+  // and so does nothing from a few paths.
+  EXPECT_EQ(photonBatchPaths(target, 0, kReachProbePaths / 2, maxEmitted), 0u);
+  EXPECT_GT(photonBatchPaths(target, 300, kReachProbePaths / 2, maxEmitted), 0u);
+  EXPECT_GT(photonBatchPaths(target, 0, 8192, maxEmitted), 0u);
+  // A target bake's pilot: 20,000 photons with the whole bake's paths
+  // (1.28 billion) to draw on. Nothing from 100,000 paths stops (judged by
+  // 64 paths per photon of the pilot); 5 photons go on.
+  const size_t pilot = 20000, bakePaths = size_t(1280) * 1000000;
+  EXPECT_EQ(photonBatchPaths(pilot, 0, 100000, bakePaths), 0u);
+  EXPECT_GT(photonBatchPaths(pilot, 5, 100000, bakePaths), 0u);
 }
 
 TEST(LightReach, ALightThatReachesNothingStopsTheBakeAtOnceNamingIt) {
