@@ -210,6 +210,17 @@ for setting in GALLIUM_DRIVER=nonsense GALLIUM_DRIVER=swr MESA_GLSL_VERSION_OVER
     fail "$setting: exit $rc: $err"
   fi
 done
+# Many of them are named three at a time, each cut short: 5,000 made a line of
+# half a megabyte (H17-2-1).
+many=()
+for i in $(seq 1 500); do many+=("MESA_X$i=$(printf '%0100d' 0)"); done
+err=$(env "${many[@]}" "$cli" render "$scene" "$out/small.vdb" -o "$out/gallium.png" \
+      --width 8 --height 8 --quiet 2>&1)
+rc=$?
+if [ "$rc" -ne 1 ] || [ -e "$out/gallium.png" ] || ! grep -q "and 497 more" <<<"$err" ||
+   [ "${#err}" -gt 1000 ]; then
+  fail "500 MESA_ settings: exit $rc, ${#err} bytes: $(head -c 300 <<<"$err")"
+fi
 # Mesa's cache and log settings are no such change.
 MESA_SHADER_CACHE_DISABLE=true "$cli" render "$scene" "$out/small.vdb" -o "$out/gallium.png" \
   --width 8 --height 8 --quiet || fail "MESA_SHADER_CACHE_DISABLE=true: the render failed"

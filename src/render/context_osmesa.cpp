@@ -11,6 +11,7 @@
 // glad's header defines __gl_h_, so osmesa.h takes glad's GL types.
 #include <GL/osmesa.h>
 
+#include <algorithm>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -110,8 +111,13 @@ std::vector<std::string> mesaSettings() {
 void refuseMesaSettings() {
   const std::vector<std::string> settings = mesaSettings();
   if (settings.empty()) return;
+  // The first three, each cut to 60 bytes: 5,000 of them made a line of
+  // half a megabyte (H17-2-1).
   std::string named;
-  for (const std::string& s : settings) named += (named.empty() ? "" : ", ") + printable(s);
+  for (size_t i = 0; i < std::min<size_t>(3, settings.size()); ++i) {
+    named += (i ? ", " : "") + printableShort(settings[i]);
+  }
+  if (settings.size() > 3) named += " and " + formatCount(settings.size() - 3) + " more";
   throw GlError("osmesa: the environment changes how Mesa draws (" + named +
                 "): unset it; lightoctree draws with Mesa's llvmpipe as it ships (GALLIUM_DRIVER "
                 "may name llvmpipe or softpipe; Mesa's cache and log settings are kept)");

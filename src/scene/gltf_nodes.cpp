@@ -82,7 +82,7 @@ void SceneBuilder::traverse() {
   std::vector<Item> stack;
   std::vector<int> roots = sceneRoots();
   for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.push_back({*r, Mat4{}, 0});
-  size_t visits = 0;
+  std::vector<char> seen(model_.nodes.size(), 0);
   while (!stack.empty()) {
     Item item = stack.back();
     stack.pop_back();
@@ -90,10 +90,14 @@ void SceneBuilder::traverse() {
       fail(path_, "node index " + std::to_string(item.node) + " out of range");
     }
     // A valid glTF node tree visits each node once; a cycle or a shared
-    // child would never end or multiply the geometry.
-    if (item.depth > model_.nodes.size() || ++visits > model_.nodes.size()) {
-      fail(path_, "the node hierarchy is not a tree (cycle or shared node " +
-                      std::to_string(item.node) + ")");
+    // child would never end or multiply the geometry. The node reached a
+    // second time is the one named (the count of visits named a later one).
+    if (seen[size_t(item.node)]++) {
+      const std::string& name = model_.nodes[size_t(item.node)].name;
+      fail(path_, "the node hierarchy is not a tree: node " + std::to_string(item.node) +
+                      (name.empty() ? "" : " ('" + printableShort(name) + "')") +
+                      " is reached twice (a child of two nodes, of a node and the scene, or "
+                      "in a cycle)");
     }
     const tinygltf::Node& node = model_.nodes[size_t(item.node)];
     checkAffine(node, item.node);

@@ -149,6 +149,7 @@ class FolderMaterialReader : public tinyobj::MaterialReader {
         error_ = scenePath_ + ": cannot open material library '" + matId + "'";
         return false;
       }
+      skipByteOrderMark(in);
       std::ostringstream text;
       text << in.rdbuf();
       MtlScan scan = scanMtl(text.str(), scenePath_ + ": " + printable(matId));
@@ -188,6 +189,7 @@ Vec3 rgb(const tinyobj::real_t c[3]) { return {float(c[0]), float(c[1]), float(c
 std::vector<double> readVerticesInDouble(const std::string& path) {
   std::vector<double> out;
   std::ifstream in(path);
+  skipByteOrderMark(in);
   std::string line;
   size_t lineNumber = 0;
   while (std::getline(in, line)) {
@@ -227,11 +229,20 @@ Vec3d originOf(const std::vector<T>& xyz) {
 
 }  // namespace
 
+void skipByteOrderMark(std::istream& in) {
+  char head[3] = {0, 0, 0};
+  in.read(head, 3);
+  const bool mark = in.gcount() == 3 && head[0] == '\xEF' && head[1] == '\xBB' && head[2] == '\xBF';
+  in.clear();
+  in.seekg(mark ? 3 : 0);
+}
+
 Scene loadObj(const std::string& path) {
   std::string baseDir = fs::path(path).parent_path().string();
   if (baseDir.empty()) baseDir = ".";
   std::ifstream in(path);
   if (!in) fail(path, "missing file (cannot open)");
+  skipByteOrderMark(in);
 
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;

@@ -97,6 +97,7 @@ std::vector<std::string> wordsAfterFirst(const std::string& line) {
 
 void objFiles(const std::string& path, const std::string& baseDir, std::vector<std::string>& out) {
   std::ifstream obj(path);
+  skipByteOrderMark(obj);
   std::string line;
   std::vector<std::string> libraries;
   while (std::getline(obj, line)) {
@@ -111,6 +112,7 @@ void objFiles(const std::string& path, const std::string& baseDir, std::vector<s
   for (const std::string& library : libraries) {
     out.push_back(library);
     std::ifstream mtl(library);
+    skipByteOrderMark(mtl);
     while (std::getline(mtl, line)) {
       const size_t start = line.find_first_not_of(" \t");
       if (start == std::string::npos || line.compare(start, 6, "map_Kd") != 0) continue;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <istream>
 #include <limits>
 #include <memory>
 #include <string>
@@ -24,6 +25,11 @@ namespace lo::scene_internal {
 /// `what` (e.g. "buffer 0") and the uri. Does not check that the file exists.
 std::string resolveInsideFolder(const std::string& scenePath, const std::string& baseDir,
                                 const std::string& uri, const std::string& what);
+
+/// Skips a UTF-8 byte-order mark at the start of a text file's stream (Windows
+/// editors write one): tinyobjloader read "\xEF\xBB\xBFmtllib" as an unknown
+/// statement, and an OBJ lost its materials without a word (H17-7-2).
+void skipByteOrderMark(std::istream& in);
 
 /// Decodes %XX escapes of a URI reference (glTF uris are URI-encoded).
 std::string percentDecode(const std::string& uri);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "scene/scene.h"
+#include "scene/scene_files.h"
 #include "scene/scene_fixture.h"
 #include "test_util.h"
 
@@ -132,6 +133,20 @@ TEST_F(SceneObj, MtlValuesThatAreNotNumbersAreWarned) {
   EXPECT_NE(s.warnings[1].find("m.mtl line 4: Ks 'seven' is not a finite number"),
             std::string::npos)
       << s.warnings[1];
+}
+
+// An OBJ and an MTL that begin with a UTF-8 byte-order mark (Windows editors
+// write one) are read whole: the first statement (mtllib, newmtl) was lost,
+// and every material with it, without a word (H17-7-2).
+TEST_F(SceneObj, AByteOrderMarkIsSkipped) {
+  write("m.mtl", "\xEF\xBB\xBFnewmtl red\nKd 0.8 0.1 0.1\n");
+  write("scene.obj", "\xEF\xBB\xBFmtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl red\nf 1 2 3\n");
+  const Scene s = loadScene(dir + "/scene.obj");
+  EXPECT_TRUE(s.warnings.empty()) << ::testing::PrintToString(s.warnings);
+  expectNear(s.albedo(0, 0, 0), {0.8f, 0.1f, 0.1f}, 1e-6f, "red");
+  const std::vector<std::string> files = sceneFiles(dir + "/scene.obj");
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(fs::path(files[1]).filename(), "m.mtl");
 }
 
 // An MTL colour of one number is grey, as the format says (tinyobjloader

@@ -263,7 +263,12 @@ TEST_F(SceneReject, InvalidJson) {
 TEST_F(SceneReject, NodeCycle) {
   MiniGltf g = oneTriangle();
   g.nodes = R"([{"mesh": 0, "children": [1]}, {"children": [0]}])";
-  expectInputError(write("cycle.gltf", g), "not a tree");
+  expectInputError(write("cycle.gltf", g), "node 0 is reached twice");
+  // A node shared by two parents is the one named (H17-7-1: a later node
+  // was, by the count of visits).
+  g.nodes = R"([{"children": [2]}, {"children": [2]}, {"mesh": 0, "name": "wall"}, {}, {}])";
+  g.sceneNodes = "[0, 1, 3, 4]";
+  expectInputError(write("shared.gltf", g), "node 2 ('wall') is reached twice");
 }
 
 // Hardening (docs/scene.md, "Limits"): inputs that used to crash or load as
