@@ -333,15 +333,19 @@ int main(int argc, char** argv) {
     char** argv;
     int rc;
   } call{argc, argv, 1};
-  pthread_t thread;  // with the default stack mainStackHolds set
-  if (::pthread_create(
-          &thread, nullptr,
-          [](void* p) -> void* {
-            auto* c = static_cast<Call*>(p);
-            c->rc = runAndReport(c->argc, c->argv);
-            return nullptr;
-          },
-          &call) != 0) {
+  pthread_attr_t attributes;
+  pthread_t thread;
+  const bool started = ::pthread_attr_init(&attributes) == 0 &&
+                       ::pthread_attr_setstacksize(&attributes, kStackBytes) == 0 &&
+                       ::pthread_create(
+                           &thread, &attributes,
+                           [](void* p) -> void* {
+                             auto* c = static_cast<Call*>(p);
+                             c->rc = runAndReport(c->argc, c->argv);
+                             return nullptr;
+                           },
+                           &call) == 0;
+  if (!started) {
     sayThreadsShort();
     return 1;
   }
