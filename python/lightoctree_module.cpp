@@ -1071,7 +1071,11 @@ py::object referenceImage(const Arg<std::string>& sceneArg, const Arg<int>& widt
                        "sample per pixel until it runs out)");
     }
   }
-  if (!camera.is_none()) opt.camera.camera = textArg(camera, "camera");
+  if (!camera.is_none()) {
+    opt.camera.camera = textArg(camera, "camera");
+    const std::string problem = tool::cameraNameProblem(opt.camera.camera);
+    if (!problem.empty()) throw InputError("camera: " + problem);
+  }
   if (!eye.is_none()) opt.camera.eye = vec3Text(eye, "eye");
   if (!target.is_none()) opt.camera.target = vec3Text(target, "target");
   if (!opt.camera.camera.empty() && !opt.camera.eye.empty()) {
@@ -1245,6 +1249,7 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
   p.output = output;
   py::object sky = py::none(), skyImage = py::none(), skyMesh = py::none(), physicalSky = py::none();
   py::object progress = py::none();
+  std::string directions;  // "": on, but for content "full"
   for (const auto& [key, value] : kw) {
     const std::string name = py::str(key);
     // The ranges and words of the command's flags (tools/lightmap_command.cpp).
@@ -1271,7 +1276,7 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
       if (on == "cpu") p.atlasGl.reset();
       else p.atlasGl = parseGlBackend(on);
     } else if (name == "directions") {
-      p.directionPages = checkChoice(textArg(value, name), {"on", "off"}, name) == "on";
+      directions = checkChoice(textArg(value, name), {"on", "off"}, name);
     } else if (name == "chart_image") {
       p.chartImages = boolArg(value, name);
     } else if (name == "sky") {
@@ -1286,6 +1291,7 @@ py::dict lightmapExport(const Arg<std::string>& sceneArg, const Arg<std::string>
       throw InputError("lightmap: unknown setting '" + printable(name) + "'");
     }
   }
+  p.directionPages = directionPagesOf(directions, p.content, "directions");
   const SceneOptions scene = sceneOptions(sky, skyImage, skyMesh, physicalSky);
   // What the command checks before any work: the folder, the name, and that
   // no file written (or removed as an earlier export's) replaces an input,

@@ -11,8 +11,15 @@
 
 namespace lo::tool {
 
+std::string cameraNameProblem(const std::string& name) {
+  return name.empty() ? "an empty name: name one of the scene's cameras, or leave it out for the "
+                        "first"
+                      : "";
+}
+
 void addCameraOptions(CLI::App* cmd, CameraOptions& opt) {
-  auto* camera = cmd->add_option("--camera", opt.camera, "Scene camera by name (default: first)");
+  auto* camera = cmd->add_option("--camera", opt.camera, "Scene camera by name (default: first)")
+                     ->check(cameraNameProblem, "NAME");
   auto* eye = cmd->add_option("--eye", opt.eye, "Camera position x,y,z (with --target)");
   cmd->add_option("--target", opt.target, "Point the camera looks at, x,y,z (with --eye)");
   camera->excludes(eye);

@@ -25,6 +25,11 @@ struct CameraOptions {
 /// Registers --camera, --eye, --target, --fov on `cmd`.
 void addCameraOptions(CLI::App* cmd, CameraOptions& opt);
 
+/// "" for a camera name given, else what is wrong with it: an empty name
+/// drew from the default camera without a word (H17-4-1). The rule of
+/// --camera and of the Python module's camera=.
+std::string cameraNameProblem(const std::string& name);
+
 /// Checks what can be checked before the scene is loaded (--eye/--target
 /// pairing and syntax). @throws InputError naming the flag.
 void checkCameraOptions(const CameraOptions& opt);

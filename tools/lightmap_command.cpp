@@ -33,7 +33,7 @@ struct LightmapOptions {
   float exposure = 0;
   std::string atlasOn = "cpu";  // cpu | osmesa | egl
   bool chartImage = false;
-  std::string directions = "on";
+  std::string directions;  // "": on, but for --content full
   std::string json;  // --json FILE: tools/json_report.h
   bool quiet = false;
 };
@@ -59,7 +59,7 @@ LightmapExportParams exportParams(const LightmapOptions& opt, const NamedPaths& 
   p.preview = opt.previewUnlit;
   p.previewExposureEv = opt.exposure;
   p.chartImages = opt.chartImage;
-  p.directionPages = opt.directions == "on";
+  p.directionPages = directionPagesOf(opt.directions, p.content, "--directions");
   if (opt.atlasOn != "cpu") p.atlasGl = parseGlBackend(opt.atlasOn);
   return p;
 }
@@ -176,10 +176,9 @@ void addLightmapOptions(CLI::App* cmd, LightmapOptions& opt) {
          "--directions", opt.directions,
          "Also write OUT-directionN.png beside each page: the mean direction the light "
          "comes from per texel (world space, 8-bit unit vectors, extras.lightmap.direction), "
-         "so viewers shade normal maps and gloss from the lightmap (on) or not (off); "
-         "never with --content full, whose E holds direct light from other directions")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
+         "so viewers shade normal maps and gloss from the lightmap (on, the default) or not "
+         "(off); never with --content full, whose E holds direct light from other directions")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_flag("--chart-image", opt.chartImage,
                 "Also write OUT-chartsN.png: each page's UV layout, one colour per chart, chart "
                 "borders darker (v = 0 is the top row)");

@@ -161,6 +161,19 @@ def test_three_numbers_are_three_real_numbers_and_text_has_no_nul(tmp_path):
         lightoctree.reference(SCENE, width=4, height=3, spp=1, camera="\udcff")
 
 
+def test_settings_that_would_be_dropped_are_refused(grid_file, tmp_path):
+    """An empty camera name drew from the first camera, and direction pages
+    asked of a lightmap of the full light were left out, without a word
+    (H17-4-1): both refused, nothing written."""
+    with pytest.raises(lightoctree.InputError, match="camera: an empty name"):
+        lightoctree.reference(SCENE, width=4, height=3, spp=1, camera="")
+    out = tmp_path / "full.glb"
+    with pytest.raises(lightoctree.InputError,
+                       match="directions on: a lightmap of the full light writes no direction"):
+        lightoctree.lightmap(SCENE, grid_file, str(out), content="full", directions="on")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_render_draws_the_scene_lit_by_the_grid(grid):
     image = lightoctree.render(SCENE, grid, width=64, height=48, mode="indirect")
     assert image.shape == (48, 64, 3) and image.dtype == np.float32

@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/file.h"
 #include "core/file_set.h"
+#include "core/printable.h"
 #include "image/image.h"
 #include "octree/gpu_octree.h"
 #include "reference/path_tracer.h"
@@ -299,6 +300,20 @@ AtlasContent parseAtlasContent(const std::string& name) {
   if (name == "indirect") return AtlasContent::Indirect;
   if (name == "full") return AtlasContent::Full;
   throw InputError("--content: '" + name + "' (expected indirect or full)");
+}
+
+bool directionPagesOf(const std::string& directions, AtlasContent content,
+                      const std::string& flag) {
+  if (directions != "" && directions != "on" && directions != "off") {
+    throw InputError(flag + ": '" + printableShort(directions) + "' (expected on or off)");
+  }
+  if (directions == "on" && content == AtlasContent::Full) {
+    throw InputError(flag +
+                     " on: a lightmap of the full light writes no direction pages (its "
+                     "light comes from other directions than a page would give): leave " +
+                     flag + " out, or export the indirect light");
+  }
+  return directions != "off" && content == AtlasContent::Indirect;
 }
 
 const char* toString(AtlasContent content) {

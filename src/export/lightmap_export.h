@@ -49,6 +49,12 @@ enum class AtlasContent {
 /// "indirect" | "full". @throws InputError naming --content and the value.
 AtlasContent parseAtlasContent(const std::string& name);
 const char* toString(AtlasContent content);  ///< "indirect" | "full"
+/// Whether an export of `content` writes direction pages: `directions` "on",
+/// "off", or "" (not given: on for AtlasContent::Indirect; Full writes none,
+/// its light holding direct light from other directions than the one a page
+/// would give). @throws InputError naming `flag` for "on" with Full (it was
+/// ignored without a word, H17-4-1) and for any other text.
+bool directionPagesOf(const std::string& directions, AtlasContent content, const std::string& flag);
 
 struct LightmapExportResult;
 

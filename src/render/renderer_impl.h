@@ -47,6 +47,19 @@ struct Vertex {
   float tangent[4];  ///< glTF TANGENT (xyz, w = +-1), w = 0 without: derived in the shader
 };
 
+/// The memory the scene's vertices take in the GL driver, per triangle:
+/// three vertices and, beside them, its corners' triangle indices
+/// (SceneGeometry::vertexCorner) and the lightmap attribute's floats; the
+/// vertices are built a chunk at a time, so their building copy is bounded.
+constexpr double kRenderBytesPerTriangle = 3.0 * (sizeof(Vertex) + 4 + 12);
+
+/// @throws InputError when `triangles` need more than the memory available
+/// (kRenderBytesPerTriangle each, and for the `added` ones of objects added
+/// after the bake, their vertices' copy that moving them starts from): the
+/// scene loader's budget (256 bytes a triangle) let a scene through whose
+/// vertices then ran the machine out of memory in the driver (H17-5-1).
+void checkGeometryMemory(size_t triangles, size_t added);
+
 /// Draw order of the scene pass: plain opaque ranges first (one call in the
 /// depth-only passes), then alpha-tested ones, then blended ones (sorted back
 /// to front, no depth writes), then transmissive ones over a copy of the rest.
@@ -140,7 +153,8 @@ struct SceneGeometry {
   int useTexture(const Scene& scene, int index, const TextureUploads& uploads);
   /// The textures and uniforms material `mat` draws with.
   DrawRange rangeOf(const Scene& scene, const Material& mat, const TextureUploads& uploads);
-  void uploadVertices(const std::vector<Vertex>& vertices);
+  /// The vertex attributes of the buffer (upload, the vao and vbo bound).
+  void setVertexAttributes();
 
  public:
   /// Rewrites the added objects' vertices in the buffer moved by `offset`

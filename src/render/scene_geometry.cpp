@@ -8,6 +8,8 @@
 #include <cstring>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "core/error.h"
+#include "core/resources.h"
 #include "render/gl_util.h"
 #include "render/renderer_impl.h"
 #include "scene/texture_mips.h"
@@ -287,6 +289,19 @@ DrawRange SceneGeometry::rangeOf(const Scene& scene, const Material& mat,
   return range;
 }
 
+void checkGeometryMemory(size_t triangles, size_t added) {
+  const size_t available = availableMemoryBytes();
+  const double needed =
+      double(triangles) * kRenderBytesPerTriangle + double(added) * 3.0 * sizeof(Vertex);
+  if (available == 0 || needed <= double(available)) return;
+  throw InputError("render: the scene's " + formatCount(triangles) + " triangles need about " +
+                   formatBytes(size_t(std::min(needed, 1e18))) + " in the GL driver (" +
+                   formatNumber(kRenderBytesPerTriangle) + " bytes each), more than the " +
+                   formatBytes(available) +
+                   " of memory available: draw a smaller scene or fewer --add objects, or give "
+                   "the process more memory");
+}
+
 void SceneGeometry::upload(const Scene& scene, const RenderSpace& space,
                            const std::function<void(int)>& textureUploaded) {
   // Anisotropic filtering: core in GL 4.6, an extension before.
@@ -297,51 +312,69 @@ void SceneGeometry::upload(const Scene& scene, const RenderSpace& space,
   textures.clear();
   textures.resize(scene.textures.size());
   const TextureUploads uploads{channelsReadOf(scene), textureUploaded};
-  std::vector<Vertex> vertices;
-  vertices.reserve(scene.triangleCount() * 3);
+  const size_t total = scene.triangleCount() * 3;
+  size_t added = 0;
+  for (size_t t = 0; t < scene.triangleCount(); ++t) added += scene.isAdded(t) ? 1 : 0;
+  checkGeometryMemory(scene.triangleCount(), added);
+  // The buffer made at its size, filled a chunk at a time: the vertices
+  // built whole beside the driver's copy of them doubled the peak (730
+  // bytes a triangle, H17-5-1).
+  vao = GlVertexArray::create();
+  glBindVertexArray(vao.get());
+  vbo = GlBuffer::create();
+  glBindBuffer(GL_ARRAY_BUFFER, vbo.get());
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(total * sizeof(Vertex)), nullptr, GL_STATIC_DRAW);
+  checkGl("making the scene's vertex buffer");
+  constexpr size_t kChunkVertices = size_t(3) << 14;
+  std::vector<Vertex> chunk;
+  chunk.reserve(std::min(total, kChunkVertices));
+  size_t written = 0;  // vertices in the buffer
+  auto flush = [&] {
+    if (chunk.empty()) return;
+    glBindBuffer(GL_ARRAY_BUFFER, vbo.get());  // a texture's upload may bind another
+    glBufferSubData(GL_ARRAY_BUFFER, GLintptr(written * sizeof(Vertex)),
+                    GLsizeiptr(chunk.size() * sizeof(Vertex)), chunk.data());
+    written += chunk.size();
+    chunk.clear();
+  };
+  vertexCorner.reserve(total);
   for (const std::vector<size_t>& group : trianglesByMaterial(scene)) {
     if (group.empty()) continue;
     const Material& mat = materialOf(scene, group.front());
     const DrawCategory category = categoryOf(mat);
     DrawRange range = rangeOf(scene, mat, uploads);
     range.moving = scene.isAdded(group.front());
-    range.first = GLint(vertices.size());
+    range.first = GLint(written + chunk.size());
     for (size_t t : group) {
       const Vec3 faceNormal = scene.faceNormal(t);
       for (int k = 0; k < 3; ++k) {
-        vertices.push_back(makeVertex(scene, space, mat, range, t, k, faceNormal));
+        chunk.push_back(makeVertex(scene, space, mat, range, t, k, faceNormal));
         vertexCorner.push_back(uint32_t(3 * t + size_t(k)));
+        if (range.moving) movingVertices.push_back(chunk.back());
       }
       if (category == kBlended) {
-        const Vertex* tri = &vertices[vertices.size() - 3];
+        const Vertex* tri = &chunk[chunk.size() - 3];
         blendCentroids.push_back((glm::make_vec3(tri[0].position) +
                                   glm::make_vec3(tri[1].position) +
                                   glm::make_vec3(tri[2].position)) /
                                  3.0f);
       }
+      if (chunk.size() >= kChunkVertices) flush();
     }
-    range.count = GLsizei(vertices.size()) - range.first;
+    const size_t end = written + chunk.size();
+    range.count = GLsizei(end) - range.first;
     ranges.push_back(range);
     rangeCategory.push_back(category);
-    if (category == kSolid) opaqueCount = GLsizei(vertices.size());
-    if (category < kBlended) blendFirst = GLsizei(vertices.size());
+    if (category == kSolid) opaqueCount = GLsizei(end);
+    if (category < kBlended) blendFirst = GLsizei(end);
   }
-  for (const DrawRange& range : ranges) {
-    if (range.moving) {
-      movingVertices.insert(movingVertices.end(), vertices.begin() + range.first,
-                            vertices.begin() + range.first + range.count);
-    }
-  }
-  uploadVertices(vertices);
+  flush();
+  setVertexAttributes();
 }
 
-void SceneGeometry::uploadVertices(const std::vector<Vertex>& vertices) {
-  vao = GlVertexArray::create();
+void SceneGeometry::setVertexAttributes() {
   glBindVertexArray(vao.get());
-  vbo = GlBuffer::create();
   glBindBuffer(GL_ARRAY_BUFFER, vbo.get());
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)),
-               vertices.empty() ? nullptr : vertices.data(), GL_STATIC_DRAW);
   auto attrib = [](GLuint location, GLint size, size_t offset) {
     glEnableVertexAttribArray(location);
     glVertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, sizeof(Vertex),

@@ -10,8 +10,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <optional>
+#include <string>
 
+#include "core/error.h"
 #include "image/image.h"
 #include "render/render_fixture.h"
 #include "render/renderer.h"
@@ -194,6 +197,36 @@ TEST_F(RenderScale, AQuadIsDrawnWithAnotherFarAway) {
       EXPECT_NEAR(c[k], centre[k], 0.02f * centre[k]) << "quad " << away << " away, channel " << k;
     }
   }
+}
+
+// The scene's vertices in the GL driver are counted before they are made:
+// a scene whose triangles need more than the memory available is refused
+// naming them, where the loader's budget (256 bytes a triangle) let it
+// through and the driver ran out of memory (H17-5-1). Each quad's two
+// triangles take kRenderBytesPerTriangle (396) bytes: 100,000 quads need
+// 79 MB, over a 64 MiB limit; the same scene draws under 256 MiB.
+TEST_F(RenderScale, AGeometryBeyondTheMemoryIsRefusedBeforeTheDriver) {
+  using test::QuadSetup;
+  const RenderParams p = QuadSetup::directParams();
+  const GpuOctree octree = test::emptyOctree();
+  QuadSetup s;
+  s.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
+  for (int i = 0; i < 100000; ++i) {
+    test::addQuad(s.scene, {-1, -1, -1.0f - 1e-4f * float(i)}, {2e-3f, 0, 0}, {0, 2e-3f, 0},
+                  {0, 0, 1}, 0);
+  }
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "64M", 1);
+  try {
+    s.render(octree, p);
+    ADD_FAILURE() << "200,000 triangles drawn under a 64 MiB limit";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the scene's 200,002 triangles need about"),
+              std::string::npos)
+        << e.what();
+  }
+  setenv("LIGHTOCTREE_MEMORY_LIMIT", "256M", 1);
+  EXPECT_NO_THROW(s.render(octree, p));
+  unsetenv("LIGHTOCTREE_MEMORY_LIMIT");
 }
 
 }  // namespace
