@@ -341,10 +341,28 @@ class GlCall {
 
 /// A message of the commands' options code (tools/) with its flags named as
 /// the Python arguments are: "--eye and --target" -> "eye and target",
-/// "--sky-image: ..." -> "sky_image: ...".
+/// "--sky-image: ..." -> "sky_image: ...". A command quoted whole ("`convert
+/// --photon-map`") is one to run, whose flags the module's functions may
+/// not take (H17-1-2: "`convert photon_map`"): kept as it is, named as the
+/// program's ("`lightoctree convert --photon-map`").
 std::string pythonNames(const std::string& message) {
+  static const char* const kCommands[] = {"bake",      "render",  "lightmap", "convert", "inspect",
+                                          "reference", "compare", "sweep",    "view"};
   std::string out;
   for (size_t i = 0; i < message.size(); ++i) {
+    const size_t close = message[i] == '`' ? message.find('`', i + 1) : std::string::npos;
+    if (close != std::string::npos) {
+      const std::string quoted = message.substr(i + 1, close - i - 1);
+      bool command = false;
+      for (const char* c : kCommands) {
+        command = command || quoted.rfind(std::string(c) + " -", 0) == 0;
+      }
+      if (command) {
+        out += "`lightoctree " + quoted + "`";
+        i = close;
+        continue;
+      }
+    }
     if (message.compare(i, 2, "--") == 0 && i + 2 < message.size() &&
         std::islower(static_cast<unsigned char>(message[i + 2])) &&
         (i == 0 || !std::isalnum(static_cast<unsigned char>(message[i - 1])))) {

@@ -261,6 +261,23 @@ def test_bake_takes_the_sky_and_the_representation():
         lightoctree.bake(SCENE, sky=(-1, 0, 0), **settings)
 
 
+def test_advice_that_names_a_command_names_the_program(tmp_path):
+    """A photon map read as a grid is refused with the command that reads it,
+    whose flag the module's convert does not take: named as the program's,
+    not as a keyword ("`convert photon_map`", H17-1-2)."""
+    cli = os.environ.get("LIGHTOCTREE_CLI")
+    if not cli:
+        pytest.skip("LIGHTOCTREE_CLI not set (ctest sets it)")
+    import subprocess
+    photons = str(tmp_path / "photons.vdb")
+    subprocess.run([cli, "bake", SCENE, "-o", str(tmp_path / "grid.vdb"), "--depth", "3",
+                    "--photons", "3000", "--knn", "20", "--photon-map", photons, "--quiet"],
+                   check=True)
+    with pytest.raises(lightoctree.InputError,
+                       match="read only beside its grid, by `lightoctree convert --photon-map`"):
+        lightoctree.read(photons)
+
+
 def test_render_equals_the_command(grid, tmp_path):
     """lightoctree.render and `lightoctree render` go through one render
     session: the same grid file at the same size gives the same floats."""

@@ -273,17 +273,22 @@ void writeSweepReport(const SweepParams& params, const std::vector<SweepResult>&
         "(docs/accuracy.md, \"How good is a bake\"). Frame times: OSMesa (software GL), "
      << params.frames
      << " frames, indirect mode. Times are wall-clock on this machine "
-        "and include every bake stage.\n\n"
-     << "The references' own noise, the floor under these errors (relative RMS standard "
-        "error of luminance, over the same pixels): irradiance "
-     << formatNumber(results.empty() ? 0.0 : percent2(results.front().referenceIrradianceNoise))
-     << "% per pixel, "
-     << formatNumber(results.empty() ? 0.0
-                                     : percent2(results.front().referenceIrradianceBinnedNoise))
-     << "% over the bins; indirect image "
-     << formatNumber(results.empty() ? 0.0 : percent2(results.front().referenceIndirectNoise))
-     << "%.\n\n"
-     << markdownTable(results) << "\n";
+        "and include every bake stage.\n\n";
+  if (params.referenceSpp < 2 || results.empty()) {
+    // One sample per pixel has no spread to estimate a standard error from:
+    // a floor of 0% was written, never measured (H17-4-2).
+    md << "The references' own noise, the floor under these errors, is not known: a standard "
+          "error needs two samples per pixel or more (--spp).\n\n";
+  } else {
+    const SweepResult& first = results.front();
+    md << "The references' own noise, the floor under these errors (relative RMS standard "
+          "error of luminance, over the same pixels): irradiance "
+       << formatNumber(percent2(first.referenceIrradianceNoise)) << "% per pixel, "
+       << formatNumber(percent2(first.referenceIrradianceBinnedNoise))
+       << "% over the bins; indirect image " << formatNumber(percent2(first.referenceIndirectNoise))
+       << "%.\n\n";
+  }
+  md << markdownTable(results) << "\n";
   if (plotted) {
     md << "![error vs bake time](error-vs-bake-time.png)\n\n"
        << "![error vs memory](error-vs-memory.png)\n\n";
