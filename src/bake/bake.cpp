@@ -874,6 +874,23 @@ BakeResult targetBake(const Scene& scene, const BakeParams& params, ProgressSink
     }
     if (!s.targetStop.empty()) break;
     goal = nextPassPhotons(raw.size(), s.noise.quantile, target, cap);
+    if (params.maxSeconds > 0) {
+      // The next pass's time, from this one's per photon (its tracing and
+      // its gather grow with the photons): cut to what the time left holds,
+      // or none where that is not half again this pass's photons. A pass 16
+      // times the last, started just inside the limit, ran it over seven
+      // times (3 s asked, 20 s taken).
+      const double perPhoton = s.passes.back().seconds / double(std::max<size_t>(raw.size(), 1));
+      const double left = params.maxSeconds - elapsed();
+      const double fits = perPhoton > 0 ? left / perPhoton : double(goal);
+      if (fits < double(goal)) {
+        if (fits < 1.5 * double(raw.size())) {
+          s.targetStop = "time cap";
+          break;
+        }
+        goal = size_t(fits);
+      }
+    }
     // Lights whose paths stored nothing take no share of the next passes,
     // which start afresh: the pilot's photons, drawn while the dark lights
     // took their share, would weigh more than the passes' own and hold the

@@ -149,7 +149,9 @@ struct BakeParams {
   /// of indirect light, the .vdb in Houdini).
   bool targetSeenLight = true;
   size_t maxPhotons = kDefaultMaxPhotons;  ///< target bakes: photon cap
-  /// Target bakes: no new pass starts after this many seconds (0: no limit).
+  /// Target bakes: no new pass starts after this many seconds, nor one whose
+  /// photons, at the last pass's time per photon, would not end within them
+  /// (cut to what fits, or none under half again the photons: 0: no limit).
   /// The only setting whose result depends on the machine's speed.
   double maxSeconds = 0;
   int knn = 300;            ///< nearest photons gathered per voxel (paper: 300)
