@@ -175,6 +175,13 @@ TEST_F(RenderScale, ASmallObjectInALargeSceneShadowsTheSameAtEveryScale) {
 namespace lo {
 namespace {
 
+/// QuadSetup's quad under a point light in front of it.
+test::QuadSetup litQuad() {
+  test::QuadSetup s;
+  s.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
+  return s;
+}
+
 // A lit quad with a second one 10^4 and 10^5 units away (a room on a large
 // ground): the camera's near plane followed the far plane (1e-4 of it), lay
 // beyond the quad, and every pixel was black (H16-4-1). It stays nearer
@@ -183,8 +190,7 @@ TEST_F(RenderScale, AQuadIsDrawnWithAnotherFarAway) {
   using test::QuadSetup;
   const RenderParams p = QuadSetup::directParams();
   const GpuOctree octree = test::emptyOctree();
-  QuadSetup alone;
-  alone.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
+  const QuadSetup alone = litQuad();
   const RgbImage near = alone.render(octree, p);
   const float* centre = near.pixel(p.width / 2, p.height / 2);
   ASSERT_GT(centre[0], 0.01f);
@@ -209,8 +215,7 @@ TEST_F(RenderScale, AGeometryBeyondTheMemoryIsRefusedBeforeTheDriver) {
   using test::QuadSetup;
   const RenderParams p = QuadSetup::directParams();
   const GpuOctree octree = test::emptyOctree();
-  QuadSetup s;
-  s.scene.lights.push_back(test::pointLight({0.1f, -0.05f, 1.0f}, 2.0f));
+  QuadSetup s = litQuad();
   for (int i = 0; i < 100000; ++i) {
     test::addQuad(s.scene, {-1, -1, -1.0f - 1e-4f * float(i)}, {2e-3f, 0, 0}, {0, 2e-3f, 0},
                   {0, 0, 1}, 0);
