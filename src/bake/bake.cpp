@@ -579,6 +579,17 @@ BakeMetadata bakeMetadata(const Scene& scene, const BakeParams& params, int64_t 
   return meta;
 }
 
+namespace {
+
+/// The content hash of `scene`'s files: as loadScene read them, else (a
+/// scene made in code with a sourcePath) as they are now; "" without either.
+std::string contentHashOf(const Scene& scene) {
+  if (!scene.contentHash.empty()) return scene.contentHash;
+  return scene.sourcePath.empty() ? std::string() : sceneContentHash(scene.sourcePath);
+}
+
+}  // namespace
+
 void recordSourceScene(BakeMetadata& meta, const Scene& scene) {
   const std::string& scenePath = scene.sourcePath;
   if (scenePath.empty()) return;
@@ -586,8 +597,7 @@ void recordSourceScene(BakeMetadata& meta, const Scene& scene) {
   const std::filesystem::path absolute = std::filesystem::absolute(scenePath, ec);
   meta.sourceScene = std::filesystem::path(scenePath).filename().string();
   meta.sourceScenePath = ec ? scenePath : absolute.lexically_normal().string();
-  meta.sourceSceneHash =
-      scene.contentHash.empty() ? sceneContentHash(scenePath) : scene.contentHash;
+  meta.sourceSceneHash = contentHashOf(scene);
 }
 
 VolumeLight bakeFreeSpaceLight(const std::vector<PhotonSegment>& segments, const GridFrame& frame,
@@ -623,10 +633,9 @@ std::string staleBakeWarning(const BakeMetadata& meta, const std::string& sceneP
 
 std::vector<std::string> gridWarnings(const BakeMetadata& meta, const Scene& scene) {
   std::vector<std::string> warnings;
-  const std::string& path = scene.sourcePath;
-  const std::string stale = !scene.contentHash.empty() ? staleWarning(meta, path, scene.contentHash)
-                            : !path.empty()            ? staleBakeWarning(meta, path)
-                                                       : std::string();
+  const std::string hash = meta.sourceSceneHash.empty() ? std::string() : contentHashOf(scene);
+  const std::string stale =
+      hash.empty() ? std::string() : staleWarning(meta, scene.sourcePath, hash);
   for (const std::string& w : {stale, skyMismatchWarning(meta, scene.sky)}) {
     if (!w.empty()) warnings.push_back(w);
   }
